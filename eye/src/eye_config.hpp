@@ -1,0 +1,28 @@
+// The `run` configuration file: calibration files, tag geometry, vehicles, detector, LCM.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "eye_camera.hpp"
+#include "eye_detect.hpp"
+#include "eye_locate.hpp"
+
+namespace eye {
+
+struct RunConfig {
+  std::string path;             // the config file itself
+  std::string intrinsics_path;  // resolved against the config file's folder
+  std::string map_path;
+  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  Intrinsics in;
+  CameraPose pose;
+  LocateParams locate;
+  DetectorParams detector;
+  std::vector<VehicleTag> vehicles;
+};
+
+// Loads the config and the calibration files it names. Throws eye::Error naming the file and
+// the field on anything missing or malformed.
+RunConfig runconfig_load(const std::string& path);
+
+}  // namespace eye

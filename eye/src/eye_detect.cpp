@@ -1,0 +1,53 @@
+#include "eye_detect.hpp"
+
+#include <apriltag.h>
+#include <tag36h11.h>
+
+#include "eye_error.hpp"
+
+namespace eye {
+
+Detector::Detector(const DetectorParams& p) : params_(p) {
+  apriltag_family_t* fam = tag36h11_create();
+  apriltag_detector_t* td = apriltag_detector_create();
+  apriltag_detector_add_family_bits(td, fam, 2);
+  td->nthreads = 1;
+  td->quad_decimate = p.decimate;
+  td->quad_sigma = p.sigma_px;
+  td->refine_edges = p.refine_edges;
+  td->decode_sharpening = p.sharpening;
+  td_ = td;
+  fam_ = fam;
+}
+
+Detector::~Detector() {
+  apriltag_detector_destroy(static_cast<apriltag_detector_t*>(td_));
+  tag36h11_destroy(static_cast<apriltag_family_t*>(fam_));
+}
+
+std::vector<Detection> Detector::detect(const cv::Mat& gray) {
+  if (gray.empty() || gray.type() != CV_8UC1)
+    throw Error("detector: frame must be a non-empty 8-bit grey image");
+  image_u8_t im{gray.cols, gray.rows, static_cast<int32_t>(gray.step[0]),
+                const_cast<uint8_t*>(gray.ptr<uint8_t>())};
+  zarray_t* dets = apriltag_detector_detect(static_cast<apriltag_detector_t*>(td_), &im);
+  std::vector<Detection> out;
+  for (int i = 0; i < zarray_size(dets); ++i) {
+    apriltag_detection_t* d;
+    zarray_get(dets, i, &d);
+    if (d->hamming > params_.max_hamming || d->decision_margin < params_.min_margin) continue;
+    Detection o;
+    o.id = d->id;
+    o.hamming = d->hamming;
+    o.margin = d->decision_margin;
+    for (int j = 0; j < 4; ++j)
+      o.corners_px[static_cast<size_t>(j)] =
+          cv::Point2d(d->p[j][0] + kApriltagToOpencvPx, d->p[j][1] + kApriltagToOpencvPx);
+    o.centre_px = cv::Point2d(d->c[0] + kApriltagToOpencvPx, d->c[1] + kApriltagToOpencvPx);
+    out.push_back(o);
+  }
+  apriltag_detections_destroy(dets);
+  return out;
+}
+
+}  // namespace eye

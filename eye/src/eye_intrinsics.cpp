@@ -1,0 +1,76 @@
+#include "eye_intrinsics.hpp"
+
+#include <opencv2/calib3d.hpp>
+
+#include <cstdio>
+
+#include "eye_error.hpp"
+
+namespace eye {
+
+IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const IntrinsicsParams& p) {
+  IntrinsicsReport rep;
+  rep.views_total = static_cast<int>(views.size());
+  if (views.empty()) throw Error("calibrate-intrinsics: no images");
+  const cv::Size pattern(p.inner_cols, p.inner_rows);
+  const cv::Size size = views[0].size();
+  std::vector<cv::Point3f> board;
+  for (int r = 0; r < p.inner_rows; ++r)
+    for (int c = 0; c < p.inner_cols; ++c)
+      board.emplace_back(static_cast<float>(c * p.square_m), static_cast<float>(r * p.square_m), 0.f);
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img;
+  bool cell[4][4] = {};
+  for (const auto& v : views) {
+    if (v.size() != size)
+      throw Error("calibrate-intrinsics: images differ in size (" + std::to_string(v.cols) + "x" +
+                  std::to_string(v.rows) + " vs " + std::to_string(size.width) + "x" +
+                  std::to_string(size.height) + ")");
+    std::vector<cv::Point2f> corners;
+    if (!cv::findChessboardCornersSB(v, pattern, corners, cv::CALIB_CB_ACCURACY)) continue;
+    for (const auto& c : corners) {
+      const int cx = std::min(3, std::max(0, static_cast<int>(4 * c.x / size.width)));
+      const int cy = std::min(3, std::max(0, static_cast<int>(4 * c.y / size.height)));
+      cell[cy][cx] = true;
+    }
+    obj.push_back(board);
+    img.push_back(corners);
+  }
+  rep.views_used = static_cast<int>(img.size());
+  int cells = 0;
+  for (auto& row : cell)
+    for (bool b : row) cells += b;
+  rep.coverage = cells / 16.0;
+  if (rep.views_used < p.min_views)
+    throw Error("calibrate-intrinsics: too few views: the board (" + std::to_string(p.inner_cols) +
+                "x" + std::to_string(p.inner_rows) + " inner corners) was found in " +
+                std::to_string(rep.views_used) + " of " + std::to_string(rep.views_total) +
+                " images, need at least " + std::to_string(p.min_views));
+  if (rep.coverage < p.min_coverage) {
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "calibrate-intrinsics: poor coverage: corners reach %.0f%% of the image's 4x4 "
+                  "grid, need %.0f%%; move the board into the corners of the image",
+                  100 * rep.coverage, 100 * p.min_coverage);
+    throw Error(b);
+  }
+  cv::Mat k, dist;
+  std::vector<cv::Mat> rv, tv;
+  const double rms = cv::calibrateCamera(obj, img, size, k, dist, rv, tv);
+  if (!(rms <= p.max_rms_px)) {
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "calibrate-intrinsics: RMS reprojection error too high: %.3f px > %.3f px", rms,
+                  p.max_rms_px);
+    throw Error(b);
+  }
+  rep.in.width_px = size.width;
+  rep.in.height_px = size.height;
+  rep.in.k = cv::Matx33d(k);
+  rep.in.dist.assign(dist.ptr<double>(), dist.ptr<double>() + dist.total());
+  rep.in.rms_px = rms;
+  rep.in.views = rep.views_used;
+  return rep;
+}
+
+}  // namespace eye

@@ -1,0 +1,33 @@
+// Intrinsic calibration from checkerboard views, with refusal of degenerate image sets.
+#pragma once
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+#include "eye_camera.hpp"
+
+namespace eye {
+
+struct IntrinsicsParams {
+  int inner_cols = 9;        // inner corners along the board's width
+  int inner_rows = 6;        // inner corners along its height
+  double square_m = 0.025;   // square edge [m] (scales extrinsics only, not K)
+  int min_views = 8;         // fewer usable views: refused
+  double min_coverage = 0.5; // fraction of a 4x4 grid over the image that corners must reach
+  double max_rms_px = 1.0;   // a worse reprojection RMS: refused
+};
+
+struct IntrinsicsReport {
+  Intrinsics in;
+  int views_total = 0;  // images offered
+  int views_used = 0;   // images where the board was found
+  double coverage = 0;  // fraction of the 4x4 grid cells holding a corner
+};
+
+// Finds the board in each image (CV_8UC1) and calibrates. Throws eye::Error with a clear
+// reason on too few views, poor coverage or too high an RMS.
+IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& gray_views,
+                                      const IntrinsicsParams& p);
+
+}  // namespace eye

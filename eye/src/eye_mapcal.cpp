@@ -1,0 +1,159 @@
+#include "eye_mapcal.hpp"
+
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "eye_error.hpp"
+#include "eye_render.hpp"
+#include "eye_yaml.hpp"
+
+namespace eye {
+
+std::vector<RefTag> reftags_load(const std::string& path) {
+  YAML::Node n = yaml_load_file(path);
+  YAML::Node tags = yaml_need(n, "tags", path);
+  if (!tags.IsSequence() || tags.size() == 0)
+    throw Error(path + ": field 'tags' must be a non-empty list");
+  std::vector<RefTag> out;
+  std::set<int> ids;
+  for (size_t i = 0; i < tags.size(); ++i) {
+    const std::string where = path + " (tags[" + std::to_string(i) + "])";
+    const YAML::Node t = tags[i];
+    if (!t.IsMap()) throw Error(where + ": each tag must be a mapping");
+    RefTag r;
+    r.id = yaml_int(t, "id", where);
+    r.x_m = yaml_double(t, "x_m", where);
+    r.y_m = yaml_double(t, "y_m", where);
+    r.z_m = t["z_m"] ? yaml_double(t, "z_m", where) : 0.0;
+    r.yaw_rad = t["yaw_rad"] ? yaml_double(t, "yaw_rad", where) : 0.0;
+    r.size_m = yaml_double(t, "size_m", where);
+    if (r.id < 0 || r.id > 586) throw Error(where + ": field 'id' must be a tag36h11 id 0..586");
+    if (!(r.size_m > 0)) throw Error(where + ": field 'size_m' must be positive");
+    if (!ids.insert(r.id).second)
+      throw Error(where + ": field 'id' " + std::to_string(r.id) + " is listed twice");
+    out.push_back(r);
+  }
+  return out;
+}
+
+// Map coordinates of a reference tag's corners, libapriltag order.
+static std::array<cv::Point3d, 4> ref_corners(const RefTag& r) {
+  const auto tf = tag_corners_tagframe(r.size_m);
+  const double c = std::cos(r.yaw_rad), s = std::sin(r.yaw_rad);
+  std::array<cv::Point3d, 4> out;
+  for (size_t i = 0; i < 4; ++i)
+    out[i] = cv::Point3d(r.x_m + c * tf[i][0] - s * tf[i][1], r.y_m + s * tf[i][0] + c * tf[i][1],
+                         r.z_m);
+  return out;
+}
+
+MapCalib map_calibrate(const Intrinsics& in, const std::vector<RefTag>& refs,
+                       const std::vector<std::vector<Detection>>& frames, int min_tags) {
+  std::map<int, const RefTag*> by_id;
+  for (const auto& r : refs) by_id[r.id] = &r;
+  std::vector<cv::Point3d> obj;
+  std::vector<cv::Point2d> img;
+  std::vector<int> obj_id;
+  std::set<int> seen;
+  for (const auto& f : frames)
+    for (const auto& d : f) {
+      auto it = by_id.find(d.id);
+      if (it == by_id.end()) continue;
+      const auto c3 = ref_corners(*it->second);
+      for (size_t i = 0; i < 4; ++i) {
+        obj.push_back(c3[i]);
+        img.push_back(d.corners_px[i]);
+        obj_id.push_back(d.id);
+      }
+      seen.insert(d.id);
+    }
+  MapCalib m;
+  m.width_px = in.width_px;
+  m.height_px = in.height_px;
+  for (const auto& r : refs)
+    if (!seen.count(r.id)) m.missing_ids.push_back(r.id);
+  if (static_cast<int>(seen.size()) < min_tags)
+    throw Error("calibrate-map: saw " + std::to_string(seen.size()) + " of " +
+                std::to_string(refs.size()) + " reference tags, need at least " +
+                std::to_string(min_tags));
+
+  cv::Mat rvec, tvec;
+  if (!cv::solvePnP(obj, img, cv::Mat(in.k), in.dist, rvec, tvec, false, cv::SOLVEPNP_SQPNP))
+    throw Error("calibrate-map: solvePnP found no camera pose for the reference tags");
+  cv::solvePnPRefineLM(obj, img, cv::Mat(in.k), in.dist, rvec, tvec);
+  cv::Mat r;
+  cv::Rodrigues(rvec, r);
+  m.pose.r_cam_map = cv::Matx33d(r);
+  m.pose.t_cam_map = cv::Vec3d(tvec);
+
+  // Residuals: each observed corner's ray on its own tag's plane vs the known corner [mm].
+  const auto norm = intrinsics_normalise(in, img);
+  std::map<int, std::pair<double, int>> acc;
+  double ss = 0;
+  for (size_t i = 0; i < obj.size(); ++i) {
+    cv::Vec2d xy;
+    double e_mm = 1e9;
+    if (camera_ray_to_plane(m.pose, norm[i], obj[i].z, &xy))
+      e_mm = 1000.0 * std::hypot(xy[0] - obj[i].x, xy[1] - obj[i].y);
+    ss += e_mm * e_mm;
+    m.max_mm = std::max(m.max_mm, e_mm);
+    acc[obj_id[i]].first += e_mm * e_mm;
+    acc[obj_id[i]].second += 1;
+  }
+  m.rms_mm = std::sqrt(ss / static_cast<double>(obj.size()));
+  for (const auto& [id, a] : acc) m.tags.push_back({id, std::sqrt(a.first / a.second)});
+  return m;
+}
+
+void mapcal_save(const std::string& path, const MapCalib& m) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(12);
+  e << YAML::BeginMap;
+  e << YAML::Key << "width_px" << YAML::Value << m.width_px;
+  e << YAML::Key << "height_px" << YAML::Value << m.height_px;
+  e << YAML::Key << "r_cam_map" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < 9; ++i) e << m.pose.r_cam_map(i / 3, i % 3);
+  e << YAML::EndSeq;
+  e << YAML::Key << "t_cam_map_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
+    << m.pose.t_cam_map[0] << m.pose.t_cam_map[1] << m.pose.t_cam_map[2] << YAML::EndSeq;
+  const cv::Vec3d c = m.pose.centre_map();
+  e << YAML::Key << "camera_centre_map_m" << YAML::Value << YAML::Flow << YAML::BeginSeq << c[0]
+    << c[1] << c[2] << YAML::EndSeq;
+  e << YAML::Key << "residual_rms_mm" << YAML::Value << m.rms_mm;
+  e << YAML::Key << "residual_max_mm" << YAML::Value << m.max_mm;
+  e << YAML::Key << "tags" << YAML::Value << YAML::BeginSeq;
+  for (const auto& t : m.tags)
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << t.id << YAML::Key
+      << "rms_mm" << YAML::Value << t.rms_mm << YAML::EndMap;
+  e << YAML::EndSeq;
+  e << YAML::Key << "missing_ids" << YAML::Value << YAML::Flow << m.missing_ids;
+  e << YAML::EndMap;
+  std::ofstream f(path);
+  if (!f) throw Error(path + ": cannot write file");
+  f << "# autodrive-eye map calibration (calibrate-map): X_cam = r_cam_map * X_map + t_cam_map\n"
+    << e.c_str() << "\n";
+}
+
+MapCalib mapcal_load(const std::string& path) {
+  YAML::Node n = yaml_load_file(path);
+  MapCalib m;
+  m.width_px = yaml_int(n, "width_px", path);
+  m.height_px = yaml_int(n, "height_px", path);
+  const auto r = yaml_doubles(n, "r_cam_map", path, 9);
+  const auto t = yaml_doubles(n, "t_cam_map_m", path, 3);
+  for (int i = 0; i < 9; ++i) m.pose.r_cam_map(i / 3, i % 3) = r[static_cast<size_t>(i)];
+  m.pose.t_cam_map = cv::Vec3d(t[0], t[1], t[2]);
+  const cv::Matx33d should_be_i = m.pose.r_cam_map * m.pose.r_cam_map.t();
+  if (cv::norm(should_be_i - cv::Matx33d::eye()) > 1e-6 || cv::determinant(m.pose.r_cam_map) < 0)
+    throw Error(path + ": field 'r_cam_map' is not a rotation matrix");
+  m.rms_mm = n["residual_rms_mm"] ? yaml_double(n, "residual_rms_mm", path) : 0.0;
+  m.max_mm = n["residual_max_mm"] ? yaml_double(n, "residual_max_mm", path) : 0.0;
+  return m;
+}
+
+}  // namespace eye

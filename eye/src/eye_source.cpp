@@ -1,0 +1,168 @@
+#include "eye_source.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+#include <autodrive/compressed_image_t.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <filesystem>
+
+#include "eye_error.hpp"
+
+namespace eye {
+
+int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+cv::Mat decode_gray(const uint8_t* data, size_t n, const std::string& what) {
+  if (n == 0) throw Error(what + ": empty image data");
+  cv::Mat buf(1, static_cast<int>(n), CV_8UC1, const_cast<uint8_t*>(data));
+  cv::Mat g = cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
+  if (g.empty()) throw Error(what + ": cannot decode the image data (not JPEG/PNG?)");
+  return g;
+}
+
+namespace {
+
+class CaptureSource : public Source {
+ public:
+  CaptureSource(const std::string& spec, cv::VideoCapture cap, bool live, double fps)
+      : spec_(spec), cap_(std::move(cap)), live_(live), fps_(fps) {}
+  bool next(Frame* f) override {
+    cv::Mat m;
+    if (!cap_.read(m) || m.empty()) return false;
+    f->utime = live_ ? now_utime() : static_cast<int64_t>(1e6 * n_ / fps_);
+    f->label = spec_ + "#" + std::to_string(n_++);
+    if (m.channels() == 3) cv::cvtColor(m, f->gray, cv::COLOR_BGR2GRAY);
+    else if (m.channels() == 1) f->gray = m;
+    else throw Error(spec_ + ": unsupported frame with " + std::to_string(m.channels()) + " channels");
+    return true;
+  }
+
+ private:
+  std::string spec_;
+  cv::VideoCapture cap_;
+  bool live_;
+  double fps_;
+  int64_t n_ = 0;
+};
+
+class FolderSource : public Source {
+ public:
+  FolderSource(const std::string& dir, double fps) : fps_(fps) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec)) throw Error(dir + ": not a folder");
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      std::string ext = e.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+      if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm")
+        files_.push_back(e.path().string());
+    }
+    std::sort(files_.begin(), files_.end());
+    if (files_.empty()) throw Error(dir + ": no .png/.jpg/.bmp/.pgm images in the folder");
+  }
+  bool next(Frame* f) override {
+    if (i_ >= files_.size()) return false;
+    f->label = files_[i_];
+    f->gray = cv::imread(files_[i_], cv::IMREAD_GRAYSCALE);
+    if (f->gray.empty()) throw Error(files_[i_] + ": cannot read the image");
+    f->utime = static_cast<int64_t>(1e6 * static_cast<double>(i_) / fps_);
+    ++i_;
+    return true;
+  }
+
+ private:
+  std::vector<std::string> files_;
+  size_t i_ = 0;
+  double fps_;
+};
+
+class LcmSource : public Source {
+ public:
+  LcmSource(const std::string& url, const std::string& channel, double idle_s)
+      : lcm_(url), channel_(channel), idle_s_(idle_s) {
+    if (!lcm_.good()) throw Error("lcm: cannot open " + url);
+    sub_ = lcm_.subscribe(channel, &LcmSource::on_image, this);
+    sub_->setQueueCapacity(4);  // drop old frames rather than fall behind the camera
+  }
+  bool next(Frame* f) override {
+    auto start = std::chrono::steady_clock::now();
+    while (q_.empty()) {
+      const int r = lcm_.handleTimeout(100);
+      if (r < 0) throw Error("lcm: handle failed on channel " + channel_);
+      const double waited =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (q_.empty() && idle_s_ > 0 && waited > idle_s_) return false;
+    }
+    *f = std::move(q_.front());
+    q_.pop_front();
+    return true;
+  }
+
+ private:
+  void on_image(const lcm::ReceiveBuffer*, const std::string& chan,
+                const autodrive::compressed_image_t* m) {
+    Frame f;
+    f.utime = m->utime;
+    f.label = chan + "@" + std::to_string(m->utime);
+    if (m->format != "jpeg" && m->format != "png") {
+      std::fprintf(stderr, "autodrive-eye: %s: skipped, format '%s' is not jpeg or png\n",
+                   f.label.c_str(), m->format.c_str());
+      return;
+    }
+    try {
+      f.gray = decode_gray(m->data.data(), m->data.size(), f.label);
+    } catch (const Error& e) {
+      std::fprintf(stderr, "autodrive-eye: %s (frame skipped)\n", e.what());
+      return;
+    }
+    if (q_.size() >= 2) q_.pop_front();  // keep the newest
+    q_.push_back(std::move(f));
+  }
+  lcm::LCM lcm_;
+  std::string channel_;
+  double idle_s_;
+  lcm::Subscription* sub_ = nullptr;
+  std::deque<Frame> q_;
+};
+
+}  // namespace
+
+std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
+                                    const std::string& lcm_url, double idle_timeout_s) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos)
+    throw Error("source '" + spec + "': expected <kind>:<what>, kind one of device, gst, video, folder, lcm");
+  const std::string kind = spec.substr(0, colon), what = spec.substr(colon + 1);
+  if (!(fps_hint > 0)) throw Error("source '" + spec + "': fps must be positive");
+  if (kind == "folder") return std::make_unique<FolderSource>(what, fps_hint);
+  if (kind == "lcm") return std::make_unique<LcmSource>(lcm_url, what, idle_timeout_s);
+  cv::VideoCapture cap;
+  if (kind == "device") {
+    int idx = -1;
+    try {
+      idx = std::stoi(what);
+    } catch (const std::exception&) {
+      throw Error("source '" + spec + "': device index must be a number");
+    }
+    cap.open(idx, cv::CAP_V4L2);
+  } else if (kind == "gst") {
+    cap.open(what, cv::CAP_GSTREAMER);
+  } else if (kind == "video") {
+    if (!std::filesystem::exists(what)) throw Error("source '" + spec + "': no such file");
+    cap.open(what, cv::CAP_FFMPEG);
+  } else {
+    throw Error("source '" + spec + "': unknown kind '" + kind + "' (device, gst, video, folder, lcm)");
+  }
+  if (!cap.isOpened()) throw Error("source '" + spec + "': cannot open");
+  return std::make_unique<CaptureSource>(spec, std::move(cap), kind != "video", fps_hint);
+}
+
+}  // namespace eye
