@@ -34,6 +34,9 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
                                 sim_render_backend_t backend, char *err, size_t err_len);
 void sim_render_destroy(sim_render_t *r);
 
+/* 1 if a width_px x height_px image fits the renderer's offscreen buffer, else 0. */
+int sim_render_fits(const sim_render_t *r, int width_px, int height_px);
+
 /* Name of the backend in use: "egl" or "osmesa". */
 const char *sim_render_backend_name(const sim_render_t *r);
 

@@ -1,0 +1,123 @@
+/* sim_camera: see sim_camera.h. */
+#include "sim_camera.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <autodrive_camera_info_t.h>
+#include <autodrive_compressed_image_t.h>
+
+#include "sim_jpeg.h"
+
+struct sim_camera {
+  sim_render_t *render;
+  sim_jpeg_t *jpeg;
+  int cam_id;
+  int w, h;
+  char frame_id[64];
+  uint8_t *rgb;
+  const uint8_t *jpg;
+  size_t jpg_len;
+  int64_t utime;
+};
+
+sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *cam_name,
+                                const char *frame_id, int width_px, int height_px,
+                                int jpeg_quality, char *err, size_t err_len) {
+  if (!r || !m || !cam_name || !frame_id) {
+    if (err && err_len) snprintf(err, err_len, "sim_camera: null argument");
+    return NULL;
+  }
+  int id = mj_name2id(m, mjOBJ_CAMERA, cam_name);
+  if (id < 0) {
+    if (err && err_len) snprintf(err, err_len, "sim_camera: no camera '%s' in the model", cam_name);
+    return NULL;
+  }
+  /* a size larger than the renderer's buffer fails here, not at the first frame */
+  if (!sim_render_fits(r, width_px, height_px) || jpeg_quality < 1 || jpeg_quality > 100) {
+    if (err && err_len)
+      snprintf(err, err_len,
+               "sim_camera: bad size %dx%d px (must fit the renderer's buffer) or JPEG quality "
+               "%d (1..100) for '%s'", width_px, height_px, jpeg_quality, cam_name);
+    return NULL;
+  }
+  sim_camera_t *c = calloc(1, sizeof *c);
+  if (!c) return NULL;
+  c->render = r;
+  c->cam_id = id;
+  c->w = width_px;
+  c->h = height_px;
+  snprintf(c->frame_id, sizeof c->frame_id, "%s", frame_id);
+  c->rgb = calloc((size_t)width_px * (size_t)height_px, 3);
+  c->jpeg = sim_jpeg_create(jpeg_quality);
+  if (!c->rgb || !c->jpeg) {
+    sim_camera_destroy(c);
+    if (err && err_len) snprintf(err, err_len, "sim_camera: out of memory for '%s'", cam_name);
+    return NULL;
+  }
+  return c;
+}
+
+void sim_camera_destroy(sim_camera_t *c) {
+  if (!c) return;
+  sim_jpeg_destroy(c->jpeg);
+  free(c->rgb);
+  free(c);
+}
+
+int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime) {
+  if (sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb) != 0) return -1;
+  if (sim_jpeg_encode(c->jpeg, c->rgb, c->w, c->h, &c->jpg, &c->jpg_len) != 0) return -1;
+  c->utime = utime;
+  return 0;
+}
+
+const uint8_t *sim_camera_rgb(const sim_camera_t *c) { return c->rgb; }
+const uint8_t *sim_camera_jpeg(const sim_camera_t *c, size_t *size_bytes) {
+  if (size_bytes) *size_bytes = c->jpg_len;
+  return c->jpg;
+}
+int sim_camera_width(const sim_camera_t *c) { return c->w; }
+int sim_camera_height(const sim_camera_t *c) { return c->h; }
+
+void sim_camera_intrinsics(const mjModel *m, int cam_id, int width_px, int height_px,
+                           double k[9]) {
+  double fovy_rad = m->cam_fovy[cam_id] * M_PI / 180.0;
+  double f = 0.5 * height_px / tan(0.5 * fovy_rad);
+  memset(k, 0, 9 * sizeof(double));
+  k[0] = f;
+  k[2] = 0.5 * (width_px - 1);
+  k[4] = f;
+  k[5] = 0.5 * (height_px - 1);
+  k[8] = 1.0;
+}
+
+int sim_camera_publish_image(const sim_camera_t *c, lcm_t *lcm, const char *channel) {
+  if (!c->jpg) return -1;
+  autodrive_compressed_image_t msg;
+  msg.utime = c->utime;
+  msg.frame_id = (char *)c->frame_id;
+  msg.format = (char *)"jpeg";
+  msg.width_px = c->w;
+  msg.height_px = c->h;
+  msg.size_bytes = (int32_t)c->jpg_len;
+  msg.data = (uint8_t *)c->jpg;
+  return autodrive_compressed_image_t_publish(lcm, channel, &msg);
+}
+
+int sim_camera_publish_info(const sim_camera_t *c, const mjModel *m, lcm_t *lcm,
+                            const char *channel, int64_t utime) {
+  autodrive_camera_info_t msg;
+  double d[5] = {0, 0, 0, 0, 0};
+  msg.utime = utime;
+  msg.frame_id = (char *)c->frame_id;
+  msg.width_px = c->w;
+  msg.height_px = c->h;
+  sim_camera_intrinsics(m, c->cam_id, c->w, c->h, msg.k);
+  msg.distortion_model = (char *)"plumb_bob";
+  msg.num_d = 5;
+  msg.d = d;
+  return autodrive_camera_info_t_publish(lcm, channel, &msg);
+}

@@ -1,0 +1,256 @@
+/* sim_lidar: see sim_lidar.h. */
+#include "sim_lidar.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct sim_lidar {
+  sim_lidar_config_t cfg;
+  int base_body;           /* body carrying the scanner */
+  int root_body;           /* its root: geoms under it are the car itself */
+  int *cand;               /* candidate geoms for this scan (not the car's, in a seen group) */
+  int ncand;
+  float *ranges_m, *quality;          /* revolution being filled */
+  float *out_ranges_m, *out_quality;  /* last completed revolution */
+  sim_lidar_scan_t last;
+  int64_t rev_start_us;    /* sim time at which the current revolution started [us] */
+  int next_ray;            /* next ray index of the current revolution */
+  int started;
+  uint64_t rng;            /* xorshift64* state for the noise */
+};
+
+static void err_set(char *err, size_t n, const char *msg, const char *arg) {
+  if (err && n) snprintf(err, n, "sim_lidar: %s%s%s", msg, arg ? ": " : "", arg ? arg : "");
+}
+
+void sim_lidar_config_default(sim_lidar_config_t *cfg) {
+  memset(cfg, 0, sizeof *cfg);
+  cfg->num_rays = 360;
+  cfg->range_min_m = 0.15;
+  cfg->range_max_m = 12.0;
+  cfg->rate_hz = 7.0;
+  cfg->mount_pos_m[0] = 0.1445;
+  cfg->mount_pos_m[1] = 0.0;
+  cfg->mount_pos_m[2] = 0.1757;
+  cfg->noise_std_m = 0.0;
+  cfg->seed = 1;
+  for (int g = 0; g < mjNGROUP; g++) cfg->geomgroup[g] = g < 3;
+}
+
+sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
+                              const sim_lidar_config_t *cfg, char *err, size_t err_len) {
+  if (!m || !base_body || !cfg) {
+    err_set(err, err_len, "null model, body name or config", NULL);
+    return NULL;
+  }
+  if (cfg->num_rays < 1 || cfg->num_rays > 100000 || !(cfg->rate_hz > 0) ||
+      !(cfg->range_min_m >= 0) || !(cfg->range_max_m > cfg->range_min_m) ||
+      !(cfg->noise_std_m >= 0)) {
+    err_set(err, err_len, "bad config (need 1..100000 rays, rate_hz > 0, "
+                          "0 <= range_min_m < range_max_m, noise_std_m >= 0)", NULL);
+    return NULL;
+  }
+  int body = mj_name2id(m, mjOBJ_BODY, base_body);
+  if (body < 0) {
+    err_set(err, err_len, "no such body in the model", base_body);
+    return NULL;
+  }
+  sim_lidar_t *l = calloc(1, sizeof *l);
+  if (!l) return NULL;
+  l->cfg = *cfg;
+  l->base_body = body;
+  l->root_body = m->body_rootid[body];
+  l->cand = calloc((size_t)(m->ngeom ? m->ngeom : 1), sizeof *l->cand);
+  size_t n = (size_t)cfg->num_rays;
+  l->ranges_m = calloc(n, sizeof(float));
+  l->quality = calloc(n, sizeof(float));
+  l->out_ranges_m = calloc(n, sizeof(float));
+  l->out_quality = calloc(n, sizeof(float));
+  if (!l->cand || !l->ranges_m || !l->quality || !l->out_ranges_m || !l->out_quality) {
+    sim_lidar_destroy(l);
+    err_set(err, err_len, "out of memory", NULL);
+    return NULL;
+  }
+  l->rng = cfg->seed ? cfg->seed : 0x9E3779B97F4A7C15ull;
+  l->last.num_rays = 0;
+  l->last.ranges_m = l->out_ranges_m;
+  l->last.intensities = l->out_quality;
+  return l;
+}
+
+void sim_lidar_destroy(sim_lidar_t *l) {
+  if (!l) return;
+  free(l->cand);
+  free(l->ranges_m);
+  free(l->quality);
+  free(l->out_ranges_m);
+  free(l->out_quality);
+  free(l);
+}
+
+/* Scanner origin in world and its x/y axes (the car body's, as the scanner is fixed). */
+static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
+                        mjtNum ax[3], mjtNum ay[3]) {
+  const mjtNum *xm = d->xmat + 9 * l->base_body;
+  const mjtNum *xp = d->xpos + 3 * l->base_body;
+  const double *p = l->cfg.mount_pos_m;
+  for (int i = 0; i < 3; i++) {
+    origin[i] = xp[i] + xm[3 * i + 0] * p[0] + xm[3 * i + 1] * p[1] + xm[3 * i + 2] * p[2];
+    ax[i] = xm[3 * i + 0];
+    ay[i] = xm[3 * i + 1];
+  }
+}
+
+/* Selects the geoms a ray from origin may hit: visible group, alpha > 0, not the car itself,
+ * and (bounded geoms) a bounding sphere that reaches the scan plane within range. The same
+ * filters as mj_ray plus the root-body exclusion and culling. */
+static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l,
+                         const mjtNum origin[3], const mjtNum ax[3], const mjtNum ay[3]) {
+  mjtNum nrm[3];
+  mju_cross(nrm, ax, ay);
+  l->ncand = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int grp = m->geom_group[g];
+    if (grp < 0 || grp >= mjNGROUP || !l->cfg.geomgroup[grp]) continue;
+    if (m->geom_rgba[4 * g + 3] == 0) continue;
+    if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue;
+    mjtNum rb = m->geom_rbound[g];
+    if (rb > 0) {  /* rbound 0 means unbounded (planes) */
+      mjtNum rel[3];
+      mju_sub3(rel, d->geom_xpos + 3 * g, origin);
+      if (fabs(mju_dot3(rel, nrm)) > rb) continue;                  /* off the scan plane */
+      if (mju_norm3(rel) - rb > l->cfg.range_max_m) continue;       /* out of range */
+    }
+    l->cand[l->ncand++] = g;
+  }
+}
+
+/* Nearest hit over the candidates along unit vec from origin, or -1. */
+static mjtNum lidar_cast(const mjModel *m, const mjData *d, const sim_lidar_t *l,
+                         const mjtNum origin[3], const mjtNum vec[3]) {
+  mjtNum best = -1;
+  for (int k = 0; k < l->ncand; k++) {
+    int g = l->cand[k];
+    mjtNum rb = m->geom_rbound[g];
+    if (rb > 0) {  /* cheap sphere test first: skip geoms the ray passes by or lies behind */
+      mjtNum rel[3];
+      mju_sub3(rel, d->geom_xpos + 3 * g, origin);
+      mjtNum along = mju_dot3(rel, vec);
+      mjtNum dist2 = mju_dot3(rel, rel) - along * along;
+      if (dist2 > rb * rb) continue;
+      if (along + rb < 0) continue;
+      if (best >= 0 && along - rb > best) continue;
+    }
+    mjtNum x;
+    int type = m->geom_type[g];
+    if (type == mjGEOM_MESH) {
+      x = mj_rayMesh(m, d, g, origin, vec);
+    } else if (type == mjGEOM_HFIELD) {
+      x = mj_rayHfield(m, d, g, origin, vec);
+    } else {
+      x = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g, m->geom_size + 3 * g, origin,
+                      vec, type);
+    }
+    if (x >= 0 && (best < 0 || x < best)) best = x;
+  }
+  return best;
+}
+
+static double lidar_range(const sim_lidar_t *l, mjtNum x) {
+  if (x < 0 || x < l->cfg.range_min_m || x > l->cfg.range_max_m) return INFINITY;
+  return x;
+}
+
+static void ray_dir(const mjtNum ax[3], const mjtNum ay[3], double angle_rad, mjtNum vec[3]) {
+  double c = cos(angle_rad), s = sin(angle_rad);
+  for (int i = 0; i < 3; i++) vec[i] = c * ax[i] + s * ay[i];
+  mju_normalize3(vec);
+}
+
+double sim_lidar_ray(const mjModel *m, const mjData *d, const sim_lidar_t *l, double angle_rad) {
+  mjtNum o[3], ax[3], ay[3], vec[3];
+  lidar_frame(d, l, o, ax, ay);
+  lidar_select(m, d, (sim_lidar_t *)l, o, ax, ay);
+  ray_dir(ax, ay, angle_rad, vec);
+  return lidar_range(l, lidar_cast(m, d, l, o, vec));
+}
+
+/* Standard normal sample from the lidar's own generator (xorshift64* + Box-Muller). */
+static double lidar_gauss(sim_lidar_t *l) {
+  double u[2];
+  for (int i = 0; i < 2; i++) {
+    l->rng ^= l->rng >> 12;
+    l->rng ^= l->rng << 25;
+    l->rng ^= l->rng >> 27;
+    uint64_t r = l->rng * 0x2545F4914F6CDD1Dull;
+    u[i] = ((double)(r >> 11) + 0.5) / 9007199254740992.0; /* (0, 1) */
+  }
+  return sqrt(-2.0 * log(u[0])) * cos(2.0 * M_PI * u[1]);
+}
+
+/* Casts rays [from, to) of the current revolution into l->ranges_m. */
+static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, int from, int to) {
+  if (from >= to) return;
+  mjtNum o[3], ax[3], ay[3], vec[3];
+  lidar_frame(d, l, o, ax, ay);
+  lidar_select(m, d, l, o, ax, ay);
+  double inc = 2.0 * M_PI / l->cfg.num_rays;
+  for (int i = from; i < to; i++) {
+    ray_dir(ax, ay, i * inc, vec);
+    double r = lidar_range(l, lidar_cast(m, d, l, o, vec));
+    if (isfinite(r) && l->cfg.noise_std_m > 0) {
+      r += l->cfg.noise_std_m * lidar_gauss(l);
+      if (r < l->cfg.range_min_m || r > l->cfg.range_max_m) r = INFINITY;
+    }
+    l->ranges_m[i] = (float)r;
+    l->quality[i] = isfinite(r) ? 47.0f : 0.0f;
+  }
+}
+
+static void lidar_publish(sim_lidar_t *l, int64_t start_us) {
+  size_t n = (size_t)l->cfg.num_rays;
+  memcpy(l->out_ranges_m, l->ranges_m, n * sizeof(float));
+  memcpy(l->out_quality, l->quality, n * sizeof(float));
+  sim_lidar_scan_t *s = &l->last;
+  s->utime = start_us;
+  s->num_rays = l->cfg.num_rays;
+  s->angle_min_rad = 0.0f;
+  s->angle_increment_rad = (float)(2.0 * M_PI / l->cfg.num_rays);
+  s->scan_time_s = (float)(1.0 / l->cfg.rate_hz);
+  s->time_increment_s = s->scan_time_s / (float)l->cfg.num_rays;
+  s->range_min_m = (float)l->cfg.range_min_m;
+  s->range_max_m = (float)l->cfg.range_max_m;
+}
+
+void sim_lidar_scan_now(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us) {
+  lidar_cast_rays(m, d, l, 0, l->cfg.num_rays);
+  lidar_publish(l, now_us);
+}
+
+int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us) {
+  if (!l->started) {
+    l->started = 1;
+    l->rev_start_us = now_us;
+    l->next_ray = 0;
+  }
+  double period_us = 1e6 / l->cfg.rate_hz;
+  /* ray i is due at rev_start + i * period / num_rays */
+  double phase = (double)(now_us - l->rev_start_us) / period_us;
+  int due = (int)floor(phase * l->cfg.num_rays) + 1;
+  if (due > l->cfg.num_rays) due = l->cfg.num_rays;
+  lidar_cast_rays(m, d, l, l->next_ray, due);
+  if (due > l->next_ray) l->next_ray = due;
+  if (phase >= 1.0) {
+    lidar_publish(l, l->rev_start_us);
+    l->rev_start_us += (int64_t)llround(period_us);
+    l->next_ray = 0;
+    /* a long pause (e.g. the sim was paused) restarts the head instead of replaying scans */
+    if (now_us - l->rev_start_us >= (int64_t)period_us) l->rev_start_us = now_us;
+    return 1;
+  }
+  return 0;
+}
+
+const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l) { return &l->last; }
