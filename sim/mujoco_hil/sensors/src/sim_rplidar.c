@@ -325,14 +325,17 @@ int sim_rplidar_poll(sim_rplidar_t *r, int64_t now_us, char *err, size_t err_len
     }
     break;
   }
-  /* wire pacing: 10 bits per byte (8N1); credit is capped so an idle wire does not burst */
+  /* wire pacing: 10 bits per byte (8N1); credit is capped at 20 ms of wire (>= 64 bytes) so an
+   * idle wire does not burst, while a caller polling every 1..20 ms still reaches full rate */
   if (!r->clock_started || now_us < r->wire_us) {
     r->clock_started = 1;
     r->wire_us = now_us;
   }
   r->credit_bytes += (double)(now_us - r->wire_us) * r->baud / 10.0 / 1e6;
   r->wire_us = now_us;
-  if (r->credit_bytes > 64) r->credit_bytes = 64;
+  double cap = r->baud / 10.0 * 0.020;
+  if (cap < 64) cap = 64;
+  if (r->credit_bytes > cap) r->credit_bytes = cap;
   size_t allow = (size_t)r->credit_bytes;
   size_t sent = 0;
   if (allow && r->out_len) {
