@@ -1,0 +1,44 @@
+/* LCM publishing (see lcmpub.h). */
+#include "lcmpub.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "autodrive_ground_truth_t.h"
+#include "autodrive_sim_clock_t.h"
+
+int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log) {
+  sim_truth_t t;
+  sim_truth(s, car, &t);
+  char vehicle[16], channel[48];
+  snprintf(vehicle, sizeof vehicle, "NIGEL%d", car);
+  snprintf(channel, sizeof channel, "%s_GROUND_TRUTH", vehicle);
+  autodrive_ground_truth_t msg;
+  memset(&msg, 0, sizeof msg);
+  msg.utime = sim_time_us(s);
+  msg.vehicle = vehicle;
+  memcpy(msg.position_m, t.pos_m, sizeof msg.position_m);
+  memcpy(msg.orientation_wxyz, t.quat_wxyz, sizeof msg.orientation_wxyz);
+  msg.yaw_rad = t.yaw_rad;
+  memcpy(msg.linear_velocity_m_s, t.vel_body_m_s, sizeof msg.linear_velocity_m_s);
+  memcpy(msg.angular_velocity_rad_s, t.gyro_body_rad_s, sizeof msg.angular_velocity_rad_s);
+  msg.steering_angle_rad = t.steering_rad;
+  msg.in_collision = (int8_t)t.in_collision;
+  if (log) {
+    uint8_t buf[512];
+    const int n = autodrive_ground_truth_t_encode(buf, 0, sizeof buf, &msg);
+    if (n > 0) {
+      const uint8_t len[4] = {(uint8_t)(n >> 24), (uint8_t)(n >> 16), (uint8_t)(n >> 8), (uint8_t)n};
+      fwrite(len, 1, 4, log);
+      fwrite(buf, 1, (size_t)n, log);
+    }
+  }
+  if (!lcm) return 0;
+  return autodrive_ground_truth_t_publish(lcm, channel, &msg) == 0 ? 0 : -1;
+}
+
+int lcmpub_clock(lcm_t *lcm, int64_t utime, double rtf, int paused) {
+  if (!lcm) return 0;
+  autodrive_sim_clock_t msg = {utime, rtf, (int8_t)paused};
+  return autodrive_sim_clock_t_publish(lcm, "SIM_CLOCK", &msg) == 0 ? 0 : -1;
+}

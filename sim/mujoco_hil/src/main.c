@@ -1,0 +1,250 @@
+/* autodrive-sim: the MuJoCo 2.2 HIL simulator of Nigel. See --help and README.md. */
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <lcm/lcm.h>
+
+#include "lcmpub.h"
+#include "sim.h"
+
+#ifdef SIM_HAVE_SENSORS
+#include "sim_lidar_lcm.h"
+#endif
+
+#define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
+#define MAIN_TRUTH_EVERY 10   /* steps between ground-truth messages: 100 Hz */
+#define MAIN_CLOCK_EVERY 10   /* steps between SIM_CLOCK messages: 100 Hz */
+#define MAIN_PROGRESS_S 5.0   /* [s] wall time between progress lines */
+
+static volatile sig_atomic_t main_stop = 0;
+static void main_on_signal(int sig) { (void)sig; main_stop = 1; }
+
+static void main_usage(FILE *f) {
+  fprintf(f,
+          "usage: autodrive-sim [options]\n"
+          "MuJoCo 2.2 HIL simulator of the AutoDRIVE Nigel car. Each car's emulated Nano (the real\n"
+          "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
+          "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
+          "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
+          "  --params FILE       vehicle parameter file (default %s/params/nigel.params)\n"
+          "  --seed N            seed of IMU biases and noise (default 1)\n"
+          "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
+          "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
+          "                      (default: real time, 1 sim second per wall second)\n"
+          "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
+          "  --lcm-url URL       LCM provider (default %s)\n"
+          "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
+          "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
+          "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
+          "  --no-pty            do not open ptys (with --script)\n"
+          "  --no-lidar          do not simulate the LIDAR\n"
+          "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
+          "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
+          "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
+          "  --quiet             no progress lines\n"
+          "  -h, --help          this text\n"
+          "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
+          "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n",
+          SIM_MAX_CARS, AUTODRIVE_SIM_DIR, MAIN_DEFAULT_URL);
+}
+
+static double main_wall_s(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int main_number(const char *opt, const char *v, double lo, double hi, double *out) {
+  char *end;
+  errno = 0;
+  const double x = v ? strtod(v, &end) : 0.0;
+  if (!v || end == v || *end || errno || !isfinite(x) || x < lo || x > hi) {
+    fprintf(stderr, "autodrive-sim: %s '%s': expected a number in [%g, %g]\n", opt, v ? v : "",
+            lo, hi);
+    return -1;
+  }
+  *out = x;
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  sim_config_t cfg = {0};
+  char params[1024], map[1024];
+  snprintf(params, sizeof params, "%s/params/nigel.params", AUTODRIVE_SIM_DIR);
+  snprintf(map, sizeof map, "%s/maps/parking_school.xml", AUTODRIVE_SIM_DIR);
+  cfg.params_path = params;
+  cfg.map_path = map;
+  cfg.run_dir = "/tmp/autodrive-sim";
+  cfg.cars = 1;
+  cfg.seed = 1;
+  cfg.open_ptys = 1;
+  cfg.lidar = 1;
+  cfg.tyre_model = -1;
+  const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
+  int lockstep = 0, bench = 0, quiet = 0;
+  double rtf = 1.0, duration = 0.0, x;
+  int rtf_given = 0;
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i], *v = (i + 1 < argc) ? argv[i + 1] : NULL;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      main_usage(stdout);
+      return 0;
+    } else if (!strcmp(a, "--cars")) {
+      if (main_number(a, v, 1, SIM_MAX_CARS, &x)) return 2;
+      cfg.cars = (int)x;
+      i++;
+    } else if (!strcmp(a, "--map") && v) {
+      if (strchr(v, '/') || strstr(v, ".xml")) snprintf(map, sizeof map, "%s", v);
+      else snprintf(map, sizeof map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
+      i++;
+    } else if (!strcmp(a, "--params") && v) {
+      snprintf(params, sizeof params, "%s", v);
+      i++;
+    } else if (!strcmp(a, "--seed")) {
+      if (main_number(a, v, 0, 4e18, &x)) return 2;
+      cfg.seed = (uint64_t)x;
+      i++;
+    } else if (!strcmp(a, "--lockstep")) {
+      lockstep = 1;
+    } else if (!strcmp(a, "--rtf")) {
+      if (main_number(a, v, 0.01, 1e6, &rtf)) return 2;
+      rtf_given = 1;
+      i++;
+    } else if (!strcmp(a, "--duration")) {
+      if (main_number(a, v, 0, 1e9, &duration)) return 2;
+      i++;
+    } else if (!strcmp(a, "--lcm-url") && v) {
+      url = v;
+      i++;
+    } else if (!strcmp(a, "--run-dir") && v) {
+      cfg.run_dir = v;
+      i++;
+    } else if (!strcmp(a, "--script") && v) {
+      cfg.script = v;
+      i++;
+    } else if (!strcmp(a, "--no-pty")) {
+      cfg.open_ptys = 0;
+    } else if (!strcmp(a, "--no-lidar")) {
+      cfg.lidar = 0;
+    } else if (!strcmp(a, "--tyre-model") && v) {
+      if (!strcmp(v, "paper")) cfg.tyre_model = 1;
+      else if (!strcmp(v, "mujoco")) cfg.tyre_model = 0;
+      else {
+        fprintf(stderr, "autodrive-sim: --tyre-model '%s': expected paper or mujoco\n", v);
+        return 2;
+      }
+      i++;
+    } else if (!strcmp(a, "--truth-log") && v) {
+      truth_log = v;
+      i++;
+    } else if (!strcmp(a, "--bench")) {
+      bench = 1;
+    } else if (!strcmp(a, "--quiet")) {
+      quiet = 1;
+    } else {
+      fprintf(stderr, "autodrive-sim: unknown option or missing value: '%s' (see --help)\n", a);
+      return 2;
+    }
+  }
+  if (lockstep && rtf_given) {
+    fprintf(stderr, "autodrive-sim: --lockstep and --rtf exclude each other\n");
+    return 2;
+  }
+
+  lcm_t *lcm = lcm_create(url);
+  if (!lcm) {
+    fprintf(stderr,
+            "autodrive-sim: cannot open LCM url '%s' (udpm:// needs a multicast route, e.g. "
+            "'ip route add 239.0.0.0/8 dev lo')\n", url);
+    return 1;
+  }
+  FILE *tlog = NULL;
+  if (truth_log && !(tlog = fopen(truth_log, "wb"))) {
+    fprintf(stderr, "autodrive-sim: --truth-log '%s': %s\n", truth_log, strerror(errno));
+    lcm_destroy(lcm);
+    return 1;
+  }
+  char err[2048] = "";
+  sim_t *s = sim_create(&cfg, err, sizeof err);
+  if (!s) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = main_on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  signal(SIGPIPE, SIG_IGN);
+
+  for (int c = 1; c <= sim_cars(s); c++) {
+    if (sim_nano_link(s, c)[0]) printf("NIGEL%d nano: %s\n", c, sim_nano_link(s, c));
+    if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
+  }
+  printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
+         lockstep ? "lockstep" : (rtf_given ? "rtf" : "real time"), url);
+  fflush(stdout);
+
+  const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
+  const double t0 = main_wall_s();
+  double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0;
+  int64_t last_progress_us = 0;
+  int rc = 0;
+  long step = 0;
+  while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
+    if (sim_step(s, err, sizeof err) != 0) {
+      fprintf(stderr, "autodrive-sim: %s\n", err);
+      rc = 1;
+      break;
+    }
+    step++;
+    const int64_t now_us = sim_time_us(s);
+    if (step % MAIN_TRUTH_EVERY == 0)
+      for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(lcm, s, c, tlog);
+#ifdef SIM_HAVE_SENSORS
+    for (int c = 1; c <= sim_cars(s); c++) {
+      const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
+      if (scan) {
+        char ch[32];
+        snprintf(ch, sizeof ch, "NIGEL%d_LIDAR", c);
+        sim_lidar_publish(lcm, ch, "laser", scan);
+      }
+    }
+#endif
+    if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) lcmpub_clock(lcm, now_us, rtf_now, 0);
+    /* pacing: real time or rtf x real time; lockstep runs free */
+    const double wall = main_wall_s();
+    if (!lockstep) {
+      const double ahead = t0 + now_us * 1e-6 / rtf - wall;
+      if (ahead > 0.0005) {
+        struct timespec ts = {(time_t)ahead, (long)((ahead - floor(ahead)) * 1e9)};
+        nanosleep(&ts, NULL);
+      }
+    }
+    if (wall >= next_progress) {
+      rtf_now = (now_us - last_progress_us) * 1e-6 / (wall - next_progress + MAIN_PROGRESS_S);
+      last_progress_us = now_us;
+      next_progress = wall + MAIN_PROGRESS_S;
+      if (!quiet) fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f\n", now_us * 1e-6, rtf_now);
+    }
+  }
+  const double wall_s = main_wall_s() - t0, sim_s = sim_time_us(s) * 1e-6;
+  if (bench) {
+    const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
+    const double bare_s = sim_bare_mj_step_s(s, bare_steps);
+    printf("{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"rtf\": %.3f, \"bare_mj_step_rtf\": %.3f}\n",
+           sim_cars(s), sim_s, wall_s, wall_s > 0 ? sim_s / wall_s : 0.0,
+           bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0);
+  }
+  sim_destroy(s); /* removes the ptys' symlinks */
+  if (tlog) fclose(tlog);
+  lcm_destroy(lcm);
+  return rc;
+}

@@ -1,0 +1,30 @@
+/* Generates the scene MJCF: simulation options, the map (by <include>) and N Nigel cars built
+ * from the vehicle parameters. Names per car i (1-based), used by the sim and the sensors:
+ *   body nigel<i>/base_link (freejoint nigel<i>/root; origin: rear-axle centre on the ground)
+ *   geom nigel<i>/chassis; tyres nigel<i>/tyre_{fl,fr,rl,rr} (spheres)
+ *   joints nigel<i>/steer_{fl,fr} (hinge z), nigel<i>/wheel_{fl,fr,rl,rr} (hinge y, + forward)
+ *   sites nigel<i>/imu, nigel<i>/lidar, nigel<i>/tag_site; geom nigel<i>/tag (roof plate)
+ *   cameras nigel<i>/cam_front, nigel<i>/cam_rear (fovy 48.8 deg = 62.2 deg HFOV at 4:3)
+ * Collision bits: world contype 1 / conaffinity 6, tyres 2 / 1, chassis 4 / 5. */
+#ifndef SIM_MJCF_GEN_H
+#define SIM_MJCF_GEN_H
+
+#include <stddef.h>
+
+#include "vparams.h"
+
+typedef struct mg_options {
+  int cars;                 /* >= 1 */
+  const char *map_path;     /* absolute path of the map MJCF */
+  const char *tag_asset_xml;        /* NULL, or <texture>/<material> elements of the roof tags */
+  const char *const *tag_geom_xml;  /* NULL, or per car the roof tag <geom> (NULL: plain plate) */
+} mg_options_t;
+
+/* Roof tag id of car i (1-based): tag36h11 id i. */
+int mg_tag_id(int car);
+
+/* Writes the scene to out_path. Returns 0, or -1 with a message in err. */
+int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
+                   size_t err_sz);
+
+#endif

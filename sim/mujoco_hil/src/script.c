@@ -1,0 +1,79 @@
+/* Scripted driver (see script.h). */
+#include "script.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SCRIPT_ARM_FRAMES 3 /* engaged=0 frames before engaging */
+
+static int script_num(const char *spec, const char *key, const char *val, double lo, double hi,
+                      double *out, char *err, size_t err_sz) {
+  char *end;
+  errno = 0;
+  double v = strtod(val, &end);
+  if (end == val || *end != '\0' || errno || !isfinite(v) || v < lo || v > hi) {
+    snprintf(err, err_sz, "--script '%s': %s='%s' is not a number in [%g, %g]", spec, key, val,
+             lo, hi);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
+  memset(s, 0, sizeof *s);
+  s->stop_us = -1;
+  const char *prefix = "constant:";
+  if (strncmp(spec, prefix, strlen(prefix)) != 0) {
+    snprintf(err, err_sz, "--script '%s': unknown kind (expected 'constant:key=value,...')",
+             spec);
+    return -1;
+  }
+  char buf[256];
+  snprintf(buf, sizeof buf, "%s", spec + strlen(prefix));
+  double start = 0.0, stop = -1.0;
+  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
+       tok = strtok_r(NULL, ",", &save)) {
+    char *eq = strchr(tok, '=');
+    if (!eq) {
+      snprintf(err, err_sz, "--script '%s': '%s' is not key=value", spec, tok);
+      return -1;
+    }
+    *eq = '\0';
+    const char *val = eq + 1;
+    int rc;
+    if (strcmp(tok, "throttle") == 0) rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
+    else if (strcmp(tok, "steering") == 0) rc = script_num(spec, tok, val, -1, 1, &s->steering, err, err_sz);
+    else if (strcmp(tok, "start") == 0) rc = script_num(spec, tok, val, 0, 1e6, &start, err, err_sz);
+    else if (strcmp(tok, "stop_after") == 0) rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
+    else {
+      snprintf(err, err_sz, "--script '%s': unknown key '%s' (throttle, steering, start, stop_after)",
+               spec, tok);
+      return -1;
+    }
+    if (rc) return -1;
+  }
+  s->start_us = (int64_t)llround(start * 1e6);
+  s->stop_us = stop < 0 ? -1 : (int64_t)llround(stop * 1e6);
+  s->next_us = s->start_us;
+  return 0;
+}
+
+size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap) {
+  if (now_us < s->next_us || (s->stop_us >= 0 && now_us >= s->stop_us)) return 0;
+  s->next_us += SCRIPT_PERIOD_US;
+  const int engaged = s->sent >= SCRIPT_ARM_FRAMES;
+  proto_command_t c = {0};
+  c.seq = s->cmd_seq++;
+  c.throttle_milli = engaged ? (int16_t)lround(s->throttle * PROTO_MILLI) : 0;
+  c.steering_milli = engaged ? (int16_t)lround(s->steering * PROTO_MILLI) : 0;
+  c.flags = engaged ? PROTO_CMD_ENGAGED : 0;
+  uint8_t payload[PROTO_LEN_COMMAND];
+  proto_command_pack(&c, payload);
+  s->sent++;
+  return proto_frame_encode(PROTO_ID_COMMAND, s->frame_seq++, payload, PROTO_LEN_COMMAND, out,
+                            cap);
+}

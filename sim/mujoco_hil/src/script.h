@@ -1,0 +1,32 @@
+/* Scripted driver: stands in for the Jetson runtime in tests and benchmarks by sending real
+ * protocol frames (COMMAND at 50 Hz, arming with engaged=0 then engaged=1 as the failsafe
+ * requires) into the emulated Nano's UART.
+ * Spec: "constant:throttle=<-1..1>,steering=<-1..1>[,start=<s>][,stop_after=<s>]"
+ *   start: first command time [s] (default 0); stop_after: the driver goes quiet at this sim
+ *   time [s] (default never), which must trip the Nano's failsafe. */
+#ifndef SIM_SCRIPT_H
+#define SIM_SCRIPT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "proto.h"
+
+#define SCRIPT_PERIOD_US 20000u /* 50 Hz, the runtime's command rate */
+
+typedef struct script {
+  double throttle, steering; /* normalised [-1, 1] */
+  int64_t start_us, stop_us; /* stop_us < 0: never */
+  int64_t next_us;
+  uint16_t cmd_seq;
+  uint8_t frame_seq;
+  int sent;
+} script_t;
+
+/* Parses spec. Returns 0, or -1 with a message naming the bad part in err. */
+int script_parse(script_t *s, const char *spec, char *err, size_t err_sz);
+/* Frames due at sim time now_us are encoded into out (cap >= 2 * PROTO_MAX_FRAME).
+ * Returns the number of bytes written. */
+size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap);
+
+#endif

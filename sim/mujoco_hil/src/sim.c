@@ -1,0 +1,610 @@
+/* Simulator core (see sim.h). Per 1 ms step and car: UART bytes in (pty or scripted driver,
+ * paced at the wire rate) -> firmware core (nigel_rx, nigel_step with encoder counts) -> HAL
+ * outputs -> servo, Ackermann, motor and tyre forces -> mj_step2. */
+#include "sim.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "drive.h"
+#include "mjcf_gen.h"
+#include "ptylink.h"
+#include "rng.h"
+#include "script.h"
+#include "tyre.h"
+#include "uart.h"
+#include "vparams.h"
+
+#ifdef SIM_HAVE_SENSORS
+#include "sim_lidar.h"
+#include "sim_rplidar.h"
+#include "sim_tags.h"
+#endif
+
+#define SIM_ENC_COUNTS_PER_REV 1920.0
+#define SIM_G_M_S2 9.80665
+#define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
+#define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
+
+enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
+
+typedef struct sim_car {
+  sim_t *sim;
+  int index; /* 1-based */
+  /* model addresses */
+  int body, root_qpos, root_dof, chassis_geom;
+  int wheel_body[W_N], wheel_qpos[W_N], wheel_dof[W_N], tyre_geom[W_N];
+  int steer_qpos[2], steer_dof[2];
+  int accel_adr, gyro_adr, mag_adr;
+  /* tyre contacts recorded after the previous step */
+  double fz_n[W_N], mu[W_N], normal[W_N][3], contact_pos[W_N][3];
+  int in_collision;
+  /* actuator outputs set by the firmware through the HAL */
+  uint8_t duty, reverse, brake, lamps;
+  uint16_t servo_us;
+  double steer_rad; /* servo output shaft, as a centre angle [rad] */
+  /* emulated Nano */
+  nigel_t nano;
+  nigel_hal_t hal;
+  uart_queue_t rx, tx;
+  ptylink_t pty;
+  int has_pty, has_script;
+  script_t script;
+  rng_t rng;
+  double accel_bias[3], gyro_bias[3];
+#ifdef SIM_HAVE_SENSORS
+  sim_lidar_t *lidar;
+  sim_rplidar_t *rplidar;
+  int lidar_new;
+#endif
+  char lidar_link[512];
+} sim_car_t;
+
+struct sim {
+  vp_params_t p;
+  mjModel *m;
+  mjData *d;
+  int ncars;
+  sim_car_t *car;
+  int64_t time_us;
+  char scene_dir[512], scene_path[600];
+  tyre_curve_t lon, lat;
+  motor_model_t motor;
+  int tyre_paper;
+  int *geom_tyre; /* per geom: car * W_N + wheel, or -1 */
+};
+
+/* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
+static void hal_motor_set(void *ctx, uint8_t duty, uint8_t reverse, uint8_t brake) {
+  sim_car_t *c = ctx;
+  c->duty = duty;
+  c->reverse = reverse;
+  c->brake = brake;
+}
+
+static void hal_servo_set_us(void *ctx, uint16_t pulse_us) { ((sim_car_t *)ctx)->servo_us = pulse_us; }
+
+static void hal_lamps_set(void *ctx, uint8_t lamps) { ((sim_car_t *)ctx)->lamps = lamps; }
+
+static int16_t sim_sat16(double v) {
+  if (v > 32767.0) return 32767;
+  if (v < -32768.0) return -32768;
+  return (int16_t)lround(v);
+}
+
+/* MPU-9250 sample from MuJoCo's accelerometer/gyro/magnetometer at the IMU site (car axes:
+ * x forward, y left, z up), plus the car's bias and white noise, in the chip's LSB. */
+static int hal_imu_read(void *ctx, nigel_imu_raw_t *out) {
+  sim_car_t *c = ctx;
+  const sim_t *s = c->sim;
+  const mjtNum *sd = s->d->sensordata;
+  for (int k = 0; k < 3; k++) {
+    const double a = sd[c->accel_adr + k] + c->accel_bias[k] + rng_gauss(&c->rng, s->p.accel_noise_m_s2);
+    const double w = sd[c->gyro_adr + k] + c->gyro_bias[k] + rng_gauss(&c->rng, s->p.gyro_noise_rad_s);
+    const double b = sd[c->mag_adr + k] + rng_gauss(&c->rng, s->p.mag_noise_ut);
+    out->accel[k] = sim_sat16(a / SIM_G_M_S2 * PROTO_ACCEL_LSB_PER_G);
+    out->gyro[k] = sim_sat16(w * (180.0 / M_PI) * PROTO_GYRO_LSB_PER_DPS);
+    out->mag[k] = sim_sat16(b / PROTO_MAG_UT_PER_LSB);
+  }
+  return 0;
+}
+
+static uint16_t hal_battery_read_mv(void *ctx) {
+  sim_car_t *c = ctx;
+  const double v = c->sim->p.battery_v + rng_gauss(&c->rng, c->sim->p.battery_noise_v);
+  return (uint16_t)lround(fmax(0.0, v) * 1000.0);
+}
+
+static void hal_serial_write(void *ctx, const uint8_t *data, uint8_t n) {
+  uart_push(&((sim_car_t *)ctx)->tx, data, n);
+}
+
+/* ---- model binding ---------------------------------------------------------------------- */
+static int sim_id(const mjModel *m, int type, int car, const char *part, char *err, size_t err_sz) {
+  char name[64];
+  snprintf(name, sizeof name, "nigel%d/%s", car, part);
+  const int id = mj_name2id(m, type, name);
+  if (id < 0) snprintf(err, err_sz, "generated model lacks '%s'", name);
+  return id;
+}
+
+static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
+  const mjModel *m = s->m;
+  static const char *wn[W_N] = {"fl", "fr", "rl", "rr"};
+  char part[32];
+  if ((c->body = sim_id(m, mjOBJ_BODY, c->index, "base_link", err, err_sz)) < 0) return -1;
+  int j = sim_id(m, mjOBJ_JOINT, c->index, "root", err, err_sz);
+  if (j < 0) return -1;
+  c->root_qpos = m->jnt_qposadr[j];
+  c->root_dof = m->jnt_dofadr[j];
+  if ((c->chassis_geom = sim_id(m, mjOBJ_GEOM, c->index, "chassis", err, err_sz)) < 0) return -1;
+  for (int w = 0; w < W_N; w++) {
+    snprintf(part, sizeof part, "wheel_%s", wn[w]);
+    if ((c->wheel_body[w] = sim_id(m, mjOBJ_BODY, c->index, part, err, err_sz)) < 0) return -1;
+    if ((j = sim_id(m, mjOBJ_JOINT, c->index, part, err, err_sz)) < 0) return -1;
+    c->wheel_qpos[w] = m->jnt_qposadr[j];
+    c->wheel_dof[w] = m->jnt_dofadr[j];
+    snprintf(part, sizeof part, "tyre_%s", wn[w]);
+    if ((c->tyre_geom[w] = sim_id(m, mjOBJ_GEOM, c->index, part, err, err_sz)) < 0) return -1;
+    s->geom_tyre[c->tyre_geom[w]] = (c->index - 1) * W_N + w;
+  }
+  for (int w = 0; w < 2; w++) {
+    snprintf(part, sizeof part, "steer_%s", wn[w]);
+    if ((j = sim_id(m, mjOBJ_JOINT, c->index, part, err, err_sz)) < 0) return -1;
+    c->steer_qpos[w] = m->jnt_qposadr[j];
+    c->steer_dof[w] = m->jnt_dofadr[j];
+  }
+  static const char *sn[3] = {"accel", "gyro", "mag"};
+  int *adr[3] = {&c->accel_adr, &c->gyro_adr, &c->mag_adr};
+  for (int k = 0; k < 3; k++) {
+    const int id = sim_id(m, mjOBJ_SENSOR, c->index, sn[k], err, err_sz);
+    if (id < 0) return -1;
+    *adr[k] = m->sensor_adr[id];
+  }
+  return 0;
+}
+
+/* Cars stand side by side to the right of the map's "spawn" site (or the origin). */
+static void sim_place_cars(sim_t *s) {
+  double base[3] = {0, 0, 0}, yaw = 0.0;
+  const int site = mj_name2id(s->m, mjOBJ_SITE, "spawn");
+  if (site >= 0) {
+    mju_copy3(base, s->m->site_pos + 3 * site);
+    const mjtNum *q = s->m->site_quat + 4 * site;
+    yaw = atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
+  }
+  for (int i = 0; i < s->ncars; i++) {
+    mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+    const double off = -SIM_CAR_SPACING_M * i;
+    qp[0] = base[0] - off * sin(yaw);
+    qp[1] = base[1] + off * cos(yaw);
+    qp[2] = 0.002;
+    qp[3] = cos(0.5 * yaw);
+    qp[4] = qp[5] = 0.0;
+    qp[6] = sin(0.5 * yaw);
+  }
+}
+
+/* ---- setup --------------------------------------------------------------------------- */
+static int sim_fail(char *err, size_t err_sz, const char *fmt, const char *a, const char *b) {
+  snprintf(err, err_sz, fmt, a, b);
+  return -1;
+}
+
+/* The map alone must compile: its errors then name the map file, not the generated scene. */
+static int sim_check_map(const char *path, char *err, size_t err_sz) {
+  if (access(path, R_OK) != 0) return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
+  char merr[1000] = "";
+  mjModel *mm = mj_loadXML(path, NULL, merr, sizeof merr);
+  if (!mm) return sim_fail(err, err_sz, "bad map file '%s': %s", path, merr);
+  mj_deleteModel(mm);
+  return 0;
+}
+
+#ifdef SIM_HAVE_SENSORS
+/* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
+static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err, size_t err_sz) {
+  const size_t asz = 512;
+  *asset = calloc((size_t)cars, asz);
+  *geoms = calloc((size_t)cars, sizeof(char *));
+  if (!*asset || !*geoms) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
+  for (int i = 1; i <= cars; i++) {
+    char png[700], file[64], prefix[32], a[asz];
+    snprintf(file, sizeof file, "tag36h11_%d.png", mg_tag_id(i));
+    snprintf(png, sizeof png, "%s/%s", s->scene_dir, file);
+    if (sim_tags_write_png(png, mg_tag_id(i), 8, err, err_sz) != 0) return -1;
+    snprintf(prefix, sizeof prefix, "nigel%d/", i);
+    (*geoms)[i - 1] = malloc(1024);
+    if (!(*geoms)[i - 1] ||
+        sim_tags_mjcf(prefix, file, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
+      return sim_fail(err, err_sz, "%s%s", "roof tag MJCF did not fit its buffer", "");
+    strcat(*asset, a);
+    strcat(*asset, "\n");
+  }
+  return 0;
+}
+#endif
+
+static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
+  mg_options_t o = {cfg->cars, NULL, NULL, NULL};
+  char map_abs[4096];
+  if (!realpath(cfg->map_path, map_abs)) return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
+  if (sim_check_map(map_abs, err, err_sz) != 0) return -1;
+  o.map_path = map_abs;
+  char *asset = NULL, **geoms = NULL;
+  int rc = 0;
+#ifdef SIM_HAVE_SENSORS
+  rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);
+  o.tag_asset_xml = asset;
+  o.tag_geom_xml = (const char *const *)geoms;
+#endif
+  if (rc == 0) rc = mg_write_scene(s->scene_path, &s->p, &o, err, err_sz);
+  if (geoms)
+    for (int i = 0; i < cfg->cars; i++) free(geoms[i]);
+  free(geoms);
+  free(asset);
+  if (rc != 0) return -1;
+  char merr[1000] = "";
+  s->m = mj_loadXML(s->scene_path, NULL, merr, sizeof merr);
+  if (!s->m) return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path, merr);
+  s->d = mj_makeData(s->m);
+  if (!s->d) return sim_fail(err, err_sz, "%s%s", "mj_makeData failed (out of memory)", "");
+  return 0;
+}
+
+static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err, size_t err_sz) {
+  c->sim = s;
+  c->servo_us = 1500;
+  c->brake = 1;
+  uart_init(&c->rx, PROTO_BAUD);
+  uart_init(&c->tx, PROTO_BAUD);
+  /* every car draws its own biases and noise from (seed, car) */
+  rng_seed(&c->rng, cfg->seed * 1000003ull + (uint64_t)c->index);
+  for (int k = 0; k < 3; k++) {
+    c->accel_bias[k] = (2.0 * rng_uniform(&c->rng) - 1.0) * s->p.accel_bias_m_s2;
+    c->gyro_bias[k] = (2.0 * rng_uniform(&c->rng) - 1.0) * s->p.gyro_bias_rad_s;
+  }
+  if (cfg->script) {
+    if (script_parse(&c->script, cfg->script, err, err_sz) != 0) return -1;
+    c->has_script = 1;
+  }
+  if (cfg->open_ptys) {
+    char link[512];
+    snprintf(link, sizeof link, "%s/nigel%d-nano", cfg->run_dir, c->index);
+    if (ptylink_open(&c->pty, link, err, err_sz) != 0) return -1;
+    c->has_pty = 1;
+  }
+#ifdef SIM_HAVE_SENSORS
+  if (cfg->lidar) {
+    sim_lidar_config_t lc;
+    sim_lidar_config_default(&lc);
+    mju_copy3(lc.mount_pos_m, s->p.lidar_pos_m);
+    lc.seed = cfg->seed * 7919ull + (uint64_t)c->index;
+    char body[32];
+    snprintf(body, sizeof body, "nigel%d/base_link", c->index);
+    c->lidar = sim_lidar_create(s->m, body, &lc, err, err_sz);
+    if (!c->lidar) return -1;
+    if (cfg->open_ptys) {
+      snprintf(c->lidar_link, sizeof c->lidar_link, "%s/nigel%d-lidar", cfg->run_dir, c->index);
+      c->rplidar = sim_rplidar_create(c->lidar_link, SIM_RPLIDAR_BAUD, err, err_sz);
+      if (!c->rplidar) return -1;
+    }
+  }
+#endif
+  c->hal.ctx = c;
+  c->hal.motor_set = hal_motor_set;
+  c->hal.servo_set_us = hal_servo_set_us;
+  c->hal.lamps_set = hal_lamps_set;
+  c->hal.imu_read = hal_imu_read;
+  c->hal.battery_read_mv = hal_battery_read_mv;
+  c->hal.serial_write = hal_serial_write;
+  nigel_init(&c->nano, &c->hal, 0, 0, SIM_BUILD_ID);
+  return 0;
+}
+
+int sim_has_sensors(void) {
+#ifdef SIM_HAVE_SENSORS
+  return 1;
+#else
+  return 0;
+#endif
+}
+
+sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
+  if (cfg->cars < 1 || cfg->cars > SIM_MAX_CARS) {
+    snprintf(err, err_sz, "--cars %d: must be 1..%d", cfg->cars, SIM_MAX_CARS);
+    return NULL;
+  }
+  sim_t *s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
+  if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
+  s->tyre_paper = s->p.tyre_model_paper;
+  if (mkdir(cfg->run_dir, 0755) != 0 && errno != EEXIST) {
+    snprintf(err, err_sz, "run dir '%s': %s", cfg->run_dir, strerror(errno));
+    goto fail;
+  }
+  /* the generated scene lives in a private dir so that parallel sims do not collide */
+  snprintf(s->scene_dir, sizeof s->scene_dir, "%s/scene-XXXXXX", cfg->run_dir);
+  if (!mkdtemp(s->scene_dir)) {
+    snprintf(err, err_sz, "scene dir in '%s': %s", cfg->run_dir, strerror(errno));
+    s->scene_dir[0] = '\0';
+    goto fail;
+  }
+  snprintf(s->scene_path, sizeof s->scene_path, "%s/scene.xml", s->scene_dir);
+  if (sim_load_model(s, cfg, err, err_sz) != 0) goto fail;
+  s->ncars = cfg->cars;
+  s->car = calloc((size_t)cfg->cars, sizeof *s->car);
+  s->geom_tyre = malloc(sizeof(int) * (size_t)s->m->ngeom);
+  if (!s->car || !s->geom_tyre) goto fail;
+  for (int g = 0; g < s->m->ngeom; g++) s->geom_tyre[g] = -1;
+  s->lon = (tyre_curve_t){s->p.long_extremum[0], s->p.long_extremum[1], s->p.long_asymptote[0], s->p.long_asymptote[1]};
+  s->lat = (tyre_curve_t){s->p.lat_extremum[0], s->p.lat_extremum[1], s->p.lat_asymptote[0], s->p.lat_asymptote[1]};
+  s->motor = (motor_model_t){s->p.motor_stall_torque_nm, s->p.motor_noload_speed_rad_s, s->p.motor_nominal_v};
+  for (int i = 0; i < cfg->cars; i++) {
+    s->car[i].index = i + 1;
+    if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
+  }
+  sim_place_cars(s);
+  mj_forward(s->m, s->d);
+  for (int i = 0; i < cfg->cars; i++)
+    if (sim_setup_car(s, cfg, &s->car[i], err, err_sz) != 0) goto fail;
+  return s;
+fail:
+  sim_destroy(s);
+  return NULL;
+}
+
+void sim_destroy(sim_t *s) {
+  if (!s) return;
+  for (int i = 0; s->car && i < s->ncars; i++) {
+    if (s->car[i].has_pty) ptylink_close(&s->car[i].pty);
+#ifdef SIM_HAVE_SENSORS
+    sim_rplidar_destroy(s->car[i].rplidar);
+    sim_lidar_destroy(s->car[i].lidar);
+#endif
+  }
+  if (s->d) mj_deleteData(s->d);
+  if (s->m) mj_deleteModel(s->m);
+  if (s->scene_dir[0]) { /* the generated scene and tag textures */
+    char path[700];
+    snprintf(path, sizeof path, "%s/scene.xml", s->scene_dir);
+    unlink(path);
+    for (int i = 1; i <= s->ncars; i++) {
+      snprintf(path, sizeof path, "%s/tag36h11_%d.png", s->scene_dir, mg_tag_id(i));
+      unlink(path);
+    }
+    rmdir(s->scene_dir);
+  }
+  free(s->geom_tyre);
+  free(s->car);
+  free(s);
+}
+
+/* ---- per step ------------------------------------------------------------------------- */
+static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
+  uint8_t buf[512];
+  if (c->has_pty) {
+    const size_t n = ptylink_read(&c->pty, buf, uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf);
+    uart_push(&c->rx, buf, n);
+  }
+  if (c->has_script) {
+    const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
+    uart_push(&c->rx, buf, n);
+  }
+  /* bytes that finished crossing the wire during this step reach the firmware now */
+  size_t n = uart_pop(&c->rx, SIM_STEP_US, buf, 255);
+  if (n > 0) nigel_rx(&c->nano, buf, (uint8_t)n, (uint32_t)s->time_us);
+  const double k = SIM_ENC_COUNTS_PER_REV / (2.0 * M_PI);
+  const int32_t enc_l = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RL]] * k);
+  const int32_t enc_r = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RR]] * k);
+  nigel_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);
+  n = uart_pop(&c->tx, SIM_STEP_US, buf, sizeof buf);
+  if (c->has_pty) ptylink_write(&c->pty, buf, n); /* a full pty drops bytes, like a UART */
+  (void)err;
+  (void)err_sz;
+  return 0;
+}
+
+static void sim_actuate(sim_t *s, sim_car_t *c) {
+  const vp_params_t *p = &s->p;
+  mjData *d = s->d;
+  mjModel *m = s->m;
+  const double dt = m->opt.timestep;
+  /* servo: pulse -> commanded angle -> rate-limited shaft -> Ackermann knuckle targets */
+  const double target = steer_command_rad(c->servo_us, p->servo_center_us, p->servo_us_per_full, p->steer_limit_rad);
+  c->steer_rad = steer_rate_limit(c->steer_rad, target, p->steer_rate_rad_s, dt);
+  double ang[2];
+  steer_ackermann(c->steer_rad, p->wheelbase_m, p->track_m, &ang[0], &ang[1]);
+  for (int w = 0; w < 2; w++) {
+    const double e = ang[w] - d->qpos[c->steer_qpos[w]];
+    d->qfrc_applied[c->steer_dof[w]] = p->steer_kp_nm_rad * e - p->steer_kv_nms_rad * d->qvel[c->steer_dof[w]];
+  }
+  /* rear gearmotors (one driver channel) and the brake's holding friction */
+  for (int w = W_RL; w <= W_RR; w++) {
+    const int dof = c->wheel_dof[w];
+    d->qfrc_applied[dof] = motor_torque_nm(&s->motor, c->duty, c->reverse, c->brake, p->battery_v, d->qvel[dof]);
+    m->dof_frictionloss[dof] = p->gearbox_friction_nm + (c->brake ? p->brake_hold_torque_nm : 0.0);
+  }
+}
+
+/* Paper tyre forces from the contacts recorded after the previous step, applied at each
+ * contact point through xfrc_applied of the wheel body. */
+static void sim_tyres(sim_t *s, sim_car_t *c) {
+  const vp_params_t *p = &s->p;
+  const mjModel *m = s->m;
+  mjData *d = s->d;
+  for (int w = 0; w < W_N; w++) {
+    const int b = c->wheel_body[w];
+    mjtNum *xf = d->xfrc_applied + 6 * b;
+    mju_zero(xf, 6);
+    if (c->fz_n[w] <= 0.0) continue;
+    const mjtNum *R = d->xmat + 9 * b;
+    const double axis[3] = {R[1], R[4], R[7]}; /* wheel y axis (spin axis) in the world */
+    double fwd[3], lat[3];
+    mju_cross(fwd, axis, c->normal[w]);
+    if (mju_normalize3(fwd) < 1e-9) continue;
+    mju_cross(lat, c->normal[w], fwd);
+    mjtNum vel[6];
+    mj_objectVelocity(m, d, mjOBJ_BODY, b, vel, 0); /* [angular, linear] world, at the CoM */
+    const double i_spin = m->body_inertia[3 * b + 1] + m->dof_armature[c->wheel_dof[w]];
+    const double r = p->wheel_radius_m;
+    tyre_in_t in;
+    in.v_x_m_s = mju_dot3(vel + 3, fwd);
+    in.v_y_m_s = mju_dot3(vel + 3, lat);
+    in.omega_r_m_s = d->qvel[c->wheel_dof[w]] * r;
+    in.fz_n = c->fz_n[w];
+    in.mu = c->mu[w];
+    in.v_min_m_s = p->tyre_v_min_m_s;
+    in.rolling_resistance = p->tyre_rolling_resistance;
+    /* half of the reduced mass of (wheel spin, quarter car): never reverses the slip */
+    in.m_long_kg = 0.5 / (r * r / i_spin + 4.0 / p->mass_kg);
+    in.m_lat_kg = 0.5 * p->mass_kg / 4.0;
+    in.dt_s = m->opt.timestep;
+    double fx, fy;
+    tyre_force(&s->lon, &s->lat, &in, &fx, &fy);
+    double f[3], arm[3], t[3];
+    for (int k = 0; k < 3; k++) f[k] = fx * fwd[k] + fy * lat[k];
+    mju_sub3(arm, c->contact_pos[w], d->xipos + 3 * b);
+    mju_cross(t, arm, f);
+    mju_copy3(xf, f);
+    mju_copy3(xf + 3, t);
+  }
+}
+
+/* After the step: normal load, surface friction and geometry of every tyre contact, and
+ * chassis collisions. */
+static void sim_record_contacts(sim_t *s) {
+  const mjModel *m = s->m;
+  const mjData *d = s->d;
+  for (int i = 0; i < s->ncars; i++) {
+    sim_car_t *c = &s->car[i];
+    c->in_collision = 0;
+    for (int w = 0; w < W_N; w++) c->fz_n[w] = 0.0;
+  }
+  double best[SIM_MAX_CARS * W_N] = {0};
+  for (int k = 0; k < d->ncon; k++) {
+    const mjContact *con = d->contact + k;
+    for (int side = 0; side < 2; side++) {
+      const int g = side ? con->geom2 : con->geom1, other = side ? con->geom1 : con->geom2;
+      const int t = s->geom_tyre[g];
+      if (t < 0) continue;
+      sim_car_t *c = &s->car[t / W_N];
+      const int w = t % W_N;
+      mjtNum f6[6];
+      mj_contactForce(m, d, k, f6);
+      const double fn = f6[0];
+      c->fz_n[w] += fn;
+      if (fn > best[t]) { /* the most loaded contact gives surface, point and normal */
+        best[t] = fn;
+        c->mu[w] = m->geom_friction[3 * other];
+        mju_copy3(c->contact_pos[w], con->pos);
+        /* frame[0..2] points from geom1 to geom2: make it point from the ground to the tyre */
+        for (int q = 0; q < 3; q++) c->normal[w][q] = side ? con->frame[q] : -con->frame[q];
+      }
+    }
+  }
+  for (int i = 0; i < s->ncars; i++) {
+    sim_car_t *c = &s->car[i];
+    for (int k = 0; k < d->ncon; k++)
+      if (d->contact[k].geom1 == c->chassis_geom || d->contact[k].geom2 == c->chassis_geom) c->in_collision = 1;
+  }
+}
+
+int sim_step(sim_t *s, char *err, size_t err_sz) {
+  mj_step1(s->m, s->d);
+  for (int i = 0; i < s->ncars; i++) {
+    sim_car_t *c = &s->car[i];
+    if (sim_nano_io(s, c, err, err_sz) != 0) return -1;
+    sim_actuate(s, c);
+    if (s->tyre_paper) sim_tyres(s, c);
+  }
+  mj_step2(s->m, s->d);
+  sim_record_contacts(s);
+  s->time_us += SIM_STEP_US;
+#ifdef SIM_HAVE_SENSORS
+  for (int i = 0; i < s->ncars; i++) {
+    sim_car_t *c = &s->car[i];
+    c->lidar_new = 0;
+    if (!c->lidar) continue;
+    /* mj_step2 leaves kinematics at the start of the step: fine for 1 ms ray timing */
+    if (sim_lidar_update(s->m, s->d, c->lidar, s->time_us)) {
+      c->lidar_new = 1;
+      const sim_lidar_scan_t *sc = sim_lidar_last_scan(c->lidar);
+      if (c->rplidar) sim_rplidar_push_scan(c->rplidar, sc->ranges_m, sc->intensities, sc->num_rays);
+    }
+    if (c->rplidar && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0) return -1;
+  }
+#endif
+  if (s->d->warning[mjWARN_BADQACC].number > 0) {
+    snprintf(err, err_sz, "physics diverged (bad qacc) at t = %.3f s", s->time_us * 1e-6);
+    return -1;
+  }
+  return 0;
+}
+
+/* ---- queries ------------------------------------------------------------------------- */
+int64_t sim_time_us(const sim_t *s) { return s->time_us; }
+int sim_cars(const sim_t *s) { return s->ncars; }
+const mjModel *sim_model(const sim_t *s) { return s->m; }
+mjData *sim_data(const sim_t *s) { return s->d; }
+const char *sim_nano_link(const sim_t *s, int car) { return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : ""; }
+const char *sim_lidar_link(const sim_t *s, int car) { return s->car[car - 1].lidar_link; }
+const nigel_t *sim_nano(const sim_t *s, int car) { return &s->car[car - 1].nano; }
+
+void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse, uint8_t *brake,
+                       uint16_t *servo_us) {
+  const sim_car_t *c = &s->car[car - 1];
+  *duty = c->duty;
+  *reverse = c->reverse;
+  *brake = c->brake;
+  *servo_us = c->servo_us;
+}
+
+const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car) {
+#ifdef SIM_HAVE_SENSORS
+  const sim_car_t *c = &s->car[car - 1];
+  return (c->lidar && c->lidar_new) ? sim_lidar_last_scan(c->lidar) : NULL;
+#else
+  (void)s;
+  (void)car;
+  return NULL;
+#endif
+}
+
+void sim_truth(const sim_t *s, int car, sim_truth_t *o) {
+  const sim_car_t *c = &s->car[car - 1];
+  const mjData *d = s->d;
+  const mjtNum *qp = d->qpos + c->root_qpos, *qv = d->qvel + c->root_dof;
+  memset(o, 0, sizeof *o);
+  mju_copy3(o->pos_m, qp);
+  mju_copy4(o->quat_wxyz, qp + 3);
+  o->yaw_rad = atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
+  /* free joint: linear velocity of the body origin in the world, angular in the body frame */
+  mjtNum R[9];
+  mju_quat2Mat(R, qp + 3);
+  mju_mulMatTVec(o->vel_body_m_s, R, qv, 3, 3);
+  mju_copy3(o->gyro_body_rad_s, qv + 3);
+  const double tl = tan(d->qpos[c->steer_qpos[0]]), tr = tan(d->qpos[c->steer_qpos[1]]);
+  o->steering_rad = (fabs(tl + tr) > 1e-12) ? atan(2.0 * tl * tr / (tl + tr)) : 0.0;
+  for (int w = 0; w < W_N; w++) o->wheel_speed_rad_s[w] = d->qvel[c->wheel_dof[w]];
+  o->in_collision = c->in_collision;
+}
+
+double sim_bare_mj_step_s(const sim_t *s, int steps) {
+  mjData *d = mj_makeData(s->m);
+  if (!d) return -1.0;
+  mju_copy(d->qpos, s->d->qpos, s->m->nq);
+  struct timespec a, b;
+  clock_gettime(CLOCK_MONOTONIC, &a);
+  for (int k = 0; k < steps; k++) mj_step(s->m, d);
+  clock_gettime(CLOCK_MONOTONIC, &b);
+  mj_deleteData(d);
+  return (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec);
+}

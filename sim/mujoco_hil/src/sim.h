@@ -1,0 +1,74 @@
+/* The simulator core: MuJoCo world of N Nigel cars, each with its emulated Nano (the real
+ * firmware core behind the sim HAL), its UART on a pty, and the drive, steering and tyre
+ * models. One call of sim_step advances everything by one 1 ms physics step of sim time.
+ * Not thread-safe; no LCM here (the program publishes, tests read state directly). */
+#ifndef SIM_SIM_H
+#define SIM_SIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <mujoco/mujoco.h>
+
+#include "nigel_core.h"
+
+#define SIM_STEP_US 1000 /* physics and Nano loop period [us] */
+#define SIM_MAX_CARS 32
+
+typedef struct sim_config {
+  const char *params_path; /* vehicle parameter file */
+  const char *map_path;    /* map MJCF */
+  const char *run_dir;     /* ptys' symlinks and the generated scene go here */
+  int cars;                /* 1..SIM_MAX_CARS */
+  uint64_t seed;           /* IMU biases and noise */
+  int open_ptys;           /* 1: Nano (and LIDAR) ptys with symlinks */
+  const char *script;      /* NULL, or the scripted driver spec for every car (script.h) */
+  int lidar;               /* 1: simulate the LIDAR (when the sensors library is built) */
+  int tyre_model;          /* -1: as the parameter file says, 0: MuJoCo friction, 1: paper */
+} sim_config_t;
+
+typedef struct sim sim_t;
+
+typedef struct sim_truth {
+  double pos_m[3];        /* base_link in the world */
+  double quat_wxyz[4];
+  double yaw_rad;
+  double vel_body_m_s[3]; /* base_link origin velocity, body frame */
+  double gyro_body_rad_s[3];
+  double steering_rad;    /* centre angle from the two knuckles (Ackermann inverse) */
+  double wheel_speed_rad_s[4]; /* fl fr rl rr, + forward */
+  int in_collision;       /* chassis touches anything */
+} sim_truth_t;
+
+/* Builds the world. Returns NULL with a message naming the bad input in err. */
+sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz);
+/* Closes ptys, removes symlinks and the generated scene. NULL is fine. */
+void sim_destroy(sim_t *s);
+
+/* One 1 ms step. Returns 0, or -1 on a fatal error (message in err). */
+int sim_step(sim_t *s, char *err, size_t err_sz);
+
+int64_t sim_time_us(const sim_t *s);
+int sim_cars(const sim_t *s);
+const mjModel *sim_model(const sim_t *s);
+mjData *sim_data(const sim_t *s);
+void sim_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
+/* The Nano's symlink path (empty without ptys). */
+const char *sim_nano_link(const sim_t *s, int car);
+const char *sim_lidar_link(const sim_t *s, int car);
+/* The emulated Nano's firmware state (read-only use, for tests). */
+const nigel_t *sim_nano(const sim_t *s, int car);
+/* Last motor outputs the firmware set through the HAL. */
+void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse, uint8_t *brake,
+                       uint16_t *servo_us);
+/* A completed LIDAR scan this step (NULL otherwise); see sim_lidar.h for the fields. */
+struct sim_lidar_scan;
+const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car);
+/* 1 when built with the sensors library. */
+int sim_has_sensors(void);
+
+/* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s];
+ * used by the benchmark to measure our overhead over MuJoCo alone. */
+double sim_bare_mj_step_s(const sim_t *s, int steps);
+
+#endif
