@@ -1,0 +1,300 @@
+#include "sil_board.h"
+
+#include <cstdlib>
+#include <stdexcept>
+
+extern "C" {
+#include <simavr/avr_adc.h>
+#include <simavr/avr_ioport.h>
+#include <simavr/avr_uart.h>
+#include <simavr/sim_avr.h>
+#include <simavr/sim_elf.h>
+#include <simavr/sim_io.h>
+#include "nigel_hal.h"
+}
+
+namespace sil {
+
+namespace {
+// ATmega328P data-space addresses of the registers the harness reads.
+constexpr uint16_t kTccr0a = 0x44, kOcr0a = 0x47, kOcr1aL = 0x88, kOcr1aH = 0x89;
+constexpr uint16_t kPortb = 0x25, kPortc = 0x28, kPortd = 0x2B;
+constexpr uint8_t kCom0a1 = 0x80;
+// Vector addresses [bytes] of INT0 and INT1 (2-word vectors).
+constexpr uint32_t kVecInt0 = 0x0004, kVecInt1 = 0x0008;
+// Quadrature phases (A, B) in forward order; A changes on 0->1 and 2->3.
+constexpr uint8_t kPhaseA[4] = {0, 1, 1, 0};
+constexpr uint8_t kPhaseB[4] = {0, 0, 1, 1};
+
+void quiet_uart(avr_t *avr) {
+  uint32_t flags = 0;
+  avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
+  flags &= ~static_cast<uint32_t>(AVR_UART_FLAG_STDIO);
+  avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+}
+
+void on_frame(const proto_frame_t *f, void *ctx) {
+  auto *b = static_cast<std::pair<Board *, std::vector<Frame> *> *>(ctx);
+  b->second->push_back(Frame{b->first->cycle(), *f});
+}
+} // namespace
+
+Board::Board(const std::string &elf_path, bool imu_present) {
+  elf_firmware_t fw{};
+  if (elf_read_firmware(elf_path.c_str(), &fw) != 0) {
+    throw std::runtime_error("cannot load firmware ELF '" + elf_path + "'");
+  }
+  avr_ = avr_make_mcu_by_name("atmega328p");
+  if (avr_ == nullptr) throw std::runtime_error("simavr has no atmega328p core");
+  avr_init(avr_);
+  avr_->log = LOG_NONE;
+  fw.frequency = kCpuHz;
+  avr_->frequency = kCpuHz;
+  avr_->vcc = avr_->avcc = avr_->aref = 5000; // [mV]
+  avr_load_firmware(avr_, &fw);
+  avr_->log = LOG_NONE;
+  for (uint32_t i = 0; i < fw.symbolcount; i++) {
+    symbols_.emplace_back(fw.symbol[i]->symbol, fw.symbol[i]->addr);
+    free(fw.symbol[i]);
+  }
+  free(fw.symbol);
+  free(fw.flash); // copied into the core by avr_load_firmware
+  free(fw.eeprom);
+  loop_addr_ = symbol("fw_loop_once");
+  quiet_uart(avr_);
+  uart_in_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+  avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
+                          &Board::uart_out_hook, this);
+  for (int s = 0; s < 2; s++) {
+    drive_pin(2 + s, 0);
+    drive_pin(4 + s, 0);
+  }
+  imu_ = std::make_unique<Mpu9250>(avr_, imu_present);
+  set_adc7_mv(2850); // ~12.1 V pack through the 10k:3.3k divider
+  proto_parser_init(&parser_);
+}
+
+Board::~Board() {
+  if (avr_ != nullptr) {
+    avr_terminate(avr_);
+    free(avr_); // avr_make_mcu_by_name() malloc()s the core
+  }
+}
+
+uint64_t Board::cycle() const { return avr_->cycle; }
+
+uint32_t Board::symbol(const std::string &name) const {
+  for (const auto &s : symbols_) {
+    if (s.first == name) return s.second >= 0x800000 ? s.second - 0x800000 : s.second;
+  }
+  return 0;
+}
+
+void Board::write_ram(uint32_t addr, uint8_t v) { avr_->data[addr] = v; }
+
+void Board::set_adc7_mv(uint32_t mv) {
+  avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC7), mv);
+}
+
+void Board::uart_out_hook(avr_irq_t *, uint32_t value, void *param) {
+  static_cast<Board *>(param)->on_uart_byte(static_cast<uint8_t>(value));
+}
+
+void Board::on_uart_byte(uint8_t b) {
+  uart_bytes_out_++;
+  std::pair<Board *, std::vector<Frame> *> ctx{this, &frames_};
+  proto_parser_feed(&parser_, &b, 1, on_frame, &ctx);
+}
+
+void Board::send(const uint8_t *data, size_t n) { tx_queue_.insert(tx_queue_.end(), data, data + n); }
+
+void Board::send_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
+  static uint8_t seq = 0;
+  uint8_t buf[PROTO_MAX_FRAME];
+  size_t n = proto_frame_encode(id, seq++, payload, len, buf, sizeof buf);
+  if (n == 0) throw std::runtime_error("send_frame: payload too long");
+  send(buf, n);
+}
+
+void Board::send_command(const proto_command_t &c) {
+  uint8_t p[PROTO_LEN_COMMAND];
+  proto_command_pack(&c, p);
+  send_frame(PROTO_ID_COMMAND, p, PROTO_LEN_COMMAND);
+}
+
+std::vector<proto_state_t> Board::states() const {
+  std::vector<proto_state_t> out;
+  for (const auto &fr : frames_) {
+    proto_state_t s;
+    if (fr.f.id == PROTO_ID_STATE && proto_state_unpack(fr.f.payload, fr.f.len, &s) == 0) {
+      out.push_back(s);
+    }
+  }
+  return out;
+}
+
+bool Board::last_state(proto_state_t *out) const {
+  for (auto it = frames_.rbegin(); it != frames_.rend(); ++it) {
+    if (it->f.id == PROTO_ID_STATE) return proto_state_unpack(it->f.payload, it->f.len, out) == 0;
+  }
+  return false;
+}
+
+size_t Board::count(uint8_t id) const {
+  size_t n = 0;
+  for (const auto &fr : frames_) n += fr.f.id == id;
+  return n;
+}
+
+void Board::drive_pin(int bit, uint8_t level) {
+  // Declared as the pin's external level too: simavr re-asserts an input's internal pull-up on
+  // every PORTD write unless an external level is set, which would fake encoder edges.
+  const uint8_t m = static_cast<uint8_t>(1u << bit);
+  ext_level_d_ = static_cast<uint8_t>(level ? (ext_level_d_ | m) : (ext_level_d_ & ~m));
+  avr_ioport_external_t ext{};
+  ext.name = 'D';
+  ext.mask = 0x3C; // D2..D5
+  ext.value = ext_level_d_;
+  avr_ioctl(avr_, AVR_IOCTL_IOPORT_SET_EXTERNAL('D'), &ext);
+  avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ('D'), bit), level);
+}
+
+void Board::encoder_edge(int side, int dir) {
+  // advance the quadrature until channel A has changed once
+  for (;;) {
+    uint8_t p = enc_phase_[side];
+    uint8_t next = static_cast<uint8_t>((p + (dir > 0 ? 1 : 3)) & 3);
+    enc_phase_[side] = next;
+    bool a_changed = kPhaseA[p] != kPhaseA[next];
+    if (a_changed) {
+      drive_pin(2 + side, kPhaseA[next]);
+      return;
+    }
+    drive_pin(4 + side, kPhaseB[next]);
+  }
+}
+
+void Board::encoder_rate(double edges_per_s, int dir) {
+  enc_rate_ = edges_per_s;
+  enc_dir_ = dir;
+  // two quadrature steps (one A, one B change) per count, evenly spaced
+  enc_phase_cycles_ = edges_per_s > 0 ? kCpuHz / (2.0 * edges_per_s) : 0;
+  enc_next_cycle_ = cycle();
+}
+
+uint16_t Board::servo_pulse_us() const {
+  return static_cast<uint16_t>((avr_->data[kOcr1aL] | avr_->data[kOcr1aH] << 8) / 2);
+}
+uint8_t Board::motor_duty() const {
+  return (avr_->data[kTccr0a] & kCom0a1) ? avr_->data[kOcr0a] : 0;
+}
+bool Board::motor_reverse() const { return avr_->data[kPortd] & 0x80; }
+bool Board::motor_brake() const { return avr_->data[kPortb] & 0x01; }
+
+uint8_t Board::lamp_pins() const {
+  const uint8_t b = avr_->data[kPortb], c = avr_->data[kPortc];
+  uint8_t l = 0;
+  if (b & 0x04) l |= NIGEL_LAMP_HEAD_LOW;
+  if (b & 0x08) l |= NIGEL_LAMP_HEAD_HIGH;
+  if (b & 0x10) l |= NIGEL_LAMP_TAIL;
+  if (b & 0x20) l |= NIGEL_LAMP_REVERSE;
+  if (c & 0x01) l |= NIGEL_LAMP_IND_LEFT;
+  if (c & 0x02) l |= NIGEL_LAMP_IND_RIGHT;
+  return l;
+}
+
+void Board::reset_cycle_stats() {
+  loop_max_ = 0;
+  loop_last_cycle_ = 0;
+  isr_max_[0] = isr_max_[1] = 0;
+}
+
+void Board::sample_pwm() {
+  PwmChange now{cycle(), static_cast<uint16_t>(avr_->data[kOcr1aL] | avr_->data[kOcr1aH] << 8),
+                motor_duty(), motor_reverse(), motor_brake()};
+  if (pwm_changes_.empty()) {
+    pwm_changes_.push_back(now);
+    return;
+  }
+  const PwmChange &last = pwm_changes_.back();
+  if (last.servo_ticks != now.servo_ticks || last.motor_duty != now.motor_duty ||
+      last.motor_reverse != now.motor_reverse || last.motor_brake != now.motor_brake) {
+    pwm_changes_.push_back(now);
+  }
+}
+
+void Board::step_io() {
+  const uint64_t c = cycle();
+  if (!tx_queue_.empty() && c >= next_tx_cycle_) {
+    avr_raise_irq(uart_in_, tx_queue_.front());
+    tx_queue_.pop_front();
+    next_tx_cycle_ = c + kUartByteCycles;
+    if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles; // stop bit done
+  }
+  if (enc_rate_ > 0 && c >= enc_next_cycle_) {
+    for (int s = 0; s < 2; s++) {
+      uint8_t p = enc_phase_[s];
+      uint8_t next = static_cast<uint8_t>((p + (enc_dir_ > 0 ? 1 : 3)) & 3);
+      enc_phase_[s] = next;
+      if (kPhaseA[p] != kPhaseA[next]) {
+        drive_pin(2 + s, kPhaseA[next]);
+      } else {
+        drive_pin(4 + s, kPhaseB[next]);
+      }
+    }
+    enc_next_cycle_ = static_cast<uint64_t>(static_cast<double>(enc_next_cycle_) + enc_phase_cycles_);
+  }
+}
+
+bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
+  const uint64_t end = cycle() + us * kCyclesPerUs;
+  uint32_t n = 0;
+  while (cycle() < end) {
+    step_io();
+    const uint32_t pc_before = avr_->pc;
+    const int state = avr_run(avr_);
+    if (state == cpu_Done || state == cpu_Crashed) return false;
+    const uint32_t pc = avr_->pc;
+    if (pc != pc_before) {
+      if (pc == 0) {
+        resets_++;
+        quiet_uart(avr_);
+        isr_active_ = -1;
+        loop_last_cycle_ = 0;
+      } else if (pc == kVecInt0 || pc == kVecInt1) {
+        isr_active_ = pc == kVecInt0 ? 0 : 1;
+        // the 4-cycle interrupt response (datasheet) counts as part of the ISR
+        isr_start_ = avr_->cycle - 4;
+      } else if (pc == loop_addr_) {
+        if (loop_last_cycle_ != 0) {
+          const uint64_t d = avr_->cycle - loop_last_cycle_;
+          if (d > loop_max_) loop_max_ = static_cast<uint32_t>(d);
+        }
+        loop_last_cycle_ = avr_->cycle;
+        loop_passes_++;
+      }
+    }
+    if (isr_active_ >= 0 && avr_->sreg[S_I]) { // RETI re-enabled interrupts
+      const uint64_t d = avr_->cycle - isr_start_;
+      if (d > isr_max_[isr_active_]) isr_max_[isr_active_] = static_cast<uint32_t>(d);
+      isr_active_ = -1;
+    }
+    sample_pwm();
+    if (pred && (++n & 63u) == 0 && pred()) return true;
+  }
+  return true;
+}
+
+proto_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
+                             bool engaged, uint8_t headlights, uint8_t indicators) {
+  proto_command_t c{};
+  c.seq = seq;
+  c.throttle_milli = throttle_milli;
+  c.steering_milli = steering_milli;
+  c.headlights = headlights;
+  c.indicators = indicators;
+  c.flags = engaged ? PROTO_CMD_ENGAGED : 0;
+  return c;
+}
+
+} // namespace sil
