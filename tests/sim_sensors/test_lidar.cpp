@@ -32,10 +32,11 @@ double analytic_range_m(double angle_rad) {
     const double disc = b * b - cc;
     if (disc >= 0) take(-b - std::sqrt(disc));
   }
-  // other car's mast: square half 0.04 centred (-1, 1.5), yaw 30 deg (slab method)
+  // other car's mast: square half 0.04 at (-0.06, 0) in the car at (-1, 1.5) with yaw 30 deg
   {
     const double yaw = 30.0 * M_PI / 180.0, cy = std::cos(yaw), sy = std::sin(yaw);
-    const double rx = kOx_m + 1.0, ry = kOy_m - 1.5;
+    const double mx = -1.0 - 0.06 * cy, my = 1.5 - 0.06 * sy;
+    const double rx = kOx_m - mx, ry = kOy_m - my;
     const double lo[2] = {rx * cy + ry * sy, -rx * sy + ry * cy};  // origin in box frame
     const double ld[2] = {c * cy + s * sy, -c * sy + s * cy};
     double tmin = -INFINITY, tmax = INFINITY;
@@ -103,13 +104,14 @@ TEST(SimLidar, OwnCarExcludedOtherCarSeen) {
   EXPECT_NEAR(fwd, 1.5 - 0.2 - kOx_m, 1e-6);
   EXPECT_GT(fwd, 0.6);
   // the other car's mast is seen: ray aimed at its centre
-  const double a = std::atan2(1.5 - kOy_m, -1.0 - kOx_m);
+  const double a = std::atan2(1.5 - 0.06 * std::sin(M_PI / 6) - kOy_m,
+                              -1.0 - 0.06 * std::cos(M_PI / 6) - kOx_m);
   const double want = analytic_range_m(a);
   EXPECT_LT(want, 2.0);
   EXPECT_NEAR(sim_lidar_ray(r.m, r.d, l, a), want, 1e-4);
   // a lidar mounted on "other" does not see its own mast but sees "car"'s bumper
   sim_lidar_config_t c2 = cfg;
-  c2.mount_pos_m[0] = 0.0;  // scanner inside its own mast
+  c2.mount_pos_m[0] = -0.06;  // scanner inside its own mast
   char err[256];
   sim_lidar_t *lo = sim_lidar_create(r.m, "other", &c2, err, sizeof err);
   ASSERT_NE(lo, nullptr) << err;

@@ -2,8 +2,8 @@
  * and publish on LCM as autodrive_compressed_image_t, with its autodrive_camera_info_t.
  *
  * MuJoCo 2.2 cameras take a vertical field of view only (fovy). Nigel's 62.2 deg horizontal
- * FOV at 4:3 is fovy = 2 atan(tan(31.1 deg) * 3/4) = 48.8 deg: put fovy="48.8" on the MJCF
- * <camera>. The intrinsics are derived from the model's fovy: fy = fx = (h/2) / tan(fovy/2),
+ * FOV at 4:3 is fovy = 2 atan(tan(31.1 deg) * 3/4) = 48.67 deg: put fovy="48.67" on the MJCF
+ * <camera> (the often quoted 48.8 gives 62.33 deg). The intrinsics are derived from the model's fovy: fy = fx = (h/2) / tan(fovy/2),
  * cx = (w-1)/2, cy = (h-1)/2 (OpenCV pixel-centre convention), no distortion.
  */
 #ifndef SIM_CAMERA_H
@@ -23,7 +23,7 @@ extern "C" {
 
 /* Nigel's cameras: 62.2 deg HFOV, 4:3, 640x480 by default. */
 #define SIM_CAMERA_HFOV_DEG 62.2
-#define SIM_CAMERA_FOVY_4_3_DEG 48.8
+#define SIM_CAMERA_FOVY_4_3_DEG 48.67
 #define SIM_CAMERA_DEFAULT_WIDTH_PX 640
 #define SIM_CAMERA_DEFAULT_HEIGHT_PX 480
 

@@ -29,8 +29,9 @@ extern "C" {
 #define SIM_TAGS_OFFSET_Y_M 0.0
 #define SIM_TAGS_OFFSET_Z_M 0.129165  /* top face height above base_link [m] */
 #define SIM_TAGS_PLATE_THICKNESS_M 0.002
-/* yaw of the plate geom in its body that gives the orientation above [deg, as MJCF text] */
-#define SIM_TAGS_EULER_Z_DEG "0"
+/* MuJoCo maps a 2D texture onto a box's top face with the image's up along the box's +y;
+ * the plate is yawed -90 deg in its body (quat below) so the tag's up is the car's +x. */
+#define SIM_TAGS_PLATE_QUAT "0.70710678 0 0 -0.70710678"
 
 /* Number of ids in tag36h11 (587). */
 int sim_tags_count(void);

@@ -36,11 +36,12 @@ static int egl_init(sim_render_t *r) {
   if (r->egl_dpy == EGL_NO_DISPLAY) return -1;
   EGLint major, minor;
   if (!eglInitialize(r->egl_dpy, &major, &minor)) return -1;
-  const EGLint attr[] = {EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_DEPTH_SIZE,
-                         24, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-  EGLConfig cfg;
+  /* Mesa's surfaceless platform offers no configs; MuJoCo draws into its own FBO, so a
+   * config-less context (EGL_KHR_no_config_context) is all it needs */
+  const EGLint attr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+  EGLConfig cfg = (EGLConfig)0; /* EGL_NO_CONFIG_KHR */
   EGLint ncfg = 0;
-  if (!eglChooseConfig(r->egl_dpy, attr, &cfg, 1, &ncfg) || ncfg < 1) goto fail;
+  if (!eglChooseConfig(r->egl_dpy, attr, &cfg, 1, &ncfg) || ncfg < 1) cfg = (EGLConfig)0;
   if (!eglBindAPI(EGL_OPENGL_API)) goto fail;
   r->egl_ctx = eglCreateContext(r->egl_dpy, cfg, EGL_NO_CONTEXT, NULL);
   if (r->egl_ctx == EGL_NO_CONTEXT) goto fail;
@@ -132,7 +133,9 @@ void sim_render_destroy(sim_render_t *r) {
   if (r->egl_dpy != EGL_NO_DISPLAY) {
     eglMakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (r->egl_ctx != EGL_NO_CONTEXT) eglDestroyContext(r->egl_dpy, r->egl_ctx);
-    eglTerminate(r->egl_dpy);
+    /* no eglTerminate: the surfaceless display is process-wide (EGL returns the same handle
+     * to every renderer), and terminating it unloads Mesa's driver, whose small internal
+     * allocations then show up as leaks under LeakSanitizer */
   }
   if (r->osm_ctx) OSMesaDestroyContext(r->osm_ctx);
   free(r->osm_buf);

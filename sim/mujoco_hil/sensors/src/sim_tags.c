@@ -75,13 +75,14 @@ int sim_tags_mjcf(const char *prefix, const char *png_path, double tag_size_m, c
                    "specular=\"0\" shininess=\"0\" reflectance=\"0\"/>\n",
                    prefix, png_path, prefix, prefix);
   if (n < 0 || (size_t)n >= asset_len) return -1;
-  /* euler: see the orientation convention in sim_tags.h (checked by the overhead test) */
+  /* quat (not euler: it does not depend on the model's angle unit): see sim_tags.h; the
+   * overhead test checks the resulting heading */
   n = snprintf(geom_out, geom_len,
                "<geom name=\"%stag\" type=\"box\" size=\"%.6f %.6f %.6f\" pos=\"%.6f %.6f %.6f\" "
-               "euler=\"0 0 %s\" material=\"%stag_mat\" contype=\"0\" conaffinity=\"0\" "
+               "quat=\"%s\" material=\"%stag_mat\" contype=\"0\" conaffinity=\"0\" "
                "group=\"1\" mass=\"0\"/>\n",
                prefix, half_m, half_m, 0.5 * t_m, SIM_TAGS_OFFSET_X_M, SIM_TAGS_OFFSET_Y_M,
-               SIM_TAGS_OFFSET_Z_M - 0.5 * t_m, SIM_TAGS_EULER_Z_DEG, prefix);
+               SIM_TAGS_OFFSET_Z_M - 0.5 * t_m, SIM_TAGS_PLATE_QUAT, prefix);
   if (n < 0 || (size_t)n >= geom_len) return -1;
   return 0;
 }

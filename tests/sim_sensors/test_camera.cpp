@@ -1,0 +1,211 @@
+// Headless cameras: a real render of the test room (EGL or OSMesa), JPEG round trip, camera
+// intrinsics, and the overhead frame's roof tags decoded by libapriltag at the true ids.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <jpeglib.h>
+
+#include "room.hpp"
+
+extern "C" {
+#include <apriltag/apriltag.h>
+#include <apriltag/tag36h11.h>
+
+#include "sim_camera.h"
+#include "sim_jpeg.h"
+#include "sim_render.h"
+}
+
+namespace {
+
+struct Px {
+  int r, g, b;
+};
+Px px(const uint8_t *rgb, int w, int x, int y) {
+  const uint8_t *p = rgb + 3 * ((size_t)y * w + x);
+  return {p[0], p[1], p[2]};
+}
+
+// Writes an RGB frame as PPM next to the test binary when SIM_SENSORS_DUMP is set (debugging).
+void maybe_dump(const char *name, const uint8_t *rgb, int w, int h) {
+  if (!std::getenv("SIM_SENSORS_DUMP")) return;
+  FILE *f = std::fopen(name, "wb");
+  if (!f) return;
+  std::fprintf(f, "P6 %d %d 255\n", w, h);
+  std::fwrite(rgb, 3, (size_t)w * h, f);
+  std::fclose(f);
+}
+
+struct Scene {
+  room::Room room;
+  sim_render_t *r = nullptr;
+  Scene() {
+    if (!room.m) return;
+    char err[256] = "";
+    r = sim_render_create(room.m, 1280, 960, SIM_RENDER_AUTO, err, sizeof err);
+    EXPECT_NE(r, nullptr) << err;
+  }
+  ~Scene() { sim_render_destroy(r); }
+};
+
+}  // namespace
+
+TEST(SimCamera, FrontFrameShowsTheRoomTopDown) {
+  Scene s;
+  ASSERT_NE(s.r, nullptr);
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
+                                      90, err, sizeof err);
+  ASSERT_NE(c, nullptr) << err;
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  const uint8_t *rgb = sim_camera_rgb(c);
+  maybe_dump("front.ppm", rgb, 640, 480);
+  // not blank: many distinct grey levels
+  std::vector<int> seen(256, 0);
+  for (size_t i = 0; i < 640u * 480 * 3; i += 3) seen[(rgb[i] + rgb[i + 1] + rgb[i + 2]) / 3] = 1;
+  int levels = 0;
+  for (int v : seen) levels += v;
+  EXPECT_GT(levels, 20);
+  // the blue pillar is straight ahead, the green floor at the bottom (rows are top-down), the
+  // red front wall to the left of the pillar
+  Px centre = px(rgb, 640, 320, 240), bottom = px(rgb, 640, 320, 470), left = px(rgb, 640, 100, 240);
+  EXPECT_GT(centre.b, centre.r + 40) << centre.r << "," << centre.g << "," << centre.b;
+  EXPECT_GT(centre.b, centre.g + 40);
+  EXPECT_GT(bottom.g, bottom.r + 40) << bottom.r << "," << bottom.g << "," << bottom.b;
+  EXPECT_GT(bottom.g, bottom.b + 40);
+  EXPECT_GT(left.r, left.g + 40) << left.r << "," << left.g << "," << left.b;
+  EXPECT_GT(left.r, left.b + 40);
+  sim_camera_destroy(c);
+}
+
+TEST(SimCamera, JpegDecodesBackToTheFrame) {
+  Scene s;
+  ASSERT_NE(s.r, nullptr);
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
+                                      90, err, sizeof err);
+  ASSERT_NE(c, nullptr) << err;
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  size_t n = 0;
+  const uint8_t *jpg = sim_camera_jpeg(c, &n);
+  ASSERT_GT(n, 1000u);
+  ASSERT_EQ(jpg[0], 0xFF);
+  ASSERT_EQ(jpg[1], 0xD8);
+  jpeg_decompress_struct d;
+  jpeg_error_mgr e;
+  d.err = jpeg_std_error(&e);
+  jpeg_create_decompress(&d);
+  jpeg_mem_src(&d, jpg, (unsigned long)n);
+  ASSERT_EQ(jpeg_read_header(&d, TRUE), JPEG_HEADER_OK);
+  jpeg_start_decompress(&d);
+  ASSERT_EQ(d.output_width, 640u);
+  ASSERT_EQ(d.output_height, 480u);
+  ASSERT_EQ(d.output_components, 3);
+  std::vector<uint8_t> out(640 * 480 * 3);
+  while (d.output_scanline < d.output_height) {
+    JSAMPROW row = out.data() + (size_t)d.output_scanline * 640 * 3;
+    jpeg_read_scanlines(&d, &row, 1);
+  }
+  jpeg_finish_decompress(&d);
+  jpeg_destroy_decompress(&d);
+  double err_sum = 0;
+  for (size_t i = 0; i < out.size(); i++) err_sum += std::abs(out[i] - sim_camera_rgb(c)[i]);
+  EXPECT_LT(err_sum / out.size(), 4.0);  // quality 90: a few levels of mean error
+  sim_camera_destroy(c);
+}
+
+TEST(SimCamera, IntrinsicsFromFovy) {
+  Scene s;
+  ASSERT_NE(s.room.m, nullptr);
+  int id = mj_name2id(s.room.m, mjOBJ_CAMERA, "car_cam_front");
+  double k[9];
+  sim_camera_intrinsics(s.room.m, id, 640, 480, k);
+  // fovy 48.8 deg at 4:3 is Nigel's 62.2 deg horizontal field of view
+  const double hfov_deg = 2 * std::atan(320.0 / k[0]) * 180 / M_PI;
+  EXPECT_NEAR(hfov_deg, SIM_CAMERA_HFOV_DEG, 0.1);
+  EXPECT_DOUBLE_EQ(k[0], k[4]);
+  EXPECT_DOUBLE_EQ(k[2], 319.5);
+  EXPECT_DOUBLE_EQ(k[5], 239.5);
+  EXPECT_EQ(k[8], 1.0);
+}
+
+TEST(SimCamera, BadCameraOrSizeIsAClearError) {
+  Scene s;
+  ASSERT_NE(s.r, nullptr);
+  char err[256] = "";
+  EXPECT_EQ(sim_camera_create(s.r, s.room.m, "nope", "x", 640, 480, 90, err, sizeof err), nullptr);
+  EXPECT_NE(std::string(err).find("nope"), std::string::npos) << err;
+  EXPECT_EQ(sim_camera_create(s.r, s.room.m, "eye", "x", 4000, 480, 90, err, sizeof err), nullptr);
+  EXPECT_NE(std::string(err).find("4000"), std::string::npos) << err;
+}
+
+TEST(SimCamera, OverheadRoofTagsDecodeAtTrueIdsAndHeadings) {
+  Scene s;
+  ASSERT_NE(s.r, nullptr);
+  const int w = 1280, h = 960;
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "eye", "eye", w, h, 90, err, sizeof err);
+  ASSERT_NE(c, nullptr) << err;
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 0), 0);
+  const uint8_t *rgb = sim_camera_rgb(c);
+  maybe_dump("eye.ppm", rgb, w, h);
+  std::vector<uint8_t> grey((size_t)w * h);
+  for (size_t i = 0; i < grey.size(); i++)
+    grey[i] = (uint8_t)((rgb[3 * i] * 77 + rgb[3 * i + 1] * 150 + rgb[3 * i + 2] * 29) >> 8);
+  image_u8_t im = {w, h, w, grey.data()};
+  apriltag_family_t *fam = tag36h11_create();
+  apriltag_detector_t *det = apriltag_detector_create();
+  apriltag_detector_add_family(det, fam);
+  det->quad_decimate = 1.0f;
+  det->nthreads = 1;
+  zarray_t *dets = apriltag_detector_detect(det, &im);
+  // truth: each car's tag centre projected into the eye camera, and the car's yaw
+  const int eye = mj_name2id(s.room.m, mjOBJ_CAMERA, "eye");
+  double k[9];
+  sim_camera_intrinsics(s.room.m, eye, w, h, k);
+  const mjtNum *cp = s.room.d->cam_xpos + 3 * eye;
+  struct Truth {
+    int id;
+    const char *body;
+    double yaw_deg;
+    bool found;
+  } truth[2] = {{room::kTagCar, "car", 0.0, false}, {room::kTagOther, "other", 30.0, false}};
+  for (int i = 0; i < zarray_size(dets); i++) {
+    apriltag_detection_t *dd;
+    zarray_get(dets, i, &dd);
+    for (Truth &t : truth) {
+      if (dd->id != t.id) continue;
+      t.found = true;
+      const int b = mj_name2id(s.room.m, mjOBJ_BODY, t.body);
+      const mjtNum *bp = s.room.d->xpos + 3 * b;
+      const double yaw = t.yaw_deg * M_PI / 180;
+      const double wx = bp[0] + SIM_TAGS_OFFSET_X_M * std::cos(yaw);
+      const double wy = bp[1] + SIM_TAGS_OFFSET_X_M * std::sin(yaw);
+      const double depth = cp[2] - (bp[2] + SIM_TAGS_OFFSET_Z_M);
+      // camera looks down with image right = world +x, image up = world +y
+      const double u = k[2] + k[0] * (wx - cp[0]) / depth;
+      const double v = k[5] - k[4] * (wy - cp[1]) / depth;
+      // libapriltag's pixel centres are 0.5 px off OpenCV's (ARCHITECTURE.md)
+      EXPECT_NEAR(dd->c[0] - 0.5, u, 1.0) << "tag " << t.id;
+      EXPECT_NEAR(dd->c[1] - 0.5, v, 1.0) << "tag " << t.id;
+      // heading: from the bottom edge's middle (p0, p1) to the top edge's middle (p3, p2)
+      const double dx = (dd->p[3][0] + dd->p[2][0] - dd->p[0][0] - dd->p[1][0]) / 2;
+      const double dy = (dd->p[3][1] + dd->p[2][1] - dd->p[0][1] - dd->p[1][1]) / 2;
+      const double heading_deg = std::atan2(-dy, dx) * 180 / M_PI;  // image y is down
+      EXPECT_NEAR(std::remainder(heading_deg - t.yaw_deg, 360.0), 0.0, 2.0) << "tag " << t.id;
+      // apparent size: black square of SIM_TAGS_SIZE_M
+      const double side_px = std::hypot(dd->p[1][0] - dd->p[0][0], dd->p[1][1] - dd->p[0][1]);
+      EXPECT_NEAR(side_px, k[0] * SIM_TAGS_SIZE_M / depth, 1.5) << "tag " << t.id;
+    }
+  }
+  for (const Truth &t : truth) EXPECT_TRUE(t.found) << "tag " << t.id << " not detected";
+  EXPECT_EQ(zarray_size(dets), 2);
+  apriltag_detections_destroy(dets);
+  apriltag_detector_destroy(det);
+  tag36h11_destroy(fam);
+  sim_camera_destroy(c);
+}
