@@ -87,7 +87,12 @@ static void feed(const uint8_t *d, size_t n) {
   if (parser.stats.frames_ok != cb_count) abort();
 }
 
+static uint16_t servo_before;
+static int32_t steer_before_u;
 static void check_outputs(void) {
+  /* the servo only moves while engaged (trim changes aside, which CONFIG makes) */
+  if (core.fs.mode != PROTO_MODE_ENGAGED && world.servo_us != servo_before &&
+      core.act.steering_u != steer_before_u) abort();
   if (world.servo_us < 1000u || world.servo_us > 2000u) abort();
   if (world.duty > 0u && (core.fs.mode != PROTO_MODE_ENGAGED || world.brake)) abort();
   if (world.tx_check.stats.bad_crc != 0u || world.tx_check.stats.bad_length != 0u) abort();
@@ -146,6 +151,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       uint32_t dt = 1u;
       if (i < size) dt = (uint32_t)data[i++] * 97u + 1u;
       now_us += dt;
+      servo_before = world.servo_us;
+      steer_before_u = core.act.steering_u;
       nigel_step(&core, now_us, (int32_t)(now_us >> 7), -(int32_t)(now_us >> 8));
       check_outputs();
     }

@@ -331,10 +331,28 @@ TEST_F(Core, BadLengthAndUnknownIdNacked) {
   EXPECT_EQ(n.fs.fresh, 0) << "a bad frame must not count as a command";
 }
 
+TEST_F(Core, ServoHoldsWhileNotEngaged) {
+  Stream(300, 0, 1000, false);  // disarmed: steering commands do not move the servo
+  EXPECT_EQ(fake.servo_us, 1500);
+  Arm();
+  Stream(300, 0, 1000, true);
+  const uint16_t turned = fake.servo_us;
+  EXPECT_GT(turned, 1700);
+  Run(100);  // failsafe: from here the servo holds, no sudden move
+  ASSERT_EQ(n.fs.mode, PROTO_MODE_FAILSAFE);
+  const uint16_t held = fake.servo_us;
+  Run(200);
+  EXPECT_EQ(fake.servo_us, held);
+  Stream(300, 0, -1000, false);
+  EXPECT_EQ(fake.servo_us, held);
+}
+
 TEST_F(Core, SteeringRateLimitTrimAndSaturation) {
   Arm();
   Command(0, 1000, true);
-  Run(100);
+  Run(50);
+  Command(0, 1000, true);
+  Run(50);
   // 0.805 rad/s over 0.5236 rad: 100 ms -> 0.1537 -> 1500 + 76.9 us
   EXPECT_NEAR(fake.servo_us, 1577, 1);
   proto_state_t s = LastState();

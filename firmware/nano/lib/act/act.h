@@ -37,7 +37,8 @@ typedef struct act {
 void act_init(act_t *a, uint32_t now_us);
 /* Moves the applied values toward the targets [milli] at the rate limits and computes the
  * outputs. stop = 1 (disarmed, failsafe, battery cut-off): throttle goes to 0 at once (no
- * slew) and the brake is applied; steering keeps following its target at its rate limit. */
+ * slew) and the brake is applied; steering keeps following its target at its rate limit
+ * (the core passes the currently applied steering as target when not engaged). */
 void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_t stop,
                 uint32_t now_us);
 int16_t act_throttle_milli(const act_t *a);

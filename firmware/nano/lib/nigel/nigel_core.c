@@ -19,7 +19,7 @@ static void send_hello(nigel_t *n) {
   h.fw_minor = NIGEL_FW_MINOR;
   h.fw_patch = NIGEL_FW_PATCH;
   h.proto_version = PROTO_VERSION;
-  h.schema_hash = proto_schema_hash();
+  h.schema_hash = n->schema_hash;
   h.build_id = n->build_id;
   proto_hello_pack(&h, p);
   send_frame(n, PROTO_ID_HELLO, p, PROTO_LEN_HELLO);
@@ -135,6 +135,7 @@ void nigel_init(nigel_t *n, const nigel_hal_t *hal, uint32_t now_us, uint8_t res
   memset(n, 0, sizeof *n);
   n->hal = hal;
   n->build_id = build_id;
+  n->schema_hash = proto_schema_hash(); /* once: ~2 ms on the AVR (schema string in flash) */
   proto_parser_init(&n->parser);
   fs_init(&n->fs, FS_DEFAULT_TIMEOUT_MS);
   act_init(&n->act, now_us);
@@ -169,6 +170,7 @@ static uint8_t due(uint32_t *next_us, uint32_t period_us, uint32_t now_us) {
 void nigel_step(nigel_t *n, uint32_t now_us, int32_t enc_left_counts, int32_t enc_right_counts) {
   const nigel_hal_t *hal = n->hal;
   uint8_t stop, indicators;
+  int16_t steer_target;
 
   if ((uint32_t)(now_us - n->last_step_us) > NIGEL_LOOP_OVERRUN_US)
     n->faults_latched |= PROTO_FAULT_LOOP_OVERRUN;
@@ -195,7 +197,10 @@ void nigel_step(nigel_t *n, uint32_t now_us, int32_t enc_left_counts, int32_t en
   wspd_update(&n->wspd, enc_left_counts, enc_right_counts, now_us);
 
   stop = (uint8_t)(!fs_may_drive(&n->fs) || n->batt.cutoff);
-  act_update(&n->act, n->cmd.throttle_milli, n->cmd.steering_milli, stop, now_us);
+  /* Not engaged: the servo holds where it is (nothing moves unless the host engaged). A flat
+   * battery only refuses drive; steering still follows. */
+  steer_target = fs_may_drive(&n->fs) ? n->cmd.steering_milli : act_steering_milli(&n->act);
+  act_update(&n->act, n->cmd.throttle_milli, steer_target, stop, now_us);
   hal->motor_set(hal->ctx, n->act.duty, n->act.reverse, n->act.brake);
   hal->servo_set_us(hal->ctx, n->act.servo_us);
 

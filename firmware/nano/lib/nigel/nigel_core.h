@@ -53,6 +53,7 @@ typedef struct nigel {
   nigel_imu_raw_t imu;       /* last good IMU sample (zeros until one is read) */
   int32_t enc[2];            /* [counts] left, right, as passed to the last nigel_step */
   uint32_t build_id;
+  uint32_t schema_hash;      /* proto_schema_hash(), computed once at init */
   uint32_t rx_now_us;        /* [us] time of the bytes being parsed */
   uint32_t last_step_us;     /* [us] */
   uint32_t imu_next_us;      /* [us] next IMU read */
