@@ -1,6 +1,7 @@
 /* sim_render: see sim_render.h. */
 #include "sim_render.h"
 
+#include <dlfcn.h>
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GL/osmesa.h>
@@ -8,8 +9,32 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* EGL and OSMesa are loaded at run time (dlopen, RTLD_GLOBAL), only the one in use: MuJoCo's
+ * GL loader looks for eglGetProcAddress before OSMesaGetProcAddress, so an OSMesa context
+ * only works when libEGL was never loaded into the process. */
+typedef struct egl_api {
+  void *lib;
+  __eglMustCastToProperFunctionPointerType (*GetProcAddress)(const char *);
+  EGLBoolean (*Initialize)(EGLDisplay, EGLint *, EGLint *);
+  EGLBoolean (*Terminate)(EGLDisplay);
+  EGLBoolean (*ChooseConfig)(EGLDisplay, const EGLint *, EGLConfig *, EGLint, EGLint *);
+  EGLBoolean (*BindAPI)(EGLenum);
+  EGLContext (*CreateContext)(EGLDisplay, EGLConfig, EGLContext, const EGLint *);
+  EGLBoolean (*DestroyContext)(EGLDisplay, EGLContext);
+  EGLBoolean (*MakeCurrent)(EGLDisplay, EGLSurface, EGLSurface, EGLContext);
+} egl_api_t;
+
+typedef struct osmesa_api {
+  void *lib;
+  OSMesaContext (*CreateContextExt)(GLenum, GLint, GLint, GLint, OSMesaContext);
+  GLboolean (*MakeCurrent)(OSMesaContext, void *, GLenum, GLsizei, GLsizei);
+  void (*DestroyContext)(OSMesaContext);
+} osmesa_api_t;
+
 struct sim_render {
   sim_render_backend_t backend;
+  egl_api_t egl;
+  osmesa_api_t osm;
   EGLDisplay egl_dpy;
   EGLContext egl_ctx;
   OSMesaContext osm_ctx;
@@ -28,41 +53,76 @@ static void err_set(char *err, size_t n, const char *msg) {
   if (err && n) snprintf(err, n, "sim_render: %s", msg);
 }
 
+/* dlsym into a function pointer without the object/function pointer cast warning */
+static int sym(void *lib, const char *name, void *fnptr) {
+  void *p = dlsym(lib, name);
+  if (!p) return -1;
+  memcpy(fnptr, &p, sizeof p);
+  return 0;
+}
+
+static int egl_load(egl_api_t *e) {
+  e->lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_GLOBAL);
+  if (!e->lib) return -1;
+  if (sym(e->lib, "eglGetProcAddress", &e->GetProcAddress) || sym(e->lib, "eglInitialize", &e->Initialize) ||
+      sym(e->lib, "eglTerminate", &e->Terminate) || sym(e->lib, "eglChooseConfig", &e->ChooseConfig) ||
+      sym(e->lib, "eglBindAPI", &e->BindAPI) || sym(e->lib, "eglCreateContext", &e->CreateContext) ||
+      sym(e->lib, "eglDestroyContext", &e->DestroyContext) ||
+      sym(e->lib, "eglMakeCurrent", &e->MakeCurrent))
+    return -1;
+  return 0;
+}
+
 static int egl_init(sim_render_t *r) {
-  PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
-      (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-  if (!get_display) return -1;
+  egl_api_t *e = &r->egl;
+  if (egl_load(e) != 0) return -1;
+  PFNEGLGETPLATFORMDISPLAYEXTPROC get_display;
+  __eglMustCastToProperFunctionPointerType gp = e->GetProcAddress("eglGetPlatformDisplayEXT");
+  if (!gp) return -1;
+  memcpy(&get_display, &gp, sizeof gp);
   r->egl_dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
   if (r->egl_dpy == EGL_NO_DISPLAY) return -1;
   EGLint major, minor;
-  if (!eglInitialize(r->egl_dpy, &major, &minor)) return -1;
+  if (!e->Initialize(r->egl_dpy, &major, &minor)) return -1;
   /* Mesa's surfaceless platform offers no configs; MuJoCo draws into its own FBO, so a
    * config-less context (EGL_KHR_no_config_context) is all it needs */
   const EGLint attr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
   EGLConfig cfg = (EGLConfig)0; /* EGL_NO_CONFIG_KHR */
   EGLint ncfg = 0;
-  if (!eglChooseConfig(r->egl_dpy, attr, &cfg, 1, &ncfg) || ncfg < 1) cfg = (EGLConfig)0;
-  if (!eglBindAPI(EGL_OPENGL_API)) goto fail;
-  r->egl_ctx = eglCreateContext(r->egl_dpy, cfg, EGL_NO_CONTEXT, NULL);
+  if (!e->ChooseConfig(r->egl_dpy, attr, &cfg, 1, &ncfg) || ncfg < 1) cfg = (EGLConfig)0;
+  if (!e->BindAPI(EGL_OPENGL_API)) goto fail;
+  r->egl_ctx = e->CreateContext(r->egl_dpy, cfg, EGL_NO_CONTEXT, NULL);
   if (r->egl_ctx == EGL_NO_CONTEXT) goto fail;
-  if (!eglMakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->egl_ctx)) goto fail;
+  if (!e->MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->egl_ctx)) goto fail;
   r->backend = SIM_RENDER_EGL;
   return 0;
 fail:
-  if (r->egl_ctx != EGL_NO_CONTEXT) eglDestroyContext(r->egl_dpy, r->egl_ctx);
+  if (r->egl_ctx != EGL_NO_CONTEXT) e->DestroyContext(r->egl_dpy, r->egl_ctx);
   r->egl_ctx = EGL_NO_CONTEXT;
-  eglTerminate(r->egl_dpy);
+  e->Terminate(r->egl_dpy);
   r->egl_dpy = EGL_NO_DISPLAY;
   return -1;
 }
 
 static int osmesa_init(sim_render_t *r) {
-  r->osm_ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+  osmesa_api_t *o = &r->osm;
+  void *egl = dlopen("libEGL.so.1", RTLD_NOW | RTLD_NOLOAD);
+  if (egl) { /* MuJoCo would pick EGL's loader and abort in mjr_makeContext */
+    dlclose(egl);
+    return -2;
+  }
+  o->lib = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_GLOBAL);
+  if (!o->lib) o->lib = dlopen("libOSMesa.so", RTLD_NOW | RTLD_GLOBAL);
+  if (!o->lib || sym(o->lib, "OSMesaCreateContextExt", &o->CreateContextExt) ||
+      sym(o->lib, "OSMesaMakeCurrent", &o->MakeCurrent) ||
+      sym(o->lib, "OSMesaDestroyContext", &o->DestroyContext))
+    return -1;
+  r->osm_ctx = o->CreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
   if (!r->osm_ctx) return -1;
   /* MuJoCo renders into its own FBO; the default buffer only has to exist */
   r->osm_buf = calloc(4 * 4, 4);
-  if (!r->osm_buf || !OSMesaMakeCurrent(r->osm_ctx, r->osm_buf, GL_UNSIGNED_BYTE, 4, 4)) {
-    OSMesaDestroyContext(r->osm_ctx);
+  if (!r->osm_buf || !o->MakeCurrent(r->osm_ctx, r->osm_buf, GL_UNSIGNED_BYTE, 4, 4)) {
+    o->DestroyContext(r->osm_ctx);
     r->osm_ctx = NULL;
     return -1;
   }
@@ -83,8 +143,15 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
   r->egl_ctx = EGL_NO_CONTEXT;
   int ok = -1;
   if (backend == SIM_RENDER_AUTO || backend == SIM_RENDER_EGL) ok = egl_init(r);
-  if (ok != 0 && (backend == SIM_RENDER_AUTO || backend == SIM_RENDER_OSMESA))
+  /* OSMesa cannot follow a loaded libEGL (see above): AUTO falls back only if EGL is absent */
+  if (ok != 0 && (backend == SIM_RENDER_OSMESA || (backend == SIM_RENDER_AUTO && !r->egl.lib)))
     ok = osmesa_init(r);
+  if (ok == -2) {
+    free(r);
+    err_set(err, err_len, "OSMesa cannot be used in a process that already loaded libEGL "
+                          "(MuJoCo would bind its GL calls to EGL): use one backend per process");
+    return NULL;
+  }
   if (ok != 0) {
     free(r);
     err_set(err, err_len, "no headless OpenGL context (tried EGL surfaceless and/or OSMesa; "
@@ -131,13 +198,17 @@ void sim_render_destroy(sim_render_t *r) {
   mjv_freeScene(&r->scn);
   mjr_freeContext(&r->con);
   if (r->egl_dpy != EGL_NO_DISPLAY) {
-    eglMakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    if (r->egl_ctx != EGL_NO_CONTEXT) eglDestroyContext(r->egl_dpy, r->egl_ctx);
+    r->egl.MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (r->egl_ctx != EGL_NO_CONTEXT) r->egl.DestroyContext(r->egl_dpy, r->egl_ctx);
     /* no eglTerminate: the surfaceless display is process-wide (EGL returns the same handle
      * to every renderer), and terminating it unloads Mesa's driver, whose small internal
      * allocations then show up as leaks under LeakSanitizer */
   }
-  if (r->osm_ctx) OSMesaDestroyContext(r->osm_ctx);
+  if (r->osm_ctx) {
+    r->osm.MakeCurrent(NULL, NULL, 0, 0, 0); /* release the context before destroying it */
+    r->osm.DestroyContext(r->osm_ctx);
+  }
+  /* the libraries stay loaded (no dlclose): MuJoCo keeps GL function pointers into them */
   free(r->osm_buf);
   free(r->mcopy);
   free(r->row);
