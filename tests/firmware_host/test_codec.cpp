@@ -58,6 +58,21 @@ TEST(Frame, LayoutByteByByte) {
   EXPECT_EQ(f[6], crc >> 8);
 }
 
+// The worked examples and the hash quoted in PROTOCOL.md: if this fails after a deliberate
+// protocol change, update PROTOCOL.md with the new bytes.
+TEST(Frame, ProtocolDocExamples) {
+  EXPECT_EQ(Encode(PROTO_ID_HELLO_REQUEST, 0, {}),
+            (std::vector<uint8_t>{0xA5, 0x5A, 0x00, 0x03, 0x00, 0xCF, 0x99}));
+  proto_command_t c{7, 500, -250, 1, 0, PROTO_CMD_ENGAGED};
+  std::vector<uint8_t> p(PROTO_LEN_COMMAND);
+  proto_command_pack(&c, p.data());
+  EXPECT_EQ(Encode(PROTO_ID_COMMAND, 7, p),
+            (std::vector<uint8_t>{0xA5, 0x5A, 0x09, 0x01, 0x07, 0x07, 0x00, 0xF4, 0x01, 0x06,
+                                  0xFF, 0x01, 0x00, 0x01, 0xF5, 0xE3}));
+  EXPECT_EQ(proto_schema_hash(), 0x265771ABu) << "schema changed: update PROTOCOL.md section 5";
+  EXPECT_EQ(std::string(PROTO_SCHEMA).size(), 715u);
+}
+
 TEST(Frame, EncodeRejectsOversizeAndSmallBuffers) {
   uint8_t payload[PROTO_MAX_PAYLOAD + 1] = {0};
   uint8_t out[PROTO_MAX_FRAME + 8];
