@@ -56,7 +56,8 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
   }
   cv::Mat k, dist;
   std::vector<cv::Mat> rv, tv;
-  const double rms = cv::calibrateCamera(obj, img, size, k, dist, rv, tv);
+  const double rms =
+      cv::calibrateCamera(obj, img, size, k, dist, rv, tv, p.fix_k3 ? cv::CALIB_FIX_K3 : 0);
   if (!(rms <= p.max_rms_px)) {
     char b[160];
     std::snprintf(b, sizeof b,

@@ -16,6 +16,7 @@ struct IntrinsicsParams {
   int min_views = 8;         // fewer usable views: refused
   double min_coverage = 0.5; // fraction of a 4x4 grid over the image that corners must reach
   double max_rms_px = 1.0;   // a worse reprojection RMS: refused
+  bool fix_k3 = true;        // k3 only for wide-angle lenses; free, it soaks up noise
 };
 
 struct IntrinsicsReport {

@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   ci->add_option("--max-rms-px", ip.max_rms_px, "refuse a higher reprojection RMS [px]")
       ->capture_default_str();
+  ci->add_flag("!--free-k3", ip.fix_k3, "also fit k3 (wide-angle lenses)");
   ci->add_option("-o,--out", ci_out, "output YAML (camera matrix, distortion, RMS)")->required();
 
   // calibrate-map
