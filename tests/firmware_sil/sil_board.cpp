@@ -102,6 +102,7 @@ void Board::uart_out_hook(avr_irq_t *, uint32_t value, void *param) {
 
 void Board::on_uart_byte(uint8_t b) {
   uart_bytes_out_++;
+  if (uart_sink_) uart_sink_(b, cycle());
   std::pair<Board *, std::vector<Frame> *> ctx{this, &frames_};
   proto_parser_feed(&parser_, &b, 1, on_frame, &ctx);
 }
@@ -167,6 +168,7 @@ void Board::encoder_edge(int side, int dir) {
     enc_phase_[side] = next;
     bool a_changed = kPhaseA[p] != kPhaseA[next];
     if (a_changed) {
+      enc_injected_[side] += dir > 0 ? 1 : -1;
       drive_pin(2 + side, kPhaseA[next]);
       return;
     }
@@ -237,6 +239,7 @@ void Board::step_io() {
       uint8_t next = static_cast<uint8_t>((p + (enc_dir_ > 0 ? 1 : 3)) & 3);
       enc_phase_[s] = next;
       if (kPhaseA[p] != kPhaseA[next]) {
+        enc_injected_[s] += enc_dir_ > 0 ? 1 : -1;
         drive_pin(2 + s, kPhaseA[next]);
       } else {
         drive_pin(4 + s, kPhaseB[next]);

@@ -64,6 +64,9 @@ class Board {
 
   // Frames decoded from the AVR's UART output, oldest first.
   const std::vector<Frame> &frames() const { return frames_; }
+  void clear_frames() { frames_.clear(); }
+  // Also hands every byte the AVR sends to sink (cycle = when it left the UART).
+  void set_uart_sink(std::function<void(uint8_t, uint64_t)> sink) { uart_sink_ = std::move(sink); }
   std::vector<proto_state_t> states() const;
   bool last_state(proto_state_t *out) const;
   size_t count(uint8_t id) const;
@@ -74,6 +77,8 @@ class Board {
   void encoder_edge(int side, int dir);
   // Schedules edges on both wheels at edges_per_s [edges/s] each until stopped (0).
   void encoder_rate(double edges_per_s, int dir = 1);
+  // A-channel edges injected so far, signed by direction [counts] (what the firmware should count).
+  int64_t encoder_injected(int side) const { return enc_injected_[side]; }
 
   // Actuators as the AVR drives them now.
   uint16_t servo_pulse_us() const;
@@ -82,6 +87,13 @@ class Board {
   bool motor_brake() const;
   uint8_t lamp_pins() const; // NIGEL_LAMP_* bits from the pin levels
   const std::vector<PwmChange> &pwm_changes() const { return pwm_changes_; }
+  // Hands over (and forgets) the changes recorded so far, for long runs.
+  std::vector<PwmChange> take_pwm_changes() {
+    std::vector<PwmChange> out;
+    out.swap(pwm_changes_);
+    if (!out.empty()) pwm_changes_.push_back(out.back()); // the reference for the next change
+    return out;
+  }
 
   Mpu9250 &imu() { return *imu_; }
   // Battery: sets the ADC7 input [mV at the pin].
@@ -112,6 +124,8 @@ class Board {
   std::vector<std::pair<std::string, uint32_t>> symbols_;
   avr_irq_t *uart_in_ = nullptr;
   uint8_t ext_level_d_ = 0; // levels driven onto PD2..PD5
+  int64_t enc_injected_[2]{};
+  std::function<void(uint8_t, uint64_t)> uart_sink_;
   uint8_t enc_phase_[2]{};
   std::deque<uint8_t> tx_queue_;
   uint64_t next_tx_cycle_ = 0, last_tx_cycle_ = 0;
