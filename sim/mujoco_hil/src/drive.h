@@ -4,6 +4,10 @@
 
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* DC gearmotor, figures at the wheel: tau = stall * (u - w / w_noload), u = +-duty/255 * Vbat
  * / Vnominal (back-EMF makes the torque fall linearly with speed). Braking shorts the motor:
  * u = 0, so the back-EMF alone brakes (tau = -stall * w / w_noload). */
@@ -24,4 +28,7 @@ double steer_rate_limit(double angle_rad, double target_rad, double rate_rad_s, 
 void steer_ackermann(double delta_rad, double wheelbase_m, double track_m, double *left_rad,
                      double *right_rad);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

@@ -9,7 +9,7 @@
 
 int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log) {
   sim_truth_t t;
-  sim_truth(s, car, &t);
+  sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
   snprintf(vehicle, sizeof vehicle, "NIGEL%d", car);
   snprintf(channel, sizeof channel, "%s_GROUND_TRUTH", vehicle);

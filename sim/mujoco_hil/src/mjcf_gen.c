@@ -76,7 +76,7 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
           i, p->cam_rear_pos_m[0], p->cam_rear_pos_m[1], p->cam_rear_pos_m[2]);
 
   const char *tyre_attr = p->tyre_model_paper
-                              ? "condim=\"1\""                          /* normal force only */
+                              ? "condim=\"1\" priority=\"1\"" /* normal force only, whatever the floor */
                               : "condim=\"3\" friction=\"0.05 0 0\""; /* the floor's mu wins */
   static const char *names[4] = {"fl", "fr", "rl", "rr"};
   for (int w = 0; w < 4; w++) {

@@ -13,6 +13,10 @@
 
 #include "vparams.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct mg_options {
   int cars;                 /* >= 1 */
   const char *map_path;     /* absolute path of the map MJCF */
@@ -27,4 +31,7 @@ int mg_tag_id(int car);
 int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

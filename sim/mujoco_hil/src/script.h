@@ -12,6 +12,10 @@
 
 #include "proto.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define SCRIPT_PERIOD_US 20000u /* 50 Hz, the runtime's command rate */
 
 typedef struct script {
@@ -29,4 +33,7 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz);
  * Returns the number of bytes written. */
 size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

@@ -463,9 +463,13 @@ static void sim_tyres(sim_t *s, sim_car_t *c) {
     in.mu = c->mu[w];
     in.v_min_m_s = p->tyre_v_min_m_s;
     in.rolling_resistance = p->tyre_rolling_resistance;
-    /* half of the reduced mass of (wheel spin, quarter car): never reverses the slip */
-    in.m_long_kg = 0.5 / (r * r / i_spin + 4.0 / p->mass_kg);
-    in.m_lat_kg = 0.5 * p->mass_kg / 4.0;
+    /* no-overshoot clamp: half the reduced mass of (wheel spin, car mass on this wheel) so
+     * one step never reverses the slip; the lateral mass is the wheel's load share (Fz / g),
+     * so the clamp keeps the axles' cornering stiffness proportional to their load (neutral
+     * steer, as the curves themselves are) */
+    const double m_load = c->fz_n[w] / 9.80665;
+    in.m_long_kg = 0.5 / (r * r / i_spin + 1.0 / fmax(m_load, 1e-3));
+    in.m_lat_kg = 1.0 * m_load;
     in.dt_s = m->opt.timestep;
     double fx, fy;
     tyre_force(&s->lon, &s->lat, &in, &fx, &fy);
@@ -578,7 +582,7 @@ const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car) {
 #endif
 }
 
-void sim_truth(const sim_t *s, int car, sim_truth_t *o) {
+void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {
   const sim_car_t *c = &s->car[car - 1];
   const mjData *d = s->d;
   const mjtNum *qp = d->qpos + c->root_qpos, *qv = d->qvel + c->root_dof;

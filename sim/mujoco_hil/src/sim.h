@@ -12,6 +12,10 @@
 
 #include "nigel_core.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define SIM_STEP_US 1000 /* physics and Nano loop period [us] */
 #define SIM_MAX_CARS 32
 
@@ -52,7 +56,7 @@ int64_t sim_time_us(const sim_t *s);
 int sim_cars(const sim_t *s);
 const mjModel *sim_model(const sim_t *s);
 mjData *sim_data(const sim_t *s);
-void sim_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
+void sim_get_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
 /* The Nano's symlink path (empty without ptys). */
 const char *sim_nano_link(const sim_t *s, int car);
 const char *sim_lidar_link(const sim_t *s, int car);
@@ -71,4 +75,7 @@ int sim_has_sensors(void);
  * used by the benchmark to measure our overhead over MuJoCo alone. */
 double sim_bare_mj_step_s(const sim_t *s, int steps);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

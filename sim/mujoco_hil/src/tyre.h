@@ -8,6 +8,10 @@
 #ifndef SIM_TYRE_H
 #define SIM_TYRE_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct tyre_curve {
   double ext_slip, ext_value;   /* extremum point */
   double asym_slip, asym_value; /* asymptote point */
@@ -33,4 +37,7 @@ typedef struct tyre_in {
 void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_t *in,
                 double *fx_n, double *fy_n);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

@@ -6,6 +6,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define UART_QUEUE_BYTES 4096u
 
 typedef struct uart_queue {
@@ -25,4 +29,7 @@ size_t uart_pop(uart_queue_t *q, uint32_t dt_us, uint8_t *out, size_t cap);
 /* Free space [bytes]. */
 size_t uart_space(const uart_queue_t *q);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

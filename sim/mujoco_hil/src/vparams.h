@@ -6,6 +6,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct vp_params {
   /* body */
   double mass_kg;                /* whole car incl. wheels */
@@ -50,4 +54,7 @@ typedef struct vp_params {
 /* Loads path into p. Returns 0, or -1 with a message in err ("<file>:<line>: key '<k>': ..."). */
 int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

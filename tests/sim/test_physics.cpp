@@ -1,0 +1,189 @@
+// Vehicle physics against Nigel's reference figures, driven through the real firmware core by
+// the scripted driver (real protocol frames into the emulated Nano). Sim time only.
+#include <gtest/gtest.h>
+#include <math.h>
+
+#include <string>
+#include <vector>
+
+#include "sim_test_util.h"
+
+namespace {
+
+const double kWheelbase_m = 0.14154, kSteerLimit_rad = 0.5236;
+
+// Least-squares circle through points (Kasa fit): returns the radius [m].
+double fit_radius(const std::vector<double> &x, const std::vector<double> &y) {
+  // minimise sum (x^2 + y^2 + D x + E y + F)^2: normal equations 3x3
+  double a[3][4] = {};
+  for (size_t i = 0; i < x.size(); i++) {
+    const double r[3] = {x[i], y[i], 1.0}, b = -(x[i] * x[i] + y[i] * y[i]);
+    for (int j = 0; j < 3; j++) {
+      for (int k = 0; k < 3; k++) a[j][k] += r[j] * r[k];
+      a[j][3] += r[j] * b;
+    }
+  }
+  for (int c = 0; c < 3; c++)  // Gauss-Jordan
+    for (int r = 0; r < 3; r++)
+      if (r != c) {
+        const double f = a[r][c] / a[c][c];
+        for (int k = 0; k < 4; k++) a[r][k] -= f * a[c][k];
+      }
+  const double D = a[0][3] / a[0][0], E = a[1][3] / a[1][1], F = a[2][3] / a[2][2];
+  return sqrt(D * D / 4 + E * E / 4 - F);
+}
+
+// Drives a constant-steering circle and returns the fitted radius of base_link's path.
+double turn_radius(double steering, int tyre_model, std::string *err) {
+  char script[96];
+  snprintf(script, sizeof script, "constant:throttle=0.6,steering=%g", steering);
+  simtest::Sim s(script, 1, 0, tyre_model);
+  if (!s.s) {
+    *err = s.err;
+    return NAN;
+  }
+  std::vector<double> x, y;
+  if (!s.run_to(3.0)) return NAN;  // steering settled, speed steady
+  for (int k = 0; k < 700; k++) {  // 7 s at 100 Hz: more than a full circle
+    if (!s.run_to(3.0 + 0.01 * (k + 1))) return NAN;
+    const sim_truth_t t = s.truth();
+    x.push_back(t.pos_m[0]);
+    y.push_back(t.pos_m[1]);
+  }
+  return fit_radius(x, y);
+}
+
+class TurnRadius : public ::testing::TestWithParam<double> {};
+
+TEST_P(TurnRadius, MatchesWheelbaseOverTanDeltaWithin1Percent) {
+  const double steering = GetParam(), delta = steering * kSteerLimit_rad;
+  std::string err;
+  const double r = turn_radius(steering, -1, &err);
+  ASSERT_TRUE(isfinite(r)) << err;
+  const double expect = kWheelbase_m / tan(fabs(delta));
+  EXPECT_NEAR(r, expect, 0.01 * expect) << "steering " << steering;
+}
+
+INSTANTIATE_TEST_SUITE_P(Steering, TurnRadius, ::testing::Values(0.3, 0.6, -1.0));
+
+TEST(Physics, TopSpeedIs0267Within3Percent) {
+  simtest::Sim s("constant:throttle=1,steering=0");
+  ASSERT_NE(s.s, nullptr) << s.err;
+  ASSERT_TRUE(s.run_to(2.0)) << s.err;
+  double sum = 0.0;
+  int n = 0;
+  for (int k = 1; k <= 200; k++) {
+    ASSERT_TRUE(s.run_to(2.0 + 0.01 * k)) << s.err;
+    sum += s.truth().vel_body_m_s[0];
+    n++;
+  }
+  const double v = sum / n;
+  EXPECT_NEAR(v, 0.267, 0.03 * 0.267);
+  EXPECT_NEAR(s.truth().yaw_rad, 0.0, 0.01);  // straight ahead
+}
+
+TEST(Physics, ReverseDrivesBackwards) {
+  simtest::Sim s("constant:throttle=-0.5,steering=0");
+  ASSERT_NE(s.s, nullptr) << s.err;
+  const double x0 = s.truth().pos_m[0];
+  ASSERT_TRUE(s.run_to(3.0)) << s.err;
+  EXPECT_LT(s.truth().pos_m[0] - x0, -0.2);
+  EXPECT_LT(s.truth().vel_body_m_s[0], -0.05);
+}
+
+TEST(Physics, SteeringRateIs0805RadPerS) {
+  simtest::Sim s("constant:throttle=0,steering=1");
+  ASSERT_NE(s.s, nullptr) << s.err;
+  // time the centre angle (from the knuckles) from 20% to 80% of full lock
+  double t20 = -1, t80 = -1;
+  for (int k = 1; k <= 1500 && t80 < 0; k++) {
+    ASSERT_TRUE(s.run_to(0.001 * k)) << s.err;
+    const double a = s.truth().steering_rad;
+    if (t20 < 0 && a >= 0.2 * kSteerLimit_rad) t20 = 0.001 * k;
+    if (t80 < 0 && a >= 0.8 * kSteerLimit_rad) t80 = 0.001 * k;
+  }
+  ASSERT_GT(t20, 0);
+  ASSERT_GT(t80, 0);
+  const double rate = 0.6 * kSteerLimit_rad / (t80 - t20);
+  EXPECT_NEAR(rate, 0.805, 0.03 * 0.805);
+  ASSERT_TRUE(s.run_to(1.5)) << s.err;
+  EXPECT_NEAR(s.truth().steering_rad, kSteerLimit_rad, 0.01 * kSteerLimit_rad);
+}
+
+TEST(Physics, EncodersCount1920PerWheelRevolution) {
+  simtest::Sim s("constant:throttle=0.5,steering=0");
+  ASSERT_NE(s.s, nullptr) << s.err;
+  ASSERT_TRUE(s.run_to(4.0)) << s.err;
+  const double wheel_rad = sim_data(s.s)->qpos[sim_model(s.s)->jnt_qposadr[mj_name2id(
+      sim_model(s.s), mjOBJ_JOINT, "nigel1/wheel_rl")]];
+  const nigel_t *n = sim_nano(s.s, 1);
+  EXPECT_GT(n->enc[0], 1000);
+  EXPECT_NEAR(n->enc[0], wheel_rad / (2 * M_PI) * 1920.0, 2.0);
+  // the distance travelled matches the counts (rolling without much slip)
+  const double dist = s.truth().pos_m[0] + 2.0;  // spawn at x = -2
+  EXPECT_NEAR(n->enc[0] / 1920.0 * 2 * M_PI * 0.0325, dist, 0.03 * dist);
+}
+
+TEST(Physics, ImuAtRestReadsGravityWithinBias) {
+  simtest::Sim s(nullptr);
+  ASSERT_NE(s.s, nullptr) << s.err;
+  ASSERT_TRUE(s.run_to(0.5)) << s.err;
+  const nigel_t *n = sim_nano(s.s, 1);
+  // +-4 g range: 8192 LSB per g on z (specific force points up at rest)
+  EXPECT_NEAR(n->imu.accel[2], 8192, 8192 * 0.05 / 9.80665 * 1.5 + 40);
+  EXPECT_LT(abs(n->imu.accel[0]), 120);
+  EXPECT_LT(abs(n->imu.gyro[2]), 40);  // 0.005 rad/s bias = 19 LSB
+  EXPECT_NEAR(n->imu.mag[2], -42 / 0.15, 15);
+}
+
+// Distance [m] the car rolls from full speed once the failsafe brakes (shorted motors).
+double braking_distance(const std::string &map, std::string *err) {
+  simtest::Sim s("constant:throttle=1,steering=0,stop_after=2", 1, 0, -1, map.c_str());
+  if (!s.s) {
+    *err = s.err;
+    return NAN;
+  }
+  if (!s.run_to(2.0)) return NAN;
+  double x0 = NAN;
+  for (int k = 1; k <= 2000; k++) {
+    if (!s.run_to(2.0 + 0.001 * k)) return NAN;
+    uint8_t duty, rev, brake;
+    uint16_t servo;
+    sim_motor_outputs(s.s, 1, &duty, &rev, &brake, &servo);
+    if (brake && isnan(x0)) x0 = s.truth().pos_m[0];
+  }
+  if (fabs(s.truth().vel_body_m_s[0]) > 0.002) return INFINITY;  // must have stopped
+  return s.truth().pos_m[0] - x0;
+}
+
+TEST(Physics, SnowGivesLessGripThanAsphalt) {
+  std::string err;
+  const double asphalt = braking_distance(simtest::fixture("flat_asphalt.xml"), &err);
+  ASSERT_TRUE(isfinite(asphalt)) << err;
+  const double snow = braking_distance(simtest::fixture("flat_snow.xml"), &err);
+  ASSERT_TRUE(isfinite(snow)) << err;
+  EXPECT_GT(asphalt, 0.001);
+  EXPECT_GT(snow, 1.5 * asphalt) << "asphalt " << asphalt << " m, snow " << snow << " m";
+}
+
+TEST(Physics, MujocoFrictionModelAlsoDrives) {
+  std::string err;
+  const double r = turn_radius(0.6, 0, &err);
+  ASSERT_TRUE(isfinite(r)) << err;
+  const double expect = kWheelbase_m / tan(0.6 * kSteerLimit_rad);
+  EXPECT_NEAR(r, expect, 0.05 * expect);  // plain contact friction: reported, looser bound
+}
+
+TEST(Physics, FourCarsDriveIndependently) {
+  simtest::Sim s("constant:throttle=0.5,steering=0", 4);
+  ASSERT_NE(s.s, nullptr) << s.err;
+  ASSERT_TRUE(s.run_to(2.0)) << s.err;
+  for (int c = 1; c <= 4; c++) {
+    const sim_truth_t t = s.truth(c);
+    EXPECT_GT(t.vel_body_m_s[0], 0.1) << c;
+    EXPECT_FALSE(t.in_collision) << c;
+    EXPECT_NEAR(t.pos_m[1], -1.5 - 0.35 * (c - 1), 0.02) << c;  // side by side, spawn y
+  }
+}
+
+}  // namespace
