@@ -16,8 +16,8 @@ struct sim_jpeg {
   struct jpeg_compress_struct cinfo;
   struct sim_jpeg_err jerr;
   int quality;
-  unsigned char *buf;   /* jpeg_mem_dest output, grown by libjpeg, reused across frames */
-  unsigned long cap;    /* its size [bytes] */
+  unsigned char *buf;   /* jpeg_mem_dest output, reused across frames */
+  unsigned long cap;    /* its usable size [bytes] */
 };
 
 static void jpeg_error_exit(j_common_ptr c) {
@@ -27,7 +27,7 @@ static void jpeg_error_exit(j_common_ptr c) {
 
 sim_jpeg_t *sim_jpeg_create(int quality) {
   if (quality < 1 || quality > 100) return NULL;
-  sim_jpeg_t *j = calloc(1, sizeof *j);
+  sim_jpeg_t *volatile j = calloc(1, sizeof *j); /* volatile: read after a longjmp */
   if (!j) return NULL;
   j->quality = quality;
   j->cinfo.err = jpeg_std_error(&j->jerr.mgr);
@@ -55,7 +55,16 @@ int sim_jpeg_encode(sim_jpeg_t *j, const uint8_t *rgb, int width_px, int height_
     jpeg_abort_compress(c);
     return -1;
   }
-  /* jpeg_mem_dest reuses buf while it is big enough and reallocates it otherwise */
+  /* one buffer for a whole raw frame: libjpeg never needs to grow it in practice; if it does,
+   * it mallocs a bigger one (ours stays ours to free) */
+  unsigned long need = (unsigned long)width_px * (unsigned long)height_px * 3 + 65536;
+  if (j->cap < need) {
+    free(j->buf);
+    j->buf = malloc(need);
+    j->cap = j->buf ? need : 0;
+    if (!j->buf) return -1;
+  }
+  unsigned char *mine = j->buf;
   unsigned long size = j->cap;
   jpeg_mem_dest(c, &j->buf, &size);
   c->image_width = (JDIMENSION)width_px;
@@ -71,7 +80,10 @@ int sim_jpeg_encode(sim_jpeg_t *j, const uint8_t *rgb, int width_px, int height_
     jpeg_write_scanlines(c, &row, 1);
   }
   jpeg_finish_compress(c);
-  if (size > j->cap) j->cap = size;
+  if (j->buf != mine) { /* libjpeg grew it: keep the new one, its size is at least size */
+    free(mine);
+    j->cap = size;
+  }
   *out = j->buf;
   *size_bytes = size;
   return 0;
