@@ -159,6 +159,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
   /* let the failsafe run out: the car must end stopped */
   now_us += 200000u;
+  servo_before = world.servo_us;
+  steer_before_u = core.act.steering_u;
   nigel_step(&core, now_us, 0, 0);
   check_outputs();
   if (world.duty != 0u) abort();

@@ -20,11 +20,25 @@ void act_init(act_t *a, uint32_t now_us) {
   a->decelerating = 0;
 }
 
-void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_t stop,
+/* |u| [1e-6] -> duty 0..255, rounded: 255/1e6 as 4279 / 2^24 (|u| <= 1e6 keeps it in 32 bit). */
+static uint8_t duty_of(int32_t u) {
+  uint32_t m = (uint32_t)(u < 0 ? -u : u);
+  return (uint8_t)((m * 4279ul + (1ul << 23)) >> 24);
+}
+
+/* steering [1e-6] -> pulse offset [us] = u * 500 / 1e6, as u * 2097 / 2^22, rounded. */
+static int16_t pulse_offset_of(int32_t u) {
+  uint32_t m = (uint32_t)(u < 0 ? -u : u);
+  int16_t off = (int16_t)((m * 2097ul + (1ul << 21)) >> 22);
+  return u < 0 ? (int16_t)-off : off;
+}
+
+void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_t flags,
                 uint32_t now_us) {
   uint32_t dt_us = (uint32_t)(now_us - a->last_us);
+  uint8_t stop = (uint8_t)(flags & ACT_STOP);
   int32_t thr_target = (int32_t)throttle_milli * 1000L;
-  int32_t steer_target = (int32_t)steering_milli * 1000L;
+  int32_t steer_target = (flags & ACT_HOLD_STEERING) ? a->steering_u : (int32_t)steering_milli * 1000L;
   int32_t pulse;
   a->last_us = now_us;
   if (dt_us > ACT_MAX_DT_US) dt_us = ACT_MAX_DT_US;
@@ -40,17 +54,15 @@ void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_
     a->throttle_u =
         move_toward(a->throttle_u, thr_target, (int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L));
   a->steering_u =
-      move_toward(a->steering_u, steer_target, (int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_X1E4) / 10000ul));
+      move_toward(a->steering_u, steer_target, (int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14));
 
-  /* duty 0..255, rounded */
-  a->duty = (uint8_t)((abs32(a->throttle_u) * 255L + ACT_FULL / 2) / ACT_FULL);
+  a->duty = duty_of(a->throttle_u);
   a->reverse = (uint8_t)(a->throttle_u < 0);
   a->brake = (uint8_t)(stop || a->duty == 0u);
   if (a->brake) a->duty = 0;
 
   /* + steering (left) lengthens the pulse */
-  pulse = ACT_SERVO_CENTER_US + a->trim_us +
-          (a->steering_u / (ACT_FULL / 1000L)) * ACT_SERVO_HALF_RANGE_US / 1000L;
+  pulse = (int32_t)ACT_SERVO_CENTER_US + a->trim_us + pulse_offset_of(a->steering_u);
   if (pulse < ACT_SERVO_MIN_US) pulse = ACT_SERVO_MIN_US;
   if (pulse > ACT_SERVO_MAX_US) pulse = ACT_SERVO_MAX_US;
   a->servo_us = (uint16_t)pulse;

@@ -13,13 +13,17 @@ extern "C" {
 #define ACT_FULL 1000000L                 /* internal full scale [1e-6 of 1.0] */
 #define ACT_THROTTLE_SLEW_PER_S 4000000L  /* [1e-6/s]: 0 -> full throttle in 250 ms */
 /* Steering rate: 0.805 rad/s over a 0.5236 rad (30 deg) full scale = 1.5374 full scale/s.
- * Step [1e-6 full scale] = dt [us] * ACT_STEER_RATE_X1E4 / 1e4. */
-#define ACT_STEER_RATE_X1E4 15374L        /* [1e-4 full scale/s] */
+ * Step [1e-6 full scale] = dt [us] * ACT_STEER_RATE_Q14 >> 14 (no division on the AVR). */
+#define ACT_STEER_RATE_Q14 25189L         /* 1.5374 * 2^14 */
 #define ACT_SERVO_CENTER_US 1500
 #define ACT_SERVO_HALF_RANGE_US 500       /* pulse change at full steering [us] */
 #define ACT_SERVO_MIN_US 1000
 #define ACT_SERVO_MAX_US 2000
 #define ACT_MAX_DT_US 50000ul             /* a longer gap is treated as this [us] */
+
+/* act_update flags */
+#define ACT_STOP 0x01u           /* throttle to 0 at once (no slew), brake on */
+#define ACT_HOLD_STEERING 0x02u  /* ignore the steering target, keep the servo where it is */
 
 typedef struct act {
   int32_t throttle_u;  /* applied throttle [1e-6], + forward */
@@ -36,10 +40,10 @@ typedef struct act {
 
 void act_init(act_t *a, uint32_t now_us);
 /* Moves the applied values toward the targets [milli] at the rate limits and computes the
- * outputs. stop = 1 (disarmed, failsafe, battery cut-off): throttle goes to 0 at once (no
- * slew) and the brake is applied; steering keeps following its target at its rate limit
- * (the core passes the currently applied steering as target when not engaged). */
-void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_t stop,
+ * outputs. flags ACT_STOP (disarmed, failsafe, battery cut-off): throttle goes to 0 at once
+ * (no slew) and the brake is applied. ACT_HOLD_STEERING (not engaged): the servo holds.
+ * Integer multiply/shift only: no division per call (~1000 calls/s on the AVR). */
+void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_t flags,
                 uint32_t now_us);
 int16_t act_throttle_milli(const act_t *a);
 int16_t act_steering_milli(const act_t *a);

@@ -19,9 +19,14 @@ extern "C" {
 typedef struct ahrs {
   float q[4];        /* w x y z, unit */
   float ei[3];       /* integral of the error [rad/s] (gyro bias estimate) */
+  float rate[3];     /* gyro rate of the pending sample [rad/s] */
+  float err[3];      /* direction error of the pending sample (gravity + field) */
+  float dt;          /* [s] to integrate; 0 when nothing is pending */
   uint32_t last_us;  /* [us] time of the last sample */
   uint32_t run_us;   /* [us] time since the first sample, saturating */
   uint8_t have;      /* last_us is valid */
+  uint8_t have_acc;  /* the pending sample had a usable accelerometer reading */
+  uint8_t settled;   /* past AHRS_SETTLE_US: normal gain */
 } ahrs_t;
 
 void ahrs_init(ahrs_t *a);
@@ -29,6 +34,13 @@ void ahrs_init(ahrs_t *a);
  * all-zero mag means "no magnetometer"). */
 void ahrs_update(ahrs_t *a, const int16_t accel[3], const int16_t gyro[3], const int16_t mag[3],
                  uint32_t now_us);
+/* ahrs_update in three steps of similar cost, so the firmware can spread one update over
+ * three loop passes (software floats on the AVR): the gravity error, the magnetic-field error
+ * (skipped when mag is all zero), and the PI feedback + integration of q. ahrs_correct_mag and
+ * ahrs_integrate do nothing unless ahrs_correct started a sample. */
+void ahrs_correct(ahrs_t *a, const int16_t accel[3], const int16_t gyro[3], uint32_t now_us);
+void ahrs_correct_mag(ahrs_t *a, const int16_t mag[3]);
+void ahrs_integrate(ahrs_t *a);
 /* The quaternion in Q14 (PROTO_QUAT_ONE = 1.0). */
 void ahrs_quat_q14(const ahrs_t *a, int16_t out[4]);
 

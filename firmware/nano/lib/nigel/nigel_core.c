@@ -169,8 +169,7 @@ static uint8_t due(uint32_t *next_us, uint32_t period_us, uint32_t now_us) {
 
 void nigel_step(nigel_t *n, uint32_t now_us, int32_t enc_left_counts, int32_t enc_right_counts) {
   const nigel_hal_t *hal = n->hal;
-  uint8_t stop, indicators;
-  int16_t steer_target;
+  uint8_t act_flags = 0, indicators;
 
   if ((uint32_t)(now_us - n->last_step_us) > NIGEL_LOOP_OVERRUN_US)
     n->faults_latched |= PROTO_FAULT_LOOP_OVERRUN;
@@ -188,19 +187,33 @@ void nigel_step(nigel_t *n, uint32_t now_us, int32_t enc_left_counts, int32_t en
     if (hal->imu_read(hal->ctx, &raw) == 0) {
       n->imu = raw;
       n->imu_lost = 0;
-      ahrs_update(&n->ahrs, raw.accel, raw.gyro, raw.mag, now_us);
+      n->imu_read_us = now_us;
+      n->ahrs_stage = 1;
     } else {
       n->imu_lost = 1;
+    }
+  } else if (n->ahrs_stage != 0u) {
+    /* the AHRS runs in the three passes after the (blocking) IMU read, a third each, so no
+     * loop pass carries more than one of these software-float costs */
+    if (n->ahrs_stage == 1u) {
+      ahrs_correct(&n->ahrs, n->imu.accel, n->imu.gyro, n->imu_read_us);
+      n->ahrs_stage = 2;
+    } else if (n->ahrs_stage == 2u) {
+      ahrs_correct_mag(&n->ahrs, n->imu.mag);
+      n->ahrs_stage = 3;
+    } else {
+      ahrs_integrate(&n->ahrs);
+      n->ahrs_stage = 0;
     }
   }
 
   wspd_update(&n->wspd, enc_left_counts, enc_right_counts, now_us);
 
-  stop = (uint8_t)(!fs_may_drive(&n->fs) || n->batt.cutoff);
-  /* Not engaged: the servo holds where it is (nothing moves unless the host engaged). A flat
-   * battery only refuses drive; steering still follows. */
-  steer_target = fs_may_drive(&n->fs) ? n->cmd.steering_milli : act_steering_milli(&n->act);
-  act_update(&n->act, n->cmd.throttle_milli, steer_target, stop, now_us);
+  /* Not engaged: no drive and the servo holds where it is (nothing moves unless the host
+   * engaged). A flat battery only refuses drive; steering still follows. */
+  if (!fs_may_drive(&n->fs)) act_flags = ACT_STOP | ACT_HOLD_STEERING;
+  if (n->batt.cutoff) act_flags |= ACT_STOP;
+  act_update(&n->act, n->cmd.throttle_milli, n->cmd.steering_milli, act_flags, now_us);
   hal->motor_set(hal->ctx, n->act.duty, n->act.reverse, n->act.brake);
   hal->servo_set_us(hal->ctx, n->act.servo_us);
 

@@ -33,7 +33,9 @@ extern "C" {
 #define NIGEL_FW_PATCH 0u
 
 #define NIGEL_IMU_PERIOD_US 10000ul     /* [us] IMU read + AHRS update: 100 Hz */
-#define NIGEL_IMU_OFFSET_US 5000ul      /* [us] IMU reads sit between telemetry frames */
+#define NIGEL_IMU_OFFSET_US 5000ul      /* [us] IMU reads sit between telemetry frames; the
+                                           AHRS runs in the three loop
+                                           passes after the read, a step each */
 #define NIGEL_BATT_OFFSET_US 2500ul     /* [us] battery reads too */
 #define NIGEL_LOOP_OVERRUN_US 20000ul   /* [us] a gap between nigel_step calls above this
                                            raises PROTO_FAULT_LOOP_OVERRUN */
@@ -59,9 +61,12 @@ typedef struct nigel {
   uint32_t imu_next_us;      /* [us] next IMU read */
   uint32_t batt_next_us;     /* [us] next battery read */
   uint32_t telem_next_us;    /* [us] next STATE frame */
+  uint32_t imu_read_us;      /* [us] time of the last good IMU sample */
   uint16_t faults_latched;   /* PROTO_FAULT_CMD_INVALID / WATCHDOG_RESET / LOOP_OVERRUN;
                                 cleared when the car is (re-)armed */
   uint8_t imu_lost;          /* the last IMU read failed (live, not latched) */
+  uint8_t ahrs_stage;        /* next AHRS step for the last sample: 0 none, 1 gravity,
+                                2 magnetic field, 3 integrate (one per loop pass) */
   uint8_t tx_seq;            /* frame seq of the next frame we send */
 } nigel_t;
 

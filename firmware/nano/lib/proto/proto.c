@@ -176,11 +176,14 @@ int proto_config_valid(const proto_config_t *m) {
 /* ---- frames ---------------------------------------------------------------------------- */
 uint16_t proto_crc16(uint16_t crc, const uint8_t *data, size_t n) {
   size_t i;
-  uint8_t bit;
   for (i = 0; i < n; ++i) {
-    crc ^= (uint16_t)((uint16_t)data[i] << 8);
-    for (bit = 0; bit < 8u; ++bit)
-      crc = (crc & 0x8000u) ? (uint16_t)((crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
+    /* Byte-at-a-time form of the bitwise MSB-first division by 0x1021 (same result as
+     * 8 shift/xor steps, ~6x fewer cycles on the AVR, no table in RAM or flash):
+     * with x = top byte ^ data and x ^= x >> 4, the remainder is x*(x^12 + x^5 + 1). */
+    uint8_t x = (uint8_t)((crc >> 8) ^ data[i]);
+    x ^= (uint8_t)(x >> 4);
+    crc = (uint16_t)((uint16_t)(crc << 8) ^ (uint16_t)((uint16_t)x << 12) ^
+                     (uint16_t)((uint16_t)x << 5) ^ (uint16_t)x);
   }
   return crc;
 }
