@@ -2,6 +2,8 @@
 # Builds the firmware core for the ATmega328P (avr-gcc -Os, gc-sections, as the firmware does)
 # with a stub HAL, runs it in simavr and prints the core's own cost per entry point [cycles
 # at 16 MHz] and its flash/RAM footprint. Usage: tests/firmware_host/avr_cycles/run.sh [outdir]
+# With AVR_CORE_MAX_PASS_CYCLES=<n> set, exits 1 if any single nigel_step pass costs more
+# (ctest firmware.core_avr_cycles uses 16000 = 1 ms at 16 MHz: the loop must keep 1 kHz).
 set -euo pipefail
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ROOT="$(cd "$HERE/../../.." && pwd)"
@@ -28,4 +30,10 @@ read -r flash0 ram0 < <(size_line "$OUT/empty.elf")
 echo "[avr-core] harness ELF: flash $flash B, static RAM $ram B (an empty program: $flash0 B, $ram0 B)" >&2
 core_size_hex="$(avr-nm -S "$OUT/core_cycles.elf" | awk '$4=="core" {print $2}')"
 echo "[avr-core] sizeof(nigel_t): $((16#$core_size_hex)) B" >&2
-XDG_CACHE_HOME="$OUT/.cache" "$OUT/sim_core_cycles" "$OUT/core_cycles.elf" "$(addr core_results)" "$(addr core_done)"
+json="$(XDG_CACHE_HOME="$OUT/.cache" "$OUT/sim_core_cycles" "$OUT/core_cycles.elf" "$(addr core_results)" "$(addr core_done)" 2>/dev/null)"
+echo "$json"
+if [ -n "${AVR_CORE_MAX_PASS_CYCLES:-}" ]; then
+  worst="$(echo "$json" | tr ',{}' '\n\n\n' | awk -F': ' '/"step_/ {if ($2 > m) {m = $2; k = $1}} END {print m, k}')"
+  echo "[avr-core] most expensive loop pass: ${worst#* } ${worst%% *} cycles (limit $AVR_CORE_MAX_PASS_CYCLES)" >&2
+  [ "${worst%% *}" -le "$AVR_CORE_MAX_PASS_CYCLES" ] || { echo "[avr-core] FAIL: a loop pass exceeds the limit" >&2; exit 1; }
+fi
