@@ -225,3 +225,84 @@ TEST(SimCamera, OverheadRoofTagsDecodeAtTrueIdsAndHeadings) {
   tag36h11_destroy(fam);
   sim_camera_destroy(c);
 }
+
+extern "C" {
+#include <autodrive_camera_info_t.h>
+#include <autodrive_compressed_image_t.h>
+#include <lcm/lcm.h>
+}
+
+namespace {
+struct GotImg {
+  int n = 0;
+  std::vector<uint8_t> data;
+  std::string format, frame;
+  int w = 0, h = 0;
+  int64_t utime = 0;
+};
+void on_img(const lcm_recv_buf_t *, const char *, const autodrive_compressed_image_t *msg,
+            void *user) {
+  GotImg *g = static_cast<GotImg *>(user);
+  g->n++;
+  g->data.assign(msg->data, msg->data + msg->size_bytes);
+  g->format = msg->format;
+  g->frame = msg->frame_id;
+  g->w = msg->width_px;
+  g->h = msg->height_px;
+  g->utime = msg->utime;
+}
+struct GotInfo {
+  int n = 0;
+  double k[9] = {0};
+  int num_d = -1;
+  std::string model;
+};
+void on_info(const lcm_recv_buf_t *, const char *, const autodrive_camera_info_t *msg, void *user) {
+  GotInfo *g = static_cast<GotInfo *>(user);
+  g->n++;
+  std::copy(msg->k, msg->k + 9, g->k);
+  g->num_d = msg->num_d;
+  g->model = msg->distortion_model;
+}
+}  // namespace
+
+TEST(SimCamera, PublishesJpegAndCameraInfoOnLcm) {
+  Scene s;
+  ASSERT_NE(s.r, nullptr);
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
+                                      85, err, sizeof err);
+  ASSERT_NE(c, nullptr) << err;
+  lcm_t *lcm = lcm_create("memq://");
+  ASSERT_NE(lcm, nullptr);
+  GotImg img;
+  GotInfo info;
+  autodrive_compressed_image_t_subscription_t *s1 =
+      autodrive_compressed_image_t_subscribe(lcm, "NIGEL1_CAM_FRONT", on_img, &img);
+  autodrive_camera_info_t_subscription_t *s2 =
+      autodrive_camera_info_t_subscribe(lcm, "NIGEL1_CAM_FRONT_INFO", on_info, &info);
+  EXPECT_NE(sim_camera_publish_image(c, lcm, "NIGEL1_CAM_FRONT"), 0);  // nothing captured yet
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 5000), 0);
+  ASSERT_EQ(sim_camera_publish_image(c, lcm, "NIGEL1_CAM_FRONT"), 0);
+  ASSERT_EQ(sim_camera_publish_info(c, s.room.m, lcm, "NIGEL1_CAM_FRONT_INFO", 5000), 0);
+  for (int i = 0; i < 2; i++) ASSERT_GE(lcm_handle_timeout(lcm, 1000), 0);
+  ASSERT_EQ(img.n, 1);
+  size_t n = 0;
+  const uint8_t *jpg = sim_camera_jpeg(c, &n);
+  EXPECT_EQ(img.data, std::vector<uint8_t>(jpg, jpg + n));
+  EXPECT_EQ(img.format, "jpeg");
+  EXPECT_EQ(img.frame, "camera_front");
+  EXPECT_EQ(img.w, 640);
+  EXPECT_EQ(img.h, 480);
+  EXPECT_EQ(img.utime, 5000);
+  ASSERT_EQ(info.n, 1);
+  double k[9];
+  sim_camera_intrinsics(s.room.m, mj_name2id(s.room.m, mjOBJ_CAMERA, "car_cam_front"), 640, 480, k);
+  for (int i = 0; i < 9; i++) EXPECT_EQ(info.k[i], k[i]);
+  EXPECT_EQ(info.num_d, 5);
+  EXPECT_EQ(info.model, "plumb_bob");
+  autodrive_compressed_image_t_unsubscribe(lcm, s1);
+  autodrive_camera_info_t_unsubscribe(lcm, s2);
+  lcm_destroy(lcm);
+  sim_camera_destroy(c);
+}

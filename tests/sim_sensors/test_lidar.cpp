@@ -219,3 +219,64 @@ TEST(SimLidar, BadInputGivesClearError) {
   EXPECT_EQ(sim_lidar_create(r.m, "car", &cfg, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("range"), std::string::npos) << err;
 }
+
+extern "C" {
+#include <autodrive_lidar_scan_t.h>
+#include <lcm/lcm.h>
+
+#include "sim_lidar_lcm.h"
+}
+
+namespace {
+struct Got {
+  int n = 0;
+  std::vector<float> ranges;
+  std::string frame;
+  float inc = 0, amax = 0, rmax = 0;
+  int64_t utime = 0;
+};
+void on_scan(const lcm_recv_buf_t *, const char *, const autodrive_lidar_scan_t *msg, void *user) {
+  Got *g = static_cast<Got *>(user);
+  g->n++;
+  g->ranges.assign(msg->ranges_m, msg->ranges_m + msg->num_ranges);
+  g->frame = msg->frame_id;
+  g->inc = msg->angle_increment_rad;
+  g->amax = msg->angle_max_rad;
+  g->rmax = msg->range_max_m;
+  g->utime = msg->utime;
+}
+}  // namespace
+
+TEST(SimLidar, PublishesLidarScanOnLcm) {
+  room::Room r;
+  ASSERT_NE(r.m, nullptr);
+  sim_lidar_config_t cfg;
+  sim_lidar_config_default(&cfg);
+  cfg.range_max_m = 2.0;  // so the message carries +inf too
+  sim_lidar_t *l = make_lidar(r.m, cfg);
+  ASSERT_NE(l, nullptr);
+  lcm_t *lcm = lcm_create("memq://");
+  ASSERT_NE(lcm, nullptr);
+  Got got;
+  autodrive_lidar_scan_t_subscription_t *sub =
+      autodrive_lidar_scan_t_subscribe(lcm, "NIGEL1_LIDAR", on_scan, &got);
+  EXPECT_EQ(sim_lidar_publish(lcm, "NIGEL1_LIDAR", "laser", sim_lidar_last_scan(l)), -1);  // empty
+  sim_lidar_scan_now(r.m, r.d, l, 777);
+  ASSERT_EQ(sim_lidar_publish(lcm, "NIGEL1_LIDAR", "laser", sim_lidar_last_scan(l)), 0);
+  ASSERT_GE(lcm_handle_timeout(lcm, 1000), 0);
+  ASSERT_EQ(got.n, 1);
+  EXPECT_EQ(got.utime, 777);
+  EXPECT_EQ(got.frame, "laser");
+  EXPECT_NEAR(got.amax, 359 * M_PI / 180, 1e-5);
+  EXPECT_FLOAT_EQ(got.rmax, 2.0f);
+  ASSERT_EQ(got.ranges.size(), 360u);
+  int inf = 0;
+  for (int i = 0; i < 360; i++) {
+    EXPECT_EQ(got.ranges[i], sim_lidar_last_scan(l)->ranges_m[i]) << "ray " << i;
+    inf += std::isinf(got.ranges[i]);
+  }
+  EXPECT_GT(inf, 0);
+  autodrive_lidar_scan_t_unsubscribe(lcm, sub);
+  lcm_destroy(lcm);
+  sim_lidar_destroy(l);
+}
