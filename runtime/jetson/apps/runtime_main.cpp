@@ -1,0 +1,116 @@
+// autodrive-runtime: runs the Jetson runtime components (Nano bridge, RPLIDAR driver,
+// cameras, estimator), all of them or a subset (--only), each in its own thread with its own
+// LCM instance. They talk only through LCM, so any split across processes behaves the same.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <csignal>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "bridge/nano_bridge.hpp"
+#include "camera/camera_driver.hpp"
+#include "common/config.hpp"
+#include "estimator/estimator_node.hpp"
+#include "rplidar/rplidar_driver.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char **argv) {
+  CLI::App app{"autodrive-runtime: the Nigel Jetson runtime (Nano bridge, RPLIDAR, cameras, "
+               "EKF estimator) over LCM. The same binary drives the car, the simulator's ptys "
+               "and the firmware in simavr: only the device paths in the config change."};
+  std::string config_path, only, level = "info";
+  app.add_option("--config", config_path, "YAML config (runtime/jetson/config/*.yaml)")->required();
+  app.add_option("--only", only,
+                 "comma-separated subset of: bridge,lidar,camera,estimator (default: every "
+                 "component with a section in the config)");
+  app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(level));
+
+  cfg::Config config;
+  try {
+    config = cfg::load(config_path);
+  } catch (const cfg::Error &e) {
+    spdlog::error("bad config: {}", e.what());
+    return 2;
+  }
+  std::set<std::string> want;
+  if (only.empty()) {
+    if (config.has_bridge) want.insert("bridge");
+    if (config.has_lidar) want.insert("lidar");
+    if (!config.cameras.empty()) want.insert("camera");
+    if (config.has_estimator) want.insert("estimator");
+  } else {
+    std::stringstream ss(only);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      if (item != "bridge" && item != "lidar" && item != "camera" && item != "estimator") {
+        spdlog::error("--only: unknown component '{}' (bridge, lidar, camera, estimator)", item);
+        return 2;
+      }
+      want.insert(item);
+    }
+  }
+  if (want.empty()) {
+    spdlog::error("{}: no component to run (no bridge/lidar/cameras/estimator section)", config.file);
+    return 2;
+  }
+
+  // Build every component first so that a bad section fails before anything starts.
+  std::vector<std::function<void()>> runners;
+  std::unique_ptr<bridge::NanoBridge> br;
+  std::unique_ptr<rplidar::Driver> lidar;
+  std::unique_ptr<est::EstimatorNode> estimator;
+  std::vector<std::unique_ptr<cam::CameraDriver>> cameras;
+  auto check = [](const std::string &what, const std::string &err) {
+    if (err.empty()) return true;
+    spdlog::error("{}: {}", what, err);
+    return false;
+  };
+  if (want.count("bridge")) {
+    br = std::make_unique<bridge::NanoBridge>(config);
+    if (!check("bridge", br->init_error())) return 2;
+    runners.push_back([&] { br->run(g_stop); });
+  }
+  if (want.count("lidar")) {
+    lidar = std::make_unique<rplidar::Driver>(config);
+    if (!check("lidar", lidar->init_error())) return 2;
+    runners.push_back([&] { lidar->run(g_stop); });
+  }
+  if (want.count("estimator")) {
+    estimator = std::make_unique<est::EstimatorNode>(config);
+    if (!check("estimator", estimator->init_error())) return 2;
+    runners.push_back([&] { estimator->run(g_stop); });
+  }
+  if (want.count("camera")) {
+    if (config.cameras.empty()) {
+      spdlog::error("{}: cameras: missing section", config.file);
+      return 2;
+    }
+    for (std::size_t i = 0; i < config.cameras.size(); ++i) {
+      cameras.push_back(std::make_unique<cam::CameraDriver>(config, i));
+      if (!check("camera", cameras.back()->init_error())) return 2;
+      cam::CameraDriver *c = cameras.back().get();
+      runners.push_back([c] { c->run(g_stop); });
+    }
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::string names;
+  for (const auto &w : want) names += (names.empty() ? "" : ",") + w;
+  spdlog::info("autodrive-runtime {}: running {} on {}", config.vehicle.name, names, config.lcm_url);
+  std::vector<std::thread> threads;
+  for (auto &r : runners) threads.emplace_back(r);
+  for (auto &t : threads) t.join();
+  spdlog::info("autodrive-runtime: stopped");
+  return 0;
+}

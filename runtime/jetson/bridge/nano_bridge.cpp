@@ -1,0 +1,334 @@
+#include "bridge/nano_bridge.hpp"
+
+#include <autodrive/imu_t.hpp>
+#include <autodrive/vehicle_command_t.hpp>
+#include <autodrive/vehicle_state_t.hpp>
+#include <lcm/lcm-cpp.hpp>
+#include <poll.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cstdio>
+#include <optional>
+
+#include "bridge/bridge_convert.hpp"
+#include "common/clock.hpp"
+#include "common/lcm_sub.hpp"
+#include "common/serial_port.hpp"
+#include "proto.h"
+
+namespace bridge {
+
+const char *link_state_name(LinkState s) {
+  switch (s) {
+    case LinkState::no_device: return "no_device";
+    case LinkState::handshaking: return "handshaking";
+    case LinkState::linked: return "linked";
+    case LinkState::refused: return "refused";
+  }
+  return "?";
+}
+
+namespace {
+std::string hex32(uint32_t v) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%08" PRIx32, v);
+  return b;
+}
+}  // namespace
+
+struct NanoBridge::Impl {
+  cfg::Config config;
+  std::string tag;  // log prefix
+  lcm::LCM lcm;
+  clk::Clock clock;
+  ser::SerialPort port;
+  proto_parser_t parser{};
+  mutable std::mutex mu;  // guards status
+  Status st;
+
+  std::optional<autodrive::vehicle_command_t> latest_cmd;
+  int64_t latest_cmd_rx_us = 0;  // monotonic
+  uint16_t cmd_seq = 0;
+  uint8_t frame_seq = 0;
+  int64_t next_tx_us = 0;         // next heartbeat / hello [monotonic us]
+  int64_t next_open_us = 0;
+  int64_t last_rx_frame_us = 0;   // last good frame from the Nano
+  bool open_failure_logged = false;
+  bool rejected_logged = false;
+
+  explicit Impl(const cfg::Config &c)
+      : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
+    proto_parser_init(&parser);
+    if (lcm.good()) {
+      lcmsub::subscribe<autodrive::vehicle_command_t, Impl, &Impl::on_command>(
+          lcm, c.vehicle.name + "_COMMAND", this);
+      clock.attach(lcm);
+    }
+  }
+
+  LinkState state() const {
+    std::lock_guard<std::mutex> g(mu);
+    return st.state;
+  }
+  void set_state(LinkState s) {
+    std::lock_guard<std::mutex> g(mu);
+    st.state = s;
+  }
+  template <typename F>
+  void count(F f) {
+    std::lock_guard<std::mutex> g(mu);
+    f(st);
+  }
+
+  int64_t heartbeat_period_us() const {
+    return static_cast<int64_t>(1e6 / config.bridge.heartbeat_hz);
+  }
+
+  void on_command(const autodrive::vehicle_command_t *m) {
+    const std::string why = command_problem(*m);
+    if (!why.empty()) {
+      // Rejected commands do not refresh the stream: a sender gone wrong disengages the car.
+      count([](Status &s) { ++s.commands_rejected; });
+      if (!rejected_logged) spdlog::warn("{}command rejected (seq {}): {}", tag, m->seq, why);
+      rejected_logged = true;
+      return;
+    }
+    rejected_logged = false;
+    latest_cmd = *m;
+    latest_cmd_rx_us = clk::monotonic_us();
+    // Forward at once (latency), then keep the heartbeat going from here.
+    if (state() == LinkState::linked) {
+      send_command(latest_cmd_rx_us);
+      next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
+    }
+  }
+
+  void write_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
+    uint8_t frame[PROTO_MAX_FRAME];
+    const size_t n = proto_frame_encode(id, frame_seq++, payload, len, frame, sizeof frame);
+    const int r = port.write_all(frame, n);
+    if (r < 0) lose_device(port.error());
+    else if (r == 0) spdlog::warn("{}{}", tag, port.error());
+  }
+
+  void send_command(int64_t now_us) {
+    const bool fresh = latest_cmd.has_value() &&
+                       now_us - latest_cmd_rx_us <= config.bridge.command_timeout_ms * 1000LL;
+    const proto_command_t c =
+        make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
+    uint8_t payload[PROTO_LEN_COMMAND];
+    proto_command_pack(&c, payload);
+    write_frame(PROTO_ID_COMMAND, payload, PROTO_LEN_COMMAND);
+    count([&](Status &s) {
+      ++s.commands_sent;
+      if (c.flags & PROTO_CMD_ENGAGED) ++s.engaged_sent;
+    });
+  }
+
+  void send_hello_request() {
+    write_frame(PROTO_ID_HELLO_REQUEST, nullptr, 0);
+    count([](Status &s) { ++s.hellos_sent; });
+  }
+
+  void send_config() {
+    if (config.bridge.telemetry_period_ms == 0) return;
+    proto_config_t c{};
+    c.servo_trim_us = static_cast<int16_t>(config.bridge.servo_trim_us);
+    c.telemetry_period_ms = static_cast<uint16_t>(config.bridge.telemetry_period_ms);
+    c.failsafe_timeout_ms = static_cast<uint16_t>(config.bridge.failsafe_timeout_ms);
+    uint8_t payload[PROTO_LEN_CONFIG];
+    proto_config_pack(&c, payload);
+    write_frame(PROTO_ID_CONFIG, payload, PROTO_LEN_CONFIG);
+  }
+
+  void try_open(int64_t now_us) {
+    if (now_us < next_open_us) return;
+    next_open_us = now_us + config.bridge.reconnect_ms * 1000LL;
+    const std::string why = port.open(config.bridge.device, config.bridge.baud);
+    if (!why.empty()) {
+      if (!open_failure_logged)
+        spdlog::warn("{}cannot open the Nano: {}; retrying every {} ms", tag, why,
+                     config.bridge.reconnect_ms);
+      open_failure_logged = true;
+      return;
+    }
+    open_failure_logged = false;
+    spdlog::info("{}opened {} at {} baud; handshaking", tag, config.bridge.device,
+                 config.bridge.baud);
+    proto_parser_init(&parser);
+    count([](Status &s) {
+      ++s.opens;
+      s.state = LinkState::handshaking;
+    });
+    next_tx_us = now_us;
+    last_rx_frame_us = now_us;
+  }
+
+  void lose_device(const std::string &why) {
+    if (!port.is_open()) return;
+    spdlog::warn("{}lost the Nano: {}; reopening {} every {} ms", tag, why,
+                 config.bridge.device, config.bridge.reconnect_ms);
+    port.close();
+    count([](Status &s) {
+      ++s.disconnects;
+      s.state = LinkState::no_device;
+    });
+    next_open_us = clk::monotonic_us() + config.bridge.reconnect_ms * 1000LL;
+  }
+
+  HostLinkStats host_stats() const {
+    HostLinkStats h;
+    h.frames_ok = parser.stats.frames_ok;
+    h.bad_crc = parser.stats.bad_crc;
+    h.dropped = parser.stats.frames_dropped;
+    return h;
+  }
+
+  void on_hello(const proto_frame_t &f, int64_t now_us) {
+    proto_hello_t h{};
+    if (proto_hello_unpack(f.payload, f.len, &h) != 0) return;
+    const uint32_t ours = proto_schema_hash();
+    if (h.schema_hash != ours || h.proto_version != PROTO_VERSION) {
+      const std::string msg =
+          "schema mismatch on " + config.bridge.device + ": the Nano (firmware " +
+          std::to_string(h.fw_major) + "." + std::to_string(h.fw_minor) + "." +
+          std::to_string(h.fw_patch) + ") speaks protocol v" + std::to_string(h.proto_version) +
+          " schema " + hex32(h.schema_hash) + ", this runtime speaks protocol v" +
+          std::to_string(PROTO_VERSION) + " schema " + hex32(ours) +
+          "; link refused (flash matching firmware or rebuild the runtime)";
+      spdlog::error("{}{}", tag, msg);
+      count([&](Status &s) {
+        ++s.refusals;
+        s.last_refusal = msg;
+        s.state = LinkState::refused;
+      });
+      next_tx_us = now_us + config.bridge.refused_retry_ms * 1000LL;
+      return;
+    }
+    if (state() == LinkState::linked) return;  // a repeated HELLO: already linked
+    spdlog::info("{}linked: Nano firmware {}.{}.{} build {}, protocol v{} schema {}", tag,
+                 h.fw_major, h.fw_minor, h.fw_patch, h.build_id, h.proto_version,
+                 hex32(h.schema_hash));
+    count([](Status &s) {
+      ++s.handshakes;
+      s.state = LinkState::linked;
+    });
+    send_config();
+    next_tx_us = now_us;
+  }
+
+  void on_state(const proto_frame_t &f) {
+    proto_state_t s{};
+    if (proto_state_unpack(f.payload, f.len, &s) != 0) return;
+    const int64_t t = clock.now_us();
+    autodrive::vehicle_state_t vs{};
+    fill_state(s, config.vehicle, host_stats(), t, &vs);
+    lcm.publish(config.vehicle.name + "_STATE", &vs);
+    bool imu = (s.faults & PROTO_FAULT_IMU_LOST) == 0;
+    if (imu) {
+      autodrive::imu_t m{};
+      fill_imu(s, config.bridge, t, &m);
+      lcm.publish(config.vehicle.name + "_IMU", &m);
+    }
+    count([&](Status &st2) {
+      ++st2.states_published;
+      if (imu) ++st2.imu_published;
+    });
+  }
+
+  static void on_frame(const proto_frame_t *f, void *ctx) {
+    auto *self = static_cast<Impl *>(ctx);
+    const int64_t now = clk::monotonic_us();
+    self->last_rx_frame_us = now;
+    const LinkState s = self->state();
+    if (f->id == PROTO_ID_HELLO) {
+      self->on_hello(*f, now);
+    } else if (f->id == PROTO_ID_STATE && s == LinkState::linked) {
+      // Telemetry counts only from a Nano whose schema we checked.
+      self->on_state(*f);
+    } else if (f->id == PROTO_ID_NACK) {
+      proto_nack_t n{};
+      if (proto_nack_unpack(f->payload, f->len, &n) == 0) {
+        self->count([](Status &st2) { ++st2.nacks; });
+        spdlog::warn("{}Nano refused frame id 0x{:02x} seq {}: reason {}", self->tag,
+                     n.rejected_id, n.seq, n.reason);
+      }
+    }
+  }
+
+  void poll_once(const std::atomic<bool> &stop) {
+    const int64_t now = clk::monotonic_us();
+    if (!port.is_open()) try_open(now);
+
+    struct pollfd fds[2];
+    int nfds = 0;
+    fds[nfds++] = {lcm.getFileno(), POLLIN, 0};
+    if (port.is_open()) fds[nfds++] = {port.fd(), POLLIN, 0};
+    int64_t wait_us = 20000;
+    if (port.is_open()) wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
+    const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
+    if (stop) return;
+    if (r > 0 && (fds[0].revents & POLLIN)) lcm.handleTimeout(0);
+    if (r > 0 && nfds == 2 && port.is_open()) {
+      if (fds[1].revents & POLLIN) {
+        uint8_t buf[512];
+        const long n = port.read_some(buf, sizeof buf);
+        if (n < 0) lose_device(port.error());
+        else if (n > 0) proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
+      } else if (fds[1].revents & (POLLHUP | POLLERR | POLLNVAL)) {
+        lose_device(config.bridge.device + ": hang-up (unplugged, or the peer closed it)");
+      }
+    }
+    if (!port.is_open()) return;
+
+    const int64_t t = clk::monotonic_us();
+    const LinkState s = state();
+    if (s == LinkState::linked && t - last_rx_frame_us > config.bridge.link_timeout_ms * 1000LL) {
+      spdlog::warn("{}no frame from the Nano for {} ms; handshaking again", tag,
+                   config.bridge.link_timeout_ms);
+      set_state(LinkState::handshaking);
+      next_tx_us = t;
+    }
+    if (t < next_tx_us) return;
+    switch (state()) {
+      case LinkState::linked:
+        send_command(t);
+        next_tx_us = t + heartbeat_period_us();
+        break;
+      case LinkState::handshaking:
+        send_hello_request();
+        next_tx_us = t + config.bridge.hello_retry_ms * 1000LL;
+        break;
+      case LinkState::refused:
+        send_hello_request();  // the Nano may be reflashed meanwhile
+        next_tx_us = t + config.bridge.refused_retry_ms * 1000LL;
+        break;
+      case LinkState::no_device: break;
+    }
+  }
+};
+
+NanoBridge::NanoBridge(const cfg::Config &config) : impl_(std::make_unique<Impl>(config)) {}
+NanoBridge::~NanoBridge() = default;
+
+std::string NanoBridge::init_error() const {
+  if (!impl_->config.has_bridge) return impl_->config.file + ": bridge: missing section";
+  if (!impl_->lcm.good())
+    return "LCM URL '" + impl_->config.lcm_url +
+           "' unusable (for udpm on a host with no multicast route: ip route add 239.0.0.0/8 dev lo)";
+  return "";
+}
+
+void NanoBridge::run(const std::atomic<bool> &stop) {
+  while (!stop) impl_->poll_once(stop);
+  impl_->port.close();
+}
+
+Status NanoBridge::status() const {
+  std::lock_guard<std::mutex> g(impl_->mu);
+  return impl_->st;
+}
+
+}  // namespace bridge

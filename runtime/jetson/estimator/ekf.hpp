@@ -1,0 +1,90 @@
+// Planar EKF for Nigel (no I/O). State [x_m, y_m, yaw_rad, v_m_s, yaw_rate_rad_s] with a
+// constant-velocity process model. Measurements: wheel-odometry speed with the Ackermann yaw
+// rate from the applied steering angle, IMU gyro yaw rate, and absolute poses (Eye/IPS).
+// Late measurements: every measurement in the last `history_us` is kept with the state after
+// it; one that arrives out of order is inserted at its own time and the ones after it are
+// replayed, so a 100 ms-old Eye pose corrects the state as of 100 ms ago. Older than the
+// history -> dropped and counted. Missing measurements simply let the covariance grow.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include <cstdint>
+#include <deque>
+
+namespace est {
+
+using Vec5 = Eigen::Matrix<double, 5, 1>;
+using Mat5 = Eigen::Matrix<double, 5, 5>;
+
+struct EkfParams {
+  double wheelbase_m = 0.14154;
+  double q_pos_m = 0.01;          // position random walk [m/sqrt(s)]
+  double q_yaw_rad = 0.01;        // heading random walk [rad/sqrt(s)]
+  double q_accel_m_s2 = 1.0;      // speed change [m/s/sqrt(s)]
+  double q_yaw_accel_rad_s2 = 2.0;// yaw-rate change [rad/s/sqrt(s)]
+  double r_speed_m_s = 0.02;      // wheel-speed noise [m/s]
+  double r_ackermann_rad_s = 0.1; // Ackermann yaw-rate noise (slip, steering lag) [rad/s]
+  double r_gyro_rad_s = 0.02;     // gyro z noise [rad/s]
+  int64_t history_us = 1000000;   // how late a measurement may be [us]
+};
+
+struct Estimate {
+  int64_t t_us = 0;
+  Vec5 x = Vec5::Zero();
+  Mat5 P = Mat5::Identity();
+};
+
+struct EkfStats {
+  uint64_t fused = 0;       // measurements applied
+  uint64_t replays = 0;     // late measurements inserted in the past and replayed
+  uint64_t too_old = 0;     // dropped: older than the history window
+  uint64_t rejected = 0;    // dropped: non-finite values
+};
+
+double wrap_angle(double a_rad);  // to (-pi, pi]
+
+class Ekf {
+ public:
+  explicit Ekf(EkfParams p = {});
+  // Sets the state at t_us (pose with the given variances, zero speed).
+  void reset(int64_t t_us, double x_m, double y_m, double yaw_rad, double pos_var_m2,
+             double yaw_var_rad2);
+  bool initialised() const { return init_; }
+
+  void add_wheel(int64_t t_us, double speed_m_s, double steering_rad);
+  void add_gyro(int64_t t_us, double yaw_rate_rad_s);
+  // Absolute pose in the filter's frame, covariance x, y, yaw [m^2, rad^2].
+  void add_pose(int64_t t_us, double x_m, double y_m, double yaw_rad,
+                const Eigen::Matrix3d &cov);
+
+  // The latest estimate, predicted forward to t_us (no change to the filter).
+  Estimate estimate_at(int64_t t_us) const;
+  const Estimate &latest() const { return cur_; }
+  const EkfStats &stats() const { return stats_; }
+
+ private:
+  enum class Kind { wheel, gyro, pose };
+  struct Event {
+    int64_t t_us;
+    Kind kind;
+    Eigen::Matrix<double, 3, 1> z;   // wheel: speed, steering; gyro: rate; pose: x y yaw
+    Eigen::Matrix3d R;               // pose covariance
+    Estimate after;                  // the state right after this event
+  };
+  void add(Event e);
+  void apply(Event &e, const Estimate &before) const;
+  static void predict(Estimate &s, int64_t t_us, const EkfParams &p);
+  template <int M>
+  static void update(Estimate &s, const Eigen::Matrix<double, M, 1> &innov,
+                     const Eigen::Matrix<double, M, 5> &H, const Eigen::Matrix<double, M, M> &R);
+
+  EkfParams p_;
+  bool init_ = false;
+  Estimate base_;              // state before the oldest kept event
+  Estimate cur_;               // state after the newest event
+  std::deque<Event> events_;   // time-ordered
+  EkfStats stats_;
+};
+
+}  // namespace est

@@ -1,0 +1,131 @@
+#include "estimator/estimator_node.hpp"
+
+#include <autodrive/imu_t.hpp>
+#include <autodrive/odometry_t.hpp>
+#include <autodrive/pose2d_t.hpp>
+#include <autodrive/vehicle_state_t.hpp>
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+#include "common/lcm_sub.hpp"
+
+namespace est {
+
+bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano_us, int32_t l,
+                               int32_t r, int64_t nano_us, int counts_per_rev,
+                               double wheel_radius_m, double *speed_m_s) {
+  // The Nano clock is 32 bit: take the difference modulo 2^32.
+  const uint32_t dt_us = static_cast<uint32_t>(nano_us) - static_cast<uint32_t>(prev_nano_us);
+  if (dt_us == 0 || dt_us > 1000000u) return false;
+  const double dl = static_cast<double>(static_cast<int64_t>(l) - prev_l);
+  const double dr = static_cast<double>(static_cast<int64_t>(r) - prev_r);
+  const double dist_m = 0.5 * (dl + dr) / counts_per_rev * 2.0 * M_PI * wheel_radius_m;
+  *speed_m_s = dist_m / (dt_us * 1e-6);
+  return true;
+}
+
+EkfParams params_from_config(const cfg::Config &c) {
+  EkfParams p;
+  p.wheelbase_m = c.vehicle.wheelbase_m;
+  p.q_pos_m = c.estimator.process_pos_std_m;
+  p.q_yaw_rad = c.estimator.process_yaw_std_rad;
+  p.r_speed_m_s = c.estimator.odom_speed_std_m_s;
+  p.r_gyro_rad_s = c.estimator.yaw_rate_std_rad_s;
+  p.history_us = c.estimator.history_ms * 1000LL;
+  return p;
+}
+
+struct EstimatorNode::Impl {
+  cfg::Config config;
+  lcm::LCM lcm;
+  Ekf odom, map;
+  bool have_prev = false;
+  autodrive::vehicle_state_t prev{};
+  int64_t last_pub_us = 0;
+
+  explicit Impl(const cfg::Config &c)
+      : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
+    if (!lcm.good()) return;
+    const std::string v = c.vehicle.name;
+    lcmsub::subscribe<autodrive::vehicle_state_t, Impl, &Impl::on_state>(lcm, v + "_STATE", this);
+    lcmsub::subscribe<autodrive::imu_t, Impl, &Impl::on_imu>(lcm, v + "_IMU", this);
+    lcmsub::subscribe<autodrive::pose2d_t, Impl, &Impl::on_pose>(lcm, v + "_POSE_EYE", this);
+  }
+
+  void on_state(const autodrive::vehicle_state_t *m) {
+    if (!odom.initialised()) odom.reset(m->utime, 0, 0, 0, 1e-9, 1e-9);
+    if (have_prev) {
+      double v = 0;
+      if (wheel_speed_from_encoders(prev.encoder_counts[0], prev.encoder_counts[1],
+                                    prev.nano_time_us, m->encoder_counts[0],
+                                    m->encoder_counts[1], m->nano_time_us,
+                                    config.vehicle.encoder_counts_per_rev,
+                                    config.vehicle.wheel_radius_m, &v)) {
+        odom.add_wheel(m->utime, v, m->steering_angle_rad);
+        map.add_wheel(m->utime, v, m->steering_angle_rad);
+      }
+    }
+    prev = *m;
+    have_prev = true;
+    const int64_t period_us = static_cast<int64_t>(1e6 / config.estimator.rate_hz);
+    if (m->utime - last_pub_us >= period_us - 500) {
+      last_pub_us = m->utime;
+      publish(odom.estimate_at(m->utime), "odom", "_ODOM");
+      if (map.initialised()) publish(map.estimate_at(m->utime), "map", "_POSE_MAP");
+    }
+  }
+
+  void on_imu(const autodrive::imu_t *m) {
+    if (!config.estimator.use_imu) return;
+    odom.add_gyro(m->utime, m->angular_velocity_rad_s[2]);
+    map.add_gyro(m->utime, m->angular_velocity_rad_s[2]);
+  }
+
+  void on_pose(const autodrive::pose2d_t *m) {
+    Eigen::Matrix3d cov = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m->covariance);
+    // A zero covariance means "not given": use the configured Eye noise.
+    if (cov.diagonal().minCoeff() <= 0.0) {
+      cov = Eigen::Matrix3d::Zero();
+      cov(0, 0) = cov(1, 1) = std::pow(config.estimator.eye_pos_std_m, 2);
+      cov(2, 2) = std::pow(config.estimator.eye_yaw_std_rad, 2);
+    }
+    map.add_pose(m->utime, m->x_m, m->y_m, m->yaw_rad, cov);
+  }
+
+  void publish(const Estimate &e, const char *frame, const char *suffix) {
+    autodrive::odometry_t o{};
+    o.utime = e.t_us;
+    o.vehicle = config.vehicle.name;
+    o.frame_id = frame;
+    o.child_frame_id = "base_link";
+    o.x_m = e.x(0);
+    o.y_m = e.x(1);
+    o.yaw_rad = e.x(2);
+    o.vx_m_s = e.x(3);
+    o.vy_m_s = 0.0;  // Ackermann, no side slip in the model
+    o.yaw_rate_rad_s = e.x(4);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) o.pose_covariance[r * 3 + c] = e.P(r, c);
+    for (double &v : o.twist_covariance) v = 0.0;
+    o.twist_covariance[0] = e.P(3, 3);
+    o.twist_covariance[8] = e.P(4, 4);
+    lcm.publish(config.vehicle.name + suffix, &o);
+  }
+};
+
+EstimatorNode::EstimatorNode(const cfg::Config &config) : impl_(std::make_unique<Impl>(config)) {}
+EstimatorNode::~EstimatorNode() = default;
+
+std::string EstimatorNode::init_error() const {
+  if (!impl_->config.has_estimator) return impl_->config.file + ": estimator: missing section";
+  if (!impl_->lcm.good()) return "LCM URL '" + impl_->config.lcm_url + "' unusable";
+  return "";
+}
+
+void EstimatorNode::run(const std::atomic<bool> &stop) {
+  while (!stop) impl_->lcm.handleTimeout(20);
+}
+
+}  // namespace est

@@ -1,0 +1,35 @@
+// State estimator component: <VEH>_STATE (encoders, applied steering) + <VEH>_IMU (gyro z)
+// + <VEH>_POSE_EYE -> <VEH>_ODOM (odometry only, continuous) and <VEH>_POSE_MAP (with the
+// Eye, in the map frame). Publishes at each STATE, at most at estimator.rate_hz.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "common/config.hpp"
+#include "estimator/ekf.hpp"
+
+namespace est {
+
+// Converts two encoder samples to the mean rear-wheel speed [m/s]; dt from the Nano clock
+// (a u32 microsecond counter that wraps). Returns false if dt is not usable.
+bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano_us,
+                               int32_t l, int32_t r, int64_t nano_us, int counts_per_rev,
+                               double wheel_radius_m, double *speed_m_s);
+
+EkfParams params_from_config(const cfg::Config &c);
+
+class EstimatorNode {
+ public:
+  explicit EstimatorNode(const cfg::Config &config);
+  ~EstimatorNode();
+  std::string init_error() const;
+  void run(const std::atomic<bool> &stop);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace est

@@ -1,0 +1,270 @@
+// The Nano bridge against a pty peer made of the shared proto codec (a fake Nano), over real
+// LCM UDP multicast. No wall-time asserts: every wait is "until it happens" with a generous
+// upper bound that only turns a hang into a failure.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
+
+#include <autodrive/imu_t.hpp>
+#include <autodrive/vehicle_command_t.hpp>
+#include <autodrive/vehicle_state_t.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include "bridge/nano_bridge.hpp"
+#include "common/config.hpp"
+#include "common/lcm_sub.hpp"
+#include "fake_nano.hpp"
+
+namespace {
+
+std::string config_yaml(int port, const std::string &device) {
+  return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0\"\n"
+         "clock: wall\n"
+         "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
+         "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
+         "bridge: {device: " + device + ", baud: 500000, heartbeat_hz: 50,\n"
+         "         command_timeout_ms: 200, hello_retry_ms: 50, refused_retry_ms: 50,\n"
+         "         reconnect_ms: 50, link_timeout_ms: 2000, telemetry_period_ms: 10,\n"
+         "         imu: {gyro_var_rad2_s2: 0.0004}}\n";
+}
+
+class BridgeHarness {
+ public:
+  BridgeHarness(int port, uint32_t hash = proto_schema_hash())
+      : link_("/tmp/adr-rt-test-" + std::to_string(getpid()) + "-" + std::to_string(port)),
+        nano(link_, hash),
+        config(cfg::parse(config_yaml(port, link_), "test config")),
+        lcm(config.lcm_url) {
+    lcmsub::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
+        lcm, "TESTCAR_STATE", this);
+    lcmsub::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(lcm, "TESTCAR_IMU",
+                                                                              this);
+  }
+  ~BridgeHarness() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  void start() {
+    bridge_ = std::make_unique<bridge::NanoBridge>(config);
+    ASSERT_EQ(bridge_->init_error(), "");
+    thread_ = std::thread([this] { bridge_->run(stop_); });
+  }
+  bridge::Status status() const { return bridge_->status(); }
+
+  // Runs the fake Nano (telemetry every ~10 ms once it said hello) and the LCM side until
+  // pred() holds; false after max_s seconds.
+  bool wait_for(const std::function<bool()> &pred, double max_s = 20.0) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(max_s);
+    while (std::chrono::steady_clock::now() < end) {
+      if (nano.pty.is_open()) nano.pump(5);
+      else std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (send_states && nano.hellos_sent > 0 && nano.pty.is_open()) {
+        proto_state_t s{};
+        s.nano_time_us = static_cast<uint32_t>(10000u * ++state_count_);
+        s.enc_counts[0] = enc_left;
+        s.enc_counts[1] = 2 * enc_left;
+        s.throttle_milli = 250;
+        s.gyro_raw[2] = 655;
+        s.quat_q14[0] = PROTO_QUAT_ONE;
+        s.battery_mv = 11700;
+        s.mode = PROTO_MODE_ENGAGED;
+        nano.send_state(s);
+      }
+      lcm.handleTimeout(1);
+      if (pred()) return true;
+    }
+    return pred();
+  }
+
+  void publish_command(float throttle, float steering, bool engaged, int8_t headlights = 1,
+                       int8_t indicators = 2) {
+    autodrive::vehicle_command_t c{};
+    c.seq = cmd_seq_++;
+    c.throttle = throttle;
+    c.steering = steering;
+    c.headlights = headlights;
+    c.indicators = indicators;
+    c.engaged = engaged;
+    lcm.publish("TESTCAR_COMMAND", &c);
+  }
+
+  std::string link_;
+  rtest::FakeNano nano;
+  cfg::Config config;
+  lcm::LCM lcm;
+  bool send_states = true;
+  int32_t enc_left = 100;
+  std::vector<autodrive::vehicle_state_t> states;
+  std::vector<autodrive::imu_t> imus;
+
+ private:
+  void on_state(const autodrive::vehicle_state_t *m) {
+    states.push_back(*m);
+  }
+  void on_imu(const autodrive::imu_t *m) {
+    imus.push_back(*m);
+  }
+  std::unique_ptr<bridge::NanoBridge> bridge_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  int state_count_ = 0;
+  int32_t cmd_seq_ = 0;
+};
+
+int count_engaged(const std::vector<proto_command_t> &cmds, std::size_t from = 0) {
+  int n = 0;
+  for (std::size_t i = from; i < cmds.size(); ++i) n += (cmds[i].flags & PROTO_CMD_ENGAGED) ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+TEST(BridgePty, HandshakeThenStateAndImuPublished) {
+  BridgeHarness h(7760);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 5 && h.imus.size() >= 5; }));
+  EXPECT_EQ(h.status().state, bridge::LinkState::linked);
+  EXPECT_GE(h.nano.hello_requests, 1);
+  // CONFIG sent after the handshake with the configured telemetry period.
+  EXPECT_GE(h.nano.configs, 1);
+  EXPECT_EQ(h.nano.last_config.telemetry_period_ms, 10);
+  const auto &s = h.states.back();
+  EXPECT_EQ(s.encoder_counts[0], 100);
+  EXPECT_EQ(s.encoder_counts[1], 200);
+  EXPECT_NEAR(s.throttle_applied, 0.25, 1e-6);
+  EXPECT_NEAR(s.battery_voltage_v, 11.7, 1e-5);
+  EXPECT_GT(s.host_frames_ok, 0);
+  const auto &m = h.imus.back();
+  EXPECT_NEAR(m.angular_velocity_rad_s[2], 10.0 * M_PI / 180.0, 1e-9);
+  EXPECT_DOUBLE_EQ(m.angular_velocity_covariance[8], 0.0004);
+}
+
+TEST(BridgePty, SchemaMismatchRefused) {
+  BridgeHarness h(7761, proto_schema_hash() ^ 0x5A5A5A5Au);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().refusals >= 1; }));
+  // Keep the peer talking (HELLOs and STATE frames) for several more retries.
+  const int hellos = h.nano.hello_requests;
+  ASSERT_TRUE(h.wait_for([&] { return h.nano.hello_requests >= hellos + 3; }));
+  const bridge::Status st = h.status();
+  EXPECT_EQ(st.state, bridge::LinkState::refused);
+  EXPECT_TRUE(h.nano.commands.empty()) << "commands sent to a mismatched Nano";
+  EXPECT_TRUE(h.states.empty()) << "telemetry published from a mismatched Nano";
+  // The message names both schema hashes and versions.
+  char ours[16], theirs[16];
+  std::snprintf(ours, sizeof ours, "0x%08x", proto_schema_hash());
+  std::snprintf(theirs, sizeof theirs, "0x%08x", proto_schema_hash() ^ 0x5A5A5A5Au);
+  EXPECT_NE(st.last_refusal.find(ours), std::string::npos) << st.last_refusal;
+  EXPECT_NE(st.last_refusal.find(theirs), std::string::npos) << st.last_refusal;
+  EXPECT_NE(st.last_refusal.find("firmware 1.2.3"), std::string::npos) << st.last_refusal;
+  EXPECT_NE(st.last_refusal.find("protocol v1"), std::string::npos) << st.last_refusal;
+}
+
+TEST(BridgePty, CommandsForwarded) {
+  BridgeHarness h(7762);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  // Heartbeat before any LCM command: frames flow, never engaged.
+  ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= 3; }));
+  EXPECT_EQ(count_engaged(h.nano.commands), 0);
+  auto found = [&] {
+    for (const auto &c : h.nano.commands)
+      if (c.throttle_milli == 500 && c.steering_milli == -250 && c.headlights == 1 &&
+          c.indicators == 2 && (c.flags & PROTO_CMD_ENGAGED))
+        return true;
+    return false;
+  };
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.5f, -0.25f, true);
+    return found();
+  }));
+}
+
+TEST(BridgePty, StaleCommandsDisengage) {
+  BridgeHarness h(7763);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.4f, 0.1f, true);
+    return count_engaged(h.nano.commands) >= 3;
+  }));
+  // Stop publishing: the heartbeat must go on, disengaged, throttle 0, lights kept.
+  const std::size_t mark = h.nano.commands.size();
+  auto disengaged_after_mark = [&] {
+    for (std::size_t i = mark; i < h.nano.commands.size(); ++i) {
+      const auto &c = h.nano.commands[i];
+      if (!(c.flags & PROTO_CMD_ENGAGED) && c.throttle_milli == 0) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(h.wait_for(disengaged_after_mark));
+  // Once disengaged it stays so while no command arrives.
+  std::size_t first = mark;
+  while (first < h.nano.commands.size() && (h.nano.commands[first].flags & PROTO_CMD_ENGAGED)) ++first;
+  const std::size_t target = h.nano.commands.size() + 5;
+  ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= target; }));
+  EXPECT_EQ(count_engaged(h.nano.commands, first), 0);
+  EXPECT_EQ(h.nano.commands.back().headlights, 1);
+  EXPECT_EQ(h.nano.commands.back().indicators, 2);
+  // A fresh command re-engages.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    return count_engaged(h.nano.commands, first) >= 1;
+  }));
+}
+
+TEST(BridgePty, InvalidCommandsRejectedNotForwarded) {
+  BridgeHarness h(7764);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(3.0f, 0.0f, true);  // throttle out of range
+    return h.status().commands_rejected >= 3;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands), 0);
+}
+
+TEST(BridgePty, ReconnectsAfterDeviceDisappears) {
+  BridgeHarness h(7765);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 3; }));
+  // Unplug: the device and its symlink vanish.
+  h.nano.close();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().disconnects >= 1; }));
+  EXPECT_EQ(h.status().state, bridge::LinkState::no_device);
+  // Replug (a new pty, as after a sim restart) with new telemetry values.
+  h.enc_left = 5000;
+  h.nano.hellos_sent = 0;
+  h.nano.open();
+  ASSERT_TRUE(h.wait_for([&] { return !h.states.empty() && h.states.back().encoder_counts[0] == 5000; }));
+  const bridge::Status st = h.status();
+  EXPECT_EQ(st.state, bridge::LinkState::linked);
+  EXPECT_GE(st.opens, 2u);
+  EXPECT_GE(st.handshakes, 2u);
+  // Commands flow to the new device.
+  h.nano.commands.clear();
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.2f, 0.0f, true);
+    return count_engaged(h.nano.commands) >= 1;
+  }));
+}
+
+TEST(BridgePty, MissingDeviceRetriedUntilItAppears) {
+  BridgeHarness h(7766);
+  h.start();  // no device yet
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::no_device; }, 5));
+  h.nano.open();
+  ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 2; }));
+  EXPECT_EQ(h.status().opens, 1u);
+}

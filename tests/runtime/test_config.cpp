@@ -1,0 +1,90 @@
+// Config loading: the shipped configs parse; a missing or bad key names the file and key.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "common/config.hpp"
+
+namespace {
+const char *kGood = R"(
+lcm_url: "udpm://239.255.76.67:7667?ttl=0"
+clock: wall
+vehicle: {name: NIGEL1, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,
+          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}
+bridge: {device: /dev/ttyUSB0, baud: 500000, heartbeat_hz: 50, command_timeout_ms: 200}
+)";
+
+std::string error_of(const std::string &text) {
+  try {
+    cfg::parse(text, "test.yaml");
+  } catch (const cfg::Error &e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string replace(std::string s, const std::string &from, const std::string &to) {
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+}  // namespace
+
+TEST(Config, GoodConfigParses) {
+  const cfg::Config c = cfg::parse(kGood, "test.yaml");
+  EXPECT_EQ(c.vehicle.name, "NIGEL1");
+  EXPECT_TRUE(c.has_bridge);
+  EXPECT_FALSE(c.has_lidar);
+  EXPECT_EQ(c.bridge.device, "/dev/ttyUSB0");
+  EXPECT_EQ(c.bridge.baud, 500000);
+  EXPECT_EQ(c.clock, cfg::ClockMode::wall);
+}
+
+TEST(Config, MissingKeyNamesFileAndKey) {
+  const std::string e = error_of(replace(kGood, "baud: 500000, ", ""));
+  EXPECT_EQ(e, "test.yaml: bridge.baud: missing key");
+}
+
+TEST(Config, BadValueNamesKeyAndValue) {
+  const std::string e = error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: fast"));
+  EXPECT_EQ(e, "test.yaml: bridge.heartbeat_hz: bad value 'fast'");
+}
+
+TEST(Config, NegativeRateRefused) {
+  EXPECT_NE(error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: -5"))
+                .find("bridge.heartbeat_hz: must be"),
+            std::string::npos);
+}
+
+TEST(Config, UnknownKeyRefused) {
+  EXPECT_EQ(error_of(replace(kGood, "baud: 500000", "baud: 500000, devcie: x")),
+            "test.yaml: bridge.devcie: unknown key");
+}
+
+TEST(Config, BadClockRefused) {
+  EXPECT_EQ(error_of(replace(kGood, "clock: wall", "clock: lunar")),
+            "test.yaml: clock: must be 'wall' or 'sim', got 'lunar'");
+}
+
+TEST(Config, MalformedYamlRefused) {
+  EXPECT_NE(error_of("vehicle: [unclosed").find("test.yaml: not valid YAML"), std::string::npos);
+}
+
+TEST(Config, MissingFileNamed) {
+  try {
+    cfg::load("/nonexistent/runtime.yaml");
+    FAIL() << "no error";
+  } catch (const cfg::Error &e) {
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/runtime.yaml: cannot open the config file");
+  }
+}
+
+TEST(Config, ShippedConfigsParse) {
+  for (const char *name : {"nigel_car.yaml", "nigel_hil.yaml", "nigel_simavr.yaml"}) {
+    const std::string path = std::string(AUTODRIVE_ROOT) + "/runtime/jetson/config/" + name;
+    SCOPED_TRACE(path);
+    const cfg::Config c = cfg::load(path);
+    EXPECT_TRUE(c.has_bridge);
+    EXPECT_TRUE(c.has_estimator);
+  }
+}
