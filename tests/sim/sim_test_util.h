@@ -28,7 +28,7 @@ struct Sim {
   sim_t *s = nullptr;
   std::string run_dir, err;
   explicit Sim(const char *script, int cars = 1, int ptys = 0, int tyre_model = -1,
-               const char *map = "parking_school") {
+               const char *map = "parking_school", int lidar = 0) {
     run_dir = temp_dir();
     const std::string params = params_path(), mp = map_path(map);
     sim_config_t cfg = {};
@@ -39,7 +39,7 @@ struct Sim {
     cfg.seed = 3;
     cfg.open_ptys = ptys;
     cfg.script = script;
-    cfg.lidar = 0;
+    cfg.lidar = lidar;
     cfg.tyre_model = tyre_model;
     char e[2048] = "";
     s = sim_create(&cfg, e, sizeof e);

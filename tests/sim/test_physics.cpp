@@ -187,3 +187,24 @@ TEST(Physics, FourCarsDriveIndependently) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Sensors, RoofTagAndMountsAreInTheModel) {
+  simtest::Sim s(nullptr, 2);
+  ASSERT_NE(s.s, nullptr) << s.err;
+  const mjModel *m = sim_model(s.s);
+  for (const char *name : {"nigel1/tag", "nigel2/tag"}) EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, name), 0) << name;
+  for (const char *name : {"nigel1/cam_front", "nigel1/cam_rear", "eye"})
+    EXPECT_GE(mj_name2id(m, mjOBJ_CAMERA, name), 0) << name;
+  const int lidar = mj_name2id(m, mjOBJ_SITE, "nigel1/lidar");
+  ASSERT_GE(lidar, 0);
+  EXPECT_NEAR(m->site_pos[3 * lidar], 0.1445, 1e-9);
+  EXPECT_NEAR(m->site_pos[3 * lidar + 2], 0.1757, 1e-9);
+  if (sim_has_sensors()) {  // real tag36h11 textures, one per car
+    EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
+    EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);
+  }
+}
+
+}  // namespace

@@ -13,7 +13,9 @@
 #include "sim.h"
 
 #ifdef SIM_HAVE_SENSORS
+#include "sim_camera.h"
 #include "sim_lidar_lcm.h"
+#include "sim_render.h"
 #endif
 
 #define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
@@ -43,6 +45,9 @@ static void main_usage(FILE *f) {
           "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
           "  --no-pty            do not open ptys (with --script)\n"
           "  --no-lidar          do not simulate the LIDAR\n"
+          "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
+          "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
+          "  --camera-fps F      camera frame rate in sim time (default 30)\n"
           "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
           "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
           "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
@@ -53,11 +58,15 @@ static void main_usage(FILE *f) {
           SIM_MAX_CARS, AUTODRIVE_SIM_DIR, MAIN_DEFAULT_URL);
 }
 
-static double main_wall_s(void) {
+static double main_clock_s(clockid_t id) {
   struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
+  clock_gettime(id, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
+static double main_wall_s(void) { return main_clock_s(CLOCK_MONOTONIC); }
+/* CPU time of this process [s]: on a shared, loaded machine it shows the cost without the
+ * time spent waiting for a core */
+static double main_cpu_s(void) { return main_clock_s(CLOCK_PROCESS_CPUTIME_ID); }
 
 static int main_number(const char *opt, const char *v, double lo, double hi, double *out) {
   char *end;
@@ -70,6 +79,85 @@ static int main_number(const char *opt, const char *v, double lo, double hi, dou
   }
   *out = x;
   return 0;
+}
+
+/* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
+#define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
+typedef struct main_cams {
+  int n;
+#ifdef SIM_HAVE_SENSORS
+  sim_render_t *render;
+  sim_camera_t *cam[MAIN_MAX_CAMS];
+  int cam_id[MAIN_MAX_CAMS];
+  char channel[MAIN_MAX_CAMS][48], info_channel[MAIN_MAX_CAMS][48];
+  int64_t next_info_us;
+#endif
+} main_cams_t;
+
+static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, char *err,
+                          size_t err_sz) {
+  memset(k, 0, sizeof *k);
+  if (!cameras && !eye) return 0;
+#ifdef SIM_HAVE_SENSORS
+  const mjModel *m = sim_model(s);
+  k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
+  if (!k->render) return -1;
+  for (int c = 1; cameras && c <= sim_cars(s); c++)
+    for (int rear = 0; rear < 2; rear++) {
+      char name[48], frame[48];
+      snprintf(name, sizeof name, "nigel%d/cam_%s", c, rear ? "rear" : "front");
+      snprintf(frame, sizeof frame, "camera_%s", rear ? "rear" : "front");
+      k->cam[k->n] = sim_camera_create(k->render, m, name, frame, 640, 480, 85, err, err_sz);
+      if (!k->cam[k->n]) return -1;
+      k->cam_id[k->n] = mj_name2id(m, mjOBJ_CAMERA, name);
+      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d_CAM_%s", c, rear ? "REAR" : "FRONT");
+      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d_CAM_%s_INFO", c, rear ? "REAR" : "FRONT");
+      k->n++;
+    }
+  if (eye) {
+    if (mj_name2id(m, mjOBJ_CAMERA, "eye") < 0) {
+      snprintf(err, err_sz, "--eye: the map has no camera named 'eye'");
+      return -1;
+    }
+    k->cam[k->n] = sim_camera_create(k->render, m, "eye", "eye", 1280, 960, 90, err, err_sz);
+    if (!k->cam[k->n]) return -1;
+    snprintf(k->channel[k->n], sizeof k->channel[0], "EYE_IMAGE");
+    snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "EYE_CAMERA_INFO");
+    k->n++;
+  }
+  return 0;
+#else
+  (void)s;
+  snprintf(err, err_sz, "--cameras/--eye: this build has no sensors library (sim/mujoco_hil/sensors)");
+  return -1;
+#endif
+}
+
+static int main_cams_publish(main_cams_t *k, const sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
+                             size_t err_sz) {
+#ifdef SIM_HAVE_SENSORS
+  const int info = now_us >= k->next_info_us;
+  if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
+  for (int i = 0; i < k->n; i++) {
+    if (sim_camera_capture(k->cam[i], sim_model(s), sim_data(s), now_us) != 0) {
+      snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
+      return -1;
+    }
+    sim_camera_publish_image(k->cam[i], lcm, k->channel[i]);
+    if (info) sim_camera_publish_info(k->cam[i], sim_model(s), lcm, k->info_channel[i], now_us);
+  }
+#else
+  (void)k, (void)s, (void)lcm, (void)now_us, (void)err, (void)err_sz;
+#endif
+  return 0;
+}
+
+static void main_cams_close(main_cams_t *k) {
+#ifdef SIM_HAVE_SENSORS
+  for (int i = 0; i < k->n; i++) sim_camera_destroy(k->cam[i]);
+  if (k->render) sim_render_destroy(k->render);
+#endif
+  k->n = 0;
 }
 
 int main(int argc, char **argv) {
@@ -86,7 +174,8 @@ int main(int argc, char **argv) {
   cfg.lidar = 1;
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
-  int lockstep = 0, bench = 0, quiet = 0;
+  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0;
+  double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
   for (int i = 1; i < argc; i++) {
@@ -131,6 +220,13 @@ int main(int argc, char **argv) {
       cfg.open_ptys = 0;
     } else if (!strcmp(a, "--no-lidar")) {
       cfg.lidar = 0;
+    } else if (!strcmp(a, "--cameras")) {
+      cameras = 1;
+    } else if (!strcmp(a, "--eye")) {
+      eye = 1;
+    } else if (!strcmp(a, "--camera-fps")) {
+      if (main_number(a, v, 0.1, 1000, &camera_fps)) return 2;
+      i++;
     } else if (!strcmp(a, "--tyre-model") && v) {
       if (!strcmp(v, "paper")) cfg.tyre_model = 1;
       else if (!strcmp(v, "mujoco")) cfg.tyre_model = 0;
@@ -184,6 +280,15 @@ int main(int argc, char **argv) {
   sigaction(SIGTERM, &sa, NULL);
   signal(SIGPIPE, SIG_IGN);
 
+  main_cams_t cams;
+  if (main_cams_open(&cams, s, cameras, eye, err, sizeof err) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
+  const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
   for (int c = 1; c <= sim_cars(s); c++) {
     if (sim_nano_link(s, c)[0]) printf("NIGEL%d nano: %s\n", c, sim_nano_link(s, c));
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
@@ -193,7 +298,7 @@ int main(int argc, char **argv) {
   fflush(stdout);
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
-  const double t0 = main_wall_s();
+  const double t0 = main_wall_s(), cpu0 = main_cpu_s();
   double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0;
   int64_t last_progress_us = 0;
   int rc = 0;
@@ -218,6 +323,12 @@ int main(int argc, char **argv) {
       }
     }
 #endif
+    if (cams.n > 0 && now_us % cam_period_us < SIM_STEP_US &&
+        main_cams_publish(&cams, s, lcm, now_us, err, sizeof err) != 0) {
+      fprintf(stderr, "autodrive-sim: %s\n", err);
+      rc = 1;
+      break;
+    }
     if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) lcmpub_clock(lcm, now_us, rtf_now, 0);
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
@@ -235,14 +346,19 @@ int main(int argc, char **argv) {
       if (!quiet) fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f\n", now_us * 1e-6, rtf_now);
     }
   }
-  const double wall_s = main_wall_s() - t0, sim_s = sim_time_us(s) * 1e-6;
+  const double wall_s = main_wall_s() - t0, cpu_s = main_cpu_s() - cpu0;
+  const double sim_s = sim_time_us(s) * 1e-6;
   if (bench) {
     const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
-    const double bare_s = sim_bare_mj_step_s(s, bare_steps);
-    printf("{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"rtf\": %.3f, \"bare_mj_step_rtf\": %.3f}\n",
-           sim_cars(s), sim_s, wall_s, wall_s > 0 ? sim_s / wall_s : 0.0,
-           bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0);
+    double bare_cpu_s = 0.0;
+    const double bare_s = sim_bare_mj_step_s(s, bare_steps, &bare_cpu_s);
+    printf("{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
+           "\"rtf_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f}\n",
+           sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
+           cpu_s > 0 ? sim_s / cpu_s : 0.0, bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
+           bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
   }
+  main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */
   if (tlog) fclose(tlog);
   lcm_destroy(lcm);

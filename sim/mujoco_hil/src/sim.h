@@ -71,9 +71,9 @@ const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car);
 /* 1 when built with the sensors library. */
 int sim_has_sensors(void);
 
-/* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s];
- * used by the benchmark to measure our overhead over MuJoCo alone. */
-double sim_bare_mj_step_s(const sim_t *s, int steps);
+/* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
+ * (and its CPU time in *cpu_s if non-NULL); the benchmark's measure of MuJoCo alone. */
+double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s);
 
 #ifdef __cplusplus
 }
