@@ -1,5 +1,7 @@
 #include "sil_board.h"
 
+#include <cstdarg>
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -33,6 +35,12 @@ void quiet_uart(avr_t *avr) {
   avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
 }
 
+// simavr's messages: errors to stderr, chatter ("Loaded 16746 .text ...") dropped so that the
+// programs' stdout stays theirs.
+void quiet_logger(avr_t *, const int level, const char *format, va_list ap) {
+  if (level <= LOG_ERROR) std::vfprintf(stderr, format, ap);
+}
+
 void on_frame(const proto_frame_t *f, void *ctx) {
   auto *b = static_cast<std::pair<Board *, std::vector<Frame> *> *>(ctx);
   b->second->push_back(Frame{b->first->cycle(), *f});
@@ -40,6 +48,7 @@ void on_frame(const proto_frame_t *f, void *ctx) {
 } // namespace
 
 Board::Board(const std::string &elf_path, bool imu_present) {
+  avr_global_logger_set(quiet_logger);
   elf_firmware_t fw{};
   if (elf_read_firmware(elf_path.c_str(), &fw) != 0) {
     throw std::runtime_error("cannot load firmware ELF '" + elf_path + "'");
@@ -208,6 +217,7 @@ uint8_t Board::lamp_pins() const {
 void Board::reset_cycle_stats() {
   loop_max_ = 0;
   loop_last_cycle_ = 0;
+  loop_cycles_.clear();
   isr_max_[0] = isr_max_[1] = 0;
 }
 
@@ -272,6 +282,7 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         if (loop_last_cycle_ != 0) {
           const uint64_t d = avr_->cycle - loop_last_cycle_;
           if (d > loop_max_) loop_max_ = static_cast<uint32_t>(d);
+        if (record_loop_) loop_cycles_.push_back(static_cast<uint32_t>(d));
         }
         loop_last_cycle_ = avr_->cycle;
         loop_passes_++;

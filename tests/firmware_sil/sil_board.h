@@ -107,6 +107,9 @@ class Board {
   uint32_t enc_isr_cycles_max() const { return isr_max_[0] > isr_max_[1] ? isr_max_[0] : isr_max_[1]; }
   uint32_t loop_cycles_max() const { return loop_max_; }
   uint64_t loop_passes() const { return loop_passes_; }
+  // Records every pass's length [cycles] (off by default: it grows by ~2400 entries/s).
+  void record_loop_cycles(bool on) { record_loop_ = on; }
+  const std::vector<uint32_t> &loop_cycles() const { return loop_cycles_; }
   void reset_cycle_stats();
   uint32_t resets() const { return resets_; } // times the CPU went through its reset vector
 
@@ -140,6 +143,8 @@ class Board {
   uint32_t loop_addr_ = 0;
   uint64_t loop_last_cycle_ = 0;
   uint32_t loop_max_ = 0;
+  bool record_loop_ = false;
+  std::vector<uint32_t> loop_cycles_;
   uint64_t loop_passes_ = 0;
   int isr_active_ = -1; // index of the encoder ISR being timed
   uint64_t isr_start_ = 0;

@@ -1,0 +1,36 @@
+#!/usr/bin/env python3
+"""platformio.ini checked offline through PlatformIO's own parser (it cannot download its AVR
+platform here): no warnings, the two Nano envs, src/lib dirs that exist and hold the firmware.
+usage: test_platformio_ini.py <repo root>"""
+import os
+import sys
+
+from platformio.project.config import ProjectConfig
+
+
+def main() -> int:
+    root = os.path.abspath(sys.argv[1])
+    os.chdir(root)  # PlatformIO resolves the dirs against the project dir, which is the cwd
+    cfg = ProjectConfig(os.path.join(root, "platformio.ini"))
+    cfg.validate()
+    assert cfg.warnings == [], f"platformio.ini warnings: {cfg.warnings}"
+    envs = cfg.envs()
+    assert sorted(envs) == ["nanoatmega328", "nanoatmega328new"], f"envs: {envs}"
+    for env in envs:
+        assert cfg.get(f"env:{env}", "board") == env, f"{env}: board"
+        assert cfg.get(f"env:{env}", "platform") == "atmelavr", f"{env}: platform"
+        assert cfg.get(f"env:{env}", "framework") == ["arduino"], f"{env}: framework"
+    src = cfg.get("platformio", "src_dir")
+    lib = cfg.get("platformio", "lib_dir")
+    assert os.path.samefile(src, os.path.join(root, "firmware/nano/src")), f"src_dir {src}"
+    assert os.path.samefile(lib, os.path.join(root, "firmware/nano/lib")), f"lib_dir {lib}"
+    main_cpp = open(os.path.join(src, "main.cpp")).read()
+    assert "void setup()" in main_cpp and "void loop()" in main_cpp, "src has no Arduino sketch"
+    for module in ("nigel", "proto", "enc"):
+        assert os.path.isdir(os.path.join(lib, module)), f"lib module {module} missing"
+    print("platformio.ini ok:", ", ".join(envs))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
