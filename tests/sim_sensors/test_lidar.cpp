@@ -174,6 +174,28 @@ TEST(SimLidar, SpinningUpdateGivesOneScanPerRevolution) {
   sim_lidar_destroy(l);
 }
 
+TEST(SimLidar, ClockResetStartsANewRevolution) {
+  room::Room r;
+  ASSERT_NE(r.m, nullptr);
+  sim_lidar_config_t cfg;
+  sim_lidar_config_default(&cfg);
+  sim_lidar_t *l = make_lidar(r.m, cfg);
+  ASSERT_NE(l, nullptr);
+  for (int64_t t_us = 5000000; t_us < 5100000; t_us += 1000) sim_lidar_update(r.m, r.d, l, t_us);
+  // the sim resets its clock to 0: scans resume one period later, stamped from 0
+  int scans = 0;
+  for (int64_t t_us = 0; t_us <= 300000; t_us += 1000) {
+    if (sim_lidar_update(r.m, r.d, l, t_us)) {
+      if (scans == 0) {
+        EXPECT_EQ(sim_lidar_last_scan(l)->utime, 0);
+      }
+      scans++;
+    }
+  }
+  EXPECT_EQ(scans, 2);
+  sim_lidar_destroy(l);
+}
+
 TEST(SimLidar, NoiseIsSeededAndSized) {
   room::Room r;
   ASSERT_NE(r.m, nullptr);

@@ -63,7 +63,8 @@ void sim_lidar_destroy(sim_lidar_t *l);
 /* Advances the spinning head to sim time now_us and casts every ray it passed since the last
  * call (call after mj_step / mj_forward so d->geom_xpos etc. are current; call at the physics
  * rate). Returns 1 when a revolution completed (then sim_lidar_last_scan is the new scan),
- * else 0. The first call starts the first revolution. */
+ * else 0. The first call starts the first revolution; a clock that goes back (sim reset)
+ * starts a new one. */
 int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us);
 
 /* Casts all rays at once at the current state (for tests, benchmarks, single shots) and

@@ -230,7 +230,8 @@ void sim_lidar_scan_now(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now
 }
 
 int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us) {
-  if (!l->started) {
+  /* first call, or the sim clock went back (a reset): start a fresh revolution now */
+  if (!l->started || now_us < l->rev_start_us) {
     l->started = 1;
     l->rev_start_us = now_us;
     l->next_ray = 0;
