@@ -113,6 +113,7 @@ TEST(Physics, SteeringRateIs0805RadPerS) {
 TEST(Physics, EncodersCount1920PerWheelRevolution) {
   simtest::Sim s("constant:throttle=0.5,steering=0");
   ASSERT_NE(s.s, nullptr) << s.err;
+  const double x0 = s.truth().pos_m[0];
   ASSERT_TRUE(s.run_to(4.0)) << s.err;
   const double wheel_rad = sim_data(s.s)->qpos[sim_model(s.s)->jnt_qposadr[mj_name2id(
       sim_model(s.s), mjOBJ_JOINT, "nigel1/wheel_rl")]];
@@ -120,7 +121,7 @@ TEST(Physics, EncodersCount1920PerWheelRevolution) {
   EXPECT_GT(n->enc[0], 1000);
   EXPECT_NEAR(n->enc[0], wheel_rad / (2 * M_PI) * 1920.0, 2.0);
   // the distance travelled matches the counts (rolling without much slip)
-  const double dist = s.truth().pos_m[0] + 2.0;  // spawn at x = -2
+  const double dist = s.truth().pos_m[0] - x0;
   EXPECT_NEAR(n->enc[0] / 1920.0 * 2 * M_PI * 0.0325, dist, 0.03 * dist);
 }
 
@@ -182,7 +183,7 @@ TEST(Physics, FourCarsDriveIndependently) {
     const sim_truth_t t = s.truth(c);
     EXPECT_GT(t.vel_body_m_s[0], 0.1) << c;
     EXPECT_FALSE(t.in_collision) << c;
-    EXPECT_NEAR(t.pos_m[1], -1.5 - 0.35 * (c - 1), 0.02) << c;  // side by side, spawn y
+    EXPECT_NEAR(t.pos_m[1], 0.6 - 0.35 * (c - 1), 0.02) << c;  // side by side from the spawn
   }
 }
 

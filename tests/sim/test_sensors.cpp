@@ -28,9 +28,11 @@ TEST(Sensors, LidarScansAt7HzAndSeesTheWall) {
   EXPECT_LE(scans, 22);
   ASSERT_NE(last, nullptr);
   ASSERT_EQ(last->num_rays, 360);
-  // car at (-2, -1.5) facing +x; the west wall's inner face is at x = -3.975; the scanner
-  // sits 0.1445 m ahead of base_link: the ray pointing backwards (180 deg) reads 2.1195 m
-  EXPECT_NEAR(last->ranges_m[180], 2.1195, 0.02);
+  // car at the spawn (-1, 0.6) facing +x; the west wall's inner face is at x = -3.975; the
+  // scanner sits 0.1445 m ahead of base_link: the ray pointing backwards (180 deg) reads
+  // 3.1195 m, and the ray to the left (90 deg) meets the north wall (inner face y = 3.975)
+  EXPECT_NEAR(last->ranges_m[180], 3.1195, 0.02);
+  EXPECT_NEAR(last->ranges_m[90], 3.375, 0.02);
 }
 
 }  // namespace

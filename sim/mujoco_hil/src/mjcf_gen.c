@@ -68,11 +68,11 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
   }
   fprintf(f,
           "   <camera name=\"nigel%d/cam_front\" pos=\"%.6g %.6g %.6g\" xyaxes=\"0 -1 0 0 0 1\" "
-          "fovy=\"48.8\"/>\n",
+          "fovy=\"48.67\"/>\n",
           i, p->cam_front_pos_m[0], p->cam_front_pos_m[1], p->cam_front_pos_m[2]);
   fprintf(f,
           "   <camera name=\"nigel%d/cam_rear\" pos=\"%.6g %.6g %.6g\" xyaxes=\"0 1 0 0 0 1\" "
-          "fovy=\"48.8\"/>\n",
+          "fovy=\"48.67\"/>\n",
           i, p->cam_rear_pos_m[0], p->cam_rear_pos_m[1], p->cam_rear_pos_m[2]);
 
   const char *tyre_attr = p->tyre_model_paper

@@ -4,7 +4,7 @@
  *   geom nigel<i>/chassis; tyres nigel<i>/tyre_{fl,fr,rl,rr} (spheres)
  *   joints nigel<i>/steer_{fl,fr} (hinge z), nigel<i>/wheel_{fl,fr,rl,rr} (hinge y, + forward)
  *   sites nigel<i>/imu, nigel<i>/lidar, nigel<i>/tag_site; geom nigel<i>/tag (roof plate)
- *   cameras nigel<i>/cam_front, nigel<i>/cam_rear (fovy 48.8 deg = 62.2 deg HFOV at 4:3)
+ *   cameras nigel<i>/cam_front, nigel<i>/cam_rear (fovy 48.67 deg = 62.2 deg HFOV at 4:3)
  * Collision bits: world contype 1 / conaffinity 6, tyres 2 / 1, chassis 4 / 5. */
 #ifndef SIM_MJCF_GEN_H
 #define SIM_MJCF_GEN_H
