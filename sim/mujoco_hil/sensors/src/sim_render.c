@@ -24,6 +24,7 @@ typedef struct egl_api {
   EGLContext (*CreateContext)(EGLDisplay, EGLConfig, EGLContext, const EGLint *);
   EGLBoolean (*DestroyContext)(EGLDisplay, EGLContext);
   EGLBoolean (*MakeCurrent)(EGLDisplay, EGLSurface, EGLSurface, EGLContext);
+  EGLContext (*GetCurrentContext)(void);
 } egl_api_t;
 
 typedef struct osmesa_api {
@@ -31,6 +32,7 @@ typedef struct osmesa_api {
   void *(*GetProcAddress)(const char *);
   OSMesaContext (*CreateContextExt)(GLenum, GLint, GLint, GLint, OSMesaContext);
   GLboolean (*MakeCurrent)(OSMesaContext, void *, GLenum, GLsizei, GLsizei);
+  OSMesaContext (*GetCurrentContext)(void);
   void (*DestroyContext)(OSMesaContext);
 } osmesa_api_t;
 
@@ -54,6 +56,8 @@ struct sim_render {
   float light_k;            /* day 1, night < 1: scales every scene light */
 };
 
+static int render_make_current(sim_render_t *r);
+
 static void err_set(char *err, size_t n, const char *msg) {
   if (err && n) snprintf(err, n, "sim_render: %s", msg);
 }
@@ -73,7 +77,8 @@ static int egl_load(egl_api_t *e) {
       sym(e->lib, "eglTerminate", &e->Terminate) || sym(e->lib, "eglChooseConfig", &e->ChooseConfig) ||
       sym(e->lib, "eglBindAPI", &e->BindAPI) || sym(e->lib, "eglCreateContext", &e->CreateContext) ||
       sym(e->lib, "eglDestroyContext", &e->DestroyContext) ||
-      sym(e->lib, "eglMakeCurrent", &e->MakeCurrent))
+      sym(e->lib, "eglMakeCurrent", &e->MakeCurrent) ||
+      sym(e->lib, "eglGetCurrentContext", &e->GetCurrentContext))
     return -1;
   return 0;
 }
@@ -121,7 +126,8 @@ static int osmesa_init(sim_render_t *r) {
   if (!o->lib || sym(o->lib, "OSMesaCreateContextExt", &o->CreateContextExt) ||
       sym(o->lib, "OSMesaMakeCurrent", &o->MakeCurrent) ||
       sym(o->lib, "OSMesaDestroyContext", &o->DestroyContext) ||
-      sym(o->lib, "OSMesaGetProcAddress", &o->GetProcAddress))
+      sym(o->lib, "OSMesaGetProcAddress", &o->GetProcAddress) ||
+      sym(o->lib, "OSMesaGetCurrentContext", &o->GetCurrentContext))
     return -1;
   r->osm_ctx = o->CreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
   if (!r->osm_ctx) return -1;
@@ -220,6 +226,8 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
 void sim_render_destroy(sim_render_t *r) {
   if (!r) return;
   mjv_freeScene(&r->scn);
+  /* GL objects are freed in the context that made them */
+  if (r->egl_ctx != EGL_NO_CONTEXT || r->osm_ctx) render_make_current(r);
   mjr_freeContext(&r->con);
   if (r->egl_dpy != EGL_NO_DISPLAY) {
     r->egl.MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -249,11 +257,23 @@ int sim_render_fits(const sim_render_t *r, int width_px, int height_px) {
 
 mjvOption *sim_render_options(sim_render_t *r) { return &r->opt; }
 
+/* Makes the renderer's context current again if something else (a viewer window) took the
+ * thread's current context since the last frame. */
+static int render_make_current(sim_render_t *r) {
+  if (r->backend == SIM_RENDER_EGL) {
+    if (r->egl.GetCurrentContext() == r->egl_ctx) return 0;
+    return r->egl.MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->egl_ctx) ? 0 : -1;
+  }
+  if (r->osm.GetCurrentContext() == r->osm_ctx) return 0;
+  return r->osm.MakeCurrent(r->osm_ctx, r->osm_buf, GL_UNSIGNED_BYTE, 4, 4) ? 0 : -1;
+}
+
 int sim_render_camera(sim_render_t *r, const mjModel *m, mjData *d, int cam_id, int width_px,
                       int height_px, uint8_t *rgb) {
   if (cam_id < 0 || cam_id >= m->ncam || width_px < 1 || height_px < 1 || width_px > r->maxw ||
       height_px > r->maxh || !rgb)
     return -1;
+  if (render_make_current(r) != 0) return -1;
   r->cam.fixedcamid = cam_id;
   mjv_updateScene(m, d, &r->opt, NULL, &r->cam, mjCAT_ALL, &r->scn);
   if (r->light_k != 1.0f)
