@@ -1,0 +1,147 @@
+// The optional GLFW viewer on a real X server (Xvfb started by the test), sharing the process
+// with the headless EGL camera renderer.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <GLFW/glfw3.h>
+
+#include <string>
+#include <vector>
+
+#include "room.hpp"
+
+extern "C" {
+#include "sim_camera.h"
+#include "sim_render.h"
+#include "sim_viewer.h"
+}
+
+namespace {
+
+// An Xvfb of our own on a display number unlikely to be taken; stopped by its pid.
+struct Xvfb {
+  pid_t pid = -1;
+  std::string display;
+  bool ready = false;
+  Xvfb() {
+    if (access("/usr/bin/Xvfb", X_OK) != 0) return;
+    int n = 200 + (int)(getpid() % 700);
+    display = ":" + std::to_string(n);
+    pid = fork();
+    if (pid == 0) {
+      execl("/usr/bin/Xvfb", "Xvfb", display.c_str(), "-screen", "0", "800x600x24", "-nolisten",
+            "tcp", (char *)nullptr);
+      _exit(127);
+    }
+    std::string sock = "/tmp/.X11-unix/X" + std::to_string(n);
+    for (int i = 0; i < 300 && !ready; i++) {  // readiness wait, not a timing assertion
+      struct stat st;
+      if (stat(sock.c_str(), &st) == 0) ready = true;
+      else usleep(50000);
+    }
+    if (ready) setenv("DISPLAY", display.c_str(), 1);
+  }
+  ~Xvfb() {
+    if (pid > 0) {
+      kill(pid, SIGTERM);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+}  // namespace
+
+TEST(SimViewer, RendersViewsAndReportsKeysNextToHeadlessCameras) {
+  if (access("/usr/bin/Xvfb", X_OK) != 0) GTEST_SKIP() << "Xvfb not installed";
+  Xvfb x;
+  ASSERT_TRUE(x.ready) << "Xvfb " << x.display << " did not start";
+  room::Room room;
+  ASSERT_NE(room.m, nullptr);
+  char err[256] = "";
+  sim_render_t *r = sim_render_create(room.m, 640, 480, SIM_RENDER_EGL, err, sizeof err);
+  ASSERT_NE(r, nullptr) << err;
+  sim_camera_t *cam = sim_camera_create(r, room.m, "car_cam_front", "f", 640, 480, 90, err, sizeof err);
+  ASSERT_NE(cam, nullptr) << err;
+  ASSERT_EQ(sim_camera_capture(cam, room.m, room.d, 0), 0);
+  std::vector<uint8_t> before(sim_camera_rgb(cam), sim_camera_rgb(cam) + 640 * 480 * 3);
+
+  ASSERT_EQ(sim_viewer_display_available(), 1);
+  sim_viewer_t *v = sim_viewer_create(room.m, 1, "car", "car_cam_front", 640, 480, err, sizeof err);
+  ASSERT_NE(v, nullptr) << err;
+  sim_viewer_capture(v, 1);
+  int w = 0, h = 0;
+  sim_viewer_size(v, &w, &h);
+  ASSERT_EQ(w, 640);
+  ASSERT_EQ(h, 480);
+  std::vector<uint8_t> shot((size_t)w * h * 3);
+  sim_viewer_input_t in;
+
+  // driver's view = the front camera: blue pillar in the centre, green floor at the bottom
+  sim_viewer_key(v, GLFW_KEY_1);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.view, SIM_VIEW_DRIVER);
+  ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
+  const uint8_t *c = shot.data() + 3 * (240 * w + 320), *b = shot.data() + 3 * (470 * w + 320);
+  EXPECT_GT(c[2], c[0] + 40);
+  EXPECT_GT(b[1], b[0] + 40);
+
+  // god's view = the "eye" camera: mostly green floor
+  sim_viewer_key(v, GLFW_KEY_3);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
+  int green = 0;
+  for (int i = 0; i < w * h; i++) green += shot[3 * i + 1] > shot[3 * i] + 40;
+  EXPECT_GT(green, w * h / 2);
+
+  // bird's view renders something other than the god's view
+  sim_viewer_key(v, GLFW_KEY_2);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  std::vector<uint8_t> bird((size_t)w * h * 3);
+  ASSERT_EQ(sim_viewer_read_rgb(v, bird.data()), 0);
+  EXPECT_NE(bird, shot);
+
+  // keys: pause toggles, reset is an edge reported once, N night darkens the frame
+  sim_viewer_key(v, GLFW_KEY_SPACE);
+  sim_viewer_key(v, GLFW_KEY_R);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.paused, 1);
+  EXPECT_EQ(in.reset_requested, 1);
+  EXPECT_EQ(in.quit, 0);
+  long day_sum = 0;
+  ASSERT_EQ(sim_viewer_read_rgb(v, bird.data()), 0);
+  for (uint8_t p : bird) day_sum += p;
+  sim_viewer_key(v, GLFW_KEY_N);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.reset_requested, 0);
+  EXPECT_EQ(in.day, 0);
+  long night_sum = 0;
+  ASSERT_EQ(sim_viewer_read_rgb(v, bird.data()), 0);
+  for (uint8_t p : bird) night_sum += p;
+  EXPECT_LT(night_sum, day_sum * 3 / 4);
+  sim_viewer_key(v, GLFW_KEY_ESCAPE);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.quit, 1);
+
+  // the headless camera still renders the same frame with the window's context in between
+  ASSERT_EQ(sim_camera_capture(cam, room.m, room.d, 0), 0);
+  EXPECT_EQ(before, std::vector<uint8_t>(sim_camera_rgb(cam), sim_camera_rgb(cam) + 640 * 480 * 3));
+  sim_viewer_destroy(v);
+  sim_camera_destroy(cam);
+  sim_render_destroy(r);
+}
+
+TEST(SimViewer, NoDisplayIsAClearError) {
+  const char *saved = getenv("DISPLAY");
+  std::string keep = saved ? saved : "";
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  room::Room room;
+  ASSERT_NE(room.m, nullptr);
+  char err[256] = "";
+  EXPECT_EQ(sim_viewer_create(room.m, 1, "car", "car_cam_front", 640, 480, err, sizeof err), nullptr);
+  EXPECT_NE(std::string(err).find("no display"), std::string::npos) << err;
+  if (saved) setenv("DISPLAY", keep.c_str(), 1);
+}
