@@ -475,6 +475,7 @@ TEST_F(Core, BatteryFilterIgnoresShortSag) {
 TEST_F(Core, FlatBatteryAtBootRefusesDrive) {
   fake.battery_mv = 9000;
   Boot(0, 0);
+  EXPECT_TRUE(nigel_faults(&n) & PROTO_FAULT_BATTERY_CUTOFF) << "known at init, before any pass";
   Arm();
   Stream(200, 800, 0, true);
   EXPECT_EQ(fake.duty, 0);

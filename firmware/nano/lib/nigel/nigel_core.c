@@ -147,6 +147,8 @@ void nigel_init(nigel_t *n, const nigel_hal_t *hal, uint32_t now_us, uint8_t res
   n->cfg.telemetry_period_ms = NIGEL_DEFAULT_TELEMETRY_MS;
   n->cfg.failsafe_timeout_ms = FS_DEFAULT_TIMEOUT_MS;
   if (reset_was_watchdog) n->faults_latched |= PROTO_FAULT_WATCHDOG_RESET;
+  /* know the pack before the first command can arm: a flat pack refuses drive from boot */
+  batt_update(&n->batt, hal->battery_read_mv(hal->ctx));
   n->last_step_us = now_us;
   n->imu_next_us = now_us + NIGEL_IMU_OFFSET_US;
   n->batt_next_us = now_us + NIGEL_BATT_OFFSET_US;
