@@ -89,7 +89,9 @@ class LcmSource : public Source {
   LcmSource(const std::string& url, const std::string& channel, double idle_s)
       : lcm_(url), channel_(channel), idle_s_(idle_s) {
     if (!lcm_.good()) throw Error("lcm: cannot open " + url);
-    sub_ = lcm_.subscribe(channel, &LcmSource::on_image, this);
+    // A plain function + context: LCM 1.3.1's member-function subscription on a polymorphic
+    // class trips UBSan (member pointer call seen as access at address 0x1).
+    sub_ = lcm_.subscribeFunction(channel, &LcmSource::on_image_cb, this);
     sub_->setQueueCapacity(4);  // drop old frames rather than fall behind the camera
   }
   bool next(Frame* f) override {
@@ -107,6 +109,10 @@ class LcmSource : public Source {
   }
 
  private:
+  static void on_image_cb(const lcm::ReceiveBuffer* rb, const std::string& chan,
+                          const autodrive::compressed_image_t* m, LcmSource* self) {
+    self->on_image(rb, chan, m);
+  }
   void on_image(const lcm::ReceiveBuffer*, const std::string& chan,
                 const autodrive::compressed_image_t* m) {
     Frame f;

@@ -1,0 +1,258 @@
+// autodrive-eye as a user runs it: calibrate-intrinsics -> calibrate-map -> run on an image
+// folder, and run on the LCM image channel over real UDP multicast (port 7790).
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <autodrive/compressed_image_t.hpp>
+#include <autodrive/pose2d_t.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "eye_render.hpp"
+#include "eye_synth.hpp"
+#include "eye_mapcal.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Runs a shell command, returns its exit status and stdout (stderr folded in).
+int run(const std::string& cmd, std::string* out) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return -1;
+  char buf[4096];
+  out->clear();
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out->append(buf, n);
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const fs::path d = fs::path(testing::TempDir()) / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d.string();
+}
+
+void write_reftags(const std::string& path, const std::vector<eye::RefTag>& refs) {
+  std::ofstream f(path);
+  f << "tags:\n";
+  for (const auto& r : refs)
+    f << " - {id: " << r.id << ", x_m: " << r.x_m << ", y_m: " << r.y_m << ", z_m: " << r.z_m
+      << ", yaw_rad: " << r.yaw_rad << ", size_m: " << r.size_m << "}\n";
+}
+
+void write_config(const std::string& path, const eye::SynthScene& s, const std::string& url) {
+  std::ofstream f(path);
+  f << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
+    << "tag_size_m: " << s.car.tag_size_m << "\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
+    << "detector: {decimate: 1}\n"
+    << "vehicles:\n - {name: NIGEL1, tag_id: 1}\n - {name: NIGEL2, tag_id: 2}\n";
+}
+
+// Every "NIGEL1 x=... y=... yaw=..." on the output line of a frame.
+bool find_pose(const std::string& line, const std::string& veh, double* x, double* y, double* yaw) {
+  const auto at = line.find("  " + veh + " x=");
+  if (at == std::string::npos) return false;
+  return std::sscanf(line.c_str() + at + veh.size() + 2, " x=%lf y=%lf yaw=%lf", x, y, yaw) == 3;
+}
+
+}  // namespace
+
+TEST(Cli, HelpForEveryCommand) {
+  std::string out;
+  EXPECT_EQ(run(std::string(EYE_BIN) + " --help", &out), 0);
+  EXPECT_NE(out.find("calibrate-intrinsics"), std::string::npos);
+  for (const char* sub : {"calibrate-intrinsics", "calibrate-map", "run"}) {
+    EXPECT_EQ(run(std::string(EYE_BIN) + " " + sub + " --help", &out), 0) << sub;
+    EXPECT_NE(out.find("Usage"), std::string::npos) << sub;
+  }
+}
+
+TEST(Cli, BadInputGivesClearErrorNotCrash) {
+  std::string out;
+  EXPECT_EQ(run(std::string(EYE_BIN) + " run -c /nonexistent/eye.yaml", &out), 1);
+  EXPECT_NE(out.find("/nonexistent/eye.yaml: cannot open file"), std::string::npos) << out;
+  const std::string d = fresh_dir("eye_cli_bad");
+  std::ofstream(d + "/broken.png") << "not a png";
+  EXPECT_EQ(run(std::string(EYE_BIN) + " calibrate-intrinsics --images " + d + " -o " + d + "/c.yaml", &out), 1);
+  EXPECT_NE(out.find("broken.png: cannot read the image"), std::string::npos) << out;
+}
+
+// The whole user flow at 640x480: checkerboard folder -> camera.yaml; map image with reference
+// tags -> map.yaml; run on a folder of frames, one of which has NIGEL1's tag missing.
+TEST(Cli, CalibrateThenRunOnFolder) {
+  const std::string d = fresh_dir("eye_cli_flow");
+  eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  s.noise_sigma = 1.5;
+  // 1. intrinsics
+  fs::create_directories(d + "/board");
+  for (int i = 0; i < 12; ++i) {
+    const double u = ((i % 4) + 0.5) / 4.0 - 0.5, v = ((i / 4) % 3 + 0.5) / 3.0 - 0.5;
+    cv::Mat rvec = (cv::Mat_<double>(3, 1) << 0.6 * std::sin(1.7 * i), 0.6 * std::cos(2.3 * i),
+                    0.2 * std::sin(0.9 * i)),
+            r;
+    cv::Rodrigues(rvec, r);
+    eye::CameraPose p;
+    p.r_cam_map = cv::Matx33d(r);
+    p.t_cam_map = cv::Vec3d(u * 0.55, v * 0.4, 0.65 + 0.1 * (i % 3)) - p.r_cam_map * cv::Vec3d(0.125, 0.0875, 0);
+    char name[64];
+    std::snprintf(name, sizeof name, "/board/view%02d.png", i);
+    ASSERT_TRUE(cv::imwrite(d + name, eye::render_checkerboard(s.in, p, 10, 7, 0.025, 2)));
+  }
+  std::string out;
+  ASSERT_EQ(run(std::string(EYE_BIN) + " calibrate-intrinsics --images " + d + "/board -o " + d +
+                    "/camera.yaml",
+                &out),
+            0)
+      << out;
+  // 2. map
+  const auto refs = eye::synth_reference_tags(s);
+  write_reftags(d + "/tags.yaml", refs);
+  fs::create_directories(d + "/mapimg");
+  ASSERT_TRUE(cv::imwrite(d + "/mapimg/map.png", eye::synth_frame(s, {}, refs, 1)));
+  ASSERT_EQ(run(std::string(EYE_BIN) + " calibrate-map --intrinsics " + d + "/camera.yaml --tags " +
+                    d + "/tags.yaml --images " + d + "/mapimg -o " + d + "/map.yaml",
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("residual rms"), std::string::npos);
+  // 3. run
+  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7791?ttl=0");
+  fs::create_directories(d + "/frames");
+  const std::vector<eye::SynthCar> truth = {{1, 0.7, 0.6, 0.4}, {1, 2.2, 1.5, -2.0}, {1, 1.5, 1.0, 3.0}};
+  for (size_t k = 0; k < 3; ++k) {
+    std::vector<eye::SynthCar> cars = {{2, 1.5, 0.4, 1.0}};
+    if (k != 1) cars.push_back(truth[k]);  // frame 1: NIGEL1 not in view
+    ASSERT_TRUE(cv::imwrite(d + "/frames/f" + std::to_string(k) + ".png",
+                            eye::synth_frame(s, cars, {}, 10 + k)));
+  }
+  ASSERT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source folder:" + d +
+                    "/frames --fps 10 --debug-image " + d + "/debug.png",
+                &out),
+            0)
+      << out;
+  std::istringstream lines(out);
+  std::string line;
+  int k = 0;
+  while (std::getline(lines, line)) {
+    if (line.find("/frames/f") == std::string::npos) continue;
+    double x, y, yaw;
+    EXPECT_EQ(find_pose(line, "NIGEL2", &x, &y, &yaw), true) << line;
+    if (k == 1) {
+      EXPECT_FALSE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << "stale pose: " << line;
+    } else {
+      ASSERT_TRUE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << line;
+      EXPECT_LT(1000 * std::hypot(x - truth[static_cast<size_t>(k)].x_m, y - truth[static_cast<size_t>(k)].y_m), 5.0) << line;
+    }
+    ++k;
+  }
+  EXPECT_EQ(k, 3) << out;
+  EXPECT_FALSE(cv::imread(d + "/debug.png").empty());
+}
+
+// run on the LCM image channel: each pose carries the frame's capture time; a frame without
+// the tag gives no pose. Real UDP multicast on loopback, port 7790.
+TEST(Cli, RunOnLcmStampsCaptureTime) {
+  const std::string url = "udpm://239.255.76.67:7790?ttl=0";
+  const std::string d = fresh_dir("eye_cli_lcm");
+  eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  {
+    eye::Intrinsics in = s.in;
+    eye::intrinsics_save(d + "/camera.yaml", in);
+    eye::MapCalib m;
+    m.pose = s.pose;
+    m.width_px = 640;
+    m.height_px = 480;
+    eye::mapcal_save(d + "/map.yaml", m);
+  }
+  write_config(d + "/eye.yaml", s, url);
+
+  lcm::LCM lcm(url);
+  ASSERT_TRUE(lcm.good());
+  std::mutex mu;
+  std::vector<autodrive::pose2d_t> got;
+  struct Handler {
+    std::mutex* mu;
+    std::vector<autodrive::pose2d_t>* got;
+    // subscribeFunction, not a member-function subscription: LCM 1.3.1's member pointer
+    // call trips UBSan ("member access within misaligned address 0x1").
+    static void on(const lcm::ReceiveBuffer*, const std::string&, const autodrive::pose2d_t* m,
+                   Handler* h) {
+      std::lock_guard<std::mutex> l(*h->mu);
+      h->got->push_back(*m);
+    }
+  } h{&mu, &got};
+  lcm.subscribeFunction("NIGEL1_POSE_EYE", &Handler::on, &h);
+
+  std::string eye_out;
+  std::atomic<int> eye_status{-2};
+  std::thread child([&] {
+    eye_status = run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source lcm:EYE_IMAGE " +
+                         "--idle-timeout-s 4",
+                     &eye_out);
+  });
+
+  auto publish = [&](int64_t utime, const std::vector<eye::SynthCar>& cars) {
+    std::vector<uchar> jpg;
+    cv::imencode(".jpg", eye::synth_frame(s, cars, {}, static_cast<uint64_t>(utime)), jpg,
+                 {cv::IMWRITE_JPEG_QUALITY, 95});
+    autodrive::compressed_image_t m;
+    m.utime = utime;
+    m.frame_id = "eye";
+    m.format = "jpeg";
+    m.width_px = 640;
+    m.height_px = 480;
+    m.size_bytes = static_cast<int32_t>(jpg.size());
+    m.data.assign(jpg.begin(), jpg.end());
+    lcm.publish("EYE_IMAGE", &m);
+  };
+  auto has = [&](int64_t utime) {
+    std::lock_guard<std::mutex> l(mu);
+    for (const auto& p : got)
+      if (p.utime == utime) return true;
+    return false;
+  };
+  // Wait for the pose of `utime`, republishing in case the Eye was not subscribed yet.
+  auto await = [&](int64_t utime, const std::vector<eye::SynthCar>& cars, bool republish) {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!has(utime) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+      if (republish) publish(utime, cars);
+      for (int i = 0; i < 10; ++i) lcm.handleTimeout(50);
+    }
+    return has(utime);
+  };
+  const eye::SynthCar car{1, 1.2, 0.9, 0.5};
+  const int64_t t0 = 1'700'000'000'000'000;
+  EXPECT_TRUE(await(t0, {car}, true));                     // the Eye is up
+  publish(t0 + 33'333, {});                                 // tag not in view
+  publish(t0 + 66'666, {{1, 1.3, 0.9, 0.5}});
+  EXPECT_TRUE(await(t0 + 66'666, {}, false));
+  child.join();
+  ASSERT_EQ(eye_status.load(), 0) << eye_out;
+  // the frame without the tag was processed, and gave no pose
+  EXPECT_NE(eye_out.find("EYE_IMAGE@" + std::to_string(t0 + 33'333)), std::string::npos) << eye_out;
+  EXPECT_FALSE(has(t0 + 33'333));
+  std::lock_guard<std::mutex> l(mu);
+  ASSERT_FALSE(got.empty());
+  for (const auto& p : got) {
+    EXPECT_EQ(p.vehicle, "NIGEL1");
+    EXPECT_EQ(p.frame_id, "map");
+    EXPECT_EQ(static_cast<int>(p.source), static_cast<int>(autodrive::pose2d_t::SOURCE_EYE));
+    EXPECT_GT(p.covariance[0], 0);
+    if (p.utime == t0 + 66'666) {
+      EXPECT_NEAR(p.x_m, 1.3, 0.005);
+      EXPECT_NEAR(p.y_m, 0.9, 0.005);
+      EXPECT_NEAR(p.yaw_rad, 0.5, 0.01);
+    }
+  }
+}
