@@ -298,6 +298,7 @@ TEST(Parser, BadCrcAndOversizeLengthCounted) {
 // Valid frames mixed with bit flips, truncation and garbage. Every untouched frame must come
 // out; frames the parser accepts that were never sent (false accepts) are counted.
 TEST(Parser, RandomizedStreamResync) {
+  uint64_t stat_bad_crc = 0, stat_bad_len = 0, stat_skipped = 0, stream_bytes = 0;
   uint64_t total_frames = 0, untouched = 0, recovered = 0, false_accepts = 0, completed = 0, flipped = 0,
            truncated = 0, garbage_runs = 0, garbage_bytes = 0;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
@@ -349,6 +350,10 @@ TEST(Parser, RandomizedStreamResync) {
       proto_parser_feed(&p, stream.data() + pos, n, Collect, &got);
       pos += n;
     }
+    stat_bad_crc += p.stats.bad_crc;
+    stat_bad_len += p.stats.bad_length;
+    stat_skipped += p.stats.skipped_bytes;
+    stream_bytes += stream.size();
     size_t e = 0;
     for (const auto &fr : got.frames) {
       std::vector<uint8_t> re = Encode(fr.id, fr.seq, std::vector<uint8_t>(fr.payload, fr.payload + fr.len));
@@ -369,6 +374,11 @@ TEST(Parser, RandomizedStreamResync) {
             << " are damaged frames with genuine content: cut inside the CRC and completed by the"
             << " next byte, a 1/256 event; " << (false_accepts - completed)
             << " carry content never sent)" << std::endl;
+  std::cout << "[stream] resync: " << (untouched - recovered)
+            << " untouched frames lost to damage or garbage before them; "
+            << "parser counted " << stat_bad_crc << " bad CRCs, " << stat_bad_len
+            << " bad lengths, skipped " << stat_skipped << " of " << stream_bytes << " bytes"
+            << std::endl;
   RecordProperty("false_accepts", static_cast<int>(false_accepts));
   RecordProperty("false_accepts_foreign_content", static_cast<int>(false_accepts - completed));
   RecordProperty("recovered", static_cast<int>(recovered));
