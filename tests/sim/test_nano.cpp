@@ -2,6 +2,7 @@
 // wire pacing, and the failsafe when the client goes quiet. Sim time only.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <math.h>
 #include <termios.h>
 #include <unistd.h>
@@ -34,7 +35,7 @@ struct Client {
   ~Client() {
     if (fd >= 0) close(fd);
   }
-  void poll() {
+  void read_all() {
     uint8_t buf[1024];
     ssize_t n;
     while ((n = read(fd, buf, sizeof buf)) > 0)
@@ -75,10 +76,16 @@ struct Client {
 void pump(simtest::Sim &s, Client &c, int ms, int16_t thr = 0, int16_t steer = 0,
           int commands = 0) {
   for (int k = 0; k < ms; k++) {
-    if (commands && k % 20 == 0) c.command(thr, steer, commands > 0);
+    if (commands && k % 20 == 0) {
+      c.command(thr, steer, commands > 0);
+      sim_nano_wait_input(s.s, 1, 1000);  // the kernel delivers pty bytes asynchronously
+    }
     ASSERT_TRUE(s.run_to(sim_time_us(s.s) * 1e-6 + 0.001)) << s.err;
-    c.poll();
+    c.read_all();
   }
+  // frames the sim wrote may still be in the kernel: collect them (waits, asserts nothing)
+  pollfd p = {c.fd, POLLIN, 0};
+  while (::poll(&p, 1, 50) > 0) c.read_all();
 }
 
 TEST(Nano, ProtocolConformanceOnThePty) {
@@ -91,6 +98,7 @@ TEST(Nano, ProtocolConformanceOnThePty) {
 
   // handshake: HELLO carries our protocol version and schema hash
   c.send(PROTO_ID_HELLO_REQUEST, nullptr, 0);
+  sim_nano_wait_input(s.s, 1, 1000);
   pump(s, c, 100);
   ASSERT_GE(c.count(PROTO_ID_HELLO), 1);
   proto_hello_t h = {};
@@ -134,6 +142,7 @@ TEST(Nano, ProtocolConformanceOnThePty) {
   const size_t n = proto_frame_encode(PROTO_ID_COMMAND, 200, p, sizeof p, junk, sizeof junk);
   junk[n - 1] ^= 0xFF;
   ASSERT_EQ(write(c.fd, junk, n), (ssize_t)n);
+  sim_nano_wait_input(s.s, 1, 1000);
   pump(s, c, 100, 500, 200, 1);
   ASSERT_TRUE(c.last_state(&st));
   EXPECT_EQ((uint16_t)(st.frames_bad_crc - bad_before), 1);
@@ -155,10 +164,11 @@ TEST(Nano, BytesArriveAtTheWireRate) {
   // 20 COMMAND frames (16 bytes each) written at once: at 500000 baud 50 bytes per ms reach
   // the firmware, so no step may deliver more than 4 frames and all take >= 6 steps
   for (int i = 0; i < 20; i++) c.command(0, 0, false);
+  sim_nano_wait_input(s.s, 1, 1000);
   const nigel_t *n = sim_nano(s.s, 1);
   const uint32_t base = n->parser.stats.frames_ok;
   int steps_with_frames = 0, max_per_step = 0;
-  for (int k = 0; k < 200 && n->parser.stats.frames_ok - base < 20; k++) {
+  for (int k = 0; k < 5000 && n->parser.stats.frames_ok - base < 20; k++) {
     const uint32_t before = n->parser.stats.frames_ok;
     ASSERT_TRUE(s.run_to(sim_time_us(s.s) * 1e-6 + 0.001)) << s.err;
     const int got = (int)(n->parser.stats.frames_ok - before);

@@ -329,7 +329,10 @@ int main(int argc, char **argv) {
       rc = 1;
       break;
     }
-    if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) lcmpub_clock(lcm, now_us, rtf_now, 0);
+    if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) {
+      const double since = main_wall_s() - t0; /* average rtf of the run so far */
+      lcmpub_clock(lcm, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
+    }
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
     if (!lockstep) {

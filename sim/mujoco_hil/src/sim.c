@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -561,6 +562,13 @@ mjData *sim_data(const sim_t *s) { return s->d; }
 const char *sim_nano_link(const sim_t *s, int car) { return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : ""; }
 const char *sim_lidar_link(const sim_t *s, int car) { return s->car[car - 1].lidar_link; }
 const nigel_t *sim_nano(const sim_t *s, int car) { return &s->car[car - 1].nano; }
+
+int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms) {
+  const sim_car_t *c = &s->car[car - 1];
+  if (!c->has_pty) return 0;
+  struct pollfd p = {c->pty.master_fd, POLLIN, 0};
+  return poll(&p, 1, timeout_ms) > 0 && (p.revents & POLLIN);
+}
 
 void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse, uint8_t *brake,
                        uint16_t *servo_us) {

@@ -60,6 +60,10 @@ void sim_get_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
 /* The Nano's symlink path (empty without ptys). */
 const char *sim_nano_link(const sim_t *s, int car);
 const char *sim_lidar_link(const sim_t *s, int car);
+/* Waits up to timeout_ms of wall time until bytes a client wrote to car's Nano pty are
+ * readable by the sim (the kernel moves pty data asynchronously). 1 if ready, 0 if not. For
+ * tests that write and then step a fixed sim time. */
+int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms);
 /* The emulated Nano's firmware state (read-only use, for tests). */
 const nigel_t *sim_nano(const sim_t *s, int car);
 /* Last motor outputs the firmware set through the HAL. */
