@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""HIL demo orchestrator: starts the simulator (Parking School), the unchanged Jetson runtime
+on the simulator's ptys, a driver, and lcm-logger; stops everything cleanly (also on Ctrl-C);
+then writes out/demo/: report.json, PNG plots and the LCM log of the run."""
+import argparse
+import json
+import math
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def log(msg):
+    print(f"[demo] {msg}", flush=True)
+
+
+def parse_args():
+    p = argparse.ArgumentParser(
+        prog="tools/demo",
+        description="Run the Nigel HIL demo: autodrive-sim (Parking School) + the unchanged "
+        "autodrive-runtime on its ptys + a driver, recorded with lcm-logger. Writes "
+        "out/demo/{report.json,*.png,run.lcmlog}.")
+    p.add_argument("--build", default=str(ROOT / "build" / "release"), help="host build dir")
+    p.add_argument("--out", default=str(ROOT / "out" / "demo"), help="output folder")
+    p.add_argument("--seed", type=int, default=1, help="scenario seed (sim noise, biases)")
+    p.add_argument("--duration", type=float, default=40.0, help="driven time [s, sim time]")
+    p.add_argument("--realtime", action="store_true",
+                   help="run in real time (default: 2x real time)")
+    p.add_argument("--rtf", type=float, default=2.0, help="real-time factor when not --realtime")
+    p.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0", help="LCM URL")
+    return p.parse_args()
+
+
+class Procs:
+    """Child processes, stopped in reverse start order with SIGINT, then SIGKILL."""
+
+    def __init__(self):
+        self.items = []
+
+    def start(self, name, argv, logfile):
+        log(f"starting {name}: {' '.join(map(str, argv))}")
+        f = open(logfile, "w")
+        proc = subprocess.Popen([str(a) for a in argv], stdout=f, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+        self.items.append((name, proc, f))
+        return proc
+
+    def check(self):
+        for name, proc, f in self.items:
+            if proc.poll() is not None and proc.returncode != 0:
+                raise RuntimeError(f"{name} exited with code {proc.returncode} (log: {f.name})")
+
+    def stop_all(self):
+        for name, proc, f in reversed(self.items):
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+                try:
+                    proc.wait(timeout=5)
+                except subprocess.TimeoutExpired:
+                    log(f"{name} did not stop on SIGINT; killing it")
+                    proc.kill()
+                    proc.wait()
+            f.close()
+        self.items.clear()
+
+
+def wait_for(path, timeout_s, procs):
+    t0 = time.time()
+    while not os.path.exists(path):
+        procs.check()
+        if time.time() - t0 > timeout_s:
+            raise RuntimeError(f"{path} did not appear within {timeout_s} s")
+        time.sleep(0.05)
+
+
+def main():
+    args = parse_args()
+    build = pathlib.Path(args.build)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    run_dir = pathlib.Path(f"/tmp/autodrive-demo-{os.getpid()}")
+    run_dir.mkdir(parents=True, exist_ok=True)
+    for prog in ("autodrive-sim", "autodrive-runtime"):
+        if not (build / "bin" / prog).exists():
+            sys.exit(f"[demo] ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
+    rtf = 1.0 if args.realtime else args.rtf
+    sys.path.insert(0, str(build / "lcm_types" / "gen" / "python"))
+    import yaml  # noqa: E402
+
+    cfg = yaml.safe_load((ROOT / "runtime/jetson/config/nigel_hil.yaml").read_text())
+    cfg["lcm_url"] = args.lcm_url
+    # Faster than real time: the runtime stamps and integrates on the sim's SIM_CLOCK.
+    cfg["clock"] = "wall" if rtf == 1.0 else "sim"
+    cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
+    cfg["lidar"]["device"] = str(run_dir / "nigel1-lidar")
+    cfg_path = out / "runtime.yaml"
+    cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
+
+    import demo_driver  # noqa: E402  (tools/demo_driver.py)
+    procs = Procs()
+    interrupted = False
+
+    def on_sigint(_sig, _frm):
+        nonlocal interrupted
+        interrupted = True
+    signal.signal(signal.SIGINT, on_sigint)
+    signal.signal(signal.SIGTERM, on_sigint)
+
+    lcm_log = out / "run.lcmlog"
+    t_wall0 = time.time()
+    result = {}
+    try:
+        procs.start("lcm-logger", ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f",
+                                   "--flush-interval=100", lcm_log], out / "lcm-logger.log")
+        sim_argv = [build / "bin" / "autodrive-sim", "--map", "parking_school",
+                    "--run-dir", run_dir, "--seed", args.seed, "--lcm-url", args.lcm_url,
+                    "--duration", args.duration + 8.0]
+        if rtf != 1.0:
+            sim_argv += ["--rtf", rtf]
+        procs.start("autodrive-sim", sim_argv, out / "sim.log")
+        wait_for(run_dir / "nigel1-nano", 30, procs)
+        procs.start("autodrive-runtime", [build / "bin" / "autodrive-runtime", "--config", cfg_path],
+                    out / "runtime.log")
+        result = demo_driver.drive(args.lcm_url, "NIGEL1", args.duration, rtf, procs,
+                                   lambda: interrupted)
+    except RuntimeError as e:
+        log(f"ERROR: {e}")
+        result = {"error": str(e)}
+    finally:
+        procs.stop_all()
+        shutil.rmtree(run_dir, ignore_errors=True)
+    wall_s = time.time() - t_wall0
+    if interrupted:
+        log("interrupted: everything stopped; analysing what was recorded")
+    import demo_report  # noqa: E402  (tools/demo_report.py)
+    report = demo_report.analyse(lcm_log, out, "NIGEL1")
+    report.update(result)
+    report["wall_s"] = round(wall_s, 2)
+    report["rtf_requested"] = rtf
+    (out / "report.json.tmp").write_text(json.dumps(report, indent=2))
+    os.replace(out / "report.json.tmp", out / "report.json")
+    log(f"report: {json.dumps(report)}")
+    log(f"wrote {out}/report.json, plots {', '.join(p.name for p in sorted(out.glob('*.png')))}, "
+        f"log {lcm_log}")
+    return 0 if report.get("ok") and not interrupted else 1
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT / "tools"))
+    sys.exit(main())
