@@ -120,6 +120,44 @@ TEST(SimLidar, OwnCarExcludedOtherCarSeen) {
   sim_lidar_destroy(l);
 }
 
+// The per-ray sector buckets (scan_now, spinning update) against testing every candidate geom
+// (sim_lidar_ray), for a moved, yawed and slightly tilted car.
+TEST(SimLidar, SectorCullingMatchesTestingEveryGeom) {
+  room::Room r;
+  ASSERT_NE(r.m, nullptr);
+  const int j = r.m->body_jntadr[mj_name2id(r.m, mjOBJ_BODY, "car")];
+  mjtNum *q = r.d->qpos + r.m->jnt_qposadr[j];
+  q[0] = 0.3;
+  q[1] = 0.4;
+  const mjtNum euler[3] = {0.03, -0.02, 37.0 * M_PI / 180};
+  mjtNum qz[4], qy[4], qx[4], tmp[4];
+  const mjtNum az[3] = {0, 0, 1}, ay[3] = {0, 1, 0}, axx[3] = {1, 0, 0};
+  mju_axisAngle2Quat(qz, az, euler[2]);
+  mju_axisAngle2Quat(qy, ay, euler[1]);
+  mju_axisAngle2Quat(qx, axx, euler[0]);
+  mju_mulQuat(tmp, qz, qy);
+  mju_mulQuat(q + 3, tmp, qx);
+  mj_forward(r.m, r.d);
+  sim_lidar_config_t cfg;
+  sim_lidar_config_default(&cfg);
+  sim_lidar_t *l = make_lidar(r.m, cfg);
+  ASSERT_NE(l, nullptr);
+  sim_lidar_scan_now(r.m, r.d, l, 0);
+  std::vector<float> now(sim_lidar_last_scan(l)->ranges_m, sim_lidar_last_scan(l)->ranges_m + 360);
+  int scans = 0;
+  for (int64_t t_us = 0; t_us <= 150000; t_us += 1000) scans += sim_lidar_update(r.m, r.d, l, t_us);
+  ASSERT_EQ(scans, 1);
+  int finite = 0;
+  for (int i = 0; i < 360; i++) {
+    const float every = (float)sim_lidar_ray(r.m, r.d, l, i * 2 * M_PI / 360);
+    EXPECT_EQ(now[i], every) << "ray " << i;
+    EXPECT_EQ(sim_lidar_last_scan(l)->ranges_m[i], every) << "ray " << i;
+    finite += std::isfinite(every);
+  }
+  EXPECT_EQ(finite, 360);
+  sim_lidar_destroy(l);
+}
+
 TEST(SimLidar, BeyondRangeIsInfinity) {
   room::Room r;
   ASSERT_NE(r.m, nullptr);

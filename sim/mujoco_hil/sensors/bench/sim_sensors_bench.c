@@ -39,9 +39,13 @@ static double median(double *v, int n) {
 
 /* A Parking-School-sized scene: 6 x 5 m walled floor, 39 construction boxes, 4 cars of ~10
  * geoms each with a front camera; car 1 carries the LIDAR. */
-static int write_scene(const char *path) {
+static int write_scene(const char *path, const char *map) {
   FILE *f = fopen(path, "w");
   if (!f) return -1;
+  if (map) { /* a real map (copied next to us as map.xml: MuJoCo includes relative to the
+              * main file), with the 4 bench cars added in a second worldbody */
+    fprintf(f, "<mujoco model=\"sim_sensors_bench\">\n<include file=\"map.xml\"/>\n<worldbody>\n");
+  } else
   fprintf(f, "<mujoco model=\"sim_sensors_bench\">\n<compiler angle=\"degree\"/>\n"
              "<statistic extent=\"8\" center=\"0 0 0.5\"/>\n<visual><map znear=\"0.005\"/></visual>\n"
              "<asset><texture name=\"grid\" type=\"2d\" builtin=\"checker\" width=\"256\" "
@@ -53,19 +57,19 @@ static int write_scene(const char *path) {
              "<geom type=\"box\" pos=\"-3 0 0.25\" size=\"0.05 2.5 0.25\"/>\n"
              "<geom type=\"box\" pos=\"0 2.5 0.25\" size=\"3 0.05 0.25\"/>\n"
              "<geom type=\"box\" pos=\"0 -2.5 0.25\" size=\"3 0.05 0.25\"/>\n");
-  for (int i = 0; i < 40; i++) {
+  for (int i = 0; i < (map ? 0 : 40); i++) {
     double x = -2.6 + 0.65 * (i % 9), y = -2.0 + 1.0 * (i / 9);
-    if (fabs(x) < 0.5 && fabs(y) < 0.5) continue;
+    if (map || (fabs(x) < 0.5 && fabs(y) < 0.5)) continue;
     fprintf(f, "<geom type=\"box\" pos=\"%.2f %.2f 0.1\" size=\"0.1 0.1 0.1\" euler=\"0 0 %d\" "
                "rgba=\"0.9 0.5 0.1 1\"/>\n", x, y, 17 * i);
   }
   for (int c = 1; c <= 4; c++) {
-    fprintf(f, "<body name=\"nigel%d\" pos=\"%.2f %.2f 0.05\" euler=\"0 0 %d\"><freejoint/>\n"
+    fprintf(f, "<body name=\"nigel%d\" pos=\"%.2f %.2f 0.05\" quat=\"%.6f 0 0 %.6f\"><freejoint/>\n"
                "<geom type=\"box\" size=\"0.12 0.08 0.04\" rgba=\"0.8 0.8 0.8 1\"/>\n"
                "<geom type=\"cylinder\" pos=\"0.1445 0 0.16\" size=\"0.035 0.02\"/>\n"
                "<camera name=\"nigel%d_cam_front\" pos=\"0.15 0 0.1\" xyaxes=\"0 -1 0 0 0 1\" "
                "fovy=\"48.67\"/>\n",
-            c, -1.0 + 0.6 * c, 0.3 * (c % 2), 90 * c, c);
+            c, -1.0 + 0.6 * c, 0.3 * (c % 2), cos(M_PI / 4 * c), sin(M_PI / 4 * c), c);
     for (int w = 0; w < 4; w++)
       fprintf(f, "<body pos=\"%.3f %.3f 0\"><joint type=\"hinge\" axis=\"0 1 0\"/>"
                  "<geom type=\"sphere\" size=\"0.0325\"/></body>\n",
@@ -76,10 +80,22 @@ static int write_scene(const char *path) {
   return fclose(f);
 }
 
+static int copy_file(const char *from, const char *to) {
+  FILE *a = fopen(from, "rb"), *b = a ? fopen(to, "wb") : NULL;
+  int rc = (a && b) ? 0 : -1;
+  char buf[65536];
+  size_t n;
+  while (rc == 0 && (n = fread(buf, 1, sizeof buf, a)) > 0)
+    if (fwrite(buf, 1, n, b) != n) rc = -1;
+  if (a) fclose(a);
+  if (b && fclose(b) != 0) rc = -1;
+  return rc;
+}
+
 static void usage(FILE *out) {
   fprintf(out,
           "usage: sim-sensors-bench [--scans N] [--frames N] [--width PX] [--height PX]\n"
-          "                         [--backend auto|egl|osmesa]\n"
+          "                         [--backend auto|egl|osmesa] [--map FILE]\n"
           "Measures, on a built-in Parking-School-sized scene (4 cars, 39 boxes, 68 geoms):\n"
           "  lidar_scan_us        median time of one full 360-ray scan [us]\n"
           "  lidar_scan_cpu_us    the same in process CPU time (insensitive to other jobs) [us]\n"
@@ -88,6 +104,8 @@ static void usage(FILE *out) {
           "  camera_cpu_us        process CPU time per frame, llvmpipe threads included [us]\n"
           "  jpeg_encode_us       median JPEG encode of one frame (quality 85) [us]\n"
           "  camera_jpeg_fps      frames/s including the JPEG encode (median)\n"
+          "--map FILE uses an MJCF map (e.g. sim/mujoco_hil/maps/driving_school.xml) with the 4\n"
+          "bench cars added near the origin instead of the built-in scene.\n"
           "Progress goes to stderr; the last stdout line is one JSON object.\n"
           "Defaults: --scans 300 --frames 200 --width 640 --height 480 --backend auto\n");
 }
@@ -95,11 +113,13 @@ static void usage(FILE *out) {
 int main(int argc, char **argv) {
   int scans = 300, frames = 200, w = 640, h = 480;
   sim_render_backend_t backend = SIM_RENDER_AUTO;
+  char *map = NULL; /* realpath of --map, or NULL for the built-in scene */
   static const struct option opts[] = {{"scans", required_argument, 0, 's'},
                                        {"frames", required_argument, 0, 'f'},
                                        {"width", required_argument, 0, 'w'},
                                        {"height", required_argument, 0, 'H'},
                                        {"backend", required_argument, 0, 'b'},
+                                       {"map", required_argument, 0, 'm'},
                                        {"help", no_argument, 0, 'h'},
                                        {0, 0, 0, 0}};
   int o;
@@ -118,6 +138,13 @@ int main(int argc, char **argv) {
           return 2;
         }
         break;
+      case 'm':
+        map = realpath(optarg, NULL);
+        if (!map) {
+          fprintf(stderr, "sim-sensors-bench: --map '%s': no such file\n", optarg);
+          return 2;
+        }
+        break;
       case 'h': usage(stdout); return 0;
       default: usage(stderr); return 2;
     }
@@ -126,17 +153,30 @@ int main(int argc, char **argv) {
     fprintf(stderr, "sim-sensors-bench: --scans/--frames must be >= 1 and the size 16..4096 px\n");
     return 2;
   }
-  char path[] = "/tmp/sim_sensors_bench_XXXXXX.xml";
-  int fd = mkstemps(path, 4);
-  if (fd < 0 || (close(fd), write_scene(path)) != 0) {
+  char dir[] = "/tmp/sim_sensors_bench_XXXXXX", path[64], map_copy[64];
+  if (!mkdtemp(dir)) {
+    fprintf(stderr, "sim-sensors-bench: cannot make a temp dir in /tmp\n");
+    return 1;
+  }
+  snprintf(path, sizeof path, "%s/scene.xml", dir);
+  snprintf(map_copy, sizeof map_copy, "%s/map.xml", dir);
+  if (map && copy_file(map, map_copy) != 0) {
+    fprintf(stderr, "sim-sensors-bench: cannot read map %s\n", map);
+    rmdir(dir);
+    return 1;
+  }
+  if (write_scene(path, map) != 0) {
     fprintf(stderr, "sim-sensors-bench: cannot write the scene file %s\n", path);
     return 1;
   }
   char err[1000] = "";
   mjModel *m = mj_loadXML(path, NULL, err, sizeof err);
   unlink(path);
+  unlink(map_copy);
+  rmdir(dir);
   if (!m) {
-    fprintf(stderr, "sim-sensors-bench: scene does not load: %s\n", err);
+    fprintf(stderr, "sim-sensors-bench: scene%s%s does not load: %s\n", map ? " with map " : "",
+            map ? map : "", err);
     return 1;
   }
   mjData *d = mj_makeData(m);
@@ -210,6 +250,7 @@ int main(int argc, char **argv) {
   free(tc);
   sim_render_destroy(r);
   sim_lidar_destroy(l);
+  free(map);
   mj_deleteData(d);
   mj_deleteModel(m);
   return 0;

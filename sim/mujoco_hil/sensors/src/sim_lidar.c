@@ -11,7 +11,11 @@ struct sim_lidar {
   int base_body;           /* body carrying the scanner */
   int root_body;           /* its root: geoms under it are the car itself */
   int *cand;               /* candidate geoms for this scan (not the car's, in a seen group) */
+  int *cand_lo, *cand_n;   /* per candidate: first ray index of its sector and its ray count */
   int ncand;
+  int *bucket_start;       /* rays [from, to): candidates of ray from+j are */
+  int *bucket;             /*   bucket[bucket_start[j] .. bucket_start[j+1]) */
+  size_t bucket_cap;
   float *ranges_m, *quality;          /* revolution being filled */
   float *out_ranges_m, *out_quality;  /* last completed revolution */
   sim_lidar_scan_t last;
@@ -62,13 +66,17 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->cfg = *cfg;
   l->base_body = body;
   l->root_body = m->body_rootid[body];
-  l->cand = calloc((size_t)(m->ngeom ? m->ngeom : 1), sizeof *l->cand);
+  size_t ng = (size_t)(m->ngeom ? m->ngeom : 1);
+  l->cand = calloc(ng, sizeof *l->cand);
+  l->cand_lo = calloc(ng, sizeof *l->cand_lo);
+  l->cand_n = calloc(ng, sizeof *l->cand_n);
+  l->bucket_start = calloc((size_t)cfg->num_rays + 1, sizeof *l->bucket_start);
   size_t n = (size_t)cfg->num_rays;
   l->ranges_m = calloc(n, sizeof(float));
   l->quality = calloc(n, sizeof(float));
   l->out_ranges_m = calloc(n, sizeof(float));
   l->out_quality = calloc(n, sizeof(float));
-  if (!l->cand || !l->ranges_m || !l->quality || !l->out_ranges_m || !l->out_quality) {
+  if (!l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality || !l->out_ranges_m || !l->out_quality) {
     sim_lidar_destroy(l);
     err_set(err, err_len, "out of memory", NULL);
     return NULL;
@@ -83,6 +91,10 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
 void sim_lidar_destroy(sim_lidar_t *l) {
   if (!l) return;
   free(l->cand);
+  free(l->cand_lo);
+  free(l->cand_n);
+  free(l->bucket_start);
+  free(l->bucket);
   free(l->ranges_m);
   free(l->quality);
   free(l->out_ranges_m);
@@ -103,36 +115,108 @@ static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
   }
 }
 
-/* Selects the geoms a ray from origin may hit: visible group, alpha > 0, not the car itself,
- * and (bounded geoms) a bounding sphere that reaches the scan plane within range. The same
- * filters as mj_ray plus the root-body exclusion and culling. */
+/* Selects the geoms a ray from origin may hit: visible group, alpha > 0, not the car itself
+ * (the same filters as mj_ray plus the root-body exclusion), and culls the rest: a geom must
+ * cross the scan plane (exact slab for boxes, bounding sphere otherwise) within range. Each
+ * candidate gets the sector of rays that can reach it, from the circle in which its bounding
+ * sphere cuts the scan plane; unbounded geoms (planes) and geoms around the origin get all. */
 static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l,
                          const mjtNum origin[3], const mjtNum ax[3], const mjtNum ay[3]) {
   mjtNum nrm[3];
   mju_cross(nrm, ax, ay);
+  const int n = l->cfg.num_rays;
+  const double inc = 2.0 * M_PI / n;
   l->ncand = 0;
   for (int g = 0; g < m->ngeom; g++) {
     int grp = m->geom_group[g];
     if (grp < 0 || grp >= mjNGROUP || !l->cfg.geomgroup[grp]) continue;
     if (m->geom_rgba[4 * g + 3] == 0) continue;
     if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue;
+    int lo = 0, cnt = n;
     mjtNum rb = m->geom_rbound[g];
     if (rb > 0) {  /* rbound 0 means unbounded (planes) */
       mjtNum rel[3];
       mju_sub3(rel, d->geom_xpos + 3 * g, origin);
-      if (fabs(mju_dot3(rel, nrm)) > rb) continue;                  /* off the scan plane */
-      if (mju_norm3(rel) - rb > l->cfg.range_max_m) continue;       /* out of range */
+      mjtNum dz = mju_dot3(rel, nrm);
+      if (fabs(dz) > rb) continue;                                  /* off the scan plane */
+      if (m->geom_type[g] == mjGEOM_BOX) { /* the box's half thickness along the normal */
+        const mjtNum *xm = d->geom_xmat + 9 * g, *sz = m->geom_size + 3 * g;
+        mjtNum hz = 0;
+        for (int k = 0; k < 3; k++)
+          hz += fabs(xm[k] * nrm[0] + xm[3 + k] * nrm[1] + xm[6 + k] * nrm[2]) * sz[k];
+        if (fabs(dz) > hz) continue;
+      }
+      mjtNum r_plane = sqrt(rb * rb - dz * dz);      /* sphere cut by the scan plane [m] */
+      mjtNum px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
+      mjtNum dist = sqrt(px * px + py * py);
+      if (dist - r_plane > l->cfg.range_max_m) continue;            /* out of range */
+      if (dist > r_plane) {
+        double centre = atan2(py, px), half = asin(r_plane / dist);
+        lo = (int)ceil((centre - half) / inc - 1e-9);
+        int hi = (int)floor((centre + half) / inc + 1e-9);
+        cnt = hi - lo + 1;
+        if (cnt <= 0) continue;  /* falls between two rays */
+        if (cnt > n) cnt = n;
+        lo = ((lo % n) + n) % n;
+      }
     }
+    l->cand_lo[l->ncand] = lo;
+    l->cand_n[l->ncand] = cnt;
     l->cand[l->ncand++] = g;
   }
 }
 
-/* Nearest hit over the candidates along unit vec from origin, or -1. */
+/* Sorts the candidates into per-ray buckets for rays [from, to), so each ray tests only the
+ * geoms whose sector holds it. Returns -1 on no memory. */
+static int lidar_bucket(sim_lidar_t *l, int from, int to) {
+  const int n = l->cfg.num_rays, span = to - from;
+  int *start = l->bucket_start;
+  memset(start, 0, (size_t)(span + 1) * sizeof *start);
+  for (int pass = 0; pass < 2; pass++) {
+    for (int k = 0; k < l->ncand; k++) {
+      const int lo = l->cand_lo[k], cnt = l->cand_n[k];
+      if (span <= 16) { /* a few rays (the spinning update): test each ray's membership */
+        for (int i = from; i < to; i++) {
+          int off = i - lo;
+          if (off < 0) off += n;
+          if (off >= cnt) continue;
+          if (pass == 0) start[i - from + 1]++;
+          else l->bucket[start[i - from]++] = k;
+        }
+      } else { /* many rays: walk the candidate's sector */
+        for (int j = 0; j < cnt; j++) {
+          int i = lo + j;
+          if (i >= n) i -= n;
+          if (i < from || i >= to) continue;
+          if (pass == 0) start[i - from + 1]++;
+          else l->bucket[start[i - from]++] = k;
+        }
+      }
+    }
+    if (pass == 0) {
+      for (int j = 0; j < span; j++) start[j + 1] += start[j];
+      size_t need = (size_t)start[span];
+      if (need > l->bucket_cap) {
+        int *b = realloc(l->bucket, (need + 64) * sizeof *b);
+        if (!b) return -1;
+        l->bucket = b;
+        l->bucket_cap = need + 64;
+      }
+    }
+  }
+  /* the fill pass advanced each start to the next bucket's start: shift back */
+  for (int j = span; j > 0; j--) start[j] = start[j - 1];
+  start[0] = 0;
+  return 0;
+}
+
+/* Nearest hit along unit vec from origin over candidates list[0..count), or -1. */
 static mjtNum lidar_cast(const mjModel *m, const mjData *d, const sim_lidar_t *l,
-                         const mjtNum origin[3], const mjtNum vec[3]) {
+                         const mjtNum origin[3], const mjtNum vec[3], const int *list,
+                         int count) {
   mjtNum best = -1;
-  for (int k = 0; k < l->ncand; k++) {
-    int g = l->cand[k];
+  for (int k = 0; k < count; k++) {
+    int g = l->cand[list ? list[k] : k];
     mjtNum rb = m->geom_rbound[g];
     if (rb > 0) {  /* cheap sphere test first: skip geoms the ray passes by or lies behind */
       mjtNum rel[3];
@@ -174,7 +258,7 @@ double sim_lidar_ray(const mjModel *m, const mjData *d, const sim_lidar_t *l, do
   lidar_frame(d, l, o, ax, ay);
   lidar_select(m, d, (sim_lidar_t *)l, o, ax, ay);
   ray_dir(ax, ay, angle_rad, vec);
-  return lidar_range(l, lidar_cast(m, d, l, o, vec));
+  return lidar_range(l, lidar_cast(m, d, l, o, vec, NULL, l->ncand));
 }
 
 /* Standard normal sample from the lidar's own generator (xorshift64* + Box-Muller). */
@@ -196,10 +280,14 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
   mjtNum o[3], ax[3], ay[3], vec[3];
   lidar_frame(d, l, o, ax, ay);
   lidar_select(m, d, l, o, ax, ay);
+  const int bucketed = lidar_bucket(l, from, to) == 0;
   double inc = 2.0 * M_PI / l->cfg.num_rays;
   for (int i = from; i < to; i++) {
     ray_dir(ax, ay, i * inc, vec);
-    double r = lidar_range(l, lidar_cast(m, d, l, o, vec));
+    mjtNum x = bucketed ? lidar_cast(m, d, l, o, vec, l->bucket + l->bucket_start[i - from],
+                                     l->bucket_start[i - from + 1] - l->bucket_start[i - from])
+                        : lidar_cast(m, d, l, o, vec, NULL, l->ncand);
+    double r = lidar_range(l, x);
     if (isfinite(r) && l->cfg.noise_std_m > 0) {
       r += l->cfg.noise_std_m * lidar_gauss(l);
       if (r < l->cfg.range_min_m || r > l->cfg.range_max_m) r = INFINITY;
