@@ -172,6 +172,52 @@ TEST(SimRplidar, ScanNodesDecodeToTheLidarScanAndStop) {
   sim_lidar_destroy(l);
 }
 
+// At 7 Hz the 115200-baud wire cannot carry 360 nodes per revolution: the device sends fewer,
+// evenly spread (like the real A1's fixed sample rate), never dropping a block of angles.
+TEST(SimRplidar, SevenHertzScansAreThinnedEvenlyNotCut) {
+  Device dev;
+  ASSERT_NE(dev.r, nullptr);
+  Client c(dev.link);
+  std::vector<uint8_t> rx;
+  std::vector<float> ranges(360);
+  for (int i = 0; i < 360; i++) ranges[i] = 1.0f + i * 0.01f;  // the range encodes the ray
+  c.send({0xA5, 0x20});
+  dev.run_ms(1, c, rx);
+  for (int rev = 0; rev < 21; rev++) {  // 3 s at 7 Hz, one scan pushed per revolution
+    sim_rplidar_push_scan(dev.r, ranges.data(), nullptr, 360);
+    dev.run_ms(rev % 7 == 6 ? 142 : 143, c, rx);  // 1/7 s in whole ms
+  }
+  ASSERT_GT(rx.size(), 7u);
+  EXPECT_EQ(std::vector<uint8_t>(rx.begin(), rx.begin() + 7), kScanDescriptor);
+  const size_t nodes = (rx.size() - 7) / 5;
+  std::vector<int> rev_sizes;
+  int max_gap_rays = 0, prev_ray = -1;
+  for (size_t k = 0; k < nodes; k++) {
+    const uint8_t *n = rx.data() + 7 + 5 * k;
+    const double dist_m = (n[3] | (n[4] << 8)) / 4000.0;
+    const int ray = (int)std::lround((dist_m - 1.0) / 0.01);  // which ray this node carries
+    const double angle_deg = ((n[1] >> 1) | (n[2] << 7)) / 64.0;
+    ASSERT_NEAR(angle_deg, std::fmod(360.0 - ray, 360.0), 1.0 / 64) << "node " << k;
+    if (n[0] & 1) {
+      rev_sizes.push_back(0);
+      prev_ray = -1;
+    }
+    if (!rev_sizes.empty()) rev_sizes.back()++;
+    if (prev_ray >= 0) max_gap_rays = std::max(max_gap_rays, ray - prev_ray);
+    prev_ray = ray;
+  }
+  ASSERT_GE(rev_sizes.size(), 15u);
+  // after the first (full) revolution: 97 % of 2304 nodes/s over 1/7 s, i.e. ~319..322 nodes
+  for (size_t i = 1; i + 1 < rev_sizes.size(); i++) {
+    EXPECT_GE(rev_sizes[i], 315) << "revolution " << i;
+    EXPECT_LE(rev_sizes[i], 325) << "revolution " << i;
+  }
+  EXPECT_LE(max_gap_rays, 2);  // evenly thinned: never more than one ray skipped in a row
+  sim_rplidar_stats_t st;
+  sim_rplidar_get_stats(dev.r, &st);
+  EXPECT_EQ(st.nodes_dropped, 0u);
+}
+
 TEST(SimRplidar, SlowWireDropsOldNodesAndClientHangupStops) {
   Device dev;
   ASSERT_NE(dev.r, nullptr);

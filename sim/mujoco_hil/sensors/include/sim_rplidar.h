@@ -13,7 +13,10 @@
  *         [3..4] distance_q2 LE        (distance in mm * 4; 0 = no return)
  * Bytes leave at the configured baud (10 bits per byte, 8N1) against the caller's clock, like
  * the real UART: 115200 baud carries at most 2304 nodes/s, i.e. 6.4 revolutions/s of 360
- * nodes. When the queue holds more than two revolutions the oldest nodes are dropped (counted).
+ * nodes. Like the real device (fixed sample rate), a faster spin gives fewer nodes per
+ * revolution: each pushed scan is thinned evenly to what the wire carries in the time since
+ * the previous push (97 %; ~322 nodes at 7 Hz). If the queue still holds more than two
+ * revolutions, the oldest nodes are dropped (counted).
  * The device angle 0 is the car's forward axis; a ray at CCW angle a reads (360 - a) mod 360.
  *
  * Not thread-safe: call everything from one thread (the sim's main loop).

@@ -45,6 +45,7 @@ struct sim_rplidar {
   int64_t wire_us;          /* wire time up to which bytes were allowed [us] */
   double credit_bytes;      /* bytes the wire may still carry now */
   int clock_started;
+  int64_t last_push_us;     /* wire clock at the previous push_scan, -1 before the first */
   sim_rplidar_stats_t stats;
 };
 
@@ -91,6 +92,7 @@ sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *er
   }
   r->master_fd = fd;
   r->baud = baud;
+  r->last_push_us = -1;
   if (ptsname_r(fd, r->slave_path, sizeof r->slave_path) != 0) {
     err_set(err, err_len, "ptsname failed", NULL);
     close(fd);
@@ -163,6 +165,7 @@ static void out_descriptor(sim_rplidar_t *r, uint32_t len, uint8_t mode, uint8_t
 
 static void rpl_stop(sim_rplidar_t *r) {
   r->scanning = 0;
+  r->last_push_us = -1;
   r->nodes_len = 0;
   r->node_off = 0;
 }
@@ -280,12 +283,23 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
     r->nodes = p;
     r->nodes_cap = cap;
   }
-  for (int i = 0; i < num_rays; i++) {
+  /* A real A1 samples at a fixed rate: a faster spin gives fewer nodes per revolution. Send
+   * what the wire carries in one revolution (the time since the previous push, 3 % margin),
+   * spread evenly over the circle, instead of a backlog that must later be cut. */
+  int send = num_rays;
+  if (r->last_push_us >= 0 && r->wire_us > r->last_push_us) {
+    double per_rev = (double)(r->wire_us - r->last_push_us) * 1e-6 * r->baud / 10.0 /
+                     RPL_NODE_BYTES * 0.97;
+    if (per_rev < send) send = per_rev < 1 ? 1 : (int)per_rev;
+  }
+  r->last_push_us = r->wire_us;
+  for (int k = 0; k < send; k++) {
+    int i = (int)((int64_t)k * num_rays / send);
     double ccw_deg = 360.0 * i / num_rays;
     double r_m = ranges_m[i];
     int hit = isfinite(r_m) && r_m > 0;
     uint8_t q = hit ? (quality ? (uint8_t)quality[i] : RPL_QUALITY_HIT) : 0;
-    sim_rplidar_encode_node(r->nodes + r->nodes_len, i == 0, q, 360.0 - ccw_deg,
+    sim_rplidar_encode_node(r->nodes + r->nodes_len, k == 0, q, 360.0 - ccw_deg,
                             hit ? r_m * 1000.0 : 0.0);
     r->nodes_len += RPL_NODE_BYTES;
   }
