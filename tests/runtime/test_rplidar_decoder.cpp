@@ -199,15 +199,56 @@ TEST(RplidarAssembler, MountYawAndRangeLimits) {
   p.range_max_m = 2.0;
   rplidar::ScanAssembler a(p);
   autodrive::lidar_scan_t s;
-  EXPECT_FALSE(a.add({true, 10, 0.0, 1000.0}, 0, &s));
-  EXPECT_FALSE(a.add({false, 10, 90.0, 1500.0}, 1, &s));   // cw 90 -> ccw 0 (forward)
-  EXPECT_FALSE(a.add({false, 10, 180.0, 2500.0}, 2, &s));  // beyond range_max -> inf
-  EXPECT_FALSE(a.add({false, 0, 270.0, 1200.0}, 3, &s));   // quality 0 -> no return
-  ASSERT_TRUE(a.add({true, 10, 0.0, 1000.0}, 100000, &s));
+  auto range_at = [](int deg_cw) {
+    if (deg_cw == 0) return 1000.0;
+    if (deg_cw == 90) return 1500.0;   // cw 90 -> ccw 0 (forward)
+    if (deg_cw == 180) return 2500.0;  // beyond range_max -> inf
+    if (deg_cw == 270) return 0.0;     // distance 0 -> no return
+    return 1800.0;
+  };
+  for (int d = 0; d < 360; ++d)
+    EXPECT_FALSE(a.add({d == 0, 10, double(d), range_at(d)}, d * 1000, &s));
+  ASSERT_TRUE(a.add({true, 10, 0.0, 1000.0}, 360000, &s));
   EXPECT_FLOAT_EQ(s.ranges_m[90], 1.0f);
   EXPECT_FLOAT_EQ(s.ranges_m[0], 1.5f);
   EXPECT_TRUE(std::isinf(s.ranges_m[270]));
   EXPECT_TRUE(std::isinf(s.ranges_m[180]));
+  EXPECT_FLOAT_EQ(s.ranges_m[1], 1.8f);
   EXPECT_EQ(s.utime, 0);
-  EXPECT_NEAR(s.scan_time_s, 0.1, 1e-6);
+  EXPECT_NEAR(s.scan_time_s, 0.36, 1e-6);
+}
+
+TEST(RplidarAssembler, FakeStartFlagMidTurnIgnored) {
+  rplidar::ScanAssembler a(rplidar::ScanParams{});
+  autodrive::lidar_scan_t s;
+  int emitted = 0;
+  for (int t = 0; t < 3; ++t)
+    for (int d = 0; d < 360; ++d) {
+      const bool fake = d == 120 || d == 15;  // S on a node far from 0, or too early in a turn
+      emitted += a.add({d == 0 || fake, 10, double(d), 1000.0}, (t * 360 + d) * 1000, &s);
+    }
+  EXPECT_EQ(emitted, 2);
+  EXPECT_NEAR(s.scan_time_s, 0.36, 1e-6);
+}
+
+TEST(RplidarAssembler, DescendingAnglesAccepted) {
+  // Nodes counting down (as some emulations send them) still make whole turns.
+  rplidar::Decoder d;
+  rplidar::ScanAssembler a(rplidar::ScanParams{});
+  std::vector<autodrive::lidar_scan_t> scans;
+  int64_t t = 0;
+  d.on_node = [&](const rplidar::Node &n) {
+    autodrive::lidar_scan_t s;
+    if (a.add(n, t += 1000, &s)) scans.push_back(s);
+  };
+  const uint8_t desc[7] = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
+  d.feed(desc, 7);
+  for (int turn = 0; turn < 3; ++turn)
+    for (int i = 0; i < 360; ++i) {
+      uint8_t b[5];
+      rplidar::encode_node({i == 0, 10, double((360 - i) % 360), 1000.0 + i}, b);
+      d.feed(b, 5);
+    }
+  ASSERT_EQ(scans.size(), 2u);
+  for (int i = 0; i < 360; ++i) EXPECT_NEAR(scans[0].ranges_m[static_cast<std::size_t>(i)], 1.0 + i / 1000.0, 1e-6);
 }

@@ -43,7 +43,7 @@ struct EstimatorNode::Impl {
   Ekf odom, map;
   bool have_prev = false;
   autodrive::vehicle_state_t prev{};
-  int64_t last_pub_us = 0;
+  int64_t next_pub_us = 0;  // next ODOM/POSE_MAP due [us, message time]
 
   explicit Impl(const cfg::Config &c)
       : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
@@ -69,9 +69,12 @@ struct EstimatorNode::Impl {
     }
     prev = *m;
     have_prev = true;
+    // Publish on the STATE stream, at most at rate_hz on average (a quarter period of slack
+    // so receive-time jitter does not skip messages).
     const int64_t period_us = static_cast<int64_t>(1e6 / config.estimator.rate_hz);
-    if (m->utime - last_pub_us >= period_us - 500) {
-      last_pub_us = m->utime;
+    if (next_pub_us == 0 || m->utime >= next_pub_us - period_us / 4) {
+      next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
+      if (next_pub_us < m->utime) next_pub_us = m->utime + period_us;  // fell behind
       publish(odom.estimate_at(m->utime), "odom", "_ODOM");
       if (map.initialised()) publish(map.estimate_at(m->utime), "map", "_POSE_MAP");
     }

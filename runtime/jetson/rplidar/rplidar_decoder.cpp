@@ -1,5 +1,6 @@
 #include "rplidar/rplidar_decoder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -8,6 +9,10 @@ namespace rplidar {
 namespace {
 // Largest angle step between consecutive nodes of a real scan [deg] (the A1 steps ~1 deg).
 constexpr double kMaxStepDeg = 20.0;
+// A turn's S node lies within this of the device's 0 deg [deg].
+constexpr double kStartWindowDeg = 30.0;
+// Fewest nodes in a real turn (the A1 sends ~360 or more); fewer = a faked S flag.
+constexpr int kMinNodesPerTurn = 90;
 }  // namespace
 
 std::vector<uint8_t> request(uint8_t cmd) { return {kCmdSync, cmd}; }
@@ -110,8 +115,11 @@ void Decoder::process() {
       continue;
     }
     if (avail < 10) break;
+    // Neighbouring nodes are a small step apart (either direction: the real A1 counts up,
+    // some emulations count down).
     auto follows = [](double from_deg, double to_deg) {
-      return std::fmod(to_deg - from_deg + 360.0, 360.0) < kMaxStepDeg;
+      const double d = std::fmod(to_deg - from_deg + 360.0, 360.0);
+      return std::min(d, 360.0 - d) < kMaxStepDeg;
     };
     Node node, next;
     bool ok = decode_node(b, &node);
@@ -153,13 +161,13 @@ void ScanAssembler::clear(int64_t t_us) {
 
 bool ScanAssembler::add(const Node &n, int64_t t_us, autodrive::lidar_scan_t *out) {
   bool emitted = false;
-  // A new turn starts where the angle wraps past 360 deg. The S flag alone is not trusted: a
-  // corrupted byte can fake it mid-turn (the node format has no checksum); it only marks the
-  // first turn when there is no previous node yet.
-  const bool wrapped = has_last_ && n.angle_deg < last_angle_deg_ - 180.0;
-  const bool new_turn = wrapped || (!has_last_ && n.start);
-  has_last_ = true;
-  last_angle_deg_ = n.angle_deg;
+  // A new turn starts at a node with the S flag. The node format has no checksum, so a
+  // corrupted byte can fake S mid-turn: S counts only near the device's 0 deg and after at
+  // least kMinNodesPerTurn nodes. (If the real S node is lost, two turns merge into one scan:
+  // still valid ranges, a longer scan_time_s.)
+  const double from_zero_deg = std::min(n.angle_deg, 360.0 - n.angle_deg);
+  const bool new_turn = n.start && from_zero_deg < kStartWindowDeg &&
+                        (turn_start_us_ < 0 || nodes_in_turn_ >= kMinNodesPerTurn);
   if (new_turn) {
     // A full turn is behind us only if we saw its start; the first partial turn is dropped.
     if (turn_start_us_ >= 0 && nodes_in_turn_ > 0) {
@@ -182,7 +190,9 @@ bool ScanAssembler::add(const Node &n, int64_t t_us, autodrive::lidar_scan_t *ou
     clear(t_us);
   }
   ++nodes_in_turn_;
-  if (n.quality == 0 || n.distance_mm <= 0.0) return emitted;
+  // Distance 0 is the device's "no return". Quality is only reported (some units and the
+  // simulator's emulation send 0 on good returns).
+  if (n.distance_mm <= 0.0) return emitted;
   const double r_m = n.distance_mm / 1000.0;
   if (r_m < p_.range_min_m || r_m > p_.range_max_m) return emitted;
   // The device measures clockwise; REP-103 angles are counter-clockwise.

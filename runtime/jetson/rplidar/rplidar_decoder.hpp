@@ -115,8 +115,6 @@ class ScanAssembler {
   int64_t turn_start_us_ = -1;
   int nodes_in_turn_ = 0;
   uint64_t scans_ = 0;
-  bool has_last_ = false;
-  double last_angle_deg_ = 0.0;
 };
 
 }  // namespace rplidar
