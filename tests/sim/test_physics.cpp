@@ -209,3 +209,24 @@ TEST(Sensors, RoofTagAndMountsAreInTheModel) {
 }
 
 }  // namespace
+
+namespace {
+
+// The firmware's lamp outputs reach the car model: reversing lights the reverse lamp.
+TEST(Sensors, LampGeomsFollowTheFirmware) {
+  simtest::Sim s("constant:throttle=-0.5,steering=0");
+  ASSERT_NE(s.s, nullptr) << s.err;
+  const mjModel *m = sim_model(s.s);
+  const int rev = mj_name2id(m, mjOBJ_GEOM, "nigel1/lamp_reverse");
+  const int head = mj_name2id(m, mjOBJ_GEOM, "nigel1/lamp_head_l");
+  ASSERT_GE(rev, 0);
+  ASSERT_GE(head, 0);
+  ASSERT_TRUE(s.run_to(0.01)) << s.err;
+  EXPECT_LT(m->geom_rgba[4 * rev], 0.5f);  // not reversing yet: dark
+  ASSERT_TRUE(s.run_to(1.0)) << s.err;
+  EXPECT_EQ(s.truth().vel_body_m_s[0] < 0, true);
+  EXPECT_GT(m->geom_rgba[4 * rev], 0.9f);   // reverse lamp lit
+  EXPECT_LT(m->geom_rgba[4 * head], 0.5f);  // headlights off (not commanded)
+}
+
+}  // namespace

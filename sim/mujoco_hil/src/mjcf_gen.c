@@ -75,6 +75,26 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
           "fovy=\"48.67\"/>\n",
           i, p->cam_rear_pos_m[0], p->cam_rear_pos_m[1], p->cam_rear_pos_m[2]);
 
+  /* lamps (visual only; the sim colours them from the firmware's lamp outputs): front and rear
+   * faces of the chassis box */
+  const double fx = p->chassis_offset_m[0] + 0.5 * p->chassis_size_m[0] + 0.002;
+  const double rx = p->chassis_offset_m[0] - 0.5 * p->chassis_size_m[0] - 0.002;
+  const double lz = p->chassis_offset_m[2] + 0.25 * p->chassis_size_m[2];
+  const double ly = 0.35 * p->chassis_size_m[1], iy = 0.45 * p->chassis_size_m[1];
+  static const struct {
+    const char *name;
+    int front;
+    double y_sign, y_frac; /* y = sign * (ly or iy) */
+  } lamp[] = {{"lamp_head_l", 1, 1, 0}, {"lamp_head_r", 1, -1, 0}, {"lamp_ind_fl", 1, 1, 1},
+              {"lamp_ind_fr", 1, -1, 1}, {"lamp_tail_l", 0, 1, 0}, {"lamp_tail_r", 0, -1, 0},
+              {"lamp_ind_rl", 0, 1, 1}, {"lamp_ind_rr", 0, -1, 1}, {"lamp_reverse", 0, 0, 0}};
+  for (size_t k = 0; k < sizeof lamp / sizeof lamp[0]; k++)
+    fprintf(f,
+            "   <geom name=\"nigel%d/%s\" type=\"box\" size=\"0.002 0.008 0.005\" pos=\"%.6g %.6g "
+            "%.6g\" contype=\"0\" conaffinity=\"0\" group=\"1\" mass=\"0\" rgba=\"0.2 0.2 0.2 1\"/>\n",
+            i, lamp[k].name, lamp[k].front ? fx : rx,
+            lamp[k].y_sign * (lamp[k].y_frac > 0 ? iy : ly), lz);
+
   const char *tyre_attr = p->tyre_model_paper
                               ? "condim=\"1\" priority=\"1\"" /* normal force only, whatever the floor */
                               : "condim=\"3\" friction=\"0.05 0 0\""; /* the floor's mu wins */

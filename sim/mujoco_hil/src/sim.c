@@ -35,6 +35,24 @@
 
 enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
 
+/* Lamp geoms and the NIGEL_LAMP_* bit and colours that drive each. */
+#define SIM_LAMPS 9
+static const struct {
+  const char *name;
+  uint8_t bits;
+  float on[3], off[3];
+} sim_lamp[SIM_LAMPS] = {
+    {"lamp_head_l", NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH, {1, 1, 0.85f}, {0.25f, 0.25f, 0.22f}},
+    {"lamp_head_r", NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH, {1, 1, 0.85f}, {0.25f, 0.25f, 0.22f}},
+    {"lamp_ind_fl", NIGEL_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_ind_fr", NIGEL_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_tail_l", NIGEL_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
+    {"lamp_tail_r", NIGEL_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
+    {"lamp_ind_rl", NIGEL_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_ind_rr", NIGEL_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_reverse", NIGEL_LAMP_REVERSE, {1, 1, 1}, {0.25f, 0.25f, 0.25f}},
+};
+
 typedef struct sim_car {
   sim_t *sim;
   int index; /* 1-based */
@@ -43,6 +61,8 @@ typedef struct sim_car {
   int wheel_body[W_N], wheel_qpos[W_N], wheel_dof[W_N], tyre_geom[W_N];
   int steer_qpos[2], steer_dof[2];
   int accel_adr, gyro_adr, mag_adr;
+  int lamp_geom[SIM_LAMPS]; /* -1 when the model has no such lamp */
+  uint8_t lamps_shown;      /* lamp bits last drawn */
   /* tyre contacts recorded after the previous step */
   double fz_n[W_N], mu[W_N], normal[W_N][3], contact_pos[W_N][3];
   int in_collision;
@@ -161,6 +181,12 @@ static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
     c->steer_qpos[w] = m->jnt_qposadr[j];
     c->steer_dof[w] = m->jnt_dofadr[j];
   }
+  for (int k = 0; k < SIM_LAMPS; k++) { /* optional: older scenes may lack lamps */
+    char name[64];
+    snprintf(name, sizeof name, "nigel%d/%s", c->index, sim_lamp[k].name);
+    c->lamp_geom[k] = mj_name2id(m, mjOBJ_GEOM, name);
+  }
+  c->lamps_shown = 0xFF; /* draw on the first step */
   static const char *sn[3] = {"accel", "gyro", "mag"};
   int *adr[3] = {&c->accel_adr, &c->gyro_adr, &c->mag_adr};
   for (int k = 0; k < 3; k++) {
@@ -413,6 +439,20 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   return 0;
 }
 
+/* Colours the lamp geoms when the firmware's lamp outputs change. */
+static void sim_draw_lamps(sim_t *s, sim_car_t *c) {
+  if (c->lamps == c->lamps_shown) return;
+  c->lamps_shown = c->lamps;
+  for (int k = 0; k < SIM_LAMPS; k++) {
+    if (c->lamp_geom[k] < 0) continue;
+    const float *rgb = (c->lamps & sim_lamp[k].bits) ? sim_lamp[k].on : sim_lamp[k].off;
+    float *dst = s->m->geom_rgba + 4 * c->lamp_geom[k];
+    dst[0] = rgb[0];
+    dst[1] = rgb[1];
+    dst[2] = rgb[2];
+  }
+}
+
 static void sim_actuate(sim_t *s, sim_car_t *c) {
   const vp_params_t *p = &s->p;
   mjData *d = s->d;
@@ -528,6 +568,7 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
     sim_car_t *c = &s->car[i];
     if (sim_nano_io(s, c, err, err_sz) != 0) return -1;
     sim_actuate(s, c);
+    sim_draw_lamps(s, c);
     if (s->tyre_paper) sim_tyres(s, c);
   }
   mj_step2(s->m, s->d);
