@@ -230,3 +230,26 @@ TEST(Sensors, LampGeomsFollowTheFirmware) {
 }
 
 }  // namespace
+
+namespace {
+
+class Maps : public ::testing::TestWithParam<const char *> {};
+
+// Every shipped map compiles with 4 cars, and they drive off their spawn without touching
+// anything.
+TEST_P(Maps, LoadsAndCarsDriveFreely) {
+  simtest::Sim s("constant:throttle=0.6,steering=0", 4, 0, -1, GetParam());
+  ASSERT_NE(s.s, nullptr) << s.err;
+  double x0[5];
+  for (int c = 1; c <= 4; c++) x0[c] = s.truth(c).pos_m[0];
+  ASSERT_TRUE(s.run_to(2.5)) << s.err;
+  for (int c = 1; c <= 4; c++) {
+    const sim_truth_t t = s.truth(c);
+    EXPECT_GT(t.pos_m[0] - x0[c], 0.2) << GetParam() << " car " << c;  // ~0.16 m/s
+    EXPECT_FALSE(t.in_collision) << GetParam() << " car " << c;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Shipped, Maps, ::testing::Values("parking_school", "driving_school"));
+
+}  // namespace

@@ -138,7 +138,8 @@ def driving_school():
     for k, (x, y, yaw) in enumerate(((0.3, 0.12, math.pi / 2), (-0.3, -0.12, math.pi / 2),
                                      (-0.12, 0.3, 0.0), (0.12, -0.3, 0.0))):
         out.append(line(f"stop_line_{k}", x, y, 0.24, yaw, width=0.03))
-    for k, (x, y) in enumerate(((1.2, 1.2), (-1.2, 1.2), (1.2, -1.2), (-1.2, -1.2))):
+    # cones off the roads and clear of the spawn line (cars line up towards -y from the spawn)
+    for k, (x, y) in enumerate(((1.2, 1.2), (-1.2, 1.2), (1.2, -1.2), (-2.0, -1.5))):
         out += cone(f"cone_{k}", x, y)
     out.append(patch("terrain_dirt", "dirt", 1.5, 1.5, 1.0, 1.0))
     out.append(patch("terrain_lawn", "lawn", -1.5, 1.5, 1.0, 1.0))
