@@ -45,6 +45,8 @@ static void main_usage(FILE *f) {
           "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
           "  --no-pty            do not open ptys (with --script)\n"
           "  --no-lidar          do not simulate the LIDAR\n"
+          "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
+          "                      unless a client is scanning on the RPLIDAR pty)\n"
           "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
           "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
           "  --camera-fps F      camera frame rate in sim time (default 30)\n"
@@ -174,7 +176,7 @@ int main(int argc, char **argv) {
   cfg.lidar = 1;
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
-  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0;
+  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1;
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -220,6 +222,8 @@ int main(int argc, char **argv) {
       cfg.open_ptys = 0;
     } else if (!strcmp(a, "--no-lidar")) {
       cfg.lidar = 0;
+    } else if (!strcmp(a, "--no-lidar-lcm")) {
+      lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {
       cameras = 1;
     } else if (!strcmp(a, "--eye")) {
@@ -316,7 +320,9 @@ int main(int argc, char **argv) {
 #ifdef SIM_HAVE_SENSORS
     for (int c = 1; c <= sim_cars(s); c++) {
       const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
-      if (scan) {
+      /* while the runtime's RPLIDAR driver scans on the pty it publishes <VEH>_LIDAR itself:
+       * the sim then stays off the channel so that nobody sees every scan twice */
+      if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
         snprintf(ch, sizeof ch, "NIGEL%d_LIDAR", c);
         sim_lidar_publish(lcm, ch, "laser", scan);

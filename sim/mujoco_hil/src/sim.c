@@ -335,6 +335,17 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
   return 0;
 }
 
+int sim_lidar_pty_scanning(const sim_t *s, int car) {
+#ifdef SIM_HAVE_SENSORS
+  const sim_car_t *c = &s->car[car - 1];
+  return c->rplidar ? sim_rplidar_scanning(c->rplidar) : 0;
+#else
+  (void)s;
+  (void)car;
+  return 0;
+#endif
+}
+
 int sim_has_sensors(void) {
 #ifdef SIM_HAVE_SENSORS
   return 1;

@@ -72,6 +72,8 @@ void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse,
 /* A completed LIDAR scan this step (NULL otherwise); see sim_lidar.h for the fields. */
 struct sim_lidar_scan;
 const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car);
+/* 1 while a client (the runtime's RPLIDAR driver) is scanning on car's emulated RPLIDAR pty. */
+int sim_lidar_pty_scanning(const sim_t *s, int car);
 /* 1 when built with the sensors library. */
 int sim_has_sensors(void);
 
