@@ -91,7 +91,7 @@ TEST(Cli, BadMapFileIsRejectedNamingTheMap) {
           " --map no_such_map");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("no_such_map"), std::string::npos) << r.out;
-  rmdir(dir.c_str());
+  EXPECT_EQ(rmdir(dir.c_str()), 0) << "a failed start left files in the run dir";
 }
 
 TEST(Cli, BadOptionsAreRejected) {

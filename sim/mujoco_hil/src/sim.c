@@ -99,6 +99,7 @@ struct sim {
   motor_model_t motor;
   int tyre_paper;
   int *geom_tyre; /* per geom: car * W_N + wheel, or -1 */
+  int ntag_files; /* roof tag PNGs that may exist in scene_dir */
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
@@ -376,6 +377,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     goto fail;
   }
   snprintf(s->scene_path, sizeof s->scene_path, "%s/scene.xml", s->scene_dir);
+  s->ntag_files = cfg->cars;
   if (sim_load_model(s, cfg, err, err_sz) != 0) goto fail;
   s->ncars = cfg->cars;
   s->car = calloc((size_t)cfg->cars, sizeof *s->car);
@@ -414,7 +416,7 @@ void sim_destroy(sim_t *s) {
     char path[700];
     snprintf(path, sizeof path, "%s/scene.xml", s->scene_dir);
     unlink(path);
-    for (int i = 1; i <= s->ncars; i++) {
+    for (int i = 1; i <= s->ntag_files; i++) {
       snprintf(path, sizeof path, "%s/tag36h11_%d.png", s->scene_dir, mg_tag_id(i));
       unlink(path);
     }
