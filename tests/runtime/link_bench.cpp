@@ -266,9 +266,11 @@ struct EkfBench {
   int64_t next_eye_us = 0;
   std::mt19937 rng{11};
   bool collided = false;
+  std::vector<std::pair<int64_t, int64_t>> clock_pairs;  // (wall receive, sim utime) [us]
 
   void on_gt(const autodrive::ground_truth_t *m) {
     const int64_t t = clk::wall_us();
+    clock_pairs.push_back({t, m->utime});
     gt.push_back({t, m->position_m[0], m->position_m[1], m->yaw_rad});
     collided = collided || m->in_collision;
     if (eye && t >= next_eye_us) {
@@ -398,10 +400,20 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
   for (std::size_t i = 1; i < b.gt.size(); ++i)
     if (b.gt[i].t_us >= t0 && b.gt[i].t_us <= t1)
       path_m += std::hypot(b.gt[i].x - b.gt[i - 1].x, b.gt[i].y - b.gt[i - 1].y);
+  // The simulator's speed during the run (sim s per wall s): below 1 on a loaded machine.
+  double rtf = NAN;
+  std::pair<int64_t, int64_t> first{0, 0}, last{0, 0};
+  for (const auto &p : b.clock_pairs)
+    if (p.first >= t0 && p.first <= t1) {
+      if (first.first == 0) first = p;
+      last = p;
+    }
+  if (last.first > first.first) rtf = double(last.second - first.second) / double(last.first - first.first);
   std::printf("{\"ekf_pos_rms_m\": %.4f, \"ekf_heading_rms_deg\": %.3f, "
               "\"ekf_pos_rms_m_no_eye\": %.4f, \"ekf_heading_rms_deg_no_eye\": %.3f, "
-              "\"ekf_samples\": %d, \"ekf_path_m\": %.2f, \"ekf_collision\": %s}\n",
-              pm, ym, po, yo, nm, path_m, b.collided ? "true" : "false");
+              "\"ekf_samples\": %d, \"ekf_path_m\": %.2f, \"ekf_collision\": %s, "
+              "\"ekf_sim_real_time_factor\": %.3f}\n",
+              pm, ym, po, yo, nm, path_m, b.collided ? "true" : "false", rtf);
   return nm > 0 ? 0 : 1;
 }
 
