@@ -1,1 +1,262 @@
-int main() { return 0; }
+// eye_bench: the Eye's whole pipeline (JPEG decode, detection, pose, LCM publish) on one
+// thread over a synthesised trajectory that drives a car across the whole map, against the
+// truth; and OpenCV's aruco (DICT_APRILTAG_36h11) as the peer on the same frames.
+// Progress on stderr; the figures as "key value" lines on stdout; a CSV of the trajectory.
+#include <CLI/CLI.hpp>
+#include <opencv2/aruco.hpp>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <optional>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+
+#include "eye_detect.hpp"
+#include "eye_mapcal.hpp"
+#include "eye_publish.hpp"
+#include "eye_source.hpp"
+#include "eye_synth.hpp"
+#include "eye_tracker.hpp"
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+
+struct Truth {
+  eye::SynthCar car;
+};
+
+// A Lissajous drive over the map (0.25 m from the edges), heading along the motion.
+std::vector<eye::SynthCar> trajectory(const eye::SynthScene& s, int n) {
+  std::vector<eye::SynthCar> out;
+  const double ax = s.map_x_m / 2 - 0.25, ay = s.map_y_m / 2 - 0.25;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n;
+    const double x = s.map_x_m / 2 + ax * std::sin(t), y = s.map_y_m / 2 + ay * std::sin(2 * t + 0.6);
+    const double dx = ax * std::cos(t), dy = 2 * ay * std::cos(2 * t + 0.6);
+    out.push_back({1, x, y, std::atan2(dy, dx)});
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double thread_cpu_s() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+struct RunResult {
+  std::vector<double> pass_fps;      // frames / wall time, per pass
+  std::vector<double> pass_fps_cpu;  // frames / thread CPU time, per pass
+  std::vector<std::optional<eye::CarPose>> est;  // per frame (first pass)
+  double fps() const { return median(pass_fps); }
+  double fps_cpu() const { return median(pass_fps_cpu); }
+};
+
+struct Scene {
+  eye::SynthScene s;
+  eye::RunConfig cfg;
+  std::vector<eye::SynthCar> path;
+  std::vector<std::vector<uchar>> jpeg;
+};
+
+Scene make_scene(int w, int h, int frames, double tag_size_m, const std::vector<eye::RefTag>* refs_in) {
+  Scene sc;
+  sc.s = eye::synth_scene(w, h, tag_size_m);
+  sc.s.blur_sigma_px = 0.6;
+  sc.s.noise_sigma = 2.0;
+  const auto refs = refs_in ? *refs_in : eye::synth_reference_tags(sc.s);
+  // Calibrate the map from the reference tags, as a user would (not the true pose).
+  eye::DetectorParams dp;
+  dp.decimate = 1;
+  eye::Detector det(dp);
+  const eye::MapCalib m = eye::map_calibrate(sc.s.in, refs, {det.detect(eye::synth_frame(sc.s, {}, refs, 1))});
+  std::fprintf(stderr, "[eye_bench] %dx%d: map calibration residual %.3f mm rms\n", w, h, m.rms_mm);
+  sc.cfg.in = sc.s.in;
+  sc.cfg.pose = m.pose;
+  sc.cfg.locate = sc.s.car;
+  sc.cfg.vehicles = {{"NIGEL1", 1, 0.0}};
+  sc.path = trajectory(sc.s, frames);
+  for (int i = 0; i < frames; ++i) {
+    std::vector<uchar> buf;
+    // The reference tags stay on the floor while cars drive: the detector sees them too.
+    cv::imencode(".jpg", eye::synth_frame(sc.s, {sc.path[static_cast<size_t>(i)]}, refs, static_cast<uint64_t>(i)),
+                 buf, {cv::IMWRITE_JPEG_QUALITY, 90});
+    sc.jpeg.push_back(std::move(buf));
+  }
+  return sc;
+}
+
+// The Eye: decode, detect, locate, publish.
+RunResult run_eye(const Scene& sc, lcm::LCM& lcm, int repeats, bool roi) {
+  RunResult r;
+  eye::RunConfig cfg = sc.cfg;
+  cfg.tracking.roi = roi;
+  for (int rep = 0; rep < repeats; ++rep) {
+    eye::Tracker tr(cfg);  // fresh: every pass starts with a full scan
+    const auto t0 = clock_type::now();
+    const double c0 = thread_cpu_s();
+    for (size_t i = 0; i < sc.jpeg.size(); ++i) {
+      const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
+      const auto poses = tr.process(g);
+      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
+      if (rep == 0) r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
+    }
+    const double n = static_cast<double>(sc.jpeg.size());
+    r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
+    r.pass_fps_cpu.push_back(n / (thread_cpu_s() - c0));
+  }
+  return r;
+}
+
+// The peer: the same pipeline with OpenCV aruco's detector in place of libapriltag.
+RunResult run_peer(const Scene& sc, lcm::LCM& lcm, int repeats) {
+  RunResult r;
+  auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
+  auto params = cv::aruco::DetectorParameters::create();
+  params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+  for (int rep = 0; rep < repeats; ++rep) {
+    const auto t0 = clock_type::now();
+    const double c0 = thread_cpu_s();
+    for (size_t i = 0; i < sc.jpeg.size(); ++i) {
+      const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
+      std::vector<int> ids;
+      std::vector<std::vector<cv::Point2f>> corners;
+      cv::aruco::detectMarkers(g, dict, corners, ids, params);
+      std::vector<eye::CarPose> poses;
+      for (size_t k = 0; k < ids.size(); ++k) {
+        if (ids[k] != 1) continue;
+        // aruco's bitmap is AprilTag's turned 180 deg; its corners (TL, TR, BR, BL of its
+        // bitmap) are our BR, BL, TL, TR: reorder to libapriltag's BL, BR, TR, TL.
+        eye::Detection d;
+        d.id = ids[k];
+        const auto& c = corners[k];
+        d.corners_px = {cv::Point2d(c[1]), cv::Point2d(c[0]), cv::Point2d(c[3]), cv::Point2d(c[2])};
+        if (auto p = eye::locate_car(sc.cfg.in, sc.cfg.pose, sc.cfg.locate, sc.cfg.vehicles[0], d))
+          poses.push_back(*p);
+      }
+      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
+      if (rep == 0) r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
+    }
+    const double n = static_cast<double>(sc.jpeg.size());
+    r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
+    r.pass_fps_cpu.push_back(n / (thread_cpu_s() - c0));
+  }
+  return r;
+}
+
+struct Accuracy {
+  double pos_rms_mm = 0, heading_rms_deg = 0, detect_rate = 0, pos_median_mm = 0, pos_max_mm = 0;
+};
+
+Accuracy accuracy(const Scene& sc, const RunResult& r) {
+  Accuracy a;
+  std::vector<double> e;
+  double ss_p = 0, ss_h = 0;
+  for (size_t i = 0; i < sc.path.size(); ++i) {
+    if (!r.est[i]) continue;
+    const auto& t = sc.path[i];
+    const double ep = 1000 * std::hypot(r.est[i]->x_m - t.x_m, r.est[i]->y_m - t.y_m);
+    const double eh = std::remainder(r.est[i]->yaw_rad - t.yaw_rad, 2 * M_PI) * 180 / M_PI;
+    ss_p += ep * ep;
+    ss_h += eh * eh;
+    e.push_back(ep);
+  }
+  const double n = static_cast<double>(e.size());
+  a.detect_rate = n / static_cast<double>(sc.path.size());
+  if (n > 0) {
+    a.pos_rms_mm = std::sqrt(ss_p / n);
+    a.heading_rms_deg = std::sqrt(ss_h / n);
+    a.pos_median_mm = median(e);
+    a.pos_max_mm = *std::max_element(e.begin(), e.end());
+  }
+  return a;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"eye_bench: Eye pipeline speed and accuracy on a synthesised drive across the map"};
+  int frames = 240, repeats = 3;
+  double tag_size_m = 0.10;
+  std::string csv, url = "udpm://239.255.76.67:7799?ttl=0";
+  app.add_option("--frames", frames, "frames in the trajectory")->capture_default_str();
+  app.add_option("--repeats", repeats, "timing passes over the frames (median per frame)")->capture_default_str();
+  app.add_option("--tag-size-m", tag_size_m, "roof tag black border [m]")->capture_default_str();
+  app.add_option("--csv", csv, "write truth vs estimate per frame (720p) here");
+  app.add_option("--lcm-url", url, "where poses are published")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  cv::setNumThreads(1);  // one thread: aruco and imdecode would otherwise use a pool
+
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::fprintf(stderr, "eye_bench: cannot open LCM %s\n", url.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "[eye_bench] rendering %d frames at 1280x720\n", frames);
+  const Scene hd = make_scene(1280, 720, frames, tag_size_m, nullptr);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720, %d passes\n", repeats);
+  const RunResult e720 = run_eye(hd, lcm, repeats, true);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720 without window tracking, %d passes\n", repeats);
+  const RunResult e720full = run_eye(hd, lcm, repeats, false);
+  std::fprintf(stderr, "[eye_bench] peer (OpenCV aruco) 1280x720, %d passes\n", repeats);
+  const RunResult p720 = run_peer(hd, lcm, repeats);
+  const Accuracy a = accuracy(hd, e720), pa = accuracy(hd, p720), afull = accuracy(hd, e720full);
+  if (!csv.empty()) {
+    std::ofstream f(csv);
+    f << "frame,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad,peer_x_m,peer_y_m,peer_yaw_rad\n";
+    for (size_t i = 0; i < hd.path.size(); ++i) {
+      f << i << "," << hd.path[i].x_m << "," << hd.path[i].y_m << "," << hd.path[i].yaw_rad;
+      for (const auto* r : {&e720, &p720}) {
+        if (r->est[i]) f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
+        else f << ",,,";
+      }
+      f << "\n";
+    }
+  }
+  std::fprintf(stderr, "[eye_bench] rendering %d frames at 1920x1080\n", frames);
+  const Scene fhd = make_scene(1920, 1080, frames, tag_size_m, nullptr);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080, %d passes\n", repeats);
+  const RunResult e1080 = run_eye(fhd, lcm, repeats, true);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080 without window tracking, %d passes\n", repeats);
+  const RunResult e1080full = run_eye(fhd, lcm, repeats, false);
+  const Accuracy a1080 = accuracy(fhd, e1080);
+
+  const double jpeg_kb = static_cast<double>(hd.jpeg[0].size()) / 1024.0;
+  std::printf("fps_1280x720_1t %.2f\n", e720.fps());
+  std::printf("fps_1920x1080_1t %.2f\n", e1080.fps());
+  std::printf("peer_fps_1280x720_1t %.2f\n", p720.fps());
+  std::printf("fps_1280x720_1t_cpu %.2f\n", e720.fps_cpu());
+  std::printf("fps_1920x1080_1t_cpu %.2f\n", e1080.fps_cpu());
+  std::printf("peer_fps_1280x720_1t_cpu %.2f\n", p720.fps_cpu());
+  std::printf("fps_1280x720_1t_fullscan %.2f\n", e720full.fps());
+  std::printf("fps_1280x720_1t_fullscan_cpu %.2f\n", e720full.fps_cpu());
+  std::printf("fps_1920x1080_1t_fullscan %.2f\n", e1080full.fps());
+  std::printf("fps_1920x1080_1t_fullscan_cpu %.2f\n", e1080full.fps_cpu());
+  std::printf("detect_rate_fullscan %.4f\n", afull.detect_rate);
+  std::printf("pos_rms_mm_fullscan %.4f\n", afull.pos_rms_mm);
+  std::printf("pos_rms_mm %.4f\n", a.pos_rms_mm);
+  std::printf("heading_rms_deg %.4f\n", a.heading_rms_deg);
+  std::printf("detect_rate %.4f\n", a.detect_rate);
+  std::printf("pos_median_mm %.4f\n", a.pos_median_mm);
+  std::printf("pos_max_mm %.4f\n", a.pos_max_mm);
+  std::printf("pos_rms_mm_1920x1080 %.4f\n", a1080.pos_rms_mm);
+  std::printf("heading_rms_deg_1920x1080 %.4f\n", a1080.heading_rms_deg);
+  std::printf("detect_rate_1920x1080 %.4f\n", a1080.detect_rate);
+  std::printf("peer_pos_rms_mm %.4f\n", pa.pos_rms_mm);
+  std::printf("peer_heading_rms_deg %.4f\n", pa.heading_rms_deg);
+  std::printf("peer_detect_rate %.4f\n", pa.detect_rate);
+  std::printf("frames %d\nrepeats %d\ntag_size_m %.3f\njpeg_kb_1280x720 %.1f\n", frames, repeats,
+              tag_size_m, jpeg_kb);
+  return 0;
+}

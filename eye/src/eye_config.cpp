@@ -40,6 +40,15 @@ RunConfig runconfig_load(const std::string& path) {
     if (d["min_margin"]) c.detector.min_margin = static_cast<float>(yaml_double(d, "min_margin", w));
     if (!(c.detector.decimate >= 1)) throw Error(w + ": field 'decimate' must be >= 1");
   }
+  if (YAML::Node t = n["tracking"]) {
+    const std::string w = path + " (tracking)";
+    if (!t.IsMap()) throw Error(w + ": must be a mapping");
+    if (t["roi"]) c.tracking.roi = yaml_int(t, "roi", w) != 0;
+    if (t["full_every"]) c.tracking.full_every = yaml_int(t, "full_every", w);
+    if (t["margin"]) c.tracking.margin = yaml_double(t, "margin", w);
+    if (c.tracking.full_every < 1) throw Error(w + ": field 'full_every' must be >= 1");
+    if (!(c.tracking.margin > 0)) throw Error(w + ": field 'margin' must be positive");
+  }
   YAML::Node vs = yaml_need(n, "vehicles", path);
   if (!vs.IsSequence() || vs.size() == 0)
     throw Error(path + ": field 'vehicles' must be a non-empty list");

@@ -9,6 +9,12 @@
 
 namespace eye {
 
+struct TrackingParams {
+  bool roi = true;          // search cars seen last frame only around their last tag
+  int full_every = 10;      // scan the whole frame every this many frames
+  double margin = 1.0;      // window = last tag box grown by this many tag sizes per side
+};
+
 struct RunConfig {
   std::string path;             // the config file itself
   std::string intrinsics_path;  // resolved against the config file's folder
@@ -18,6 +24,7 @@ struct RunConfig {
   CameraPose pose;
   LocateParams locate;
   DetectorParams detector;
+  TrackingParams tracking;
   std::vector<VehicleTag> vehicles;
 };
 

@@ -56,6 +56,7 @@ void write_config(const std::string& path, const eye::SynthScene& s, const std::
   f << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
     << "tag_size_m: " << s.car.tag_size_m << "\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
     << "detector: {decimate: 1}\n"
+    << "tracking: {roi: 0}\n"  // the folder's frames are unrelated scenes
     << "vehicles:\n - {name: NIGEL1, tag_id: 1}\n - {name: NIGEL2, tag_id: 2}\n";
 }
 

@@ -173,3 +173,35 @@ TEST(Frames, WrongSizeFrameIsRejected) {
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   EXPECT_THROW(tr.process(cv::Mat(480, 640, CV_8UC1, cv::Scalar(0))), eye::Error);
 }
+
+// Window tracking along a drive: every frame gives the pose, most frames without a full scan;
+// a car that appears is found at the next full scan; a car that leaves gives no pose at once.
+TEST(Tracking, WindowsFollowACarAndFullScansFindNewOnes) {
+  const Calibrated& c = calibrated();
+  eye::RunConfig cfg = eye_test::config_for(c.scene, c.map.pose);
+  cfg.tracking.roi = true;
+  cfg.tracking.full_every = 5;
+  eye::Tracker tr(cfg);
+  int full = 0;
+  for (int k = 0; k < 15; ++k) {
+    const eye::SynthCar a{1, 0.6 + 0.02 * k, 0.8 + 0.01 * k, 0.3 + 0.02 * k};
+    std::vector<eye::SynthCar> cars{a};
+    const eye::SynthCar b{2, 2.3, 1.4, -1.0};
+    if (k >= 6) cars.push_back(b);  // NIGEL2 drives in at frame 6
+    const auto poses = tr.process(eye::synth_frame(c.scene, cars, {}, static_cast<uint64_t>(k)));
+    full += tr.last_was_full_scan();
+    bool seen1 = false, seen2 = false;
+    for (const auto& p : poses) {
+      const eye::SynthCar& t = p.vehicle == "NIGEL1" ? a : b;
+      EXPECT_LT(1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m), 3.0) << p.vehicle << " frame " << k;
+      seen1 |= p.vehicle == "NIGEL1";
+      seen2 |= p.vehicle == "NIGEL2";
+    }
+    EXPECT_TRUE(seen1) << "frame " << k;
+    // frames 0, 5, 10 are full scans: NIGEL2 (in from frame 6) is found at frame 10
+    EXPECT_EQ(seen2, k >= 10) << "frame " << k;
+  }
+  EXPECT_EQ(full, 3);
+  // NIGEL1 leaves the map: no pose, no stale pose, from the very next frame
+  EXPECT_TRUE(tr.process(eye::synth_frame(c.scene, {}, {}, 99)).empty());
+}
