@@ -69,10 +69,14 @@ def main() -> int:
             buf, frames = bytearray(), []
             seq, state = 0, None
 
-            def pump(seconds, cmd=None):
+            def pump(until, cmd=None, limit_s=60.0):
+                """Streams cmd every 10 ms and reads frames until until() or the liveness
+                limit (the simulation may run slower than real time on a loaded machine)."""
                 nonlocal seq
-                end = time.monotonic() + seconds
-                while time.monotonic() < end:
+                end = time.monotonic() + limit_s
+                while not until():
+                    assert time.monotonic() < end, "nano-simavr stopped answering"
+                    assert proc.poll() is None, "nano-simavr exited"
                     if cmd is not None:
                         os.write(fd, frame(ID_COMMAND, seq, struct.pack("<HhhBBB", seq, *cmd)))
                         seq += 1
@@ -83,20 +87,21 @@ def main() -> int:
                         pass
                     frames.extend(parse(buf))
 
+            def states():
+                return [p for i, p in frames if i == ID_STATE]
+
+            def mode():  # u8 mode after u16 battery_mv and u8 lights
+                return states()[-1][49] if states() else None
+
             os.set_blocking(fd, False)
             os.write(fd, frame(0x03, 0, b""))  # HELLO_REQUEST
-            pump(3)
-            hellos = [p for i, p in frames if i == ID_HELLO]
-            states = [p for i, p in frames if i == ID_STATE]
-            assert hellos, "no HELLO on the pty"
-            assert len(states) >= 10, f"only {len(states)} STATE frames"
+            pump(lambda: any(i == ID_HELLO for i, _ in frames) and len(states()) >= 10)
             # arm (engaged=0 then engaged=1) and drive at half throttle
-            pump(0.3, (0, 0, 0, 0, 0))
-            pump(1.5, (500, 0, 0, 0, 1))
-            states = [p for i, p in frames if i == ID_STATE]
-            mode = states[-1][49]  # u8 mode after u16 battery_mv, u8 lights
-            enc_left = struct.unpack_from("<i", states[-1], 4)[0]
-            assert mode == 1, f"not engaged over the pty (mode {mode})"
+            n0 = len(states())
+            pump(lambda: len(states()) >= n0 + 5, (0, 0, 0, 0, 0))
+            pump(lambda: mode() == 1 and struct.unpack_from("<h", states()[-1], 16)[0] >= 500,
+                 (500, 0, 0, 0, 1))
+            enc_left = struct.unpack_from("<i", states()[-1], 4)[0]
             assert enc_left > 0, "encoder edges from --encoder-hz not counted"
             os.close(fd)
         finally:

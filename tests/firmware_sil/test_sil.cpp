@@ -312,3 +312,35 @@ TEST(Sil, watchdog_reset_safe_state) {
 }
 
 } // namespace
+
+namespace {
+
+TEST(Sil, config_applied) {
+  Board b(NANO_ELF);
+  ASSERT_TRUE(b.run_us(20 * kMs));
+  proto_config_t c{};
+  c.servo_trim_us = 50;
+  c.telemetry_period_ms = 20;
+  c.failsafe_timeout_ms = 50;
+  uint8_t p[PROTO_LEN_CONFIG];
+  proto_config_pack(&c, p);
+  b.send_frame(PROTO_ID_CONFIG, p, PROTO_LEN_CONFIG);
+  ASSERT_TRUE(b.run_us(50 * kMs));
+  const size_t before = b.count(PROTO_ID_STATE);
+  ASSERT_TRUE(b.run_us(1000 * kMs));
+  const size_t n = b.count(PROTO_ID_STATE) - before;
+  EXPECT_GE(n, 49u) << "STATE every 20 ms";
+  EXPECT_LE(n, 51u);
+  EXPECT_EQ(b.servo_pulse_us(), 1550) << "trim moves the centre";
+  EXPECT_EQ(b.count(PROTO_ID_NACK), 0u);
+  // a CONFIG out of range is refused with a NACK and changes nothing
+  c.telemetry_period_ms = 1;
+  proto_config_pack(&c, p);
+  b.send_frame(PROTO_ID_CONFIG, p, PROTO_LEN_CONFIG);
+  ASSERT_TRUE(b.run_until([&] { return b.count(PROTO_ID_NACK) == 1; }, 10 * kMs));
+  const size_t before2 = b.count(PROTO_ID_STATE);
+  ASSERT_TRUE(b.run_us(200 * kMs));
+  EXPECT_LE(b.count(PROTO_ID_STATE) - before2, 11u) << "still 50 Hz";
+}
+
+} // namespace

@@ -7,7 +7,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-#define FW_UART_RX_SIZE 64u  /* [bytes], power of two; ~1.3 ms of line time at 500 kbaud */
+#define FW_UART_RX_SIZE 128u /* [bytes], power of two; 2.5 ms of line time at 500 kbaud */
 #define FW_UART_TX_SIZE 128u /* [bytes], power of two; holds one STATE frame plus a NACK */
 
 void fw_uart_init(void);
