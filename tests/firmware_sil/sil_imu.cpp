@@ -72,6 +72,10 @@ void Mpu9250::handle(uint32_t value) {
   uint8_t *regs = regs_of(selected_);
   const uint8_t mask = selected_ == kMpuAddr ? 0x7F : 0x1F;
   if (cond & TWI_COND_WRITE) {
+    if (stuck_) {
+      avr_raise_irq(to_avr_, avr_twi_irq_msg(TWI_COND_ACK, selected_, 0)); // NACK
+      return;
+    }
     avr_raise_irq(to_avr_, avr_twi_irq_msg(TWI_COND_ACK, selected_, 1));
     if (reg_pending_) {
       ptr_ = msg.u.twi.data & mask;

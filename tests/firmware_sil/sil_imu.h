@@ -15,6 +15,9 @@ class Mpu9250 {
   // Connects to the TWI of avr; present = answers on the bus.
   Mpu9250(avr_t *avr, bool present);
   void set_present(bool present) { present_ = present; }
+  // Still acknowledges its address but no longer the register bytes written to it, like a
+  // device that locked up mid-transfer.
+  void set_stuck(bool stuck) { stuck_ = stuck; }
   // Raw readings [LSB] in the MPU's axes; mag in the AK8963's own axes.
   void set_sample(const std::array<int16_t, 3> &accel, const std::array<int16_t, 3> &gyro,
                   const std::array<int16_t, 3> &mag);
@@ -30,6 +33,7 @@ class Mpu9250 {
   avr_t *avr_;
   avr_irq_t *to_avr_ = nullptr;
   bool present_;
+  bool stuck_ = false;
   std::array<uint8_t, 128> mpu_{};
   std::array<uint8_t, 32> ak_{};
   uint8_t selected_ = 0; // 7-bit address being talked to, 0 = none

@@ -84,8 +84,8 @@ TEST(Sil, command_to_servo_and_motor) {
   uint16_t seq = 1;
   arm(b, seq);
   // full left, half forward; the servo is rate limited (0.65 s for full scale), the throttle
-  // slew-limited (0.25 s for full scale): after 1 s both have arrived
-  stream(b, seq, 1000 * kMs, 500, 1000, true);
+  // slew-limited (0.25 s for full scale): after 0.7 s both have arrived
+  stream(b, seq, 700 * kMs, 500, 1000, true);
   ASSERT_TRUE(b.run_us(12 * kMs)); // one more STATE after the last COMMAND was parsed
   EXPECT_EQ(b.servo_pulse_us(), 2000);
   EXPECT_EQ(b.motor_duty(), 128); // 0.5 * 255, rounded
@@ -96,8 +96,8 @@ TEST(Sil, command_to_servo_and_motor) {
   EXPECT_EQ(s.throttle_milli, 500);
   EXPECT_EQ(s.steering_milli, 1000);
   EXPECT_EQ(s.last_cmd_seq, static_cast<uint16_t>(seq - 1));
-  // reverse, right
-  stream(b, seq, 1500 * kMs, -300, -400, true);
+  // reverse, right: 1.4 full scale of steering takes 0.91 s
+  stream(b, seq, 1000 * kMs, -300, -400, true);
   EXPECT_EQ(b.servo_pulse_us(), 1300);
   EXPECT_EQ(b.motor_duty(), 77); // 0.3 * 255, rounded
   EXPECT_TRUE(b.motor_reverse());
@@ -314,6 +314,22 @@ TEST(Sil, watchdog_reset_safe_state) {
 } // namespace
 
 namespace {
+
+TEST(Sil, imu_stuck_fault) {
+  Board b(NANO_ELF);
+  b.imu().set_sample({0, 0, 8192}, {0, 0, 0}, {100, 0, 0});
+  ASSERT_TRUE(b.run_us(100 * kMs));
+  proto_state_t s{};
+  ASSERT_TRUE(b.last_state(&s));
+  ASSERT_EQ(s.faults & PROTO_FAULT_IMU_LOST, 0);
+  b.imu().set_stuck(true);
+  const size_t states_before = b.states().size();
+  ASSERT_TRUE(b.run_us(200 * kMs));
+  ASSERT_TRUE(b.last_state(&s));
+  EXPECT_TRUE(s.faults & PROTO_FAULT_IMU_LOST);
+  EXPECT_EQ(s.faults & PROTO_FAULT_LOOP_OVERRUN, 0);
+  EXPECT_GE(b.states().size() - states_before, 18u) << "telemetry continues";
+}
 
 TEST(Sil, config_applied) {
   Board b(NANO_ELF);
