@@ -28,7 +28,7 @@ struct Sim {
   sim_t *s = nullptr;
   std::string run_dir, err;
   explicit Sim(const char *script, int cars = 1, int ptys = 0, int tyre_model = -1,
-               const char *map = "parking_school", int lidar = 0) {
+               const char *map = "parking_school", int lidar = 0, uint64_t seed = 3) {
     run_dir = temp_dir();
     const std::string params = params_path(), mp = map_path(map);
     sim_config_t cfg = {};
@@ -36,7 +36,7 @@ struct Sim {
     cfg.map_path = mp.c_str();
     cfg.run_dir = run_dir.c_str();
     cfg.cars = cars;
-    cfg.seed = 3;
+    cfg.seed = seed;
     cfg.open_ptys = ptys;
     cfg.script = script;
     cfg.lidar = lidar;
