@@ -17,7 +17,7 @@
 #endif
 #endif
 #ifndef NIGEL_BUILD_ID
-#define NIGEL_BUILD_ID 0ul /* PlatformIO builds without the CMake build-id stamp */
+#define NIGEL_BUILD_ID 0ul /* neither the CMake stamp nor the PlatformIO build flag */
 #endif
 
 static nigel_t g_nigel;
