@@ -331,6 +331,28 @@ TEST(Sil, imu_stuck_fault) {
   EXPECT_GE(b.states().size() - states_before, 18u) << "telemetry continues";
 }
 
+// ADC7 through the 10k:3.3k divider: pack [mV] = pin [mV] * 13.3 / 3.3.
+TEST(Sil, battery_monitoring) {
+  Board b(NANO_ELF);
+  b.set_adc7_mv(2850); // 11.49 V pack
+  uint16_t seq = 1;
+  arm(b, seq);
+  stream(b, seq, 500 * kMs, 400, 0, true);
+  proto_state_t s{};
+  ASSERT_TRUE(b.last_state(&s));
+  EXPECT_NEAR(s.battery_mv, 11486, 60);
+  EXPECT_EQ(s.faults & (PROTO_FAULT_BATTERY_LOW | PROTO_FAULT_BATTERY_CUTOFF), 0);
+  ASSERT_GT(b.motor_duty(), 0);
+  b.set_adc7_mv(2400); // 9.67 V: below the 9.9 V cut-off
+  stream(b, seq, 800 * kMs, 400, 0, true);
+  ASSERT_TRUE(b.last_state(&s));
+  EXPECT_NEAR(s.battery_mv, 9673, 60);
+  EXPECT_TRUE(s.faults & PROTO_FAULT_BATTERY_LOW);
+  EXPECT_TRUE(s.faults & PROTO_FAULT_BATTERY_CUTOFF);
+  EXPECT_EQ(b.motor_duty(), 0) << "drive refused below cut-off";
+  EXPECT_TRUE(b.motor_brake());
+}
+
 TEST(Sil, config_applied) {
   Board b(NANO_ELF);
   ASSERT_TRUE(b.run_us(20 * kMs));
