@@ -141,6 +141,14 @@ class LcmSource : public Source {
 
 }  // namespace
 
+// A 720p-960p JPEG is ~100-200 KB, several UDP fragments: with the kernel's default receive
+// buffer (~200 KB) LCM 1.3.1 loses most such frames on udpm (measured: 0 of 6 arrived; with a
+// 4 MB buffer 6 of 6). Ask for 4 MB (net.core.rmem_max here) unless the URL says otherwise.
+std::string lcm_url_for_images(const std::string& url) {
+  if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size=") != std::string::npos) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
+}
+
 std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
                                     const std::string& lcm_url, double idle_timeout_s) {
   const auto colon = spec.find(':');
@@ -149,7 +157,7 @@ std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
   const std::string kind = spec.substr(0, colon), what = spec.substr(colon + 1);
   if (!(fps_hint > 0)) throw Error("source '" + spec + "': fps must be positive");
   if (kind == "folder") return std::make_unique<FolderSource>(what, fps_hint);
-  if (kind == "lcm") return std::make_unique<LcmSource>(lcm_url, what, idle_timeout_s);
+  if (kind == "lcm") return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s);
   cv::VideoCapture cap;
   if (kind == "device") {
     int idx = -1;

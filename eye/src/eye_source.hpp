@@ -34,4 +34,7 @@ cv::Mat decode_gray(const uint8_t* data, size_t n, const std::string& what);
 
 int64_t now_utime();
 
+// The LCM URL with a 4 MB socket receive buffer for udpm (large image messages).
+std::string lcm_url_for_images(const std::string& url);
+
 }  // namespace eye
