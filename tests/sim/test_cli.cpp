@@ -106,7 +106,8 @@ TEST(Cli, BadOptionsAreRejected) {
 
 TEST(Cli, PtySymlinksArePrintedAndRemovedOnExit) {
   const std::string dir = simtest::temp_dir();
-  const ProcResult r = run("--lockstep --duration 0.2 --cars 2 --no-lidar --lcm-url memq:// --run-dir " + dir);
+  const ProcResult r =
+      run("--lockstep --duration 0.2 --cars 2 --no-lidar --lcm-url memq:// --run-dir " + dir);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find(dir + "/nigel1-nano"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(dir + "/nigel2-nano"), std::string::npos) << r.out;

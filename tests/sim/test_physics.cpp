@@ -195,7 +195,8 @@ TEST(Sensors, RoofTagAndMountsAreInTheModel) {
   simtest::Sim s(nullptr, 2);
   ASSERT_NE(s.s, nullptr) << s.err;
   const mjModel *m = sim_model(s.s);
-  for (const char *name : {"nigel1/tag", "nigel2/tag"}) EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, name), 0) << name;
+  for (const char *name : {"nigel1/tag", "nigel2/tag"})
+    EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, name), 0) << name;
   for (const char *name : {"nigel1/cam_front", "nigel1/cam_rear", "eye"})
     EXPECT_GE(mj_name2id(m, mjOBJ_CAMERA, name), 0) << name;
   const int lidar = mj_name2id(m, mjOBJ_SITE, "nigel1/lidar");

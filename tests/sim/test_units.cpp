@@ -193,7 +193,9 @@ TEST(Uart, PacesBytesAtTheWireRate) {
 TEST(Script, ArmsThenDrivesAndParsesErrors) {
   script_t s;
   char err[256];
-  ASSERT_EQ(script_parse(&s, "constant:throttle=0.5,steering=-0.25,stop_after=1", err, sizeof err), 0) << err;
+  ASSERT_EQ(
+      script_parse(&s, "constant:throttle=0.5,steering=-0.25,stop_after=1", err, sizeof err), 0)
+      << err;
   proto_parser_t p;
   proto_parser_init(&p);
   struct Got {

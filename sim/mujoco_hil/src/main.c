@@ -113,7 +113,8 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
       if (!k->cam[k->n]) return -1;
       k->cam_id[k->n] = mj_name2id(m, mjOBJ_CAMERA, name);
       snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d_CAM_%s", c, rear ? "REAR" : "FRONT");
-      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d_CAM_%s_INFO", c, rear ? "REAR" : "FRONT");
+      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d_CAM_%s_INFO", c,
+               rear ? "REAR" : "FRONT");
       k->n++;
     }
   if (eye) {

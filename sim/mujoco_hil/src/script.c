@@ -45,13 +45,18 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     *eq = '\0';
     const char *val = eq + 1;
     int rc;
-    if (strcmp(tok, "throttle") == 0) rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
-    else if (strcmp(tok, "steering") == 0) rc = script_num(spec, tok, val, -1, 1, &s->steering, err, err_sz);
-    else if (strcmp(tok, "start") == 0) rc = script_num(spec, tok, val, 0, 1e6, &start, err, err_sz);
-    else if (strcmp(tok, "stop_after") == 0) rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
-    else {
-      snprintf(err, err_sz, "--script '%s': unknown key '%s' (throttle, steering, start, stop_after)",
-               spec, tok);
+    if (strcmp(tok, "throttle") == 0) {
+      rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
+    } else if (strcmp(tok, "steering") == 0) {
+      rc = script_num(spec, tok, val, -1, 1, &s->steering, err, err_sz);
+    } else if (strcmp(tok, "start") == 0) {
+      rc = script_num(spec, tok, val, 0, 1e6, &start, err, err_sz);
+    } else if (strcmp(tok, "stop_after") == 0) {
+      rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
+    } else {
+      snprintf(err, err_sz,
+               "--script '%s': unknown key '%s' (throttle, steering, start, stop_after)", spec,
+               tok);
       return -1;
     }
     if (rc) return -1;

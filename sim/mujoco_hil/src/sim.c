@@ -262,7 +262,8 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
   mg_options_t o = {cfg->cars, NULL, NULL, NULL};
   char map_abs[4096];
-  if (!realpath(cfg->map_path, map_abs)) return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
+  if (!realpath(cfg->map_path, map_abs))
+    return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
   if (sim_check_map(map_abs, err, err_sz) != 0) return -1;
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;
@@ -280,7 +281,9 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   if (rc != 0) return -1;
   char merr[1000] = "";
   s->m = mj_loadXML(s->scene_path, NULL, merr, sizeof merr);
-  if (!s->m) return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path, merr);
+  if (!s->m)
+    return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path,
+                    merr);
   s->d = mj_makeData(s->m);
   if (!s->d) return sim_fail(err, err_sz, "%s%s", "mj_makeData failed (out of memory)", "");
   return 0;
@@ -384,9 +387,13 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   s->geom_tyre = malloc(sizeof(int) * (size_t)s->m->ngeom);
   if (!s->car || !s->geom_tyre) goto fail;
   for (int g = 0; g < s->m->ngeom; g++) s->geom_tyre[g] = -1;
-  s->lon = (tyre_curve_t){s->p.long_extremum[0], s->p.long_extremum[1], s->p.long_asymptote[0], s->p.long_asymptote[1]};
-  s->lat = (tyre_curve_t){s->p.lat_extremum[0], s->p.lat_extremum[1], s->p.lat_asymptote[0], s->p.lat_asymptote[1]};
-  s->motor = (motor_model_t){s->p.motor_stall_torque_nm, s->p.motor_noload_speed_rad_s, s->p.motor_nominal_v};
+  const vp_params_t *p = &s->p;
+  s->lon = (tyre_curve_t){p->long_extremum[0], p->long_extremum[1], p->long_asymptote[0],
+                          p->long_asymptote[1]};
+  s->lat = (tyre_curve_t){p->lat_extremum[0], p->lat_extremum[1], p->lat_asymptote[0],
+                          p->lat_asymptote[1]};
+  s->motor = (motor_model_t){p->motor_stall_torque_nm, p->motor_noload_speed_rad_s,
+                             p->motor_nominal_v};
   for (int i = 0; i < cfg->cars; i++) {
     s->car[i].index = i + 1;
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
@@ -431,7 +438,8 @@ void sim_destroy(sim_t *s) {
 static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   uint8_t buf[512];
   if (c->has_pty) {
-    const size_t n = ptylink_read(&c->pty, buf, uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf);
+    const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
+    const size_t n = ptylink_read(&c->pty, buf, room);
     uart_push(&c->rx, buf, n);
   }
   if (c->has_script) {
@@ -472,18 +480,21 @@ static void sim_actuate(sim_t *s, sim_car_t *c) {
   mjModel *m = s->m;
   const double dt = m->opt.timestep;
   /* servo: pulse -> commanded angle -> rate-limited shaft -> Ackermann knuckle targets */
-  const double target = steer_command_rad(c->servo_us, p->servo_center_us, p->servo_us_per_full, p->steer_limit_rad);
+  const double target =
+      steer_command_rad(c->servo_us, p->servo_center_us, p->servo_us_per_full, p->steer_limit_rad);
   c->steer_rad = steer_rate_limit(c->steer_rad, target, p->steer_rate_rad_s, dt);
   double ang[2];
   steer_ackermann(c->steer_rad, p->wheelbase_m, p->track_m, &ang[0], &ang[1]);
   for (int w = 0; w < 2; w++) {
     const double e = ang[w] - d->qpos[c->steer_qpos[w]];
-    d->qfrc_applied[c->steer_dof[w]] = p->steer_kp_nm_rad * e - p->steer_kv_nms_rad * d->qvel[c->steer_dof[w]];
+    d->qfrc_applied[c->steer_dof[w]] =
+        p->steer_kp_nm_rad * e - p->steer_kv_nms_rad * d->qvel[c->steer_dof[w]];
   }
   /* rear gearmotors (one driver channel) and the brake's holding friction */
   for (int w = W_RL; w <= W_RR; w++) {
     const int dof = c->wheel_dof[w];
-    d->qfrc_applied[dof] = motor_torque_nm(&s->motor, c->duty, c->reverse, c->brake, p->battery_v, d->qvel[dof]);
+    d->qfrc_applied[dof] =
+        motor_torque_nm(&s->motor, c->duty, c->reverse, c->brake, p->battery_v, d->qvel[dof]);
     m->dof_frictionloss[dof] = p->gearbox_friction_nm + (c->brake ? p->brake_hold_torque_nm : 0.0);
   }
 }
@@ -571,7 +582,8 @@ static void sim_record_contacts(sim_t *s) {
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
     for (int k = 0; k < d->ncon; k++)
-      if (d->contact[k].geom1 == c->chassis_geom || d->contact[k].geom2 == c->chassis_geom) c->in_collision = 1;
+      if (d->contact[k].geom1 == c->chassis_geom || d->contact[k].geom2 == c->chassis_geom)
+        c->in_collision = 1;
   }
 }
 
@@ -613,7 +625,9 @@ int64_t sim_time_us(const sim_t *s) { return s->time_us; }
 int sim_cars(const sim_t *s) { return s->ncars; }
 const mjModel *sim_model(const sim_t *s) { return s->m; }
 mjData *sim_data(const sim_t *s) { return s->d; }
-const char *sim_nano_link(const sim_t *s, int car) { return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : ""; }
+const char *sim_nano_link(const sim_t *s, int car) {
+  return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : "";
+}
 const char *sim_lidar_link(const sim_t *s, int car) { return s->car[car - 1].lidar_link; }
 const nigel_t *sim_nano(const sim_t *s, int car) { return &s->car[car - 1].nano; }
 
