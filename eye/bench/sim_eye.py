@@ -5,7 +5,7 @@ compares every NIGEL1_POSE_EYE with NIGEL1_GROUND_TRUTH interpolated at the pose
 frame's capture time). Intrinsics from the sim's EYE_CAMERA_INFO (checked against the camera's
 MJCF: 1280x960, fovy 60 deg); extrinsics from the MJCF camera pose (2.5 m above the origin,
 looking down, image up = map +y), not from calibrate-map (the sim maps carry no floor tags).
-Usage: sim_eye.py <build dir> [duration_s]. Progress on stderr; "key value" lines on stdout."""
+Usage: sim_eye.py <build dir> [duration_s] [out prefix for .csv/.png]. Progress on stderr; "key value" lines on stdout."""
 import math
 import os
 import subprocess
@@ -87,7 +87,7 @@ def main():
     truth.sort(key=lambda m: m.utime)
     tu = [m.utime for m in truth]
     import bisect
-    errs_mm, errs_deg = [], []
+    errs_mm, errs_deg, rows = [], [], []
     for p in poses:
         i = bisect.bisect_left(tu, p.utime)
         if i == 0 or i >= len(tu):
@@ -98,6 +98,7 @@ def main():
         y = a.position_m[1] + s * (b.position_m[1] - a.position_m[1])
         dyaw = math.remainder(b.yaw_rad - a.yaw_rad, 2 * math.pi)
         yaw = a.yaw_rad + s * dyaw
+        rows.append((p.utime, x, y, yaw, p.x_m, p.y_m, p.yaw_rad))
         errs_mm.append(1000 * math.hypot(p.x_m - x, p.y_m - y))
         errs_deg.append(math.degrees(abs(math.remainder(p.yaw_rad - yaw, 2 * math.pi))))
     n = len(errs_mm)
@@ -112,6 +113,36 @@ def main():
     print(f"sim_pos_median_mm {sorted(errs_mm)[n // 2]:.3f}")
     print(f"sim_pos_max_mm {max(errs_mm):.3f}")
     print(f"sim_heading_rms_deg {hrms:.4f}")
+    xs, ys = [r[1] for r in rows], [r[2] for r in rows]
+    print(f"sim_path_extent_x_m {max(xs) - min(xs):.3f}")
+    print(f"sim_path_extent_y_m {max(ys) - min(ys):.3f}")
+    if len(sys.argv) > 3:  # CSV and plot
+        out = sys.argv[3]
+        with open(out + ".csv", "w") as fh:
+            fh.write("utime,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad\n")
+            for r in rows:
+                fh.write(",".join(str(v) for v in r) + "\n")
+        try:
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+            fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5))
+            a1.plot(xs, ys, "-", color="0.6", lw=3, label="sim ground truth (base_link)")
+            a1.plot([r[4] for r in rows], [r[5] for r in rows], ".", ms=3, label="Eye")
+            a1.set_aspect("equal")
+            a1.set_xlabel("map x [m]")
+            a1.set_ylabel("map y [m]")
+            a1.set_title("autodrive-sim overhead camera (1280x960), NIGEL1")
+            a1.legend(fontsize=8)
+            a2.plot([(r[0] - rows[0][0]) / 1e6 for r in rows], errs_mm, lw=1)
+            a2.set_xlabel("sim time [s]")
+            a2.set_ylabel("position error [mm]")
+            a2.set_title("Eye vs ground truth")
+            fig.tight_layout()
+            fig.savefig(out + ".png", dpi=110)
+            log(f"plot {out}.png")
+        except ImportError:
+            log("matplotlib missing: no plot")
 
 
 if __name__ == "__main__":
