@@ -81,6 +81,7 @@ struct LoadFigures {
   double telemetry_hz = 0, loop_hz = 0;
   uint32_t loop_cycles_p50 = 0, loop_cycles_p99 = 0;
   uint32_t loop_cycles_max = 0, isr_cycles_max = 0;
+  uint32_t other_isr[4] = {0, 0, 0, 0}; // TIMER0_OVF, USART_RX, USART_UDRE, TWI
 };
 
 // Driving with everything on: IMU, encoders at edges_hz, commands at 100 Hz.
@@ -113,6 +114,8 @@ LoadFigures measure_load(const std::string &elf, double edges_hz, uint64_t durat
     f.loop_cycles_p99 = passes[passes.size() * 99 / 100];
   }
   f.isr_cycles_max = b.enc_isr_cycles_max();
+  const int vectors[4] = {16, 18, 19, 24};
+  for (int i = 0; i < 4; i++) f.other_isr[i] = b.isr_cycles_max(vectors[i]);
   return f;
 }
 
@@ -178,6 +181,8 @@ int main(int argc, char **argv) {
     const uint32_t loop_max = std::max(load.loop_cycles_max, fast.loop_cycles_max);
     std::fprintf(stderr, "[bench]   at %.0f edges/s: loop max %u cycles, ISR max %u cycles\n", best,
                  fast.loop_cycles_max, fast.isr_cycles_max);
+    std::fprintf(stderr, "[bench]   other ISRs max [cycles]: TIMER0_OVF %u, USART_RX %u, USART_UDRE %u, TWI %u\n",
+                 fast.other_isr[0], fast.other_isr[1], fast.other_isr[2], fast.other_isr[3]);
 
     std::printf("{\"encoder_isr_cycles_max\": %u, \"loop_cycles_max\": %u, \"cmd_to_pwm_us\": %.0f, "
                 "\"failsafe_stop_ms\": %.1f, \"telemetry_hz\": %.1f, \"max_edge_rate_hz\": %.0f}\n",

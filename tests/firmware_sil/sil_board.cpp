@@ -22,8 +22,8 @@ namespace {
 constexpr uint16_t kTccr0a = 0x44, kOcr0a = 0x47, kOcr1aL = 0x88, kOcr1aH = 0x89;
 constexpr uint16_t kPortb = 0x25, kPortc = 0x28, kPortd = 0x2B;
 constexpr uint8_t kCom0a1 = 0x80;
-// Vector addresses [bytes] of INT0 and INT1 (2-word vectors).
-constexpr uint32_t kVecInt0 = 0x0004, kVecInt1 = 0x0008;
+// 26 vectors of 2 words: the table ends at byte 0x68.
+constexpr uint32_t kVectorTableBytes = 26 * 4;
 // Quadrature phases (A, B) in forward order; A changes on 0->1 and 2->3.
 constexpr uint8_t kPhaseA[4] = {0, 1, 1, 0};
 constexpr uint8_t kPhaseB[4] = {0, 0, 1, 1};
@@ -218,7 +218,7 @@ void Board::reset_cycle_stats() {
   loop_max_ = 0;
   loop_last_cycle_ = 0;
   loop_cycles_.clear();
-  isr_max_[0] = isr_max_[1] = 0;
+  for (auto &m : isr_max_) m = 0;
 }
 
 void Board::sample_pwm() {
@@ -274,8 +274,8 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         quiet_uart(avr_);
         isr_active_ = -1;
         loop_last_cycle_ = 0;
-      } else if (pc == kVecInt0 || pc == kVecInt1) {
-        isr_active_ = pc == kVecInt0 ? 0 : 1;
+      } else if (pc < kVectorTableBytes && (pc & 3u) == 0) { // entered an interrupt vector
+        isr_active_ = static_cast<int>(pc / 4);
         // the 4-cycle interrupt response (datasheet) counts as part of the ISR
         isr_start_ = avr_->cycle - 4;
       } else if (pc == loop_addr_) {

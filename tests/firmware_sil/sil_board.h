@@ -104,7 +104,10 @@ class Board {
   void write_ram(uint32_t addr, uint8_t v);
 
   // Cycle statistics.
-  uint32_t enc_isr_cycles_max() const { return isr_max_[0] > isr_max_[1] ? isr_max_[0] : isr_max_[1]; }
+  // Longest run of an ISR [cycles], by vector number (1 INT0, 2 INT1, 16 TIMER0_OVF,
+  // 18 USART_RX, 19 USART_UDRE, 24 TWI), from the vector to the RETI.
+  uint32_t isr_cycles_max(int vector) const { return isr_max_[vector]; }
+  uint32_t enc_isr_cycles_max() const { return isr_max_[1] > isr_max_[2] ? isr_max_[1] : isr_max_[2]; }
   uint32_t loop_cycles_max() const { return loop_max_; }
   uint64_t loop_passes() const { return loop_passes_; }
   // Records every pass's length [cycles] (off by default: it grows by ~2400 entries/s).
@@ -146,9 +149,9 @@ class Board {
   bool record_loop_ = false;
   std::vector<uint32_t> loop_cycles_;
   uint64_t loop_passes_ = 0;
-  int isr_active_ = -1; // index of the encoder ISR being timed
+  int isr_active_ = -1; // vector number of the ISR being timed
   uint64_t isr_start_ = 0;
-  uint32_t isr_max_[2]{};
+  uint32_t isr_max_[26]{};
   uint32_t resets_ = 0;
 };
 
