@@ -214,7 +214,7 @@ static const char schema_text[] = PROTO_SCHEMA;
 #define SCHEMA_BYTE(i) ((uint8_t)schema_text[i])
 #endif
 
-uint32_t proto_schema_hash(void) {
+static uint32_t schema_fnv1a(void) {
   uint32_t h = 2166136261ul;
   size_t i;
   for (i = 0; i + 1u < sizeof schema_text; ++i) {
@@ -223,6 +223,22 @@ uint32_t proto_schema_hash(void) {
   }
   return h;
 }
+
+#ifdef __AVR__
+/* Cached on the AVR: hashing ~900 flash bytes costs ~4.5 ms, too long for every HELLO. The
+ * firmware is single-threaded, so a plain static is safe there (not on a threaded host). */
+uint32_t proto_schema_hash(void) {
+  static uint32_t cached;
+  static uint8_t have;
+  if (!have) {
+    cached = schema_fnv1a();
+    have = 1;
+  }
+  return cached;
+}
+#else
+uint32_t proto_schema_hash(void) { return schema_fnv1a(); }
+#endif
 
 /* ---- parser ---------------------------------------------------------------------------- */
 void proto_parser_init(proto_parser_t *p) { memset(p, 0, sizeof *p); }
