@@ -209,28 +209,35 @@ std::vector<Backend> lidar_backends() {
 TEST_P(LidarE2E, RplidarDriverAgainstEmulatedA1) {
   start_backend();
   start_runtime();
-  ASSERT_TRUE(wait_for([&] { return scans_.size() >= 5 && sim_scans_.size() >= 5; }))
+  // (The simulator's own NIGEL1_LIDAR has been seen to arrive only a few times a minute in
+  // this setup while its emulated A1 streams at 7 Hz: one is enough for the comparison.)
+  ASSERT_TRUE(wait_for([&] { return scans_.size() >= 5 && !sim_scans_.empty(); }))
+      << "driver scans " << scans_.size() << ", simulator scans " << sim_scans_.size() << "\n"
       << log("runtime.log");
-  // The car stands still: the driver's scan must equal the simulator's own published scan
-  // (to the protocol's quarter-millimetre quantisation), ray for ray.
+  // The car stands still: every ray the driver reports must equal the simulator's own
+  // published scan (to the protocol's quarter-millimetre quantisation). The emulated A1, like
+  // the real one, sends a fixed number of samples per second, so at 7 Hz a turn has fewer
+  // than 360 nodes and some bins stay empty (+inf): most bins must be filled.
   const auto &ours = scans_.back();
   const auto &truth = sim_scans_.back();
   ASSERT_EQ(ours.num_ranges, 360);
   ASSERT_EQ(truth.num_ranges, 360);
-  int finite = 0, match = 0;
+  int truth_finite = 0, ours_finite = 0, match = 0;
   for (int i = 0; i < 360; ++i) {
     const float a = ours.ranges_m[static_cast<std::size_t>(i)];
     const float b = truth.ranges_m[static_cast<std::size_t>(i)];
-    finite += std::isfinite(b) ? 1 : 0;
-    if (std::isfinite(a) && std::isfinite(b) ? std::fabs(a - b) < 0.002f : std::isinf(a) == std::isinf(b))
-      ++match;
+    truth_finite += std::isfinite(b) ? 1 : 0;
+    if (!std::isfinite(a)) continue;
+    ++ours_finite;
+    if (std::isfinite(b) && std::fabs(a - b) < 0.002f) ++match;
   }
-  EXPECT_GT(finite, 100);
+  EXPECT_GT(truth_finite, 100);
+  EXPECT_GE(ours_finite, truth_finite * 8 / 10);
   std::ostringstream diff;
   for (int i = 0; i < 360; i += 15)
     diff << i << ": " << ours.ranges_m[static_cast<std::size_t>(i)] << " vs "
          << truth.ranges_m[static_cast<std::size_t>(i)] << "\n";
-  EXPECT_GE(match, 350) << "driver scan differs from the simulator's:\n" << diff.str();
+  EXPECT_GE(match, ours_finite * 99 / 100) << "driver scan differs from the simulator's:\n" << diff.str();
 }
 
 std::string backend_name(const ::testing::TestParamInfo<Backend> &i) { return i.param.name; }

@@ -28,6 +28,7 @@ struct Driver::Impl {
   int64_t deadline_us = 0;    // current phase times out here [monotonic us]
   int64_t next_open_us = 0;
   int64_t last_node_us = 0;
+  int64_t next_report_us = 0;  // next statistics log line [monotonic us]
   bool open_failure_logged = false;
 
   explicit Impl(const cfg::Config &c)
@@ -147,6 +148,13 @@ struct Driver::Impl {
     } else if (phase == Phase::scan && t - last_node_us > 2000000) {
       spdlog::warn("{}no measurement for 2 s; restarting the scan", tag);
       start_health(t);
+    }
+    if (t >= next_report_us) {
+      // A periodic health line: what the link carried and what was published.
+      const DecoderStats &d = decoder.stats();
+      spdlog::info("{}nodes {} bad {} skipped bytes {} descriptors {} scans published {}", tag,
+                   d.nodes, d.bad_nodes, d.skipped_bytes, d.descriptors, assembler.scans());
+      next_report_us = t + 10000000;
     }
     std::lock_guard<std::mutex> g(mu);
     st.scanning = decoder.scanning();
