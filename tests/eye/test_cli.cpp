@@ -6,6 +6,7 @@
 #include <autodrive/pose2d_t.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -256,4 +257,43 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
       EXPECT_NEAR(p.yaw_rad, 0.5, 0.01);
     }
   }
+}
+
+// run on a video file (MJPG in AVI via FFMPEG): frames stamped index / --fps, poses found.
+TEST(Cli, RunOnVideoFile) {
+  const std::string d = fresh_dir("eye_cli_video");
+  const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  eye::intrinsics_save(d + "/camera.yaml", s.in);
+  eye::MapCalib m;
+  m.pose = s.pose;
+  m.width_px = 640;
+  m.height_px = 480;
+  eye::mapcal_save(d + "/map.yaml", m);
+  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7792?ttl=0");
+  cv::VideoWriter vw(d + "/drive.avi", cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
+                     cv::Size(640, 480), false);
+  ASSERT_TRUE(vw.isOpened());
+  for (int k = 0; k < 3; ++k) vw.write(eye::synth_frame(s, {{1, 1.0 + 0.05 * k, 1.0, 0.2}}, {}, k));
+  vw.release();
+  std::string out;
+  ASSERT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source video:" + d +
+                    "/drive.avi --fps 10",
+                &out),
+            0)
+      << out;
+  std::istringstream lines(out);
+  std::string line;
+  int k = 0;
+  while (std::getline(lines, line)) {
+    if (line.find("drive.avi#") == std::string::npos) continue;
+    EXPECT_NE(line.find("utime=" + std::to_string(k * 100000)), std::string::npos) << line;
+    double x, y, yaw;
+    ASSERT_TRUE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << line;
+    EXPECT_NEAR(x, 1.0 + 0.05 * k, 0.005) << line;
+    EXPECT_NEAR(y, 1.0, 0.005) << line;
+    ++k;
+  }
+  EXPECT_EQ(k, 3) << out;
+  EXPECT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source video:" + d + "/none.avi", &out), 1);
+  EXPECT_NE(out.find("none.avi"), std::string::npos) << out;
 }

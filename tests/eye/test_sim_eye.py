@@ -1,0 +1,29 @@
+#!/usr/bin/env python3
+"""eye.Sim.OverheadCameraMatchesGroundTruth: autodrive-sim --eye (real time, scripted car) and
+autodrive-eye run on EYE_IMAGE; every NIGEL1_POSE_EYE vs the sim's ground truth at its utime.
+Usage: test_sim_eye.py <root> <build dir> <duration_s>"""
+import subprocess
+import sys
+
+root, build, dur = sys.argv[1], sys.argv[2], sys.argv[3]
+r = subprocess.run([sys.executable, f"{root}/eye/bench/sim_eye.py", build, dur],
+                   capture_output=True, text=True, timeout=300)
+sys.stderr.write(r.stderr)
+print(r.stdout)
+if r.returncode != 0:
+    sys.exit(f"FAIL: sim_eye.py exited {r.returncode}")
+fig = {k: float(v) for k, v in (line.split() for line in r.stdout.splitlines() if line.strip())}
+fails = []
+if fig["sim_frames"] < 10:
+    fails.append(f"only {fig['sim_frames']} frames processed")
+if fig["sim_detect_rate"] < 0.99:
+    fails.append(f"detect rate {fig['sim_detect_rate']} < 0.99")
+if fig["sim_pos_rms_mm"] > 5.0:
+    fails.append(f"position rms {fig['sim_pos_rms_mm']} mm > 5")
+if fig["sim_heading_rms_deg"] > 0.5:
+    fails.append(f"heading rms {fig['sim_heading_rms_deg']} deg > 0.5")
+if fig["sim_path_extent_x_m"] < 0.05:
+    fails.append("the car did not move")
+if fails:
+    sys.exit("FAIL: " + "; ".join(fails))
+print("PASS")
