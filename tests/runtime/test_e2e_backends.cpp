@@ -16,6 +16,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
@@ -81,6 +82,11 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
   void TearDown() override {
     runtime_.reset();
     backend_.reset();
+    // Keep the logs of a failed test for a post-mortem; otherwise leave nothing behind.
+    if (!HasFailure()) {
+      std::error_code ec;
+      std::filesystem::remove_all(dir_, ec);
+    }
   }
 
   void start_backend() {
