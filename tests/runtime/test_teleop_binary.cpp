@@ -1,0 +1,81 @@
+// autodrive-teleop as a program: its gamepad path reads Linux joystick events (js_event) from
+// a FIFO standing in for /dev/input/js0; dead-man held -> engaged commands, released ->
+// disengaged, over real LCM UDP multicast.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <linux/joystick.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <autodrive/vehicle_command_t.hpp>
+
+#include <chrono>
+#include <functional>
+
+#include "child_process.hpp"
+#include "common/lcm_sub.hpp"
+
+namespace {
+struct Commands {
+  std::vector<autodrive::vehicle_command_t> got;
+  void on(const autodrive::vehicle_command_t *m) { got.push_back(*m); }
+};
+
+void send_js(int fd, uint8_t type, uint8_t number, int16_t value) {
+  js_event e{};
+  e.type = type;
+  e.number = number;
+  e.value = value;
+  ASSERT_EQ(::write(fd, &e, sizeof e), static_cast<ssize_t>(sizeof e));
+}
+
+bool pump_until(lcm::LCM &lcm, const std::function<bool()> &pred, double max_s = 30.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(max_s);
+  while (std::chrono::steady_clock::now() < end) {
+    lcm.handleTimeout(20);
+    if (pred()) return true;
+  }
+  return pred();
+}
+}  // namespace
+
+TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
+  const std::string fifo = "/tmp/adr-rt-js-" + std::to_string(getpid());
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const int w = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK);  // keeps a writer for the test's life
+  ASSERT_GE(w, 0);
+  const std::string url = "udpm://239.255.76.67:7777?ttl=0";
+  lcm::LCM lcm(url);
+  Commands cmds;
+  lcmsub::subscribe<autodrive::vehicle_command_t, Commands, &Commands::on>(lcm, "JS1_COMMAND", &cmds);
+  rtest::Child teleop({AUTODRIVE_TELEOP_EXE, "--vehicle", "JS1", "--lcm-url", url, "--joystick",
+                       fifo, "--no-keyboard", "--max-throttle", "0.5"},
+                      fifo + ".log");
+  // Released: commands flow, disengaged.
+  ASSERT_TRUE(pump_until(lcm, [&] { return cmds.got.size() >= 5; }));
+  EXPECT_FALSE(cmds.got.back().engaged);
+  // Stick up, steer right, hold the dead-man (button 4), headlights (button 0).
+  send_js(w, JS_EVENT_AXIS, 1, -32767);
+  send_js(w, JS_EVENT_AXIS, 3, 32767);
+  send_js(w, JS_EVENT_BUTTON, 4, 1);
+  send_js(w, JS_EVENT_BUTTON, 0, 1);
+  ASSERT_TRUE(pump_until(lcm, [&] { return !cmds.got.empty() && cmds.got.back().engaged; }));
+  const auto held = cmds.got.back();
+  EXPECT_NEAR(held.throttle, 0.5, 1e-3);
+  EXPECT_NEAR(held.steering, -1.0, 1e-3);
+  EXPECT_EQ(held.headlights, 1);
+  // Release the dead-man: stop.
+  send_js(w, JS_EVENT_BUTTON, 4, 0);
+  ASSERT_TRUE(pump_until(lcm, [&] { return !cmds.got.back().engaged; }));
+  EXPECT_EQ(cmds.got.back().throttle, 0.0f);
+  EXPECT_EQ(cmds.got.back().headlights, 1);  // lights stay as set
+  // Quit: the last command it sends is disengaged.
+  teleop.stop();
+  lcm.handleTimeout(100);
+  EXPECT_FALSE(cmds.got.back().engaged);
+  ::close(w);
+  ::unlink(fifo.c_str());
+  ::unlink((fifo + ".log").c_str());
+}
