@@ -1,5 +1,6 @@
 #include "eye_intrinsics.hpp"
 
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include <cstdio>
@@ -21,19 +22,38 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
   std::vector<std::vector<cv::Point3f>> obj;
   std::vector<std::vector<cv::Point2f>> img;
   bool cell[4][4] = {};
+  const auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100);
+  const auto charuco = cv::aruco::CharucoBoard::create(
+      p.inner_cols + 1, p.inner_rows + 1, static_cast<float>(p.square_m),
+      static_cast<float>(p.square_m * p.marker_ratio), dict);
   for (const auto& v : views) {
     if (v.size() != size)
       throw Error("calibrate-intrinsics: images differ in size (" + std::to_string(v.cols) + "x" +
                   std::to_string(v.rows) + " vs " + std::to_string(size.width) + "x" +
                   std::to_string(size.height) + ")");
     std::vector<cv::Point2f> corners;
-    if (!cv::findChessboardCornersSB(v, pattern, corners, cv::CALIB_CB_ACCURACY)) continue;
+    std::vector<cv::Point3f> points;
+    if (p.charuco) {
+      std::vector<int> mids, cids;
+      std::vector<std::vector<cv::Point2f>> mcorners;
+      cv::aruco::detectMarkers(v, dict, mcorners, mids);
+      if (mids.size() < 4) continue;
+      cv::aruco::interpolateCornersCharuco(mcorners, mids, v, charuco, corners, cids);
+      if (corners.size() < 6) continue;
+      for (auto& c : corners) c += cv::Point2f(static_cast<float>(kArucoToOpencvPx),
+                                               static_cast<float>(kArucoToOpencvPx));
+      // Calibrate from ids' board points with calibrateCamera (same solver as checkerboards).
+      for (int id : cids) points.push_back(charuco->chessboardCorners[static_cast<size_t>(id)]);
+    } else {
+      if (!cv::findChessboardCornersSB(v, pattern, corners, cv::CALIB_CB_ACCURACY)) continue;
+      points = board;
+    }
     for (const auto& c : corners) {
       const int cx = std::min(3, std::max(0, static_cast<int>(4 * c.x / size.width)));
       const int cy = std::min(3, std::max(0, static_cast<int>(4 * c.y / size.height)));
       cell[cy][cx] = true;
     }
-    obj.push_back(board);
+    obj.push_back(points);
     img.push_back(corners);
   }
   rep.views_used = static_cast<int>(img.size());
@@ -42,8 +62,10 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
     for (bool b : row) cells += b;
   rep.coverage = cells / 16.0;
   if (rep.views_used < p.min_views)
-    throw Error("calibrate-intrinsics: too few views: the board (" + std::to_string(p.inner_cols) +
-                "x" + std::to_string(p.inner_rows) + " inner corners) was found in " +
+    throw Error("calibrate-intrinsics: too few views: the " +
+                std::string(p.charuco ? "ChArUco board" : "checkerboard") + " (" +
+                std::to_string(p.inner_cols) + "x" + std::to_string(p.inner_rows) +
+                " inner corners) was found in " +
                 std::to_string(rep.views_used) + " of " + std::to_string(rep.views_total) +
                 " images, need at least " + std::to_string(p.min_views));
   if (rep.coverage < p.min_coverage) {

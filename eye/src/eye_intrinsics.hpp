@@ -9,8 +9,15 @@
 
 namespace eye {
 
+// OpenCV 4.6's aruco marker and ChArUco corners put pixel centres at +0.5 like libapriltag
+// (measured on the board's own drawing at 1:1: +0.49 px), unlike findChessboardCornersSB:
+// ChArUco corners are shifted by this much [px] (asserted by eye.Intrinsics.Charuco*).
+constexpr double kArucoToOpencvPx = -0.5;
+
 struct IntrinsicsParams {
-  int inner_cols = 9;        // inner corners along the board's width
+  bool charuco = false;      // ChArUco board (aruco DICT_5X5_100 markers) instead of a checkerboard
+  double marker_ratio = 0.7; // ChArUco: marker edge / square edge
+  int inner_cols = 9;        // inner corners along the board's width (squares - 1)
   int inner_rows = 6;        // inner corners along its height
   double square_m = 0.025;   // square edge [m] (scales extrinsics only, not K)
   int min_views = 8;         // fewer usable views: refused
@@ -26,7 +33,8 @@ struct IntrinsicsReport {
   double coverage = 0;  // fraction of the 4x4 grid cells holding a corner
 };
 
-// Finds the board in each image (CV_8UC1) and calibrates. Throws eye::Error with a clear
+// Finds the board in each image (CV_8UC1; a ChArUco view counts if >= 6 corners are seen)
+// and calibrates. Throws eye::Error with a clear
 // reason on too few views, poor coverage or too high an RMS.
 IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& gray_views,
                                       const IntrinsicsParams& p);

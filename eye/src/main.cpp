@@ -96,6 +96,10 @@ int main(int argc, char** argv) {
   ci->add_option("--max-rms-px", ip.max_rms_px, "refuse a higher reprojection RMS [px]")
       ->capture_default_str();
   ci->add_flag("!--free-k3", ip.fix_k3, "also fit k3 (wide-angle lenses)");
+  ci->add_flag("--charuco", ip.charuco,
+               "ChArUco board (DICT_5X5_100, squares = cols+1 x rows+1) instead of a checkerboard");
+  ci->add_option("--marker-ratio", ip.marker_ratio, "ChArUco: marker edge / square edge")
+      ->capture_default_str();
   ci->add_option("-o,--out", ci_out, "output YAML (camera matrix, distortion, RMS)")->required();
 
   // calibrate-map

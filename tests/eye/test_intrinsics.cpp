@@ -2,6 +2,7 @@
 // matrix, and refusal of degenerate image sets.
 #include <gtest/gtest.h>
 
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include <cstdio>
@@ -25,7 +26,7 @@ eye::Intrinsics truth_camera() {
 // The board (9x6 inner corners, 25 mm squares, 10x7 squares) seen from `n` poses spread over
 // the image: board centre near each cell of a 4x3 grid, tilted by up to ~25 deg.
 std::vector<cv::Mat> board_views(const eye::Intrinsics& in, int n, double spread,
-                                 std::vector<eye::CameraPose>* poses = nullptr) {
+                                 std::vector<eye::CameraPose>* poses = nullptr, double scale = 1.0) {
   std::vector<cv::Mat> out;
   const double sq = 0.025, bw = 10 * sq, bh = 7 * sq;
   for (int i = 0; i < n; ++i) {
@@ -36,7 +37,7 @@ std::vector<cv::Mat> board_views(const eye::Intrinsics& in, int n, double spread
     eye::CameraPose p;  // board -> camera
     p.r_cam_map = cv::Matx33d(r);
     const cv::Vec3d centre_board(bw / 2, bh / 2, 0);
-    const cv::Vec3d centre_cam(u * 0.75, v * 0.55, 0.7 + 0.1 * (i % 3));
+    const cv::Vec3d centre_cam = scale * cv::Vec3d(u * 0.75, v * 0.55, 0.7 + 0.1 * (i % 3));
     p.t_cam_map = centre_cam - p.r_cam_map * centre_board;
     out.push_back(eye::render_checkerboard(in, p, 10, 7, sq, 2));
     if (poses) poses->push_back(p);
@@ -131,4 +132,57 @@ TEST(Intrinsics, RefusesHighRms) {
 TEST(Intrinsics, RefusesImagesWithoutBoard) {
   std::vector<cv::Mat> blank(10, cv::Mat(480, 640, CV_8UC1, cv::Scalar(90)));
   EXPECT_THROW(eye::intrinsics_calibrate(blank, eye::IntrinsicsParams()), eye::Error);
+}
+
+// ChArUco: the board image from OpenCV (5x5-bit markers, 10x7 squares of 25 mm, 40 px per
+// square) as a texture on the board plane: texel u covers board x in [u, u+1] * sq / 40.
+TEST(Intrinsics, CharucoRoundTripRecoversKnownCameraMatrix) {
+  const eye::Intrinsics truth = truth_camera();
+  const double sq = 0.025;
+  const int px_per_sq = 40;
+  auto board = cv::aruco::CharucoBoard::create(10, 7, static_cast<float>(sq), static_cast<float>(0.7 * sq),
+                                               cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100));
+  cv::Mat tex;
+  board->draw(cv::Size(10 * px_per_sq, 7 * px_per_sq), tex, 0, 1);
+  const double s = sq / px_per_sq;
+  const cv::Matx33d tex_to_board(s, 0, 0.5 * s, 0, s, 0.5 * s, 0, 0, 1);
+  std::vector<cv::Mat> views;
+  std::vector<eye::CameraPose> poses;
+  // The checkerboard poses 0.6x as far: markers of 17.5 mm need ~20 px; boards may leave the
+  // image partly, which ChArUco (unlike a checkerboard) tolerates.
+  board_views(truth, 12, 1.0, &poses, 0.6);
+  for (const auto& p : poses) {
+    cv::Mat img(truth.height_px, truth.width_px, CV_8UC1, cv::Scalar(128));
+    eye::render_texture(img, tex, eye::render_plane_to_image(truth, p, 0.0) * tex_to_board, 2);
+    views.push_back(img);
+  }
+  // Corner convention: OpenCV's interpolated ChArUco corners vs their true projections carry
+  // +0.5 px (pixel centres at +0.5), which eye::intrinsics_calibrate removes.
+  {
+    std::vector<int> mids, cids;
+    std::vector<std::vector<cv::Point2f>> mc;
+    std::vector<cv::Point2f> cc;
+    cv::aruco::detectMarkers(views[5], board->dictionary, mc, mids);
+    ASSERT_GE(cv::aruco::interpolateCornersCharuco(mc, mids, views[5], board, cc, cids), 20);
+    double sx = 0, sy = 0;
+    for (size_t i = 0; i < cc.size(); ++i) {
+      const auto& b = board->chessboardCorners[static_cast<size_t>(cids[i])];
+      const cv::Point2d t = eye::camera_project(truth, poses[5], {b.x, b.y, 0});
+      sx += cc[i].x - t.x;
+      sy += cc[i].y - t.y;
+    }
+    EXPECT_NEAR(sx / cc.size() + eye::kArucoToOpencvPx, 0.0, 0.1);
+    EXPECT_NEAR(sy / cc.size() + eye::kArucoToOpencvPx, 0.0, 0.1);
+  }
+  eye::IntrinsicsParams p;
+  p.charuco = true;
+  const auto rep = eye::intrinsics_calibrate(views, p);
+  std::printf("charuco: %d views, rms %.3f px, fx %.2f fy %.2f cx %.2f cy %.2f\n", rep.views_used,
+              rep.in.rms_px, rep.in.k(0, 0), rep.in.k(1, 1), rep.in.k(0, 2), rep.in.k(1, 2));
+  EXPECT_GE(rep.views_used, 10);
+  EXPECT_LT(rep.in.rms_px, 0.3);
+  EXPECT_NEAR(rep.in.k(0, 0), truth.k(0, 0), 0.005 * truth.k(0, 0));
+  EXPECT_NEAR(rep.in.k(1, 1), truth.k(1, 1), 0.005 * truth.k(1, 1));
+  EXPECT_NEAR(rep.in.k(0, 2), truth.k(0, 2), 2.0);
+  EXPECT_NEAR(rep.in.k(1, 2), truth.k(1, 2), 2.0);
 }
