@@ -13,13 +13,17 @@ struct Echo {
   lcm::LCM *lcm;
   std::string out;
   int remaining;
-  void on(const lcm::ReceiveBuffer *, const std::string &, const autodrive::vehicle_command_t *m) {
-    autodrive::vehicle_command_t r = *m;
-    r.seq = m->seq + 1;
-    lcm->publish(out, &r);
-    --remaining;
-  }
 };
+
+// subscribeFunction, not the member-function subscribe(): LCM 1.3.1's member-function path
+// hands its callback a null subscription under UBSan (see runtime/jetson/common/lcm_sub.hpp).
+void on_command(const lcm::ReceiveBuffer *, const std::string &,
+                const autodrive::vehicle_command_t *m, Echo *echo) {
+  autodrive::vehicle_command_t r = *m;
+  r.seq = m->seq + 1;
+  echo->lcm->publish(echo->out, &r);
+  --echo->remaining;
+}
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -34,7 +38,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   Echo echo{&lcm, argv[3], std::atoi(argv[4])};
-  lcm.subscribe(argv[2], &Echo::on, &echo);
+  lcm.subscribeFunction(argv[2], &on_command, &echo);
   std::printf("ready\n");
   std::fflush(stdout);
   while (echo.remaining > 0) {
