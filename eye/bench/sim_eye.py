@@ -20,7 +20,8 @@ sys.path.insert(0, os.path.join(BUILD, "lcm_types", "gen", "python"))
 import lcm  # noqa: E402
 from autodrive import camera_info_t, ground_truth_t, pose2d_t  # noqa: E402
 
-URL = "udpm://239.255.76.67:7798?ttl=0"  # eye's port range 7790-7809
+# eye's port range 7790-7809: 7798 for the benchmark, EYE_SIM_PORT=7797 for the test
+URL = f"udpm://239.255.76.67:{os.environ.get('EYE_SIM_PORT', '7798')}?ttl=0"
 W, H, FOVY_DEG, CAM_Z_M = 1280, 960, 60.0, 2.5
 
 
