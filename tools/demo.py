@@ -31,7 +31,9 @@ def parse_args():
     p.add_argument("--seed", type=int, default=1, help="scenario seed (sim noise, biases)")
     p.add_argument("--duration", type=float, default=40.0, help="driven time [s, sim time]")
     p.add_argument("--realtime", action="store_true",
-                   help="run in real time (default: 2x real time)")
+                   help="run in real time (default: 2x real time); opens the simulator's "
+                   "window when a display exists")
+    p.add_argument("--headless", action="store_true", help="never open a window")
     p.add_argument("--rtf", type=float, default=2.0, help="real-time factor when not --realtime")
     p.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0", help="LCM URL")
     return p.parse_args()
@@ -123,6 +125,9 @@ def main():
                     "--duration", args.duration + 8.0]
         if rtf != 1.0:
             sim_argv += ["--rtf", rtf]
+        if args.realtime and (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) \
+                and not args.headless:
+            sim_argv += ["--view"]  # a window when a display exists; headless otherwise
         procs.start("autodrive-sim", sim_argv, out / "sim.log")
         wait_for(run_dir / "nigel1-nano", 30, procs)
         procs.start("autodrive-runtime", [build / "bin" / "autodrive-runtime", "--config", cfg_path],

@@ -16,6 +16,7 @@
 #include "sim_camera.h"
 #include "sim_lidar_lcm.h"
 #include "sim_render.h"
+#include "sim_viewer.h"
 #endif
 
 #define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
@@ -53,6 +54,8 @@ static void main_usage(FILE *f) {
           "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
           "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
           "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
+          "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
+          "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
           "  --quiet             no progress lines\n"
           "  -h, --help          this text\n"
           "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
@@ -163,6 +166,69 @@ static void main_cams_close(main_cams_t *k) {
   k->n = 0;
 }
 
+/* The optional window (sensors library, EGL context): drawn at ~30 Hz of wall time. */
+typedef struct main_view {
+  void *v; /* sim_viewer_t*, NULL when off */
+  double next_frame_s;
+} main_view_t;
+
+static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, size_t err_sz) {
+  memset(w, 0, sizeof *w);
+  if (!want) return 0;
+#ifdef SIM_HAVE_SENSORS
+  if (!sim_viewer_display_available()) {
+    snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
+    return -1;
+  }
+  w->v = sim_viewer_create(sim_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
+                           1024, 768, err, err_sz);
+  return w->v ? 0 : -1;
+#else
+  (void)s;
+  snprintf(err, err_sz, "this build has no sensors library (sim/mujoco_hil/sensors)");
+  return -1;
+#endif
+}
+
+/* Draws a frame when one is due; blocks while paused (shifting *t0_s so pacing resumes
+ * smoothly). Returns 1 when the user quit. */
+static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
+#ifdef SIM_HAVE_SENSORS
+  sim_viewer_input_t in;
+  double now = main_wall_s();
+  if (now < w->next_frame_s) return 0;
+  do {
+    w->next_frame_s = now + 1.0 / 30.0;
+    if (sim_viewer_frame((sim_viewer_t *)w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
+    if (in.quit || main_stop) return 1;
+    if (in.reset_requested) {
+      /* back to the spawn poses; encoder counts restart with the wheel angles, as when a car
+       * is picked up and put back */
+      mj_resetData(sim_model(s), sim_data(s));
+      mj_forward(sim_model(s), sim_data(s));
+    }
+    if (in.paused) {
+      struct timespec ts = {0, 30000000L};
+      nanosleep(&ts, NULL);
+      const double later = main_wall_s();
+      *t0_s += later - now;
+      now = later;
+    }
+  } while (in.paused);
+  return 0;
+#else
+  (void)w, (void)s, (void)t0_s;
+  return 0;
+#endif
+}
+
+static void main_view_close(main_view_t *w) {
+#ifdef SIM_HAVE_SENSORS
+  if (w->v) sim_viewer_destroy((sim_viewer_t *)w->v);
+#endif
+  w->v = NULL;
+}
+
 int main(int argc, char **argv) {
   sim_config_t cfg = {0};
   char params[1024], map[1024];
@@ -177,7 +243,7 @@ int main(int argc, char **argv) {
   cfg.lidar = 1;
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
-  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1;
+  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1, view = 0;
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -229,6 +295,8 @@ int main(int argc, char **argv) {
       cameras = 1;
     } else if (!strcmp(a, "--eye")) {
       eye = 1;
+    } else if (!strcmp(a, "--view")) {
+      view = 1;
     } else if (!strcmp(a, "--camera-fps")) {
       if (main_number(a, v, 0.1, 1000, &camera_fps)) return 2;
       i++;
@@ -294,6 +362,15 @@ int main(int argc, char **argv) {
     return 1;
   }
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
+  main_view_t viewer;
+  if (main_view_open(&viewer, s, view, err, sizeof err) != 0) {
+    fprintf(stderr, "autodrive-sim: --view: %s\n", err);
+    main_cams_close(&cams);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
   for (int c = 1; c <= sim_cars(s); c++) {
     if (sim_nano_link(s, c)[0]) printf("NIGEL%d nano: %s\n", c, sim_nano_link(s, c));
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
@@ -303,7 +380,8 @@ int main(int argc, char **argv) {
   fflush(stdout);
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
-  const double t0 = main_wall_s(), cpu0 = main_cpu_s();
+  double t0 = main_wall_s(); /* moved forward by the time spent paused in the viewer */
+  const double cpu0 = main_cpu_s();
   double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0;
   int64_t last_progress_us = 0;
   int rc = 0;
@@ -340,6 +418,7 @@ int main(int argc, char **argv) {
       const double since = main_wall_s() - t0; /* average rtf of the run so far */
       lcmpub_clock(lcm, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
     }
+    if (viewer.v && main_view_frame(&viewer, s, &t0) != 0) break;
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
     if (!lockstep) {
@@ -368,6 +447,7 @@ int main(int argc, char **argv) {
            cpu_s > 0 ? sim_s / cpu_s : 0.0, bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
            bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
   }
+  main_view_close(&viewer);
   main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */
   if (tlog) fclose(tlog);
