@@ -1,0 +1,84 @@
+// node_: wires the modules into the parking mission, without any I/O transport: the program
+// (main.cpp) feeds it LCM messages, the closed-loop test feeds it a simulated car. Time comes
+// from message stamps, so it follows the sim clock in lockstep runs.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "autonomy/amcl.hpp"
+#include "autonomy/footprint.hpp"
+#include "autonomy/hybrid_astar.hpp"
+#include "autonomy/mission.hpp"
+#include "autonomy/pure_pursuit.hpp"
+#include "autonomy/slam.hpp"
+
+namespace autonomy {
+
+struct NodeConfig {
+  std::string map_yaml_out = "out/autonomy/map.yaml";  // written in SAVING
+  std::string map_yaml_in;  // non-empty: load this map, skip MAPPING and SAVING
+  Pose2 start_pose;         // map-frame pose at start (SLAM origin / AMCL initial guess)
+  double initial_sigma_xy_m = 0.05, initial_sigma_yaw_rad = 0.05;
+  Pose2 goal;               // parking pose of the base (rear axle) in the map frame
+  int mapping_scans = 15;
+  int localising_min_updates = 8;
+  double localised_std_m = 0.02, localised_std_yaw_rad = 0.03;
+  double goal_tolerance_m = 0.03, goal_tolerance_yaw_rad = 0.06;
+  double obstacle_horizon_m = 0.5;     // look this far ahead along the path
+  double unmapped_min_dist_m = 0.06;   // scan points this far from mapped walls are new
+  double obstacle_inflation_m = 0.06;  // new obstacles are marked as discs this big
+  // Unknown cells (LIDAR shadows, e.g. behind slot dividers seen from one place) are free for
+  // the planner by default; the live obstacle check guards them while driving.
+  bool unknown_is_obstacle = false;
+  SlamConfig slam;
+  AmclConfig amcl;
+  Footprint footprint;
+  HybridAStarConfig planner;
+  TrackerConfig tracker;
+  MissionConfig mission;
+};
+
+class AutonomyNode {
+ public:
+  explicit AutonomyNode(const NodeConfig &cfg);
+  void on_odom(const Pose2 &odom, int64_t utime_us);  // runs the tracker
+  void on_scan(const Scan &scan, int64_t utime_us);   // mapping, localisation, obstacles
+
+  const Mission &mission() const { return mission_; }
+  const TrackerCommand &command() const { return command_; }
+  bool engaged() const { return mission_.state() == MissionState::kDriving; }
+  bool have_pose() const { return have_map_odom_; }
+  Pose2 pose_map() const;  // best map-frame pose now
+  std::optional<Pose2> amcl_pose() const;
+  Eigen::Matrix3d amcl_covariance() const;
+  const Path &path() const { return tracker_.path(); }
+  const std::vector<Eigen::Vector2d> &route_m() const { return route_m_; }
+  const GridMap *map() const;  // the SLAM map while mapping, then the saved/loaded one
+  int plans() const { return plans_; }
+
+ private:
+  double now_s(int64_t utime_us) const { return static_cast<double>(utime_us) * 1e-6; }
+  void after_map_ready(double t_s);
+  void plan(double t_s);
+
+  NodeConfig cfg_;
+  Mission mission_;
+  std::unique_ptr<HectorSlam> slam_;
+  std::unique_ptr<GridMap> map_;       // saved / loaded map (AMCL)
+  std::unique_ptr<GridMap> plan_map_;  // map + obstacles seen live (planning)
+  std::unique_ptr<CollisionChecker> checker_;
+  std::unique_ptr<Amcl> amcl_;
+  std::vector<float> amcl_field_m_;
+  PurePursuit tracker_;
+  TrackerCommand command_;
+  std::vector<Eigen::Vector2d> route_m_;
+  bool have_odom_ = false, have_map_odom_ = false;
+  Pose2 odom_, odom_at_last_scan_;
+  Pose2 map_from_odom_;  // T_map_odom
+  int64_t last_odom_us_ = 0;
+  int scans_ = 0, localising_updates_ = 0, plans_ = 0;
+};
+
+}  // namespace autonomy

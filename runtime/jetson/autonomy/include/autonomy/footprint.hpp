@@ -1,0 +1,41 @@
+// fp_: collision checking of the car's rectangular footprint on an inflated grid. The
+// rectangle is covered by a row of discs; a pose is free when every disc centre lies on a
+// cell at least (disc radius + margin) from the nearest obstacle (unknown counts as obstacle),
+// i.e. on a grid inflated by that amount.
+#pragma once
+#include <vector>
+
+#include "autonomy/grid_map.hpp"
+#include "autonomy/path.hpp"
+
+namespace autonomy {
+
+struct Footprint {
+  double length_m = 0.19;         // Nigel's body, bumper to bumper
+  double width_m = 0.13;
+  double center_ahead_m = 0.0708;  // rectangle centre ahead of the base (rear axle) [m]
+  double margin_m = 0.015;         // extra clearance kept from obstacles [m]
+  int discs = 4;
+};
+
+class CollisionChecker {
+ public:
+  CollisionChecker(const GridMap &map, const Footprint &fp, bool unknown_is_obstacle = true);
+  // Smallest (distance to obstacle - disc radius) over the discs [m]; < margin = collision.
+  double clearance_m(const Pose2 &base) const;
+  bool pose_free(const Pose2 &base) const { return clearance_m(base) >= fp_.margin_m; }
+  bool path_free(const Path &path) const;
+  double disc_radius_m() const { return disc_radius_m_; }
+  const GridMap &map() const { return map_; }
+  const std::vector<float> &field_m() const { return field_m_; }
+  const Footprint &footprint() const { return fp_; }
+
+ private:
+  const GridMap &map_;
+  Footprint fp_;
+  double disc_radius_m_;
+  std::vector<double> disc_offsets_m_;
+  std::vector<float> field_m_;
+};
+
+}  // namespace autonomy

@@ -1,0 +1,59 @@
+// pp_: path tracking by pure pursuit on the rear axle, forward and reverse, with a speed
+// profile (accelerate, cruise, slow for curvature, brake to a stop at every cusp and at the
+// goal) and a short standstill at each cusp before the direction changes.
+// Output is the vehicle_command_t convention: throttle and steering in [-1, 1].
+// Throttle-to-speed map (assumed, linear, no deadband): throttle 1.0 -> top_speed_m_s
+// (0.267 m/s, Nigel's top speed), so throttle = speed / top_speed_m_s, sign = direction.
+#pragma once
+#include "autonomy/path.hpp"
+
+namespace autonomy {
+
+struct TrackerConfig {
+  double wheelbase_m = 0.14154;
+  double max_steer_rad = 0.5236;    // steering 1.0 = this angle
+  double top_speed_m_s = 0.267;     // speed at throttle 1.0
+  double cruise_speed_m_s = 0.2;
+  double min_speed_m_s = 0.025;     // creep speed just before a stop
+  double accel_m_s2 = 0.4, decel_m_s2 = 0.3;
+  double lateral_accel_m_s2 = 0.25;  // slows in tight arcs
+  double lookahead_min_m = 0.07, lookahead_time_s = 0.4;
+  double stop_tolerance_m = 0.004;  // a segment ends when less than this remains
+  double cusp_pause_s = 0.4;        // standstill between direction changes
+  double steer_rate_rad_s = 0.805;  // Nigel's servo: slow down before curvature changes
+  double steer_preview_m = 0.25;
+};
+
+struct TrackerCommand {
+  double throttle = 0.0;     // [-1, 1]
+  double steering = 0.0;     // [-1, 1], + left
+  double speed_m_s = 0.0;    // signed target speed
+  double steer_rad = 0.0;
+  bool done = false;         // the last segment has been completed: hold still
+};
+
+class PurePursuit {
+ public:
+  explicit PurePursuit(const TrackerConfig &cfg = TrackerConfig{}) : cfg_(cfg) {}
+  void set_path(const Path &path);
+  // One control step at the current base pose; dt_s since the last step.
+  TrackerCommand step(const Pose2 &pose, double dt_s);
+  bool done() const { return done_; }
+  bool has_path() const { return !segments_.empty(); }
+  // Index in the full path of the sample nearest to the car (for the obstacle check).
+  size_t progress_index() const { return seg_offset_ + nearest_; }
+  const Path &path() const { return path_; }
+
+ private:
+  TrackerConfig cfg_;
+  Path path_;
+  std::vector<Path> segments_;  // split at cusps
+  std::vector<size_t> offsets_;
+  size_t seg_ = 0, seg_offset_ = 0, nearest_ = 0;
+  double speed_m_s_ = 0.0;      // magnitude of the last commanded speed
+  double last_steer_rad_ = 0.0;
+  double pause_left_s_ = 0.0;
+  bool done_ = true;
+};
+
+}  // namespace autonomy

@@ -1,0 +1,173 @@
+#include "autonomy/autonomy_node.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "autonomy/local_planner.hpp"
+#include "autonomy/map_io.hpp"
+
+namespace autonomy {
+namespace {
+
+MissionConfig mission_cfg(const NodeConfig &cfg) {
+  MissionConfig m = cfg.mission;
+  m.start_with_map = !cfg.map_yaml_in.empty();
+  return m;
+}
+
+}  // namespace
+
+AutonomyNode::AutonomyNode(const NodeConfig &cfg)
+    : cfg_(cfg), mission_(mission_cfg(cfg)), tracker_(cfg.tracker) {
+  if (cfg_.map_yaml_in.empty()) {
+    slam_ = std::make_unique<HectorSlam>(cfg_.slam, cfg_.start_pose);
+  } else {
+    try {
+      map_ = std::make_unique<GridMap>(map_load(cfg_.map_yaml_in));
+      after_map_ready(0.0);
+    } catch (const std::exception &e) {
+      mission_.fail(e.what(), 0.0);
+    }
+  }
+}
+
+const GridMap *AutonomyNode::map() const {
+  if (map_) return map_.get();
+  return slam_ ? &slam_->map() : nullptr;
+}
+
+Pose2 AutonomyNode::pose_map() const { return pose_compose(map_from_odom_, odom_); }
+
+std::optional<Pose2> AutonomyNode::amcl_pose() const {
+  if (!amcl_ || localising_updates_ == 0) return std::nullopt;
+  return amcl_->estimate();
+}
+
+Eigen::Matrix3d AutonomyNode::amcl_covariance() const {
+  return amcl_ ? amcl_->covariance() : Eigen::Matrix3d::Identity();
+}
+
+void AutonomyNode::after_map_ready(double) {
+  plan_map_ = std::make_unique<GridMap>(*map_);
+  checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+  amcl_field_m_ = grid_distance_field_m(*map_, false);
+  amcl_ = std::make_unique<Amcl>(*map_, cfg_.amcl);
+  // From SLAM: its pose is on this very map; otherwise the configured start guess.
+  const Pose2 guess = slam_ ? slam_->pose() : cfg_.start_pose;
+  amcl_->init_gaussian(guess, cfg_.initial_sigma_xy_m, cfg_.initial_sigma_xy_m, cfg_.initial_sigma_yaw_rad);
+  localising_updates_ = 0;
+}
+
+void AutonomyNode::on_odom(const Pose2 &odom, int64_t utime_us) {
+  const double dt_s = have_odom_ ? std::max(0.0, (utime_us - last_odom_us_) * 1e-6) : 0.0;
+  odom_ = odom;
+  last_odom_us_ = utime_us;
+  have_odom_ = true;
+  const double t = now_s(utime_us);
+  mission_.tick(t);
+  if (mission_.state() != MissionState::kDriving) {
+    command_ = TrackerCommand{};
+    return;
+  }
+  command_ = tracker_.step(pose_map(), dt_s);
+  if (command_.done) {
+    const Pose2 e = pose_between(cfg_.goal, pose_map());
+    const double pos_err_m = std::hypot(e.x_m, e.y_m), yaw_err_rad = std::abs(e.yaw_rad);
+    std::ostringstream why;
+    why.precision(3);
+    why << "stopped " << pos_err_m << " m, " << yaw_err_rad * 180.0 / kPi << " deg from the goal";
+    mission_.arrived(pos_err_m <= cfg_.goal_tolerance_m && yaw_err_rad <= cfg_.goal_tolerance_yaw_rad,
+                     why.str(), t);
+    if (mission_.state() == MissionState::kPlanning) plan(t);
+  }
+}
+
+void AutonomyNode::plan(double t_s) {
+  ++plans_;
+  const PlanResult r = hybrid_astar_plan(*checker_, pose_map(), cfg_.goal, cfg_.planner);
+  route_m_ = r.route_m;
+  if (r.failed) {
+    mission_.planned(false, "planning failed: " + r.detail, t_s);
+    return;
+  }
+  tracker_.set_path(r.path);
+  std::ostringstream why;
+  why.precision(3);
+  why << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, "
+      << r.expansions << " expansions";
+  mission_.planned(true, why.str(), t_s);
+}
+
+void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
+  const double t = now_s(utime_us);
+  mission_.tick(t);
+  ++scans_;
+  const Pose2 odom_motion = pose_between(odom_at_last_scan_, odom_);
+  odom_at_last_scan_ = odom_;
+  switch (mission_.state()) {
+    case MissionState::kMapping: {
+      const Pose2 p = slam_->update(scan, scans_ > 1 ? odom_motion : Pose2{});
+      map_from_odom_ = pose_compose(p, pose_inverse(odom_));
+      have_map_odom_ = true;
+      if (slam_->scans_processed() >= cfg_.mapping_scans) {
+        mission_.mapping_done(t);
+        // SAVING: write the map, then read it back so localisation runs on the saved file.
+        try {
+          const auto parent = std::filesystem::path(cfg_.map_yaml_out).parent_path();
+          if (!parent.empty()) std::filesystem::create_directories(parent);
+          map_save(slam_->map(), cfg_.map_yaml_out);
+          map_ = std::make_unique<GridMap>(map_load(cfg_.map_yaml_out));
+          after_map_ready(t);
+          mission_.saved(true, "map saved to " + cfg_.map_yaml_out, t);
+        } catch (const std::exception &e) {
+          mission_.saved(false, e.what(), t);
+        }
+      }
+      break;
+    }
+    case MissionState::kLocalising: {
+      amcl_->update(odom_, scan, true);
+      ++localising_updates_;
+      map_from_odom_ = pose_compose(amcl_->estimate(), pose_inverse(odom_));
+      have_map_odom_ = true;
+      const Eigen::Matrix3d c = amcl_->covariance();
+      if (localising_updates_ >= cfg_.localising_min_updates &&
+          std::sqrt(std::max(c(0, 0), c(1, 1))) <= cfg_.localised_std_m &&
+          std::sqrt(c(2, 2)) <= cfg_.localised_std_yaw_rad) {
+        mission_.localised(t);
+        plan(t);
+      }
+      break;
+    }
+    case MissionState::kDriving: {
+      if (amcl_->update(odom_, scan, false)) {
+        ++localising_updates_;
+        map_from_odom_ = pose_compose(amcl_->estimate(), pose_inverse(odom_));
+      }
+      // Obstacles not on the map, in the map frame.
+      std::vector<Eigen::Vector2d> pts;
+      const Pose2 base = pose_map();
+      for (const auto &q : scan_points_base(scan, cfg_.amcl.lidar_in_base)) pts.push_back(pose_apply(base, q));
+      const auto unmapped = lp_unmapped_points(*map_, amcl_field_m_, pts, cfg_.unmapped_min_dist_m);
+      const LocalCheck lc = lp_check_path(tracker_.path(), tracker_.progress_index(),
+                                          cfg_.obstacle_horizon_m, unmapped, cfg_.footprint);
+      if (lc.blocked) {
+        grid_mark_occupied(*plan_map_, unmapped, cfg_.obstacle_inflation_m);
+        checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+        std::ostringstream why;
+        why.precision(3);
+        why << "unmapped obstacle at (" << lc.obstacle_m.x() << ", " << lc.obstacle_m.y() << ") "
+            << lc.distance_ahead_m << " m ahead";
+        command_ = TrackerCommand{};
+        mission_.blocked(why.str(), t);
+        if (mission_.state() == MissionState::kPlanning) plan(t);
+      }
+      break;
+    }
+    default:
+      break;
+  }
+}
+
+}  // namespace autonomy

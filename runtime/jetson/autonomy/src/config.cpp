@@ -1,0 +1,142 @@
+#include "config.hpp"
+
+#include <set>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace autonomy {
+namespace {
+
+struct Reader {
+  std::string file;
+  [[noreturn]] void fail(const std::string &what) const {
+    throw std::runtime_error("config '" + file + "': " + what);
+  }
+  // Rejects keys of node (at path) that are not in allowed.
+  void only(const YAML::Node &node, const std::string &path, const std::set<std::string> &allowed) const {
+    if (!node.IsMap()) fail("'" + path + "' must be a mapping");
+    for (const auto &kv : node) {
+      const auto k = kv.first.as<std::string>();
+      if (!allowed.count(k)) fail("unknown key '" + (path.empty() ? k : path + "." + k) + "'");
+    }
+  }
+  template <typename T>
+  void get(const YAML::Node &node, const std::string &path, const char *key, T &out) const {
+    if (!node[key]) return;
+    try {
+      out = node[key].as<T>();
+    } catch (const YAML::Exception &) {
+      fail("key '" + (path.empty() ? std::string(key) : path + "." + key) + "' has the wrong type");
+    }
+  }
+  void pose(const YAML::Node &node, const std::string &path, const char *key, Pose2 &p) const {
+    if (!node[key]) return;
+    const std::string sub = path.empty() ? key : path + "." + key;
+    only(node[key], sub, {"x_m", "y_m", "yaw_rad"});
+    get(node[key], sub, "x_m", p.x_m);
+    get(node[key], sub, "y_m", p.y_m);
+    get(node[key], sub, "yaw_rad", p.yaw_rad);
+  }
+};
+
+}  // namespace
+
+ProgramConfig cfg_load(const std::string &path) {
+  Reader r{path};
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile &) {
+    r.fail("cannot be opened");
+  } catch (const YAML::Exception &e) {
+    r.fail(std::string("is not valid YAML: ") + e.what());
+  }
+  ProgramConfig c;
+  NodeConfig &n = c.node;
+  r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
+                    "start", "goal", "lidar_in_base", "mapping_scans", "goal_tolerance_m",
+                    "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "unknown_is_obstacle", "footprint", "slam", "amcl",
+                    "planner", "tracker", "mission"});
+  r.get(root, "", "vehicle", c.vehicle);
+  r.get(root, "", "lcm_url", c.lcm_url);
+  r.get(root, "", "out_dir", c.out_dir);
+  r.get(root, "", "command_rate_hz", c.command_rate_hz);
+  r.get(root, "", "exit_after_finish_s", c.exit_after_finish_s);
+  if (root["map"]) {
+    r.only(root["map"], "map", {"save_to", "load_from"});
+    r.get(root["map"], "map", "save_to", n.map_yaml_out);
+    r.get(root["map"], "map", "load_from", n.map_yaml_in);
+  }
+  if (!root["goal"]) r.fail("missing key 'goal' (the parking pose {x_m, y_m, yaw_rad})");
+  r.pose(root, "", "start", n.start_pose);
+  r.pose(root, "", "goal", n.goal);
+  Pose2 lidar = n.slam.lidar_in_base;
+  r.pose(root, "", "lidar_in_base", lidar);
+  n.slam.lidar_in_base = n.amcl.lidar_in_base = lidar;
+  r.get(root, "", "mapping_scans", n.mapping_scans);
+  r.get(root, "", "goal_tolerance_m", n.goal_tolerance_m);
+  r.get(root, "", "goal_tolerance_yaw_rad", n.goal_tolerance_yaw_rad);
+  r.get(root, "", "obstacle_horizon_m", n.obstacle_horizon_m);
+  r.get(root, "", "unknown_is_obstacle", n.unknown_is_obstacle);
+  r.get(root, "", "obstacle_inflation_m", n.obstacle_inflation_m);
+  if (const auto f = root["footprint"]) {
+    r.only(f, "footprint", {"length_m", "width_m", "center_ahead_m", "margin_m"});
+    r.get(f, "footprint", "length_m", n.footprint.length_m);
+    r.get(f, "footprint", "width_m", n.footprint.width_m);
+    r.get(f, "footprint", "center_ahead_m", n.footprint.center_ahead_m);
+    r.get(f, "footprint", "margin_m", n.footprint.margin_m);
+  }
+  if (const auto s = root["slam"]) {
+    r.only(s, "slam", {"resolution_m", "levels", "width_m", "height_m", "origin_x_m", "origin_y_m"});
+    r.get(s, "slam", "resolution_m", n.slam.resolution_m);
+    r.get(s, "slam", "levels", n.slam.levels);
+    r.get(s, "slam", "width_m", n.slam.width_m);
+    r.get(s, "slam", "height_m", n.slam.height_m);
+    r.get(s, "slam", "origin_x_m", n.slam.origin_x_m);
+    r.get(s, "slam", "origin_y_m", n.slam.origin_y_m);
+  }
+  if (const auto a = root["amcl"]) {
+    r.only(a, "amcl", {"min_particles", "max_particles", "sigma_hit_m", "beams", "seed"});
+    r.get(a, "amcl", "min_particles", n.amcl.min_particles);
+    r.get(a, "amcl", "max_particles", n.amcl.max_particles);
+    r.get(a, "amcl", "sigma_hit_m", n.amcl.sigma_hit_m);
+    r.get(a, "amcl", "beams", n.amcl.beams);
+    r.get(a, "amcl", "seed", n.amcl.seed);
+  }
+  if (const auto p = root["planner"]) {
+    r.only(p, "planner", {"wheelbase_m", "max_steer_rad", "steer_use_fraction", "max_expansions"});
+    r.get(p, "planner", "wheelbase_m", n.planner.wheelbase_m);
+    r.get(p, "planner", "max_steer_rad", n.planner.max_steer_rad);
+    r.get(p, "planner", "steer_use_fraction", n.planner.steer_use_fraction);
+    r.get(p, "planner", "max_expansions", n.planner.max_expansions);
+  }
+  n.tracker.wheelbase_m = n.planner.wheelbase_m;
+  n.tracker.max_steer_rad = n.planner.max_steer_rad;
+  if (const auto t = root["tracker"]) {
+    r.only(t, "tracker", {"top_speed_m_s", "cruise_speed_m_s", "lookahead_min_m", "lookahead_time_s"});
+    r.get(t, "tracker", "top_speed_m_s", n.tracker.top_speed_m_s);
+    r.get(t, "tracker", "cruise_speed_m_s", n.tracker.cruise_speed_m_s);
+    r.get(t, "tracker", "lookahead_min_m", n.tracker.lookahead_min_m);
+    r.get(t, "tracker", "lookahead_time_s", n.tracker.lookahead_time_s);
+  }
+  if (const auto m = root["mission"]) {
+    r.only(m, "mission", {"max_replans", "timeout_mapping_s", "timeout_localising_s",
+                          "timeout_planning_s", "timeout_driving_s"});
+    r.get(m, "mission", "max_replans", n.mission.max_replans);
+    r.get(m, "mission", "timeout_mapping_s", n.mission.timeout_mapping_s);
+    r.get(m, "mission", "timeout_localising_s", n.mission.timeout_localising_s);
+    r.get(m, "mission", "timeout_planning_s", n.mission.timeout_planning_s);
+    r.get(m, "mission", "timeout_driving_s", n.mission.timeout_driving_s);
+  }
+  if (c.vehicle.empty()) r.fail("'vehicle' must not be empty");
+  if (!(c.command_rate_hz > 0)) r.fail("'command_rate_hz' must be > 0");
+  if (n.slam.levels < 1 || n.slam.levels > 4) r.fail("'slam.levels' must be 1..4");
+  if (!(n.slam.resolution_m > 0)) r.fail("'slam.resolution_m' must be > 0");
+  if (n.amcl.min_particles < 1 || n.amcl.max_particles < n.amcl.min_particles)
+    r.fail("'amcl' needs 1 <= min_particles <= max_particles");
+  if (!(n.tracker.top_speed_m_s > 0)) r.fail("'tracker.top_speed_m_s' must be > 0");
+  return c;
+}
+
+}  // namespace autonomy

@@ -1,0 +1,185 @@
+// autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
+// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL and <VEH>_MISSION, and prints each mission state
+// change. Writes path.csv, route.csv and trajectory.csv into out_dir for tools/plot-parking.
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <autodrive/lidar_scan_t.hpp>
+#include <autodrive/mission_status_t.hpp>
+#include <autodrive/odometry_t.hpp>
+#include <autodrive/pose2d_t.hpp>
+#include <autodrive/vehicle_command_t.hpp>
+
+#include "config.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+using namespace autonomy;
+
+class App {
+ public:
+  App(const ProgramConfig &cfg, lcm::LCM &lcm) : cfg_(cfg), lcm_(lcm), node_(cfg.node) {
+    std::filesystem::create_directories(cfg_.out_dir);
+    traj_.open(std::filesystem::path(cfg_.out_dir) / "trajectory.csv");
+    traj_ << "t_s,x_m,y_m,yaw_rad,state\n";
+    report_state(0);
+  }
+
+  void on_scan(const lcm::ReceiveBuffer *, const std::string &, const autodrive::lidar_scan_t *m) {
+    Scan s;
+    s.angle_min_rad = m->angle_min_rad;
+    s.angle_increment_rad = m->angle_increment_rad;
+    s.range_min_m = m->range_min_m;
+    s.range_max_m = m->range_max_m;
+    s.ranges_m = m->ranges_m;
+    const int plans_before = node_.plans();
+    node_.on_scan(s, m->utime);
+    if (node_.plans() != plans_before) write_plan();
+    last_utime_ = std::max(last_utime_, m->utime);
+    if (auto p = node_.amcl_pose()) publish_amcl(*p, m->utime);
+    report_state(m->utime);
+  }
+
+  void on_odom(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
+    const int plans_before = node_.plans();
+    node_.on_odom({m->x_m, m->y_m, m->yaw_rad}, m->utime);
+    if (node_.plans() != plans_before) write_plan();
+    last_utime_ = std::max(last_utime_, m->utime);
+    if (m->utime - last_cmd_us_ >= static_cast<int64_t>(1e6 / cfg_.command_rate_hz)) {
+      publish_command(m->utime);
+      last_cmd_us_ = m->utime;
+    }
+    if (node_.have_pose() && m->utime - last_traj_us_ >= 50000) {
+      const Pose2 p = node_.pose_map();
+      traj_ << m->utime * 1e-6 << "," << p.x_m << "," << p.y_m << "," << p.yaw_rad << ","
+            << mission_state_name(node_.mission().state()) << "\n";
+      last_traj_us_ = m->utime;
+    }
+    report_state(m->utime);
+  }
+
+  bool finished() const { return node_.mission().finished(); }
+  bool parked() const { return node_.mission().state() == MissionState::kParked; }
+  int64_t last_utime() const { return last_utime_; }
+  void publish_command(int64_t utime) {
+    autodrive::vehicle_command_t c{};
+    c.utime = utime;
+    c.seq = seq_++;
+    c.throttle = static_cast<float>(node_.command().throttle);
+    c.steering = static_cast<float>(node_.command().steering);
+    c.headlights = 0;
+    c.indicators = node_.mission().state() == MissionState::kParked ? 3 : 0;
+    c.engaged = node_.engaged();
+    lcm_.publish(cfg_.vehicle + "_COMMAND", &c);
+  }
+
+ private:
+  void publish_amcl(const Pose2 &p, int64_t utime) {
+    autodrive::pose2d_t m{};
+    m.utime = utime;
+    m.vehicle = cfg_.vehicle;
+    m.frame_id = "map";
+    m.source = autodrive::pose2d_t::SOURCE_AMCL;
+    m.x_m = p.x_m;
+    m.y_m = p.y_m;
+    m.yaw_rad = p.yaw_rad;
+    const Eigen::Matrix3d c = node_.amcl_covariance();
+    for (int i = 0; i < 9; ++i) m.covariance[i] = c(i / 3, i % 3);
+    lcm_.publish(cfg_.vehicle + "_POSE_AMCL", &m);
+  }
+
+  // Publishes on every state change and at 2 Hz; prints state changes.
+  void report_state(int64_t utime) {
+    const auto &ms = node_.mission();
+    const bool changed = ms.history().size() != printed_;
+    for (; printed_ < ms.history().size(); ++printed_)
+      std::printf("[autonomy] %.2f s  %s\n", utime * 1e-6, ms.history()[printed_].c_str());
+    if (changed) std::fflush(stdout);
+    if (!changed && utime - last_status_us_ < 500000) return;
+    last_status_us_ = utime;
+    autodrive::mission_status_t m{};
+    m.utime = utime;
+    m.vehicle = cfg_.vehicle;
+    m.state = static_cast<int8_t>(ms.state());
+    m.progress = ms.finished() ? 1.0f : 0.0f;
+    m.detail = ms.detail();
+    lcm_.publish(cfg_.vehicle + "_MISSION", &m);
+  }
+
+  void write_plan() {
+    std::ofstream p(std::filesystem::path(cfg_.out_dir) / "path.csv");
+    p << "x_m,y_m,yaw_rad,direction,curvature_1pm\n";
+    for (const auto &q : node_.path())
+      p << q.pose.x_m << "," << q.pose.y_m << "," << q.pose.yaw_rad << "," << q.direction << ","
+        << q.curvature_1pm << "\n";
+    std::ofstream r(std::filesystem::path(cfg_.out_dir) / "route.csv");
+    r << "x_m,y_m\n";
+    for (const auto &q : node_.route_m()) r << q.x() << "," << q.y() << "\n";
+  }
+
+  const ProgramConfig &cfg_;
+  lcm::LCM &lcm_;
+  AutonomyNode node_;
+  std::ofstream traj_;
+  int32_t seq_ = 0;
+  int64_t last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
+  size_t printed_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  CLI::App cli{"autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on LCM"};
+  std::string config_path, url_override, vehicle_override;
+  cli.add_option("--config", config_path, "YAML configuration (see runtime/jetson/autonomy/config/)")
+      ->required();
+  cli.add_option("--lcm-url", url_override, "override lcm_url of the config");
+  cli.add_option("--vehicle", vehicle_override, "override vehicle (e.g. NIGEL1)");
+  CLI11_PARSE(cli, argc, argv);
+
+  ProgramConfig cfg;
+  try {
+    cfg = cfg_load(config_path);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "autodrive-autonomy: %s\n", e.what());
+    return 2;
+  }
+  if (!url_override.empty()) cfg.lcm_url = url_override;
+  if (!vehicle_override.empty()) cfg.vehicle = vehicle_override;
+
+  lcm::LCM lcm(cfg.lcm_url);
+  if (!lcm.good()) {
+    std::fprintf(stderr, "autodrive-autonomy: cannot open LCM at '%s' (multicast route missing?)\n",
+                 cfg.lcm_url.c_str());
+    return 2;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  App app(cfg, lcm);
+  auto *s1 = lcm.subscribe(cfg.vehicle + "_LIDAR", &App::on_scan, &app);
+  auto *s2 = lcm.subscribe(cfg.vehicle + "_ODOM", &App::on_odom, &app);
+  s1->setQueueCapacity(10);
+  s2->setQueueCapacity(200);
+  std::printf("[autonomy] %s on %s: listening to %s_LIDAR, %s_ODOM\n", cfg.vehicle.c_str(),
+              cfg.lcm_url.c_str(), cfg.vehicle.c_str(), cfg.vehicle.c_str());
+  std::fflush(stdout);
+  int64_t finished_at = -1;
+  while (!g_stop) {
+    lcm.handleTimeout(100);
+    if (app.finished()) {
+      if (finished_at < 0) finished_at = app.last_utime();
+      if (app.last_utime() - finished_at >= static_cast<int64_t>(cfg.exit_after_finish_s * 1e6)) break;
+    }
+  }
+  app.publish_command(app.last_utime());  // a final stop (engaged only while DRIVING)
+  if (!app.finished()) return 130;
+  return app.parked() ? 0 : 1;
+}

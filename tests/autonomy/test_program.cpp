@@ -1,0 +1,141 @@
+// autodrive-autonomy over real LCM (UDP multicast, port 7811): given a saved map it localises
+// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, MISSION and engaged
+// COMMANDs. Also --help and a clear error on a bad config.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <autodrive/lidar_scan_t.hpp>
+#include <autodrive/mission_status_t.hpp>
+#include <autodrive/odometry_t.hpp>
+#include <autodrive/pose2d_t.hpp>
+#include <autodrive/vehicle_command_t.hpp>
+
+#include "autonomy/map_io.hpp"
+#include "synthetic_world.hpp"
+
+using namespace autonomy;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char *kUrl = "udpm://239.255.76.67:7811?ttl=0";
+
+int run_program(const std::vector<std::string> &args, std::string *out) {
+  const std::string cmd = std::string(AUTONOMY_PROGRAM) + [&] {
+    std::string s;
+    for (const auto &a : args) s += " '" + a + "'";
+    return s;
+  }() + " 2>&1";
+  FILE *p = popen(cmd.c_str(), "r");
+  if (!p) return -1;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p)) *out += buf;
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+struct Listener {
+  int max_state = -1;
+  bool engaged_motion = false;
+  bool have_amcl = false;
+  autodrive::pose2d_t amcl{};
+  void on_mission(const lcm::ReceiveBuffer *, const std::string &, const autodrive::mission_status_t *m) {
+    max_state = std::max<int>(max_state, m->state);
+  }
+  void on_cmd(const lcm::ReceiveBuffer *, const std::string &, const autodrive::vehicle_command_t *m) {
+    if (m->engaged && std::abs(m->throttle) > 0.0f && std::abs(m->throttle) <= 1.0f) engaged_motion = true;
+  }
+  void on_amcl(const lcm::ReceiveBuffer *, const std::string &, const autodrive::pose2d_t *m) {
+    have_amcl = true;
+    amcl = *m;
+  }
+};
+
+}  // namespace
+
+TEST(Program, HelpAndBadConfig) {
+  std::string out;
+  EXPECT_EQ(run_program({"--help"}, &out), 0);
+  EXPECT_NE(out.find("--config"), std::string::npos);
+  const fs::path bad = fs::temp_directory_path() / ("autonomy_bad_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(bad) << "goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nplanner: {wheelbase: 0.1}\n";
+  out.clear();
+  EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2);
+  EXPECT_NE(out.find("unknown key 'planner.wheelbase'"), std::string::npos) << out;
+  fs::remove(bad);
+}
+
+TEST(Program, LocalisesPlansAndCommandsOverLcm) {
+  const synth::World world = synth::World::parking_lot();
+  const fs::path dir = fs::temp_directory_path() / ("autonomy_program_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  map_save(world.rasterize(0.02), (dir / "map.yaml").string());
+  const Pose2 truth{1.8, 1.2, 0.0};
+  std::ofstream(dir / "cfg.yaml") << "vehicle: NIGELT\nlcm_url: \"" << kUrl << "\"\n"
+                                  << "out_dir: " << (dir / "out").string() << "\n"
+                                  << "map: {load_from: " << (dir / "map.yaml").string() << "}\n"
+                                  << "start: {x_m: 1.8, y_m: 1.2, yaw_rad: 0.0}\n"
+                                  << "goal: {x_m: 2.45, y_m: 0.12, yaw_rad: 1.5707963}\n";
+  lcm::LCM lcm(kUrl);
+  ASSERT_TRUE(lcm.good());
+  Listener l;
+  lcm.subscribe("NIGELT_MISSION", &Listener::on_mission, &l);
+  lcm.subscribe("NIGELT_COMMAND", &Listener::on_cmd, &l);
+  lcm.subscribe("NIGELT_POSE_AMCL", &Listener::on_amcl, &l);
+
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string cfg = (dir / "cfg.yaml").string();
+    execl(AUTONOMY_PROGRAM, AUTONOMY_PROGRAM, "--config", cfg.c_str(), static_cast<char *>(nullptr));
+    _exit(127);
+  }
+  const Pose2 lidar{0.1445, 0, 0};
+  // The car stands still: odometry at its origin, scans from the true pose, 100 Hz / 7 Hz of
+  // message time; a bounded number of steps, never a wall-time assert.
+  for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl); ++i) {
+    const int64_t t_us = 1000000 + static_cast<int64_t>(i) * 10000;
+    autodrive::odometry_t o{};
+    o.utime = t_us;
+    o.vehicle = "NIGELT";
+    o.frame_id = "odom";
+    o.child_frame_id = "base_link";
+    lcm.publish("NIGELT_ODOM", &o);
+    if (i % 14 == 0) {
+      const Scan s = world.scan(truth, lidar);
+      autodrive::lidar_scan_t m{};
+      m.utime = t_us;
+      m.frame_id = "laser";
+      m.angle_min_rad = static_cast<float>(s.angle_min_rad);
+      m.angle_increment_rad = static_cast<float>(s.angle_increment_rad);
+      m.angle_max_rad = static_cast<float>(s.angle_min_rad + 359 * s.angle_increment_rad);
+      m.range_min_m = 0.15f;
+      m.range_max_m = 12.0f;
+      m.scan_time_s = 1.0f / 7.0f;
+      m.num_ranges = 360;
+      m.ranges_m = s.ranges_m;
+      m.intensities.assign(360, 47.0f);
+      lcm.publish("NIGELT_LIDAR", &m);
+    }
+    lcm.handleTimeout(10);
+  }
+  kill(pid, SIGTERM);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  EXPECT_GE(l.max_state, 4) << "never reached DRIVING";  // mission_status_t.DRIVING
+  EXPECT_TRUE(l.engaged_motion) << "no engaged command with a throttle";
+  ASSERT_TRUE(l.have_amcl);
+  EXPECT_NEAR(l.amcl.x_m, truth.x_m, 0.03);
+  EXPECT_NEAR(l.amcl.y_m, truth.y_m, 0.03);
+  EXPECT_EQ(static_cast<int>(l.amcl.source), static_cast<int>(autodrive::pose2d_t::SOURCE_AMCL));
+  EXPECT_TRUE(fs::exists(dir / "out" / "path.csv"));
+  EXPECT_TRUE(WIFEXITED(st)) << "killed by a signal instead of exiting cleanly";
+  fs::remove_all(dir);
+}
