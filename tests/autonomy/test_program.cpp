@@ -41,6 +41,14 @@ int run_program(const std::vector<std::string> &args, std::string *out) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+// LCM 1.3.1's member-function subscribe() hands its callback a null subscription under UBSan
+// (see runtime/jetson/common/lcm_sub.hpp): subscribe through subscribeFunction and this thunk.
+template <class Msg, class Obj,
+          void (Obj::*Method)(const lcm::ReceiveBuffer *, const std::string &, const Msg *)>
+void lcm_member_thunk(const lcm::ReceiveBuffer *rb, const std::string &ch, const Msg *m, Obj *o) {
+  (o->*Method)(rb, ch, m);
+}
+
 struct Listener {
   int max_state = -1;
   bool engaged_motion = false;
@@ -86,9 +94,12 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   lcm::LCM lcm(kUrl);
   ASSERT_TRUE(lcm.good());
   Listener l;
-  lcm.subscribe("NIGELT_MISSION", &Listener::on_mission, &l);
-  lcm.subscribe("NIGELT_COMMAND", &Listener::on_cmd, &l);
-  lcm.subscribe("NIGELT_POSE_AMCL", &Listener::on_amcl, &l);
+  lcm.subscribeFunction("NIGELT_MISSION",
+                        &lcm_member_thunk<autodrive::mission_status_t, Listener, &Listener::on_mission>, &l);
+  lcm.subscribeFunction("NIGELT_COMMAND",
+                        &lcm_member_thunk<autodrive::vehicle_command_t, Listener, &Listener::on_cmd>, &l);
+  lcm.subscribeFunction("NIGELT_POSE_AMCL",
+                        &lcm_member_thunk<autodrive::pose2d_t, Listener, &Listener::on_amcl>, &l);
 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
