@@ -29,7 +29,13 @@ def parse_args():
     p.add_argument("--build", default=str(ROOT / "build" / "release"), help="host build dir")
     p.add_argument("--out", default=str(ROOT / "out" / "demo"), help="output folder")
     p.add_argument("--seed", type=int, default=1, help="scenario seed (sim noise, biases)")
-    p.add_argument("--duration", type=float, default=40.0, help="driven time [s, sim time]")
+    p.add_argument("--mission", choices=("parking", "loop"), default="parking",
+                   help="parking (default): map, localise, plan and park autonomously; loop: "
+                   "drive a stadium track with pure pursuit on the EKF")
+    p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
+    p.add_argument("--timeout", type=float, default=240.0,
+                   help="parking: give up after this many wall seconds")
+    p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
     p.add_argument("--realtime", action="store_true",
                    help="run in real time (default: 2x real time); opens the simulator's "
                    "window when a display exists")
@@ -88,7 +94,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     run_dir = pathlib.Path(f"/tmp/autodrive-demo-{os.getpid()}")
     run_dir.mkdir(parents=True, exist_ok=True)
-    for prog in ("autodrive-sim", "autodrive-runtime"):
+    for prog in ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy"):
         if not (build / "bin" / prog).exists():
             sys.exit(f"[demo] ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
     rtf = 1.0 if args.realtime else args.rtf
@@ -105,6 +111,7 @@ def main():
     cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
 
     import demo_driver  # noqa: E402  (tools/demo_driver.py)
+    import demo_parking  # noqa: E402  (tools/demo_parking.py)
     procs = Procs()
     interrupted = False
 
@@ -122,7 +129,10 @@ def main():
                                    "--flush-interval=100", lcm_log], out / "lcm-logger.log")
         sim_argv = [build / "bin" / "autodrive-sim", "--map", "parking_school",
                     "--run-dir", run_dir, "--seed", args.seed, "--lcm-url", args.lcm_url,
-                    "--duration", args.duration + 8.0]
+                    "--duration", (args.duration + 8.0) if args.mission == "loop"
+                    else args.timeout * max(rtf, 1.0) + 30.0]
+        if args.mission == "parking":
+            sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
         if rtf != 1.0:
             sim_argv += ["--rtf", rtf]
         if args.realtime and (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) \
@@ -132,8 +142,12 @@ def main():
         wait_for(run_dir / "nigel1-nano", 30, procs)
         procs.start("autodrive-runtime", [build / "bin" / "autodrive-runtime", "--config", cfg_path],
                     out / "runtime.log")
-        result = demo_driver.drive(args.lcm_url, "NIGEL1", args.duration, rtf, procs,
-                                   lambda: interrupted)
+        if args.mission == "loop":
+            result = demo_driver.drive(args.lcm_url, "NIGEL1", args.duration, rtf, procs,
+                                       lambda: interrupted)
+        else:
+            result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed,
+                                      args.timeout, procs, lambda: interrupted)
     except RuntimeError as e:
         log(f"ERROR: {e}")
         result = {"error": str(e)}
@@ -146,6 +160,9 @@ def main():
     import demo_report  # noqa: E402  (tools/demo_report.py)
     report = demo_report.analyse(lcm_log, out, "NIGEL1")
     report.update(result)
+    if args.mission == "parking" and "goal_world" in result:
+        report.update(demo_parking.score(lcm_log, out, "NIGEL1", result))
+        report["ok"] = bool(report.get("success")) and report.get("collisions", 1) == 0
     report["wall_s"] = round(wall_s, 2)
     report["rtf_requested"] = rtf
     (out / "report.json.tmp").write_text(json.dumps(report, indent=2))

@@ -59,7 +59,13 @@ class AutonomyNode {
   int plans() const { return plans_; }
 
  private:
-  double now_s(int64_t utime_us) const { return static_cast<double>(utime_us) * 1e-6; }
+  // Mission time [s] since the first message: stamps may be epoch microseconds (wall clock)
+  // or sim time, and the mission's timeouts start at 0.
+  double now_s(int64_t utime_us) const {
+    if (t0_us_ < 0) t0_us_ = utime_us;
+    return static_cast<double>(utime_us - t0_us_) * 1e-6;
+  }
+  mutable int64_t t0_us_ = -1;
   void after_map_ready(double t_s);
   void plan(double t_s);
 

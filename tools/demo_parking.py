@@ -1,0 +1,191 @@
+"""Autonomous parking mission for tools/demo: runs autodrive-autonomy (mapping, saving,
+localising, Hybrid A* planning, pure-pursuit driving) on the runtime's LIDAR and EKF odometry,
+then scores the run against the simulator's ground truth.
+
+Frames: the autonomy works in the frame of the car's start pose (its SLAM origin); the
+simulator's world frame is the map's. The start pose is the map's `spawn` site."""
+import math
+import pathlib
+import re
+import subprocess
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+# Parking School slots (sim/mujoco_hil/tools/gen_maps.py): 0.3 m wide, lines at x = -1.2 +
+# 0.3 k, centre line y = 1.25 [m]. Forward-in: the rear axle (base_link) sits 0.07 m behind
+# the slot centre, so the car body (centre 0.0708 m ahead of the axle) is centred in it.
+SLOT_X0_M, SLOT_PITCH_M, SLOT_Y_M, SLOTS = -1.05, 0.30, 1.25, 6
+CENTRE_AHEAD_M = 0.0708
+
+
+def spawn_pose(map_xml):
+    m = re.search(r'<site name="spawn" pos="([-\d.]+) ([-\d.]+) [-\d.]+" euler="[-\d.]+ [-\d.]+ ([-\d.]+)"',
+                  pathlib.Path(map_xml).read_text())
+    if not m:
+        raise RuntimeError(f"{map_xml}: no <site name=\"spawn\" pos=.. euler=..>")
+    return float(m.group(1)), float(m.group(2)), math.radians(float(m.group(3)))
+
+
+def slot_goal_world(slot):
+    if not 0 <= slot < SLOTS:
+        raise RuntimeError(f"--slot {slot}: Parking School has slots 0..{SLOTS - 1}")
+    return SLOT_X0_M + SLOT_PITCH_M * slot, SLOT_Y_M - CENTRE_AHEAD_M, math.pi / 2
+
+
+def to_frame(origin, p):
+    """World pose p expressed in the frame whose pose in the world is origin."""
+    dx, dy = p[0] - origin[0], p[1] - origin[1]
+    c, s = math.cos(origin[2]), math.sin(origin[2])
+    return c * dx + s * dy, -s * dx + c * dy, _wrap(p[2] - origin[2])
+
+
+def to_world(origin, p):
+    c, s = math.cos(origin[2]), math.sin(origin[2])
+    return origin[0] + c * p[0] - s * p[1], origin[1] + s * p[0] + c * p[1], _wrap(p[2] + origin[2])
+
+
+def _wrap(a):
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def write_config(example, out_dir, url, goal_local, seed):
+    import yaml
+    cfg = yaml.safe_load(pathlib.Path(example).read_text())
+    cfg["lcm_url"] = url
+    cfg["out_dir"] = str(out_dir / "autonomy")
+    cfg["map"]["save_to"] = str(out_dir / "map.yaml")
+    cfg["map"]["load_from"] = ""
+    cfg["goal"] = {"x_m": goal_local[0], "y_m": goal_local[1], "yaw_rad": goal_local[2]}
+    cfg["amcl"]["seed"] = seed
+    path = out_dir / "autonomy.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
+    return path
+
+
+def run(build, out_dir, url, slot, seed, timeout_s, procs, stop_requested):
+    map_xml = ROOT / "sim/mujoco_hil/maps/parking_school.xml"
+    start = spawn_pose(map_xml)
+    goal_w = slot_goal_world(slot)
+    goal_l = to_frame(start, goal_w)
+    cfg = write_config(ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml", out_dir,
+                       url, goal_l, seed)
+    print(f"[demo] mission: park in slot {slot} at world ({goal_w[0]:.3f}, {goal_w[1]:.3f}, "
+          f"{math.degrees(goal_w[2]):.0f} deg)", flush=True)
+    proc = procs.start("autodrive-autonomy", [build / "bin" / "autodrive-autonomy", "--config", cfg],
+                       out_dir / "autonomy.log")
+    t0 = time.time()
+    seen = 0
+    while proc.poll() is None:
+        if stop_requested():
+            break
+        if time.time() - t0 > timeout_s:
+            raise RuntimeError(f"the mission did not finish within {timeout_s:.0f} s wall")
+        for name, p, _ in procs.items:
+            if name != "autodrive-autonomy" and p.poll() is not None:
+                raise RuntimeError(f"{name} exited with code {p.returncode}")
+        lines = (out_dir / "autonomy.log").read_text().splitlines()
+        for ln in lines[seen:]:
+            print(ln, flush=True)  # the mission's state changes, as they happen
+        seen = len(lines)
+        time.sleep(0.2)
+    for ln in (out_dir / "autonomy.log").read_text().splitlines()[seen:]:
+        print(ln, flush=True)
+    return {"mission_exit_code": proc.returncode, "slot": slot,
+            "start_world": list(start), "goal_world": list(goal_w)}
+
+
+def score(log_path, out_dir, veh, mission):
+    """Parking figures against ground truth; writes gt.csv (in the autonomy frame) and plots."""
+    import lcm
+    from autodrive import ground_truth_t, pose2d_t
+    start, goal_w = mission["start_world"], mission["goal_world"]
+    gt, gt_rx, amcl = [], [], []
+    for ev in lcm.EventLog(str(log_path), "r"):
+        if ev.channel == f"{veh}_GROUND_TRUTH":
+            m = ground_truth_t.decode(ev.data)
+            gt.append((m.position_m[0], m.position_m[1], m.yaw_rad))
+            gt_rx.append(ev.timestamp)
+        elif ev.channel == f"{veh}_POSE_AMCL":
+            m = pose2d_t.decode(ev.data)
+            amcl.append((ev.timestamp, m.x_m, m.y_m, m.yaw_rad))
+    rep = {}
+    if not gt:
+        return {"error": "no ground truth in the log"}
+    final = gt[-1]
+    rep["success"] = mission.get("mission_exit_code") == 0
+    rep["final_pos_error_m"] = round(math.hypot(final[0] - goal_w[0], final[1] - goal_w[1]), 4)
+    rep["final_heading_error_deg"] = round(abs(math.degrees(_wrap(final[2] - goal_w[2]))), 3)
+    rep["min_clearance_m"] = round(min_clearance(gt), 4)
+    import bisect
+    errs = []
+    for t, x, y, yaw in amcl:
+        i = min(bisect.bisect_left(gt_rx, t), len(gt) - 1)
+        w = to_world(start, (x, y, yaw))
+        errs.append(math.hypot(w[0] - gt[i][0], w[1] - gt[i][1]))
+    rep["localization_rms_m"] = round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
+    with open(out_dir / "gt.csv", "w") as f:
+        f.write("x_m,y_m,yaw_rad\n")
+        for g in gt[::10]:
+            p = to_frame(start, g)
+            f.write(f"{p[0]:.5f},{p[1]:.5f},{p[2]:.5f}\n")
+    auto = out_dir / "autonomy"
+    goal_l = to_frame(start, goal_w)
+    argv = [str(ROOT / "tools/plot-parking"), "--map", str(out_dir / "map.yaml"),
+            "--truth", str(out_dir / "gt.csv"), "--goal", ",".join(f"{v:.4f}" for v in goal_l),
+            "--out", str(out_dir / "parking.png")]
+    for name in ("path", "route", "trajectory"):
+        if (auto / f"{name}.csv").exists():
+            argv += [f"--{name}", str(auto / f"{name}.csv")]
+    if (out_dir / "map.yaml").exists():
+        r = subprocess.run(argv, capture_output=True, text=True)
+        if r.returncode != 0:
+            rep["plot_error"] = r.stderr.strip()[-300:]
+    return rep
+
+
+def _obstacles():
+    """Collidable boxes and cones of Parking School as (centre, half sizes, yaw) rectangles."""
+    text = (ROOT / "sim/mujoco_hil/maps/parking_school.xml").read_text()
+    obs = []
+    for m in re.finditer(r'<geom name="box_\w+" type="box" pos="([-\d. ]+)" size="([-\d. ]+)" '
+                         r'euler="[-\d.]+ [-\d.]+ ([-\d.]+)"', text):
+        p = [float(v) for v in m.group(1).split()]
+        s = [float(v) for v in m.group(2).split()]
+        obs.append((p[0], p[1], s[0], s[1], float(m.group(3))))
+    for m in re.finditer(r'<body name="cone_\d+" pos="([-\d. ]+)"', text):
+        p = [float(v) for v in m.group(1).split()]
+        obs.append((p[0], p[1], 0.025, 0.025, 0.0))
+    return obs
+
+
+def _corners(cx, cy, hx, hy, yaw):
+    c, s = math.cos(yaw), math.sin(yaw)
+    return [(cx + c * dx - s * dy, cy + s * dx + c * dy)
+            for dx, dy in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))]
+
+
+def _seg_dist(p, a, b):
+    ax, ay = b[0] - a[0], b[1] - a[1]
+    t = max(0.0, min(1.0, ((p[0] - a[0]) * ax + (p[1] - a[1]) * ay) / (ax * ax + ay * ay)))
+    return math.hypot(a[0] + t * ax - p[0], a[1] + t * ay - p[1])
+
+
+def _poly_dist(pa, pb):
+    d = float("inf")
+    for P, Q in ((pa, pb), (pb, pa)):
+        for p in P:
+            for i in range(4):
+                d = min(d, _seg_dist(p, Q[i], Q[(i + 1) % 4]))
+    return d  # overlapping rectangles are caught by the collision flag instead
+
+
+def min_clearance(gt, length_m=0.19, width_m=0.13, centre_ahead_m=CENTRE_AHEAD_M):
+    """Smallest gap [m] between the car's body rectangle and any obstacle over the run."""
+    obs = [_corners(*o) for o in _obstacles()]
+    best = float("inf")
+    for x, y, yaw in gt[::10]:
+        car = _corners(x + centre_ahead_m * math.cos(yaw), y + centre_ahead_m * math.sin(yaw),
+                       length_m / 2, width_m / 2, yaw)
+        for o in obs:
+            best = min(best, _poly_dist(car, o))
+    return best
