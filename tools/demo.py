@@ -37,9 +37,9 @@ def parse_args():
                    help="parking: give up after this many wall seconds")
     p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
     p.add_argument("--realtime", action="store_true",
-                   help="run in real time (default: 2x real time); opens the simulator's "
-                   "window when a display exists")
-    p.add_argument("--headless", action="store_true", help="never open a window")
+                   help="run in real time (default: 2x real time)")
+    p.add_argument("--headless", action="store_true",
+                   help="never open the simulator's window (default: open it when a display exists)")
     p.add_argument("--rtf", type=float, default=2.0, help="real-time factor when not --realtime")
     p.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0", help="LCM URL")
     return p.parse_args()
@@ -103,8 +103,9 @@ def main():
 
     cfg = yaml.safe_load((ROOT / "runtime/jetson/config/nigel_hil.yaml").read_text())
     cfg["lcm_url"] = args.lcm_url
-    # Faster than real time: the runtime stamps and integrates on the sim's SIM_CLOCK.
-    cfg["clock"] = "wall" if rtf == 1.0 else "sim"
+    # The runtime stamps and integrates on the sim's SIM_CLOCK: right faster than real time, and
+    # also in real time when the sim falls behind (a window, a loaded CPU) and slips.
+    cfg["clock"] = "sim"
     cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
     cfg["lidar"]["device"] = str(run_dir / "nigel1-lidar")
     cfg_path = out / "runtime.yaml"
@@ -133,10 +134,8 @@ def main():
                     else args.timeout * max(rtf, 1.0) + 30.0]
         if args.mission == "parking":
             sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
-        if rtf != 1.0:
-            sim_argv += ["--rtf", rtf]
-        if args.realtime and (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) \
-                and not args.headless:
+        sim_argv += ["--rtf", rtf]  # also at 1: the sim then publishes SIM_CLOCK
+        if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim_argv += ["--view"]  # a window when a display exists; headless otherwise
         procs.start("autodrive-sim", sim_argv, out / "sim.log")
         wait_for(run_dir / "nigel1-nano", 30, procs)

@@ -25,6 +25,8 @@
 #define MAIN_PROGRESS_S 5.0   /* [s] wall time between progress lines */
 
 static volatile sig_atomic_t main_stop = 0;
+/* Largest lag behind the real-time schedule [s] before the schedule slips (see pacing). */
+#define MAIN_MAX_LAG_S 0.02
 static void main_on_signal(int sig) { (void)sig; main_stop = 1; }
 
 static void main_usage(FILE *f) {
@@ -385,7 +387,7 @@ int main(int argc, char **argv) {
   double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0;
   int64_t last_progress_us = 0;
   int rc = 0;
-  long step = 0;
+  long step = 0, slips = 0;
   while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
@@ -423,7 +425,13 @@ int main(int argc, char **argv) {
     const double wall = main_wall_s();
     if (!lockstep) {
       const double ahead = t0 + now_us * 1e-6 / rtf - wall;
-      if (ahead > 0.0005) {
+      if (ahead < -MAIN_MAX_LAG_S) {
+        /* Behind (a slow frame, the window, a loaded CPU): slip the schedule rather than burst
+         * through the backlog. A burst would advance sim time with no bytes arriving on the
+         * pty, and the emulated Nano's failsafe would trip on a client that is fine. */
+        t0 -= ahead;
+        slips++;
+      } else if (ahead > 0.0005) {
         struct timespec ts = {(time_t)ahead, (long)((ahead - floor(ahead)) * 1e9)};
         nanosleep(&ts, NULL);
       }
@@ -432,7 +440,10 @@ int main(int argc, char **argv) {
       rtf_now = (now_us - last_progress_us) * 1e-6 / (wall - next_progress + MAIN_PROGRESS_S);
       last_progress_us = now_us;
       next_progress = wall + MAIN_PROGRESS_S;
-      if (!quiet) fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f\n", now_us * 1e-6, rtf_now);
+      if (!quiet)
+        fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f%s\n", now_us * 1e-6, rtf_now,
+                slips ? " (fell behind: schedule slipped)" : "");
+      slips = 0;
     }
   }
   const double wall_s = main_wall_s() - t0, cpu_s = main_cpu_s() - cpu0;
