@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
+#include <autodrive_lcm/subscribe.hpp>
 
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/mission_status_t.hpp>
@@ -39,14 +40,6 @@ int run_program(const std::vector<std::string> &args, std::string *out) {
   while (fgets(buf, sizeof buf, p)) *out += buf;
   const int st = pclose(p);
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-// LCM 1.3.1's member-function subscribe() hands its callback a null subscription under UBSan
-// (see runtime/jetson/common/lcm_sub.hpp): subscribe through subscribeFunction and this thunk.
-template <class Msg, class Obj,
-          void (Obj::*Method)(const lcm::ReceiveBuffer *, const std::string &, const Msg *)>
-void lcm_member_thunk(const lcm::ReceiveBuffer *rb, const std::string &ch, const Msg *m, Obj *o) {
-  (o->*Method)(rb, ch, m);
 }
 
 struct Listener {
@@ -94,12 +87,12 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   lcm::LCM lcm(kUrl);
   ASSERT_TRUE(lcm.good());
   Listener l;
-  lcm.subscribeFunction("NIGELT_MISSION",
-                        &lcm_member_thunk<autodrive::mission_status_t, Listener, &Listener::on_mission>, &l);
-  lcm.subscribeFunction("NIGELT_COMMAND",
-                        &lcm_member_thunk<autodrive::vehicle_command_t, Listener, &Listener::on_cmd>, &l);
-  lcm.subscribeFunction("NIGELT_POSE_AMCL",
-                        &lcm_member_thunk<autodrive::pose2d_t, Listener, &Listener::on_amcl>, &l);
+  autodrive_lcm::subscribe<autodrive::mission_status_t, Listener, &Listener::on_mission>(
+      lcm, "NIGELT_MISSION", &l);
+  autodrive_lcm::subscribe<autodrive::vehicle_command_t, Listener, &Listener::on_cmd>(
+      lcm, "NIGELT_COMMAND", &l);
+  autodrive_lcm::subscribe<autodrive::pose2d_t, Listener, &Listener::on_amcl>(
+      lcm, "NIGELT_POSE_AMCL", &l);
 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);

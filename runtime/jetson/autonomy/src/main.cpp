@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include <autodrive_lcm/subscribe.hpp>
 
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/mission_status_t.hpp>
@@ -136,14 +137,6 @@ class App {
 
 }  // namespace
 
-// LCM 1.3.1's member-function subscribe() hands its callback a null subscription under UBSan
-// (see runtime/jetson/common/lcm_sub.hpp): subscribe through subscribeFunction and this thunk.
-template <class Msg, class Obj,
-          void (Obj::*Method)(const lcm::ReceiveBuffer *, const std::string &, const Msg *)>
-void lcm_member_thunk(const lcm::ReceiveBuffer *rb, const std::string &ch, const Msg *m, Obj *o) {
-  (o->*Method)(rb, ch, m);
-}
-
 int main(int argc, char **argv) {
   CLI::App cli{"autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on LCM"};
   std::string config_path, url_override, vehicle_override;
@@ -172,10 +165,10 @@ int main(int argc, char **argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   App app(cfg, lcm);
-  auto *s1 = lcm.subscribeFunction(
-      cfg.vehicle + "_LIDAR", &lcm_member_thunk<autodrive::lidar_scan_t, App, &App::on_scan>, &app);
-  auto *s2 = lcm.subscribeFunction(
-      cfg.vehicle + "_ODOM", &lcm_member_thunk<autodrive::odometry_t, App, &App::on_odom>, &app);
+  auto *s1 = autodrive_lcm::subscribe<autodrive::lidar_scan_t, App, &App::on_scan>(
+      lcm, cfg.vehicle + "_LIDAR", &app);
+  auto *s2 = autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_odom>(
+      lcm, cfg.vehicle + "_ODOM", &app);
   s1->setQueueCapacity(10);
   s2->setQueueCapacity(200);
   std::printf("[autonomy] %s on %s: listening to %s_LIDAR, %s_ODOM\n", cfg.vehicle.c_str(),
