@@ -62,29 +62,53 @@ void AutonomyNode::after_map_ready(double) {
 void AutonomyNode::on_odom(const Pose2 &odom, int64_t utime_us) {
   const double dt_s = have_odom_ ? std::max(0.0, (utime_us - last_odom_us_) * 1e-6) : 0.0;
   odom_ = odom;
+  odom_history_.add(utime_us, odom);
   last_odom_us_ = utime_us;
   have_odom_ = true;
   const double t = now_s(utime_us);
   mission_.tick(t);
-  if (mission_.state() != MissionState::kDriving) {
+  if (mission_.state() != MissionState::kDriving || settling_) {
     command_ = TrackerCommand{};
     return;
   }
   command_ = tracker_.step(pose_map(), dt_s);
   if (command_.done) {
-    const Pose2 e = pose_between(cfg_.goal, pose_map());
-    const double pos_err_m = std::hypot(e.x_m, e.y_m), yaw_err_rad = std::abs(e.yaw_rad);
-    std::ostringstream why;
-    why.precision(3);
-    why << "stopped " << pos_err_m << " m, " << yaw_err_rad * 180.0 / kPi << " deg from the goal";
-    mission_.arrived(pos_err_m <= cfg_.goal_tolerance_m && yaw_err_rad <= cfg_.goal_tolerance_yaw_rad,
-                     why.str(), t);
-    if (mission_.state() == MissionState::kPlanning) plan(t);
+    // Hold still; on_scan judges the stop on a scan that starts after the car has settled.
+    settling_ = true;
+    settled_at_us_ = utime_us + static_cast<int64_t>(cfg_.settle_s * 1e6);
+    command_ = TrackerCommand{};
   }
+}
+
+void AutonomyNode::judge_arrival(double t_s) {
+  settling_ = false;
+  const Pose2 e = pose_between(cfg_.goal, pose_map());
+  const double pos_err_m = std::hypot(e.x_m, e.y_m), yaw_err_rad = std::abs(e.yaw_rad);
+  std::ostringstream why;
+  why.precision(3);
+  why << "stopped " << pos_err_m << " m, " << yaw_err_rad * 180.0 / kPi << " deg from the goal";
+  mission_.arrived(pos_err_m <= cfg_.goal_tolerance_m && yaw_err_rad <= cfg_.goal_tolerance_yaw_rad,
+                   why.str(), t_s);
+  if (mission_.state() == MissionState::kPlanning) plan(t_s);
+}
+
+void AutonomyNode::localise(const Pose2 &odom_scan, const Scan &scan, int64_t scan_mid_us) {
+  Pose2 est = amcl_->estimate();
+  if (cfg_.refine_scan_match) {
+    const Pose2 refined = scan_match_level(*map_, scan_points_base(scan, cfg_.amcl.lidar_in_base), est, 10);
+    const Pose2 d = pose_between(est, refined);
+    if (std::hypot(d.x_m, d.y_m) <= cfg_.refine_max_m && std::abs(d.yaw_rad) <= cfg_.refine_max_yaw_rad)
+      est = refined;
+  }
+  map_from_odom_ = pose_compose(est, pose_inverse(odom_scan));
+  have_map_odom_ = true;
+  loc_pose_ = est;
+  loc_utime_us_ = scan_mid_us;
 }
 
 void AutonomyNode::plan(double t_s) {
   ++plans_;
+  settling_ = false;
   const PlanResult r = hybrid_astar_plan(*checker_, pose_map(), cfg_.goal, cfg_.planner);
   route_m_ = r.route_m;
   if (r.failed) {
@@ -103,12 +127,15 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
   const double t = now_s(utime_us);
   mission_.tick(t);
   ++scans_;
-  const Pose2 odom_motion = pose_between(odom_at_last_scan_, odom_);
-  odom_at_last_scan_ = odom_;
+  // Where the car was while the scan was measured: odometry at the scan's mid-time.
+  const int64_t mid_us = utime_us + static_cast<int64_t>(scan.scan_time_s * 0.5e6);
+  const Pose2 odom_scan = odom_history_.at(mid_us).value_or(odom_);
+  const Pose2 odom_motion = pose_between(odom_at_last_scan_, odom_scan);
+  odom_at_last_scan_ = odom_scan;
   switch (mission_.state()) {
     case MissionState::kMapping: {
       const Pose2 p = slam_->update(scan, scans_ > 1 ? odom_motion : Pose2{});
-      map_from_odom_ = pose_compose(p, pose_inverse(odom_));
+      map_from_odom_ = pose_compose(p, pose_inverse(odom_scan));
       have_map_odom_ = true;
       if (slam_->scans_processed() >= cfg_.mapping_scans) {
         mission_.mapping_done(t);
@@ -127,10 +154,9 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
       break;
     }
     case MissionState::kLocalising: {
-      amcl_->update(odom_, scan, true);
+      amcl_->update(odom_scan, scan, true);
       ++localising_updates_;
-      map_from_odom_ = pose_compose(amcl_->estimate(), pose_inverse(odom_));
-      have_map_odom_ = true;
+      localise(odom_scan, scan, mid_us);
       const Eigen::Matrix3d c = amcl_->covariance();
       if (localising_updates_ >= cfg_.localising_min_updates &&
           std::sqrt(std::max(c(0, 0), c(1, 1))) <= cfg_.localised_std_m &&
@@ -141,19 +167,33 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
       break;
     }
     case MissionState::kDriving: {
-      if (amcl_->update(odom_, scan, false)) {
-        ++localising_updates_;
-        map_from_odom_ = pose_compose(amcl_->estimate(), pose_inverse(odom_));
+      if (settling_) {
+        if (utime_us >= settled_at_us_) {
+          amcl_->update(odom_scan, scan, true);  // a standstill scan: always worth an update
+          ++localising_updates_;
+          localise(odom_scan, scan, mid_us);
+          judge_arrival(t);
+        }
+        break;
       }
-      // Obstacles not on the map, in the map frame.
+      if (amcl_->update(odom_scan, scan, false)) {
+        ++localising_updates_;
+        localise(odom_scan, scan, mid_us);
+      }
+      // Obstacles not on the map, in the map frame, seen from where the scan was taken.
       std::vector<Eigen::Vector2d> pts;
-      const Pose2 base = pose_map();
+      const Pose2 base = pose_compose(map_from_odom_, odom_scan);
       for (const auto &q : scan_points_base(scan, cfg_.amcl.lidar_in_base)) pts.push_back(pose_apply(base, q));
       const auto unmapped = lp_unmapped_points(*map_, amcl_field_m_, pts, cfg_.unmapped_min_dist_m);
       const LocalCheck lc = lp_check_path(tracker_.path(), tracker_.progress_index(),
                                           cfg_.obstacle_horizon_m, unmapped, cfg_.footprint);
       if (lc.blocked) {
-        grid_mark_occupied(*plan_map_, unmapped, cfg_.obstacle_inflation_m);
+        // Mark the obstacle that blocks the path, not every return the map lacks: a wall that
+        // was in a LIDAR shadow while mapping, inflated, could wall off the goal itself.
+        std::vector<Eigen::Vector2d> blocking;
+        for (const auto &u : unmapped)
+          if ((u - lc.obstacle_m).norm() <= cfg_.obstacle_cluster_m) blocking.push_back(u);
+        grid_mark_occupied(*plan_map_, blocking, cfg_.obstacle_inflation_m);
         checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
         std::ostringstream why;
         why.precision(3);

@@ -56,7 +56,8 @@ ProgramConfig cfg_load(const std::string &path) {
   NodeConfig &n = c.node;
   r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
                     "start", "goal", "lidar_in_base", "mapping_scans", "goal_tolerance_m",
-                    "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "unknown_is_obstacle", "footprint", "slam", "amcl",
+                    "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "obstacle_cluster_m",
+                    "unknown_is_obstacle", "settle_s", "refine_scan_match", "footprint", "slam", "amcl",
                     "planner", "tracker", "mission"});
   r.get(root, "", "vehicle", c.vehicle);
   r.get(root, "", "lcm_url", c.lcm_url);
@@ -80,6 +81,10 @@ ProgramConfig cfg_load(const std::string &path) {
   r.get(root, "", "obstacle_horizon_m", n.obstacle_horizon_m);
   r.get(root, "", "unknown_is_obstacle", n.unknown_is_obstacle);
   r.get(root, "", "obstacle_inflation_m", n.obstacle_inflation_m);
+  r.get(root, "", "obstacle_cluster_m", n.obstacle_cluster_m);
+  r.get(root, "", "settle_s", n.settle_s);
+  r.get(root, "", "refine_scan_match", n.refine_scan_match);
+  if (n.settle_s < 0 || n.settle_s > 10) r.fail("'settle_s' must be 0..10 [s]");
   if (const auto f = root["footprint"]) {
     r.only(f, "footprint", {"length_m", "width_m", "center_ahead_m", "margin_m"});
     r.get(f, "footprint", "length_m", n.footprint.length_m);

@@ -1,6 +1,7 @@
 // autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
 // publishes <VEH>_COMMAND, <VEH>_POSE_AMCL and <VEH>_MISSION, and prints each mission state
 // change. Writes path.csv, route.csv and trajectory.csv into out_dir for tools/plot-parking.
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -40,12 +41,17 @@ class App {
     s.angle_increment_rad = m->angle_increment_rad;
     s.range_min_m = m->range_min_m;
     s.range_max_m = m->range_max_m;
+    s.scan_time_s = std::isfinite(m->scan_time_s) && m->scan_time_s > 0 ? m->scan_time_s : 0.0;
     s.ranges_m = m->ranges_m;
     const int plans_before = node_.plans();
     node_.on_scan(s, m->utime);
     if (node_.plans() != plans_before) write_plan();
     last_utime_ = std::max(last_utime_, m->utime);
-    if (auto p = node_.amcl_pose()) publish_amcl(*p, m->utime);
+    // The localisation estimate, once per scan that produced one, stamped when it was true.
+    if (node_.localised_utime_us() > last_loc_us_) {
+      last_loc_us_ = node_.localised_utime_us();
+      publish_amcl(node_.localised_pose(), last_loc_us_);
+    }
     report_state(m->utime);
   }
 
@@ -131,7 +137,7 @@ class App {
   AutonomyNode node_;
   std::ofstream traj_;
   int32_t seq_ = 0;
-  int64_t last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
+  int64_t last_loc_us_ = -1, last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
   size_t printed_ = 0;
 };
 

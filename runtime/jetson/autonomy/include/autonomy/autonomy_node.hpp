@@ -11,6 +11,7 @@
 #include "autonomy/footprint.hpp"
 #include "autonomy/hybrid_astar.hpp"
 #include "autonomy/mission.hpp"
+#include "autonomy/odom_history.hpp"
 #include "autonomy/pure_pursuit.hpp"
 #include "autonomy/slam.hpp"
 
@@ -26,9 +27,17 @@ struct NodeConfig {
   int localising_min_updates = 8;
   double localised_std_m = 0.02, localised_std_yaw_rad = 0.03;
   double goal_tolerance_m = 0.03, goal_tolerance_yaw_rad = 0.06;
+  // At the end of the path the car holds still this long [s], then localises on a scan taken
+  // entirely at standstill (no motion blur, no lag) before it judges the stop against the goal.
+  double settle_s = 0.3;
+  // AMCL's estimate is refined by Gauss-Newton scan-to-map matching (Hector's matcher on the
+  // saved map); a refinement that moves it more than this is rejected as a wrong basin.
+  bool refine_scan_match = true;
+  double refine_max_m = 0.05, refine_max_yaw_rad = 0.05;
   double obstacle_horizon_m = 0.5;     // look this far ahead along the path
   double unmapped_min_dist_m = 0.06;   // scan points this far from mapped walls are new
   double obstacle_inflation_m = 0.06;  // new obstacles are marked as discs this big
+  double obstacle_cluster_m = 0.3;     // unmapped returns this near the blocking one are marked
   // Unknown cells (LIDAR shadows, e.g. behind slot dividers seen from one place) are free for
   // the planner by default; the live obstacle check guards them while driving.
   bool unknown_is_obstacle = false;
@@ -52,6 +61,10 @@ class AutonomyNode {
   bool have_pose() const { return have_map_odom_; }
   Pose2 pose_map() const;  // best map-frame pose now
   std::optional<Pose2> amcl_pose() const;
+  // The localisation estimate (AMCL refined by scan matching) of the latest scan, stamped at
+  // the scan's mid-time [us]; stamp < 0 before the first.
+  Pose2 localised_pose() const { return loc_pose_; }
+  int64_t localised_utime_us() const { return loc_utime_us_; }
   Eigen::Matrix3d amcl_covariance() const;
   const Path &path() const { return tracker_.path(); }
   const std::vector<Eigen::Vector2d> &route_m() const { return route_m_; }
@@ -68,6 +81,9 @@ class AutonomyNode {
   mutable int64_t t0_us_ = -1;
   void after_map_ready(double t_s);
   void plan(double t_s);
+  // Takes AMCL's estimate for the scan taken at odom_scan (refined), as the map pose.
+  void localise(const Pose2 &odom_scan, const Scan &scan, int64_t scan_mid_us);
+  void judge_arrival(double t_s);
 
   NodeConfig cfg_;
   Mission mission_;
@@ -82,6 +98,11 @@ class AutonomyNode {
   std::vector<Eigen::Vector2d> route_m_;
   bool have_odom_ = false, have_map_odom_ = false;
   Pose2 odom_, odom_at_last_scan_;
+  OdomHistory odom_history_;
+  bool settling_ = false;       // stopped at the path's end, waiting for a standstill scan
+  int64_t settled_at_us_ = 0;   // scans that start after this were taken at standstill
+  Pose2 loc_pose_;
+  int64_t loc_utime_us_ = -1;
   Pose2 map_from_odom_;  // T_map_odom
   int64_t last_odom_us_ = 0;
   int scans_ = 0, localising_updates_ = 0, plans_ = 0;

@@ -53,6 +53,7 @@ struct Scan {
   double angle_increment_rad = 0.0;
   double range_min_m = 0.15;
   double range_max_m = 12.0;
+  double scan_time_s = 0.0;  // one revolution; the scan's stamp is its start
   std::vector<float> ranges_m;
 };
 
