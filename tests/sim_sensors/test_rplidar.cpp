@@ -306,3 +306,39 @@ TEST(SimRplidar, RefusesToReplaceARegularFile) {
   unlink(path.c_str());
   rmdir(dir.c_str());
 }
+
+// Streamed like the real A1 (rays pushed as the head passes them): a revolution's first node
+// reaches the client a few ms after it is measured, not one revolution (143 ms) later, and
+// the thinning is the same as for whole-revolution pushes.
+TEST(SimRplidar, StreamedRaysArriveWhileTheHeadSpins) {
+  Device dev;
+  ASSERT_NE(dev.r, nullptr);
+  Client c(dev.link);
+  std::vector<uint8_t> rx;
+  std::vector<float> ranges(360);
+  for (int i = 0; i < 360; i++) ranges[i] = 1.0f + i * 0.01f;  // the range encodes the ray
+  c.send({0xA5, 0x20});
+  dev.run_ms(1, c, rx);
+  std::vector<int64_t> start_pushed_ms, start_seen_ms;
+  size_t parsed = 7;  // after the descriptor
+  int next_ray = 0;
+  for (int ms = 0; ms < 3000; ms++) {  // 3 s at 7 Hz: ray i is due at i / 360 / 7 s
+    const int due = std::min(360, static_cast<int>((ms % 143 + 1) * 360 / 143));
+    if (ms % 143 == 0) {
+      next_ray = 0;
+      start_pushed_ms.push_back(ms);
+    }
+    sim_rplidar_push_rays(dev.r, ranges.data(), nullptr, next_ray, due, 360);
+    next_ray = std::max(next_ray, due);
+    dev.run_ms(1, c, rx);
+    for (; parsed + 5 <= rx.size(); parsed += 5)
+      if (rx[parsed] & 1) start_seen_ms.push_back(ms);
+  }
+  ASSERT_GE(start_seen_ms.size(), 15u);
+  // The queue never holds more than about one ray's worth of lag beyond the wire's own
+  // pace: every revolution start is on the wire within 20 ms of being measured [ms].
+  for (size_t k = 1; k < start_seen_ms.size(); k++) {
+    const auto pushed = *std::prev(std::upper_bound(start_pushed_ms.begin(), start_pushed_ms.end(), start_seen_ms[k]));
+    EXPECT_LE(start_seen_ms[k] - pushed, 20) << "revolution " << k;
+  }
+}

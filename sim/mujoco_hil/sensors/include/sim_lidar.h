@@ -74,6 +74,12 @@ void sim_lidar_scan_now(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now
 /* The last completed scan (num_rays == 0 before the first). Borrowed pointer. */
 const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l);
 
+/* The rays [from, to) the last sim_lidar_update cast (from == to: none) of num_rays per
+ * revolution, indexed like a scan (CCW angle i * 360 / num_rays deg); ranges_m / quality are borrowed, valid until the next
+ * update. An emulated RPLIDAR streams these as they are measured, like the real device. */
+void sim_lidar_last_cast(const sim_lidar_t *l, int *from, int *to, int *num_rays,
+                         const float **ranges_m, const float **quality);
+
 /* Casts one ray from the scanner at angle_rad (CCW from car x) and returns its range [m]
  * (+INFINITY if no return in range), without noise. Exposed for tests. */
 double sim_lidar_ray(const mjModel *m, const mjData *d, const sim_lidar_t *l, double angle_rad);

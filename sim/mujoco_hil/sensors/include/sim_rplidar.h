@@ -60,6 +60,12 @@ const char *sim_rplidar_slave_path(const sim_rplidar_t *r);
 void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float *quality,
                            int num_rays);
 
+/* Streams rays [from, to) of the revolution being measured, as a real A1 sends nodes while it
+ * spins (a whole-revolution push delays every node by up to one revolution, ~143 ms at 7 Hz).
+ * Ray 0 starts a revolution (the S flag). Same node subset and encoding as push_scan. */
+void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality,
+                           int from, int to, int num_rays);
+
 /* Reads and answers requests and writes the bytes the wire could carry up to now_us (sim or
  * wall clock, monotonic, [us]). Never blocks. Call often (e.g. every physics step).
  * Returns 0, or -1 on a fatal pty error (message in err). */

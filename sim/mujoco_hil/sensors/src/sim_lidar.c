@@ -21,6 +21,7 @@ struct sim_lidar {
   sim_lidar_scan_t last;
   int64_t rev_start_us;    /* sim time at which the current revolution started [us] */
   int next_ray;            /* next ray index of the current revolution */
+  int cast_from, cast_to;  /* rays [from, to) cast by the last update, in ranges_m */
   int started;
   uint64_t rng;            /* xorshift64* state for the noise */
 };
@@ -330,6 +331,8 @@ int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us
   int due = (int)floor(phase * l->cfg.num_rays) + 1;
   if (due > l->cfg.num_rays) due = l->cfg.num_rays;
   lidar_cast_rays(m, d, l, l->next_ray, due);
+  l->cast_from = l->next_ray;
+  l->cast_to = due > l->next_ray ? due : l->next_ray;
   if (due > l->next_ray) l->next_ray = due;
   if (phase >= 1.0) {
     lidar_publish(l, l->rev_start_us);
@@ -343,3 +346,12 @@ int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us
 }
 
 const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l) { return &l->last; }
+
+void sim_lidar_last_cast(const sim_lidar_t *l, int *from, int *to, int *num_rays,
+                         const float **ranges_m, const float **quality) {
+  *from = l->cast_from;
+  *to = l->cast_to;
+  *num_rays = l->cfg.num_rays;
+  *ranges_m = l->ranges_m;
+  *quality = l->quality;
+}

@@ -45,7 +45,8 @@ struct sim_rplidar {
   int64_t wire_us;          /* wire time up to which bytes were allowed [us] */
   double credit_bytes;      /* bytes the wire may still carry now */
   int clock_started;
-  int64_t last_push_us;     /* wire clock at the previous push_scan, -1 before the first */
+  int64_t last_push_us;     /* wire clock at the previous revolution's start, -1 before the first */
+  int rev_send;             /* nodes sent in the current streamed revolution (0: not started) */
   sim_rplidar_stats_t stats;
 };
 
@@ -93,6 +94,7 @@ sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *er
   r->master_fd = fd;
   r->baud = baud;
   r->last_push_us = -1;
+  r->rev_send = 0;
   if (ptsname_r(fd, r->slave_path, sizeof r->slave_path) != 0) {
     err_set(err, err_len, "ptsname failed", NULL);
     close(fd);
@@ -166,6 +168,7 @@ static void out_descriptor(sim_rplidar_t *r, uint32_t len, uint8_t mode, uint8_t
 static void rpl_stop(sim_rplidar_t *r) {
   r->scanning = 0;
   r->last_push_us = -1;
+  r->rev_send = 0;
   r->nodes_len = 0;
   r->node_off = 0;
 }
@@ -250,14 +253,12 @@ static void rpl_rx_byte(sim_rplidar_t *r, uint8_t b) {
   }
 }
 
-void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float *quality,
-                           int num_rays) {
-  if (!r->scanning || num_rays <= 0 || !ranges_m) return;
-  size_t need = (size_t)num_rays * RPL_NODE_BYTES;
-  /* keep at most two revolutions queued: drop the oldest whole nodes beyond that */
+/* Makes room for need more node bytes: drops the oldest whole nodes beyond two revolutions
+ * (keep_bytes) and compacts the sent prefix. Returns 0, or -1 when memory ran out. */
+static int rpl_queue_reserve(sim_rplidar_t *r, size_t need, size_t keep_bytes) {
   size_t queued = r->nodes_len - r->node_off;
-  if (queued + need > 2 * need) {
-    size_t drop = queued + need - 2 * need;
+  if (queued + need > keep_bytes) {
+    size_t drop = queued + need - keep_bytes;
     drop -= drop % RPL_NODE_BYTES;
     /* never cut the node that is half on the wire: drop from after it */
     size_t keep_head = (r->node_off % RPL_NODE_BYTES) ? RPL_NODE_BYTES - r->node_off % RPL_NODE_BYTES : 0;
@@ -267,7 +268,6 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
     r->nodes_len -= drop;
     r->stats.nodes_dropped += drop / RPL_NODE_BYTES;
   }
-  /* compact the sent prefix */
   if (r->node_off > 0) {
     memmove(r->nodes, r->nodes + r->node_off, r->nodes_len - r->node_off);
     r->nodes_len -= r->node_off;
@@ -276,16 +276,17 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
   if (r->nodes_len + need > r->nodes_cap) {
     size_t cap = (r->nodes_len + need) * 2;
     uint8_t *p = realloc(r->nodes, cap);
-    if (!p) {
-      r->stats.nodes_dropped += (uint64_t)num_rays;
-      return;
-    }
+    if (!p) return -1;
     r->nodes = p;
     r->nodes_cap = cap;
   }
-  /* A real A1 samples at a fixed rate: a faster spin gives fewer nodes per revolution. Send
-   * what the wire carries in one revolution (the time since the previous push, 3 % margin),
-   * spread evenly over the circle, instead of a backlog that must later be cut. */
+  return 0;
+}
+
+/* A real A1 samples at a fixed rate: a faster spin gives fewer nodes per revolution. Nodes
+ * the wire carries in one revolution (the wire time since the previous revolution's start,
+ * 3 % margin), at most num_rays. Called at each revolution's start. */
+static int rpl_nodes_per_rev(sim_rplidar_t *r, int num_rays) {
   int send = num_rays;
   if (r->last_push_us >= 0 && r->wire_us > r->last_push_us) {
     double per_rev = (double)(r->wire_us - r->last_push_us) * 1e-6 * r->baud / 10.0 /
@@ -293,15 +294,50 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
     if (per_rev < send) send = per_rev < 1 ? 1 : (int)per_rev;
   }
   r->last_push_us = r->wire_us;
-  for (int k = 0; k < send; k++) {
-    int i = (int)((int64_t)k * num_rays / send);
-    double ccw_deg = 360.0 * i / num_rays;
-    double r_m = ranges_m[i];
-    int hit = isfinite(r_m) && r_m > 0;
-    uint8_t q = hit ? (quality ? (uint8_t)quality[i] : RPL_QUALITY_HIT) : 0;
-    sim_rplidar_encode_node(r->nodes + r->nodes_len, k == 0, q, 360.0 - ccw_deg,
-                            hit ? r_m * 1000.0 : 0.0);
-    r->nodes_len += RPL_NODE_BYTES;
+  return send;
+}
+
+static void rpl_queue_node(sim_rplidar_t *r, const float *ranges_m, const float *quality, int i,
+                           int num_rays, int start) {
+  double ccw_deg = 360.0 * i / num_rays;
+  double r_m = ranges_m[i];
+  int hit = isfinite(r_m) && r_m > 0;
+  uint8_t q = hit ? (quality ? (uint8_t)quality[i] : RPL_QUALITY_HIT) : 0;
+  sim_rplidar_encode_node(r->nodes + r->nodes_len, start, q, 360.0 - ccw_deg,
+                          hit ? r_m * 1000.0 : 0.0);
+  r->nodes_len += RPL_NODE_BYTES;
+}
+
+void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float *quality,
+                           int num_rays) {
+  if (!r->scanning || num_rays <= 0 || !ranges_m) return;
+  size_t need = (size_t)num_rays * RPL_NODE_BYTES;
+  if (rpl_queue_reserve(r, need, 2 * need) != 0) {
+    r->stats.nodes_dropped += (uint64_t)num_rays;
+    return;
+  }
+  /* Send what the wire carries in one revolution, spread evenly over the circle, instead of
+   * a backlog that must later be cut. */
+  int send = rpl_nodes_per_rev(r, num_rays);
+  for (int k = 0; k < send; k++)
+    rpl_queue_node(r, ranges_m, quality, (int)((int64_t)k * num_rays / send), num_rays, k == 0);
+}
+
+void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality,
+                           int from, int to, int num_rays) {
+  if (!r->scanning || num_rays <= 0 || !ranges_m || from >= to) return;
+  if (from == 0 || r->rev_send <= 0) r->rev_send = rpl_nodes_per_rev(r, num_rays);
+  const int64_t send = r->rev_send;
+  size_t need = (size_t)(to - from) * RPL_NODE_BYTES;
+  if (rpl_queue_reserve(r, need, 2 * (size_t)num_rays * RPL_NODE_BYTES) != 0) {
+    r->stats.nodes_dropped += (uint64_t)(to - from);
+    return;
+  }
+  for (int i = from; i < to; i++) {
+    /* ray i is sent when it is one of floor(k * num_rays / send), k = 0..send-1: the same
+     * evenly spread subset as a whole-revolution push */
+    int64_t k = ((int64_t)i * send + num_rays - 1) / num_rays;
+    if (k < send && k * num_rays / send == i) rpl_queue_node(r, ranges_m, quality, i, num_rays, i == 0);
   }
 }
 
