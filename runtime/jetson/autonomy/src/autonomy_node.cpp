@@ -134,7 +134,11 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
   odom_at_last_scan_ = odom_scan;
   switch (mission_.state()) {
     case MissionState::kMapping: {
-      const Pose2 p = slam_->update(scan, scans_ > 1 ? odom_motion : Pose2{});
+      // Standing still (odometry moved < 2 mm and < 0.2 deg): every scan is taken from the
+      // start pose, so the map is built there instead of drifting with scan matches.
+      const bool still = std::hypot(odom_motion.x_m, odom_motion.y_m) < cfg_.still_m &&
+                         std::abs(odom_motion.yaw_rad) < cfg_.still_yaw_rad;
+      const Pose2 p = slam_->update(scan, scans_ > 1 ? odom_motion : Pose2{}, !(still && have_odom_));
       map_from_odom_ = pose_compose(p, pose_inverse(odom_scan));
       have_map_odom_ = true;
       if (slam_->scans_processed() >= cfg_.mapping_scans) {

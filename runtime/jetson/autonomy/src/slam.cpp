@@ -122,7 +122,7 @@ void HectorSlam::integrate(const std::vector<Eigen::Vector2d> &, const Pose2 &po
   ++scans_integrated_;
 }
 
-Pose2 HectorSlam::update(const Scan &scan, const Pose2 &motion_guess) {
+Pose2 HectorSlam::update(const Scan &scan, const Pose2 &motion_guess, bool match) {
   ++scans_processed_;
   const auto pts = scan_points_base(scan, cfg_.lidar_in_base);
   if (scans_integrated_ == 0) {
@@ -130,7 +130,8 @@ Pose2 HectorSlam::update(const Scan &scan, const Pose2 &motion_guess) {
     last_update_pose_ = pose_;
     return pose_;
   }
-  pose_ = scan_match(levels_, pts, pose_compose(pose_, motion_guess), cfg_.iterations_per_level);
+  pose_ = pose_compose(pose_, motion_guess);
+  if (match) pose_ = scan_match(levels_, pts, pose_, cfg_.iterations_per_level);
   const Pose2 d = pose_between(last_update_pose_, pose_);
   if (std::hypot(d.x_m, d.y_m) >= cfg_.update_min_dist_m ||
       std::abs(d.yaw_rad) >= cfg_.update_min_angle_rad || scans_integrated_ < cfg_.initial_integrations) {

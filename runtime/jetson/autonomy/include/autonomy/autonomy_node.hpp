@@ -24,6 +24,8 @@ struct NodeConfig {
   double initial_sigma_xy_m = 0.05, initial_sigma_yaw_rad = 0.05;
   Pose2 goal;               // parking pose of the base (rear axle) in the map frame
   int mapping_scans = 15;
+  // While mapping, odometry motion below this between scans means standing still [m], [rad].
+  double still_m = 0.002, still_yaw_rad = 0.0035;
   int localising_min_updates = 8;
   double localised_std_m = 0.02, localised_std_yaw_rad = 0.03;
   double goal_tolerance_m = 0.03, goal_tolerance_yaw_rad = 0.06;

@@ -37,7 +37,9 @@ class HectorSlam {
   HectorSlam(const SlamConfig &cfg, const Pose2 &start_pose);
   // Matches the scan (starting from the last pose, moved by the optional motion guess in the
   // base frame), updates the map, returns the new pose estimate in the map frame.
-  Pose2 update(const Scan &scan, const Pose2 &motion_guess = Pose2{});
+  // match = false trusts the motion guess (odometry says the car stood still: matching a scan
+  // against a map of one or two scans can slide into a wrong basin by centimetres).
+  Pose2 update(const Scan &scan, const Pose2 &motion_guess = Pose2{}, bool match = true);
   const GridMap &map() const { return levels_.front(); }
   const std::vector<GridMap> &levels() const { return levels_; }
   Pose2 pose() const { return pose_; }
