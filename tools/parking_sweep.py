@@ -233,15 +233,19 @@ def _read_gt(path):
     return xs, ys
 
 
-def _goal_in_start_frame(runs):
-    for r in runs:
-        rep = r["report"] or {}
-        st, g = rep.get("start_world"), rep.get("goal_world")
-        if isinstance(st, list) and isinstance(g, list) and len(st) == 3 and len(g) == 3:
-            dx, dy = g[0] - st[0], g[1] - st[1]
-            c, s = math.cos(st[2]), math.sin(st[2])
-            return c * dx + s * dy, -s * dx + c * dy, g[2] - st[2]
+def _start_and_goal(rep):
+    """The run's world start and goal poses [m, m, rad], or None."""
+    st, g = (rep or {}).get("start_world"), (rep or {}).get("goal_world")
+    if isinstance(st, list) and isinstance(g, list) and len(st) == 3 and len(g) == 3:
+        return st, g
     return None
+
+
+def _to_world(start, xs, ys):
+    """gt.csv is in the run's start frame: each seed starts elsewhere, so plot in the world."""
+    c, s = math.cos(start[2]), math.sin(start[2])
+    return ([start[0] + c * x - s * y for x, y in zip(xs, ys)],
+            [start[1] + s * x + c * y for x, y in zip(xs, ys)])
 
 
 def plot(summary, runs, out, png):
@@ -269,17 +273,19 @@ def plot(summary, runs, out, png):
         ax.set_ylabel(f"{label} [{unit}]")
         ax.legend(loc="upper right", fontsize=8)
     ax = axs[1][1]
+    goals = set()
     for r in runs:
         gt = _read_gt(seed_dir(out, r["seed"]) / "gt.csv")
-        if gt:
-            ax.plot(gt[0], gt[1], "-", lw=1, color=None if r["ok"] else "tab:red",
+        sg = _start_and_goal(r["report"])
+        if gt and sg:
+            ax.plot(*_to_world(sg[0], *gt), "-", lw=1, color=None if r["ok"] else "tab:red",
                     label=f"seed {r['seed']}" + ("" if r["ok"] else " (failed)"))
-    goal = _goal_in_start_frame(runs)
-    if goal:
-        ax.plot([goal[0]], [goal[1]], "kx", ms=10, label="goal (rear axle)")
+            goals.add(tuple(round(v, 4) for v in sg[1][:2]))
+    for i, g in enumerate(sorted(goals)):
+        ax.plot([g[0]], [g[1]], "kx", ms=10, label="goal (rear axle)" if i == 0 else None)
     ax.set_aspect("equal")
-    ax.set_xlabel("x [m] (start frame)")
-    ax.set_ylabel("y [m] (start frame)")
+    ax.set_xlabel("x [m] (world)")
+    ax.set_ylabel("y [m] (world)")
     ax.set_title("ground-truth trajectories")
     if ax.lines:
         ax.legend(loc="best", fontsize=7)
