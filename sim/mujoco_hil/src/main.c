@@ -38,6 +38,15 @@ static void main_usage(FILE *f) {
           "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
           "  --params FILE       vehicle parameter file (default %s/params/nigel.params)\n"
           "  --seed N            seed of IMU biases and noise (default 1)\n"
+          "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
+          "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
+          "                      cars line up to its right as usual. Refused when a car would\n"
+          "                      be off the floor or overlap a wall or obstacle\n"
+          "  --late-box X,Y,T[,SX,SY]\n"
+          "                      a box obstacle (half sizes SX, SY [m], default %g; %g m tall)\n"
+          "                      that appears at x, y [m] at sim time T [s]: a change to the\n"
+          "                      place after it was mapped. Up to %d; LIDAR, cameras and the\n"
+          "                      collision flag see it once it is there\n"
           "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
           "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
           "                      (default: real time, 1 sim second per wall second)\n"
@@ -61,8 +70,11 @@ static void main_usage(FILE *f) {
           "  --quiet             no progress lines\n"
           "  -h, --help          this text\n"
           "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
-          "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n",
-          SIM_MAX_CARS, AUTODRIVE_SIM_DIR, MAIN_DEFAULT_URL);
+          "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n"
+          "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
+          "not fit the map); 1 any other error (files, map, LCM, physics).\n",
+          SIM_MAX_CARS, AUTODRIVE_SIM_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
+          SCN_MAX_LATE_BOXES, MAIN_DEFAULT_URL);
 }
 
 static double main_clock_s(clockid_t id) {
@@ -86,6 +98,20 @@ static int main_number(const char *opt, const char *v, double lo, double hi, dou
   }
   *out = x;
   return 0;
+}
+
+/* One line on stdout per late box as it appears (scenario logs, tests). */
+static void main_report_late_boxes(const sim_t *s) {
+  for (int k = 0; k < sim_late_boxes(s); k++) {
+    int car = 0;
+    if (!sim_late_box_appeared(s, k, &car)) continue;
+    const scn_late_box_t *b = sim_late_box(s, k);
+    printf("late box %d appeared at t = %.3f s: centre x %.3f, y %.3f m, half sizes %.3f x %.3f m",
+           k + 1, (sim_time_us(s) - SIM_STEP_US) * 1e-6, b->x_m, b->y_m, b->half_x_m, b->half_y_m);
+    if (car) printf(" (on top of NIGEL%d: contacts will push the car out)", car);
+    printf("\n");
+    fflush(stdout);
+  }
 }
 
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
@@ -204,7 +230,8 @@ static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
     if (sim_viewer_frame((sim_viewer_t *)w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
     if (in.quit || main_stop) return 1;
     if (in.reset_requested) {
-      /* back to the spawn poses; encoder counts restart with the wheel angles, as when a car
+      /* back to the start poses (qpos0, sim.c); late boxes that appeared come back on the next
+       * step; encoder counts restart with the wheel angles, as when a car
        * is picked up and put back */
       mj_resetData(sim_model(s), sim_data(s));
       mj_forward(sim_model(s), sim_data(s));
@@ -249,6 +276,9 @@ int main(int argc, char **argv) {
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
+  scn_pose_t start;
+  scn_late_box_t late_box[SCN_MAX_LATE_BOXES];
+  char perr[512];
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *v = (i + 1 < argc) ? argv[i + 1] : NULL;
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -268,6 +298,26 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--seed")) {
       if (main_number(a, v, 0, 4e18, &x)) return 2;
       cfg.seed = (uint64_t)x;
+      i++;
+    } else if (!strcmp(a, "--start")) {
+      if (scn_parse_start(v, &start, perr, sizeof perr) != 0) {
+        fprintf(stderr, "autodrive-sim: %s\n", perr);
+        return 2;
+      }
+      cfg.start = &start;
+      i++;
+    } else if (!strcmp(a, "--late-box")) {
+      if (cfg.late_boxes == SCN_MAX_LATE_BOXES) {
+        fprintf(stderr, "autodrive-sim: --late-box '%s': at most %d late boxes\n", v ? v : "",
+                SCN_MAX_LATE_BOXES);
+        return 2;
+      }
+      if (scn_parse_late_box(v, &late_box[cfg.late_boxes], perr, sizeof perr) != 0) {
+        fprintf(stderr, "autodrive-sim: %s\n", perr);
+        return 2;
+      }
+      cfg.late_boxes++;
+      cfg.late_box = late_box;
       i++;
     } else if (!strcmp(a, "--lockstep")) {
       lockstep = 1;
@@ -348,6 +398,13 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
+  if (sim_check_scenario(s, err, sizeof err) != 0) { /* a bad --start / --late-box value */
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 2;
+  }
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = main_on_signal;
@@ -379,6 +436,9 @@ int main(int argc, char **argv) {
   }
   printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
          lockstep ? "lockstep" : (rtf_given ? "rtf" : "real time"), url);
+  if (cfg.start)
+    printf("NIGEL1 start (--start): x %.3f, y %.3f m, yaw %.1f deg\n", start.x_m, start.y_m,
+           start.yaw_deg);
   fflush(stdout);
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
@@ -396,6 +456,7 @@ int main(int argc, char **argv) {
     }
     step++;
     const int64_t now_us = sim_time_us(s);
+    main_report_late_boxes(s);
     if (step % MAIN_TRUTH_EVERY == 0)
       for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(lcm, s, c, tlog);
 #ifdef SIM_HAVE_SENSORS

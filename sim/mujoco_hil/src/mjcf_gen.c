@@ -137,6 +137,19 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
   fprintf(f, "  </body>\n");
 }
 
+/* A --late-box obstacle: a mocap body (MuJoCo 2.2 cannot add bodies at run time) carrying a
+ * box with the world's collision bits and surface, coloured apart from the map's boxes. */
+static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
+  fprintf(f, "  <body name=\"scenario/late_box%d\" mocap=\"true\" pos=\"0 0 %g\">\n", k,
+          MG_PARKED_Z_M);
+  fprintf(f,
+          "   <geom name=\"scenario/late_box%d\" type=\"box\" size=\"%.6g %.6g %.6g\" "
+          "contype=\"1\" conaffinity=\"6\" friction=\"0.5 0.005 0.0001\" "
+          "rgba=\"0.15 0.35 0.85 1\"/>\n",
+          k, b->half_x_m, b->half_y_m, 0.5 * SCN_LATE_BOX_HEIGHT_M);
+  fprintf(f, "  </body>\n");
+}
+
 int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz) {
   FILE *f = fopen(out_path, "w");
@@ -161,6 +174,7 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
   if (o->tag_asset_xml) fprintf(f, " <asset>\n%s\n </asset>\n", o->tag_asset_xml);
   fprintf(f, " <worldbody>\n");
   for (int i = 1; i <= o->cars; i++) mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL);
+  for (int k = 0; k < o->late_boxes; k++) mg_late_box(f, k + 1, &o->late_box[k]);
   fprintf(f, " </worldbody>\n <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */
     fprintf(f,

@@ -5,12 +5,17 @@
  *   joints nigel<i>/steer_{fl,fr} (hinge z), nigel<i>/wheel_{fl,fr,rl,rr} (hinge y, + forward)
  *   sites nigel<i>/imu, nigel<i>/lidar, nigel<i>/tag_site; geom nigel<i>/tag (roof plate)
  *   cameras nigel<i>/cam_front, nigel<i>/cam_rear (fovy 48.67 deg = 62.2 deg HFOV at 4:3)
- * Collision bits: world contype 1 / conaffinity 6, tyres 2 / 1, chassis 4 / 5. */
+ * Late boxes k = 1..: mocap body and geom scenario/late_box<k>, parked at MG_PARKED_Z_M
+ * (below the floor, beyond every camera's far plane, out of every LIDAR's scan plane) until
+ * the sim moves them onto the floor; the body's origin is the box's centre.
+ * Collision bits: world contype 1 / conaffinity 6, tyres 2 / 1, chassis 4 / 5; late boxes as
+ * the world. */
 #ifndef SIM_MJCF_GEN_H
 #define SIM_MJCF_GEN_H
 
 #include <stddef.h>
 
+#include "scenario.h"
 #include "vparams.h"
 
 #ifdef __cplusplus
@@ -22,7 +27,11 @@ typedef struct mg_options {
   const char *map_path;     /* absolute path of the map MJCF */
   const char *tag_asset_xml;        /* NULL, or <texture>/<material> elements of the roof tags */
   const char *const *tag_geom_xml;  /* NULL, or per car the roof tag <geom> (NULL: plain plate) */
+  int late_boxes;                   /* 0..SCN_MAX_LATE_BOXES --late-box obstacles */
+  const scn_late_box_t *late_box;   /* their sizes (positions are set at run time) */
 } mg_options_t;
+
+#define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */
 
 /* Roof tag id of car i (1-based): tag36h11 id i. */
 int mg_tag_id(int car);

@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "clearance.h"
 #include "drive.h"
 #include "mjcf_gen.h"
 #include "ptylink.h"
@@ -32,6 +33,10 @@
 #define SIM_G_M_S2 9.80665
 #define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
 #define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
+#define SIM_SPAWN_Z_M 0.002      /* base_link starts this high and settles on its tyres */
+/* Parts of the map lower than this are driven over (terrain patches 1 mm, markings), not
+ * obstacles, when checking a start pose or a late box [m] */
+#define SIM_GROUND_CLEARANCE_M 0.005
 
 enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
 
@@ -100,6 +105,14 @@ struct sim {
   int tyre_paper;
   int *geom_tyre; /* per geom: car * W_N + wheel, or -1 */
   int ntag_files; /* roof tag PNGs that may exist in scene_dir */
+  int has_start;
+  scn_pose_t start;
+  int nbox;
+  scn_late_box_t box[SCN_MAX_LATE_BOXES];
+  int box_mocap[SCN_MAX_LATE_BOXES];     /* index into mocap_pos */
+  int box_placed[SCN_MAX_LATE_BOXES];    /* has appeared */
+  int box_new[SCN_MAX_LATE_BOXES];       /* appeared during the last step */
+  int box_car_below[SCN_MAX_LATE_BOXES]; /* car it landed on (1-based), 0: none */
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
@@ -198,11 +211,17 @@ static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   return 0;
 }
 
-/* Cars stand side by side to the right of the map's "spawn" site (or the origin). */
+/* Car 1 stands at --start, else at the map's "spawn" site (or the origin); the others side
+ * by side to its right. The model's qpos0 gets the same poses, so a reset (mj_resetData, the
+ * viewer's R) puts the cars back where they started. */
 static void sim_place_cars(sim_t *s) {
   double base[3] = {0, 0, 0}, yaw = 0.0;
   const int site = mj_name2id(s->m, mjOBJ_SITE, "spawn");
-  if (site >= 0) {
+  if (s->has_start) {
+    base[0] = s->start.x_m;
+    base[1] = s->start.y_m;
+    yaw = s->start.yaw_deg * (M_PI / 180.0);
+  } else if (site >= 0) {
     mju_copy3(base, s->m->site_pos + 3 * site);
     const mjtNum *q = s->m->site_quat + 4 * site;
     yaw = atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
@@ -212,11 +231,104 @@ static void sim_place_cars(sim_t *s) {
     const double off = -SIM_CAR_SPACING_M * i;
     qp[0] = base[0] - off * sin(yaw);
     qp[1] = base[1] + off * cos(yaw);
-    qp[2] = 0.002;
+    qp[2] = SIM_SPAWN_Z_M;
     qp[3] = cos(0.5 * yaw);
     qp[4] = qp[5] = 0.0;
     qp[6] = sin(0.5 * yaw);
+    mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
   }
+}
+
+/* The upright prism around car i's chassis and wheels at its current pose. */
+static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
+  const vp_params_t *p = &s->p;
+  const double *co = p->chassis_offset_m, *cs = p->chassis_size_m;
+  const double r = p->wheel_radius_m, wy = 0.5 * (p->track_m + p->wheel_width_m);
+  const double x0 = fmin(co[0] - 0.5 * cs[0], -r), x1 = fmax(co[0] + 0.5 * cs[0], p->wheelbase_m + r);
+  const double y0 = fmin(co[1] - 0.5 * cs[1], -wy), y1 = fmax(co[1] + 0.5 * cs[1], wy);
+  const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+  const double yaw = atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1); /* in the car's frame */
+  out->centre_m[0] = qp[0] + cos(yaw) * cx - sin(yaw) * cy;
+  out->centre_m[1] = qp[1] + sin(yaw) * cx + cos(yaw) * cy;
+  out->yaw_rad = yaw;
+  out->half_m[0] = 0.5 * (x1 - x0);
+  out->half_m[1] = 0.5 * (y1 - y0);
+  out->z_lo_m = SIM_GROUND_CLEARANCE_M;
+  out->z_hi_m = qp[2] + co[2] + 0.5 * cs[2];
+}
+
+static void sim_box_prism(const scn_late_box_t *b, cl_prism_t *out) {
+  out->centre_m[0] = b->x_m;
+  out->centre_m[1] = b->y_m;
+  out->yaw_rad = 0.0;
+  out->half_m[0] = b->half_x_m;
+  out->half_m[1] = b->half_y_m;
+  out->z_lo_m = SIM_GROUND_CLEARANCE_M;
+  out->z_hi_m = SCN_LATE_BOX_HEIGHT_M;
+}
+
+int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
+  const mjModel *m = s->m;
+  const int ct = m->geom_contype[s->car[0].chassis_geom], ca = m->geom_conaffinity[s->car[0].chassis_geom];
+  char why[512];
+  cl_prism_t pr;
+  for (int i = 0; s->has_start && i < s->ncars; i++) {
+    sim_car_prism(s, i, &pr);
+    if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
+    const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+    char who[96] = "";
+    if (i > 0)
+      snprintf(who, sizeof who, " (%.2f m to the right of NIGEL1 with --cars %d)",
+               SIM_CAR_SPACING_M * i, s->ncars);
+    snprintf(err, err_sz, "--start '%g,%g,%g': NIGEL%d%s at x %.3f, y %.3f m %s", s->start.x_m,
+             s->start.y_m, s->start.yaw_deg, i + 1, who, qp[0], qp[1], why);
+    return -1;
+  }
+  for (int k = 0; k < s->nbox; k++) {
+    const scn_late_box_t *b = &s->box[k];
+    sim_box_prism(b, &pr);
+    if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
+    snprintf(err, err_sz, "--late-box '%g,%g,%g,%g,%g': the box %s", b->x_m, b->y_m, b->t_s,
+             b->half_x_m, b->half_y_m, why);
+    return -1;
+  }
+  return 0;
+}
+
+/* Moves the late boxes that are due onto the floor (again after a reset). */
+static void sim_place_late_boxes(sim_t *s) {
+  for (int k = 0; k < s->nbox; k++) {
+    s->box_new[k] = 0;
+    const scn_late_box_t *b = &s->box[k];
+    if (s->time_us < (int64_t)llround(b->t_s * 1e6)) continue;
+    mjtNum *pos = s->d->mocap_pos + 3 * s->box_mocap[k];
+    pos[0] = b->x_m;
+    pos[1] = b->y_m;
+    pos[2] = 0.5 * SCN_LATE_BOX_HEIGHT_M;
+    if (s->box_placed[k]) continue;
+    s->box_placed[k] = s->box_new[k] = 1;
+    cl_prism_t bp, cp;
+    sim_box_prism(b, &bp);
+    for (int i = 0; i < s->ncars && !s->box_car_below[k]; i++) {
+      sim_car_prism(s, i, &cp);
+      if (cl_prisms_overlap(&bp, &cp)) s->box_car_below[k] = i + 1;
+    }
+  }
+}
+
+static int sim_bind_late_boxes(sim_t *s, char *err, size_t err_sz) {
+  for (int k = 0; k < s->nbox; k++) {
+    char name[48];
+    snprintf(name, sizeof name, "scenario/late_box%d", k + 1);
+    const int b = mj_name2id(s->m, mjOBJ_BODY, name);
+    if (b < 0 || s->m->body_mocapid[b] < 0) {
+      snprintf(err, err_sz, "generated model lacks mocap body '%s'", name);
+      return -1;
+    }
+    s->box_mocap[k] = s->m->body_mocapid[b];
+  }
+  return 0;
 }
 
 /* ---- setup --------------------------------------------------------------------------- */
@@ -260,7 +372,7 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
 #endif
 
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
-  mg_options_t o = {cfg->cars, NULL, NULL, NULL};
+  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box};
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
@@ -350,6 +462,13 @@ int sim_lidar_pty_scanning(const sim_t *s, int car) {
 #endif
 }
 
+int sim_late_boxes(const sim_t *s) { return s->nbox; }
+const scn_late_box_t *sim_late_box(const sim_t *s, int k) { return &s->box[k]; }
+int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
+  if (car_below) *car_below = s->box_car_below[k];
+  return s->box_new[k];
+}
+
 int sim_has_sensors(void) {
 #ifdef SIM_HAVE_SENSORS
   return 1;
@@ -363,8 +482,19 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     snprintf(err, err_sz, "--cars %d: must be 1..%d", cfg->cars, SIM_MAX_CARS);
     return NULL;
   }
+  if (cfg->late_boxes < 0 || cfg->late_boxes > SCN_MAX_LATE_BOXES) {
+    snprintf(err, err_sz, "--late-box: at most %d boxes (got %d)", SCN_MAX_LATE_BOXES,
+             cfg->late_boxes);
+    return NULL;
+  }
   sim_t *s = calloc(1, sizeof *s);
   if (!s) return NULL;
+  if (cfg->start) {
+    s->has_start = 1;
+    s->start = *cfg->start;
+  }
+  s->nbox = cfg->late_boxes;
+  for (int k = 0; k < s->nbox; k++) s->box[k] = cfg->late_box[k];
   if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
   if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
   s->tyre_paper = s->p.tyre_model_paper;
@@ -398,6 +528,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     s->car[i].index = i + 1;
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
   }
+  if (sim_bind_late_boxes(s, err, err_sz) != 0) goto fail;
   sim_place_cars(s);
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
@@ -588,6 +719,7 @@ static void sim_record_contacts(sim_t *s) {
 }
 
 int sim_step(sim_t *s, char *err, size_t err_sz) {
+  sim_place_late_boxes(s); /* before mj_step1: its kinematics, contacts and rays see them */
   mj_step1(s->m, s->d);
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
@@ -605,10 +737,12 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
     c->lidar_new = 0;
     if (!c->lidar) continue;
     /* mj_step2 leaves kinematics at the start of the step: fine for 1 ms ray timing */
-    if (sim_lidar_update(s->m, s->d, c->lidar, s->time_us)) {
-      c->lidar_new = 1;
-      const sim_lidar_scan_t *sc = sim_lidar_last_scan(c->lidar);
-      if (c->rplidar) sim_rplidar_push_scan(c->rplidar, sc->ranges_m, sc->intensities, sc->num_rays);
+    if (sim_lidar_update(s->m, s->d, c->lidar, s->time_us)) c->lidar_new = 1;
+    if (c->rplidar) { /* stream the rays just measured, as the real device does */
+      int from, to, num_rays;
+      const float *ranges_m, *quality;
+      sim_lidar_last_cast(c->lidar, &from, &to, &num_rays, &ranges_m, &quality);
+      sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
     if (c->rplidar && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0) return -1;
   }

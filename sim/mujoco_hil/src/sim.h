@@ -11,6 +11,7 @@
 #include <mujoco/mujoco.h>
 
 #include "nigel_core.h"
+#include "scenario.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -29,6 +30,9 @@ typedef struct sim_config {
   const char *script;      /* NULL, or the scripted driver spec for every car (script.h) */
   int lidar;               /* 1: simulate the LIDAR (when the sensors library is built) */
   int tyre_model;          /* -1: as the parameter file says, 0: MuJoCo friction, 1: paper */
+  const scn_pose_t *start; /* NULL: car 1 at the map's "spawn" site; else at this pose */
+  int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run */
+  const scn_late_box_t *late_box;
 } sim_config_t;
 
 typedef struct sim sim_t;
@@ -46,6 +50,12 @@ typedef struct sim_truth {
 
 /* Builds the world. Returns NULL with a message naming the bad input in err. */
 sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz);
+/* Checks the scenario options against the map: with a start pose, every car's footprint
+ * (car 1 there, the others beside it as usual) must be on the floor and clear of walls and
+ * static obstacles; every late box likewise. Returns 0, or -1 with a message that starts with
+ * the option (--start, --late-box) and says what is in the way. The program refuses to run a
+ * scenario that fails it (exit 2); without these options it checks nothing. */
+int sim_check_scenario(const sim_t *s, char *err, size_t err_sz);
 /* Closes ptys, removes symlinks and the generated scene. NULL is fine. */
 void sim_destroy(sim_t *s);
 
@@ -74,6 +84,12 @@ struct sim_lidar_scan;
 const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car);
 /* 1 while a client (the runtime's RPLIDAR driver) is scanning on car's emulated RPLIDAR pty. */
 int sim_lidar_pty_scanning(const sim_t *s, int car);
+/* Late boxes (k 0-based): the count, and 1 when box k appeared on the floor during the last
+ * sim_step; then *car_below (if non-NULL) is the first car (1-based) whose footprint it
+ * landed on, or 0. A box stays on the floor once it has appeared (also after a reset). */
+int sim_late_boxes(const sim_t *s);
+const scn_late_box_t *sim_late_box(const sim_t *s, int k);
+int sim_late_box_appeared(const sim_t *s, int k, int *car_below);
 /* 1 when built with the sensors library. */
 int sim_has_sensors(void);
 
