@@ -33,6 +33,13 @@ def parse_args():
                    help="parking (default): map, localise, plan and park autonomously; loop: "
                    "drive a stadium track with pure pursuit on the EKF")
     p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
+    p.add_argument("--start", metavar="X,Y,YAW_DEG",
+                   help="parking: the car's start pose in the world [m, m, deg] (default: the "
+                   "map's spawn moved by up to 5 cm and 5 deg, drawn from --seed; seed 0: exactly "
+                   "the spawn)")
+    p.add_argument("--late-box", metavar="X,Y,T", action="append", default=[],
+                   help="parking: a box the map does not have appears at world (X, Y) [m] at sim "
+                   "time T [s] (after mapping, ~3 s); repeatable. The car must replan around it")
     p.add_argument("--timeout", type=float, default=240.0,
                    help="parking: give up after this many wall seconds")
     p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
@@ -98,6 +105,11 @@ def main():
         if not (build / "bin" / prog).exists():
             sys.exit(f"[demo] ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
     rtf = 1.0 if args.realtime else args.rtf
+    import demo_parking  # noqa: E402  (tools/demo_parking.py)
+    try:
+        start = demo_parking.start_pose(args.start, args.seed)
+    except ValueError as e:
+        sys.exit(f"[demo] ERROR: --start {args.start}: {e}")
     sys.path.insert(0, str(build / "lcm_types" / "gen" / "python"))
     import yaml  # noqa: E402
 
@@ -112,7 +124,6 @@ def main():
     cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
 
     import demo_driver  # noqa: E402  (tools/demo_driver.py)
-    import demo_parking  # noqa: E402  (tools/demo_parking.py)
     procs = Procs()
     interrupted = False
 
@@ -134,6 +145,9 @@ def main():
                     else args.timeout * max(rtf, 1.0) + 30.0]
         if args.mission == "parking":
             sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
+            sim_argv += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
+            for box in args.late_box:
+                sim_argv += ["--late-box", box]
         sim_argv += ["--rtf", rtf]  # also at 1: the sim then publishes SIM_CLOCK
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim_argv += ["--view"]  # a window when a display exists; headless otherwise
@@ -145,7 +159,7 @@ def main():
             result = demo_driver.drive(args.lcm_url, "NIGEL1", args.duration, rtf, procs,
                                        lambda: interrupted)
         else:
-            result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed,
+            result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed, start,
                                       args.timeout, procs, lambda: interrupted)
     except RuntimeError as e:
         log(f"ERROR: {e}")

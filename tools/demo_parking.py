@@ -26,6 +26,28 @@ def spawn_pose(map_xml):
     return float(m.group(1)), float(m.group(2)), math.radians(float(m.group(3)))
 
 
+def start_pose(text, seed):
+    """World start pose [m, m, rad]: --start X,Y,YAW_DEG, or the spawn moved by the seed."""
+    if text:
+        parts = text.split(",")
+        if len(parts) != 3:
+            raise ValueError("expected X,Y,YAW_DEG, e.g. -1.0,0.6,0")
+        try:
+            x, y, yaw_deg = (float(v) for v in parts)
+        except ValueError:
+            raise ValueError("X, Y and YAW_DEG must be numbers") from None
+        if not all(map(math.isfinite, (x, y, yaw_deg))):
+            raise ValueError("X, Y and YAW_DEG must be finite")
+        return x, y, math.radians(yaw_deg)
+    x, y, yaw = spawn_pose(ROOT / "sim/mujoco_hil/maps/parking_school.xml")
+    if seed == 0:
+        return x, y, yaw
+    import random
+    rng = random.Random(seed)  # the same seed, the same scenario
+    return (x + rng.uniform(-0.05, 0.05), y + rng.uniform(-0.05, 0.05),
+            yaw + math.radians(rng.uniform(-5.0, 5.0)))
+
+
 def slot_goal_world(slot):
     if not 0 <= slot < SLOTS:
         raise RuntimeError(f"--slot {slot}: Parking School has slots 0..{SLOTS - 1}")
@@ -62,13 +84,13 @@ def write_config(example, out_dir, url, goal_local, seed):
     return path
 
 
-def run(build, out_dir, url, slot, seed, timeout_s, procs, stop_requested):
-    map_xml = ROOT / "sim/mujoco_hil/maps/parking_school.xml"
-    start = spawn_pose(map_xml)
+def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested):
     goal_w = slot_goal_world(slot)
     goal_l = to_frame(start, goal_w)
     cfg = write_config(ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml", out_dir,
                        url, goal_l, seed)
+    print(f"[demo] start at world ({start[0]:.3f}, {start[1]:.3f}, {math.degrees(start[2]):.1f} deg)",
+          flush=True)
     print(f"[demo] mission: park in slot {slot} at world ({goal_w[0]:.3f}, {goal_w[1]:.3f}, "
           f"{math.degrees(goal_w[2]):.0f} deg)", flush=True)
     proc = procs.start("autodrive-autonomy", [build / "bin" / "autodrive-autonomy", "--config", cfg],
@@ -99,15 +121,15 @@ def score(log_path, out_dir, veh, mission):
     import lcm
     from autodrive import ground_truth_t, pose2d_t
     start, goal_w = mission["start_world"], mission["goal_world"]
-    gt, gt_rx, amcl = [], [], []
+    gt, gt_t, amcl = [], [], []
     for ev in lcm.EventLog(str(log_path), "r"):
         if ev.channel == f"{veh}_GROUND_TRUTH":
             m = ground_truth_t.decode(ev.data)
             gt.append((m.position_m[0], m.position_m[1], m.yaw_rad))
-            gt_rx.append(ev.timestamp)
+            gt_t.append(m.utime)
         elif ev.channel == f"{veh}_POSE_AMCL":
             m = pose2d_t.decode(ev.data)
-            amcl.append((ev.timestamp, m.x_m, m.y_m, m.yaw_rad))
+            amcl.append((m.utime, m.x_m, m.y_m, m.yaw_rad))
     rep = {}
     if not gt:
         return {"error": "no ground truth in the log"}
@@ -116,10 +138,12 @@ def score(log_path, out_dir, veh, mission):
     rep["final_pos_error_m"] = round(math.hypot(final[0] - goal_w[0], final[1] - goal_w[1]), 4)
     rep["final_heading_error_deg"] = round(abs(math.degrees(_wrap(final[2] - goal_w[2]))), 3)
     rep["min_clearance_m"] = round(min_clearance(gt), 4)
+    # Each estimate against the truth at its own stamp (the scan's mid-time; both are sim time
+    # [us], the runtime runs on SIM_CLOCK), not at its arrival: the arrival lags by the scan.
     import bisect
     errs = []
     for t, x, y, yaw in amcl:
-        i = min(bisect.bisect_left(gt_rx, t), len(gt) - 1)
+        i = min(bisect.bisect_left(gt_t, t), len(gt) - 1)
         w = to_world(start, (x, y, yaw))
         errs.append(math.hypot(w[0] - gt[i][0], w[1] - gt[i][1]))
     rep["localization_rms_m"] = round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
