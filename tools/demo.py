@@ -14,6 +14,9 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+# The default scenario's unmapped box [m, m, s]: it appears after the map is saved, while the
+# car localises, on the direct way to slot 2.
+DEFAULT_LATE_BOX = "-0.62,0.76,3.5"
 
 
 def log(msg):
@@ -39,7 +42,11 @@ def parse_args():
                    "the spawn)")
     p.add_argument("--late-box", metavar="X,Y,T", action="append", default=[],
                    help="parking: a box the map does not have appears at world (X, Y) [m] at sim "
-                   "time T [s] (after mapping, ~3 s); repeatable. The car must replan around it")
+                   "time T [s]; repeatable; replaces the default box. Write --late-box=-0.6,... "
+                   f"for negative X. Default: {DEFAULT_LATE_BOX} (on the direct way to slot 2, "
+                   "after mapping): the car must see it and replan around it")
+    p.add_argument("--no-late-box", action="store_true",
+                   help="parking: no box appears (the lot is as mapped)")
     p.add_argument("--timeout", type=float, default=240.0,
                    help="parking: give up after this many wall seconds")
     p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
@@ -146,6 +153,10 @@ def main():
         if args.mission == "parking":
             sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
             sim_argv += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
+            if not args.late_box and not args.no_late_box:
+                args.late_box = [DEFAULT_LATE_BOX]
+            if args.no_late_box:
+                args.late_box = []
             for box in args.late_box:
                 sim_argv += ["--late-box", box]
         sim_argv += ["--rtf", rtf]  # also at 1: the sim then publishes SIM_CLOCK
@@ -160,7 +171,8 @@ def main():
                                        lambda: interrupted)
         else:
             result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed, start,
-                                      args.timeout, procs, lambda: interrupted)
+                                      args.timeout, procs, lambda: interrupted,
+                                      demo_parking.late_boxes(args.late_box))
     except RuntimeError as e:
         log(f"ERROR: {e}")
         result = {"error": str(e)}

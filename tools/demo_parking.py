@@ -84,7 +84,17 @@ def write_config(example, out_dir, url, goal_local, seed):
     return path
 
 
-def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested):
+def late_boxes(specs):
+    """--late-box X,Y,T[,SX,SY] values as (x, y, t, half_x, half_y) [m, m, s, m, m]; the
+    simulator validates them and exits 2 on a bad one."""
+    out = []
+    for spec in specs:
+        v = [float(f) for f in spec.split(",")]
+        out.append((v[0], v[1], v[2], v[3] if len(v) > 3 else 0.06, v[4] if len(v) > 4 else 0.06))
+    return out
+
+
+def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested, boxes=()):
     goal_w = slot_goal_world(slot)
     goal_l = to_frame(start, goal_w)
     cfg = write_config(ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml", out_dir,
@@ -113,7 +123,8 @@ def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested
     for ln in (out_dir / "autonomy.log").read_text().splitlines()[seen:]:
         print(ln, flush=True)
     return {"mission_exit_code": proc.returncode, "slot": slot,
-            "start_world": list(start), "goal_world": list(goal_w)}
+            "start_world": list(start), "goal_world": list(goal_w),
+            "late_boxes_world": [list(b) for b in boxes]}
 
 
 def score(log_path, out_dir, veh, mission):
@@ -137,7 +148,8 @@ def score(log_path, out_dir, veh, mission):
     rep["success"] = mission.get("mission_exit_code") == 0
     rep["final_pos_error_m"] = round(math.hypot(final[0] - goal_w[0], final[1] - goal_w[1]), 4)
     rep["final_heading_error_deg"] = round(abs(math.degrees(_wrap(final[2] - goal_w[2]))), 3)
-    rep["min_clearance_m"] = round(min_clearance(gt), 4)
+    boxes = mission.get("late_boxes_world", [])
+    rep["min_clearance_m"] = round(min_clearance(gt, extra=[(b[0], b[1], b[3], b[4], 0.0) for b in boxes]), 4)
     # Each estimate against the truth at its own stamp (the scan's mid-time; both are sim time
     # [us], the runtime runs on SIM_CLOCK), not at its arrival: the arrival lags by the scan.
     import bisect
@@ -157,6 +169,9 @@ def score(log_path, out_dir, veh, mission):
     argv = [str(ROOT / "tools/plot-parking"), "--map", str(out_dir / "map.yaml"),
             "--truth", str(out_dir / "gt.csv"), "--goal", ",".join(f"{v:.4f}" for v in goal_l),
             "--out", str(out_dir / "parking.png")]
+    for b in boxes:
+        p = to_frame(start, (b[0], b[1], 0.0))
+        argv += ["--box", f"{p[0]:.4f},{p[1]:.4f},{p[2]:.4f},{b[3]:.4f},{b[4]:.4f}"]
     for name in ("path", "route", "trajectory"):
         if (auto / f"{name}.csv").exists():
             argv += [f"--{name}", str(auto / f"{name}.csv")]
@@ -203,9 +218,10 @@ def _poly_dist(pa, pb):
     return d  # overlapping rectangles are caught by the collision flag instead
 
 
-def min_clearance(gt, length_m=0.19, width_m=0.13, centre_ahead_m=CENTRE_AHEAD_M):
-    """Smallest gap [m] between the car's body rectangle and any obstacle over the run."""
-    obs = [_corners(*o) for o in _obstacles()]
+def min_clearance(gt, length_m=0.19, width_m=0.13, centre_ahead_m=CENTRE_AHEAD_M, extra=()):
+    """Smallest gap [m] between the car's body rectangle and any obstacle over the run (the
+    map's and the extra (x, y, half_x, half_y, yaw) boxes; a late box counts all run long)."""
+    obs = [_corners(*o) for o in list(_obstacles()) + list(extra)]
     best = float("inf")
     for x, y, yaw in gt[::10]:
         car = _corners(x + centre_ahead_m * math.cos(yaw), y + centre_ahead_m * math.sin(yaw),
