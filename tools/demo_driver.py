@@ -65,7 +65,7 @@ def drive(url, veh, duration_s, rtf, procs, stop_requested):
     seq = 0
     laps = 0
     print(f"[demo] driving the stadium track for {duration_s:.0f} s of sim time "
-          f"(rtf {rtf:g}) ...", flush=True)
+          f"({'lockstep' if rtf is None else f'rtf {rtf:g}'}) ...", flush=True)
     t_start = time.time()
     next_cmd = t_start
     last_print = t_start

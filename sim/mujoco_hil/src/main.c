@@ -48,6 +48,9 @@ static void main_usage(FILE *f) {
           "                      place after it was mapped. Up to %d; LIDAR, cameras and the\n"
           "                      collision flag see it once it is there\n"
           "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
+          "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
+          "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
+          "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
           "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
           "                      (default: real time, 1 sim second per wall second)\n"
           "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
@@ -86,6 +89,38 @@ static double main_wall_s(void) { return main_clock_s(CLOCK_MONOTONIC); }
 /* CPU time of this process [s]: on a shared, loaded machine it shows the cost without the
  * time spent waiting for a core */
 static double main_cpu_s(void) { return main_clock_s(CLOCK_PROCESS_CPUTIME_ID); }
+
+/* --lockstep-client: the sim never runs more than MAIN_SYNC_HORIZON_US of sim time past the
+ * last bytes a client wrote on a car's Nano pty. The runtime's bridge writes a COMMAND frame
+ * every 20 ms of its clock, which is SIM_CLOCK: so the sim goes as fast as the runtime keeps
+ * up, and the emulated Nano never sees a gap the runtime did not make (its failsafe is 100 ms). */
+#define MAIN_SYNC_HORIZON_US 40000
+#define MAIN_SYNC_LOST_S 2.0 /* [s] wall without bytes: the client is gone; stop waiting for it */
+typedef struct {
+  int started;                         /* a client has written at least once */
+  int64_t lost_rx_us[SIM_MAX_CARS + 1]; /* host_rx of a client given up on (0: none) */
+} main_sync_t;
+
+static void main_sync_wait(sim_t *s, main_sync_t *st) {
+  const int64_t now_us = sim_time_us(s);
+  for (int c = 1; c <= sim_cars(s); c++) {
+    const int64_t rx_us = sim_host_rx_us(s, c);
+    if (rx_us < 0) continue; /* no client yet on this car */
+    st->started = 1;
+    if (st->lost_rx_us[c] == rx_us + 1 || now_us - rx_us < MAIN_SYNC_HORIZON_US) continue;
+    const double t_give_up = main_wall_s() + MAIN_SYNC_LOST_S;
+    while (!main_stop && !sim_nano_wait_input(s, c, 50)) {
+      if (main_wall_s() > t_give_up) {
+        fprintf(stderr, "[autodrive-sim] NIGEL%d: no bytes from the client for %.1f s (wall): "
+                "running on without it\n", c, MAIN_SYNC_LOST_S);
+        st->lost_rx_us[c] = rx_us + 1;
+        break;
+      }
+      struct timespec ts = {0, 1000000}; /* a hung-up pty polls ready at once: 1 ms pause */
+      nanosleep(&ts, NULL);
+    }
+  }
+}
 
 static int main_number(const char *opt, const char *v, double lo, double hi, double *out) {
   char *end;
@@ -272,7 +307,8 @@ int main(int argc, char **argv) {
   cfg.lidar = 1;
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
-  int lockstep = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1, view = 0;
+  int lockstep = 0, client_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1,
+      view = 0;
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -321,6 +357,8 @@ int main(int argc, char **argv) {
       i++;
     } else if (!strcmp(a, "--lockstep")) {
       lockstep = 1;
+    } else if (!strcmp(a, "--lockstep-client")) {
+      lockstep = client_sync = 1;
     } else if (!strcmp(a, "--rtf")) {
       if (main_number(a, v, 0.01, 1e6, &rtf)) return 2;
       rtf_given = 1;
@@ -373,7 +411,12 @@ int main(int argc, char **argv) {
     }
   }
   if (lockstep && rtf_given) {
-    fprintf(stderr, "autodrive-sim: --lockstep and --rtf exclude each other\n");
+    fprintf(stderr, "autodrive-sim: --lockstep%s and --rtf exclude each other\n",
+            client_sync ? "-client" : "");
+    return 2;
+  }
+  if (client_sync && !cfg.open_ptys) {
+    fprintf(stderr, "autodrive-sim: --lockstep-client needs the ptys (drop --no-pty)\n");
     return 2;
   }
 
@@ -435,7 +478,7 @@ int main(int argc, char **argv) {
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
   }
   printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
-         lockstep ? "lockstep" : (rtf_given ? "rtf" : "real time"), url);
+         client_sync ? "lockstep with the client" : lockstep ? "lockstep" : (rtf_given ? "rtf" : "real time"), url);
   if (cfg.start)
     printf("NIGEL1 start (--start): x %.3f, y %.3f m, yaw %.1f deg\n", start.x_m, start.y_m,
            start.yaw_deg);
@@ -448,7 +491,9 @@ int main(int argc, char **argv) {
   int64_t last_progress_us = 0;
   int rc = 0;
   long step = 0, slips = 0;
+  main_sync_t sync = {0};
   while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
+    if (client_sync) main_sync_wait(s, &sync);
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
@@ -484,7 +529,8 @@ int main(int argc, char **argv) {
     if (viewer.v && main_view_frame(&viewer, s, &t0) != 0) break;
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
-    if (!lockstep) {
+    /* --lockstep-client runs in real time until a client first writes, then in step with it */
+    if (!lockstep || (client_sync && !sync.started)) {
       const double ahead = t0 + now_us * 1e-6 / rtf - wall;
       if (ahead < -MAIN_MAX_LAG_S) {
         /* Behind (a slow frame, the window, a loaded CPU): slip the schedule rather than burst

@@ -81,6 +81,7 @@ typedef struct sim_car {
   uart_queue_t rx, tx;
   ptylink_t pty;
   int has_pty, has_script;
+  int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
   script_t script;
   rng_t rng;
   double accel_bias[3], gyro_bias[3];
@@ -422,6 +423,7 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
     snprintf(link, sizeof link, "%s/nigel%d-nano", cfg->run_dir, c->index);
     if (ptylink_open(&c->pty, link, err, err_sz) != 0) return -1;
     c->has_pty = 1;
+    c->host_rx_us = -1;
   }
 #ifdef SIM_HAVE_SENSORS
   if (cfg->lidar) {
@@ -572,6 +574,7 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
     const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
     const size_t n = ptylink_read(&c->pty, buf, room);
     uart_push(&c->rx, buf, n);
+    if (n > 0) c->host_rx_us = s->time_us;
   }
   if (c->has_script) {
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
@@ -764,6 +767,11 @@ const char *sim_nano_link(const sim_t *s, int car) {
 }
 const char *sim_lidar_link(const sim_t *s, int car) { return s->car[car - 1].lidar_link; }
 const nigel_t *sim_nano(const sim_t *s, int car) { return &s->car[car - 1].nano; }
+
+int64_t sim_host_rx_us(const sim_t *s, int car) {
+  const sim_car_t *c = &s->car[car - 1];
+  return c->has_pty ? c->host_rx_us : -1;
+}
 
 int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms) {
   const sim_car_t *c = &s->car[car - 1];

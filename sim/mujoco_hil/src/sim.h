@@ -74,6 +74,9 @@ const char *sim_lidar_link(const sim_t *s, int car);
  * readable by the sim (the kernel moves pty data asynchronously). 1 if ready, 0 if not. For
  * tests that write and then step a fixed sim time. */
 int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms);
+/* Sim time at which the client on car's Nano pty last wrote bytes [us]; -1 before the first
+ * (or without a pty). --lockstep-client paces the sim by it. */
+int64_t sim_host_rx_us(const sim_t *s, int car);
 /* The emulated Nano's firmware state (read-only use, for tests). */
 const nigel_t *sim_nano(const sim_t *s, int car);
 /* Last motor outputs the firmware set through the HAL. */
