@@ -121,12 +121,16 @@ class App {
     lcm_.publish(cfg_.vehicle + "_MISSION", &m);
   }
 
+  // path.csv keeps every plan of the run (column plan = 1, 2, ...: replans and retries), so a
+  // plot shows the path the car gave up as well as the one it finished on.
   void write_plan() {
-    std::ofstream p(std::filesystem::path(cfg_.out_dir) / "path.csv");
-    p << "x_m,y_m,yaw_rad,direction,curvature_1pm\n";
+    const bool first = node_.plans() <= 1;
+    std::ofstream p(std::filesystem::path(cfg_.out_dir) / "path.csv",
+                    first ? std::ios::trunc : std::ios::app);
+    if (first) p << "x_m,y_m,yaw_rad,direction,curvature_1pm,plan\n";
     for (const auto &q : node_.path())
       p << q.pose.x_m << "," << q.pose.y_m << "," << q.pose.yaw_rad << "," << q.direction << ","
-        << q.curvature_1pm << "\n";
+        << q.curvature_1pm << "," << node_.plans() << "\n";
     std::ofstream r(std::filesystem::path(cfg_.out_dir) / "route.csv");
     r << "x_m,y_m\n";
     for (const auto &q : node_.route_m()) r << q.x() << "," << q.y() << "\n";
