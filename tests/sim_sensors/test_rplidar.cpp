@@ -75,6 +75,20 @@ struct Device {
 
 const std::vector<uint8_t> kScanDescriptor = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
 
+// A device asked to SCAN by its client; ranges[i] = 1 + 0.01 i m, so a node's distance says
+// which ray it carries.
+struct ScanSession {
+  Device dev;
+  Client c{dev.link};
+  std::vector<uint8_t> rx;
+  std::vector<float> ranges = std::vector<float>(360);
+  ScanSession() {
+    for (int i = 0; i < 360; i++) ranges[i] = 1.0f + i * 0.01f;
+    c.send({0xA5, 0x20});
+    dev.run_ms(1, c, rx);
+  }
+};
+
 }  // namespace
 
 TEST(SimRplidar, SymlinkPointsAtPty) {
@@ -175,17 +189,12 @@ TEST(SimRplidar, ScanNodesDecodeToTheLidarScanAndStop) {
 // At 7 Hz the 115200-baud wire cannot carry 360 nodes per revolution: the device sends fewer,
 // evenly spread (like the real A1's fixed sample rate), never dropping a block of angles.
 TEST(SimRplidar, SevenHertzScansAreThinnedEvenlyNotCut) {
-  Device dev;
-  ASSERT_NE(dev.r, nullptr);
-  Client c(dev.link);
-  std::vector<uint8_t> rx;
-  std::vector<float> ranges(360);
-  for (int i = 0; i < 360; i++) ranges[i] = 1.0f + i * 0.01f;  // the range encodes the ray
-  c.send({0xA5, 0x20});
-  dev.run_ms(1, c, rx);
+  ScanSession ss;
+  ASSERT_NE(ss.dev.r, nullptr);
+  std::vector<uint8_t> &rx = ss.rx;
   for (int rev = 0; rev < 21; rev++) {  // 3 s at 7 Hz, one scan pushed per revolution
-    sim_rplidar_push_scan(dev.r, ranges.data(), nullptr, 360);
-    dev.run_ms(rev % 7 == 6 ? 142 : 143, c, rx);  // 1/7 s in whole ms
+    sim_rplidar_push_scan(ss.dev.r, ss.ranges.data(), nullptr, 360);
+    ss.dev.run_ms(rev % 7 == 6 ? 142 : 143, ss.c, rx);  // 1/7 s in whole ms
   }
   ASSERT_GT(rx.size(), 7u);
   EXPECT_EQ(std::vector<uint8_t>(rx.begin(), rx.begin() + 7), kScanDescriptor);
@@ -214,7 +223,7 @@ TEST(SimRplidar, SevenHertzScansAreThinnedEvenlyNotCut) {
   }
   EXPECT_LE(max_gap_rays, 2);  // evenly thinned: never more than one ray skipped in a row
   sim_rplidar_stats_t st;
-  sim_rplidar_get_stats(dev.r, &st);
+  sim_rplidar_get_stats(ss.dev.r, &st);
   EXPECT_EQ(st.nodes_dropped, 0u);
 }
 
@@ -311,14 +320,9 @@ TEST(SimRplidar, RefusesToReplaceARegularFile) {
 // reaches the client a few ms after it is measured, not one revolution (143 ms) later, and
 // the thinning is the same as for whole-revolution pushes.
 TEST(SimRplidar, StreamedRaysArriveWhileTheHeadSpins) {
-  Device dev;
-  ASSERT_NE(dev.r, nullptr);
-  Client c(dev.link);
-  std::vector<uint8_t> rx;
-  std::vector<float> ranges(360);
-  for (int i = 0; i < 360; i++) ranges[i] = 1.0f + i * 0.01f;  // the range encodes the ray
-  c.send({0xA5, 0x20});
-  dev.run_ms(1, c, rx);
+  ScanSession ss;
+  ASSERT_NE(ss.dev.r, nullptr);
+  std::vector<uint8_t> &rx = ss.rx;
   std::vector<int64_t> start_pushed_ms, start_seen_ms;
   size_t parsed = 7;  // after the descriptor
   int next_ray = 0;
@@ -328,9 +332,9 @@ TEST(SimRplidar, StreamedRaysArriveWhileTheHeadSpins) {
       next_ray = 0;
       start_pushed_ms.push_back(ms);
     }
-    sim_rplidar_push_rays(dev.r, ranges.data(), nullptr, next_ray, due, 360);
+    sim_rplidar_push_rays(ss.dev.r, ss.ranges.data(), nullptr, next_ray, due, 360);
     next_ray = std::max(next_ray, due);
-    dev.run_ms(1, c, rx);
+    ss.dev.run_ms(1, ss.c, rx);
     for (; parsed + 5 <= rx.size(); parsed += 5)
       if (rx[parsed] & 1) start_seen_ms.push_back(ms);
   }
