@@ -31,7 +31,8 @@ def parse_args():
         "out/demo/{report.json,*.png,run.lcmlog}.")
     p.add_argument("--build", default=str(ROOT / "build" / "release"), help="host build dir")
     p.add_argument("--out", default=str(ROOT / "out" / "demo"), help="output folder")
-    p.add_argument("--seed", type=int, default=1, help="scenario seed (sim noise, biases)")
+    p.add_argument("--seed", type=int, default=1,
+                   help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start)")
     p.add_argument("--mission", choices=("parking", "loop"), default="parking",
                    help="parking (default): map, localise, plan and park autonomously; loop: "
                    "drive a stadium track with pure pursuit on the EKF")
