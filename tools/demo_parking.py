@@ -130,9 +130,10 @@ def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested
 def score(log_path, out_dir, veh, mission):
     """Parking figures against ground truth; writes gt.csv (in the autonomy frame) and plots."""
     import lcm
-    from autodrive import ground_truth_t, pose2d_t
+    from autodrive import ground_truth_t, odometry_t, pose2d_t
     start, goal_w = mission["start_world"], mission["goal_world"]
     gt, gt_t, amcl = [], [], []
+    odom = {"laser_odom": [], "ekf_odom": []}
     for ev in lcm.EventLog(str(log_path), "r"):
         if ev.channel == f"{veh}_GROUND_TRUTH":
             m = ground_truth_t.decode(ev.data)
@@ -141,6 +142,10 @@ def score(log_path, out_dir, veh, mission):
         elif ev.channel == f"{veh}_POSE_AMCL":
             m = pose2d_t.decode(ev.data)
             amcl.append((m.utime, m.x_m, m.y_m, m.yaw_rad))
+        elif ev.channel in (f"{veh}_LASER_ODOM", f"{veh}_ODOM"):
+            m = odometry_t.decode(ev.data)
+            odom["laser_odom" if ev.channel.endswith("LASER_ODOM") else "ekf_odom"].append(
+                (m.utime, m.x_m, m.y_m, m.yaw_rad))
     rep = {}
     if not gt:
         return {"error": "no ground truth in the log"}
@@ -159,6 +164,12 @@ def score(log_path, out_dir, veh, mission):
         w = to_world(start, (x, y, yaw))
         errs.append(math.hypot(w[0] - gt[i][0], w[1] - gt[i][1]))
     rep["localization_rms_m"] = round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
+    # Dead reckoning, laser (ICP) against wheel/IMU (EKF), over the same span of the run.
+    span = (odom["laser_odom"][0][0], odom["laser_odom"][-1][0]) if odom["laser_odom"] else None
+    for name, samples in odom.items():
+        d = odometry_drift(samples, gt_t, gt, span)
+        if d:
+            rep[f"{name}_final_error_m"], rep[f"{name}_drift_pct"] = d
     with open(out_dir / "gt.csv", "w") as f:
         f.write("x_m,y_m,yaw_rad\n")
         for g in gt[::10]:
@@ -180,6 +191,31 @@ def score(log_path, out_dir, veh, mission):
         if r.returncode != 0:
             rep["plot_error"] = r.stderr.strip()[-300:]
     return rep
+
+
+def odometry_drift(samples, gt_t, gt, span):
+    """(final position error [m], as % of the distance driven) of an odometry track aligned
+    with the truth at its first sample inside span (sim-time stamps [us]), or None."""
+    import bisect
+    if not span:
+        return None
+    samples = [s for s in samples if span[0] <= s[0] <= span[1]]
+    if len(samples) < 2:
+        return None
+    def truth(t):
+        return gt[min(bisect.bisect_left(gt_t, t), len(gt) - 1)]
+    t0, x0, y0, yaw0 = samples[0]
+    g0 = truth(t0)
+    dyaw = _wrap(g0[2] - yaw0)
+    c, s = math.cos(dyaw), math.sin(dyaw)
+    t1, x1, y1, _ = samples[-1]
+    g1 = truth(t1)
+    xw = g0[0] + c * (x1 - x0) - s * (y1 - y0)
+    yw = g0[1] + s * (x1 - x0) + c * (y1 - y0)
+    err = math.hypot(xw - g1[0], yw - g1[1])
+    i0, i1 = bisect.bisect_left(gt_t, t0), bisect.bisect_left(gt_t, t1)
+    dist = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(gt[i0:i1], gt[i0 + 1:i1 + 1]))
+    return round(err, 4), round(100.0 * err / dist, 2) if dist > 0.05 else None
 
 
 def _obstacles():

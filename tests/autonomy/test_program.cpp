@@ -1,10 +1,11 @@
 // autodrive-autonomy over real LCM (UDP multicast, port 7811): given a saved map it localises
-// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, MISSION and engaged
+// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, LASER_ODOM, MISSION and engaged
 // COMMANDs. Also --help and a clear error on a bad config.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -47,6 +48,12 @@ struct Listener {
   bool engaged_motion = false;
   bool have_amcl = false;
   autodrive::pose2d_t amcl{};
+  int laser_odom_msgs = 0;
+  autodrive::odometry_t laser_odom{};
+  void on_laser_odom(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
+    ++laser_odom_msgs;
+    laser_odom = *m;
+  }
   void on_mission(const lcm::ReceiveBuffer *, const std::string &, const autodrive::mission_status_t *m) {
     max_state = std::max<int>(max_state, m->state);
   }
@@ -93,6 +100,8 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
       lcm, "NIGELT_COMMAND", &l);
   autodrive_lcm::subscribe<autodrive::pose2d_t, Listener, &Listener::on_amcl>(
       lcm, "NIGELT_POSE_AMCL", &l);
+  autodrive_lcm::subscribe<autodrive::odometry_t, Listener, &Listener::on_laser_odom>(
+      lcm, "NIGELT_LASER_ODOM", &l);
 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
@@ -139,6 +148,10 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   EXPECT_NEAR(l.amcl.x_m, truth.x_m, 0.03);
   EXPECT_NEAR(l.amcl.y_m, truth.y_m, 0.03);
   EXPECT_EQ(static_cast<int>(l.amcl.source), static_cast<int>(autodrive::pose2d_t::SOURCE_AMCL));
+  // Laser odometry, once per scan: the car stood still, so it stayed at its origin.
+  EXPECT_GE(l.laser_odom_msgs, 8);
+  EXPECT_EQ(l.laser_odom.frame_id, "laser_odom");
+  EXPECT_LT(std::hypot(l.laser_odom.x_m, l.laser_odom.y_m), 0.005);
   EXPECT_TRUE(fs::exists(dir / "out" / "path.csv"));
   EXPECT_TRUE(WIFEXITED(st)) << "killed by a signal instead of exiting cleanly";
   fs::remove_all(dir);

@@ -19,7 +19,7 @@ MissionConfig mission_cfg(const NodeConfig &cfg) {
 }  // namespace
 
 AutonomyNode::AutonomyNode(const NodeConfig &cfg)
-    : cfg_(cfg), mission_(mission_cfg(cfg)), tracker_(cfg.tracker) {
+    : cfg_(cfg), mission_(mission_cfg(cfg)), tracker_(cfg.tracker), laser_odom_(cfg.laser_odom) {
   if (cfg_.map_yaml_in.empty()) {
     slam_ = std::make_unique<HectorSlam>(cfg_.slam, cfg_.start_pose);
   } else {
@@ -132,13 +132,18 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
   const Pose2 odom_scan = odom_history_.at(mid_us).value_or(odom_);
   const Pose2 odom_motion = pose_between(odom_at_last_scan_, odom_scan);
   odom_at_last_scan_ = odom_scan;
+  const LaserOdomStep lo = laser_odom_.update(scan, scans_ > 1 ? odom_motion : Pose2{});
+  lo_utime_us_ = mid_us;
   switch (mission_.state()) {
     case MissionState::kMapping: {
       // Standing still (odometry moved < 2 mm and < 0.2 deg): every scan is taken from the
       // start pose, so the map is built there instead of drifting with scan matches.
       const bool still = std::hypot(odom_motion.x_m, odom_motion.y_m) < cfg_.still_m &&
                          std::abs(odom_motion.yaw_rad) < cfg_.still_yaw_rad;
-      const Pose2 p = slam_->update(scan, scans_ > 1 ? odom_motion : Pose2{}, !(still && have_odom_));
+      // Moving: the laser odometry's motion is the guess for the match (it falls back to the
+      // wheel/EKF odometry by itself when ICP is not trusted).
+      const Pose2 guess = scans_ <= 1 ? Pose2{} : still ? odom_motion : lo.motion;
+      const Pose2 p = slam_->update(scan, guess, !(still && have_odom_));
       map_from_odom_ = pose_compose(p, pose_inverse(odom_scan));
       have_map_odom_ = true;
       if (slam_->scans_processed() >= cfg_.mapping_scans) {

@@ -57,7 +57,7 @@ ProgramConfig cfg_load(const std::string &path) {
   r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
                     "start", "goal", "lidar_in_base", "mapping_scans", "goal_tolerance_m",
                     "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "obstacle_cluster_m",
-                    "unknown_is_obstacle", "settle_s", "refine_scan_match", "footprint", "slam", "amcl",
+                    "unknown_is_obstacle", "settle_s", "refine_scan_match", "footprint", "slam", "laser_odom", "amcl",
                     "planner", "tracker", "mission"});
   r.get(root, "", "vehicle", c.vehicle);
   r.get(root, "", "lcm_url", c.lcm_url);
@@ -74,7 +74,7 @@ ProgramConfig cfg_load(const std::string &path) {
   r.pose(root, "", "goal", n.goal);
   Pose2 lidar = n.slam.lidar_in_base;
   r.pose(root, "", "lidar_in_base", lidar);
-  n.slam.lidar_in_base = n.amcl.lidar_in_base = lidar;
+  n.slam.lidar_in_base = n.amcl.lidar_in_base = n.laser_odom.lidar_in_base = lidar;
   r.get(root, "", "mapping_scans", n.mapping_scans);
   r.get(root, "", "goal_tolerance_m", n.goal_tolerance_m);
   r.get(root, "", "goal_tolerance_yaw_rad", n.goal_tolerance_yaw_rad);
@@ -100,6 +100,18 @@ ProgramConfig cfg_load(const std::string &path) {
     r.get(s, "slam", "height_m", n.slam.height_m);
     r.get(s, "slam", "origin_x_m", n.slam.origin_x_m);
     r.get(s, "slam", "origin_y_m", n.slam.origin_y_m);
+  }
+  if (const auto l = root["laser_odom"]) {
+    r.only(l, "laser_odom", {"max_rms_m", "min_inliers", "max_disagree_m", "max_disagree_rad",
+                             "keyframe_dist_m", "keyframe_angle_rad"});
+    r.get(l, "laser_odom", "max_rms_m", n.laser_odom.max_rms_m);
+    r.get(l, "laser_odom", "min_inliers", n.laser_odom.min_inliers);
+    r.get(l, "laser_odom", "max_disagree_m", n.laser_odom.max_disagree_m);
+    r.get(l, "laser_odom", "max_disagree_rad", n.laser_odom.max_disagree_rad);
+    r.get(l, "laser_odom", "keyframe_dist_m", n.laser_odom.keyframe_dist_m);
+    r.get(l, "laser_odom", "keyframe_angle_rad", n.laser_odom.keyframe_angle_rad);
+    if (!(n.laser_odom.keyframe_dist_m > 0) || !(n.laser_odom.keyframe_angle_rad > 0))
+      r.fail("'laser_odom.keyframe_dist_m' and 'keyframe_angle_rad' must be > 0");
   }
   if (const auto a = root["amcl"]) {
     r.only(a, "amcl", {"min_particles", "max_particles", "sigma_hit_m", "beams", "seed"});

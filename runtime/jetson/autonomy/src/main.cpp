@@ -1,5 +1,5 @@
 // autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
-// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL and <VEH>_MISSION, and prints each mission state
+// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM and <VEH>_MISSION, and prints each mission state
 // change. Writes path.csv, route.csv and trajectory.csv into out_dir for tools/plot-parking.
 #include <cmath>
 #include <csignal>
@@ -46,6 +46,7 @@ class App {
     const int plans_before = node_.plans();
     node_.on_scan(s, m->utime);
     if (node_.plans() != plans_before) write_plan();
+    publish_laser_odom();
     last_utime_ = std::max(last_utime_, m->utime);
     // The localisation estimate, once per scan that produced one, stamped when it was true.
     if (node_.localised_utime_us() > last_loc_us_) {
@@ -103,6 +104,31 @@ class App {
     lcm_.publish(cfg_.vehicle + "_POSE_AMCL", &m);
   }
 
+  // Laser odometry in its own frame (the base pose at the first scan), at the scan's mid-time;
+  // the twist is the last step over the time between scans.
+  void publish_laser_odom() {
+    const int64_t t = node_.laser_odom_utime_us();
+    const Pose2 p = node_.laser_odometry().pose();
+    autodrive::odometry_t m{};
+    m.utime = t;
+    m.vehicle = cfg_.vehicle;
+    m.frame_id = "laser_odom";
+    m.child_frame_id = "base_link";
+    m.x_m = p.x_m;
+    m.y_m = p.y_m;
+    m.yaw_rad = p.yaw_rad;
+    if (last_lo_us_ >= 0 && t > last_lo_us_) {
+      const double dt_s = (t - last_lo_us_) * 1e-6;
+      const Pose2 d = pose_between(last_lo_pose_, p);
+      m.vx_m_s = d.x_m / dt_s;
+      m.vy_m_s = d.y_m / dt_s;
+      m.yaw_rate_rad_s = d.yaw_rad / dt_s;
+    }
+    last_lo_us_ = t;
+    last_lo_pose_ = p;
+    lcm_.publish(cfg_.vehicle + "_LASER_ODOM", &m);
+  }
+
   // Publishes on every state change and at 2 Hz; prints state changes.
   void report_state(int64_t utime) {
     const auto &ms = node_.mission();
@@ -141,7 +167,8 @@ class App {
   AutonomyNode node_;
   std::ofstream traj_;
   int32_t seq_ = 0;
-  int64_t last_loc_us_ = -1, last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
+  Pose2 last_lo_pose_;
+  int64_t last_lo_us_ = -1, last_loc_us_ = -1, last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
   size_t printed_ = 0;
 };
 

@@ -10,6 +10,7 @@
 #include "autonomy/amcl.hpp"
 #include "autonomy/footprint.hpp"
 #include "autonomy/hybrid_astar.hpp"
+#include "autonomy/laser_odometry.hpp"
 #include "autonomy/mission.hpp"
 #include "autonomy/odom_history.hpp"
 #include "autonomy/pure_pursuit.hpp"
@@ -44,6 +45,7 @@ struct NodeConfig {
   // the planner by default; the live obstacle check guards them while driving.
   bool unknown_is_obstacle = false;
   SlamConfig slam;
+  LaserOdomConfig laser_odom;
   AmclConfig amcl;
   Footprint footprint;
   HybridAStarConfig planner;
@@ -68,6 +70,9 @@ class AutonomyNode {
   Pose2 localised_pose() const { return loc_pose_; }
   int64_t localised_utime_us() const { return loc_utime_us_; }
   Eigen::Matrix3d amcl_covariance() const;
+  // Laser odometry (ICP on keyframes) of the latest scan, stamped at the scan's mid-time [us].
+  const LaserOdometry &laser_odometry() const { return laser_odom_; }
+  int64_t laser_odom_utime_us() const { return lo_utime_us_; }
   const Path &path() const { return tracker_.path(); }
   const std::vector<Eigen::Vector2d> &route_m() const { return route_m_; }
   const GridMap *map() const;  // the SLAM map while mapping, then the saved/loaded one
@@ -101,6 +106,8 @@ class AutonomyNode {
   bool have_odom_ = false, have_map_odom_ = false;
   Pose2 odom_, odom_at_last_scan_;
   OdomHistory odom_history_;
+  LaserOdometry laser_odom_;
+  int64_t lo_utime_us_ = -1;
   bool settling_ = false;       // stopped at the path's end, waiting for a standstill scan
   int64_t settled_at_us_ = 0;   // scans that start after this were taken at standstill
   Pose2 loc_pose_;
