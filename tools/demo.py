@@ -16,7 +16,12 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 # The default scenario's unmapped box [m, m, s]: it appears after the map is saved, while the
 # car localises, on the direct way to slot 2.
-DEFAULT_LATE_BOX = "-0.62,0.76,3.5"
+# On the direct way from the spawn to slot 2. After a mapping route it steps out once the car
+# comes back within 0.5 m of it (and not before 5 s of sim time), so the map never has it;
+# mapping standing still, it appears at 3.5 s, after the map is saved.
+DEFAULT_LATE_BOX = "-0.62,0.76,5,0.06,0.06,0.5"
+DEFAULT_LATE_BOX_STILL = "-0.62,0.76,3.5"
+DEFAULT_MAPPING_ROUTE = "-0.35,0,0"
 
 
 def log(msg):
@@ -41,11 +46,18 @@ def parse_args():
                    help="parking: the car's start pose in the world [m, m, deg] (default: the "
                    "map's spawn moved by up to 5 cm and 5 deg, drawn from --seed; seed 0: exactly "
                    "the spawn)")
-    p.add_argument("--late-box", metavar="X,Y,T", action="append", default=[],
+    p.add_argument("--late-box", metavar="X,Y,T[,SX,SY[,R]]", action="append", default=[],
                    help="parking: a box the map does not have appears at world (X, Y) [m] at sim "
-                   "time T [s]; repeatable; replaces the default box. Write --late-box=-0.6,... "
-                   f"for negative X. Default: {DEFAULT_LATE_BOX} (on the direct way to slot 2, "
-                   "after mapping): the car must see it and replan around it")
+                   "time T [s] (half sizes SX, SY [m]; with R, once the car is within R [m]); "
+                   "repeatable; replaces the default box. Write --late-box=-0.6,... for negative "
+                   f"X. Default: {DEFAULT_LATE_BOX} ({DEFAULT_LATE_BOX_STILL} with an empty "
+                   "--mapping-route): on the direct way to slot 2, after mapping; the car must "
+                   "see it and replan around it")
+    p.add_argument("--mapping-route", metavar="X,Y,YAW_DEG[;...]", default=DEFAULT_MAPPING_ROUTE,
+                   help="parking: after mapping standing still, the car drives these poses of "
+                   "its start frame [m, m, deg] (x ahead, y left), mapping as it goes, and "
+                   f"parks from the last; '' maps standing still only. Default: {DEFAULT_MAPPING_ROUTE} "
+                   "(0.35 m back)")
     p.add_argument("--no-late-box", action="store_true",
                    help="parking: no box appears (the lot is as mapped)")
     p.add_argument("--timeout", type=float, default=240.0,
@@ -124,6 +136,10 @@ def main():
         start = demo_parking.start_pose(args.start, args.seed)
     except ValueError as e:
         sys.exit(f"[demo] ERROR: --start {args.start}: {e}")
+    try:
+        mapping_route = demo_parking.mapping_route(args.mapping_route)
+    except ValueError as e:
+        sys.exit(f"[demo] ERROR: {e}")
     sys.path.insert(0, str(build / "lcm_types" / "gen" / "python"))
     import yaml  # noqa: E402
 
@@ -161,7 +177,7 @@ def main():
             sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
             sim_argv += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
             if not args.late_box and not args.no_late_box:
-                args.late_box = [DEFAULT_LATE_BOX]
+                args.late_box = [DEFAULT_LATE_BOX if mapping_route else DEFAULT_LATE_BOX_STILL]
             if args.no_late_box:
                 args.late_box = []
             for box in args.late_box:
@@ -180,7 +196,7 @@ def main():
         else:
             result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed, start,
                                       args.timeout, procs, lambda: interrupted,
-                                      demo_parking.late_boxes(args.late_box))
+                                      demo_parking.late_boxes(args.late_box), mapping_route)
     except RuntimeError as e:
         log(f"ERROR: {e}")
         result = {"error": str(e)}

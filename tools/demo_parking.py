@@ -70,7 +70,22 @@ def _wrap(a):
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
-def write_config(example, out_dir, url, goal_local, seed):
+def mapping_route(text):
+    """--mapping-route X,Y,YAW_DEG[;...] (start frame) as [(x, y, yaw_rad)]; '' = none."""
+    route = []
+    for leg in filter(None, (t.strip() for t in text.split(";"))):
+        parts = leg.split(",")
+        try:
+            x, y, yaw_deg = (float(v) for v in parts)
+        except ValueError:
+            raise ValueError(f"--mapping-route leg '{leg}': expected X,Y,YAW_DEG numbers") from None
+        if not all(map(math.isfinite, (x, y, yaw_deg))):
+            raise ValueError(f"--mapping-route leg '{leg}': X, Y and YAW_DEG must be finite")
+        route.append((x, y, math.radians(yaw_deg)))
+    return route
+
+
+def write_config(example, out_dir, url, goal_local, seed, route=()):
     import yaml
     cfg = yaml.safe_load(pathlib.Path(example).read_text())
     cfg["lcm_url"] = url
@@ -79,6 +94,7 @@ def write_config(example, out_dir, url, goal_local, seed):
     cfg["map"]["load_from"] = ""
     cfg["goal"] = {"x_m": goal_local[0], "y_m": goal_local[1], "yaw_rad": goal_local[2]}
     cfg["amcl"]["seed"] = seed
+    cfg["mapping_route"] = [{"x_m": x, "y_m": y, "yaw_rad": yaw} for x, y, yaw in route]
     path = out_dir / "autonomy.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=False))
     return path
@@ -94,11 +110,12 @@ def late_boxes(specs):
     return out
 
 
-def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested, boxes=()):
+def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested, boxes=(),
+        route=()):
     goal_w = slot_goal_world(slot)
     goal_l = to_frame(start, goal_w)
     cfg = write_config(ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml", out_dir,
-                       url, goal_l, seed)
+                       url, goal_l, seed, route)
     print(f"[demo] start at world ({start[0]:.3f}, {start[1]:.3f}, {math.degrees(start[2]):.1f} deg)",
           flush=True)
     print(f"[demo] mission: park in slot {slot} at world ({goal_w[0]:.3f}, {goal_w[1]:.3f}, "
@@ -254,9 +271,10 @@ def _poly_dist(pa, pb):
     return d  # overlapping rectangles are caught by the collision flag instead
 
 
-def min_clearance(gt, length_m=0.19, width_m=0.13, centre_ahead_m=CENTRE_AHEAD_M, extra=()):
-    """Smallest gap [m] between the car's body rectangle and any obstacle over the run (the
-    map's and the extra (x, y, half_x, half_y, yaw) boxes; a late box counts all run long)."""
+def min_clearance(gt, length_m=0.24, width_m=0.178, centre_ahead_m=0.07, extra=()):
+    """Smallest gap [m] between the car's envelope (chassis box and wheels) and any obstacle over
+    the run (the map's and the extra (x, y, half_x, half_y, yaw) boxes; a late box counts all
+    run long)."""
     obs = [_corners(*o) for o in list(_obstacles()) + list(extra)]
     best = float("inf")
     for x, y, yaw in gt[::10]:

@@ -51,7 +51,7 @@ Outcome run_mission(bool add_box, const std::string &tag) {
   cfg.slam.origin_x_m = -0.5;
   cfg.slam.origin_y_m = -0.5;
   cfg.start_pose = {1.8, 1.2, 0.0};
-  cfg.goal = {2.45, 0.12, kPi / 2};
+  cfg.goal = {2.45, 0.18, kPi / 2};
   cfg.mapping_scans = 10;
   cfg.amcl.max_particles = 2000;
   AutonomyNode node(cfg);

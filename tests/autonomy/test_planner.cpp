@@ -89,7 +89,7 @@ TEST(HybridAStar, ReversesIntoASlotWithinTheTurningRadiusAndClearOfObstacles) {
   const GridMap map = world.rasterize(0.02);
   const CollisionChecker cc(map, nigel());
   const Pose2 start{0.5, 1.0, 0.0};
-  const Pose2 slot{2.45, 0.12, kPi / 2};  // nose out, rear axle 0.12 m from the back wall
+  const Pose2 slot{2.45, 0.18, kPi / 2};  // nose out, rear axle 0.18 m from the back wall (tail 0.13 m)
   const PlanResult r = hybrid_astar_plan(cc, start, slot);
   ASSERT_FALSE(r.failed) << r.detail;
   expect_feasible(r.path);
@@ -126,7 +126,7 @@ TEST(HybridAStar, FailsCleanlyOnAnUnreachableOrBlockedGoal) {
   const CollisionChecker cc(map, nigel());
   HybridAStarConfig cfg;
   cfg.max_expansions = 3000;
-  const PlanResult r = hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {2.45, 0.12, kPi / 2}, cfg);
+  const PlanResult r = hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {2.45, 0.18, kPi / 2}, cfg);
   EXPECT_TRUE(r.failed);
   EXPECT_FALSE(r.detail.empty());
   const PlanResult r2 = hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {1.15, 1.75, 0.0}, cfg);  // inside a box

@@ -90,7 +90,7 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
                                   << "out_dir: " << (dir / "out").string() << "\n"
                                   << "map: {load_from: " << (dir / "map.yaml").string() << "}\n"
                                   << "start: {x_m: 1.8, y_m: 1.2, yaw_rad: 0.0}\n"
-                                  << "goal: {x_m: 2.45, y_m: 0.12, yaw_rad: 1.5707963}\n";
+                                  << "goal: {x_m: 2.45, y_m: 0.18, yaw_rad: 1.5707963}\n";
   lcm::LCM lcm(kUrl);
   ASSERT_TRUE(lcm.good());
   Listener l;

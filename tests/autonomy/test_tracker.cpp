@@ -154,3 +154,44 @@ TEST(PurePursuit, SpeedProfileSlowsToAStopAndRespectsTopSpeed) {
   EXPECT_TRUE(pp.done());
   EXPECT_EQ(pp.step(car.pose, 0.02).throttle, 0.0);  // clean stop: stays stopped
 }
+
+// A drivetrain that needs throttle 0.5 to move at all (friction, a sagging battery): open loop,
+// the creep before the stop stalls the car short of the end; with the measured speed fed
+// back, the stall boost gets it there.
+TEST(PurePursuit, StallBoostGetsAStickyCarToTheEnd) {
+  const Path p = straight({0, 0, 0}, 0.6, 1);
+  auto drive = [&](bool feedback) {
+    PurePursuit pp;
+    pp.set_path(p);
+    synth::Bicycle car;
+    double max_boost = 0;
+    for (int i = 0; i < 3000; ++i) {  // 60 s at 50 Hz
+      const TrackerCommand c = pp.step(car.pose, 0.02, feedback ? car.speed_m_s : std::nan(""));
+      max_boost = std::max(max_boost, pp.boost());
+      if (c.done) break;
+      car.step(std::abs(c.throttle) < 0.5 ? 0.0 : c.throttle * 0.267, c.steering * 0.5236, 0.02);
+    }
+    return std::make_pair(pp.done(), std::make_pair(car.pose.x_m, max_boost));
+  };
+  const auto open_loop = drive(false);
+  EXPECT_FALSE(open_loop.first) << "stalled short of the end, as expected open loop";
+  EXPECT_LT(open_loop.second.first, 0.6 - 0.01);
+  const auto closed = drive(true);
+  ASSERT_TRUE(closed.first);
+  EXPECT_NEAR(closed.second.first, 0.6, 0.02);
+  EXPECT_GT(closed.second.second, 0.0);
+}
+
+// A car that keeps up never gets a boost (the boost must not change normal driving).
+TEST(PurePursuit, NoBoostWhileTheCarKeepsUp) {
+  const Path p = straight({0, 0, 0}, 0.8, 1);
+  PurePursuit pp;
+  pp.set_path(p);
+  synth::Bicycle car;
+  for (int i = 0; i < 3000 && !pp.done(); ++i) {
+    const TrackerCommand c = pp.step(car.pose, 0.02, car.speed_m_s);
+    EXPECT_EQ(pp.boost(), 0.0) << "at step " << i;
+    car.step(c.throttle * 0.267, c.steering * 0.5236, 0.02);
+  }
+  EXPECT_TRUE(pp.done());
+}

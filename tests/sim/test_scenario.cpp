@@ -1,4 +1,4 @@
-// Scenario options of autodrive-sim: --start X,Y,YAW_DEG and --late-box X,Y,T[,SX,SY].
+// Scenario options of autodrive-sim: --start X,Y,YAW_DEG and --late-box X,Y,T[,SX,SY[,R]].
 // The real program publishes on real LCM UDP multicast (loopback, ttl=0, ports 7750-7752):
 // ground truth at the start pose; a late box that the LIDAR sees only after its time and that
 // sets the collision flag when driven into; bad values exit 2 naming the option. In-process:
@@ -177,11 +177,15 @@ TEST(Scenario, ParsesStartAndLateBoxValues) {
   ASSERT_EQ(scn_parse_late_box("0.5,0.6,10,0.2,0.03", &b, err, sizeof err), 0) << err;
   EXPECT_DOUBLE_EQ(b.half_x_m, 0.2);
   EXPECT_DOUBLE_EQ(b.half_y_m, 0.03);
+  EXPECT_DOUBLE_EQ(b.near_m, 0.0);
+  ASSERT_EQ(scn_parse_late_box("0.5,0.6,10,0.06,0.06,0.4", &b, err, sizeof err), 0) << err;
+  EXPECT_DOUBLE_EQ(b.near_m, 0.4);
   for (const char *bad : {"", "1,2", "1,2,3,4", "1,,3", "1,2,3x", "nan,0,0", "0,0,361", "1e9,0,0"}) {
     EXPECT_EQ(scn_parse_start(bad, &p, err, sizeof err), -1) << bad;
     EXPECT_NE(std::string(err).find("--start"), std::string::npos) << err;
   }
-  for (const char *bad : {"1,2", "1,2,3,4", "1,2,-1", "1,2,3,0,0.1", "1,2,3,0.1,5", "a,2,3"}) {
+  for (const char *bad : {"1,2", "1,2,3,4", "1,2,-1", "1,2,3,0,0.1", "1,2,3,0.1,5", "a,2,3",
+                          "1,2,3,0.1,0.1,0", "1,2,3,0.1,0.1,0.3,1"}) {
     EXPECT_EQ(scn_parse_late_box(bad, &b, err, sizeof err), -1) << bad;
     EXPECT_NE(std::string(err).find("--late-box"), std::string::npos) << err;
   }
@@ -363,7 +367,7 @@ struct ScenarioSim {
 
 TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   const scn_pose_t start = {0.4, -2.0, 90.0};
-  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06};
+  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06, 0.0};
   ScenarioSim k(start, box);
   ASSERT_NE(k.s, nullptr) << k.err;
   ASSERT_EQ(k.run_to(0.5), 1) << k.err;
@@ -387,10 +391,32 @@ TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12) << "box not back after the reset";
 }
 
+// With R, a box waits past its time until car 1 comes within R m, like one stepping out.
+TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
+  const scn_pose_t start = {0.4, -2.0, 90.0};
+  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0};
+  box.near_m = 0.25;  // the car starts 0.35 m away
+  ScenarioSim k(start, box);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  ASSERT_EQ(k.run_to(0.5), 0) << "appeared with the car 0.35 m away; " << k.err;
+  mjData *d = sim_data(k.s);
+  const mjModel *m = sim_model(k.s);
+  const mjtNum *box_pos = d->mocap_pos + 3 * m->body_mocapid[mj_name2id(m, mjOBJ_BODY, "scenario/late_box1")];
+  EXPECT_LT(box_pos[2], -1000.0) << "still parked out of sight";
+  d->qpos[1] += 0.15;  // move the car 0.15 m towards it: 0.2 m away
+  mj_forward(m, d);
+  ASSERT_EQ(k.run_to(0.6), 1) << k.err;
+  EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
+  d->qpos[1] -= 0.5;  // once there, it stays when the car leaves
+  mj_forward(m, d);
+  ASSERT_EQ(k.run_to(0.7), 0) << k.err;
+  EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
+}
+
 #ifdef SIM_TEST_HAVE_SENSORS
 TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   // in-process: the sim core with a late box 0.5 m ahead of car 1, appearing at 0.2 s
-  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06});
+  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0});
   ASSERT_NE(k.s, nullptr) << k.err;
   sim_t *s = k.s;
   const mjModel *m = sim_model(s);

@@ -74,17 +74,23 @@ int scn_parse_late_box(const char *text, scn_late_box_t *out, char *err, size_t 
   double v[SCN_MAX_FIELDS];
   const int n = scn_numbers(opt, text, v, err, err_sz);
   if (n < 0) return -1;
-  if (n != 3 && n != 5) {
+  if (n != 3 && n != 5 && n != 6) {
     snprintf(err, err_sz,
-             "%s '%s': expected X,Y,T[,SX,SY] (centre x, y [m], appearance sim time T [s], "
-             "optional half sizes SX, SY [m]), e.g. --late-box 0.5,0.6,10; got %d number(s)",
+             "%s '%s': expected X,Y,T[,SX,SY[,R]] (centre x, y [m], appearance sim time T [s], "
+             "optional half sizes SX, SY [m], optional distance R [m] NIGEL1 must come within "
+             "first), e.g. --late-box 0.5,0.6,10; got %d number(s)",
              opt, text, n);
     return -1;
   }
   out->half_x_m = out->half_y_m = SCN_LATE_BOX_HALF_DEFAULT_M;
-  if (n == 5) {
+  out->near_m = 0.0;
+  if (n >= 5) {
     out->half_x_m = v[3];
     out->half_y_m = v[4];
+  }
+  if (n == 6) {
+    out->near_m = v[5];
+    if (scn_in(opt, text, "R [m]", v[5], 0.01, SCN_COORD_MAX_M, err, err_sz)) return -1;
   }
   if (scn_in(opt, text, "x [m]", v[0], -SCN_COORD_MAX_M, SCN_COORD_MAX_M, err, err_sz) ||
       scn_in(opt, text, "y [m]", v[1], -SCN_COORD_MAX_M, SCN_COORD_MAX_M, err, err_sz) ||

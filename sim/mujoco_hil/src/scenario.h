@@ -1,5 +1,5 @@
 /* Scenario options of autodrive-sim: the start pose of car 1 (--start X,Y,YAW_DEG) and boxes
- * that appear during the run (--late-box X,Y,T[,SX,SY]). Parsing only; where they go in the
+ * that appear during the run (--late-box X,Y,T[,SX,SY[,R]]). Parsing only; where they go in the
  * world and whether they fit the map is the sim's business (sim.h, clearance.h). */
 #ifndef SIM_SCENARIO_H
 #define SIM_SCENARIO_H
@@ -26,11 +26,13 @@ typedef struct scn_late_box {
   double x_m, y_m;           /* centre on the floor [m] */
   double t_s;                /* sim time at which it appears [s] */
   double half_x_m, half_y_m; /* half sizes along world x and y [m] */
+  double near_m;             /* > 0: and not before NIGEL1's base_link is this close [m] */
 } scn_late_box_t;
 
 /* Parse "X,Y,YAW_DEG". Returns 0, or -1 with a message naming --start and text in err. */
 int scn_parse_start(const char *text, scn_pose_t *out, char *err, size_t err_sz);
-/* Parse "X,Y,T" or "X,Y,T,SX,SY". Returns 0, or -1 with a message naming --late-box and text. */
+/* Parse "X,Y,T", "X,Y,T,SX,SY" or "X,Y,T,SX,SY,R". Returns 0, or -1 with a message naming
+ * --late-box and text. */
 int scn_parse_late_box(const char *text, scn_late_box_t *out, char *err, size_t err_sz);
 
 #ifdef __cplusplus

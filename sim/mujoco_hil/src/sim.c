@@ -303,6 +303,10 @@ static void sim_place_late_boxes(sim_t *s) {
     s->box_new[k] = 0;
     const scn_late_box_t *b = &s->box[k];
     if (s->time_us < (int64_t)llround(b->t_s * 1e6)) continue;
+    if (!s->box_placed[k] && b->near_m > 0) {  /* a box that steps out as the car comes near */
+      const mjtNum *car = s->d->qpos + s->car[0].root_qpos;
+      if (hypot(car[0] - b->x_m, car[1] - b->y_m) > b->near_m) continue;
+    }
     mjtNum *pos = s->d->mocap_pos + 3 * s->box_mocap[k];
     pos[0] = b->x_m;
     pos[1] = b->y_m;

@@ -67,17 +67,26 @@ void AutonomyNode::on_odom(const Pose2 &odom, int64_t utime_us) {
   have_odom_ = true;
   const double t = now_s(utime_us);
   mission_.tick(t);
-  if (mission_.state() != MissionState::kDriving || settling_) {
+  if (!engaged() || settling_) {
     command_ = TrackerCommand{};
     return;
   }
-  command_ = tracker_.step(pose_map(), dt_s);
+  command_ = tracker_.step(pose_map(), dt_s, measured_speed_m_s(utime_us));
   if (command_.done) {
     // Hold still; on_scan judges the stop on a scan that starts after the car has settled.
     settling_ = true;
     settled_at_us_ = utime_us + static_cast<int64_t>(cfg_.settle_s * 1e6);
     command_ = TrackerCommand{};
   }
+}
+
+double AutonomyNode::measured_speed_m_s(int64_t utime_us) const {
+  // Over the last 0.2 s of odometry: long enough to average the encoder ticks.
+  const int64_t window_us = 200000;
+  const auto before = odom_history_.at(utime_us - window_us);
+  if (!before) return std::nan("");
+  const Pose2 d = pose_between(*before, odom_);
+  return d.x_m / (window_us * 1e-6);
 }
 
 void AutonomyNode::judge_arrival(double t_s) {
@@ -123,6 +132,69 @@ void AutonomyNode::plan(double t_s) {
   mission_.planned(true, why.str(), t_s);
 }
 
+void AutonomyNode::map_scan(const Scan &scan, const Pose2 &odom_scan, const Pose2 &odom_motion,
+                            const Pose2 &lo_motion, int64_t utime_us, double t_s) {
+  // Standing still (odometry moved < 2 mm and < 0.2 deg): the scan is taken from where the
+  // last one was, so it is written there instead of drifting with scan matches. Moving: the
+  // laser odometry's motion is the guess for the match (it falls back to the wheel/EKF
+  // odometry by itself when ICP is not trusted).
+  const bool still = std::hypot(odom_motion.x_m, odom_motion.y_m) < cfg_.still_m &&
+                     std::abs(odom_motion.yaw_rad) < cfg_.still_yaw_rad;
+  const Pose2 guess = scans_ <= 1 ? Pose2{} : still ? odom_motion : lo_motion;
+  const Pose2 p = slam_->update(scan, guess, !(still && have_odom_));
+  map_from_odom_ = pose_compose(p, pose_inverse(odom_scan));
+  have_map_odom_ = true;
+  if (slam_->scans_processed() < cfg_.mapping_scans) return;
+  if (mapping_leg_) {
+    // A leg ends like a parking drive: the car holds still, then the next leg starts from a
+    // scan taken at standstill.
+    if (!settling_ || utime_us < settled_at_us_) return;
+    settling_ = mapping_leg_ = false;
+    ++mapping_leg_index_;
+  }
+  if (mapping_leg_index_ < cfg_.mapping_route.size()) {
+    plan_mapping_leg(t_s);
+    return;
+  }
+  save_map(t_s);
+}
+
+void AutonomyNode::plan_mapping_leg(double t_s) {
+  const Pose2 &to = cfg_.mapping_route[mapping_leg_index_];
+  mapping_plan_map_ = std::make_unique<GridMap>(slam_->map());
+  const CollisionChecker checker(*mapping_plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+  const PlanResult r = hybrid_astar_plan(checker, pose_map(), to, cfg_.planner);
+  std::ostringstream what;
+  what.precision(3);
+  what << "route leg " << mapping_leg_index_ + 1 << "/" << cfg_.mapping_route.size() << " to ("
+       << to.x_m << ", " << to.y_m << ", " << to.yaw_rad * 180.0 / kPi << " deg)";
+  if (r.failed) {
+    mission_.fail(what.str() + ": planning failed: " + r.detail, t_s);
+    return;
+  }
+  ++plans_;
+  route_m_ = r.route_m;
+  tracker_.set_path(r.path);
+  mapping_leg_ = true;
+  what << ": path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps";
+  mission_.note(what.str());
+}
+
+void AutonomyNode::save_map(double t_s) {
+  mission_.mapping_done(t_s);
+  // SAVING: write the map, then read it back so localisation runs on the saved file.
+  try {
+    const auto parent = std::filesystem::path(cfg_.map_yaml_out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    map_save(slam_->map(), cfg_.map_yaml_out);
+    map_ = std::make_unique<GridMap>(map_load(cfg_.map_yaml_out));
+    after_map_ready(t_s);
+    mission_.saved(true, "map saved to " + cfg_.map_yaml_out, t_s);
+  } catch (const std::exception &e) {
+    mission_.saved(false, e.what(), t_s);
+  }
+}
+
 void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
   const double t = now_s(utime_us);
   mission_.tick(t);
@@ -135,33 +207,9 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
   const LaserOdomStep lo = laser_odom_.update(scan, scans_ > 1 ? odom_motion : Pose2{});
   lo_utime_us_ = mid_us;
   switch (mission_.state()) {
-    case MissionState::kMapping: {
-      // Standing still (odometry moved < 2 mm and < 0.2 deg): every scan is taken from the
-      // start pose, so the map is built there instead of drifting with scan matches.
-      const bool still = std::hypot(odom_motion.x_m, odom_motion.y_m) < cfg_.still_m &&
-                         std::abs(odom_motion.yaw_rad) < cfg_.still_yaw_rad;
-      // Moving: the laser odometry's motion is the guess for the match (it falls back to the
-      // wheel/EKF odometry by itself when ICP is not trusted).
-      const Pose2 guess = scans_ <= 1 ? Pose2{} : still ? odom_motion : lo.motion;
-      const Pose2 p = slam_->update(scan, guess, !(still && have_odom_));
-      map_from_odom_ = pose_compose(p, pose_inverse(odom_scan));
-      have_map_odom_ = true;
-      if (slam_->scans_processed() >= cfg_.mapping_scans) {
-        mission_.mapping_done(t);
-        // SAVING: write the map, then read it back so localisation runs on the saved file.
-        try {
-          const auto parent = std::filesystem::path(cfg_.map_yaml_out).parent_path();
-          if (!parent.empty()) std::filesystem::create_directories(parent);
-          map_save(slam_->map(), cfg_.map_yaml_out);
-          map_ = std::make_unique<GridMap>(map_load(cfg_.map_yaml_out));
-          after_map_ready(t);
-          mission_.saved(true, "map saved to " + cfg_.map_yaml_out, t);
-        } catch (const std::exception &e) {
-          mission_.saved(false, e.what(), t);
-        }
-      }
+    case MissionState::kMapping:
+      map_scan(scan, odom_scan, odom_motion, lo.motion, utime_us, t);
       break;
-    }
     case MissionState::kLocalising: {
       amcl_->update(odom_scan, scan, true);
       ++localising_updates_;

@@ -32,11 +32,13 @@ struct Reader {
   }
   void pose(const YAML::Node &node, const std::string &path, const char *key, Pose2 &p) const {
     if (!node[key]) return;
-    const std::string sub = path.empty() ? key : path + "." + key;
-    only(node[key], sub, {"x_m", "y_m", "yaw_rad"});
-    get(node[key], sub, "x_m", p.x_m);
-    get(node[key], sub, "y_m", p.y_m);
-    get(node[key], sub, "yaw_rad", p.yaw_rad);
+    pose_of(node[key], path.empty() ? key : path + "." + key, p);
+  }
+  void pose_of(const YAML::Node &n, const std::string &sub, Pose2 &p) const {
+    only(n, sub, {"x_m", "y_m", "yaw_rad"});
+    get(n, sub, "x_m", p.x_m);
+    get(n, sub, "y_m", p.y_m);
+    get(n, sub, "yaw_rad", p.yaw_rad);
   }
 };
 
@@ -55,7 +57,7 @@ ProgramConfig cfg_load(const std::string &path) {
   ProgramConfig c;
   NodeConfig &n = c.node;
   r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
-                    "start", "goal", "lidar_in_base", "mapping_scans", "goal_tolerance_m",
+                    "start", "goal", "lidar_in_base", "mapping_scans", "mapping_route", "goal_tolerance_m",
                     "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "obstacle_cluster_m",
                     "unknown_is_obstacle", "settle_s", "refine_scan_match", "footprint", "slam", "laser_odom", "amcl",
                     "planner", "tracker", "mission"});
@@ -76,6 +78,15 @@ ProgramConfig cfg_load(const std::string &path) {
   r.pose(root, "", "lidar_in_base", lidar);
   n.slam.lidar_in_base = n.amcl.lidar_in_base = n.laser_odom.lidar_in_base = lidar;
   r.get(root, "", "mapping_scans", n.mapping_scans);
+  if (const auto route = root["mapping_route"]) {
+    if (!route.IsSequence())
+      r.fail("'mapping_route' must be a list of poses [{x_m, y_m, yaw_rad}, ...]");
+    for (size_t i = 0; i < route.size(); ++i) {
+      Pose2 p;
+      r.pose_of(route[i], "mapping_route[" + std::to_string(i) + "]", p);
+      n.mapping_route.push_back(p);
+    }
+  }
   r.get(root, "", "goal_tolerance_m", n.goal_tolerance_m);
   r.get(root, "", "goal_tolerance_yaw_rad", n.goal_tolerance_yaw_rad);
   r.get(root, "", "obstacle_horizon_m", n.obstacle_horizon_m);

@@ -28,6 +28,11 @@ void Mission::go(MissionState to, const std::string &why, double now_s) {
   entered_s_ = now_s;
 }
 
+void Mission::note(const std::string &what) {
+  history_.push_back(std::string(mission_state_name(state_)) + ": " + what);
+  detail_ = what;
+}
+
 bool Mission::mapping_done(double now_s) {
   if (state_ != MissionState::kMapping) return false;
   go(MissionState::kSaving, "map complete", now_s);

@@ -28,19 +28,22 @@ void PurePursuit::set_path(const Path &path) {
   nearest_ = 0;
   speed_m_s_ = 0.0;
   pause_left_s_ = 0.0;
+  stalled_s_ = boost_ = 0.0;
   done_ = segments_.empty();
 }
 
-TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s) {
+TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured_speed_m_s) {
   TrackerCommand cmd;
   if (done_) {
     cmd.done = true;
     speed_m_s_ = 0;
+    stalled_s_ = boost_ = 0.0;
     return cmd;
   }
   if (pause_left_s_ > 0.0) {  // standing still at a cusp
     pause_left_s_ -= dt_s;
     speed_m_s_ = 0;
+    stalled_s_ = boost_ = 0.0;
     return cmd;
   }
   const Path &seg = segments_[seg_];
@@ -127,8 +130,21 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s) {
   cmd.steering = cmd.steer_rad / cfg_.max_steer_rad;
   last_steer_rad_ = cmd.steer_rad;
   cmd.speed_m_s = dir * v;
-  cmd.throttle = std::clamp(cmd.speed_m_s / cfg_.top_speed_m_s, -1.0, 1.0);
+  update_stall_boost(dir * measured_speed_m_s, v, dt_s);
+  cmd.throttle = std::clamp(dir * (v / cfg_.top_speed_m_s + boost_), -1.0, 1.0);
   return cmd;
+}
+
+void PurePursuit::update_stall_boost(double along_m_s, double target_m_s, double dt_s) {
+  if (!std::isfinite(along_m_s)) return;
+  if (along_m_s >= cfg_.boost_release_fraction * target_m_s) {  // moving: let the boost go
+    stalled_s_ = 0.0;
+    boost_ = std::max(0.0, boost_ - 2.0 * cfg_.boost_rate_per_s * dt_s);
+    return;
+  }
+  if (along_m_s >= cfg_.stall_fraction * target_m_s) return;  // slow, not stuck: hold
+  stalled_s_ += dt_s;
+  if (stalled_s_ >= cfg_.stall_s) boost_ = std::min(cfg_.boost_max, boost_ + cfg_.boost_rate_per_s * dt_s);
 }
 
 }  // namespace autonomy

@@ -24,7 +24,11 @@ struct NodeConfig {
   Pose2 start_pose;         // map-frame pose at start (SLAM origin / AMCL initial guess)
   double initial_sigma_xy_m = 0.05, initial_sigma_yaw_rad = 0.05;
   Pose2 goal;               // parking pose of the base (rear axle) in the map frame
-  int mapping_scans = 15;
+  int mapping_scans = 15;  // scans standing still at the start before anything else
+  // Then the car drives these map-frame poses in turn (Hybrid A* on the map so far, SLAM
+  // localising), mapping as it goes, and the map is saved where the route ends. Empty: the
+  // map is what the start pose sees.
+  std::vector<Pose2> mapping_route;
   // While mapping, odometry motion below this between scans means standing still [m], [rad].
   double still_m = 0.002, still_yaw_rad = 0.0035;
   int localising_min_updates = 8;
@@ -61,7 +65,10 @@ class AutonomyNode {
 
   const Mission &mission() const { return mission_; }
   const TrackerCommand &command() const { return command_; }
-  bool engaged() const { return mission_.state() == MissionState::kDriving; }
+  bool engaged() const {
+    return mission_.state() == MissionState::kDriving ||
+           (mission_.state() == MissionState::kMapping && mapping_leg_);
+  }
   bool have_pose() const { return have_map_odom_; }
   Pose2 pose_map() const;  // best map-frame pose now
   std::optional<Pose2> amcl_pose() const;
@@ -87,10 +94,15 @@ class AutonomyNode {
   }
   mutable int64_t t0_us_ = -1;
   void after_map_ready(double t_s);
+  void map_scan(const Scan &scan, const Pose2 &odom_scan, const Pose2 &odom_motion,
+                const Pose2 &lo_motion, int64_t utime_us, double t_s);
+  void plan_mapping_leg(double t_s);
+  void save_map(double t_s);
   void plan(double t_s);
   // Takes AMCL's estimate for the scan taken at odom_scan (refined), as the map pose.
   void localise(const Pose2 &odom_scan, const Scan &scan, int64_t scan_mid_us);
   void judge_arrival(double t_s);
+  double measured_speed_m_s(int64_t utime_us) const;  // signed, base x, from odometry
 
   NodeConfig cfg_;
   Mission mission_;
@@ -103,6 +115,9 @@ class AutonomyNode {
   PurePursuit tracker_;
   TrackerCommand command_;
   std::vector<Eigen::Vector2d> route_m_;
+  size_t mapping_leg_index_ = 0;  // next mapping_route pose
+  bool mapping_leg_ = false;      // driving a mapping-route leg
+  std::unique_ptr<GridMap> mapping_plan_map_;  // SLAM map snapshot the leg was planned on
   bool have_odom_ = false, have_map_odom_ = false;
   Pose2 odom_, odom_at_last_scan_;
   OdomHistory odom_history_;

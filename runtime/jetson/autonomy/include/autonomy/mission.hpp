@@ -38,6 +38,8 @@ class Mission {
   bool blocked(const std::string &why, double now_s);
   bool arrived(bool within_tolerance, const std::string &why, double now_s);
   bool fail(const std::string &why, double now_s);
+  // Progress within the current state (e.g. a mapping-route leg): history and detail, no change.
+  void note(const std::string &what);
   // Fails the mission when the current state has lasted longer than its timeout.
   void tick(double now_s);
 

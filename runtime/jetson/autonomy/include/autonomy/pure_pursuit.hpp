@@ -5,6 +5,8 @@
 // Throttle-to-speed map (assumed, linear, no deadband): throttle 1.0 -> top_speed_m_s
 // (0.267 m/s, Nigel's top speed), so throttle = speed / top_speed_m_s, sign = direction.
 #pragma once
+#include <cmath>
+
 #include "autonomy/path.hpp"
 
 namespace autonomy {
@@ -22,6 +24,12 @@ struct TrackerConfig {
   double cusp_pause_s = 0.4;        // standstill between direction changes
   double steer_rate_rad_s = 0.805;  // Nigel's servo: slow down before curvature changes
   double steer_preview_m = 0.25;
+  // Stall recovery: the throttle map is open loop, and at creep speed with the wheels on full
+  // lock the drivetrain's friction can hold the car. Moving slower than stall_fraction of the
+  // target for stall_s, the throttle gets a boost growing at boost_rate_per_s up to boost_max
+  // (throttle units); it goes once the car moves at boost_release_fraction of the target.
+  double stall_fraction = 0.3, stall_s = 0.5;
+  double boost_rate_per_s = 0.3, boost_max = 0.4, boost_release_fraction = 0.8;
 };
 
 struct TrackerCommand {
@@ -36,8 +44,10 @@ class PurePursuit {
  public:
   explicit PurePursuit(const TrackerConfig &cfg = TrackerConfig{}) : cfg_(cfg) {}
   void set_path(const Path &path);
-  // One control step at the current base pose; dt_s since the last step.
-  TrackerCommand step(const Pose2 &pose, double dt_s);
+  // One control step at the current base pose; dt_s since the last step. measured_speed_m_s:
+  // the car's signed speed from odometry, for stall recovery (NaN: open loop only).
+  TrackerCommand step(const Pose2 &pose, double dt_s, double measured_speed_m_s = std::nan(""));
+  double boost() const { return boost_; }  // current stall boost [throttle units]
   bool done() const { return done_; }
   bool has_path() const { return !segments_.empty(); }
   // Index in the full path of the sample nearest to the car (for the obstacle check).
@@ -45,6 +55,7 @@ class PurePursuit {
   const Path &path() const { return path_; }
 
  private:
+  void update_stall_boost(double along_m_s, double target_m_s, double dt_s);
   TrackerConfig cfg_;
   Path path_;
   std::vector<Path> segments_;  // split at cusps
@@ -53,6 +64,7 @@ class PurePursuit {
   double speed_m_s_ = 0.0;      // magnitude of the last commanded speed
   double last_steer_rad_ = 0.0;
   double pause_left_s_ = 0.0;
+  double stalled_s_ = 0.0, boost_ = 0.0;
   bool done_ = true;
 };
 
