@@ -29,7 +29,7 @@ GOAL_LOCALIZATION_RMS_M = 0.03
 GOAL_WALL_S = 120.0
 # Figures summarised by median and max over the runs that report them.
 MEDIAN_MAX_KEYS = ("final_pos_error_m", "final_heading_error_deg", "localization_rms_m",
-                   "wall_s", "sim_s")
+                   "wall_s", "sim_s", "laser_odom_drift_pct", "ekf_odom_drift_pct")
 PER_SEED_KEYS = MEDIAN_MAX_KEYS + ("min_clearance_m", "collisions", "path_length_m")
 EXIT_FILE = "demo_exit_code"  # per seed dir: demo.py's exit code, kept for --aggregate-only
 
@@ -184,6 +184,10 @@ def aggregate(runs):
         vals = [v for v in per[k] if v is not None]
         s[f"{k}_median"] = round(statistics.median(vals), 4) if vals else None
         s[f"{k}_max"] = round(max(vals), 4) if vals else None
+    # Laser odometry against its peer, the EKF's wheel/IMU odometry, over the same span of each run.
+    ratios = [a / b for a, b in zip(per["laser_odom_drift_pct"], per["ekf_odom_drift_pct"])
+              if a is not None and b]
+    s["laser_over_ekf_drift_ratio_median"] = round(statistics.median(ratios), 3) if ratios else None
     clear = [v for v in per["min_clearance_m"] if v is not None]
     s["min_clearance_m_min"] = round(min(clear), 4) if clear else None
     # Goals of issue 7; each holds only if every run meets it (a run without a figure fails it).

@@ -1,6 +1,7 @@
 // The whole mission in closed loop on the synthetic lot: AutonomyNode maps with Hector SLAM,
 // saves and reloads the map, localises with AMCL on drifting odometry, plans with Hybrid A*,
-// drives with pure pursuit on a kinematic bicycle, replans around an unmapped box, parks.
+// drives with pure pursuit on a kinematic bicycle, replans around an unmapped box, parks; and
+// maps along a route while driving.
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -20,6 +21,8 @@ struct Outcome {
   double min_clearance_m = 1e9;  // true footprint vs the true world (incl. the new box)
   int plans = 0;
   double sim_s = 0;
+  double mapped_pose_err_m = -1;  // SLAM pose vs truth when the map was saved
+  int laser_odom_scans = 0, laser_odom_rejected = 0;
 };
 
 // Distance from the true car body (rectangle) to the nearest wall point [m]; 0 = touching.
@@ -40,7 +43,7 @@ double body_clearance_m(const synth::World &w, const Pose2 &base, const Footprin
   return best;
 }
 
-Outcome run_mission(bool add_box, const std::string &tag) {
+Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose2> &route = {}) {
   synth::World world = synth::World::parking_lot();
   const Pose2 lidar{0.1445, 0.0, 0.0};
   NodeConfig cfg;
@@ -54,6 +57,7 @@ Outcome run_mission(bool add_box, const std::string &tag) {
   cfg.goal = {2.45, 0.18, kPi / 2};
   cfg.mapping_scans = 10;
   cfg.amcl.max_particles = 2000;
+  cfg.mapping_route = route;
   AutonomyNode node(cfg);
 
   synth::Bicycle car;
@@ -66,7 +70,14 @@ Outcome run_mission(bool add_box, const std::string &tag) {
   bool box_added = false;
   for (int i = 0; i < 20000 && !node.mission().finished(); ++i, t_us += 10000) {
     node.on_odom(odom, t_us);
-    if (i % 14 == 0) node.on_scan(world.scan(car.pose, lidar, 0.005, &rng), t_us);
+    if (i % 14 == 0) {
+      const bool mapping = node.mission().state() == MissionState::kMapping;
+      node.on_scan(world.scan(car.pose, lidar, 0.005, &rng), t_us);
+      if (mapping && node.mission().state() != MissionState::kMapping) {
+        const Pose2 e = pose_between(car.pose, node.pose_map());
+        out.mapped_pose_err_m = std::hypot(e.x_m, e.y_m);
+      }
+    }
     // Once the first path exists, drop a 10 cm box on it, 0.45 m from the car.
     if (add_box && !box_added && node.path().size() > 50) {
       for (const auto &q : node.path()) {
@@ -93,6 +104,8 @@ Outcome run_mission(bool add_box, const std::string &tag) {
   out.pos_err_m = std::hypot(e.x_m, e.y_m);
   out.yaw_err_rad = std::abs(e.yaw_rad);
   out.plans = node.plans();
+  out.laser_odom_scans = node.laser_odometry().scans();
+  out.laser_odom_rejected = node.laser_odometry().rejected();
   fs::remove_all(dir);
   return out;
 }
@@ -112,6 +125,21 @@ TEST(ClosedLoop, ReplansAroundAnUnmappedBoxAndStillParks) {
   ASSERT_EQ(o.state, MissionState::kParked) << o.history;
   EXPECT_GE(o.plans, 2) << o.history;
   EXPECT_NE(o.history.find("unmapped obstacle"), std::string::npos) << o.history;
+  EXPECT_LT(o.pos_err_m, 0.03) << o.history;
+  EXPECT_GT(o.min_clearance_m, 0.0) << "collision";
+}
+
+// Mapping while driving: 0.5 m back and forth along the lot before parking. SLAM matches each
+// moving scan from the laser odometry's guess; the map it saves is good enough to park on.
+TEST(ClosedLoop, MapsAlongARouteThenParks) {
+  const Outcome o = run_mission(false, "route", {{1.3, 1.2, 0.0}, {1.8, 1.35, 0.0}});
+  ASSERT_EQ(o.state, MissionState::kParked) << o.history;
+  EXPECT_NE(o.history.find("route leg 1/2"), std::string::npos) << o.history;
+  EXPECT_NE(o.history.find("route leg 2/2"), std::string::npos) << o.history;
+  EXPECT_GE(o.mapped_pose_err_m, 0.0);
+  EXPECT_LT(o.mapped_pose_err_m, 0.02) << "SLAM pose off the truth at the end of the route";  // 0.5 cm
+  EXPECT_GT(o.laser_odom_scans, 50);
+  EXPECT_LT(o.laser_odom_rejected, o.laser_odom_scans / 10) << "ICP rejected too often";
   EXPECT_LT(o.pos_err_m, 0.03) << o.history;
   EXPECT_GT(o.min_clearance_m, 0.0) << "collision";
 }
