@@ -221,9 +221,11 @@ def main():
     log(f"report: {json.dumps(report)}")
     log(f"wrote {out}/report.json, plots {', '.join(p.name for p in sorted(out.glob('*.png')))}, "
         f"log {lcm_log}")
+    if interrupted:
+        return 130
     if not report.get("ok"):
         log(f"FAILED: {report.get('error', 'see report.json')}")
-    return 0 if report.get("ok") and not interrupted else 1
+    return 0 if report.get("ok") else 1
 
 
 if __name__ == "__main__":

@@ -77,15 +77,16 @@ class App {
   bool finished() const { return node_.mission().finished(); }
   bool parked() const { return node_.mission().state() == MissionState::kParked; }
   int64_t last_utime() const { return last_utime_; }
-  void publish_command(int64_t utime) {
+  // stop: a disengaged zero command (on the way out), whatever the mission was doing.
+  void publish_command(int64_t utime, bool stop = false) {
     autodrive::vehicle_command_t c{};
     c.utime = utime;
     c.seq = seq_++;
-    c.throttle = static_cast<float>(node_.command().throttle);
-    c.steering = static_cast<float>(node_.command().steering);
+    c.throttle = stop ? 0.0f : static_cast<float>(node_.command().throttle);
+    c.steering = stop ? 0.0f : static_cast<float>(node_.command().steering);
     c.headlights = 0;
     c.indicators = node_.mission().state() == MissionState::kParked ? 3 : 0;
-    c.engaged = node_.engaged();
+    c.engaged = !stop && node_.engaged();
     lcm_.publish(cfg_.vehicle + "_COMMAND", &c);
   }
 
@@ -219,7 +220,7 @@ int main(int argc, char **argv) {
       if (app.last_utime() - finished_at >= static_cast<int64_t>(cfg.exit_after_finish_s * 1e6)) break;
     }
   }
-  app.publish_command(app.last_utime());  // a final stop (engaged only while DRIVING)
+  app.publish_command(app.last_utime(), true);  // a final stop, also when interrupted mid-drive
   if (!app.finished()) return 130;
   return app.parked() ? 0 : 1;
 }

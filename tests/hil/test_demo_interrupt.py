@@ -1,0 +1,56 @@
+"""HIL: Ctrl-C on tools/demo.py mid-mission. While the car drives its mapping route, SIGINT
+must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable report and
+LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is timed: the
+test waits for the demo's own progress lines."""
+import json
+import pathlib
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
+sys.path.insert(0, str(pathlib.Path(build) / "lcm_types" / "gen" / "python"))
+import lcm  # noqa: E402
+from autodrive import vehicle_command_t  # noqa: E402
+
+
+def alive(pattern):
+    r = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True)
+    return [p for p in r.stdout.split() if p and int(p) != 0]
+
+
+with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
+    demo = subprocess.Popen([sys.executable, str(root / "tools" / "demo.py"), "--build", build,
+                             "--out", tmp, "--headless", "--timeout", "200",
+                             "--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    seen = []
+    for line in demo.stdout:
+        seen.append(line)
+        sys.stdout.write(line)
+        if "route leg 1/" in line:  # the car is engaged and moving
+            break
+    assert demo.poll() is None, "the demo ended before the mapping route:\n" + "".join(seen)
+    time.sleep(0.5)  # well into the leg
+    children = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
+    assert len(children) >= 3, f"expected the demo's children running, found {children}"
+    demo.send_signal(signal.SIGINT)
+    rest, _ = demo.communicate(timeout=120)
+    sys.stdout.write(rest)
+    assert demo.returncode == 130, f"demo exited {demo.returncode}, want 130 (interrupted)"
+    assert "interrupted" in rest
+    left = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
+    assert not left, f"processes left behind: {left}"
+    report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
+    assert not report.get("ok"), "an interrupted mission must not report ok"
+    assert report.get("gt_samples", 0) > 100, "the LCM log lost what was recorded"
+    last = None
+    for ev in lcm.EventLog(str(pathlib.Path(tmp) / "run.lcmlog"), "r"):
+        if ev.channel == "NIGEL1_COMMAND":
+            last = vehicle_command_t.decode(ev.data)
+    assert last is not None, "no command in the log"
+    assert not last.engaged and last.throttle == 0.0, \
+        f"last command engaged={last.engaged} throttle={last.throttle}: the autonomy left no stop"
+print("hil demo interrupt ok")
