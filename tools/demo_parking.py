@@ -183,10 +183,16 @@ def score(log_path, out_dir, veh, mission):
     rep["localization_rms_m"] = round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
     # Dead reckoning, laser (ICP) against wheel/IMU (EKF), over the same span of the run.
     span = (odom["laser_odom"][0][0], odom["laser_odom"][-1][0]) if odom["laser_odom"] else None
+    tracks = {}
     for name, samples in odom.items():
-        d = odometry_drift(samples, gt_t, gt, span)
-        if d:
-            rep[f"{name}_final_error_m"], rep[f"{name}_drift_pct"] = d
+        tr = aligned_track(samples, gt_t, gt, span)
+        if tr:
+            tracks[name] = tr
+            rep[f"{name}_final_error_m"], rep[f"{name}_drift_pct"] = odometry_drift(tr, gt_t, gt)
+    if tracks:
+        err = plot_odometry(tracks, gt, gt_t, span, rep, out_dir / "odometry.png")
+        if err:
+            rep["plot_error"] = err
     with open(out_dir / "gt.csv", "w") as f:
         f.write("x_m,y_m,yaw_rad\n")
         for g in gt[::10]:
@@ -210,29 +216,63 @@ def score(log_path, out_dir, veh, mission):
     return rep
 
 
-def odometry_drift(samples, gt_t, gt, span):
-    """(final position error [m], as % of the distance driven) of an odometry track aligned
-    with the truth at its first sample inside span (sim-time stamps [us]), or None."""
+def aligned_track(samples, gt_t, gt, span):
+    """An odometry track [(t_us, x, y)] in the world, aligned with the truth at its first
+    sample inside span (sim-time stamps [us]): dead reckoning from a known start. None if
+    fewer than two samples."""
     import bisect
     if not span:
         return None
     samples = [s for s in samples if span[0] <= s[0] <= span[1]]
     if len(samples) < 2:
         return None
-    def truth(t):
-        return gt[min(bisect.bisect_left(gt_t, t), len(gt) - 1)]
     t0, x0, y0, yaw0 = samples[0]
-    g0 = truth(t0)
+    g0 = gt[min(bisect.bisect_left(gt_t, t0), len(gt) - 1)]
     dyaw = _wrap(g0[2] - yaw0)
     c, s = math.cos(dyaw), math.sin(dyaw)
-    t1, x1, y1, _ = samples[-1]
-    g1 = truth(t1)
-    xw = g0[0] + c * (x1 - x0) - s * (y1 - y0)
-    yw = g0[1] + s * (x1 - x0) + c * (y1 - y0)
-    err = math.hypot(xw - g1[0], yw - g1[1])
-    i0, i1 = bisect.bisect_left(gt_t, t0), bisect.bisect_left(gt_t, t1)
+    return [(t, g0[0] + c * (x - x0) - s * (y - y0), g0[1] + s * (x - x0) + c * (y - y0))
+            for t, x, y, _ in samples]
+
+
+def odometry_drift(track, gt_t, gt):
+    """(final position error [m], as % of the distance driven) of an aligned track."""
+    import bisect
+    i0 = bisect.bisect_left(gt_t, track[0][0])
+    i1 = min(bisect.bisect_left(gt_t, track[-1][0]), len(gt) - 1)
+    err = math.hypot(track[-1][1] - gt[i1][0], track[-1][2] - gt[i1][1])
     dist = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(gt[i0:i1], gt[i0 + 1:i1 + 1]))
     return round(err, 4), round(100.0 * err / dist, 2) if dist > 0.05 else None
+
+
+def plot_odometry(tracks, gt, gt_t, span, rep, path):
+    """odometry.png: laser and EKF dead reckoning against the truth over the same span."""
+    import bisect
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        return str(e)
+    i0, i1 = bisect.bisect_left(gt_t, span[0]), bisect.bisect_left(gt_t, span[1])
+    fig, ax = plt.subplots(figsize=(7, 6))
+    ax.plot([g[0] for g in gt[i0:i1]], [g[1] for g in gt[i0:i1]], "k-", lw=2, label="ground truth")
+    style = {"laser_odom": ("tab:blue", "laser odometry (ICP)"),
+             "ekf_odom": ("tab:red", "EKF odometry (wheels + IMU)")}
+    for name, tr in tracks.items():
+        colour, label = style[name]
+        pct = rep.get(f"{name}_drift_pct")
+        ax.plot([p[1] for p in tr], [p[2] for p in tr], "--", color=colour, lw=1.2,
+                label=f"{label}: {pct} % drift" if pct is not None else label)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("dead reckoning from the same start, world frame")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return None
 
 
 def _obstacles():
