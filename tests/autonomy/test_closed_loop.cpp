@@ -23,6 +23,8 @@ struct Outcome {
   double sim_s = 0;
   double mapped_pose_err_m = -1;  // SLAM pose vs truth when the map was saved
   int laser_odom_scans = 0, laser_odom_rejected = 0;
+  double max_progress[7] = {};     // per MissionState
+  bool progress_in_range = true;
 };
 
 // Distance from the true car body (rectangle) to the nearest wall point [m]; 0 = touching.
@@ -88,6 +90,10 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
       }
       box_added = true;
     }
+    const double pr = node.progress();
+    out.progress_in_range = out.progress_in_range && pr >= 0.0 && pr <= 1.0;
+    double &mp = out.max_progress[static_cast<int>(node.mission().state())];
+    mp = std::max(mp, pr);
     const TrackerCommand &c = node.command();
     const Pose2 before = car.pose;
     car.step(c.throttle * 0.267, c.steering * 0.5236, dt);
@@ -140,6 +146,11 @@ TEST(ClosedLoop, MapsAlongARouteThenParks) {
   EXPECT_LT(o.mapped_pose_err_m, 0.02) << "SLAM pose off the truth at the end of the route";  // 0.5 cm
   EXPECT_GT(o.laser_odom_scans, 50);
   EXPECT_LT(o.laser_odom_rejected, o.laser_odom_scans / 10) << "ICP rejected too often";
+  // mission_status_t.progress: through the route while mapping, along the path while driving.
+  EXPECT_TRUE(o.progress_in_range);
+  EXPECT_GT(o.max_progress[static_cast<int>(MissionState::kMapping)], 0.9);
+  EXPECT_GT(o.max_progress[static_cast<int>(MissionState::kDriving)], 0.9);
+  EXPECT_EQ(o.max_progress[static_cast<int>(MissionState::kParked)], 1.0);
   EXPECT_LT(o.pos_err_m, 0.03) << o.history;
   EXPECT_GT(o.min_clearance_m, 0.0) << "collision";
 }

@@ -1,6 +1,6 @@
 """HIL integration: the full default demo (tools/demo.py: Parking School, the simulator in
-lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a box that appears after
-mapping). It must map, localise, see the box and replan, park without a collision, and meet
+lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping route, a box that
+steps out after mapping). It must map, localise, see the box and replan, park without a collision, and meet
 issue 7's bounds by the simulator's ground truth. Lockstep makes the run independent of how
 loaded the machine is (the sim waits for the runtime), so the bounds are the issue's own."""
 import json
@@ -25,6 +25,10 @@ with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
     assert report["localization_rms_m"] <= 0.03, "localisation RMS over 3 cm"
     assert report["rtf_requested"] == "lockstep"
     log = (pathlib.Path(tmp) / "autonomy.log").read_text()
-    assert "unmapped obstacle" in log, "the box that appeared after mapping was not seen"
+    sim_log = (pathlib.Path(tmp) / "sim.log").read_text()
+    appeared = [ln for ln in sim_log.splitlines() if ln.startswith("late box 1 appeared")]
+    assert appeared, "the box never stepped out (the car did not come within 0.5 m of it)"
+    assert "unmapped obstacle" in log, \
+        f"the box that appeared after mapping was not seen ({appeared[0]}); autonomy:\n{log}"
     assert (pathlib.Path(tmp) / "parking.png").stat().st_size > 1000, "parking plot missing"
 print("hil parking ok")

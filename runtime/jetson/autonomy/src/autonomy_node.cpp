@@ -1,5 +1,6 @@
 #include "autonomy/autonomy_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -35,6 +36,34 @@ AutonomyNode::AutonomyNode(const NodeConfig &cfg)
 const GridMap *AutonomyNode::map() const {
   if (map_) return map_.get();
   return slam_ ? &slam_->map() : nullptr;
+}
+
+double AutonomyNode::progress() const {
+  const auto path_fraction = [this] {
+    const size_t n = tracker_.path().size();
+    if (n < 2) return 0.0;
+    return tracker_.done() ? 1.0 : static_cast<double>(tracker_.progress_index()) / (n - 1);
+  };
+  switch (mission_.state()) {
+    case MissionState::kMapping: {
+      // The standstill scans count as one step, each route leg as another.
+      const double steps = 1.0 + static_cast<double>(cfg_.mapping_route.size());
+      const double scans = slam_ ? std::min(1.0, static_cast<double>(slam_->scans_processed()) /
+                                                     std::max(1, cfg_.mapping_scans))
+                                 : 0.0;
+      const double legs = mapping_leg_index_ + (mapping_leg_ ? path_fraction() : 0.0);
+      return std::clamp((scans + legs) / steps, 0.0, 1.0);
+    }
+    case MissionState::kLocalising:
+      return std::min(1.0, static_cast<double>(localising_updates_) / std::max(1, cfg_.localising_min_updates));
+    case MissionState::kDriving:
+      return std::clamp(path_fraction(), 0.0, 1.0);
+    case MissionState::kParked:
+    case MissionState::kFailed:
+      return 1.0;
+    default:
+      return 0.0;
+  }
 }
 
 Pose2 AutonomyNode::pose_map() const { return pose_compose(map_from_odom_, odom_); }

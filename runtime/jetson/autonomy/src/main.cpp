@@ -143,7 +143,7 @@ class App {
     m.utime = utime;
     m.vehicle = cfg_.vehicle;
     m.state = static_cast<int8_t>(ms.state());
-    m.progress = ms.finished() ? 1.0f : 0.0f;
+    m.progress = static_cast<float>(node_.progress());
     m.detail = ms.detail();
     lcm_.publish(cfg_.vehicle + "_MISSION", &m);
   }

@@ -64,6 +64,9 @@ class AutonomyNode {
   void on_scan(const Scan &scan, int64_t utime_us);   // mapping, localisation, obstacles
 
   const Mission &mission() const { return mission_; }
+  // Progress within the current state [0, 1] (mission_status_t.progress): mapping scans and
+  // route legs, localisation updates, the path driven; 1 once finished.
+  double progress() const;
   const TrackerCommand &command() const { return command_; }
   bool engaged() const {
     return mission_.state() == MissionState::kDriving ||
