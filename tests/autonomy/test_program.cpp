@@ -1,5 +1,5 @@
 // autodrive-autonomy over real LCM (UDP multicast, port 7811): given a saved map it localises
-// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, LASER_ODOM, MISSION and engaged
+// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, LASER_ODOM, PATH, MISSION and engaged
 // COMMANDs. Also --help and a clear error on a bad config.
 #include <signal.h>
 #include <sys/wait.h>
@@ -16,6 +16,7 @@
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/mission_status_t.hpp>
 #include <autodrive/odometry_t.hpp>
+#include <autodrive/path2d_t.hpp>
 #include <autodrive/pose2d_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
@@ -49,6 +50,12 @@ struct Listener {
   bool have_amcl = false;
   autodrive::pose2d_t amcl{};
   int laser_odom_msgs = 0;
+  bool have_path = false;
+  autodrive::path2d_t path{};
+  void on_path(const lcm::ReceiveBuffer *, const std::string &, const autodrive::path2d_t *m) {
+    have_path = true;
+    path = *m;
+  }
   autodrive::odometry_t laser_odom{};
   void on_laser_odom(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
     ++laser_odom_msgs;
@@ -102,6 +109,7 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
       lcm, "NIGELT_POSE_AMCL", &l);
   autodrive_lcm::subscribe<autodrive::odometry_t, Listener, &Listener::on_laser_odom>(
       lcm, "NIGELT_LASER_ODOM", &l);
+  autodrive_lcm::subscribe<autodrive::path2d_t, Listener, &Listener::on_path>(lcm, "NIGELT_PATH", &l);
 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
@@ -113,7 +121,7 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   const Pose2 lidar{0.1445, 0, 0};
   // The car stands still: odometry at its origin, scans from the true pose, 100 Hz / 7 Hz of
   // message time; a bounded number of steps, never a wall-time assert.
-  for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl); ++i) {
+  for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl && l.have_path); ++i) {
     const int64_t t_us = 1000000 + static_cast<int64_t>(i) * 10000;
     autodrive::odometry_t o{};
     o.utime = t_us;
@@ -152,6 +160,14 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   EXPECT_GE(l.laser_odom_msgs, 8);
   EXPECT_EQ(l.laser_odom.frame_id, "laser_odom");
   EXPECT_LT(std::hypot(l.laser_odom.x_m, l.laser_odom.y_m), 0.005);
+  // The plan, on NIGELT_PATH: from where the car stands to the goal.
+  ASSERT_TRUE(l.have_path);
+  EXPECT_EQ(l.path.purpose, "parking");
+  EXPECT_GE(l.path.plan, 1);
+  ASSERT_GE(l.path.num_poses, 2);
+  EXPECT_NEAR(l.path.x_m.front(), truth.x_m, 0.05);
+  EXPECT_NEAR(l.path.x_m.back(), 2.45, 1e-3);
+  EXPECT_NEAR(l.path.y_m.back(), 0.18, 1e-3);
   EXPECT_TRUE(fs::exists(dir / "out" / "path.csv"));
   EXPECT_TRUE(WIFEXITED(st)) << "killed by a signal instead of exiting cleanly";
   fs::remove_all(dir);

@@ -1,5 +1,5 @@
 // autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
-// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM and <VEH>_MISSION, and prints each mission state
+// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM, <VEH>_PATH and <VEH>_MISSION, and prints each mission state
 // change. Writes path.csv, route.csv and trajectory.csv into out_dir for tools/plot-parking.
 #include <cmath>
 #include <csignal>
@@ -14,6 +14,7 @@
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/mission_status_t.hpp>
 #include <autodrive/odometry_t.hpp>
+#include <autodrive/path2d_t.hpp>
 #include <autodrive/pose2d_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
@@ -45,7 +46,7 @@ class App {
     s.ranges_m = m->ranges_m;
     const int plans_before = node_.plans();
     node_.on_scan(s, m->utime);
-    if (node_.plans() != plans_before) write_plan();
+    if (node_.plans() != plans_before) write_plan(m->utime);
     publish_laser_odom();
     last_utime_ = std::max(last_utime_, m->utime);
     // The localisation estimate, once per scan that produced one, stamped when it was true.
@@ -59,7 +60,7 @@ class App {
   void on_odom(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
     const int plans_before = node_.plans();
     node_.on_odom({m->x_m, m->y_m, m->yaw_rad}, m->utime);
-    if (node_.plans() != plans_before) write_plan();
+    if (node_.plans() != plans_before) write_plan(m->utime);
     last_utime_ = std::max(last_utime_, m->utime);
     if (m->utime - last_cmd_us_ >= static_cast<int64_t>(1e6 / cfg_.command_rate_hz)) {
       publish_command(m->utime);
@@ -103,6 +104,24 @@ class App {
     const Eigen::Matrix3d c = node_.amcl_covariance();
     for (int i = 0; i < 9; ++i) m.covariance[i] = c(i / 3, i % 3);
     lcm_.publish(cfg_.vehicle + "_POSE_AMCL", &m);
+  }
+
+  void publish_path(int64_t utime) {
+    autodrive::path2d_t m{};
+    m.utime = utime;
+    m.vehicle = cfg_.vehicle;
+    m.frame_id = "map";
+    m.plan = node_.plans();
+    m.purpose = node_.mission().state() == MissionState::kMapping ? "mapping" : "parking";
+    for (const auto &q : node_.path()) {
+      m.x_m.push_back(q.pose.x_m);
+      m.y_m.push_back(q.pose.y_m);
+      m.yaw_rad.push_back(q.pose.yaw_rad);
+      m.direction.push_back(static_cast<int8_t>(q.direction));
+      m.curvature_1pm.push_back(q.curvature_1pm);
+    }
+    m.num_poses = static_cast<int32_t>(m.x_m.size());
+    lcm_.publish(cfg_.vehicle + "_PATH", &m);
   }
 
   // Laser odometry in its own frame (the base pose at the first scan), at the scan's mid-time;
@@ -150,7 +169,9 @@ class App {
 
   // path.csv keeps every plan of the run (column plan = 1, 2, ...: replans and retries), so a
   // plot shows the path the car gave up as well as the one it finished on.
-  void write_plan() {
+  void write_plan(int64_t utime) {
+    if (node_.mission().state() == MissionState::kFailed) return;  // no new path, only the old
+    publish_path(utime);
     const bool first = node_.plans() <= 1;
     std::ofstream p(std::filesystem::path(cfg_.out_dir) / "path.csv",
                     first ? std::ios::trunc : std::ios::app);
