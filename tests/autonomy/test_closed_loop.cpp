@@ -23,6 +23,7 @@ struct Outcome {
   double sim_s = 0;
   double mapped_pose_err_m = -1;  // SLAM pose vs truth when the map was saved
   int laser_odom_scans = 0, laser_odom_rejected = 0;
+  Path retry_path;  // the first plan made after a stop off the goal
   double max_progress[7] = {};     // per MissionState
   bool progress_in_range = true;
 };
@@ -45,7 +46,8 @@ double body_clearance_m(const synth::World &w, const Pose2 &base, const Footprin
   return best;
 }
 
-Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose2> &route = {}) {
+Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose2> &route = {},
+                    double yaw_tolerance_rad = -1.0, double retry_backoff_m = 0.0) {
   synth::World world = synth::World::parking_lot();
   const Pose2 lidar{0.1445, 0.0, 0.0};
   NodeConfig cfg;
@@ -60,6 +62,8 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
   cfg.mapping_scans = 10;
   cfg.amcl.max_particles = 2000;
   cfg.mapping_route = route;
+  if (yaw_tolerance_rad >= 0) cfg.goal_tolerance_yaw_rad = yaw_tolerance_rad;
+  cfg.retry_backoff_m = retry_backoff_m;
   AutonomyNode node(cfg);
 
   synth::Bicycle car;
@@ -90,6 +94,8 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
       }
       box_added = true;
     }
+    if (out.retry_path.empty() && node.mission().detail().find("staging") != std::string::npos)
+      out.retry_path = node.path();
     const double pr = node.progress();
     out.progress_in_range = out.progress_in_range && pr >= 0.0 && pr <= 1.0;
     double &mp = out.max_progress[static_cast<int>(node.mission().state())];
@@ -152,5 +158,26 @@ TEST(ClosedLoop, MapsAlongARouteThenParks) {
   EXPECT_GT(o.max_progress[static_cast<int>(MissionState::kDriving)], 0.9);
   EXPECT_EQ(o.max_progress[static_cast<int>(MissionState::kParked)], 1.0);
   EXPECT_LT(o.pos_err_m, 0.03) << o.history;
+  EXPECT_GT(o.min_clearance_m, 0.0) << "collision";
+}
+
+// A stop off the goal (here: any stop, with a 0.01 deg heading tolerance) is retried through a
+// staging pose 0.2 m back along the approach, so the car runs the last 0.2 m straight in.
+TEST(ClosedLoop, ARetryBacksOffToAStagingPoseAndRunsStraightIn) {
+  const Outcome o = run_mission(false, "retry", {}, 0.0002, 0.2);
+  EXPECT_NE(o.history.find("retry: stopped"), std::string::npos) << o.history;
+  ASSERT_FALSE(o.retry_path.empty()) << o.history;
+  const Pose2 goal{2.45, 0.18, kPi / 2};
+  // The car reverses into this slot (nose out): the staging pose is 0.2 m ahead of the goal.
+  const int dir = o.retry_path.back().direction;
+  EXPECT_EQ(dir, -1);
+  const Pose2 staging = pose_compose(goal, Pose2{-dir * 0.2, 0.0, 0.0});
+  double to_staging = 1e9;
+  for (const auto &q : o.retry_path)
+    to_staging = std::min(to_staging, std::hypot(q.pose.x_m - staging.x_m, q.pose.y_m - staging.y_m));
+  EXPECT_LT(to_staging, 1e-3) << "the retry does not pass the staging pose";
+  EXPECT_GE(path_cusps(o.retry_path), 1);
+  EXPECT_NEAR(o.retry_path.back().pose.x_m, goal.x_m, 1e-6);
+  EXPECT_NEAR(o.retry_path.back().pose.y_m, goal.y_m, 1e-6);
   EXPECT_GT(o.min_clearance_m, 0.0) << "collision";
 }

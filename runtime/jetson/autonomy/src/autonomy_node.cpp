@@ -127,7 +127,27 @@ void AutonomyNode::judge_arrival(double t_s) {
   why << "stopped " << pos_err_m << " m, " << yaw_err_rad * 180.0 / kPi << " deg from the goal";
   mission_.arrived(pos_err_m <= cfg_.goal_tolerance_m && yaw_err_rad <= cfg_.goal_tolerance_yaw_rad,
                    why.str(), t_s);
-  if (mission_.state() == MissionState::kPlanning) plan(t_s);
+  if (mission_.state() == MissionState::kPlanning) plan(t_s, true);
+}
+
+PlanResult AutonomyNode::plan_via_staging(const Pose2 &from) {
+  // Back off against the direction the last path arrived in, then run straight in.
+  const int arrive_dir = tracker_.path().empty() ? 1 : tracker_.path().back().direction;
+  const Pose2 staging = pose_compose(cfg_.goal, Pose2{-arrive_dir * cfg_.retry_backoff_m, 0.0, 0.0});
+  PlanResult out;
+  out.detail = "staging pose not reachable";
+  if (!checker_->pose_free(staging)) return out;
+  const PlanResult a = hybrid_astar_plan(*checker_, from, staging, cfg_.planner);
+  if (a.failed) return out;
+  const PlanResult b = hybrid_astar_plan(*checker_, staging, cfg_.goal, cfg_.planner);
+  if (b.failed) return out;
+  out = b;
+  out.path = a.path;
+  out.path.insert(out.path.end(), b.path.begin() + (b.path.empty() ? 0 : 1), b.path.end());
+  out.expansions = a.expansions + b.expansions;
+  out.route_m = a.route_m;
+  out.route_m.insert(out.route_m.end(), b.route_m.begin(), b.route_m.end());
+  return out;
 }
 
 void AutonomyNode::localise(const Pose2 &odom_scan, const Scan &scan, int64_t scan_mid_us) {
@@ -144,10 +164,16 @@ void AutonomyNode::localise(const Pose2 &odom_scan, const Scan &scan, int64_t sc
   loc_utime_us_ = scan_mid_us;
 }
 
-void AutonomyNode::plan(double t_s) {
+void AutonomyNode::plan(double t_s, bool retry) {
   ++plans_;
   settling_ = false;
-  const PlanResult r = hybrid_astar_plan(*checker_, pose_map(), cfg_.goal, cfg_.planner);
+  bool staged = false;
+  PlanResult r;
+  if (retry && cfg_.retry_backoff_m > 0) {
+    r = plan_via_staging(pose_map());
+    staged = !r.failed;
+  }
+  if (!staged) r = hybrid_astar_plan(*checker_, pose_map(), cfg_.goal, cfg_.planner);
   route_m_ = r.route_m;
   if (r.failed) {
     mission_.planned(false, "planning failed: " + r.detail, t_s);
@@ -158,6 +184,7 @@ void AutonomyNode::plan(double t_s) {
   why.precision(3);
   why << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, "
       << r.expansions << " expansions";
+  if (staged) why << ", via a staging pose " << cfg_.retry_backoff_m << " m back";
   mission_.planned(true, why.str(), t_s);
 }
 

@@ -59,7 +59,7 @@ ProgramConfig cfg_load(const std::string &path) {
   r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
                     "start", "goal", "lidar_in_base", "mapping_scans", "mapping_route", "goal_tolerance_m",
                     "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "obstacle_cluster_m",
-                    "unknown_is_obstacle", "settle_s", "refine_scan_match", "footprint", "slam", "laser_odom", "amcl",
+                    "unknown_is_obstacle", "settle_s", "retry_backoff_m", "refine_scan_match", "footprint", "slam", "laser_odom", "amcl",
                     "planner", "tracker", "mission"});
   r.get(root, "", "vehicle", c.vehicle);
   r.get(root, "", "lcm_url", c.lcm_url);
@@ -94,6 +94,8 @@ ProgramConfig cfg_load(const std::string &path) {
   r.get(root, "", "obstacle_inflation_m", n.obstacle_inflation_m);
   r.get(root, "", "obstacle_cluster_m", n.obstacle_cluster_m);
   r.get(root, "", "settle_s", n.settle_s);
+  r.get(root, "", "retry_backoff_m", n.retry_backoff_m);
+  if (n.retry_backoff_m < 0 || n.retry_backoff_m > 2) r.fail("'retry_backoff_m' must be 0..2 [m]");
   r.get(root, "", "refine_scan_match", n.refine_scan_match);
   if (n.settle_s < 0 || n.settle_s > 10) r.fail("'settle_s' must be 0..10 [s]");
   if (const auto f = root["footprint"]) {
