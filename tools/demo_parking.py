@@ -26,19 +26,24 @@ def spawn_pose(map_xml):
     return float(m.group(1)), float(m.group(2)), math.radians(float(m.group(3)))
 
 
+def parse_pose_deg(text):
+    """"X,Y,YAW_DEG" as (x, y, yaw_rad) [m, m, rad]; ValueError saying what is wrong."""
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise ValueError("expected X,Y,YAW_DEG, e.g. -1.0,0.6,0")
+    try:
+        x, y, yaw_deg = (float(v) for v in parts)
+    except ValueError:
+        raise ValueError("X, Y and YAW_DEG must be numbers") from None
+    if not all(map(math.isfinite, (x, y, yaw_deg))):
+        raise ValueError("X, Y and YAW_DEG must be finite")
+    return x, y, math.radians(yaw_deg)
+
+
 def start_pose(text, seed):
     """World start pose [m, m, rad]: --start X,Y,YAW_DEG, or the spawn moved by the seed."""
     if text:
-        parts = text.split(",")
-        if len(parts) != 3:
-            raise ValueError("expected X,Y,YAW_DEG, e.g. -1.0,0.6,0")
-        try:
-            x, y, yaw_deg = (float(v) for v in parts)
-        except ValueError:
-            raise ValueError("X, Y and YAW_DEG must be numbers") from None
-        if not all(map(math.isfinite, (x, y, yaw_deg))):
-            raise ValueError("X, Y and YAW_DEG must be finite")
-        return x, y, math.radians(yaw_deg)
+        return parse_pose_deg(text)
     x, y, yaw = spawn_pose(ROOT / "sim/mujoco_hil/maps/parking_school.xml")
     if seed == 0:
         return x, y, yaw
@@ -74,14 +79,10 @@ def mapping_route(text):
     """--mapping-route X,Y,YAW_DEG[;...] (start frame) as [(x, y, yaw_rad)]; '' = none."""
     route = []
     for leg in filter(None, (t.strip() for t in text.split(";"))):
-        parts = leg.split(",")
         try:
-            x, y, yaw_deg = (float(v) for v in parts)
-        except ValueError:
-            raise ValueError(f"--mapping-route leg '{leg}': expected X,Y,YAW_DEG numbers") from None
-        if not all(map(math.isfinite, (x, y, yaw_deg))):
-            raise ValueError(f"--mapping-route leg '{leg}': X, Y and YAW_DEG must be finite")
-        route.append((x, y, math.radians(yaw_deg)))
+            route.append(parse_pose_deg(leg))
+        except ValueError as e:
+            raise ValueError(f"--mapping-route leg '{leg}': {e}") from None
     return route
 
 

@@ -17,6 +17,15 @@ MissionConfig mission_cfg(const NodeConfig &cfg) {
   return m;
 }
 
+// "path 1.28 m, 0 cusps, 1 expansions": what the terminal and mission_status_t show of a plan.
+std::string describe_plan(const PlanResult &r) {
+  std::ostringstream d;
+  d.precision(3);
+  d << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, " << r.expansions
+    << " expansions";
+  return d.str();
+}
+
 }  // namespace
 
 AutonomyNode::AutonomyNode(const NodeConfig &cfg)
@@ -182,8 +191,7 @@ void AutonomyNode::plan(double t_s, bool retry) {
   tracker_.set_path(r.path);
   std::ostringstream why;
   why.precision(3);
-  why << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, "
-      << r.expansions << " expansions";
+  why << describe_plan(r);
   if (staged) why << ", via a staging pose " << cfg_.retry_backoff_m << " m back";
   mission_.planned(true, why.str(), t_s);
 }
@@ -217,8 +225,9 @@ void AutonomyNode::map_scan(const Scan &scan, const Pose2 &odom_scan, const Pose
 
 void AutonomyNode::plan_mapping_leg(double t_s) {
   const Pose2 &to = cfg_.mapping_route[mapping_leg_index_];
-  mapping_plan_map_ = std::make_unique<GridMap>(slam_->map());
-  const CollisionChecker checker(*mapping_plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+  // A snapshot: the checker keeps a reference, and SLAM writes its map as the car moves.
+  const GridMap snapshot = slam_->map();
+  const CollisionChecker checker(snapshot, cfg_.footprint, cfg_.unknown_is_obstacle);
   const PlanResult r = hybrid_astar_plan(checker, pose_map(), to, cfg_.planner);
   std::ostringstream what;
   what.precision(3);
@@ -232,8 +241,7 @@ void AutonomyNode::plan_mapping_leg(double t_s) {
   route_m_ = r.route_m;
   tracker_.set_path(r.path);
   mapping_leg_ = true;
-  what << ": path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps";
-  mission_.note(what.str());
+  mission_.note(what.str() + ": " + describe_plan(r));
 }
 
 void AutonomyNode::save_map(double t_s) {

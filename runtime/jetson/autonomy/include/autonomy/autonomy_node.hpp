@@ -126,7 +126,6 @@ class AutonomyNode {
   std::vector<Eigen::Vector2d> route_m_;
   size_t mapping_leg_index_ = 0;  // next mapping_route pose
   bool mapping_leg_ = false;      // driving a mapping-route leg
-  std::unique_ptr<GridMap> mapping_plan_map_;  // SLAM map snapshot the leg was planned on
   bool have_odom_ = false, have_map_odom_ = false;
   Pose2 odom_, odom_at_last_scan_;
   OdomHistory odom_history_;
