@@ -33,43 +33,72 @@ def parse_args():
         prog="tools/demo",
         description="Run the Nigel HIL demo: autodrive-sim (Parking School) + the unchanged "
         "autodrive-runtime on its ptys + a driver, recorded with lcm-logger. Writes "
-        "out/demo/{report.json,*.png,run.lcmlog}.")
+        "out/demo/{report.json,*.png,run.lcmlog}.",
+    )
     p.add_argument("--build", default=str(ROOT / "build" / "release"), help="host build dir")
     p.add_argument("--out", default=str(ROOT / "out" / "demo"), help="output folder")
-    p.add_argument("--seed", type=int, default=1,
-                   help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start)")
-    p.add_argument("--mission", choices=("parking", "loop"), default="parking",
-                   help="parking (default): map, localise, plan and park autonomously; loop: "
-                   "drive a stadium track with pure pursuit on the EKF")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=1,
+        help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start)",
+    )
+    p.add_argument(
+        "--mission",
+        choices=("parking", "loop"),
+        default="parking",
+        help="parking (default): map, localise, plan and park autonomously; loop: "
+        "drive a stadium track with pure pursuit on the EKF",
+    )
     p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
-    p.add_argument("--start", metavar="X,Y,YAW_DEG",
-                   help="parking: the car's start pose in the world [m, m, deg] (default: the "
-                   "map's spawn moved by up to 5 cm and 5 deg, drawn from --seed; seed 0: exactly "
-                   "the spawn)")
-    p.add_argument("--late-box", metavar="X,Y,T[,SX,SY[,R]]", action="append", default=[],
-                   help="parking: a box the map does not have appears at world (X, Y) [m] at sim "
-                   "time T [s] (half sizes SX, SY [m]; with R, once the car is within R [m]); "
-                   "repeatable; replaces the default box. Write --late-box=-0.6,... for negative "
-                   f"X. Default: {DEFAULT_LATE_BOX} ({DEFAULT_LATE_BOX_STILL} with an empty "
-                   "--mapping-route): on the direct way to slot 2, after mapping; the car must "
-                   "see it and replan around it")
-    p.add_argument("--mapping-route", metavar="X,Y,YAW_DEG[;...]", default=DEFAULT_MAPPING_ROUTE,
-                   help="parking: after mapping standing still, the car drives these poses of "
-                   "its start frame [m, m, deg] (x ahead, y left), mapping as it goes, and "
-                   f"parks from the last; '' maps standing still only. Default: {DEFAULT_MAPPING_ROUTE} "
-                   "(0.35 m back)")
-    p.add_argument("--no-late-box", action="store_true",
-                   help="parking: no box appears (the lot is as mapped)")
-    p.add_argument("--timeout", type=float, default=240.0,
-                   help="parking: give up after this many wall seconds")
+    p.add_argument(
+        "--start",
+        metavar="X,Y,YAW_DEG",
+        help="parking: the car's start pose in the world [m, m, deg] (default: the "
+        "map's spawn moved by up to 5 cm and 5 deg, drawn from --seed; seed 0: exactly "
+        "the spawn)",
+    )
+    p.add_argument(
+        "--late-box",
+        metavar="X,Y,T[,SX,SY[,R]]",
+        action="append",
+        default=[],
+        help="parking: a box the map does not have appears at world (X, Y) [m] at sim "
+        "time T [s] (half sizes SX, SY [m]; with R, once the car is within R [m]); "
+        "repeatable; replaces the default box. Write --late-box=-0.6,... for negative "
+        f"X. Default: {DEFAULT_LATE_BOX} ({DEFAULT_LATE_BOX_STILL} with an empty "
+        "--mapping-route): on the direct way to slot 2, after mapping; the car must "
+        "see it and replan around it",
+    )
+    p.add_argument(
+        "--mapping-route",
+        metavar="X,Y,YAW_DEG[;...]",
+        default=DEFAULT_MAPPING_ROUTE,
+        help="parking: after mapping standing still, the car drives these poses of "
+        "its start frame [m, m, deg] (x ahead, y left), mapping as it goes, and "
+        f"parks from the last; '' maps standing still only. Default: {DEFAULT_MAPPING_ROUTE} "
+        "(0.35 m back)",
+    )
+    p.add_argument(
+        "--no-late-box", action="store_true", help="parking: no box appears (the lot is as mapped)"
+    )
+    p.add_argument(
+        "--timeout", type=float, default=240.0, help="parking: give up after this many wall seconds"
+    )
     p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
-    p.add_argument("--realtime", action="store_true",
-                   help="run in real time (default: lockstep with the runtime, as fast as it "
-                   "keeps up)")
-    p.add_argument("--headless", action="store_true",
-                   help="never open the simulator's window (default: open it when a display exists)")
-    p.add_argument("--rtf", type=float,
-                   help="pace the simulator at this real-time factor instead of lockstep")
+    p.add_argument(
+        "--realtime",
+        action="store_true",
+        help="run in real time (default: lockstep with the runtime, as fast as it " "keeps up)",
+    )
+    p.add_argument(
+        "--headless",
+        action="store_true",
+        help="never open the simulator's window (default: open it when a display exists)",
+    )
+    p.add_argument(
+        "--rtf", type=float, help="pace the simulator at this real-time factor instead of lockstep"
+    )
     p.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0", help="LCM URL")
     return p.parse_args()
 
@@ -83,8 +112,9 @@ class Procs:
     def start(self, name, argv, logfile):
         log(f"starting {name}: {' '.join(map(str, argv))}")
         f = open(logfile, "w")
-        proc = subprocess.Popen([str(a) for a in argv], stdout=f, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+        proc = subprocess.Popen(
+            [str(a) for a in argv], stdout=f, stderr=subprocess.STDOUT, start_new_session=True
+        )
         self.items.append((name, proc, f))
         return proc
 
@@ -125,13 +155,16 @@ def main():
     run_dir.mkdir(parents=True, exist_ok=True)
     for prog in ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy"):
         if not (build / "bin" / prog).exists():
-            sys.exit(f"[demo] ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
+            sys.exit(
+                f"[demo] ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)"
+            )
     # None: lockstep. The sim then steps only while the runtime's bridge keeps writing (its
     # 50 Hz COMMAND stream on SIM_CLOCK), never more than 40 ms of sim time ahead of it.
     rtf = 1.0 if args.realtime else args.rtf
     if rtf is None and args.mission == "loop":
         rtf = 2.0  # the loop driver commands at 50 Hz of wall time: keep the sim paced
     import demo_parking  # noqa: E402  (tools/demo_parking.py)
+
     try:
         start = demo_parking.start_pose(args.start, args.seed)
     except ValueError as e:
@@ -154,12 +187,14 @@ def main():
     cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
 
     import demo_driver  # noqa: E402  (tools/demo_driver.py)
+
     procs = Procs()
     interrupted = False
 
     def on_sigint(_sig, _frm):
         nonlocal interrupted
         interrupted = True
+
     signal.signal(signal.SIGINT, on_sigint)
     signal.signal(signal.SIGTERM, on_sigint)
 
@@ -167,12 +202,26 @@ def main():
     t_wall0 = time.time()
     result = {}
     try:
-        procs.start("lcm-logger", ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f",
-                                   "--flush-interval=100", lcm_log], out / "lcm-logger.log")
-        sim_argv = [build / "bin" / "autodrive-sim", "--map", "parking_school",
-                    "--run-dir", run_dir, "--seed", args.seed, "--lcm-url", args.lcm_url,
-                    "--duration", (args.duration + 8.0) if args.mission == "loop"
-                    else args.timeout * max(rtf or 20.0, 1.0) + 30.0]
+        procs.start(
+            "lcm-logger",
+            ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f", "--flush-interval=100", lcm_log],
+            out / "lcm-logger.log",
+        )
+        sim_argv = [
+            build / "bin" / "autodrive-sim",
+            "--map",
+            "parking_school",
+            "--run-dir",
+            run_dir,
+            "--seed",
+            args.seed,
+            "--lcm-url",
+            args.lcm_url,
+            "--duration",
+            (args.duration + 8.0)
+            if args.mission == "loop"
+            else args.timeout * max(rtf or 20.0, 1.0) + 30.0,
+        ]
         if args.mission == "parking":
             sim_argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
             sim_argv += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
@@ -188,15 +237,29 @@ def main():
             sim_argv += ["--view"]  # a window when a display exists; headless otherwise
         procs.start("autodrive-sim", sim_argv, out / "sim.log")
         wait_for(run_dir / "nigel1-nano", 30, procs)
-        procs.start("autodrive-runtime", [build / "bin" / "autodrive-runtime", "--config", cfg_path],
-                    out / "runtime.log")
+        procs.start(
+            "autodrive-runtime",
+            [build / "bin" / "autodrive-runtime", "--config", cfg_path],
+            out / "runtime.log",
+        )
         if args.mission == "loop":
-            result = demo_driver.drive(args.lcm_url, "NIGEL1", args.duration, rtf, procs,
-                                       lambda: interrupted)
+            result = demo_driver.drive(
+                args.lcm_url, "NIGEL1", args.duration, rtf, procs, lambda: interrupted
+            )
         else:
-            result = demo_parking.run(build, out, args.lcm_url, args.slot, args.seed, start,
-                                      args.timeout, procs, lambda: interrupted,
-                                      demo_parking.late_boxes(args.late_box), mapping_route)
+            result = demo_parking.run(
+                build,
+                out,
+                args.lcm_url,
+                args.slot,
+                args.seed,
+                start,
+                args.timeout,
+                procs,
+                lambda: interrupted,
+                demo_parking.late_boxes(args.late_box),
+                mapping_route,
+            )
     except RuntimeError as e:
         log(f"ERROR: {e}")
         result = {"error": str(e)}
@@ -207,6 +270,7 @@ def main():
     if interrupted:
         log("interrupted: everything stopped; analysing what was recorded")
     import demo_report  # noqa: E402  (tools/demo_report.py)
+
     report = demo_report.analyse(lcm_log, out, "NIGEL1")
     report.update(result)
     if args.mission == "parking" and "goal_world" in result:
@@ -219,8 +283,10 @@ def main():
     (out / "report.json.tmp").write_text(json.dumps(report, indent=2))
     os.replace(out / "report.json.tmp", out / "report.json")
     log(f"report: {json.dumps(report)}")
-    log(f"wrote {out}/report.json, plots {', '.join(p.name for p in sorted(out.glob('*.png')))}, "
-        f"log {lcm_log}")
+    log(
+        f"wrote {out}/report.json, plots {', '.join(p.name for p in sorted(out.glob('*.png')))}, "
+        f"log {lcm_log}"
+    )
     if interrupted:
         return 130
     if not report.get("ok"):

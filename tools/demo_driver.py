@@ -12,8 +12,8 @@ from autodrive import odometry_t, vehicle_command_t, vehicle_state_t
 WHEELBASE_M = 0.14154
 STEER_LIMIT_RAD = 0.5236
 LOOKAHEAD_M = 0.25
-THROTTLE = 0.7            # normalised; ~0.19 m/s on the flat
-COMMAND_PERIOD_S = 0.02   # 50 Hz
+THROTTLE = 0.7  # normalised; ~0.19 m/s on the flat
+COMMAND_PERIOD_S = 0.02  # 50 Hz
 
 
 def stadium_track(step_m=0.02):
@@ -64,8 +64,11 @@ def drive(url, veh, duration_s, rtf, procs, stop_requested):
     idx = 0
     seq = 0
     laps = 0
-    print(f"[demo] driving the stadium track for {duration_s:.0f} s of sim time "
-          f"({'lockstep' if rtf is None else f'rtf {rtf:g}'}) ...", flush=True)
+    print(
+        f"[demo] driving the stadium track for {duration_s:.0f} s of sim time "
+        f"({'lockstep' if rtf is None else f'rtf {rtf:g}'}) ...",
+        flush=True,
+    )
     t_start = time.time()
     next_cmd = t_start
     last_print = t_start
@@ -104,9 +107,12 @@ def drive(url, veh, duration_s, rtf, procs, stop_requested):
         lc.publish(f"{veh}_COMMAND", cmd.encode())
         if now - last_print > 2.0:
             last_print = now
-            print(f"[demo] t_sim={sim_elapsed:5.1f}/{duration_s:.0f} s  lap {laps}  "
-                  f"pose=({x:+.2f}, {y:+.2f}, {math.degrees(yaw):+6.1f} deg)  "
-                  f"mode={state.get('mode')} faults=0x{state.get('faults', 0):x}", flush=True)
+            print(
+                f"[demo] t_sim={sim_elapsed:5.1f}/{duration_s:.0f} s  lap {laps}  "
+                f"pose=({x:+.2f}, {y:+.2f}, {math.degrees(yaw):+6.1f} deg)  "
+                f"mode={state.get('mode')} faults=0x{state.get('faults', 0):x}",
+                flush=True,
+            )
     # Stop: a few disengaged zero commands, then silence (the firmware brakes either way).
     for _ in range(10):
         cmd = vehicle_command_t()
@@ -116,5 +122,8 @@ def drive(url, veh, duration_s, rtf, procs, stop_requested):
         cmd.engaged = False
         lc.publish(f"{veh}_COMMAND", cmd.encode())
         time.sleep(COMMAND_PERIOD_S)
-    return {"driver": "pure pursuit on the runtime EKF (stadium track)", "laps": laps,
-            "track_start_map": [start["x"], start["y"], start["yaw"]]}
+    return {
+        "driver": "pure pursuit on the runtime EKF (stadium track)",
+        "laps": laps,
+        "track_start_map": [start["x"], start["y"], start["yaw"]],
+    }

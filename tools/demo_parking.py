@@ -19,15 +19,17 @@ CENTRE_AHEAD_M = 0.0708
 
 
 def spawn_pose(map_xml):
-    m = re.search(r'<site name="spawn" pos="([-\d.]+) ([-\d.]+) [-\d.]+" euler="[-\d.]+ [-\d.]+ ([-\d.]+)"',
-                  pathlib.Path(map_xml).read_text())
+    m = re.search(
+        r'<site name="spawn" pos="([-\d.]+) ([-\d.]+) [-\d.]+" euler="[-\d.]+ [-\d.]+ ([-\d.]+)"',
+        pathlib.Path(map_xml).read_text(),
+    )
     if not m:
-        raise RuntimeError(f"{map_xml}: no <site name=\"spawn\" pos=.. euler=..>")
+        raise RuntimeError(f'{map_xml}: no <site name="spawn" pos=.. euler=..>')
     return float(m.group(1)), float(m.group(2)), math.radians(float(m.group(3)))
 
 
 def parse_pose_deg(text):
-    """"X,Y,YAW_DEG" as (x, y, yaw_rad) [m, m, rad]; ValueError saying what is wrong."""
+    """ "X,Y,YAW_DEG" as (x, y, yaw_rad) [m, m, rad]; ValueError saying what is wrong."""
     parts = text.split(",")
     if len(parts) != 3:
         raise ValueError("expected X,Y,YAW_DEG, e.g. -1.0,0.6,0")
@@ -48,9 +50,13 @@ def start_pose(text, seed):
     if seed == 0:
         return x, y, yaw
     import random
+
     rng = random.Random(seed)  # the same seed, the same scenario
-    return (x + rng.uniform(-0.05, 0.05), y + rng.uniform(-0.05, 0.05),
-            yaw + math.radians(rng.uniform(-5.0, 5.0)))
+    return (
+        x + rng.uniform(-0.05, 0.05),
+        y + rng.uniform(-0.05, 0.05),
+        yaw + math.radians(rng.uniform(-5.0, 5.0)),
+    )
 
 
 def slot_goal_world(slot):
@@ -88,6 +94,7 @@ def mapping_route(text):
 
 def write_config(example, out_dir, url, goal_local, seed, route=()):
     import yaml
+
     cfg = yaml.safe_load(pathlib.Path(example).read_text())
     cfg["lcm_url"] = url
     cfg["out_dir"] = str(out_dir / "autonomy")
@@ -111,18 +118,33 @@ def late_boxes(specs):
     return out
 
 
-def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested, boxes=(),
-        route=()):
+def run(
+    build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested, boxes=(), route=()
+):
     goal_w = slot_goal_world(slot)
     goal_l = to_frame(start, goal_w)
-    cfg = write_config(ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml", out_dir,
-                       url, goal_l, seed, route)
-    print(f"[demo] start at world ({start[0]:.3f}, {start[1]:.3f}, {math.degrees(start[2]):.1f} deg)",
-          flush=True)
-    print(f"[demo] mission: park in slot {slot} at world ({goal_w[0]:.3f}, {goal_w[1]:.3f}, "
-          f"{math.degrees(goal_w[2]):.0f} deg)", flush=True)
-    proc = procs.start("autodrive-autonomy", [build / "bin" / "autodrive-autonomy", "--config", cfg],
-                       out_dir / "autonomy.log")
+    cfg = write_config(
+        ROOT / "runtime/jetson/autonomy/config/autonomy.example.yaml",
+        out_dir,
+        url,
+        goal_l,
+        seed,
+        route,
+    )
+    print(
+        f"[demo] start at world ({start[0]:.3f}, {start[1]:.3f}, {math.degrees(start[2]):.1f} deg)",
+        flush=True,
+    )
+    print(
+        f"[demo] mission: park in slot {slot} at world ({goal_w[0]:.3f}, {goal_w[1]:.3f}, "
+        f"{math.degrees(goal_w[2]):.0f} deg)",
+        flush=True,
+    )
+    proc = procs.start(
+        "autodrive-autonomy",
+        [build / "bin" / "autodrive-autonomy", "--config", cfg],
+        out_dir / "autonomy.log",
+    )
     t0 = time.time()
     seen = 0
     while proc.poll() is None:
@@ -140,15 +162,20 @@ def run(build, out_dir, url, slot, seed, start, timeout_s, procs, stop_requested
         time.sleep(0.2)
     for ln in (out_dir / "autonomy.log").read_text().splitlines()[seen:]:
         print(ln, flush=True)
-    return {"mission_exit_code": proc.returncode, "slot": slot,
-            "start_world": list(start), "goal_world": list(goal_w),
-            "late_boxes_world": [list(b) for b in boxes]}
+    return {
+        "mission_exit_code": proc.returncode,
+        "slot": slot,
+        "start_world": list(start),
+        "goal_world": list(goal_w),
+        "late_boxes_world": [list(b) for b in boxes],
+    }
 
 
 def score(log_path, out_dir, veh, mission):
     """Parking figures against ground truth; writes gt.csv (in the autonomy frame) and plots."""
     import lcm
     from autodrive import ground_truth_t, odometry_t, pose2d_t
+
     start, goal_w = mission["start_world"], mission["goal_world"]
     gt, gt_t, amcl = [], [], []
     odom = {"laser_odom": [], "ekf_odom": []}
@@ -163,7 +190,8 @@ def score(log_path, out_dir, veh, mission):
         elif ev.channel in (f"{veh}_LASER_ODOM", f"{veh}_ODOM"):
             m = odometry_t.decode(ev.data)
             odom["laser_odom" if ev.channel.endswith("LASER_ODOM") else "ekf_odom"].append(
-                (m.utime, m.x_m, m.y_m, m.yaw_rad))
+                (m.utime, m.x_m, m.y_m, m.yaw_rad)
+            )
     rep = {}
     if not gt:
         return {"error": "no ground truth in the log"}
@@ -172,16 +200,21 @@ def score(log_path, out_dir, veh, mission):
     rep["final_pos_error_m"] = round(math.hypot(final[0] - goal_w[0], final[1] - goal_w[1]), 4)
     rep["final_heading_error_deg"] = round(abs(math.degrees(_wrap(final[2] - goal_w[2]))), 3)
     boxes = mission.get("late_boxes_world", [])
-    rep["min_clearance_m"] = round(min_clearance(gt, extra=[(b[0], b[1], b[3], b[4], 0.0) for b in boxes]), 4)
+    rep["min_clearance_m"] = round(
+        min_clearance(gt, extra=[(b[0], b[1], b[3], b[4], 0.0) for b in boxes]), 4
+    )
     # Each estimate against the truth at its own stamp (the scan's mid-time; both are sim time
     # [us], the runtime runs on SIM_CLOCK), not at its arrival: the arrival lags by the scan.
     import bisect
+
     errs = []
     for t, x, y, yaw in amcl:
         i = min(bisect.bisect_left(gt_t, t), len(gt) - 1)
         w = to_world(start, (x, y, yaw))
         errs.append(math.hypot(w[0] - gt[i][0], w[1] - gt[i][1]))
-    rep["localization_rms_m"] = round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
+    rep["localization_rms_m"] = (
+        round(math.sqrt(sum(e * e for e in errs) / len(errs)), 4) if errs else None
+    )
     # Dead reckoning, laser (ICP) against wheel/IMU (EKF), over the same span of the run.
     span = (odom["laser_odom"][0][0], odom["laser_odom"][-1][0]) if odom["laser_odom"] else None
     tracks = {}
@@ -201,9 +234,17 @@ def score(log_path, out_dir, veh, mission):
             f.write(f"{p[0]:.5f},{p[1]:.5f},{p[2]:.5f}\n")
     auto = out_dir / "autonomy"
     goal_l = to_frame(start, goal_w)
-    argv = [str(ROOT / "tools/plot-parking"), "--map", str(out_dir / "map.yaml"),
-            "--truth", str(out_dir / "gt.csv"), "--goal", ",".join(f"{v:.4f}" for v in goal_l),
-            "--out", str(out_dir / "parking.png")]
+    argv = [
+        str(ROOT / "tools/plot-parking"),
+        "--map",
+        str(out_dir / "map.yaml"),
+        "--truth",
+        str(out_dir / "gt.csv"),
+        "--goal",
+        ",".join(f"{v:.4f}" for v in goal_l),
+        "--out",
+        str(out_dir / "parking.png"),
+    ]
     for b in boxes:
         p = to_frame(start, (b[0], b[1], 0.0))
         argv += ["--box", f"{p[0]:.4f},{p[1]:.4f},{p[2]:.4f},{b[3]:.4f},{b[4]:.4f}"]
@@ -222,6 +263,7 @@ def aligned_track(samples, gt_t, gt, span):
     sample inside span (sim-time stamps [us]): dead reckoning from a known start. None if
     fewer than two samples."""
     import bisect
+
     if not span:
         return None
     samples = [s for s in samples if span[0] <= s[0] <= span[1]]
@@ -231,25 +273,30 @@ def aligned_track(samples, gt_t, gt, span):
     g0 = gt[min(bisect.bisect_left(gt_t, t0), len(gt) - 1)]
     dyaw = _wrap(g0[2] - yaw0)
     c, s = math.cos(dyaw), math.sin(dyaw)
-    return [(t, g0[0] + c * (x - x0) - s * (y - y0), g0[1] + s * (x - x0) + c * (y - y0))
-            for t, x, y, _ in samples]
+    return [
+        (t, g0[0] + c * (x - x0) - s * (y - y0), g0[1] + s * (x - x0) + c * (y - y0))
+        for t, x, y, _ in samples
+    ]
 
 
 def odometry_drift(track, gt_t, gt):
     """(final position error [m], as % of the distance driven) of an aligned track."""
     import bisect
+
     i0 = bisect.bisect_left(gt_t, track[0][0])
     i1 = min(bisect.bisect_left(gt_t, track[-1][0]), len(gt) - 1)
     err = math.hypot(track[-1][1] - gt[i1][0], track[-1][2] - gt[i1][1])
-    dist = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(gt[i0:i1], gt[i0 + 1:i1 + 1]))
+    dist = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(gt[i0:i1], gt[i0 + 1 : i1 + 1]))
     return round(err, 4), round(100.0 * err / dist, 2) if dist > 0.05 else None
 
 
 def plot_odometry(tracks, gt, gt_t, span, rep, path):
     """odometry.png: laser and EKF dead reckoning against the truth over the same span."""
     import bisect
+
     try:
         import matplotlib
+
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as e:
@@ -257,13 +304,21 @@ def plot_odometry(tracks, gt, gt_t, span, rep, path):
     i0, i1 = bisect.bisect_left(gt_t, span[0]), bisect.bisect_left(gt_t, span[1])
     fig, ax = plt.subplots(figsize=(7, 6))
     ax.plot([g[0] for g in gt[i0:i1]], [g[1] for g in gt[i0:i1]], "k-", lw=2, label="ground truth")
-    style = {"laser_odom": ("tab:blue", "laser odometry (ICP)"),
-             "ekf_odom": ("tab:red", "EKF odometry (wheels + IMU)")}
+    style = {
+        "laser_odom": ("tab:blue", "laser odometry (ICP)"),
+        "ekf_odom": ("tab:red", "EKF odometry (wheels + IMU)"),
+    }
     for name, tr in tracks.items():
         colour, label = style[name]
         pct = rep.get(f"{name}_drift_pct")
-        ax.plot([p[1] for p in tr], [p[2] for p in tr], "--", color=colour, lw=1.2,
-                label=f"{label}: {pct} % drift" if pct is not None else label)
+        ax.plot(
+            [p[1] for p in tr],
+            [p[2] for p in tr],
+            "--",
+            color=colour,
+            lw=1.2,
+            label=f"{label}: {pct} % drift" if pct is not None else label,
+        )
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -280,8 +335,11 @@ def _obstacles():
     """Collidable boxes and cones of Parking School as (centre, half sizes, yaw) rectangles."""
     text = (ROOT / "sim/mujoco_hil/maps/parking_school.xml").read_text()
     obs = []
-    for m in re.finditer(r'<geom name="box_\w+" type="box" pos="([-\d. ]+)" size="([-\d. ]+)" '
-                         r'euler="[-\d.]+ [-\d.]+ ([-\d.]+)"', text):
+    for m in re.finditer(
+        r'<geom name="box_\w+" type="box" pos="([-\d. ]+)" size="([-\d. ]+)" '
+        r'euler="[-\d.]+ [-\d.]+ ([-\d.]+)"',
+        text,
+    ):
         p = [float(v) for v in m.group(1).split()]
         s = [float(v) for v in m.group(2).split()]
         obs.append((p[0], p[1], s[0], s[1], float(m.group(3))))
@@ -293,8 +351,10 @@ def _obstacles():
 
 def _corners(cx, cy, hx, hy, yaw):
     c, s = math.cos(yaw), math.sin(yaw)
-    return [(cx + c * dx - s * dy, cy + s * dx + c * dy)
-            for dx, dy in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))]
+    return [
+        (cx + c * dx - s * dy, cy + s * dx + c * dy)
+        for dx, dy in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))
+    ]
 
 
 def _seg_dist(p, a, b):
@@ -319,8 +379,13 @@ def min_clearance(gt, length_m=0.24, width_m=0.178, centre_ahead_m=0.07, extra=(
     obs = [_corners(*o) for o in list(_obstacles()) + list(extra)]
     best = float("inf")
     for x, y, yaw in gt[::10]:
-        car = _corners(x + centre_ahead_m * math.cos(yaw), y + centre_ahead_m * math.sin(yaw),
-                       length_m / 2, width_m / 2, yaw)
+        car = _corners(
+            x + centre_ahead_m * math.cos(yaw),
+            y + centre_ahead_m * math.sin(yaw),
+            length_m / 2,
+            width_m / 2,
+            yaw,
+        )
         for o in obs:
             best = min(best, _poly_dist(car, o))
     return best

@@ -28,8 +28,15 @@ GOAL_HEADING_ERROR_DEG = 2.0
 GOAL_LOCALIZATION_RMS_M = 0.03
 GOAL_WALL_S = 120.0
 # Figures summarised by median and max over the runs that report them.
-MEDIAN_MAX_KEYS = ("final_pos_error_m", "final_heading_error_deg", "localization_rms_m",
-                   "wall_s", "sim_s", "laser_odom_drift_pct", "ekf_odom_drift_pct")
+MEDIAN_MAX_KEYS = (
+    "final_pos_error_m",
+    "final_heading_error_deg",
+    "localization_rms_m",
+    "wall_s",
+    "sim_s",
+    "laser_odom_drift_pct",
+    "ekf_odom_drift_pct",
+)
 PER_SEED_KEYS = MEDIAN_MAX_KEYS + ("min_clearance_m", "collisions", "path_length_m")
 EXIT_FILE = "demo_exit_code"  # per seed dir: demo.py's exit code, kept for --aggregate-only
 
@@ -43,7 +50,7 @@ def parse_args(argv):
     extra = []
     if "--extra" in argv:
         i = argv.index("--extra")
-        argv, extra = argv[:i], argv[i + 1:]
+        argv, extra = argv[:i], argv[i + 1 :]
         if not extra:
             sys.exit("parking_sweep: --extra needs at least one argument for demo.py")
     p = argparse.ArgumentParser(
@@ -53,25 +60,48 @@ def parse_args(argv):
         "[s] against the goals of issue 7. Writes OUT/seed<N>/ (each run), OUT/summary.json and "
         "OUT/parking_sweep.png; prints the summary JSON as the last stdout line. Exit code 0 "
         "when the sweep ran (whether or not the goals are met), 2 bad input, 130 interrupted.",
-        epilog="example: tools/parking_sweep.py --seeds 2 --out /tmp/sweep --extra --realtime")
+        epilog="example: tools/parking_sweep.py --seeds 2 --out /tmp/sweep --extra --realtime",
+    )
     p.add_argument("--seeds", type=int, default=10, help="number of seeds to run (default 10)")
     p.add_argument("--first-seed", type=int, default=1, help="first seed (default 1)")
-    p.add_argument("--slot", type=int, default=None,
-                   help="parking slot 0..5 (default: the demo's default)")
-    p.add_argument("--out", default=str(ROOT / "out" / "bench" / "parking"),
-                   help="output folder (default out/bench/parking)")
-    p.add_argument("--build", default=os.environ.get("AUTODRIVE_BUILD", str(ROOT / "build" / "release")),
-                   help="host build dir (default $AUTODRIVE_BUILD or build/release)")
-    p.add_argument("--lcm-url", default=DEFAULT_LCM_URL,
-                   help=f"LCM URL for the runs (default {DEFAULT_LCM_URL})")
-    p.add_argument("--run-timeout", type=float, default=600.0,
-                   help="stop a demo run after this many wall seconds [s] (default 600; the "
-                   "demo's own --timeout is 240 s of wall time)")
-    p.add_argument("--aggregate-only", action="store_true",
-                   help="run nothing: aggregate the reports already in OUT/seed<N>/")
-    p.add_argument("--extra", metavar="ARG", nargs="*", default=[],
-                   help="must come last: every following argument is passed to demo.py "
-                   "(e.g. --extra --realtime)")
+    p.add_argument(
+        "--slot", type=int, default=None, help="parking slot 0..5 (default: the demo's default)"
+    )
+    p.add_argument(
+        "--out",
+        default=str(ROOT / "out" / "bench" / "parking"),
+        help="output folder (default out/bench/parking)",
+    )
+    p.add_argument(
+        "--build",
+        default=os.environ.get("AUTODRIVE_BUILD", str(ROOT / "build" / "release")),
+        help="host build dir (default $AUTODRIVE_BUILD or build/release)",
+    )
+    p.add_argument(
+        "--lcm-url",
+        default=DEFAULT_LCM_URL,
+        help=f"LCM URL for the runs (default {DEFAULT_LCM_URL})",
+    )
+    p.add_argument(
+        "--run-timeout",
+        type=float,
+        default=600.0,
+        help="stop a demo run after this many wall seconds [s] (default 600; the "
+        "demo's own --timeout is 240 s of wall time)",
+    )
+    p.add_argument(
+        "--aggregate-only",
+        action="store_true",
+        help="run nothing: aggregate the reports already in OUT/seed<N>/",
+    )
+    p.add_argument(
+        "--extra",
+        metavar="ARG",
+        nargs="*",
+        default=[],
+        help="must come last: every following argument is passed to demo.py "
+        "(e.g. --extra --realtime)",
+    )
     args = p.parse_args(argv)
     args.extra = extra
     if args.seeds < 1:
@@ -110,8 +140,19 @@ def run_demo(args, seed):
     d.mkdir(parents=True, exist_ok=True)
     for stale in ("report.json", "gt.csv", EXIT_FILE):  # a failed run must not reuse old figures
         (d / stale).unlink(missing_ok=True)
-    argv = [sys.executable, str(ROOT / "tools" / "demo.py"), "--build", str(args.build),
-            "--out", str(d), "--seed", str(seed), "--headless", "--lcm-url", args.lcm_url]
+    argv = [
+        sys.executable,
+        str(ROOT / "tools" / "demo.py"),
+        "--build",
+        str(args.build),
+        "--out",
+        str(d),
+        "--seed",
+        str(seed),
+        "--headless",
+        "--lcm-url",
+        args.lcm_url,
+    ]
     if args.slot is not None:
         argv += ["--slot", str(args.slot)]
     argv += args.extra
@@ -146,8 +187,13 @@ def load_run(out, seed):
         error = "no report.json"
     except (OSError, ValueError) as e:
         error = f"{d / 'report.json'}: unreadable ({e})"
-    ok = bool(report and report.get("ok") is True and report.get("success") is True
-              and report.get("collisions") == 0 and exit_code in (0, None))
+    ok = bool(
+        report
+        and report.get("ok") is True
+        and report.get("success") is True
+        and report.get("collisions") == 0
+        and exit_code in (0, None)
+    )
     if report and not ok:  # the report's own reason first, then how the demo ended
         reasons = [report["error"]] if report.get("error") else []
         if report.get("collisions"):
@@ -164,7 +210,9 @@ def load_run(out, seed):
 
 def _number(report, key):
     v = (report or {}).get(key)
-    return v if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) else None
+    return (
+        v if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) else None
+    )
 
 
 def _all_within(values, bound):
@@ -175,9 +223,12 @@ def aggregate(runs):
     """Summary figures of the runs (each from load_run), goals as booleans."""
     reps = [r["report"] for r in runs]
     per = {k: [_number(rep, k) for rep in reps] for k in PER_SEED_KEYS}
-    s = {"runs": len(runs), "successes": sum(r["ok"] for r in runs),
-         "reports": sum(rep is not None for rep in reps),
-         "collisions_total": sum(v for v in per["collisions"] if v is not None)}
+    s = {
+        "runs": len(runs),
+        "successes": sum(r["ok"] for r in runs),
+        "reports": sum(rep is not None for rep in reps),
+        "collisions_total": sum(v for v in per["collisions"] if v is not None),
+    }
     slots = {rep.get("slot") for rep in reps if rep and rep.get("slot") is not None}
     s["slot"] = slots.pop() if len(slots) == 1 else sorted(slots) or None
     for k in MEDIAN_MAX_KEYS:
@@ -185,25 +236,42 @@ def aggregate(runs):
         s[f"{k}_median"] = round(statistics.median(vals), 4) if vals else None
         s[f"{k}_max"] = round(max(vals), 4) if vals else None
     # Laser odometry against its peer, the EKF's wheel/IMU odometry, over the same span of each run.
-    ratios = [a / b for a, b in zip(per["laser_odom_drift_pct"], per["ekf_odom_drift_pct"])
-              if a is not None and b]
+    ratios = [
+        a / b
+        for a, b in zip(per["laser_odom_drift_pct"], per["ekf_odom_drift_pct"])
+        if a is not None and b
+    ]
     s["laser_over_ekf_drift_ratio_median"] = round(statistics.median(ratios), 3) if ratios else None
     clear = [v for v in per["min_clearance_m"] if v is not None]
     s["min_clearance_m_min"] = round(min(clear), 4) if clear else None
     # Goals of issue 7; each holds only if every run meets it (a run without a figure fails it).
     s["goal_all_success_no_collisions"] = s["successes"] == len(runs) and s["collisions_total"] == 0
-    s["goal_final_pose"] = (_all_within(per["final_pos_error_m"], GOAL_POS_ERROR_M)
-                            and _all_within(per["final_heading_error_deg"], GOAL_HEADING_ERROR_DEG))
+    s["goal_final_pose"] = _all_within(per["final_pos_error_m"], GOAL_POS_ERROR_M) and _all_within(
+        per["final_heading_error_deg"], GOAL_HEADING_ERROR_DEG
+    )
     s["goal_localization_rms"] = _all_within(per["localization_rms_m"], GOAL_LOCALIZATION_RMS_M)
     s["goal_wall_s"] = _all_within(per["wall_s"], GOAL_WALL_S)
-    s["goals_met"] = (len(runs) >= GOAL_RUNS and s["goal_all_success_no_collisions"]
-                      and s["goal_final_pose"] and s["goal_localization_rms"] and s["goal_wall_s"])
-    s["goal_bounds"] = {"runs": GOAL_RUNS, "final_pos_error_m": GOAL_POS_ERROR_M,
-                        "final_heading_error_deg": GOAL_HEADING_ERROR_DEG,
-                        "localization_rms_m": GOAL_LOCALIZATION_RMS_M, "wall_s": GOAL_WALL_S}
-    s["per_seed"] = {"seed": [r["seed"] for r in runs], "ok": [r["ok"] for r in runs],
-                     "exit_code": [r["exit_code"] for r in runs],
-                     "error": [r["error"] for r in runs], **per}
+    s["goals_met"] = (
+        len(runs) >= GOAL_RUNS
+        and s["goal_all_success_no_collisions"]
+        and s["goal_final_pose"]
+        and s["goal_localization_rms"]
+        and s["goal_wall_s"]
+    )
+    s["goal_bounds"] = {
+        "runs": GOAL_RUNS,
+        "final_pos_error_m": GOAL_POS_ERROR_M,
+        "final_heading_error_deg": GOAL_HEADING_ERROR_DEG,
+        "localization_rms_m": GOAL_LOCALIZATION_RMS_M,
+        "wall_s": GOAL_WALL_S,
+    }
+    s["per_seed"] = {
+        "seed": [r["seed"] for r in runs],
+        "ok": [r["ok"] for r in runs],
+        "exit_code": [r["exit_code"] for r in runs],
+        "error": [r["error"] for r in runs],
+        **per,
+    }
     return s
 
 
@@ -248,12 +316,15 @@ def _start_and_goal(rep):
 def _to_world(start, xs, ys):
     """gt.csv is in the run's start frame: each seed starts elsewhere, so plot in the world."""
     c, s = math.cos(start[2]), math.sin(start[2])
-    return ([start[0] + c * x - s * y for x, y in zip(xs, ys)],
-            [start[1] + s * x + c * y for x, y in zip(xs, ys)])
+    return (
+        [start[0] + c * x - s * y for x, y in zip(xs, ys)],
+        [start[1] + s * x + c * y for x, y in zip(xs, ys)],
+    )
 
 
 def plot(summary, runs, out, png):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -262,9 +333,32 @@ def plot(summary, runs, out, png):
     x = list(range(len(seeds)))
     colours = ["tab:blue" if ok else "tab:red" for ok in per["ok"]]
     fig, axs = plt.subplots(2, 2, figsize=(12, 9))
-    bars = ((axs[0][0], "final_pos_error_m", 100.0, "final position error", "cm", 100 * GOAL_POS_ERROR_M),
-            (axs[0][1], "final_heading_error_deg", 1.0, "final heading error", "deg", GOAL_HEADING_ERROR_DEG),
-            (axs[1][0], "localization_rms_m", 100.0, "localisation RMS", "cm", 100 * GOAL_LOCALIZATION_RMS_M))
+    bars = (
+        (
+            axs[0][0],
+            "final_pos_error_m",
+            100.0,
+            "final position error",
+            "cm",
+            100 * GOAL_POS_ERROR_M,
+        ),
+        (
+            axs[0][1],
+            "final_heading_error_deg",
+            1.0,
+            "final heading error",
+            "deg",
+            GOAL_HEADING_ERROR_DEG,
+        ),
+        (
+            axs[1][0],
+            "localization_rms_m",
+            100.0,
+            "localisation RMS",
+            "cm",
+            100 * GOAL_LOCALIZATION_RMS_M,
+        ),
+    )
     for ax, key, scale, label, unit, goal in bars:
         vals = [scale * v if v is not None else 0.0 for v in per[key]]
         ax.bar(x, vals, color=colours)
@@ -282,8 +376,13 @@ def plot(summary, runs, out, png):
         gt = _read_gt(seed_dir(out, r["seed"]) / "gt.csv")
         sg = _start_and_goal(r["report"])
         if gt and sg:
-            ax.plot(*_to_world(sg[0], *gt), "-", lw=1, color=None if r["ok"] else "tab:red",
-                    label=f"seed {r['seed']}" + ("" if r["ok"] else " (failed)"))
+            ax.plot(
+                *_to_world(sg[0], *gt),
+                "-",
+                lw=1,
+                color=None if r["ok"] else "tab:red",
+                label=f"seed {r['seed']}" + ("" if r["ok"] else " (failed)"),
+            )
             goals.add(tuple(round(v, 4) for v in sg[1][:2]))
     for i, g in enumerate(sorted(goals)):
         ax.plot([g[0]], [g[1]], "kx", ms=10, label="goal (rear axle)" if i == 0 else None)
@@ -293,8 +392,10 @@ def plot(summary, runs, out, png):
     ax.set_title("ground-truth trajectories")
     if ax.lines:
         ax.legend(loc="best", fontsize=7)
-    fig.suptitle(f"parking sweep: {summary['successes']}/{summary['runs']} parked without collision"
-                 f" (slot {summary['slot'] if summary['slot'] is not None else '?'}; red = failed)")
+    fig.suptitle(
+        f"parking sweep: {summary['successes']}/{summary['runs']} parked without collision"
+        f" (slot {summary['slot'] if summary['slot'] is not None else '?'}; red = failed)"
+    )
     fig.tight_layout()
     tmp = png.with_name(png.name + ".tmp")
     fig.savefig(tmp, dpi=110, format="png")
@@ -319,8 +420,10 @@ def main(argv):
     if not args.aggregate_only:
         for prog in ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy"):
             if not (pathlib.Path(args.build) / "bin" / prog).exists():
-                log(f"[parking] ERROR: --build {args.build}: bin/{prog} is missing "
-                    "(tools/bench parking builds the release preset)")
+                log(
+                    f"[parking] ERROR: --build {args.build}: bin/{prog} is missing "
+                    "(tools/bench parking builds the release preset)"
+                )
                 return 2
     signal.signal(signal.SIGINT, on_stop_signal)
     signal.signal(signal.SIGTERM, on_stop_signal)
@@ -328,7 +431,9 @@ def main(argv):
     runs, interrupted = [], False
     for i, seed in enumerate(seeds, 1):
         if not args.aggregate_only:
-            log(f"[parking {i}/{len(seeds)}] seed {seed}: running (log {seed_dir(out, seed)}/demo.log)")
+            log(
+                f"[parking {i}/{len(seeds)}] seed {seed}: running (log {seed_dir(out, seed)}/demo.log)"
+            )
             t0 = time.monotonic()
             try:
                 run_demo(args, seed)
@@ -356,10 +461,12 @@ def main(argv):
         log(f"[parking] wrote {out / 'summary.json'} and {png}")
     except Exception as e:  # the figures matter more than the picture
         log(f"[parking] plot failed ({type(e).__name__}: {e}); wrote {out / 'summary.json'}")
-    log(f"[parking] {summary['successes']}/{summary['runs']} ok; final error median/max "
+    log(
+        f"[parking] {summary['successes']}/{summary['runs']} ok; final error median/max "
         f"{summary['final_pos_error_m_median']}/{summary['final_pos_error_m_max']} m, "
         f"{summary['final_heading_error_deg_median']}/{summary['final_heading_error_deg_max']} deg; "
-        f"goals met: {summary['goals_met']}")
+        f"goals met: {summary['goals_met']}"
+    )
     print(json.dumps(summary), flush=True)
     return 130 if interrupted else 0
 

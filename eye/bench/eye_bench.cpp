@@ -31,12 +31,13 @@ struct Truth {
 };
 
 // A Lissajous drive over the map (0.25 m from the edges), heading along the motion.
-std::vector<eye::SynthCar> trajectory(const eye::SynthScene& s, int n) {
+std::vector<eye::SynthCar> trajectory(const eye::SynthScene &s, int n) {
   std::vector<eye::SynthCar> out;
   const double ax = s.map_x_m / 2 - 0.25, ay = s.map_y_m / 2 - 0.25;
   for (int i = 0; i < n; ++i) {
     const double t = 2 * M_PI * i / n;
-    const double x = s.map_x_m / 2 + ax * std::sin(t), y = s.map_y_m / 2 + ay * std::sin(2 * t + 0.6);
+    const double x = s.map_x_m / 2 + ax * std::sin(t),
+                 y = s.map_y_m / 2 + ay * std::sin(2 * t + 0.6);
     const double dx = ax * std::cos(t), dy = 2 * ay * std::cos(2 * t + 0.6);
     out.push_back({1, x, y, std::atan2(dy, dx)});
   }
@@ -56,8 +57,8 @@ double thread_cpu_s() {
 }
 
 struct RunResult {
-  std::vector<double> pass_fps;      // frames / wall time, per pass
-  std::vector<double> pass_fps_cpu;  // frames / thread CPU time, per pass
+  std::vector<double> pass_fps;                  // frames / wall time, per pass
+  std::vector<double> pass_fps_cpu;              // frames / thread CPU time, per pass
   std::vector<std::optional<eye::CarPose>> est;  // per frame (first pass)
   double fps() const { return median(pass_fps); }
   double fps_cpu() const { return median(pass_fps_cpu); }
@@ -70,7 +71,8 @@ struct Scene {
   std::vector<std::vector<uchar>> jpeg;
 };
 
-Scene make_scene(int w, int h, int frames, double tag_size_m, const std::vector<eye::RefTag>* refs_in) {
+Scene make_scene(int w, int h, int frames, double tag_size_m,
+                 const std::vector<eye::RefTag> *refs_in) {
   Scene sc;
   sc.s = eye::synth_scene(w, h, tag_size_m);
   sc.s.blur_sigma_px = 0.6;
@@ -80,7 +82,8 @@ Scene make_scene(int w, int h, int frames, double tag_size_m, const std::vector<
   eye::DetectorParams dp;
   dp.decimate = 1;
   eye::Detector det(dp);
-  const eye::MapCalib m = eye::map_calibrate(sc.s.in, refs, {det.detect(eye::synth_frame(sc.s, {}, refs, 1))});
+  const eye::MapCalib m =
+      eye::map_calibrate(sc.s.in, refs, {det.detect(eye::synth_frame(sc.s, {}, refs, 1))});
   std::fprintf(stderr, "[eye_bench] %dx%d: map calibration residual %.3f mm rms\n", w, h, m.rms_mm);
   sc.cfg.in = sc.s.in;
   sc.cfg.pose = m.pose;
@@ -90,15 +93,17 @@ Scene make_scene(int w, int h, int frames, double tag_size_m, const std::vector<
   for (int i = 0; i < frames; ++i) {
     std::vector<uchar> buf;
     // The reference tags stay on the floor while cars drive: the detector sees them too.
-    cv::imencode(".jpg", eye::synth_frame(sc.s, {sc.path[static_cast<size_t>(i)]}, refs, static_cast<uint64_t>(i)),
-                 buf, {cv::IMWRITE_JPEG_QUALITY, 90});
+    cv::imencode(
+        ".jpg",
+        eye::synth_frame(sc.s, {sc.path[static_cast<size_t>(i)]}, refs, static_cast<uint64_t>(i)),
+        buf, {cv::IMWRITE_JPEG_QUALITY, 90});
     sc.jpeg.push_back(std::move(buf));
   }
   return sc;
 }
 
 // The Eye: decode, detect, locate, publish.
-RunResult run_eye(const Scene& sc, lcm::LCM& lcm, int repeats, bool roi) {
+RunResult run_eye(const Scene &sc, lcm::LCM &lcm, int repeats, bool roi) {
   RunResult r;
   eye::RunConfig cfg = sc.cfg;
   cfg.tracking.roi = roi;
@@ -110,7 +115,8 @@ RunResult run_eye(const Scene& sc, lcm::LCM& lcm, int repeats, bool roi) {
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
       const auto poses = tr.process(g);
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
-      if (rep == 0) r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
+      if (rep == 0)
+        r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
     }
     const double n = static_cast<double>(sc.jpeg.size());
     r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
@@ -120,7 +126,7 @@ RunResult run_eye(const Scene& sc, lcm::LCM& lcm, int repeats, bool roi) {
 }
 
 // The peer: the same pipeline with OpenCV aruco's detector in place of libapriltag.
-RunResult run_peer(const Scene& sc, lcm::LCM& lcm, int repeats) {
+RunResult run_peer(const Scene &sc, lcm::LCM &lcm, int repeats) {
   RunResult r;
   auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
   auto params = cv::aruco::DetectorParameters::create();
@@ -140,7 +146,7 @@ RunResult run_peer(const Scene& sc, lcm::LCM& lcm, int repeats) {
         // bitmap) are our BR, BL, TL, TR: reorder to libapriltag's BL, BR, TR, TL.
         eye::Detection d;
         d.id = ids[k];
-        const auto& c = corners[k];
+        const auto &c = corners[k];
         // No half-pixel shift: with CORNER_REFINE_SUBPIX the marker corners follow OpenCV's
         // convention (shifting them by -0.5 px measured worse: 2.9 vs 2.0 mm RMS).
         d.corners_px = {cv::Point2d(c[1]), cv::Point2d(c[0]), cv::Point2d(c[3]), cv::Point2d(c[2])};
@@ -148,7 +154,8 @@ RunResult run_peer(const Scene& sc, lcm::LCM& lcm, int repeats) {
           poses.push_back(*p);
       }
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
-      if (rep == 0) r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
+      if (rep == 0)
+        r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
     }
     const double n = static_cast<double>(sc.jpeg.size());
     r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
@@ -161,13 +168,13 @@ struct Accuracy {
   double pos_rms_mm = 0, heading_rms_deg = 0, detect_rate = 0, pos_median_mm = 0, pos_max_mm = 0;
 };
 
-Accuracy accuracy(const Scene& sc, const RunResult& r) {
+Accuracy accuracy(const Scene &sc, const RunResult &r) {
   Accuracy a;
   std::vector<double> e;
   double ss_p = 0, ss_h = 0;
   for (size_t i = 0; i < sc.path.size(); ++i) {
     if (!r.est[i]) continue;
-    const auto& t = sc.path[i];
+    const auto &t = sc.path[i];
     const double ep = 1000 * std::hypot(r.est[i]->x_m - t.x_m, r.est[i]->y_m - t.y_m);
     const double eh = std::remainder(r.est[i]->yaw_rad - t.yaw_rad, 2 * M_PI) * 180 / M_PI;
     ss_p += ep * ep;
@@ -187,13 +194,14 @@ Accuracy accuracy(const Scene& sc, const RunResult& r) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char **argv) {
   CLI::App app{"eye_bench: Eye pipeline speed and accuracy on a synthesised drive across the map"};
   int frames = 240, repeats = 3;
   double tag_size_m = 0.10;
   std::string csv, url = "udpm://239.255.76.67:7799?ttl=0";
   app.add_option("--frames", frames, "frames in the trajectory")->capture_default_str();
-  app.add_option("--repeats", repeats, "timing passes over the frames (median per frame)")->capture_default_str();
+  app.add_option("--repeats", repeats, "timing passes over the frames (median per frame)")
+      ->capture_default_str();
   app.add_option("--tag-size-m", tag_size_m, "roof tag black border [m]")->capture_default_str();
   app.add_option("--csv", csv, "write truth vs estimate per frame (720p) here");
   app.add_option("--lcm-url", url, "where poses are published")->capture_default_str();
@@ -209,19 +217,23 @@ int main(int argc, char** argv) {
   const Scene hd = make_scene(1280, 720, frames, tag_size_m, nullptr);
   std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720, %d passes\n", repeats);
   const RunResult e720 = run_eye(hd, lcm, repeats, true);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720 without window tracking, %d passes\n", repeats);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720 without window tracking, %d passes\n",
+               repeats);
   const RunResult e720full = run_eye(hd, lcm, repeats, false);
   std::fprintf(stderr, "[eye_bench] peer (OpenCV aruco) 1280x720, %d passes\n", repeats);
   const RunResult p720 = run_peer(hd, lcm, repeats);
   const Accuracy a = accuracy(hd, e720), pa = accuracy(hd, p720), afull = accuracy(hd, e720full);
   if (!csv.empty()) {
     std::ofstream f(csv);
-    f << "frame,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad,peer_x_m,peer_y_m,peer_yaw_rad\n";
+    f << "frame,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad,peer_x_m,peer_y_m,peer_"
+         "yaw_rad\n";
     for (size_t i = 0; i < hd.path.size(); ++i) {
       f << i << "," << hd.path[i].x_m << "," << hd.path[i].y_m << "," << hd.path[i].yaw_rad;
-      for (const auto* r : {&e720, &p720}) {
-        if (r->est[i]) f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
-        else f << ",,,";
+      for (const auto *r : {&e720, &p720}) {
+        if (r->est[i])
+          f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
+        else
+          f << ",,,";
       }
       f << "\n";
     }
@@ -230,7 +242,8 @@ int main(int argc, char** argv) {
   const Scene fhd = make_scene(1920, 1080, frames, tag_size_m, nullptr);
   std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080, %d passes\n", repeats);
   const RunResult e1080 = run_eye(fhd, lcm, repeats, true);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080 without window tracking, %d passes\n", repeats);
+  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080 without window tracking, %d passes\n",
+               repeats);
   const RunResult e1080full = run_eye(fhd, lcm, repeats, false);
   const Accuracy a1080 = accuracy(fhd, e1080);
 

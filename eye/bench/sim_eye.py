@@ -42,12 +42,16 @@ def main():
         fh.write(f"width_px: {W}\nheight_px: {H}\nk: {k}\ndist: [0, 0, 0, 0, 0]\n")
     # camera x = map x, camera y (image down) = map -y, optical axis = map -z, centre (0,0,2.5)
     with open(os.path.join(tmp, "map.yaml"), "w") as fh:
-        fh.write(f"width_px: {W}\nheight_px: {H}\nr_cam_map: [1, 0, 0, 0, -1, 0, 0, 0, -1]\n"
-                 f"t_cam_map_m: [0, 0, {CAM_Z_M}]\n")
+        fh.write(
+            f"width_px: {W}\nheight_px: {H}\nr_cam_map: [1, 0, 0, 0, -1, 0, 0, 0, -1]\n"
+            f"t_cam_map_m: [0, 0, {CAM_Z_M}]\n"
+        )
     with open(os.path.join(tmp, "eye.yaml"), "w") as fh:
-        fh.write(f'intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: "{URL}"\n'
-                 "tag_size_m: 0.08\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
-                 "base_link_height_m: 0.0\nvehicles:\n - {name: NIGEL1, tag_id: 1}\n")
+        fh.write(
+            f'intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: "{URL}"\n'
+            "tag_size_m: 0.08\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
+            "base_link_height_m: 0.0\nvehicles:\n - {name: NIGEL1, tag_id: 1}\n"
+        )
 
     lc = lcm.LCM(URL + "&recv_buf_size=4194304")  # the socket also gets the JPEG frames
     truth, poses, info = [], [], []
@@ -59,17 +63,47 @@ def main():
     def pump():
         while not stop.is_set():
             lc.handle_timeout(50)
+
     th = threading.Thread(target=pump, daemon=True)
     th.start()
 
-    eye_p = subprocess.Popen([eye, "run", "-c", os.path.join(tmp, "eye.yaml"), "--source", "lcm:EYE_IMAGE",
-                              "--idle-timeout-s", "6", "-q"], stderr=subprocess.PIPE, text=True)
+    eye_p = subprocess.Popen(
+        [
+            eye,
+            "run",
+            "-c",
+            os.path.join(tmp, "eye.yaml"),
+            "--source",
+            "lcm:EYE_IMAGE",
+            "--idle-timeout-s",
+            "6",
+            "-q",
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     time.sleep(1.0)
     log(f"autodrive-sim --eye for {DURATION_S} s (real time), car on a right-hand circle")
-    simp = subprocess.run([sim, "--eye", "--camera-fps", "30", "--duration", str(DURATION_S),
-                           "--lcm-url", URL, "--run-dir", os.path.join(tmp, "run"), "--quiet",
-                           "--script", "constant:throttle=0.6,steering=-0.35,start=0.5"],
-                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    simp = subprocess.run(
+        [
+            sim,
+            "--eye",
+            "--camera-fps",
+            "30",
+            "--duration",
+            str(DURATION_S),
+            "--lcm-url",
+            URL,
+            "--run-dir",
+            os.path.join(tmp, "run"),
+            "--quiet",
+            "--script",
+            "constant:throttle=0.6,steering=-0.35,start=0.5",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     if simp.returncode != 0:
         sys.exit(f"sim_eye: autodrive-sim failed: {simp.stderr[-2000:]}")
     _, eye_err = eye_p.communicate(timeout=120)
@@ -88,6 +122,7 @@ def main():
     truth.sort(key=lambda m: m.utime)
     tu = [m.utime for m in truth]
     import bisect
+
     errs_mm, errs_deg, rows = [], [], []
     for p in poses:
         i = bisect.bisect_left(tu, p.utime)
@@ -104,7 +139,9 @@ def main():
         errs_deg.append(math.degrees(abs(math.remainder(p.yaw_rad - yaw, 2 * math.pi))))
     n = len(errs_mm)
     if n == 0:
-        sys.exit(f"sim_eye: no Eye pose matched the ground truth ({len(poses)} poses, {len(truth)} truth, {frames} frames)")
+        sys.exit(
+            f"sim_eye: no Eye pose matched the ground truth ({len(poses)} poses, {len(truth)} truth, {frames} frames)"
+        )
     rms = math.sqrt(sum(e * e for e in errs_mm) / n)
     hrms = math.sqrt(sum(e * e for e in errs_deg) / n)
     print(f"sim_frames {frames}")
@@ -125,8 +162,10 @@ def main():
                 fh.write(",".join(str(v) for v in r) + "\n")
         try:
             import matplotlib
+
             matplotlib.use("Agg")
             import matplotlib.pyplot as plt
+
             fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5))
             a1.plot(xs, ys, "-", color="0.6", lw=3, label="sim ground truth (base_link)")
             a1.plot([r[4] for r in rows], [r[5] for r in rows], ".", ms=3, label="Eye")

@@ -10,9 +10,11 @@
 
 namespace eye {
 
-cv::Vec3d CameraPose::centre_map() const { return -(r_cam_map.t() * t_cam_map); }
+cv::Vec3d CameraPose::centre_map() const {
+  return -(r_cam_map.t() * t_cam_map);
+}
 
-Intrinsics intrinsics_load(const std::string& path) {
+Intrinsics intrinsics_load(const std::string &path) {
   YAML::Node n = yaml_load_file(path);
   Intrinsics in;
   in.width_px = yaml_int(n, "width_px", path);
@@ -23,16 +25,18 @@ Intrinsics intrinsics_load(const std::string& path) {
   for (int i = 0; i < 9; ++i) in.k(i / 3, i % 3) = k[static_cast<size_t>(i)];
   if (!(in.k(0, 0) > 0 && in.k(1, 1) > 0) || in.k(2, 2) != 1.0 || in.k(1, 0) != 0 ||
       in.k(2, 0) != 0 || in.k(2, 1) != 0)
-    throw Error(path + ": field 'k' is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0");
+    throw Error(path +
+                ": field 'k' is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0");
   in.dist = yaml_doubles(n, "dist", path, -1);
   if (in.dist.size() != 4 && in.dist.size() != 5 && in.dist.size() != 8)
-    throw Error(path + ": field 'dist' must have 4, 5 or 8 coefficients (plumb_bob k1 k2 p1 p2 [k3])");
+    throw Error(path +
+                ": field 'dist' must have 4, 5 or 8 coefficients (plumb_bob k1 k2 p1 p2 [k3])");
   in.rms_px = n["rms_px"] ? yaml_double(n, "rms_px", path) : 0.0;
   in.views = n["views"] ? yaml_int(n, "views", path) : 0;
   return in;
 }
 
-void intrinsics_save(const std::string& path, const Intrinsics& in) {
+void intrinsics_save(const std::string &path, const Intrinsics &in) {
   YAML::Emitter e;
   e.SetDoublePrecision(12);
   e << YAML::BeginMap;
@@ -52,8 +56,8 @@ void intrinsics_save(const std::string& path, const Intrinsics& in) {
   f << "# autodrive-eye camera intrinsics (calibrate-intrinsics)\n" << e.c_str() << "\n";
 }
 
-std::vector<cv::Point2d> intrinsics_normalise(const Intrinsics& in,
-                                              const std::vector<cv::Point2d>& px) {
+std::vector<cv::Point2d> intrinsics_normalise(const Intrinsics &in,
+                                              const std::vector<cv::Point2d> &px) {
   std::vector<cv::Point2d> out;
   if (px.empty()) return out;
   // More iterations than the default 5: the Eye wants sub-millimetre agreement at the borders.
@@ -62,7 +66,7 @@ std::vector<cv::Point2d> intrinsics_normalise(const Intrinsics& in,
   return out;
 }
 
-cv::Point2d camera_project(const Intrinsics& in, const CameraPose& pose, const cv::Vec3d& p_map) {
+cv::Point2d camera_project(const Intrinsics &in, const CameraPose &pose, const cv::Vec3d &p_map) {
   std::vector<cv::Point3d> obj{cv::Point3d(p_map[0], p_map[1], p_map[2])};
   std::vector<cv::Point2d> img;
   cv::Mat r(pose.r_cam_map), rvec;
@@ -71,8 +75,8 @@ cv::Point2d camera_project(const Intrinsics& in, const CameraPose& pose, const c
   return img[0];
 }
 
-bool camera_ray_to_plane(const CameraPose& pose, const cv::Point2d& norm, double z_m,
-                         cv::Vec2d* xy_m) {
+bool camera_ray_to_plane(const CameraPose &pose, const cv::Point2d &norm, double z_m,
+                         cv::Vec2d *xy_m) {
   const cv::Vec3d d = pose.r_cam_map.t() * cv::Vec3d(norm.x, norm.y, 1.0);
   const cv::Vec3d c = pose.centre_map();
   if (std::abs(d[2]) < 1e-12) return false;

@@ -25,17 +25,17 @@ struct CameraPose {
   cv::Vec3d centre_map() const;  // camera centre in the map frame [m]
 };
 
-Intrinsics intrinsics_load(const std::string& path);
-void intrinsics_save(const std::string& path, const Intrinsics& in);
+Intrinsics intrinsics_load(const std::string &path);
+void intrinsics_save(const std::string &path, const Intrinsics &in);
 
 // Undistorted, normalised image coordinates (x/z, y/z) of pixel points.
-std::vector<cv::Point2d> intrinsics_normalise(const Intrinsics& in,
-                                              const std::vector<cv::Point2d>& px);
+std::vector<cv::Point2d> intrinsics_normalise(const Intrinsics &in,
+                                              const std::vector<cv::Point2d> &px);
 // Pixel of a map point (with distortion).
-cv::Point2d camera_project(const Intrinsics& in, const CameraPose& pose, const cv::Vec3d& p_map);
+cv::Point2d camera_project(const Intrinsics &in, const CameraPose &pose, const cv::Vec3d &p_map);
 // Intersects the ray of a normalised image point with the horizontal plane z = z_m [m].
 // Returns false if the ray is parallel to or points away from the plane.
-bool camera_ray_to_plane(const CameraPose& pose, const cv::Point2d& norm, double z_m,
-                         cv::Vec2d* xy_m);
+bool camera_ray_to_plane(const CameraPose &pose, const cv::Point2d &norm, double z_m,
+                         cv::Vec2d *xy_m);
 
 }  // namespace eye

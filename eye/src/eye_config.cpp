@@ -9,13 +9,13 @@
 
 namespace eye {
 
-static std::string resolve(const std::string& base_file, const std::string& p) {
+static std::string resolve(const std::string &base_file, const std::string &p) {
   const std::filesystem::path q(p);
   if (q.is_absolute()) return p;
   return (std::filesystem::path(base_file).parent_path() / q).string();
 }
 
-RunConfig runconfig_load(const std::string& path) {
+RunConfig runconfig_load(const std::string &path) {
   YAML::Node n = yaml_load_file(path);
   RunConfig c;
   c.path = path;
@@ -26,7 +26,8 @@ RunConfig runconfig_load(const std::string& path) {
   if (!(c.locate.tag_size_m > 0)) throw Error(path + ": field 'tag_size_m' must be positive");
   const auto off = yaml_doubles(n, "tag_offset_m", path, 3);
   c.locate.tag_offset_m = cv::Vec3d(off[0], off[1], off[2]);
-  if (n["base_link_height_m"]) c.locate.base_link_height_m = yaml_double(n, "base_link_height_m", path);
+  if (n["base_link_height_m"])
+    c.locate.base_link_height_m = yaml_double(n, "base_link_height_m", path);
   if (n["corner_sigma_px"]) c.locate.corner_sigma_px = yaml_double(n, "corner_sigma_px", path);
   if (n["max_fit_rms_m"]) c.locate.max_fit_rms_m = yaml_double(n, "max_fit_rms_m", path);
   if (YAML::Node d = n["detector"]) {
@@ -37,7 +38,8 @@ RunConfig runconfig_load(const std::string& path) {
     if (d["refine_edges"]) c.detector.refine_edges = yaml_int(d, "refine_edges", w) != 0;
     if (d["sharpening"]) c.detector.sharpening = yaml_double(d, "sharpening", w);
     if (d["max_hamming"]) c.detector.max_hamming = yaml_int(d, "max_hamming", w);
-    if (d["min_margin"]) c.detector.min_margin = static_cast<float>(yaml_double(d, "min_margin", w));
+    if (d["min_margin"])
+      c.detector.min_margin = static_cast<float>(yaml_double(d, "min_margin", w));
     if (!(c.detector.decimate >= 1)) throw Error(w + ": field 'decimate' must be >= 1");
   }
   if (YAML::Node t = n["tracking"]) {

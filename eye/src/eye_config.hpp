@@ -10,9 +10,9 @@
 namespace eye {
 
 struct TrackingParams {
-  bool roi = true;          // search cars seen last frame only around their last tag
-  int full_every = 10;      // scan the whole frame every this many frames
-  double margin = 1.0;      // window = last tag box grown by this many tag sizes per side
+  bool roi = true;      // search cars seen last frame only around their last tag
+  int full_every = 10;  // scan the whole frame every this many frames
+  double margin = 1.0;  // window = last tag box grown by this many tag sizes per side
 };
 
 struct RunConfig {
@@ -30,6 +30,6 @@ struct RunConfig {
 
 // Loads the config and the calibration files it names. Throws eye::Error naming the file and
 // the field on anything missing or malformed.
-RunConfig runconfig_load(const std::string& path);
+RunConfig runconfig_load(const std::string &path);
 
 }  // namespace eye

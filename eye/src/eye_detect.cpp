@@ -7,9 +7,9 @@
 
 namespace eye {
 
-Detector::Detector(const DetectorParams& p) : params_(p) {
-  apriltag_family_t* fam = tag36h11_create();
-  apriltag_detector_t* td = apriltag_detector_create();
+Detector::Detector(const DetectorParams &p) : params_(p) {
+  apriltag_family_t *fam = tag36h11_create();
+  apriltag_detector_t *td = apriltag_detector_create();
   apriltag_detector_add_family_bits(td, fam, 2);
   td->nthreads = 1;
   td->quad_decimate = p.decimate;
@@ -21,19 +21,19 @@ Detector::Detector(const DetectorParams& p) : params_(p) {
 }
 
 Detector::~Detector() {
-  apriltag_detector_destroy(static_cast<apriltag_detector_t*>(td_));
-  tag36h11_destroy(static_cast<apriltag_family_t*>(fam_));
+  apriltag_detector_destroy(static_cast<apriltag_detector_t *>(td_));
+  tag36h11_destroy(static_cast<apriltag_family_t *>(fam_));
 }
 
-std::vector<Detection> Detector::detect(const cv::Mat& gray) {
+std::vector<Detection> Detector::detect(const cv::Mat &gray) {
   if (gray.empty() || gray.type() != CV_8UC1)
     throw Error("detector: frame must be a non-empty 8-bit grey image");
   image_u8_t im{gray.cols, gray.rows, static_cast<int32_t>(gray.step[0]),
-                const_cast<uint8_t*>(gray.ptr<uint8_t>())};
-  zarray_t* dets = apriltag_detector_detect(static_cast<apriltag_detector_t*>(td_), &im);
+                const_cast<uint8_t *>(gray.ptr<uint8_t>())};
+  zarray_t *dets = apriltag_detector_detect(static_cast<apriltag_detector_t *>(td_), &im);
   std::vector<Detection> out;
   for (int i = 0; i < zarray_size(dets); ++i) {
-    apriltag_detection_t* d;
+    apriltag_detection_t *d;
     zarray_get(dets, i, &d);
     if (d->hamming > params_.max_hamming || d->decision_margin < params_.min_margin) continue;
     Detection o;

@@ -13,12 +13,12 @@ namespace eye {
 constexpr double kApriltagToOpencvPx = -0.5;
 
 struct DetectorParams {
-  float decimate = 2.0f;          // quad_decimate: detect quads at 1/decimate resolution
-  float sigma_px = 0.0f;          // quad_sigma: Gaussian blur before quad detection [px]
-  bool refine_edges = true;       // refit edges at full resolution (keeps sub-pixel corners)
-  double sharpening = 0.25;       // decode_sharpening
-  int max_hamming = 1;            // reject detections with more corrected bits than this
-  float min_margin = 20.0f;       // reject detections with a lower decision margin
+  float decimate = 2.0f;     // quad_decimate: detect quads at 1/decimate resolution
+  float sigma_px = 0.0f;     // quad_sigma: Gaussian blur before quad detection [px]
+  bool refine_edges = true;  // refit edges at full resolution (keeps sub-pixel corners)
+  double sharpening = 0.25;  // decode_sharpening
+  int max_hamming = 1;       // reject detections with more corrected bits than this
+  float min_margin = 20.0f;  // reject detections with a lower decision margin
 };
 
 struct Detection {
@@ -34,17 +34,17 @@ struct Detection {
 // Owns a libapriltag detector for tag36h11, one thread. Not copyable.
 class Detector {
  public:
-  explicit Detector(const DetectorParams& p = DetectorParams());
+  explicit Detector(const DetectorParams &p = DetectorParams());
   ~Detector();
-  Detector(const Detector&) = delete;
-  Detector& operator=(const Detector&) = delete;
+  Detector(const Detector &) = delete;
+  Detector &operator=(const Detector &) = delete;
   // gray: CV_8UC1 image. Throws eye::Error on another type.
-  std::vector<Detection> detect(const cv::Mat& gray);
+  std::vector<Detection> detect(const cv::Mat &gray);
 
  private:
   DetectorParams params_;
-  void* td_ = nullptr;   // apriltag_detector_t*
-  void* fam_ = nullptr;  // apriltag_family_t*
+  void *td_ = nullptr;   // apriltag_detector_t*
+  void *fam_ = nullptr;  // apriltag_family_t*
 };
 
 }  // namespace eye

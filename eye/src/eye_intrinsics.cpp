@@ -9,7 +9,8 @@
 
 namespace eye {
 
-IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const IntrinsicsParams& p) {
+IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
+                                      const IntrinsicsParams &p) {
   IntrinsicsReport rep;
   rep.views_total = static_cast<int>(views.size());
   if (views.empty()) throw Error("calibrate-intrinsics: no images");
@@ -18,7 +19,8 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
   std::vector<cv::Point3f> board;
   for (int r = 0; r < p.inner_rows; ++r)
     for (int c = 0; c < p.inner_cols; ++c)
-      board.emplace_back(static_cast<float>(c * p.square_m), static_cast<float>(r * p.square_m), 0.f);
+      board.emplace_back(static_cast<float>(c * p.square_m), static_cast<float>(r * p.square_m),
+                         0.f);
   std::vector<std::vector<cv::Point3f>> obj;
   std::vector<std::vector<cv::Point2f>> img;
   bool cell[4][4] = {};
@@ -26,7 +28,7 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
   const auto charuco = cv::aruco::CharucoBoard::create(
       p.inner_cols + 1, p.inner_rows + 1, static_cast<float>(p.square_m),
       static_cast<float>(p.square_m * p.marker_ratio), dict);
-  for (const auto& v : views) {
+  for (const auto &v : views) {
     if (v.size() != size)
       throw Error("calibrate-intrinsics: images differ in size (" + std::to_string(v.cols) + "x" +
                   std::to_string(v.rows) + " vs " + std::to_string(size.width) + "x" +
@@ -40,15 +42,16 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
       if (mids.size() < 4) continue;
       cv::aruco::interpolateCornersCharuco(mcorners, mids, v, charuco, corners, cids);
       if (corners.size() < 6) continue;
-      for (auto& c : corners) c += cv::Point2f(static_cast<float>(kArucoToOpencvPx),
-                                               static_cast<float>(kArucoToOpencvPx));
+      for (auto &c : corners)
+        c +=
+            cv::Point2f(static_cast<float>(kArucoToOpencvPx), static_cast<float>(kArucoToOpencvPx));
       // Calibrate from ids' board points with calibrateCamera (same solver as checkerboards).
       for (int id : cids) points.push_back(charuco->chessboardCorners[static_cast<size_t>(id)]);
     } else {
       if (!cv::findChessboardCornersSB(v, pattern, corners, cv::CALIB_CB_ACCURACY)) continue;
       points = board;
     }
-    for (const auto& c : corners) {
+    for (const auto &c : corners) {
       const int cx = std::min(3, std::max(0, static_cast<int>(4 * c.x / size.width)));
       const int cy = std::min(3, std::max(0, static_cast<int>(4 * c.y / size.height)));
       cell[cy][cx] = true;
@@ -58,16 +61,16 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& views, const I
   }
   rep.views_used = static_cast<int>(img.size());
   int cells = 0;
-  for (auto& row : cell)
+  for (auto &row : cell)
     for (bool b : row) cells += b;
   rep.coverage = cells / 16.0;
   if (rep.views_used < p.min_views)
     throw Error("calibrate-intrinsics: too few views: the " +
                 std::string(p.charuco ? "ChArUco board" : "checkerboard") + " (" +
                 std::to_string(p.inner_cols) + "x" + std::to_string(p.inner_rows) +
-                " inner corners) was found in " +
-                std::to_string(rep.views_used) + " of " + std::to_string(rep.views_total) +
-                " images, need at least " + std::to_string(p.min_views));
+                " inner corners) was found in " + std::to_string(rep.views_used) + " of " +
+                std::to_string(rep.views_total) + " images, need at least " +
+                std::to_string(p.min_views));
   if (rep.coverage < p.min_coverage) {
     char b[160];
     std::snprintf(b, sizeof b,

@@ -15,15 +15,15 @@ namespace eye {
 constexpr double kArucoToOpencvPx = -0.5;
 
 struct IntrinsicsParams {
-  bool charuco = false;      // ChArUco board (aruco DICT_5X5_100 markers) instead of a checkerboard
-  double marker_ratio = 0.7; // ChArUco: marker edge / square edge
-  int inner_cols = 9;        // inner corners along the board's width (squares - 1)
-  int inner_rows = 6;        // inner corners along its height
-  double square_m = 0.025;   // square edge [m] (scales extrinsics only, not K)
-  int min_views = 8;         // fewer usable views: refused
-  double min_coverage = 0.5; // fraction of a 4x4 grid over the image that corners must reach
-  double max_rms_px = 1.0;   // a worse reprojection RMS: refused
-  bool fix_k3 = true;        // k3 only for wide-angle lenses; free, it soaks up noise
+  bool charuco = false;  // ChArUco board (aruco DICT_5X5_100 markers) instead of a checkerboard
+  double marker_ratio = 0.7;  // ChArUco: marker edge / square edge
+  int inner_cols = 9;         // inner corners along the board's width (squares - 1)
+  int inner_rows = 6;         // inner corners along its height
+  double square_m = 0.025;    // square edge [m] (scales extrinsics only, not K)
+  int min_views = 8;          // fewer usable views: refused
+  double min_coverage = 0.5;  // fraction of a 4x4 grid over the image that corners must reach
+  double max_rms_px = 1.0;    // a worse reprojection RMS: refused
+  bool fix_k3 = true;         // k3 only for wide-angle lenses; free, it soaks up noise
 };
 
 struct IntrinsicsReport {
@@ -36,7 +36,7 @@ struct IntrinsicsReport {
 // Finds the board in each image (CV_8UC1; a ChArUco view counts if >= 6 corners are seen)
 // and calibrates. Throws eye::Error with a clear
 // reason on too few views, poor coverage or too high an RMS.
-IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat>& gray_views,
-                                      const IntrinsicsParams& p);
+IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &gray_views,
+                                      const IntrinsicsParams &p);
 
 }  // namespace eye

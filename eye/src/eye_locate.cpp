@@ -6,8 +6,8 @@
 
 namespace eye {
 
-double fit_rigid2d(const std::vector<cv::Vec2d>& src, const std::vector<cv::Vec2d>& dst,
-                   cv::Vec2d* t_m, double* yaw_rad) {
+double fit_rigid2d(const std::vector<cv::Vec2d> &src, const std::vector<cv::Vec2d> &dst,
+                   cv::Vec2d *t_m, double *yaw_rad) {
   const size_t n = src.size();
   cv::Vec2d cs(0, 0), cd(0, 0);
   for (size_t i = 0; i < n; ++i) {
@@ -27,8 +27,8 @@ double fit_rigid2d(const std::vector<cv::Vec2d>& src, const std::vector<cv::Vec2
   const cv::Vec2d t = cd - cv::Vec2d(c * cs[0] - s * cs[1], s * cs[0] + c * cs[1]);
   double ss = 0;
   for (size_t i = 0; i < n; ++i) {
-    const cv::Vec2d r = cv::Vec2d(c * src[i][0] - s * src[i][1], s * src[i][0] + c * src[i][1]) +
-                        t - dst[i];
+    const cv::Vec2d r =
+        cv::Vec2d(c * src[i][0] - s * src[i][1], s * src[i][0] + c * src[i][1]) + t - dst[i];
     ss += r.dot(r);
   }
   *t_m = t;
@@ -36,8 +36,8 @@ double fit_rigid2d(const std::vector<cv::Vec2d>& src, const std::vector<cv::Vec2
   return std::sqrt(ss / static_cast<double>(n));
 }
 
-std::optional<CarPose> locate_car(const Intrinsics& in, const CameraPose& pose,
-                                  const LocateParams& p, const VehicleTag& v, const Detection& d) {
+std::optional<CarPose> locate_car(const Intrinsics &in, const CameraPose &pose,
+                                  const LocateParams &p, const VehicleTag &v, const Detection &d) {
   const double z_tag_m = p.base_link_height_m + p.tag_offset_m[2];
   const std::vector<cv::Point2d> px(d.corners_px.begin(), d.corners_px.end());
   const std::vector<cv::Point2d> norm = intrinsics_normalise(in, px);
@@ -73,9 +73,15 @@ std::optional<CarPose> locate_car(const Intrinsics& in, const CameraPose& pose,
   const double var_yaw = sc_m * sc_m / (2.0 * p.tag_size_m * p.tag_size_m);
   // d(base)/d(yaw) = -R'(yaw) offset
   const double jx = s * ox + c * oy, jy = -(c * ox - s * oy);
-  out.cov = {var_t + jx * jx * var_yaw, jx * jy * var_yaw, jx * var_yaw,
-             jx * jy * var_yaw, var_t + jy * jy * var_yaw, jy * var_yaw,
-             jx * var_yaw, jy * var_yaw, var_yaw};
+  out.cov = {var_t + jx * jx * var_yaw,
+             jx * jy * var_yaw,
+             jx * var_yaw,
+             jx * jy * var_yaw,
+             var_t + jy * jy * var_yaw,
+             jy * var_yaw,
+             jx * var_yaw,
+             jy * var_yaw,
+             var_yaw};
   return out;
 }
 

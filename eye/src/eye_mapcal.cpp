@@ -14,7 +14,7 @@
 
 namespace eye {
 
-std::vector<RefTag> reftags_load(const std::string& path) {
+std::vector<RefTag> reftags_load(const std::string &path) {
   YAML::Node n = yaml_load_file(path);
   YAML::Node tags = yaml_need(n, "tags", path);
   if (!tags.IsSequence() || tags.size() == 0)
@@ -42,7 +42,7 @@ std::vector<RefTag> reftags_load(const std::string& path) {
 }
 
 // Map coordinates of a reference tag's corners, libapriltag order.
-static std::array<cv::Point3d, 4> ref_corners(const RefTag& r) {
+static std::array<cv::Point3d, 4> ref_corners(const RefTag &r) {
   const auto tf = tag_corners_tagframe(r.size_m);
   const double c = std::cos(r.yaw_rad), s = std::sin(r.yaw_rad);
   std::array<cv::Point3d, 4> out;
@@ -52,16 +52,16 @@ static std::array<cv::Point3d, 4> ref_corners(const RefTag& r) {
   return out;
 }
 
-MapCalib map_calibrate(const Intrinsics& in, const std::vector<RefTag>& refs,
-                       const std::vector<std::vector<Detection>>& frames, int min_tags) {
-  std::map<int, const RefTag*> by_id;
-  for (const auto& r : refs) by_id[r.id] = &r;
+MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
+                       const std::vector<std::vector<Detection>> &frames, int min_tags) {
+  std::map<int, const RefTag *> by_id;
+  for (const auto &r : refs) by_id[r.id] = &r;
   std::vector<cv::Point3d> obj;
   std::vector<cv::Point2d> img;
   std::vector<int> obj_id;
   std::set<int> seen;
-  for (const auto& f : frames)
-    for (const auto& d : f) {
+  for (const auto &f : frames)
+    for (const auto &d : f) {
       auto it = by_id.find(d.id);
       if (it == by_id.end()) continue;
       const auto c3 = ref_corners(*it->second);
@@ -75,7 +75,7 @@ MapCalib map_calibrate(const Intrinsics& in, const std::vector<RefTag>& refs,
   MapCalib m;
   m.width_px = in.width_px;
   m.height_px = in.height_px;
-  for (const auto& r : refs)
+  for (const auto &r : refs)
     if (!seen.count(r.id)) m.missing_ids.push_back(r.id);
   if (static_cast<int>(seen.size()) < min_tags)
     throw Error("calibrate-map: saw " + std::to_string(seen.size()) + " of " +
@@ -106,11 +106,11 @@ MapCalib map_calibrate(const Intrinsics& in, const std::vector<RefTag>& refs,
     acc[obj_id[i]].second += 1;
   }
   m.rms_mm = std::sqrt(ss / static_cast<double>(obj.size()));
-  for (const auto& [id, a] : acc) m.tags.push_back({id, std::sqrt(a.first / a.second)});
+  for (const auto &[id, a] : acc) m.tags.push_back({id, std::sqrt(a.first / a.second)});
   return m;
 }
 
-void mapcal_save(const std::string& path, const MapCalib& m) {
+void mapcal_save(const std::string &path, const MapCalib &m) {
   YAML::Emitter e;
   e.SetDoublePrecision(12);
   e << YAML::BeginMap;
@@ -127,7 +127,7 @@ void mapcal_save(const std::string& path, const MapCalib& m) {
   e << YAML::Key << "residual_rms_mm" << YAML::Value << m.rms_mm;
   e << YAML::Key << "residual_max_mm" << YAML::Value << m.max_mm;
   e << YAML::Key << "tags" << YAML::Value << YAML::BeginSeq;
-  for (const auto& t : m.tags)
+  for (const auto &t : m.tags)
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << t.id << YAML::Key
       << "rms_mm" << YAML::Value << t.rms_mm << YAML::EndMap;
   e << YAML::EndSeq;
@@ -139,7 +139,7 @@ void mapcal_save(const std::string& path, const MapCalib& m) {
     << e.c_str() << "\n";
 }
 
-MapCalib mapcal_load(const std::string& path) {
+MapCalib mapcal_load(const std::string &path) {
   YAML::Node n = yaml_load_file(path);
   MapCalib m;
   m.width_px = yaml_int(n, "width_px", path);

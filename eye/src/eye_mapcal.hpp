@@ -26,19 +26,19 @@ struct MapCalib {
   int width_px = 0, height_px = 0;
   double rms_mm = 0, max_mm = 0;  // over all reference corners seen
   std::vector<TagResidual> tags;
-  std::vector<int> missing_ids;    // reference tags never detected
+  std::vector<int> missing_ids;  // reference tags never detected
 };
 
 // Reads the reference tag list:  tags: [{id, x_m, y_m, z_m, yaw_rad, size_m}, ...]
-std::vector<RefTag> reftags_load(const std::string& path);
+std::vector<RefTag> reftags_load(const std::string &path);
 
 // Solves the camera pose from the detections of one or more frames of a fixed camera. Throws
 // eye::Error if fewer than min_tags distinct reference tags are seen.
-MapCalib map_calibrate(const Intrinsics& in, const std::vector<RefTag>& refs,
-                       const std::vector<std::vector<Detection>>& frames, int min_tags = 3);
+MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
+                       const std::vector<std::vector<Detection>> &frames, int min_tags = 3);
 
-void mapcal_save(const std::string& path, const MapCalib& m);
+void mapcal_save(const std::string &path, const MapCalib &m);
 // Throws eye::Error naming the file and the field if it is missing or malformed.
-MapCalib mapcal_load(const std::string& path);
+MapCalib mapcal_load(const std::string &path);
 
 }  // namespace eye

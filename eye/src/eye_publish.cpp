@@ -4,9 +4,9 @@
 
 namespace eye {
 
-int publish_poses(lcm::LCM& lcm, const std::vector<CarPose>& poses, int64_t utime) {
+int publish_poses(lcm::LCM &lcm, const std::vector<CarPose> &poses, int64_t utime) {
   int n = 0;
-  for (const auto& p : poses) {
+  for (const auto &p : poses) {
     autodrive::pose2d_t m;
     m.utime = utime;
     m.vehicle = p.vehicle;

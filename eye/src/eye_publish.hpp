@@ -11,6 +11,6 @@ namespace eye {
 
 // One message per pose, stamped with the frame's capture time utime [us]. Returns how many
 // were published (publish failures are counted out, not thrown).
-int publish_poses(lcm::LCM& lcm, const std::vector<CarPose>& poses, int64_t utime);
+int publish_poses(lcm::LCM &lcm, const std::vector<CarPose> &poses, int64_t utime);
 
 }  // namespace eye

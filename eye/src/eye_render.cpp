@@ -11,7 +11,7 @@
 namespace eye {
 
 cv::Mat render_tag_bitmap(int id) {
-  apriltag_family_t* fam = tag36h11_create();
+  apriltag_family_t *fam = tag36h11_create();
   if (id < 0 || id >= static_cast<int>(fam->ncodes)) {
     tag36h11_destroy(fam);
     throw Error("render_tag_bitmap: tag36h11 has no id " + std::to_string(id));
@@ -24,27 +24,28 @@ cv::Mat render_tag_bitmap(int id) {
   const uint64_t code = fam->codes[id];
   for (uint32_t i = 0; i < fam->nbits; ++i)
     if ((code >> (fam->nbits - 1 - i)) & 1u)
-      out.at<uint8_t>(static_cast<int>(fam->bit_y[i]) + off, static_cast<int>(fam->bit_x[i]) + off) = 255;
+      out.at<uint8_t>(static_cast<int>(fam->bit_y[i]) + off,
+                      static_cast<int>(fam->bit_x[i]) + off) = 255;
   tag36h11_destroy(fam);
   return out;
 }
 
-cv::Matx33d render_plane_to_image(const Intrinsics& in, const CameraPose& pose, double z_m) {
-  const cv::Matx33d& r = pose.r_cam_map;
-  cv::Matx33d m(r(0, 0), r(0, 1), r(0, 2) * z_m + pose.t_cam_map[0],
-                r(1, 0), r(1, 1), r(1, 2) * z_m + pose.t_cam_map[1],
-                r(2, 0), r(2, 1), r(2, 2) * z_m + pose.t_cam_map[2]);
+cv::Matx33d render_plane_to_image(const Intrinsics &in, const CameraPose &pose, double z_m) {
+  const cv::Matx33d &r = pose.r_cam_map;
+  cv::Matx33d m(r(0, 0), r(0, 1), r(0, 2) * z_m + pose.t_cam_map[0], r(1, 0), r(1, 1),
+                r(1, 2) * z_m + pose.t_cam_map[1], r(2, 0), r(2, 1),
+                r(2, 2) * z_m + pose.t_cam_map[2]);
   return in.k * m;
 }
 
-void render_texture(cv::Mat& img, const cv::Mat& tex, const cv::Matx33d& h, int ss) {
+void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int ss) {
   CV_Assert(img.type() == CV_8UC1 && tex.type() == CV_8UC1 && ss >= 1);
   const double tw = tex.cols, th = tex.rows;
   // Bounding box of the texture's outer edge in the image.
-  const cv::Vec3d edge[4] = {{-0.5, -0.5, 1}, {tw - 0.5, -0.5, 1}, {tw - 0.5, th - 0.5, 1},
-                             {-0.5, th - 0.5, 1}};
+  const cv::Vec3d edge[4] = {
+      {-0.5, -0.5, 1}, {tw - 0.5, -0.5, 1}, {tw - 0.5, th - 0.5, 1}, {-0.5, th - 0.5, 1}};
   double x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
-  for (const auto& e : edge) {
+  for (const auto &e : edge) {
     cv::Vec3d p = h * e;
     if (p[2] <= 0) return;  // behind the camera
     x0 = std::min(x0, p[0] / p[2]);
@@ -59,7 +60,7 @@ void render_texture(cv::Mat& img, const cv::Mat& tex, const cv::Matx33d& h, int 
   const cv::Matx33d hi = h.inv();
   const double n = ss * ss;
   for (int row = r0; row <= r1; ++row) {
-    uint8_t* line = img.ptr<uint8_t>(row);
+    uint8_t *line = img.ptr<uint8_t>(row);
     for (int col = c0; col <= c1; ++col) {
       double sum = 0, inside = 0;
       for (int j = 0; j < ss; ++j) {
@@ -86,31 +87,30 @@ void render_texture(cv::Mat& img, const cv::Mat& tex, const cv::Matx33d& h, int 
 // Homography from texture coordinates of a w x h texel texture spread over length_m (texture
 // rows, towards -x: row 0 is the top = +x) by width_m (columns, towards -y: col 0 is the left =
 // +y) to the plane frame of the object, then to the map, then to pixels.
-static cv::Matx33d texture_homography(const Intrinsics& in, const CameraPose& pose, int tw, int th,
+static cv::Matx33d texture_homography(const Intrinsics &in, const CameraPose &pose, int tw, int th,
                                       double length_m, double width_m, double x_m, double y_m,
                                       double z_m, double yaw_rad) {
   const double sx = length_m / th, sy = width_m / tw;
   // texture (u, v) -> object plane (x, y): x = (th/2 - (v + 0.5)) sx, y = (tw/2 - (u + 0.5)) sy
-  const cv::Matx33d tex_to_obj(0, -sx, (th / 2.0 - 0.5) * sx,
-                               -sy, 0, (tw / 2.0 - 0.5) * sy,
-                               0, 0, 1);
+  const cv::Matx33d tex_to_obj(0, -sx, (th / 2.0 - 0.5) * sx, -sy, 0, (tw / 2.0 - 0.5) * sy, 0, 0,
+                               1);
   const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
   const cv::Matx33d obj_to_map(c, -s, x_m, s, c, y_m, 0, 0, 1);
   return render_plane_to_image(in, pose, z_m) * obj_to_map * tex_to_obj;
 }
 
-void render_tag(cv::Mat& img, const Intrinsics& in, const CameraPose& pose, int id, double size_m,
+void render_tag(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, int id, double size_m,
                 double x_m, double y_m, double z_m, double yaw_rad, int ss) {
   const cv::Mat bmp = render_tag_bitmap(id);
   // tag36h11: 10 cells in total, the black border spans the middle 8.
   const double whole_m = size_m * bmp.cols / 8.0;
-  render_texture(img, bmp,
-                 texture_homography(in, pose, bmp.cols, bmp.rows, whole_m, whole_m, x_m, y_m, z_m,
-                                    yaw_rad),
-                 ss);
+  render_texture(
+      img, bmp,
+      texture_homography(in, pose, bmp.cols, bmp.rows, whole_m, whole_m, x_m, y_m, z_m, yaw_rad),
+      ss);
 }
 
-void render_rect(cv::Mat& img, const Intrinsics& in, const CameraPose& pose, uint8_t grey,
+void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uint8_t grey,
                  double length_m, double width_m, double x_m, double y_m, double z_m,
                  double yaw_rad, int ss) {
   const cv::Mat tex(1, 1, CV_8UC1, cv::Scalar(grey));
@@ -123,7 +123,8 @@ std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m) {
   return {cv::Vec2d(-h, h), cv::Vec2d(-h, -h), cv::Vec2d(h, -h), cv::Vec2d(h, h)};
 }
 
-CameraPose camera_look_at(const cv::Vec3d& eye_m, const cv::Vec3d& target_m, const cv::Vec3d& up_m) {
+CameraPose camera_look_at(const cv::Vec3d &eye_m, const cv::Vec3d &target_m,
+                          const cv::Vec3d &up_m) {
   const cv::Vec3d z = cv::normalize(target_m - eye_m);
   const cv::Vec3d x = cv::normalize((-up_m).cross(z));
   const cv::Vec3d y = z.cross(x);
@@ -133,7 +134,7 @@ CameraPose camera_look_at(const cv::Vec3d& eye_m, const cv::Vec3d& target_m, con
   return p;
 }
 
-cv::Mat render_checkerboard(const Intrinsics& in, const CameraPose& board_pose, int cols, int rows,
+cv::Mat render_checkerboard(const Intrinsics &in, const CameraPose &board_pose, int cols, int rows,
                             double square_m, int ss) {
   cv::Mat img(in.height_px, in.width_px, CV_8UC1, cv::Scalar(128));
   // Texture: one texel per square plus a white margin of one square around the board.

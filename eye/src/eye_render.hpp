@@ -17,19 +17,19 @@ namespace eye {
 cv::Mat render_tag_bitmap(int id);
 
 // Homography taking (x, y) on the horizontal plane z = z_m of the map to undistorted pixels.
-cv::Matx33d render_plane_to_image(const Intrinsics& in, const CameraPose& pose, double z_m);
+cv::Matx33d render_plane_to_image(const Intrinsics &in, const CameraPose &pose, double z_m);
 
 // Paints texture `tex` (CV_8UC1) into `img` (CV_8UC1). h_tex_to_img maps texture coordinates
 // (texel centres at integers, same convention) to image pixels; ss: samples per pixel side.
-void render_texture(cv::Mat& img, const cv::Mat& tex, const cv::Matx33d& h_tex_to_img, int ss);
+void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h_tex_to_img, int ss);
 
 // Paints tag `id` whose black border is size_m wide, centred at (x_m, y_m) on plane z_m, its
 // x axis (towards the top of the print) at yaw_rad from map x, seen by a distortion-free camera.
-void render_tag(cv::Mat& img, const Intrinsics& in, const CameraPose& pose, int id, double size_m,
+void render_tag(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, int id, double size_m,
                 double x_m, double y_m, double z_m, double yaw_rad, int ss);
 
 // Paints a uniform rectangle (length_m along its x, width_m along its y) on plane z_m.
-void render_rect(cv::Mat& img, const Intrinsics& in, const CameraPose& pose, uint8_t grey,
+void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uint8_t grey,
                  double length_m, double width_m, double x_m, double y_m, double z_m,
                  double yaw_rad, int ss);
 
@@ -39,11 +39,11 @@ void render_rect(cv::Mat& img, const Intrinsics& in, const CameraPose& pose, uin
 std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m);
 
 // A camera at eye_m looking at target_m, with image "up" towards +up_m (REP-103 map frame).
-CameraPose camera_look_at(const cv::Vec3d& eye_m, const cv::Vec3d& target_m, const cv::Vec3d& up_m);
+CameraPose camera_look_at(const cv::Vec3d &eye_m, const cv::Vec3d &target_m, const cv::Vec3d &up_m);
 
 // A checkerboard of cols x rows squares (square_m each) on the board plane z = 0, board
 // frame -> camera by pose; renders into a w x h grey image. Distortion-free camera.
-cv::Mat render_checkerboard(const Intrinsics& in, const CameraPose& board_pose, int cols, int rows,
+cv::Mat render_checkerboard(const Intrinsics &in, const CameraPose &board_pose, int cols, int rows,
                             double square_m, int ss);
 
 }  // namespace eye

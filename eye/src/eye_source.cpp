@@ -21,9 +21,9 @@ int64_t now_utime() {
       .count();
 }
 
-cv::Mat decode_gray(const uint8_t* data, size_t n, const std::string& what) {
+cv::Mat decode_gray(const uint8_t *data, size_t n, const std::string &what) {
   if (n == 0) throw Error(what + ": empty image data");
-  cv::Mat buf(1, static_cast<int>(n), CV_8UC1, const_cast<uint8_t*>(data));
+  cv::Mat buf(1, static_cast<int>(n), CV_8UC1, const_cast<uint8_t *>(data));
   cv::Mat g = cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
   if (g.empty()) throw Error(what + ": cannot decode the image data (not JPEG/PNG?)");
   return g;
@@ -33,16 +33,19 @@ namespace {
 
 class CaptureSource : public Source {
  public:
-  CaptureSource(const std::string& spec, cv::VideoCapture cap, bool live, double fps)
+  CaptureSource(const std::string &spec, cv::VideoCapture cap, bool live, double fps)
       : spec_(spec), cap_(std::move(cap)), live_(live), fps_(fps) {}
-  bool next(Frame* f) override {
+  bool next(Frame *f) override {
     cv::Mat m;
     if (!cap_.read(m) || m.empty()) return false;
     f->utime = live_ ? now_utime() : static_cast<int64_t>(1e6 * n_ / fps_);
     f->label = spec_ + "#" + std::to_string(n_++);
-    if (m.channels() == 3) cv::cvtColor(m, f->gray, cv::COLOR_BGR2GRAY);
-    else if (m.channels() == 1) f->gray = m;
-    else throw Error(spec_ + ": unsupported frame with " + std::to_string(m.channels()) + " channels");
+    if (m.channels() == 3)
+      cv::cvtColor(m, f->gray, cv::COLOR_BGR2GRAY);
+    else if (m.channels() == 1)
+      f->gray = m;
+    else
+      throw Error(spec_ + ": unsupported frame with " + std::to_string(m.channels()) + " channels");
     return true;
   }
 
@@ -56,10 +59,10 @@ class CaptureSource : public Source {
 
 class FolderSource : public Source {
  public:
-  FolderSource(const std::string& dir, double fps) : fps_(fps) {
+  FolderSource(const std::string &dir, double fps) : fps_(fps) {
     std::error_code ec;
     if (!std::filesystem::is_directory(dir, ec)) throw Error(dir + ": not a folder");
-    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    for (const auto &e : std::filesystem::directory_iterator(dir)) {
       std::string ext = e.path().extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
       if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm")
@@ -68,7 +71,7 @@ class FolderSource : public Source {
     std::sort(files_.begin(), files_.end());
     if (files_.empty()) throw Error(dir + ": no .png/.jpg/.bmp/.pgm images in the folder");
   }
-  bool next(Frame* f) override {
+  bool next(Frame *f) override {
     if (i_ >= files_.size()) return false;
     f->label = files_[i_];
     f->gray = cv::imread(files_[i_], cv::IMREAD_GRAYSCALE);
@@ -86,7 +89,7 @@ class FolderSource : public Source {
 
 class LcmSource : public Source {
  public:
-  LcmSource(const std::string& url, const std::string& channel, double idle_s)
+  LcmSource(const std::string &url, const std::string &channel, double idle_s)
       : lcm_(url), channel_(channel), idle_s_(idle_s) {
     if (!lcm_.good()) throw Error("lcm: cannot open " + url);
     // A plain function + context: LCM 1.3.1's member-function subscription on a polymorphic
@@ -94,7 +97,7 @@ class LcmSource : public Source {
     sub_ = lcm_.subscribeFunction(channel, &LcmSource::on_image_cb, this);
     sub_->setQueueCapacity(4);  // drop old frames rather than fall behind the camera
   }
-  bool next(Frame* f) override {
+  bool next(Frame *f) override {
     auto start = std::chrono::steady_clock::now();
     while (q_.empty()) {
       const int r = lcm_.handleTimeout(100);
@@ -109,12 +112,12 @@ class LcmSource : public Source {
   }
 
  private:
-  static void on_image_cb(const lcm::ReceiveBuffer* rb, const std::string& chan,
-                          const autodrive::compressed_image_t* m, LcmSource* self) {
+  static void on_image_cb(const lcm::ReceiveBuffer *rb, const std::string &chan,
+                          const autodrive::compressed_image_t *m, LcmSource *self) {
     self->on_image(rb, chan, m);
   }
-  void on_image(const lcm::ReceiveBuffer*, const std::string& chan,
-                const autodrive::compressed_image_t* m) {
+  void on_image(const lcm::ReceiveBuffer *, const std::string &chan,
+                const autodrive::compressed_image_t *m) {
     Frame f;
     f.utime = m->utime;
     f.label = chan + "@" + std::to_string(m->utime);
@@ -125,7 +128,7 @@ class LcmSource : public Source {
     }
     try {
       f.gray = decode_gray(m->data.data(), m->data.size(), f.label);
-    } catch (const Error& e) {
+    } catch (const Error &e) {
       std::fprintf(stderr, "autodrive-eye: %s (frame skipped)\n", e.what());
       return;
     }
@@ -135,7 +138,7 @@ class LcmSource : public Source {
   lcm::LCM lcm_;
   std::string channel_;
   double idle_s_;
-  lcm::Subscription* sub_ = nullptr;
+  lcm::Subscription *sub_ = nullptr;
   std::deque<Frame> q_;
 };
 
@@ -144,26 +147,28 @@ class LcmSource : public Source {
 // A 720p-960p JPEG is ~100-200 KB, several UDP fragments: with the kernel's default receive
 // buffer (~200 KB) LCM 1.3.1 loses most such frames on udpm (measured: 0 of 6 arrived; with a
 // 4 MB buffer 6 of 6). Ask for 4 MB (net.core.rmem_max here) unless the URL says otherwise.
-std::string lcm_url_for_images(const std::string& url) {
+std::string lcm_url_for_images(const std::string &url) {
   if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size=") != std::string::npos) return url;
   return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
 }
 
-std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
-                                    const std::string& lcm_url, double idle_timeout_s) {
+std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
+                                    const std::string &lcm_url, double idle_timeout_s) {
   const auto colon = spec.find(':');
   if (colon == std::string::npos)
-    throw Error("source '" + spec + "': expected <kind>:<what>, kind one of device, gst, video, folder, lcm");
+    throw Error("source '" + spec +
+                "': expected <kind>:<what>, kind one of device, gst, video, folder, lcm");
   const std::string kind = spec.substr(0, colon), what = spec.substr(colon + 1);
   if (!(fps_hint > 0)) throw Error("source '" + spec + "': fps must be positive");
   if (kind == "folder") return std::make_unique<FolderSource>(what, fps_hint);
-  if (kind == "lcm") return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s);
+  if (kind == "lcm")
+    return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s);
   cv::VideoCapture cap;
   if (kind == "device") {
     int idx = -1;
     try {
       idx = std::stoi(what);
-    } catch (const std::exception&) {
+    } catch (const std::exception &) {
       throw Error("source '" + spec + "': device index must be a number");
     }
     cap.open(idx, cv::CAP_V4L2);
@@ -173,7 +178,8 @@ std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
     if (!std::filesystem::exists(what)) throw Error("source '" + spec + "': no such file");
     cap.open(what, cv::CAP_FFMPEG);
   } else {
-    throw Error("source '" + spec + "': unknown kind '" + kind + "' (device, gst, video, folder, lcm)");
+    throw Error("source '" + spec + "': unknown kind '" + kind +
+                "' (device, gst, video, folder, lcm)");
   }
   if (!cap.isOpened()) throw Error("source '" + spec + "': cannot open");
   return std::make_unique<CaptureSource>(spec, std::move(cap), kind != "video", fps_hint);

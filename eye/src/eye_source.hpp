@@ -10,31 +10,31 @@
 namespace eye {
 
 struct Frame {
-  cv::Mat gray;        // CV_8UC1
-  int64_t utime = 0;   // capture time [us]
-  std::string label;   // file name or frame counter, for messages
+  cv::Mat gray;       // CV_8UC1
+  int64_t utime = 0;  // capture time [us]
+  std::string label;  // file name or frame counter, for messages
 };
 
 class Source {
  public:
   virtual ~Source() = default;
   // Next frame; false at the end of the stream (or after timeout for a live source).
-  virtual bool next(Frame* f) = 0;
+  virtual bool next(Frame *f) = 0;
 };
 
 // spec: "device:<index>", "gst:<pipeline>", "video:<file>", "folder:<dir>", "lcm:<channel>".
 // fps_hint: frame period used to stamp video and folder frames (their capture time is not
 // recorded); lcm_url: for lcm sources; idle_timeout_s: a live source with no frame for this
 // long ends the stream (0: wait forever). Throws eye::Error naming the source if it cannot open.
-std::unique_ptr<Source> source_open(const std::string& spec, double fps_hint,
-                                    const std::string& lcm_url, double idle_timeout_s);
+std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
+                                    const std::string &lcm_url, double idle_timeout_s);
 
 // Decodes a JPEG/PNG buffer to grey; throws eye::Error naming `what` if it is not an image.
-cv::Mat decode_gray(const uint8_t* data, size_t n, const std::string& what);
+cv::Mat decode_gray(const uint8_t *data, size_t n, const std::string &what);
 
 int64_t now_utime();
 
 // The LCM URL with a 4 MB socket receive buffer for udpm (large image messages).
-std::string lcm_url_for_images(const std::string& url);
+std::string lcm_url_for_images(const std::string &url);
 
 }  // namespace eye

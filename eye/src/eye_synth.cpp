@@ -24,18 +24,18 @@ SynthScene synth_scene(int w, int h, double tag_size_m) {
   s.floor = cv::Mat(h, w, CV_8UC1);
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c)
-      s.floor.at<uint8_t>(r, c) = static_cast<uint8_t>(
-          120 + 25 * std::sin(c * 0.011) * std::cos(r * 0.017) + 20.0 * c / w);
+      s.floor.at<uint8_t>(r, c) =
+          static_cast<uint8_t>(120 + 25 * std::sin(c * 0.011) * std::cos(r * 0.017) + 20.0 * c / w);
   return s;
 }
 
-cv::Mat synth_frame(const SynthScene& s, const std::vector<SynthCar>& cars,
-                    const std::vector<RefTag>& floor_tags, uint64_t seed) {
+cv::Mat synth_frame(const SynthScene &s, const std::vector<SynthCar> &cars,
+                    const std::vector<RefTag> &floor_tags, uint64_t seed) {
   cv::Mat img = s.floor.clone();
-  for (const auto& t : floor_tags)
+  for (const auto &t : floor_tags)
     render_tag(img, s.in, s.pose, t.id, t.size_m, t.x_m, t.y_m, t.z_m, t.yaw_rad, s.ss);
   const double z_roof = s.car.base_link_height_m + s.car.tag_offset_m[2];
-  for (const auto& car : cars) {
+  for (const auto &car : cars) {
     const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
     const double ox = s.car.tag_offset_m[0], oy = s.car.tag_offset_m[1];
     const double tx = car.x_m + c * ox - sn * oy, ty = car.y_m + sn * ox + c * oy;
@@ -58,7 +58,7 @@ cv::Mat synth_frame(const SynthScene& s, const std::vector<SynthCar>& cars,
   return img;
 }
 
-std::vector<RefTag> synth_reference_tags(const SynthScene& s) {
+std::vector<RefTag> synth_reference_tags(const SynthScene &s) {
   std::vector<RefTag> out;
   const double xs[3] = {0.15, s.map_x_m / 2, s.map_x_m - 0.15};
   const double ys[3] = {0.15, s.map_y_m / 2, s.map_y_m - 0.15};

@@ -14,14 +14,14 @@
 namespace eye {
 
 struct SynthScene {
-  Intrinsics in;           // distortion-free
+  Intrinsics in;  // distortion-free
   CameraPose pose;
-  LocateParams car;        // tag size, tag offset, base_link height
+  LocateParams car;                     // tag size, tag offset, base_link height
   double map_x_m = 3.0, map_y_m = 2.0;  // map extent from the origin [m]
-  int ss = 4;              // samples per pixel side
+  int ss = 4;                           // samples per pixel side
   double blur_sigma_px = 0.0;
   double noise_sigma = 0.0;  // grey levels
-  cv::Mat floor;           // pre-rendered background
+  cv::Mat floor;             // pre-rendered background
 };
 
 struct SynthCar {
@@ -32,9 +32,9 @@ struct SynthCar {
 // width_px x height_px camera over the map; tag_size_m: black border of the roof tags.
 SynthScene synth_scene(int width_px, int height_px, double tag_size_m = 0.10);
 // Renders a frame; floor_tags are drawn on their own plane (z_m). seed: noise.
-cv::Mat synth_frame(const SynthScene& s, const std::vector<SynthCar>& cars,
-                    const std::vector<RefTag>& floor_tags, uint64_t seed);
+cv::Mat synth_frame(const SynthScene &s, const std::vector<SynthCar> &cars,
+                    const std::vector<RefTag> &floor_tags, uint64_t seed);
 // Reference tags near the corners and edges of the map (ids 100..), for calibrate-map.
-std::vector<RefTag> synth_reference_tags(const SynthScene& s);
+std::vector<RefTag> synth_reference_tags(const SynthScene &s);
 
 }  // namespace eye

@@ -15,16 +15,16 @@ static DetectorParams roi_params(DetectorParams p) {
   return p;
 }
 
-Tracker::Tracker(const RunConfig& c) : cfg_(c), det_(c.detector), roi_det_(roi_params(c.detector)) {
-  for (const auto& v : c.vehicles) by_tag_[v.tag_id] = v;
+Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector), roi_det_(roi_params(c.detector)) {
+  for (const auto &v : c.vehicles) by_tag_[v.tag_id] = v;
 }
 
-std::vector<Detection> Tracker::detect_windows(const cv::Mat& gray) {
+std::vector<Detection> Tracker::detect_windows(const cv::Mat &gray) {
   std::vector<Detection> out;
   const cv::Rect frame(0, 0, gray.cols, gray.rows);
-  for (const auto& [id, c] : last_corners_) {
+  for (const auto &[id, c] : last_corners_) {
     double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
-    for (const auto& p : c) {
+    for (const auto &p : c) {
       x0 = std::min(x0, p.x);
       x1 = std::max(x1, p.x);
       y0 = std::min(y0, p.y);
@@ -40,7 +40,7 @@ std::vector<Detection> Tracker::detect_windows(const cv::Mat& gray) {
     // Window pixel (c, r) is frame pixel (c + x, r + y): shifting corners is exact.
     for (auto d : roi_det_.detect(gray(win))) {
       if (d.id != id) continue;
-      for (auto& p : d.corners_px) p += cv::Point2d(win.x, win.y);
+      for (auto &p : d.corners_px) p += cv::Point2d(win.x, win.y);
       d.centre_px += cv::Point2d(win.x, win.y);
       out.push_back(d);
     }
@@ -48,7 +48,7 @@ std::vector<Detection> Tracker::detect_windows(const cv::Mat& gray) {
   return out;
 }
 
-std::vector<CarPose> Tracker::process(const cv::Mat& gray) {
+std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
   if (gray.cols != cfg_.in.width_px || gray.rows != cfg_.in.height_px)
     throw Error("frame: size " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
                 " differs from the calibrated " + std::to_string(cfg_.in.width_px) + "x" +
@@ -63,9 +63,9 @@ std::vector<CarPose> Tracker::process(const cv::Mat& gray) {
     dets = detect_windows(gray);
     // A tracked car missing from its window (fast motion, occlusion): scan the whole frame
     // now rather than lose the frame; windows only ever save time, never detections.
-    for (const auto& kv : last_corners_) {
+    for (const auto &kv : last_corners_) {
       const int id = kv.first;
-      if (std::none_of(dets.begin(), dets.end(), [id](const Detection& d) { return d.id == id; })) {
+      if (std::none_of(dets.begin(), dets.end(), [id](const Detection &d) { return d.id == id; })) {
         last_full_ = true;
         break;
       }
@@ -73,8 +73,8 @@ std::vector<CarPose> Tracker::process(const cv::Mat& gray) {
   }
   if (last_full_) dets = det_.detect(gray);
   last_corners_.clear();
-  for (const auto& d : dets) count[d.id]++;
-  for (const auto& d : dets) {
+  for (const auto &d : dets) count[d.id]++;
+  for (const auto &d : dets) {
     auto it = by_tag_.find(d.id);
     // A tag seen twice in one frame is ambiguous (a copy, a reflection): publish neither.
     if (it == by_tag_.end() || count[d.id] > 1) continue;
@@ -86,10 +86,10 @@ std::vector<CarPose> Tracker::process(const cv::Mat& gray) {
   return out;
 }
 
-cv::Mat Tracker::annotate(const cv::Mat& gray, const std::vector<CarPose>& poses) const {
+cv::Mat Tracker::annotate(const cv::Mat &gray, const std::vector<CarPose> &poses) const {
   cv::Mat bgr;
   cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
-  for (const auto& p : poses) {
+  for (const auto &p : poses) {
     for (size_t i = 0; i < 4; ++i)
       cv::line(bgr, p.corners_px[i], p.corners_px[(i + 1) % 4], cv::Scalar(0, 255, 0), 2,
                cv::LINE_AA);

@@ -19,17 +19,17 @@ namespace eye {
 
 class Tracker {
  public:
-  explicit Tracker(const RunConfig& c);
+  explicit Tracker(const RunConfig &c);
   // gray: CV_8UC1 of the calibrated size; throws eye::Error on another size or type.
-  std::vector<CarPose> process(const cv::Mat& gray);
+  std::vector<CarPose> process(const cv::Mat &gray);
   // The frame with the tags, ids, vehicle names and poses drawn in (BGR).
-  cv::Mat annotate(const cv::Mat& gray, const std::vector<CarPose>& poses) const;
-  const RunConfig& config() const { return cfg_; }
+  cv::Mat annotate(const cv::Mat &gray, const std::vector<CarPose> &poses) const;
+  const RunConfig &config() const { return cfg_; }
   // Whether the last process() scanned the whole frame.
   bool last_was_full_scan() const { return last_full_; }
 
  private:
-  std::vector<Detection> detect_windows(const cv::Mat& gray);
+  std::vector<Detection> detect_windows(const cv::Mat &gray);
   RunConfig cfg_;
   Detector det_;
   Detector roi_det_;  // decimate 1: windows are small

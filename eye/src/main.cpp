@@ -21,14 +21,16 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
+void on_signal(int) {
+  g_stop = 1;
+}
 
 // Grey images from a folder (sorted by name) or a single image file.
-std::vector<std::pair<std::string, cv::Mat>> load_images(const std::string& path) {
+std::vector<std::pair<std::string, cv::Mat>> load_images(const std::string &path) {
   std::vector<std::string> files;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
-    for (const auto& e : std::filesystem::directory_iterator(path)) {
+    for (const auto &e : std::filesystem::directory_iterator(path)) {
       std::string ext = e.path().extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
       if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm")
@@ -42,7 +44,7 @@ std::vector<std::pair<std::string, cv::Mat>> load_images(const std::string& path
     throw eye::Error(path + ": no such file or folder");
   }
   std::vector<std::pair<std::string, cv::Mat>> out;
-  for (const auto& f : files) {
+  for (const auto &f : files) {
     cv::Mat g = cv::imread(f, cv::IMREAD_GRAYSCALE);
     if (g.empty()) throw eye::Error(f + ": cannot read the image");
     out.emplace_back(f, g);
@@ -51,15 +53,17 @@ std::vector<std::pair<std::string, cv::Mat>> load_images(const std::string& path
 }
 
 // Every `every`-th frame of a video file or camera, up to max_views.
-std::vector<cv::Mat> grab_views(cv::VideoCapture& cap, const std::string& what, int every,
+std::vector<cv::Mat> grab_views(cv::VideoCapture &cap, const std::string &what, int every,
                                 int max_views) {
   if (!cap.isOpened()) throw eye::Error(what + ": cannot open");
   std::vector<cv::Mat> out;
   cv::Mat m, g;
   for (int i = 0; static_cast<int>(out.size()) < max_views && cap.read(m) && !g_stop; ++i) {
     if (i % every) continue;
-    if (m.channels() == 3) cv::cvtColor(m, g, cv::COLOR_BGR2GRAY);
-    else g = m;
+    if (m.channels() == 3)
+      cv::cvtColor(m, g, cv::COLOR_BGR2GRAY);
+    else
+      g = m;
     out.push_back(g.clone());
   }
   return out;
@@ -67,27 +71,31 @@ std::vector<cv::Mat> grab_views(cv::VideoCapture& cap, const std::string& what, 
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{"autodrive-eye: overhead AprilTag (tag36h11) localisation of every car on the map.\n"
-               "Calibrate the camera (calibrate-intrinsics), then its pose over the map from\n"
-               "reference tags (calibrate-map), then localise the cars (run)."};
+int main(int argc, char **argv) {
+  CLI::App app{
+      "autodrive-eye: overhead AprilTag (tag36h11) localisation of every car on the map.\n"
+      "Calibrate the camera (calibrate-intrinsics), then its pose over the map from\n"
+      "reference tags (calibrate-map), then localise the cars (run)."};
   app.require_subcommand(1);
 
   // calibrate-intrinsics
-  auto* ci = app.add_subcommand("calibrate-intrinsics",
+  auto *ci = app.add_subcommand("calibrate-intrinsics",
                                 "Camera matrix and distortion from checkerboard views");
   std::string ci_images, ci_video, ci_out;
   int ci_device = -1, ci_every = 15, ci_max = 40;
   eye::IntrinsicsParams ip;
-  auto* ci_src = ci->add_option_group("input", "one of");
+  auto *ci_src = ci->add_option_group("input", "one of");
   ci_src->add_option("--images", ci_images, "folder of checkerboard images (png/jpg)");
   ci_src->add_option("--video", ci_video, "video file of the board moving");
   ci_src->add_option("--device", ci_device, "live camera index (V4L2)");
   ci_src->require_option(1);
   ci->add_option("--every", ci_every, "video/device: use every N-th frame")->capture_default_str();
-  ci->add_option("--max-views", ci_max, "video/device: stop after this many frames")->capture_default_str();
-  ci->add_option("--cols", ip.inner_cols, "inner corners along the board's width")->capture_default_str();
-  ci->add_option("--rows", ip.inner_rows, "inner corners along the board's height")->capture_default_str();
+  ci->add_option("--max-views", ci_max, "video/device: stop after this many frames")
+      ->capture_default_str();
+  ci->add_option("--cols", ip.inner_cols, "inner corners along the board's width")
+      ->capture_default_str();
+  ci->add_option("--rows", ip.inner_rows, "inner corners along the board's height")
+      ->capture_default_str();
   ci->add_option("--square-m", ip.square_m, "square edge [m]")->capture_default_str();
   ci->add_option("--min-views", ip.min_views, "refuse fewer usable views")->capture_default_str();
   ci->add_option("--min-coverage", ip.min_coverage,
@@ -103,14 +111,15 @@ int main(int argc, char** argv) {
   ci->add_option("-o,--out", ci_out, "output YAML (camera matrix, distortion, RMS)")->required();
 
   // calibrate-map
-  auto* cm = app.add_subcommand("calibrate-map",
+  auto *cm = app.add_subcommand("calibrate-map",
                                 "Camera pose over the map from reference tags at known places");
   std::string cm_intr, cm_tags, cm_images, cm_out;
   double cm_max_rms_mm = 5.0;
   int cm_min_tags = 3;
   float cm_decimate = 1.0f;
   cm->add_option("--intrinsics", cm_intr, "intrinsics YAML from calibrate-intrinsics")->required();
-  cm->add_option("--tags", cm_tags, "reference tags YAML: tags: [{id, x_m, y_m, z_m, yaw_rad, size_m}]")
+  cm->add_option("--tags", cm_tags,
+                 "reference tags YAML: tags: [{id, x_m, y_m, z_m, yaw_rad, size_m}]")
       ->required();
   cm->add_option("--images", cm_images, "an image or a folder of images of the map (fixed camera)")
       ->required();
@@ -123,7 +132,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   // run
-  auto* rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
+  auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
   std::string rn_config, rn_source = "lcm:EYE_IMAGE", rn_debug, rn_url;
   double rn_fps = 30.0, rn_idle_s = 0.0;
   int rn_max_frames = 0, rn_debug_every = 1;
@@ -140,7 +149,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rn->add_option("--max-frames", rn_max_frames, "stop after this many frames (0: never)")
       ->capture_default_str();
-  rn->add_option("--idle-timeout-s", rn_idle_s, "lcm source: stop after this long without a frame (0: never)")
+  rn->add_option("--idle-timeout-s", rn_idle_s,
+                 "lcm source: stop after this long without a frame (0: never)")
       ->capture_default_str();
   rn->add_flag("-q,--quiet", rn_quiet, "no per-frame line on stdout");
 
@@ -152,21 +162,23 @@ int main(int argc, char** argv) {
     if (*ci) {
       std::vector<cv::Mat> views;
       if (!ci_images.empty()) {
-        for (auto& [name, img] : load_images(ci_images)) views.push_back(img);
+        for (auto &[name, img] : load_images(ci_images)) views.push_back(img);
       } else if (!ci_video.empty()) {
         if (!std::filesystem::exists(ci_video)) throw eye::Error(ci_video + ": no such file");
         cv::VideoCapture cap(ci_video, cv::CAP_FFMPEG);
         views = grab_views(cap, ci_video, std::max(1, ci_every), ci_max);
       } else {
         cv::VideoCapture cap(ci_device, cv::CAP_V4L2);
-        views = grab_views(cap, "camera " + std::to_string(ci_device), std::max(1, ci_every), ci_max);
+        views =
+            grab_views(cap, "camera " + std::to_string(ci_device), std::max(1, ci_every), ci_max);
       }
       const auto rep = eye::intrinsics_calibrate(views, ip);
       eye::intrinsics_save(ci_out, rep.in);
-      std::printf("views %d/%d, coverage %.0f%%, rms %.4f px\nfx %.3f fy %.3f cx %.3f cy %.3f\n"
-                  "wrote %s\n",
-                  rep.views_used, rep.views_total, 100 * rep.coverage, rep.in.rms_px,
-                  rep.in.k(0, 0), rep.in.k(1, 1), rep.in.k(0, 2), rep.in.k(1, 2), ci_out.c_str());
+      std::printf(
+          "views %d/%d, coverage %.0f%%, rms %.4f px\nfx %.3f fy %.3f cx %.3f cy %.3f\n"
+          "wrote %s\n",
+          rep.views_used, rep.views_total, 100 * rep.coverage, rep.in.rms_px, rep.in.k(0, 0),
+          rep.in.k(1, 1), rep.in.k(0, 2), rep.in.k(1, 2), ci_out.c_str());
       return 0;
     }
     if (*cm) {
@@ -176,19 +188,20 @@ int main(int argc, char** argv) {
       dp.decimate = cm_decimate;
       eye::Detector det(dp);
       std::vector<std::vector<eye::Detection>> frames;
-      for (auto& [name, img] : load_images(cm_images)) {
+      for (auto &[name, img] : load_images(cm_images)) {
         if (img.cols != in.width_px || img.rows != in.height_px)
           throw eye::Error(name + ": image size " + std::to_string(img.cols) + "x" +
                            std::to_string(img.rows) + " differs from the intrinsics in " + cm_intr);
         frames.push_back(det.detect(img));
       }
       const auto m = eye::map_calibrate(in, refs, frames, cm_min_tags);
-      for (const auto& t : m.tags) std::printf("tag %3d  residual %.3f mm\n", t.id, t.rms_mm);
+      for (const auto &t : m.tags) std::printf("tag %3d  residual %.3f mm\n", t.id, t.rms_mm);
       for (int id : m.missing_ids) std::printf("tag %3d  NOT SEEN\n", id);
       const cv::Vec3d c = m.pose.centre_map();
-      std::printf("camera centre on the map (%.4f, %.4f, %.4f) m\n"
-                  "residual rms %.3f mm, max %.3f mm over %zu tags\n",
-                  c[0], c[1], c[2], m.rms_mm, m.max_mm, m.tags.size());
+      std::printf(
+          "camera centre on the map (%.4f, %.4f, %.4f) m\n"
+          "residual rms %.3f mm, max %.3f mm over %zu tags\n",
+          c[0], c[1], c[2], m.rms_mm, m.max_mm, m.tags.size());
       if (!(m.rms_mm <= cm_max_rms_mm)) {
         std::fprintf(stderr,
                      "autodrive-eye: calibrate-map: residual rms %.3f mm > %.3f mm: check the "
@@ -217,7 +230,7 @@ int main(int argc, char** argv) {
           throw eye::Error(rn_debug + ": cannot write the debug image");
         if (!rn_quiet) {
           std::printf("%s utime=%lld", f.label.c_str(), static_cast<long long>(f.utime));
-          for (const auto& p : poses)
+          for (const auto &p : poses)
             std::printf("  %s x=%.4f y=%.4f yaw=%.4f", p.vehicle.c_str(), p.x_m, p.y_m, p.yaw_rad);
           std::printf("\n");
           std::fflush(stdout);
@@ -227,10 +240,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "autodrive-eye: %ld frames, %ld poses published\n", frames, published);
       return 0;
     }
-  } catch (const eye::Error& e) {
+  } catch (const eye::Error &e) {
     std::fprintf(stderr, "autodrive-eye: error: %s\n", e.what());
     return 1;
-  } catch (const cv::Exception& e) {
+  } catch (const cv::Exception &e) {
     std::fprintf(stderr, "autodrive-eye: OpenCV error: %s\n", e.what());
     return 1;
   }

@@ -76,8 +76,8 @@ struct World {
   // Occupied where a wall passes through the cell, free elsewhere inside [0,4]x[0,3],
   // unknown outside; the grid spans [-0.5, 4.5] x [-0.5, 3.5].
   autonomy::GridMap rasterize(double res_m) const {
-    autonomy::GridMap g(static_cast<int>(std::round(5.0 / res_m)), static_cast<int>(std::round(4.0 / res_m)),
-                        res_m, -0.5, -0.5);
+    autonomy::GridMap g(static_cast<int>(std::round(5.0 / res_m)),
+                        static_cast<int>(std::round(4.0 / res_m)), res_m, -0.5, -0.5);
     for (int cy = 0; cy < g.height_cells; ++cy) {
       for (int cx = 0; cx < g.width_cells; ++cx) {
         const Eigen::Vector2d c = g.cell_center_m(cx, cy);
@@ -89,8 +89,10 @@ struct World {
         }
         const bool inside = c.x() > 0 && c.x() < 4 && c.y() > 0 && c.y() < 3;
         float &l = g.log_odds[g.index(cx, cy)];
-        if (dmin <= 0.5 * res_m * 1.4143) l = 5.0f;
-        else l = inside ? -5.0f : 0.0f;
+        if (dmin <= 0.5 * res_m * 1.4143)
+          l = 5.0f;
+        else
+          l = inside ? -5.0f : 0.0f;
       }
     }
     return g;
@@ -104,7 +106,8 @@ struct Bicycle {
   double wheelbase_m = 0.14154, speed_tau_s = 0.1, steer_rate_rad_s = 0.805;
   void step(double cmd_speed_m_s, double cmd_steer_rad, double dt_s) {
     speed_m_s += (cmd_speed_m_s - speed_m_s) * std::min(1.0, dt_s / speed_tau_s);
-    const double ds = std::clamp(cmd_steer_rad - steer_rad, -steer_rate_rad_s * dt_s, steer_rate_rad_s * dt_s);
+    const double ds =
+        std::clamp(cmd_steer_rad - steer_rad, -steer_rate_rad_s * dt_s, steer_rate_rad_s * dt_s);
     steer_rad += ds;
     pose = autonomy::arc_step(pose, speed_m_s * dt_s, std::tan(steer_rad) / wheelbase_m);
   }
@@ -114,9 +117,11 @@ struct Bicycle {
 inline double distance_to_path_m(const autonomy::Path &path, const Eigen::Vector2d &p) {
   double best = 1e9;
   for (size_t i = 1; i < path.size(); ++i) {
-    const Eigen::Vector2d a(path[i - 1].pose.x_m, path[i - 1].pose.y_m), b(path[i].pose.x_m, path[i].pose.y_m);
+    const Eigen::Vector2d a(path[i - 1].pose.x_m, path[i - 1].pose.y_m),
+        b(path[i].pose.x_m, path[i].pose.y_m);
     const Eigen::Vector2d e = b - a;
-    const double t = e.squaredNorm() < 1e-12 ? 0.0 : std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+    const double t =
+        e.squaredNorm() < 1e-12 ? 0.0 : std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
     best = std::min(best, (a + t * e - p).norm());
   }
   return best;

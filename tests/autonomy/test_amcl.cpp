@@ -16,8 +16,8 @@ struct Drive {
     const Pose2 before = truth;
     truth = arc_step(truth, ds_m, k_1pm);
     Pose2 d = pose_between(before, truth);
-    d.x_m *= 1.03;          // 3% odometry scale error
-    d.yaw_rad += 0.002;     // gyro bias
+    d.x_m *= 1.03;       // 3% odometry scale error
+    d.yaw_rad += 0.002;  // gyro bias
     odom = pose_compose(odom, d);
   }
 };
@@ -32,7 +32,8 @@ TEST(Amcl, ConvergesFromAWrongStartAndAdaptsTheParticleCount) {
   Amcl amcl(map, cfg);
   Drive d;
   // 0.3 m and 0.25 rad off, with a spread wide enough to contain the truth.
-  amcl.init_gaussian({d.truth.x_m + 0.25, d.truth.y_m - 0.18, d.truth.yaw_rad + 0.25}, 0.25, 0.25, 0.3);
+  amcl.init_gaussian({d.truth.x_m + 0.25, d.truth.y_m - 0.18, d.truth.yaw_rad + 0.25}, 0.25, 0.25,
+                     0.3);
   const size_t n_start = amcl.particles().size();
   std::mt19937 rng(2);
   double err = 1e9;
@@ -58,7 +59,7 @@ TEST(Amcl, DoesNotUpdateWithoutMotionUnlessForced) {
   const Pose2 p{1.5, 1.0, 0.0};
   amcl.init_gaussian(p, 0.05, 0.05, 0.05);
   const auto scan = world.scan(p, AmclConfig{}.lidar_in_base);
-  EXPECT_TRUE(amcl.update({0, 0, 0}, scan));   // the first one always runs
+  EXPECT_TRUE(amcl.update({0, 0, 0}, scan));  // the first one always runs
   EXPECT_FALSE(amcl.update({0.001, 0, 0}, scan));
   EXPECT_TRUE(amcl.update({0.001, 0, 0}, scan, true));
 }

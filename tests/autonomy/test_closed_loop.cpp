@@ -23,8 +23,8 @@ struct Outcome {
   double sim_s = 0;
   double mapped_pose_err_m = -1;  // SLAM pose vs truth when the map was saved
   int laser_odom_scans = 0, laser_odom_rejected = 0;
-  Path retry_path;  // the first plan made after a stop off the goal
-  double max_progress[7] = {};     // per MissionState
+  Path retry_path;              // the first plan made after a stop off the goal
+  double max_progress[7] = {};  // per MissionState
   bool progress_in_range = true;
 };
 
@@ -51,7 +51,8 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
   synth::World world = synth::World::parking_lot();
   const Pose2 lidar{0.1445, 0.0, 0.0};
   NodeConfig cfg;
-  const fs::path dir = fs::temp_directory_path() / ("autonomy_closed_loop_" + tag + "_" + std::to_string(::getpid()));
+  const fs::path dir = fs::temp_directory_path() /
+                       ("autonomy_closed_loop_" + tag + "_" + std::to_string(::getpid()));
   cfg.map_yaml_out = (dir / "map.yaml").string();
   cfg.slam.width_m = 5.0;
   cfg.slam.height_m = 4.0;
@@ -104,10 +105,12 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
     const Pose2 before = car.pose;
     car.step(c.throttle * 0.267, c.steering * 0.5236, dt);
     Pose2 d = pose_between(before, car.pose);
-    d.x_m *= 1.02;       // wheel odometry scale error
-    d.yaw_rad += 1e-5;   // gyro bias, 1 mrad/s
+    d.x_m *= 1.02;      // wheel odometry scale error
+    d.yaw_rad += 1e-5;  // gyro bias, 1 mrad/s
     odom = pose_compose(odom, d);
-    if (i % 5 == 0) out.min_clearance_m = std::min(out.min_clearance_m, body_clearance_m(world, car.pose, cfg.footprint));
+    if (i % 5 == 0)
+      out.min_clearance_m =
+          std::min(out.min_clearance_m, body_clearance_m(world, car.pose, cfg.footprint));
     out.sim_s = t_us * 1e-6;
   }
   out.state = node.mission().state();
@@ -149,7 +152,8 @@ TEST(ClosedLoop, MapsAlongARouteThenParks) {
   EXPECT_NE(o.history.find("route leg 1/2"), std::string::npos) << o.history;
   EXPECT_NE(o.history.find("route leg 2/2"), std::string::npos) << o.history;
   EXPECT_GE(o.mapped_pose_err_m, 0.0);
-  EXPECT_LT(o.mapped_pose_err_m, 0.02) << "SLAM pose off the truth at the end of the route";  // 0.5 cm
+  EXPECT_LT(o.mapped_pose_err_m, 0.02)
+      << "SLAM pose off the truth at the end of the route";  // 0.5 cm
   EXPECT_GT(o.laser_odom_scans, 50);
   EXPECT_LT(o.laser_odom_rejected, o.laser_odom_scans / 10) << "ICP rejected too often";
   // mission_status_t.progress: through the route while mapping, along the path while driving.
@@ -174,7 +178,8 @@ TEST(ClosedLoop, ARetryBacksOffToAStagingPoseAndRunsStraightIn) {
   const Pose2 staging = pose_compose(goal, Pose2{-dir * 0.2, 0.0, 0.0});
   double to_staging = 1e9;
   for (const auto &q : o.retry_path)
-    to_staging = std::min(to_staging, std::hypot(q.pose.x_m - staging.x_m, q.pose.y_m - staging.y_m));
+    to_staging =
+        std::min(to_staging, std::hypot(q.pose.x_m - staging.x_m, q.pose.y_m - staging.y_m));
   EXPECT_LT(to_staging, 1e-3) << "the retry does not pass the staging pose";
   EXPECT_GE(path_cusps(o.retry_path), 1);
   EXPECT_NEAR(o.retry_path.back().pose.x_m, goal.x_m, 1e-6);

@@ -17,7 +17,9 @@ LaserOdomConfig lo_config() {
   return c;
 }
 
-Pose2 scaled(const Pose2 &m, double k) { return {m.x_m * k, m.y_m * k, m.yaw_rad * k}; }
+Pose2 scaled(const Pose2 &m, double k) {
+  return {m.x_m * k, m.y_m * k, m.yaw_rad * k};
+}
 }  // namespace
 
 // Wheel odometry 10 % long (a worn tyre, a wrong wheel radius): the laser odometry follows the
@@ -39,7 +41,7 @@ TEST(LaserOdometry, FollowsTheTruthWhenTheOdometryIsScaled) {
   const Pose2 want = pose_between(start, truth);
   const Pose2 err = pose_between(want, lo.pose());
   const Pose2 werr = pose_between(want, wheel);
-  EXPECT_LT(std::hypot(err.x_m, err.y_m), 0.02);   // measured 0.57 cm
+  EXPECT_LT(std::hypot(err.x_m, err.y_m), 0.02);  // measured 0.57 cm
   EXPECT_LT(std::abs(err.yaw_rad), 0.02);
   EXPECT_GT(std::hypot(werr.x_m, werr.y_m), 0.08);  // the guess alone: 12 cm
   EXPECT_EQ(lo.rejected(), 0);
@@ -71,7 +73,8 @@ TEST(LaserOdometry, FallsBackToTheOdometryWhenIcpCannotWork) {
   EXPECT_NEAR(lo.pose().x_m, 0.02, 1e-9);
   EXPECT_NEAR(lo.pose().yaw_rad, 0.01, 1e-9);
   // Registration resumes on the next good scan, against the old keyframe.
-  const LaserOdomStep s2 = lo.update(world.scan(pose_compose(p, Pose2{0.03, 0, 0}), kLidar), Pose2{0.01, 0, 0});
+  const LaserOdomStep s2 =
+      lo.update(world.scan(pose_compose(p, Pose2{0.03, 0, 0}), kLidar), Pose2{0.01, 0, 0});
   EXPECT_TRUE(s2.from_icp);
   EXPECT_NEAR(lo.pose().x_m, 0.03, 0.003);
 }

@@ -13,12 +13,15 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path tmp_dir(const std::string &name) {
-  const fs::path d = fs::temp_directory_path() / ("autonomy_map_io_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("autonomy_map_io_" + name + "_" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }
 
-void write(const fs::path &p, const std::string &text) { std::ofstream(p, std::ios::binary) << text; }
+void write(const fs::path &p, const std::string &text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
 
 // Expects map_load to throw a message that names `file` and contains `what`.
 void expect_load_error(const fs::path &yaml, const std::string &file, const std::string &what) {
@@ -32,8 +35,9 @@ void expect_load_error(const fs::path &yaml, const std::string &file, const std:
   }
 }
 
-const char *kGoodYaml = "image: m.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
-                        "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+const char *kGoodYaml =
+    "image: m.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+    "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
 
 }  // namespace
 
@@ -53,7 +57,8 @@ TEST(MapIo, RoundTripKeepsEveryCellAndTheGeometry) {
   int occupied = 0, unknown = 0;
   for (int cy = 0; cy < m.height_cells; ++cy) {
     for (int cx = 0; cx < m.width_cells; ++cx) {
-      ASSERT_EQ(static_cast<int>(r.state(cx, cy)), static_cast<int>(m.state(cx, cy))) << cx << "," << cy;
+      ASSERT_EQ(static_cast<int>(r.state(cx, cy)), static_cast<int>(m.state(cx, cy)))
+          << cx << "," << cy;
       occupied += m.state(cx, cy) == CellState::kOccupied;
       unknown += m.state(cx, cy) == CellState::kUnknown;
     }

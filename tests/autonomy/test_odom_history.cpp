@@ -16,7 +16,7 @@ TEST(OdomHistory, InterpolatesBetweenSamplesAcrossTheHeadingWrap) {
 }
 
 TEST(OdomHistory, ClampsOutsideTheKeptSpanAndForgetsOldSamples) {
-  OdomHistory h(100000);  // keep 0.1 s
+  OdomHistory h(100000);                                                 // keep 0.1 s
   for (int i = 0; i <= 50; ++i) h.add(i * 10000, {0.01 * i, 0.0, 0.0});  // 1 m/s for 0.5 s
   EXPECT_NEAR(h.at(900000)->x_m, 0.50, 1e-9);   // after the newest: the newest
   EXPECT_NEAR(h.at(0)->x_m, 0.40, 1e-9);        // older than kept: the oldest kept (0.4 s)

@@ -19,9 +19,11 @@ void expect_feasible(const Path &path) {
     ASSERT_LE(std::abs(path[i].curvature_1pm), kMaxCurvature + 1e-9) << "sample " << i;
     if (i + 1 < path.size()) {
       // Heading change over distance between consecutive samples of one direction.
-      const double ds = std::hypot(path[i + 1].pose.x_m - path[i].pose.x_m, path[i + 1].pose.y_m - path[i].pose.y_m);
+      const double ds = std::hypot(path[i + 1].pose.x_m - path[i].pose.x_m,
+                                   path[i + 1].pose.y_m - path[i].pose.y_m);
       if (ds > 1e-4) {
-        const double k = std::abs(angle_wrap_rad(path[i + 1].pose.yaw_rad - path[i].pose.yaw_rad)) / ds;
+        const double k =
+            std::abs(angle_wrap_rad(path[i + 1].pose.yaw_rad - path[i].pose.yaw_rad)) / ds;
         ASSERT_LE(k, kMaxCurvature * 1.01) << "traced curvature at sample " << i;
         ASSERT_LT(ds, 0.03) << "gap in the path at sample " << i;
       }
@@ -29,7 +31,9 @@ void expect_feasible(const Path &path) {
   }
 }
 
-Footprint nigel() { return Footprint{}; }
+Footprint nigel() {
+  return Footprint{};
+}
 
 }  // namespace
 
@@ -89,7 +93,8 @@ TEST(HybridAStar, ReversesIntoASlotWithinTheTurningRadiusAndClearOfObstacles) {
   const GridMap map = world.rasterize(0.02);
   const CollisionChecker cc(map, nigel());
   const Pose2 start{0.5, 1.0, 0.0};
-  const Pose2 slot{2.45, 0.18, kPi / 2};  // nose out, rear axle 0.18 m from the back wall (tail 0.13 m)
+  const Pose2 slot{2.45, 0.18,
+                   kPi / 2};  // nose out, rear axle 0.18 m from the back wall (tail 0.13 m)
   const PlanResult r = hybrid_astar_plan(cc, start, slot);
   ASSERT_FALSE(r.failed) << r.detail;
   expect_feasible(r.path);
@@ -129,7 +134,8 @@ TEST(HybridAStar, FailsCleanlyOnAnUnreachableOrBlockedGoal) {
   const PlanResult r = hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {2.45, 0.18, kPi / 2}, cfg);
   EXPECT_TRUE(r.failed);
   EXPECT_FALSE(r.detail.empty());
-  const PlanResult r2 = hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {1.15, 1.75, 0.0}, cfg);  // inside a box
+  const PlanResult r2 =
+      hybrid_astar_plan(cc, {0.5, 1.0, 0.0}, {1.15, 1.75, 0.0}, cfg);  // inside a box
   EXPECT_TRUE(r2.failed);
   EXPECT_EQ(r2.detail, "goal pose is in collision");
 }

@@ -1,6 +1,6 @@
 // autodrive-autonomy over real LCM (UDP multicast, port 7811): given a saved map it localises
-// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, LASER_ODOM, PATH, MISSION and engaged
-// COMMANDs. Also --help and a clear error on a bad config.
+// from the LIDAR and odometry it hears, plans, and publishes POSE_AMCL, LASER_ODOM, PATH, MISSION
+// and engaged COMMANDs. Also --help and a clear error on a bad config.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -57,15 +57,19 @@ struct Listener {
     path = *m;
   }
   autodrive::odometry_t laser_odom{};
-  void on_laser_odom(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
+  void on_laser_odom(const lcm::ReceiveBuffer *, const std::string &,
+                     const autodrive::odometry_t *m) {
     ++laser_odom_msgs;
     laser_odom = *m;
   }
-  void on_mission(const lcm::ReceiveBuffer *, const std::string &, const autodrive::mission_status_t *m) {
+  void on_mission(const lcm::ReceiveBuffer *, const std::string &,
+                  const autodrive::mission_status_t *m) {
     max_state = std::max<int>(max_state, m->state);
   }
-  void on_cmd(const lcm::ReceiveBuffer *, const std::string &, const autodrive::vehicle_command_t *m) {
-    if (m->engaged && std::abs(m->throttle) > 0.0f && std::abs(m->throttle) <= 1.0f) engaged_motion = true;
+  void on_cmd(const lcm::ReceiveBuffer *, const std::string &,
+              const autodrive::vehicle_command_t *m) {
+    if (m->engaged && std::abs(m->throttle) > 0.0f && std::abs(m->throttle) <= 1.0f)
+      engaged_motion = true;
   }
   void on_amcl(const lcm::ReceiveBuffer *, const std::string &, const autodrive::pose2d_t *m) {
     have_amcl = true;
@@ -79,7 +83,8 @@ TEST(Program, HelpAndBadConfig) {
   std::string out;
   EXPECT_EQ(run_program({"--help"}, &out), 0);
   EXPECT_NE(out.find("--config"), std::string::npos);
-  const fs::path bad = fs::temp_directory_path() / ("autonomy_bad_" + std::to_string(getpid()) + ".yaml");
+  const fs::path bad =
+      fs::temp_directory_path() / ("autonomy_bad_" + std::to_string(getpid()) + ".yaml");
   std::ofstream(bad) << "goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nplanner: {wheelbase: 0.1}\n";
   out.clear();
   EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2);
@@ -109,19 +114,22 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
       lcm, "NIGELT_POSE_AMCL", &l);
   autodrive_lcm::subscribe<autodrive::odometry_t, Listener, &Listener::on_laser_odom>(
       lcm, "NIGELT_LASER_ODOM", &l);
-  autodrive_lcm::subscribe<autodrive::path2d_t, Listener, &Listener::on_path>(lcm, "NIGELT_PATH", &l);
+  autodrive_lcm::subscribe<autodrive::path2d_t, Listener, &Listener::on_path>(lcm, "NIGELT_PATH",
+                                                                              &l);
 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     const std::string cfg = (dir / "cfg.yaml").string();
-    execl(AUTONOMY_PROGRAM, AUTONOMY_PROGRAM, "--config", cfg.c_str(), static_cast<char *>(nullptr));
+    execl(AUTONOMY_PROGRAM, AUTONOMY_PROGRAM, "--config", cfg.c_str(),
+          static_cast<char *>(nullptr));
     _exit(127);
   }
   const Pose2 lidar{0.1445, 0, 0};
   // The car stands still: odometry at its origin, scans from the true pose, 100 Hz / 7 Hz of
   // message time; a bounded number of steps, never a wall-time assert.
-  for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl && l.have_path); ++i) {
+  for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl && l.have_path);
+       ++i) {
     const int64_t t_us = 1000000 + static_cast<int64_t>(i) * 10000;
     autodrive::odometry_t o{};
     o.utime = t_us;

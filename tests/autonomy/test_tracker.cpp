@@ -63,7 +63,8 @@ RunResult run(const Path &path, const Pose2 &start, double settle_m = 0.0) {
     car.step(c.throttle * 0.267, c.steering * 0.5236, dt);
     travelled += std::hypot(car.pose.x_m - before.x_m, car.pose.y_m - before.y_m);
     if (travelled > settle_m)
-      r.max_cross_track_m = std::max(r.max_cross_track_m, synth::distance_to_path_m(path, {car.pose.x_m, car.pose.y_m}));
+      r.max_cross_track_m = std::max(r.max_cross_track_m,
+                                     synth::distance_to_path_m(path, {car.pose.x_m, car.pose.y_m}));
     r.sim_s += dt;
   }
   const Pose2 g = path.back().pose;

@@ -8,7 +8,7 @@
 
 namespace eye_test {
 
-inline eye::RunConfig config_for(const eye::SynthScene& s, const eye::CameraPose& pose) {
+inline eye::RunConfig config_for(const eye::SynthScene &s, const eye::CameraPose &pose) {
   eye::RunConfig c;
   c.in = s.in;
   c.pose = pose;
@@ -19,7 +19,8 @@ inline eye::RunConfig config_for(const eye::SynthScene& s, const eye::CameraPose
 }
 
 // Truth pixel corners of a car's roof tag (libapriltag order).
-inline std::array<cv::Point2d, 4> truth_corners(const eye::SynthScene& s, const eye::SynthCar& car) {
+inline std::array<cv::Point2d, 4> truth_corners(const eye::SynthScene &s,
+                                                const eye::SynthCar &car) {
   const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
   const double tx = car.x_m + c * s.car.tag_offset_m[0], ty = car.y_m + sn * s.car.tag_offset_m[0];
   const double z = s.car.base_link_height_m + s.car.tag_offset_m[2];
@@ -31,6 +32,8 @@ inline std::array<cv::Point2d, 4> truth_corners(const eye::SynthScene& s, const 
   return out;
 }
 
-inline double angle_diff_rad(double a, double b) { return std::remainder(a - b, 2 * M_PI); }
+inline double angle_diff_rad(double a, double b) {
+  return std::remainder(a - b, 2 * M_PI);
+}
 
 }  // namespace eye_test

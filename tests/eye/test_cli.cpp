@@ -26,8 +26,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // Runs a shell command, returns its exit status and stdout (stderr folded in).
-int run(const std::string& cmd, std::string* out) {
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+int run(const std::string &cmd, std::string *out) {
+  FILE *p = popen((cmd + " 2>&1").c_str(), "r");
   if (!p) return -1;
   char buf[4096];
   out->clear();
@@ -37,22 +37,22 @@ int run(const std::string& cmd, std::string* out) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-std::string fresh_dir(const std::string& name) {
+std::string fresh_dir(const std::string &name) {
   const fs::path d = fs::path(testing::TempDir()) / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d.string();
 }
 
-void write_reftags(const std::string& path, const std::vector<eye::RefTag>& refs) {
+void write_reftags(const std::string &path, const std::vector<eye::RefTag> &refs) {
   std::ofstream f(path);
   f << "tags:\n";
-  for (const auto& r : refs)
+  for (const auto &r : refs)
     f << " - {id: " << r.id << ", x_m: " << r.x_m << ", y_m: " << r.y_m << ", z_m: " << r.z_m
       << ", yaw_rad: " << r.yaw_rad << ", size_m: " << r.size_m << "}\n";
 }
 
-void write_config(const std::string& path, const eye::SynthScene& s, const std::string& url) {
+void write_config(const std::string &path, const eye::SynthScene &s, const std::string &url) {
   std::ofstream f(path);
   f << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
     << "tag_size_m: " << s.car.tag_size_m << "\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
@@ -62,7 +62,7 @@ void write_config(const std::string& path, const eye::SynthScene& s, const std::
 }
 
 // Every "NIGEL1 x=... y=... yaw=..." on the output line of a frame.
-bool find_pose(const std::string& line, const std::string& veh, double* x, double* y, double* yaw) {
+bool find_pose(const std::string &line, const std::string &veh, double *x, double *y, double *yaw) {
   const auto at = line.find("  " + veh + " x=");
   if (at == std::string::npos) return false;
   return std::sscanf(line.c_str() + at + veh.size() + 2, " x=%lf y=%lf yaw=%lf", x, y, yaw) == 3;
@@ -74,7 +74,7 @@ TEST(Cli, HelpForEveryCommand) {
   std::string out;
   EXPECT_EQ(run(std::string(EYE_BIN) + " --help", &out), 0);
   EXPECT_NE(out.find("calibrate-intrinsics"), std::string::npos);
-  for (const char* sub : {"calibrate-intrinsics", "calibrate-map", "run"}) {
+  for (const char *sub : {"calibrate-intrinsics", "calibrate-map", "run"}) {
     EXPECT_EQ(run(std::string(EYE_BIN) + " " + sub + " --help", &out), 0) << sub;
     EXPECT_NE(out.find("Usage"), std::string::npos) << sub;
   }
@@ -86,7 +86,10 @@ TEST(Cli, BadInputGivesClearErrorNotCrash) {
   EXPECT_NE(out.find("/nonexistent/eye.yaml: cannot open file"), std::string::npos) << out;
   const std::string d = fresh_dir("eye_cli_bad");
   std::ofstream(d + "/broken.png") << "not a png";
-  EXPECT_EQ(run(std::string(EYE_BIN) + " calibrate-intrinsics --images " + d + " -o " + d + "/c.yaml", &out), 1);
+  EXPECT_EQ(
+      run(std::string(EYE_BIN) + " calibrate-intrinsics --images " + d + " -o " + d + "/c.yaml",
+          &out),
+      1);
   EXPECT_NE(out.find("broken.png: cannot read the image"), std::string::npos) << out;
 }
 
@@ -106,7 +109,8 @@ TEST(Cli, CalibrateThenRunOnFolder) {
     cv::Rodrigues(rvec, r);
     eye::CameraPose p;
     p.r_cam_map = cv::Matx33d(r);
-    p.t_cam_map = cv::Vec3d(u * 0.55, v * 0.4, 0.65 + 0.1 * (i % 3)) - p.r_cam_map * cv::Vec3d(0.125, 0.0875, 0);
+    p.t_cam_map = cv::Vec3d(u * 0.55, v * 0.4, 0.65 + 0.1 * (i % 3)) -
+                  p.r_cam_map * cv::Vec3d(0.125, 0.0875, 0);
     char name[64];
     std::snprintf(name, sizeof name, "/board/view%02d.png", i);
     ASSERT_TRUE(cv::imwrite(d + name, eye::render_checkerboard(s.in, p, 10, 7, 0.025, 2)));
@@ -131,7 +135,8 @@ TEST(Cli, CalibrateThenRunOnFolder) {
   // 3. run
   write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7791?ttl=0");
   fs::create_directories(d + "/frames");
-  const std::vector<eye::SynthCar> truth = {{1, 0.7, 0.6, 0.4}, {1, 2.2, 1.5, -2.0}, {1, 1.5, 1.0, 3.0}};
+  const std::vector<eye::SynthCar> truth = {
+      {1, 0.7, 0.6, 0.4}, {1, 2.2, 1.5, -2.0}, {1, 1.5, 1.0, 3.0}};
   for (size_t k = 0; k < 3; ++k) {
     std::vector<eye::SynthCar> cars = {{2, 1.5, 0.4, 1.0}};
     if (k != 1) cars.push_back(truth[k]);  // frame 1: NIGEL1 not in view
@@ -154,7 +159,10 @@ TEST(Cli, CalibrateThenRunOnFolder) {
       EXPECT_FALSE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << "stale pose: " << line;
     } else {
       ASSERT_TRUE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << line;
-      EXPECT_LT(1000 * std::hypot(x - truth[static_cast<size_t>(k)].x_m, y - truth[static_cast<size_t>(k)].y_m), 5.0) << line;
+      EXPECT_LT(1000 * std::hypot(x - truth[static_cast<size_t>(k)].x_m,
+                                  y - truth[static_cast<size_t>(k)].y_m),
+                5.0)
+          << line;
     }
     ++k;
   }
@@ -184,12 +192,12 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
   std::mutex mu;
   std::vector<autodrive::pose2d_t> got;
   struct Handler {
-    std::mutex* mu;
-    std::vector<autodrive::pose2d_t>* got;
+    std::mutex *mu;
+    std::vector<autodrive::pose2d_t> *got;
     // subscribeFunction, not a member-function subscription: LCM 1.3.1's member pointer
     // call trips UBSan ("member access within misaligned address 0x1").
-    static void on(const lcm::ReceiveBuffer*, const std::string&, const autodrive::pose2d_t* m,
-                   Handler* h) {
+    static void on(const lcm::ReceiveBuffer *, const std::string &, const autodrive::pose2d_t *m,
+                   Handler *h) {
       std::lock_guard<std::mutex> l(*h->mu);
       h->got->push_back(*m);
     }
@@ -204,7 +212,7 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
                      &eye_out);
   });
 
-  auto publish = [&](int64_t utime, const std::vector<eye::SynthCar>& cars) {
+  auto publish = [&](int64_t utime, const std::vector<eye::SynthCar> &cars) {
     std::vector<uchar> jpg;
     cv::imencode(".jpg", eye::synth_frame(s, cars, {}, static_cast<uint64_t>(utime)), jpg,
                  {cv::IMWRITE_JPEG_QUALITY, 95});
@@ -220,12 +228,12 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
   };
   auto has = [&](int64_t utime) {
     std::lock_guard<std::mutex> l(mu);
-    for (const auto& p : got)
+    for (const auto &p : got)
       if (p.utime == utime) return true;
     return false;
   };
   // Wait for the pose of `utime`, republishing in case the Eye was not subscribed yet.
-  auto await = [&](int64_t utime, const std::vector<eye::SynthCar>& cars, bool republish) {
+  auto await = [&](int64_t utime, const std::vector<eye::SynthCar> &cars, bool republish) {
     const auto t0 = std::chrono::steady_clock::now();
     while (!has(utime) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
       if (republish) publish(utime, cars);
@@ -235,8 +243,8 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
   };
   const eye::SynthCar car{1, 1.2, 0.9, 0.5};
   const int64_t t0 = 1'700'000'000'000'000;
-  EXPECT_TRUE(await(t0, {car}, true));                     // the Eye is up
-  publish(t0 + 33'333, {});                                 // tag not in view
+  EXPECT_TRUE(await(t0, {car}, true));  // the Eye is up
+  publish(t0 + 33'333, {});             // tag not in view
   publish(t0 + 66'666, {{1, 1.3, 0.9, 0.5}});
   EXPECT_TRUE(await(t0 + 66'666, {}, false));
   child.join();
@@ -246,7 +254,7 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
   EXPECT_FALSE(has(t0 + 33'333));
   std::lock_guard<std::mutex> l(mu);
   ASSERT_FALSE(got.empty());
-  for (const auto& p : got) {
+  for (const auto &p : got) {
     EXPECT_EQ(p.vehicle, "NIGEL1");
     EXPECT_EQ(p.frame_id, "map");
     EXPECT_EQ(static_cast<int>(p.source), static_cast<int>(autodrive::pose2d_t::SOURCE_EYE));
@@ -270,8 +278,8 @@ TEST(Cli, RunOnVideoFile) {
   m.height_px = 480;
   eye::mapcal_save(d + "/map.yaml", m);
   write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7792?ttl=0");
-  cv::VideoWriter vw(d + "/drive.avi", cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
-                     cv::Size(640, 480), false);
+  cv::VideoWriter vw(d + "/drive.avi", cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                     10, cv::Size(640, 480), false);
   ASSERT_TRUE(vw.isOpened());
   for (int k = 0; k < 3; ++k) vw.write(eye::synth_frame(s, {{1, 1.0 + 0.05 * k, 1.0, 0.2}}, {}, k));
   vw.release();
@@ -294,6 +302,9 @@ TEST(Cli, RunOnVideoFile) {
     ++k;
   }
   EXPECT_EQ(k, 3) << out;
-  EXPECT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source video:" + d + "/none.avi", &out), 1);
+  EXPECT_EQ(
+      run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source video:" + d + "/none.avi",
+          &out),
+      1);
   EXPECT_NE(out.find("none.avi"), std::string::npos) << out;
 }

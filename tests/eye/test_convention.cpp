@@ -50,7 +50,8 @@ TEST(Convention, ApriltagCornersMatchRenderedTruth) {
   double sx = 0, sy = 0, ss = 0;
   int n = 0;
   for (int k = 0; k < 12; ++k) {
-    const eye::SynthCar car{1, rng.uniform(0.2, 2.8), rng.uniform(0.2, 1.8), rng.uniform(-3.1, 3.1)};
+    const eye::SynthCar car{1, rng.uniform(0.2, 2.8), rng.uniform(0.2, 1.8),
+                            rng.uniform(-3.1, 3.1)};
     const auto dets = det.detect(eye::synth_frame(s, {car}, {}, static_cast<uint64_t>(k)));
     ASSERT_EQ(dets.size(), 1u) << "frame " << k;
     const auto truth = eye_test::truth_corners(s, car);

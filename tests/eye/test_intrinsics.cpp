@@ -25,13 +25,16 @@ eye::Intrinsics truth_camera() {
 
 // The board (9x6 inner corners, 25 mm squares, 10x7 squares) seen from `n` poses spread over
 // the image: board centre near each cell of a 4x3 grid, tilted by up to ~25 deg.
-std::vector<cv::Mat> board_views(const eye::Intrinsics& in, int n, double spread,
-                                 std::vector<eye::CameraPose>* poses = nullptr, double scale = 1.0) {
+std::vector<cv::Mat> board_views(const eye::Intrinsics &in, int n, double spread,
+                                 std::vector<eye::CameraPose> *poses = nullptr,
+                                 double scale = 1.0) {
   std::vector<cv::Mat> out;
   const double sq = 0.025, bw = 10 * sq, bh = 7 * sq;
   for (int i = 0; i < n; ++i) {
-    const double u = spread * (((i % 4) + 0.5) / 4.0 - 0.5), v = spread * (((i / 4) % 3 + 0.5) / 3.0 - 0.5);
-    const double ax = 0.6 * std::sin(1.7 * i), ay = 0.6 * std::cos(2.3 * i), az = 0.2 * std::sin(0.9 * i);
+    const double u = spread * (((i % 4) + 0.5) / 4.0 - 0.5),
+                 v = spread * (((i / 4) % 3 + 0.5) / 3.0 - 0.5);
+    const double ax = 0.6 * std::sin(1.7 * i), ay = 0.6 * std::cos(2.3 * i),
+                 az = 0.2 * std::sin(0.9 * i);
     cv::Mat rvec = (cv::Mat_<double>(3, 1) << ax, ay, az), r;
     cv::Rodrigues(rvec, r);
     eye::CameraPose p;  // board -> camera
@@ -100,7 +103,7 @@ TEST(Intrinsics, RefusesTooFewViews) {
   try {
     eye::intrinsics_calibrate(views, eye::IntrinsicsParams());
     FAIL() << "4 views accepted";
-  } catch (const eye::Error& e) {
+  } catch (const eye::Error &e) {
     EXPECT_NE(std::string(e.what()).find("too few views"), std::string::npos) << e.what();
   }
 }
@@ -111,7 +114,7 @@ TEST(Intrinsics, RefusesPoorCoverage) {
   try {
     eye::intrinsics_calibrate(views, eye::IntrinsicsParams());
     FAIL() << "centre-only views accepted";
-  } catch (const eye::Error& e) {
+  } catch (const eye::Error &e) {
     EXPECT_NE(std::string(e.what()).find("poor coverage"), std::string::npos) << e.what();
   }
 }
@@ -123,7 +126,7 @@ TEST(Intrinsics, RefusesHighRms) {
   try {
     eye::intrinsics_calibrate(views, p);
     FAIL() << "rms bound ignored";
-  } catch (const eye::Error& e) {
+  } catch (const eye::Error &e) {
     EXPECT_NE(std::string(e.what()).find("RMS reprojection error too high"), std::string::npos)
         << e.what();
   }
@@ -140,8 +143,9 @@ TEST(Intrinsics, CharucoRoundTripRecoversKnownCameraMatrix) {
   const eye::Intrinsics truth = truth_camera();
   const double sq = 0.025;
   const int px_per_sq = 40;
-  auto board = cv::aruco::CharucoBoard::create(10, 7, static_cast<float>(sq), static_cast<float>(0.7 * sq),
-                                               cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100));
+  auto board =
+      cv::aruco::CharucoBoard::create(10, 7, static_cast<float>(sq), static_cast<float>(0.7 * sq),
+                                      cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100));
   cv::Mat tex;
   board->draw(cv::Size(10 * px_per_sq, 7 * px_per_sq), tex, 0, 1);
   const double s = sq / px_per_sq;
@@ -151,7 +155,7 @@ TEST(Intrinsics, CharucoRoundTripRecoversKnownCameraMatrix) {
   // The checkerboard poses 0.6x as far: markers of 17.5 mm need ~20 px; boards may leave the
   // image partly, which ChArUco (unlike a checkerboard) tolerates.
   board_views(truth, 12, 1.0, &poses, 0.6);
-  for (const auto& p : poses) {
+  for (const auto &p : poses) {
     cv::Mat img(truth.height_px, truth.width_px, CV_8UC1, cv::Scalar(128));
     eye::render_texture(img, tex, eye::render_plane_to_image(truth, p, 0.0) * tex_to_board, 2);
     views.push_back(img);
@@ -166,7 +170,7 @@ TEST(Intrinsics, CharucoRoundTripRecoversKnownCameraMatrix) {
     ASSERT_GE(cv::aruco::interpolateCornersCharuco(mc, mids, views[5], board, cc, cids), 20);
     double sx = 0, sy = 0;
     for (size_t i = 0; i < cc.size(); ++i) {
-      const auto& b = board->chessboardCorners[static_cast<size_t>(cids[i])];
+      const auto &b = board->chessboardCorners[static_cast<size_t>(cids[i])];
       const cv::Point2d t = eye::camera_project(truth, poses[5], {b.x, b.y, 0});
       sx += cc[i].x - t.x;
       sy += cc[i].y - t.y;

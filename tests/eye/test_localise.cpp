@@ -19,7 +19,7 @@ struct Calibrated {
   eye::MapCalib map;
 };
 
-const Calibrated& calibrated() {
+const Calibrated &calibrated() {
   static const Calibrated c = [] {
     Calibrated out;
     out.scene = eye::synth_scene(1280, 720, 0.10);
@@ -39,7 +39,7 @@ const Calibrated& calibrated() {
 }  // namespace
 
 TEST(MapCalib, RecoversCameraPoseFromReferenceTags) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   EXPECT_TRUE(c.map.missing_ids.empty());
   EXPECT_EQ(c.map.tags.size(), 8u);
   EXPECT_LT(c.map.rms_mm, 1.0);
@@ -58,7 +58,7 @@ TEST(MapCalib, RecoversCameraPoseFromReferenceTags) {
 }
 
 TEST(MapCalib, RefusesTooFewReferenceTags) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   auto refs = eye::synth_reference_tags(c.scene);
   refs.resize(2);
   eye::Detector det;
@@ -66,26 +66,29 @@ TEST(MapCalib, RefusesTooFewReferenceTags) {
   try {
     eye::map_calibrate(c.scene.in, eye::synth_reference_tags(c.scene), {det.detect(frame)});
     FAIL() << "two reference tags accepted";
-  } catch (const eye::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("saw 2 of 8 reference tags"), std::string::npos) << e.what();
+  } catch (const eye::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("saw 2 of 8 reference tags"), std::string::npos)
+        << e.what();
   }
 }
 
 // Golden frames: two cars at known poses all over the map, through the calibrated camera.
 TEST(Golden, CarPosesWithinBounds) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   cv::RNG rng(2026);
   double ss_pos = 0, ss_yaw = 0;
   int n = 0;
   for (int k = 0; k < 16; ++k) {
-    const eye::SynthCar a{1, rng.uniform(0.2, 2.8), rng.uniform(0.2, 1.8), rng.uniform(-M_PI, M_PI)};
+    const eye::SynthCar a{1, rng.uniform(0.2, 2.8), rng.uniform(0.2, 1.8),
+                          rng.uniform(-M_PI, M_PI)};
     eye::SynthCar b{2, rng.uniform(0.2, 2.8), rng.uniform(0.2, 1.8), rng.uniform(-M_PI, M_PI)};
-    if (std::hypot(a.x_m - b.x_m, a.y_m - b.y_m) < 0.35) b.x_m = a.x_m > 1.5 ? a.x_m - 0.6 : a.x_m + 0.6;
+    if (std::hypot(a.x_m - b.x_m, a.y_m - b.y_m) < 0.35)
+      b.x_m = a.x_m > 1.5 ? a.x_m - 0.6 : a.x_m + 0.6;
     const auto poses = tr.process(eye::synth_frame(c.scene, {a, b}, {}, static_cast<uint64_t>(k)));
     ASSERT_EQ(poses.size(), 2u) << "frame " << k;
-    for (const auto& p : poses) {
-      const eye::SynthCar& t = p.vehicle == "NIGEL1" ? a : b;
+    for (const auto &p : poses) {
+      const eye::SynthCar &t = p.vehicle == "NIGEL1" ? a : b;
       EXPECT_EQ(p.tag_id, t.tag_id);
       const double e_mm = 1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m);
       const double e_deg = std::abs(eye_test::angle_diff_rad(p.yaw_rad, t.yaw_rad)) * 180 / M_PI;
@@ -109,7 +112,7 @@ TEST(Golden, CarPosesWithinBounds) {
 // The tag is on the roof: locating it on the floor plane instead would misplace the car by
 // d*h/(H-h), tens of millimetres off-axis. The Eye must use the roof plane.
 TEST(Golden, RoofHeightParallaxIsAccountedFor) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::RunConfig cfg = eye_test::config_for(c.scene, c.map.pose);
   eye::Tracker roof(cfg);
   cfg.locate.tag_offset_m[2] = 0.0;  // pretend the tag lies on the floor
@@ -124,7 +127,7 @@ TEST(Golden, RoofHeightParallaxIsAccountedFor) {
 }
 
 TEST(Golden, PoseIsOfBaseLinkNotOfTag) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   const eye::SynthCar car{1, 1.0, 0.7, M_PI / 2};  // tag 35 mm ahead of base_link: +y here
   const auto p = tr.process(eye::synth_frame(c.scene, {car}, {}, 9));
@@ -134,7 +137,7 @@ TEST(Golden, PoseIsOfBaseLinkNotOfTag) {
 }
 
 TEST(LostTag, NoPoseForUnseenOrUnknownTags) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   // nothing on the map
   EXPECT_TRUE(tr.process(eye::synth_frame(c.scene, {}, {}, 1)).empty());
@@ -150,26 +153,27 @@ TEST(LostTag, NoPoseForUnseenOrUnknownTags) {
 }
 
 TEST(LostTag, HalfCoveredTagGivesNoPose) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   const eye::SynthCar a{1, 1.2, 1.0, 0.0};
   cv::Mat frame = eye::synth_frame(c.scene, {a}, {}, 6);
   ASSERT_EQ(tr.process(frame).size(), 1u);
   // a hand (grey box) over half of the tag, just above the roof
-  eye::render_rect(frame, c.scene.in, c.scene.pose, 150, 0.07, 0.2, 1.2 + 0.035 + 0.03, 1.0,
-                   0.2, 0.0, 2);
+  eye::render_rect(frame, c.scene.in, c.scene.pose, 150, 0.07, 0.2, 1.2 + 0.035 + 0.03, 1.0, 0.2,
+                   0.0, 2);
   EXPECT_TRUE(tr.process(frame).empty());
 }
 
 TEST(LostTag, DuplicateTagInOneFrameGivesNoPose) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
-  const auto p = tr.process(eye::synth_frame(c.scene, {{1, 0.8, 0.8, 0.0}, {1, 2.0, 1.2, 0.0}}, {}, 7));
+  const auto p =
+      tr.process(eye::synth_frame(c.scene, {{1, 0.8, 0.8, 0.0}, {1, 2.0, 1.2, 0.0}}, {}, 7));
   EXPECT_TRUE(p.empty());
 }
 
 TEST(Frames, WrongSizeFrameIsRejected) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::Tracker tr(eye_test::config_for(c.scene, c.map.pose));
   EXPECT_THROW(tr.process(cv::Mat(480, 640, CV_8UC1, cv::Scalar(0))), eye::Error);
 }
@@ -177,7 +181,7 @@ TEST(Frames, WrongSizeFrameIsRejected) {
 // Window tracking along a drive: every frame gives the pose, most frames without a full scan;
 // a car that appears is found at the next full scan; a car that leaves gives no pose at once.
 TEST(Tracking, WindowsFollowACarAndFullScansFindNewOnes) {
-  const Calibrated& c = calibrated();
+  const Calibrated &c = calibrated();
   eye::RunConfig cfg = eye_test::config_for(c.scene, c.map.pose);
   cfg.tracking.roi = true;
   cfg.tracking.full_every = 5;
@@ -191,9 +195,10 @@ TEST(Tracking, WindowsFollowACarAndFullScansFindNewOnes) {
     const auto poses = tr.process(eye::synth_frame(c.scene, cars, {}, static_cast<uint64_t>(k)));
     full += tr.last_was_full_scan();
     bool seen1 = false, seen2 = false;
-    for (const auto& p : poses) {
-      const eye::SynthCar& t = p.vehicle == "NIGEL1" ? a : b;
-      EXPECT_LT(1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m), 3.0) << p.vehicle << " frame " << k;
+    for (const auto &p : poses) {
+      const eye::SynthCar &t = p.vehicle == "NIGEL1" ? a : b;
+      EXPECT_LT(1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m), 3.0)
+          << p.vehicle << " frame " << k;
       seen1 |= p.vehicle == "NIGEL1";
       seen2 |= p.vehicle == "NIGEL2";
     }

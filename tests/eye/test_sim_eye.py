@@ -6,8 +6,12 @@ import subprocess
 import sys
 
 root, build, dur = sys.argv[1], sys.argv[2], sys.argv[3]
-r = subprocess.run([sys.executable, f"{root}/eye/bench/sim_eye.py", build, dur],
-                   capture_output=True, text=True, timeout=300)
+r = subprocess.run(
+    [sys.executable, f"{root}/eye/bench/sim_eye.py", build, dur],
+    capture_output=True,
+    text=True,
+    timeout=300,
+)
 sys.stderr.write(r.stderr)
 print(r.stdout)
 if r.returncode != 0:

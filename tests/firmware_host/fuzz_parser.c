@@ -30,8 +30,13 @@ static void motor_set(void *c, uint8_t duty, uint8_t rev, uint8_t brake) {
   w->reverse = rev;
   w->brake = brake;
 }
-static void servo_set_us(void *c, uint16_t us) { ((world_t *)c)->servo_us = us; }
-static void lamps_set(void *c, uint8_t l) { (void)c; (void)l; }
+static void servo_set_us(void *c, uint16_t us) {
+  ((world_t *)c)->servo_us = us;
+}
+static void lamps_set(void *c, uint8_t l) {
+  (void)c;
+  (void)l;
+}
 static int imu_read(void *c, nigel_imu_raw_t *out) {
   world_t *w = (world_t *)c;
   memset(out, 0, sizeof *out);
@@ -53,9 +58,9 @@ static void count_cb(const proto_frame_t *f, void *ctx) {
   ++cb_count;
 }
 
-static const uint8_t real_ids[] = {PROTO_ID_COMMAND, PROTO_ID_CONFIG, PROTO_ID_HELLO_REQUEST,
+static const uint8_t real_ids[] = {PROTO_ID_COMMAND, PROTO_ID_CONFIG,  PROTO_ID_HELLO_REQUEST,
                                    PROTO_ID_COMMAND, PROTO_ID_COMMAND, PROTO_ID_STATE,
-                                   PROTO_ID_HELLO, PROTO_ID_NACK};
+                                   PROTO_ID_HELLO,   PROTO_ID_NACK};
 static uint8_t real_len(uint8_t id) {
   switch (id) {
     case PROTO_ID_COMMAND: return PROTO_LEN_COMMAND;
@@ -92,7 +97,8 @@ static int32_t steer_before_u;
 static void check_outputs(void) {
   /* the servo only moves while engaged (trim changes aside, which CONFIG makes) */
   if (core.fs.mode != PROTO_MODE_ENGAGED && world.servo_us != servo_before &&
-      core.act.steering_u != steer_before_u) abort();
+      core.act.steering_u != steer_before_u)
+    abort();
   if (world.servo_us < 1000u || world.servo_us > 2000u) abort();
   if (world.duty > 0u && (core.fs.mode != PROTO_MODE_ENGAGED || world.brake)) abort();
   if (world.tx_check.stats.bad_crc != 0u || world.tx_check.stats.bad_length != 0u) abort();

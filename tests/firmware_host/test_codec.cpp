@@ -67,8 +67,8 @@ TEST(Frame, ProtocolDocExamples) {
   std::vector<uint8_t> p(PROTO_LEN_COMMAND);
   proto_command_pack(&c, p.data());
   EXPECT_EQ(Encode(PROTO_ID_COMMAND, 7, p),
-            (std::vector<uint8_t>{0xA5, 0x5A, 0x09, 0x01, 0x07, 0x07, 0x00, 0xF4, 0x01, 0x06,
-                                  0xFF, 0x01, 0x00, 0x01, 0xF5, 0xE3}));
+            (std::vector<uint8_t>{0xA5, 0x5A, 0x09, 0x01, 0x07, 0x07, 0x00, 0xF4, 0x01, 0x06, 0xFF,
+                                  0x01, 0x00, 0x01, 0xF5, 0xE3}));
   EXPECT_EQ(proto_schema_hash(), 0x265771ABu) << "schema changed: update PROTOCOL.md section 5";
   EXPECT_EQ(std::string(PROTO_SCHEMA).size(), 715u);
 }
@@ -217,7 +217,7 @@ TEST(Schema, StringMatchesLengthsAndIds) {
   std::string part;
   ASSERT_TRUE(std::getline(ss, part, ';'));
   EXPECT_EQ(part, "v" + std::to_string(PROTO_VERSION));
-  const std::map<std::string, size_t> size_of = {{"u8", 1}, {"i8", 1},  {"u16", 2},
+  const std::map<std::string, size_t> size_of = {{"u8", 1},  {"i8", 1},  {"u16", 2},
                                                  {"i16", 2}, {"u32", 4}, {"i32", 4}};
   const std::map<std::string, std::pair<int, size_t>> expect = {
       {"command", {PROTO_ID_COMMAND, PROTO_LEN_COMMAND}},
@@ -299,8 +299,8 @@ TEST(Parser, BadCrcAndOversizeLengthCounted) {
 // out; frames the parser accepts that were never sent (false accepts) are counted.
 TEST(Parser, RandomizedStreamResync) {
   uint64_t stat_bad_crc = 0, stat_bad_len = 0, stat_skipped = 0, stream_bytes = 0;
-  uint64_t total_frames = 0, untouched = 0, recovered = 0, false_accepts = 0, completed = 0, flipped = 0,
-           truncated = 0, garbage_runs = 0, garbage_bytes = 0;
+  uint64_t total_frames = 0, untouched = 0, recovered = 0, false_accepts = 0, completed = 0,
+           flipped = 0, truncated = 0, garbage_runs = 0, garbage_bytes = 0;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
     std::mt19937 rng(seed);
     std::vector<uint8_t> stream;
@@ -319,7 +319,8 @@ TEST(Parser, RandomizedStreamResync) {
       sent.insert(orig);
       if (r < 15) {  // 1-3 bit flips anywhere in the frame (the same bit twice undoes itself)
         int nflip = 1 + static_cast<int>(rng() % 3);
-        for (int k = 0; k < nflip; ++k) f[rng() % f.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
+        for (int k = 0; k < nflip; ++k)
+          f[rng() % f.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
       }
       if (r < 15 && f != orig) {
         ++flipped;
@@ -356,7 +357,8 @@ TEST(Parser, RandomizedStreamResync) {
     stream_bytes += stream.size();
     size_t e = 0;
     for (const auto &fr : got.frames) {
-      std::vector<uint8_t> re = Encode(fr.id, fr.seq, std::vector<uint8_t>(fr.payload, fr.payload + fr.len));
+      std::vector<uint8_t> re =
+          Encode(fr.id, fr.seq, std::vector<uint8_t>(fr.payload, fr.payload + fr.len));
       if (e < expected.size() && re == expected[e]) {
         ++e;
         ++recovered;

@@ -37,8 +37,9 @@ class Core : public ::testing::Test {
   }
   void Command(int16_t thr, int16_t steer, bool engaged, uint8_t head = 0, uint8_t ind = 0,
                uint8_t extra_flags = 0) {
-    proto_command_t c{cmd_seq++, thr, steer, head, ind,
-                      static_cast<uint8_t>((engaged ? PROTO_CMD_ENGAGED : 0) | extra_flags)};
+    proto_command_t c{
+        cmd_seq++, thr, steer,
+        head,      ind, static_cast<uint8_t>((engaged ? PROTO_CMD_ENGAGED : 0) | extra_flags)};
     uint8_t p[PROTO_LEN_COMMAND];
     proto_command_pack(&c, p);
     Send(PROTO_ID_COMMAND, p, PROTO_LEN_COMMAND);
@@ -204,7 +205,7 @@ TEST_F(Core, FailsafeTripsAtTimeoutNotBefore) {
 TEST_F(Core, FailsafeWhenCommandArrivesLateBeforeAnyStep) {
   Arm();
   Stream(100, 500, 0, true);
-  t_us += 200 * kMs;            // the loop stalled, then a command arrives first
+  t_us += 200 * kMs;  // the loop stalled, then a command arrives first
   Command(500, 0, true);
   EXPECT_EQ(n.fs.mode, PROTO_MODE_FAILSAFE);
   Run(1);
@@ -530,8 +531,8 @@ TEST_F(Core, TelemetryPeriodDefaultAndConfigured) {
 }
 
 TEST_F(Core, EncoderCountsAndWheelSpeedsInTelemetry) {
-  enc_rate_l = 1920;   // [counts/1000 per 1 ms step]: 1 rev/s = 6283 mrad/s
-  enc_rate_r = -960;   // -0.5 rev/s
+  enc_rate_l = 1920;  // [counts/1000 per 1 ms step]: 1 rev/s = 6283 mrad/s
+  enc_rate_r = -960;  // -0.5 rev/s
   Run(500);
   proto_state_t s = LastState();
   EXPECT_EQ(s.enc_counts[0], 960);
@@ -550,7 +551,7 @@ TEST_F(Core, LinkStatisticsReported) {
   f[6] ^= 1;  // corrupt
   nigel_rx(&n, f, static_cast<uint8_t>(sz), t_us);
   f[6] ^= 1;
-  f[4] = 5;   // seq 0 -> 5: four dropped; recompute the CRC
+  f[4] = 5;  // seq 0 -> 5: four dropped; recompute the CRC
   sz = proto_frame_encode(PROTO_ID_COMMAND, 5, p, PROTO_LEN_COMMAND, f, sizeof f);
   nigel_rx(&n, f, static_cast<uint8_t>(sz), t_us);
   Run(10);

@@ -21,10 +21,13 @@
 namespace {
 
 volatile sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
+void on_signal(int) {
+  g_stop = 1;
+}
 
 void usage(FILE *out) {
-  std::fprintf(out,
+  std::fprintf(
+      out,
       "usage: nano-simavr [options]\n"
       "Runs the Nigel Nano firmware ELF in simavr (ATmega328P, 16 MHz) paced to the wall clock,\n"
       "with UART0 (500000 baud) on a pseudo-terminal.\n"
@@ -80,13 +83,13 @@ int open_pty(std::string *slave_name, int *slave_fd) {
   if (*slave_fd < 0) return -1;
   termios t{};
   tcgetattr(*slave_fd, &t);
-  cfmakeraw(&t); // no echo, no line discipline: bytes pass through untouched
+  cfmakeraw(&t);  // no echo, no line discipline: bytes pass through untouched
   tcsetattr(*slave_fd, TCSANOW, &t);
   fcntl(m, F_SETFL, fcntl(m, F_GETFL) | O_NONBLOCK);
   return m;
 }
 
-} // namespace
+}  // namespace
 
 int main(int argc, char **argv) {
   std::string elf = default_elf(argv[0]);
@@ -133,7 +136,8 @@ int main(int argc, char **argv) {
   if (!pwm_log.empty()) {
     log = std::fopen(pwm_log.c_str(), "w");
     if (log == nullptr) {
-      std::fprintf(stderr, "nano-simavr: --pwm-log '%s': %s\n", pwm_log.c_str(), std::strerror(errno));
+      std::fprintf(stderr, "nano-simavr: --pwm-log '%s': %s\n", pwm_log.c_str(),
+                   std::strerror(errno));
       return 1;
     }
     std::fprintf(log, "# t_sim_us t_mono_us servo_us motor_duty reverse brake\n");
@@ -148,7 +152,7 @@ int main(int argc, char **argv) {
   }
   const std::string dir = pty_link.substr(0, pty_link.rfind('/'));
   if (pty_link.find('/') != std::string::npos && !dir.empty()) {
-    for (size_t p = 1; p <= dir.size(); p++) { // mkdir -p
+    for (size_t p = 1; p <= dir.size(); p++) {  // mkdir -p
       if (p == dir.size() || dir[p] == '/') mkdir(dir.substr(0, p).c_str(), 0755);
     }
   }
@@ -187,7 +191,7 @@ int main(int argc, char **argv) {
       while (off < out.size()) {
         ssize_t w = write(master, out.data() + off, out.size() - off);
         if (w <= 0) {
-          dropped += out.size() - off; // nobody reading and the pty buffer is full
+          dropped += out.size() - off;  // nobody reading and the pty buffer is full
           break;
         }
         off += static_cast<size_t>(w);
@@ -214,8 +218,9 @@ int main(int argc, char **argv) {
         if (due > now) usleep(static_cast<useconds_t>(due - now));
       }
     }
-    if (dropped > 0) std::fprintf(stderr, "nano-simavr: %llu bytes dropped (no reader)\n",
-                                  static_cast<unsigned long long>(dropped));
+    if (dropped > 0)
+      std::fprintf(stderr, "nano-simavr: %llu bytes dropped (no reader)\n",
+                   static_cast<unsigned long long>(dropped));
   } catch (const std::exception &e) {
     std::fprintf(stderr, "nano-simavr: %s\n", e.what());
     rc = 1;

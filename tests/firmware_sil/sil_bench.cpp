@@ -17,7 +17,8 @@ using sil::Board;
 using sil::make_command;
 constexpr uint64_t kMs = 1000;
 
-void stream(Board &b, uint16_t &seq, uint64_t duration_us, int16_t thr, int16_t steer, bool engaged) {
+void stream(Board &b, uint16_t &seq, uint64_t duration_us, int16_t thr, int16_t steer,
+            bool engaged) {
   for (uint64_t t = 0; t < duration_us; t += 10 * kMs) {
     b.send_command(make_command(seq++, thr, steer, engaged));
     b.run_us(10 * kMs);
@@ -30,7 +31,8 @@ void arm(Board &b, uint16_t &seq) {
   stream(b, seq, 30 * kMs, 0, 0, true);
 }
 
-template <typename T> T median(std::vector<T> v) {
+template <typename T>
+T median(std::vector<T> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? T{} : v[v.size() / 2];
 }
@@ -43,8 +45,8 @@ std::vector<double> measure_cmd_to_pwm(const std::string &elf, int samples) {
   arm(b, seq);
   std::vector<double> out;
   for (int i = 0; i < samples; i++) {
-    stream(b, seq, 300 * kMs, 0, 0, true); // back to standstill (slew down takes 250 ms)
-    b.run_us(static_cast<uint64_t>((i * 7919) % 9000)); // vary the phase against the loop
+    stream(b, seq, 300 * kMs, 0, 0, true);  // back to standstill (slew down takes 250 ms)
+    b.run_us(static_cast<uint64_t>((i * 7919) % 9000));  // vary the phase against the loop
     b.take_pwm_changes();
     b.send_command(make_command(seq++, 1000, 0, true));
     b.run_until([&] { return b.tx_idle() && b.motor_duty() > 0; }, 20 * kMs);
@@ -81,7 +83,7 @@ struct LoadFigures {
   double telemetry_hz = 0, loop_hz = 0;
   uint32_t loop_cycles_p50 = 0, loop_cycles_p99 = 0;
   uint32_t loop_cycles_max = 0, isr_cycles_max = 0;
-  uint32_t other_isr[4] = {0, 0, 0, 0}; // TIMER0_OVF, USART_RX, USART_UDRE, TWI
+  uint32_t other_isr[4] = {0, 0, 0, 0};  // TIMER0_OVF, USART_RX, USART_UDRE, TWI
 };
 
 // Driving with everything on: IMU, encoders at edges_hz, commands at 100 Hz.
@@ -134,32 +136,34 @@ bool edges_all_counted(const std::string &elf, double edges_hz) {
   return s.enc_counts[0] == b.encoder_injected(0) && s.enc_counts[1] == b.encoder_injected(1);
 }
 
-} // namespace
+}  // namespace
 
 int main(int argc, char **argv) {
   if (argc != 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
-    std::fprintf(argc == 2 ? stdout : stderr,
-                 "usage: nano-sil-bench <firmware.elf>\n"
-                 "Measures the firmware in simavr (simulated time): cmd_to_pwm_us, failsafe_stop_ms,\n"
-                 "telemetry_hz, loop_cycles_max, encoder_isr_cycles_max, max_edge_rate_hz.\n"
-                 "Progress on stderr; the last stdout line is JSON.\n");
+    std::fprintf(
+        argc == 2 ? stdout : stderr,
+        "usage: nano-sil-bench <firmware.elf>\n"
+        "Measures the firmware in simavr (simulated time): cmd_to_pwm_us, failsafe_stop_ms,\n"
+        "telemetry_hz, loop_cycles_max, encoder_isr_cycles_max, max_edge_rate_hz.\n"
+        "Progress on stderr; the last stdout line is JSON.\n");
     return argc == 2 ? 0 : 2;
   }
   const std::string elf = argv[1];
   try {
     std::fprintf(stderr, "[bench] load: IMU + encoders 8000 edges/s + commands, 3 s simulated\n");
     const LoadFigures load = measure_load(elf, 8000, 3000 * kMs);
-    std::fprintf(stderr, "[bench]   telemetry %.1f Hz, loop %.0f passes/s, loop pass median %u / p99 %u / "
-                 "max %u cycles (max %.0f us), encoder ISR max %u cycles\n", load.telemetry_hz,
-                 load.loop_hz, load.loop_cycles_p50, load.loop_cycles_p99, load.loop_cycles_max,
-                 load.loop_cycles_max / 16.0, load.isr_cycles_max);
+    std::fprintf(stderr,
+                 "[bench]   telemetry %.1f Hz, loop %.0f passes/s, loop pass median %u / p99 %u / "
+                 "max %u cycles (max %.0f us), encoder ISR max %u cycles\n",
+                 load.telemetry_hz, load.loop_hz, load.loop_cycles_p50, load.loop_cycles_p99,
+                 load.loop_cycles_max, load.loop_cycles_max / 16.0, load.isr_cycles_max);
 
     std::fprintf(stderr, "[bench] cmd_to_pwm: 31 samples\n");
     const auto c2p = measure_cmd_to_pwm(elf, 31);
     if (c2p.empty()) throw std::runtime_error("cmd_to_pwm: the motor never moved");
     std::fprintf(stderr, "[bench]   median %.0f us, min %.0f, max %.0f (n=%zu)\n", median(c2p),
-                 *std::min_element(c2p.begin(), c2p.end()), *std::max_element(c2p.begin(), c2p.end()),
-                 c2p.size());
+                 *std::min_element(c2p.begin(), c2p.end()),
+                 *std::max_element(c2p.begin(), c2p.end()), c2p.size());
 
     std::fprintf(stderr, "[bench] failsafe: 7 link losses\n");
     const auto fs = measure_failsafe(elf, 7);
@@ -171,7 +175,8 @@ int main(int argc, char **argv) {
     uint32_t isr_max = load.isr_cycles_max;
     for (double hz = 10000; hz <= 400000; hz += 5000) {
       const bool ok = edges_all_counted(elf, hz);
-      std::fprintf(stderr, "[bench]   %6.0f edges/s per wheel: %s\n", hz, ok ? "all counted" : "LOST");
+      std::fprintf(stderr, "[bench]   %6.0f edges/s per wheel: %s\n", hz,
+                   ok ? "all counted" : "LOST");
       if (!ok) break;
       best = hz;
     }
@@ -181,12 +186,15 @@ int main(int argc, char **argv) {
     const uint32_t loop_max = std::max(load.loop_cycles_max, fast.loop_cycles_max);
     std::fprintf(stderr, "[bench]   at %.0f edges/s: loop max %u cycles, ISR max %u cycles\n", best,
                  fast.loop_cycles_max, fast.isr_cycles_max);
-    std::fprintf(stderr, "[bench]   other ISRs max [cycles]: TIMER0_OVF %u, USART_RX %u, USART_UDRE %u, TWI %u\n",
-                 fast.other_isr[0], fast.other_isr[1], fast.other_isr[2], fast.other_isr[3]);
+    std::fprintf(
+        stderr,
+        "[bench]   other ISRs max [cycles]: TIMER0_OVF %u, USART_RX %u, USART_UDRE %u, TWI %u\n",
+        fast.other_isr[0], fast.other_isr[1], fast.other_isr[2], fast.other_isr[3]);
 
-    std::printf("{\"encoder_isr_cycles_max\": %u, \"loop_cycles_max\": %u, \"cmd_to_pwm_us\": %.0f, "
-                "\"failsafe_stop_ms\": %.1f, \"telemetry_hz\": %.1f, \"max_edge_rate_hz\": %.0f}\n",
-                isr_max, loop_max, median(c2p), median(fs), load.telemetry_hz, best);
+    std::printf(
+        "{\"encoder_isr_cycles_max\": %u, \"loop_cycles_max\": %u, \"cmd_to_pwm_us\": %.0f, "
+        "\"failsafe_stop_ms\": %.1f, \"telemetry_hz\": %.1f, \"max_edge_rate_hz\": %.0f}\n",
+        isr_max, loop_max, median(c2p), median(fs), load.telemetry_hz, best);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "nano-sil-bench: %s\n", e.what());
     return 1;

@@ -45,7 +45,7 @@ void on_frame(const proto_frame_t *f, void *ctx) {
   auto *b = static_cast<std::pair<Board *, std::vector<Frame> *> *>(ctx);
   b->second->push_back(Frame{b->first->cycle(), *f});
 }
-} // namespace
+}  // namespace
 
 Board::Board(const std::string &elf_path, bool imu_present) {
   avr_global_logger_set(quiet_logger);
@@ -59,7 +59,7 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   avr_->log = LOG_NONE;
   fw.frequency = kCpuHz;
   avr_->frequency = kCpuHz;
-  avr_->vcc = avr_->avcc = avr_->aref = 5000; // [mV]
+  avr_->vcc = avr_->avcc = avr_->aref = 5000;  // [mV]
   avr_load_firmware(avr_, &fw);
   avr_->log = LOG_NONE;
   for (uint32_t i = 0; i < fw.symbolcount; i++) {
@@ -67,7 +67,7 @@ Board::Board(const std::string &elf_path, bool imu_present) {
     free(fw.symbol[i]);
   }
   free(fw.symbol);
-  free(fw.flash); // copied into the core by avr_load_firmware
+  free(fw.flash);  // copied into the core by avr_load_firmware
   free(fw.eeprom);
   loop_addr_ = symbol("fw_loop_once");
   quiet_uart(avr_);
@@ -79,18 +79,20 @@ Board::Board(const std::string &elf_path, bool imu_present) {
     drive_pin(4 + s, 0);
   }
   imu_ = std::make_unique<Mpu9250>(avr_, imu_present);
-  set_adc7_mv(2850); // ~12.1 V pack through the 10k:3.3k divider
+  set_adc7_mv(2850);  // ~12.1 V pack through the 10k:3.3k divider
   proto_parser_init(&parser_);
 }
 
 Board::~Board() {
   if (avr_ != nullptr) {
     avr_terminate(avr_);
-    free(avr_); // avr_make_mcu_by_name() malloc()s the core
+    free(avr_);  // avr_make_mcu_by_name() malloc()s the core
   }
 }
 
-uint64_t Board::cycle() const { return avr_->cycle; }
+uint64_t Board::cycle() const {
+  return avr_->cycle;
+}
 
 uint32_t Board::symbol(const std::string &name) const {
   for (const auto &s : symbols_) {
@@ -99,7 +101,9 @@ uint32_t Board::symbol(const std::string &name) const {
   return 0;
 }
 
-void Board::write_ram(uint32_t addr, uint8_t v) { avr_->data[addr] = v; }
+void Board::write_ram(uint32_t addr, uint8_t v) {
+  avr_->data[addr] = v;
+}
 
 void Board::set_adc7_mv(uint32_t mv) {
   avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC7), mv);
@@ -116,7 +120,9 @@ void Board::on_uart_byte(uint8_t b) {
   proto_parser_feed(&parser_, &b, 1, on_frame, &ctx);
 }
 
-void Board::send(const uint8_t *data, size_t n) { tx_queue_.insert(tx_queue_.end(), data, data + n); }
+void Board::send(const uint8_t *data, size_t n) {
+  tx_queue_.insert(tx_queue_.end(), data, data + n);
+}
 
 void Board::send_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
   static uint8_t seq = 0;
@@ -163,7 +169,7 @@ void Board::drive_pin(int bit, uint8_t level) {
   ext_level_d_ = static_cast<uint8_t>(level ? (ext_level_d_ | m) : (ext_level_d_ & ~m));
   avr_ioport_external_t ext{};
   ext.name = 'D';
-  ext.mask = 0x3C; // D2..D5
+  ext.mask = 0x3C;  // D2..D5
   ext.value = ext_level_d_;
   avr_ioctl(avr_, AVR_IOCTL_IOPORT_SET_EXTERNAL('D'), &ext);
   avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ('D'), bit), level);
@@ -199,8 +205,12 @@ uint16_t Board::servo_pulse_us() const {
 uint8_t Board::motor_duty() const {
   return (avr_->data[kTccr0a] & kCom0a1) ? avr_->data[kOcr0a] : 0;
 }
-bool Board::motor_reverse() const { return avr_->data[kPortd] & 0x80; }
-bool Board::motor_brake() const { return avr_->data[kPortb] & 0x01; }
+bool Board::motor_reverse() const {
+  return avr_->data[kPortd] & 0x80;
+}
+bool Board::motor_brake() const {
+  return avr_->data[kPortb] & 0x01;
+}
 
 uint8_t Board::lamp_pins() const {
   const uint8_t b = avr_->data[kPortb], c = avr_->data[kPortc];
@@ -241,7 +251,7 @@ void Board::step_io() {
     avr_raise_irq(uart_in_, tx_queue_.front());
     tx_queue_.pop_front();
     next_tx_cycle_ = c + kUartByteCycles;
-    if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles; // stop bit done
+    if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
   }
   if (enc_rate_ > 0 && c >= enc_next_cycle_) {
     for (int s = 0; s < 2; s++) {
@@ -255,7 +265,8 @@ void Board::step_io() {
         drive_pin(4 + s, kPhaseB[next]);
       }
     }
-    enc_next_cycle_ = static_cast<uint64_t>(static_cast<double>(enc_next_cycle_) + enc_phase_cycles_);
+    enc_next_cycle_ =
+        static_cast<uint64_t>(static_cast<double>(enc_next_cycle_) + enc_phase_cycles_);
   }
 }
 
@@ -274,7 +285,7 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         quiet_uart(avr_);
         isr_active_ = -1;
         loop_last_cycle_ = 0;
-      } else if (pc < kVectorTableBytes && (pc & 3u) == 0) { // entered an interrupt vector
+      } else if (pc < kVectorTableBytes && (pc & 3u) == 0) {  // entered an interrupt vector
         isr_active_ = static_cast<int>(pc / 4);
         // the 4-cycle interrupt response (datasheet) counts as part of the ISR
         isr_start_ = avr_->cycle - 4;
@@ -282,13 +293,13 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         if (loop_last_cycle_ != 0) {
           const uint64_t d = avr_->cycle - loop_last_cycle_;
           if (d > loop_max_) loop_max_ = static_cast<uint32_t>(d);
-        if (record_loop_) loop_cycles_.push_back(static_cast<uint32_t>(d));
+          if (record_loop_) loop_cycles_.push_back(static_cast<uint32_t>(d));
         }
         loop_last_cycle_ = avr_->cycle;
         loop_passes_++;
       }
     }
-    if (isr_active_ >= 0 && avr_->sreg[S_I]) { // RETI re-enabled interrupts
+    if (isr_active_ >= 0 && avr_->sreg[S_I]) {  // RETI re-enabled interrupts
       const uint64_t d = avr_->cycle - isr_start_;
       if (d > isr_max_[isr_active_]) isr_max_[isr_active_] = static_cast<uint32_t>(d);
       isr_active_ = -1;
@@ -311,4 +322,4 @@ proto_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steer
   return c;
 }
 
-} // namespace sil
+}  // namespace sil

@@ -24,17 +24,17 @@ namespace sil {
 
 constexpr uint32_t kCpuHz = 16000000;
 constexpr uint64_t kCyclesPerUs = kCpuHz / 1000000;
-constexpr uint64_t kUartByteCycles = 320; // 10 bits at 500000 baud = 20 us
+constexpr uint64_t kUartByteCycles = 320;  // 10 bits at 500000 baud = 20 us
 
 struct Frame {
-  uint64_t cycle; // when its last byte left the AVR
+  uint64_t cycle;  // when its last byte left the AVR
   proto_frame_t f;
 };
 
-struct PwmChange { // an actuator register changed
+struct PwmChange {  // an actuator register changed
   uint64_t cycle;
-  uint16_t servo_ticks; // OCR1A [0.5 us ticks]
-  uint8_t motor_duty;   // OCR0A if the pin is connected, else 0
+  uint16_t servo_ticks;  // OCR1A [0.5 us ticks]
+  uint8_t motor_duty;    // OCR0A if the pin is connected, else 0
   uint8_t motor_reverse, motor_brake;
 };
 
@@ -85,13 +85,13 @@ class Board {
   uint8_t motor_duty() const;
   bool motor_reverse() const;
   bool motor_brake() const;
-  uint8_t lamp_pins() const; // NIGEL_LAMP_* bits from the pin levels
+  uint8_t lamp_pins() const;  // NIGEL_LAMP_* bits from the pin levels
   const std::vector<PwmChange> &pwm_changes() const { return pwm_changes_; }
   // Hands over (and forgets) the changes recorded so far, for long runs.
   std::vector<PwmChange> take_pwm_changes() {
     std::vector<PwmChange> out;
     out.swap(pwm_changes_);
-    if (!out.empty()) pwm_changes_.push_back(out.back()); // the reference for the next change
+    if (!out.empty()) pwm_changes_.push_back(out.back());  // the reference for the next change
     return out;
   }
 
@@ -107,20 +107,22 @@ class Board {
   // Longest run of an ISR [cycles], by vector number (1 INT0, 2 INT1, 16 TIMER0_OVF,
   // 18 USART_RX, 19 USART_UDRE, 24 TWI), from the vector to the RETI.
   uint32_t isr_cycles_max(int vector) const { return isr_max_[vector]; }
-  uint32_t enc_isr_cycles_max() const { return isr_max_[1] > isr_max_[2] ? isr_max_[1] : isr_max_[2]; }
+  uint32_t enc_isr_cycles_max() const {
+    return isr_max_[1] > isr_max_[2] ? isr_max_[1] : isr_max_[2];
+  }
   uint32_t loop_cycles_max() const { return loop_max_; }
   uint64_t loop_passes() const { return loop_passes_; }
   // Records every pass's length [cycles] (off by default: it grows by ~2400 entries/s).
   void record_loop_cycles(bool on) { record_loop_ = on; }
   const std::vector<uint32_t> &loop_cycles() const { return loop_cycles_; }
   void reset_cycle_stats();
-  uint32_t resets() const { return resets_; } // times the CPU went through its reset vector
+  uint32_t resets() const { return resets_; }  // times the CPU went through its reset vector
 
   avr_t *avr() const { return avr_; }
 
  private:
   void step_io();
-  void drive_pin(int bit, uint8_t level); // PORTD input pin driven from outside
+  void drive_pin(int bit, uint8_t level);  // PORTD input pin driven from outside
   void on_uart_byte(uint8_t b);
   void sample_pwm();
   static void uart_out_hook(avr_irq_t *irq, uint32_t value, void *param);
@@ -129,7 +131,7 @@ class Board {
   std::unique_ptr<Mpu9250> imu_;
   std::vector<std::pair<std::string, uint32_t>> symbols_;
   avr_irq_t *uart_in_ = nullptr;
-  uint8_t ext_level_d_ = 0; // levels driven onto PD2..PD5
+  uint8_t ext_level_d_ = 0;  // levels driven onto PD2..PD5
   int64_t enc_injected_[2]{};
   std::function<void(uint8_t, uint64_t)> uart_sink_;
   uint8_t enc_phase_[2]{};
@@ -149,7 +151,7 @@ class Board {
   bool record_loop_ = false;
   std::vector<uint32_t> loop_cycles_;
   uint64_t loop_passes_ = 0;
-  int isr_active_ = -1; // vector number of the ISR being timed
+  int isr_active_ = -1;  // vector number of the ISR being timed
   uint64_t isr_start_ = 0;
   uint32_t isr_max_[26]{};
   uint32_t resets_ = 0;
@@ -159,4 +161,4 @@ class Board {
 proto_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
                              bool engaged, uint8_t headlights = 0, uint8_t indicators = 0);
 
-} // namespace sil
+}  // namespace sil

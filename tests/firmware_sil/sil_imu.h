@@ -23,7 +23,7 @@ class Mpu9250 {
                   const std::array<int16_t, 3> &mag);
   uint8_t mpu_reg(uint8_t r) const { return mpu_[r & 0x7F]; }
   uint8_t ak_reg(uint8_t r) const { return ak_[r & 0x1F]; }
-  uint32_t reads() const { return reads_; } // bytes read by the master
+  uint32_t reads() const { return reads_; }  // bytes read by the master
 
  private:
   static void on_twi(avr_irq_t *irq, uint32_t value, void *param);
@@ -36,10 +36,10 @@ class Mpu9250 {
   bool stuck_ = false;
   std::array<uint8_t, 128> mpu_{};
   std::array<uint8_t, 32> ak_{};
-  uint8_t selected_ = 0; // 7-bit address being talked to, 0 = none
-  bool reg_pending_ = false; // next written byte is the register pointer
+  uint8_t selected_ = 0;      // 7-bit address being talked to, 0 = none
+  bool reg_pending_ = false;  // next written byte is the register pointer
   uint8_t ptr_ = 0;
   uint32_t reads_ = 0;
 };
 
-} // namespace sil
+}  // namespace sil

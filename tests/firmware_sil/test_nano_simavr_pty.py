@@ -36,17 +36,17 @@ def parse(buf: bytearray):
     while True:
         i = buf.find(SYNC)
         if i < 0:
-            del buf[:max(0, len(buf) - 1)]
+            del buf[: max(0, len(buf) - 1)]
             return out
         del buf[:i]
         if len(buf) < 7 or len(buf) < 7 + buf[2]:
             return out
         n = buf[2]
-        body = bytes(buf[2:5 + n])
-        (crc,) = struct.unpack("<H", buf[5 + n:7 + n])
+        body = bytes(buf[2 : 5 + n])
+        (crc,) = struct.unpack("<H", buf[5 + n : 7 + n])
         if crc == crc16(body):
-            out.append((buf[3], bytes(buf[5:5 + n])))
-            del buf[:7 + n]
+            out.append((buf[3], bytes(buf[5 : 5 + n])))
+            del buf[: 7 + n]
         else:
             del buf[:1]
 
@@ -55,8 +55,9 @@ def main() -> int:
     exe, elf = sys.argv[1], sys.argv[2]
     with tempfile.TemporaryDirectory() as tmp:
         link, log = os.path.join(tmp, "nano"), os.path.join(tmp, "pwm.log")
-        proc = subprocess.Popen([exe, "--elf", elf, "--pty", link, "--pwm-log", log,
-                                 "--encoder-hz", "1000"])
+        proc = subprocess.Popen(
+            [exe, "--elf", elf, "--pty", link, "--pwm-log", log, "--encoder-hz", "1000"]
+        )
         try:
             deadline = time.monotonic() + 60
             while not os.path.islink(link):
@@ -99,8 +100,10 @@ def main() -> int:
             # arm (engaged=0 then engaged=1) and drive at half throttle
             n0 = len(states())
             pump(lambda: len(states()) >= n0 + 5, (0, 0, 0, 0, 0))
-            pump(lambda: mode() == 1 and struct.unpack_from("<h", states()[-1], 16)[0] >= 500,
-                 (500, 0, 0, 0, 1))
+            pump(
+                lambda: mode() == 1 and struct.unpack_from("<h", states()[-1], 16)[0] >= 500,
+                (500, 0, 0, 0, 1),
+            )
             enc_left = struct.unpack_from("<i", states()[-1], 4)[0]
             assert enc_left > 0, "encoder edges from --encoder-hz not counted"
             os.close(fd)

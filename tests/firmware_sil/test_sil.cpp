@@ -9,7 +9,7 @@ namespace {
 using sil::Board;
 using sil::make_command;
 
-constexpr uint64_t kMs = 1000; // [us]
+constexpr uint64_t kMs = 1000;  // [us]
 
 // Streams one COMMAND every period_us for duration_us.
 void stream(Board &b, uint16_t &seq, uint64_t duration_us, int16_t throttle, int16_t steering,
@@ -86,9 +86,9 @@ TEST(Sil, command_to_servo_and_motor) {
   // full left, half forward; the servo is rate limited (0.65 s for full scale), the throttle
   // slew-limited (0.25 s for full scale): after 0.7 s both have arrived
   stream(b, seq, 700 * kMs, 500, 1000, true);
-  ASSERT_TRUE(b.run_us(12 * kMs)); // one more STATE after the last COMMAND was parsed
+  ASSERT_TRUE(b.run_us(12 * kMs));  // one more STATE after the last COMMAND was parsed
   EXPECT_EQ(b.servo_pulse_us(), 2000);
-  EXPECT_EQ(b.motor_duty(), 128); // 0.5 * 255, rounded
+  EXPECT_EQ(b.motor_duty(), 128);  // 0.5 * 255, rounded
   EXPECT_FALSE(b.motor_reverse());
   EXPECT_FALSE(b.motor_brake());
   proto_state_t s{};
@@ -99,7 +99,7 @@ TEST(Sil, command_to_servo_and_motor) {
   // reverse, right: 1.4 full scale of steering takes 0.91 s
   stream(b, seq, 1000 * kMs, -300, -400, true);
   EXPECT_EQ(b.servo_pulse_us(), 1300);
-  EXPECT_EQ(b.motor_duty(), 77); // 0.3 * 255, rounded
+  EXPECT_EQ(b.motor_duty(), 77);  // 0.3 * 255, rounded
   EXPECT_TRUE(b.motor_reverse());
   EXPECT_FALSE(b.motor_brake());
   EXPECT_TRUE(b.lamp_pins() & NIGEL_LAMP_REVERSE);
@@ -113,7 +113,7 @@ TEST(Sil, encoder_edges_to_counts) {
     if (i < 300) b.encoder_edge(1, +1);
     ASSERT_TRUE(b.run_us(50));
   }
-  ASSERT_TRUE(b.run_us(25 * kMs)); // two telemetry periods
+  ASSERT_TRUE(b.run_us(25 * kMs));  // two telemetry periods
   proto_state_t s{};
   ASSERT_TRUE(b.last_state(&s));
   EXPECT_EQ(s.enc_counts[0], 500);
@@ -123,7 +123,7 @@ TEST(Sil, encoder_edges_to_counts) {
 TEST(Sil, encoder_reverse_counts) {
   Board b(NANO_ELF);
   ASSERT_TRUE(b.run_us(10 * kMs));
-  b.encoder_rate(4000.0, -1); // 4000 edges/s per wheel, backwards, for 250 ms
+  b.encoder_rate(4000.0, -1);  // 4000 edges/s per wheel, backwards, for 250 ms
   ASSERT_TRUE(b.run_us(250 * kMs));
   b.encoder_rate(0);
   ASSERT_TRUE(b.run_us(25 * kMs));
@@ -154,11 +154,13 @@ TEST(Sil, failsafe_on_link_loss) {
   EXPECT_EQ(s.throttle_milli, 0);
   // both indicator lamps blink together
   bool both_lit = false;
-  ASSERT_TRUE(b.run_until([&] {
-    const uint8_t l = b.lamp_pins();
-    both_lit = (l & NIGEL_LAMP_IND_LEFT) && (l & NIGEL_LAMP_IND_RIGHT);
-    return both_lit;
-  }, 800 * kMs));
+  ASSERT_TRUE(b.run_until(
+      [&] {
+        const uint8_t l = b.lamp_pins();
+        both_lit = (l & NIGEL_LAMP_IND_LEFT) && (l & NIGEL_LAMP_IND_RIGHT);
+        return both_lit;
+      },
+      800 * kMs));
   // the stream comes back with engaged=1: still in failsafe, fault still latched
   stream(b, seq, 100 * kMs, 600, 0, true);
   ASSERT_TRUE(b.last_state(&s));
@@ -183,7 +185,7 @@ TEST(Sil, out_of_range_rejected) {
   ASSERT_GT(duty_before, 0);
   const size_t nacks_before = b.count(PROTO_ID_NACK);
   const uint16_t bad_seq = seq;
-  b.send_command(make_command(seq++, 1500, 0, true)); // throttle beyond 1000
+  b.send_command(make_command(seq++, 1500, 0, true));  // throttle beyond 1000
   ASSERT_TRUE(b.run_until([&] { return b.count(PROTO_ID_NACK) > nacks_before; }, 5 * kMs));
   proto_nack_t k{};
   const auto &last = b.frames().back();
@@ -217,14 +219,14 @@ TEST(Sil, lights_follow_command) {
   Board b(NANO_ELF);
   uint16_t seq = 1;
   arm(b, seq);
-  stream(b, seq, 100 * kMs, 0, 0, true, 2, 1); // high beams, left indicator
+  stream(b, seq, 100 * kMs, 0, 0, true, 2, 1);  // high beams, left indicator
   EXPECT_TRUE(b.lamp_pins() & NIGEL_LAMP_HEAD_HIGH);
   EXPECT_TRUE(b.lamp_pins() & NIGEL_LAMP_HEAD_LOW) << "high beams keep the low beams lit";
-  stream(b, seq, 50 * kMs, 0, 0, true, 1, 1); // low beams only
+  stream(b, seq, 50 * kMs, 0, 0, true, 1, 1);  // low beams only
   EXPECT_FALSE(b.lamp_pins() & NIGEL_LAMP_HEAD_HIGH);
   EXPECT_TRUE(b.lamp_pins() & NIGEL_LAMP_HEAD_LOW);
   bool left_on = false, left_off = false, right_on = false;
-  for (int i = 0; i < 100; i++) { // 1 s: the indicator blinks at ~1.5 Hz
+  for (int i = 0; i < 100; i++) {  // 1 s: the indicator blinks at ~1.5 Hz
     b.send_command(make_command(seq++, 0, 0, true, 1, 1));
     ASSERT_TRUE(b.run_us(10 * kMs));
     const uint8_t l = b.lamp_pins();
@@ -301,7 +303,7 @@ TEST(Sil, watchdog_reset_safe_state) {
   }
   ASSERT_EQ(b.resets(), 1u) << "the watchdog reset the board";
   ASSERT_TRUE(b.run_until([&] { return b.count(PROTO_ID_HELLO) > hellos; }, 50 * kMs));
-  stream(b, seq, 100 * kMs, 500, 300, true); // the host keeps sending engaged=1
+  stream(b, seq, 100 * kMs, 500, 300, true);  // the host keeps sending engaged=1
   proto_state_t s{};
   ASSERT_TRUE(b.last_state(&s));
   EXPECT_EQ(s.mode, PROTO_MODE_DISARMED);
@@ -311,7 +313,7 @@ TEST(Sil, watchdog_reset_safe_state) {
   EXPECT_EQ(s.throttle_milli, 0);
 }
 
-} // namespace
+}  // namespace
 
 namespace {
 
@@ -334,7 +336,7 @@ TEST(Sil, imu_stuck_fault) {
 // ADC7 through the 10k:3.3k divider: pack [mV] = pin [mV] * 13.3 / 3.3.
 TEST(Sil, battery_monitoring) {
   Board b(NANO_ELF);
-  b.set_adc7_mv(2850); // 11.49 V pack
+  b.set_adc7_mv(2850);  // 11.49 V pack
   uint16_t seq = 1;
   arm(b, seq);
   stream(b, seq, 500 * kMs, 400, 0, true);
@@ -343,7 +345,7 @@ TEST(Sil, battery_monitoring) {
   EXPECT_NEAR(s.battery_mv, 11486, 60);
   EXPECT_EQ(s.faults & (PROTO_FAULT_BATTERY_LOW | PROTO_FAULT_BATTERY_CUTOFF), 0);
   ASSERT_GT(b.motor_duty(), 0);
-  b.set_adc7_mv(2400); // 9.67 V: below the 9.9 V cut-off
+  b.set_adc7_mv(2400);  // 9.67 V: below the 9.9 V cut-off
   stream(b, seq, 800 * kMs, 400, 0, true);
   ASSERT_TRUE(b.last_state(&s));
   EXPECT_NEAR(s.battery_mv, 9673, 60);
@@ -381,4 +383,4 @@ TEST(Sil, config_applied) {
   EXPECT_LE(b.count(PROTO_ID_STATE) - before2, 11u) << "still 50 Hz";
 }
 
-} // namespace
+}  // namespace

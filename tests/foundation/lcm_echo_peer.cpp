@@ -28,8 +28,10 @@ void on_command(const lcm::ReceiveBuffer *, const std::string &,
 
 int main(int argc, char **argv) {
   if (argc != 5) {
-    std::fprintf(stderr, "usage: %s <lcm-url> <in-channel> <out-channel> <count>\n"
-                 "Echoes vehicle_command_t from <in> to <out> with seq+1, <count> times.\n", argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s <lcm-url> <in-channel> <out-channel> <count>\n"
+                 "Echoes vehicle_command_t from <in> to <out> with seq+1, <count> times.\n",
+                 argv[0]);
     return 2;
   }
   lcm::LCM lcm(argv[1]);

@@ -37,7 +37,9 @@ for ln in (root / "lcm_types" / "CHANNELS.md").read_text().splitlines():
         errors.append(f"channel {name}: listed twice")
     channels[name] = typ
     if typ.split(".")[-1] not in types:
-        errors.append(f"channel {name}: type {typ} has no lcm_types/autodrive/{typ.split('.')[-1]}.lcm")
+        errors.append(
+            f"channel {name}: type {typ} has no lcm_types/autodrive/{typ.split('.')[-1]}.lcm"
+        )
     if not cells[2] or not cells[3]:
         errors.append(f"channel {name}: rate and publisher must be given")
 

@@ -12,8 +12,9 @@ from autodrive import vehicle_command_t
 peer, port = sys.argv[1], int(sys.argv[2])
 url = f"udpm://239.255.76.67:{port}?ttl=0"
 count = 20
-proc = subprocess.Popen([peer, url, "INTEROP_IN", "INTEROP_OUT", str(count)],
-                        stdout=subprocess.PIPE, text=True)
+proc = subprocess.Popen(
+    [peer, url, "INTEROP_IN", "INTEROP_OUT", str(count)], stdout=subprocess.PIPE, text=True
+)
 assert proc.stdout.readline().strip() == "ready", "C++ peer did not start"
 
 lc = lcm.LCM(url)
@@ -27,7 +28,7 @@ for i in range(count):
     m.steering = -0.5
     m.headlights = 2
     m.indicators = 3
-    m.engaged = (i % 2 == 0)
+    m.engaged = i % 2 == 0
     lc.publish("INTEROP_IN", m.encode())
     deadline = time.time() + 5.0
     while len(got) <= i and time.time() < deadline:

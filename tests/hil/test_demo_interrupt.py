@@ -22,10 +22,24 @@ def alive(pattern):
 
 
 with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
-    demo = subprocess.Popen([sys.executable, str(root / "tools" / "demo.py"), "--build", build,
-                             "--out", tmp, "--headless", "--timeout", "200",
-                             "--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    demo = subprocess.Popen(
+        [
+            sys.executable,
+            str(root / "tools" / "demo.py"),
+            "--build",
+            build,
+            "--out",
+            tmp,
+            "--headless",
+            "--timeout",
+            "200",
+            "--lcm-url",
+            f"udpm://239.255.76.67:{port}?ttl=0",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     seen = []
     for line in demo.stdout:
         seen.append(line)
@@ -51,6 +65,7 @@ with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
         if ev.channel == "NIGEL1_COMMAND":
             last = vehicle_command_t.decode(ev.data)
     assert last is not None, "no command in the log"
-    assert not last.engaged and last.throttle == 0.0, \
-        f"last command engaged={last.engaged} throttle={last.throttle}: the autonomy left no stop"
+    assert (
+        not last.engaged and last.throttle == 0.0
+    ), f"last command engaged={last.engaged} throttle={last.throttle}: the autonomy left no stop"
 print("hil demo interrupt ok")

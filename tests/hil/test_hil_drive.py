@@ -10,9 +10,25 @@ import tempfile
 
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 with tempfile.TemporaryDirectory(prefix="hil-drive-") as tmp:
-    r = subprocess.run([sys.executable, str(root / "tools" / "demo.py"), "--build", build,
-                        "--out", tmp, "--mission", "loop", "--duration", "20", "--realtime", "--headless",
-                        "--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0"], timeout=240)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(root / "tools" / "demo.py"),
+            "--build",
+            build,
+            "--out",
+            tmp,
+            "--mission",
+            "loop",
+            "--duration",
+            "20",
+            "--realtime",
+            "--headless",
+            "--lcm-url",
+            f"udpm://239.255.76.67:{port}?ttl=0",
+        ],
+        timeout=240,
+    )
     report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
     print(json.dumps(report, indent=2))
     assert r.returncode == 0, f"demo exited {r.returncode}"

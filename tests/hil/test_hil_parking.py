@@ -11,10 +11,24 @@ import tempfile
 
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
-    r = subprocess.run([sys.executable, str(root / "tools" / "demo.py"), "--build", build,
-                        "--out", tmp, "--mission", "parking", "--headless",
-                        "--timeout", "200", "--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0"],
-                       timeout=280)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(root / "tools" / "demo.py"),
+            "--build",
+            build,
+            "--out",
+            tmp,
+            "--mission",
+            "parking",
+            "--headless",
+            "--timeout",
+            "200",
+            "--lcm-url",
+            f"udpm://239.255.76.67:{port}?ttl=0",
+        ],
+        timeout=280,
+    )
     report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
     print(json.dumps(report, indent=2))
     assert r.returncode == 0, f"demo exited {r.returncode}"
@@ -28,7 +42,8 @@ with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
     sim_log = (pathlib.Path(tmp) / "sim.log").read_text()
     appeared = [ln for ln in sim_log.splitlines() if ln.startswith("late box 1 appeared")]
     assert appeared, "the box never stepped out (the car did not come within 0.5 m of it)"
-    assert "unmapped obstacle" in log, \
-        f"the box that appeared after mapping was not seen ({appeared[0]}); autonomy:\n{log}"
+    assert (
+        "unmapped obstacle" in log
+    ), f"the box that appeared after mapping was not seen ({appeared[0]}); autonomy:\n{log}"
     assert (pathlib.Path(tmp) / "parking.png").stat().st_size > 1000, "parking plot missing"
 print("hil parking ok")

@@ -13,11 +13,21 @@ SWEEP = root / "tools" / "parking_sweep.py"
 
 
 def report(pos_m, head_deg, loc_m, wall_s, collisions=0, success=True, clearance_m=0.3):
-    return {"ok": success and collisions == 0, "success": success, "collisions": collisions,
-            "final_pos_error_m": pos_m, "final_heading_error_deg": head_deg,
-            "localization_rms_m": loc_m, "wall_s": wall_s, "sim_s": 2 * wall_s,
-            "min_clearance_m": clearance_m, "path_length_m": 0.93, "slot": 2,
-            "start_world": [-1.0, 0.6, 0.0], "goal_world": [-0.45, 1.1792, 1.5708]}
+    return {
+        "ok": success and collisions == 0,
+        "success": success,
+        "collisions": collisions,
+        "final_pos_error_m": pos_m,
+        "final_heading_error_deg": head_deg,
+        "localization_rms_m": loc_m,
+        "wall_s": wall_s,
+        "sim_s": 2 * wall_s,
+        "min_clearance_m": clearance_m,
+        "path_length_m": 0.93,
+        "slot": 2,
+        "start_world": [-1.0, 0.6, 0.0],
+        "goal_world": [-0.45, 1.1792, 1.5708],
+    }
 
 
 def put(out, seed, rep=None, exit_code=None, gt=True):
@@ -32,9 +42,22 @@ def put(out, seed, rep=None, exit_code=None, gt=True):
 
 
 def sweep(out, seeds, first=1):
-    r = subprocess.run([sys.executable, str(SWEEP), "--aggregate-only", "--first-seed", str(first),
-                        "--seeds", str(seeds), "--out", str(out)],
-                       capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(SWEEP),
+            "--aggregate-only",
+            "--first-seed",
+            str(first),
+            "--seeds",
+            str(seeds),
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0, f"sweep exited {r.returncode}: {r.stderr}"
     last = json.loads(r.stdout.strip().splitlines()[-1])
     assert last == json.loads((out / "summary.json").read_text()), "stdout JSON != summary.json"
@@ -46,9 +69,9 @@ def sweep(out, seeds, first=1):
 with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     mixed = pathlib.Path(tmp) / "mixed"
     put(mixed, 1, report(0.010, 1.0, 0.020, 8.0), exit_code=0)
-    put(mixed, 2, None, exit_code=1, gt=False)                         # demo died: no report
+    put(mixed, 2, None, exit_code=1, gt=False)  # demo died: no report
     put(mixed, 3, report(0.050, 3.0, 0.040, 9.0, collisions=2, clearance_m=0.0), exit_code=1)
-    put(mixed, 4, report(0.012, 0.5, 0.025, 130.0), exit_code=1)      # ok report, exit 1
+    put(mixed, 4, report(0.012, 0.5, 0.025, 130.0), exit_code=1)  # ok report, exit 1
     s, err = sweep(mixed, 4)
     print(err)
     assert s["runs"] == 4 and s["reports"] == 3, s
@@ -64,8 +87,13 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     assert s["per_seed"]["error"][1] == "no report.json, demo exit 1"
     assert s["per_seed"]["error"][2] == "2 collision(s), demo exit 1"
     assert s["per_seed"]["error"][3] == "demo exit 1"
-    for goal in ("goal_all_success_no_collisions", "goal_final_pose", "goal_localization_rms",
-                 "goal_wall_s", "goals_met"):
+    for goal in (
+        "goal_all_success_no_collisions",
+        "goal_final_pose",
+        "goal_localization_rms",
+        "goal_wall_s",
+        "goals_met",
+    ):
         assert s[goal] is False, goal
     assert "[parking 2/4] seed 2: FAILED (no report.json, demo exit 1)\n" in err, err
 
@@ -75,13 +103,19 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     s, _ = sweep(good, 10, first=5)
     assert s["runs"] == 10 and s["successes"] == 10 and s["collisions_total"] == 0, s
     assert s["final_pos_error_m_max"] == 0.019 and s["final_pos_error_m_median"] == 0.0145
-    for goal in ("goal_all_success_no_collisions", "goal_final_pose", "goal_localization_rms",
-                 "goal_wall_s", "goals_met"):
+    for goal in (
+        "goal_all_success_no_collisions",
+        "goal_final_pose",
+        "goal_localization_rms",
+        "goal_wall_s",
+        "goals_met",
+    ):
         assert s[goal] is True, goal
     s, _ = sweep(good, 2, first=5)  # the first two of them: every goal but the ten runs
     assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
 
-    bad = subprocess.run([sys.executable, str(SWEEP), "--seeds", "0"], capture_output=True,
-                         text=True, timeout=60)
+    bad = subprocess.run(
+        [sys.executable, str(SWEEP), "--seeds", "0"], capture_output=True, text=True, timeout=60
+    )
     assert bad.returncode == 2 and "--seeds 0" in bad.stderr, bad.stderr
 print("parking sweep aggregate ok")

@@ -59,8 +59,10 @@ void PtyPeer::write(const std::vector<uint8_t> &bytes) {
   std::size_t done = 0;
   while (master_ >= 0 && done < bytes.size()) {
     const ssize_t n = ::write(master_, bytes.data() + done, bytes.size() - done);
-    if (n > 0) done += static_cast<std::size_t>(n);
-    else if (n < 0 && errno != EAGAIN && errno != EINTR) break;
+    if (n > 0)
+      done += static_cast<std::size_t>(n);
+    else if (n < 0 && errno != EAGAIN && errno != EINTR)
+      break;
     else {
       pollfd p{master_, POLLOUT, 0};
       ::poll(&p, 1, 10);

@@ -33,7 +33,10 @@ class PtyPeer {
 class FakeNano {
  public:
   explicit FakeNano(const std::string &link, uint32_t schema_hash = proto_schema_hash());
-  void open() { pty.open(); proto_parser_init(&parser_); }
+  void open() {
+    pty.open();
+    proto_parser_init(&parser_);
+  }
   void close() { pty.close(); }
   // Reads and handles what arrived (up to timeout_ms for the first byte).
   void pump(int timeout_ms);

@@ -99,11 +99,13 @@ int run_serial(const std::string &url, const std::string &vehicle, const std::st
         if (nano.commands[i].throttle_milli == milli) seen = true;
     }
     if (seen) lat_us.push_back(static_cast<double>(clk::monotonic_us() - t0));
-    if (k % 100 == 0) progress("serial: %.0f samples, p50 so far %.0f us\n", k, percentile(lat_us, 50));
+    if (k % 100 == 0)
+      progress("serial: %.0f samples, p50 so far %.0f us\n", k, percentile(lat_us, 50));
   }
-  std::printf("{\"cmd_to_serial_us_p50\": %.1f, \"cmd_to_serial_us_p90\": %.1f, "
-              "\"cmd_to_serial_us_p99\": %.1f, \"cmd_to_serial_samples\": %zu}\n",
-              percentile(lat_us, 50), percentile(lat_us, 90), percentile(lat_us, 99), lat_us.size());
+  std::printf(
+      "{\"cmd_to_serial_us_p50\": %.1f, \"cmd_to_serial_us_p90\": %.1f, "
+      "\"cmd_to_serial_us_p99\": %.1f, \"cmd_to_serial_samples\": %zu}\n",
+      percentile(lat_us, 50), percentile(lat_us, 90), percentile(lat_us, 99), lat_us.size());
   return lat_us.empty() ? 1 : 0;
 }
 
@@ -141,7 +143,8 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
             int samples) {
   lcm::LCM lcm(url);
   StateWatch w;
-  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(lcm, vehicle + "_STATE", &w);
+  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
+      lcm, vehicle + "_STATE", &w);
   const int64_t give_up = clk::monotonic_us() + 60000000;
   while (w.states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
   if (w.states.size() < 10) {
@@ -199,11 +202,13 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
   for (const auto &l : lines)
     if (l.t_mono_us >= step_t0.front() && !first) first = &l;
   if (first && lines.back().t_mono_us > first->t_mono_us)
-    rtf = double(lines.back().t_sim_us - first->t_sim_us) / double(lines.back().t_mono_us - first->t_mono_us);
-  std::printf("{\"cmd_to_pwm_ms_p50\": %.3f, \"cmd_to_pwm_ms_p90\": %.3f, \"cmd_to_pwm_samples\": %zu, "
-              "\"simavr_real_time_factor\": %.3f, \"cmd_to_pwm_ms_p50_at_real_time\": %.3f}\n",
-              percentile(lat_ms, 50), percentile(lat_ms, 90), lat_ms.size(), rtf,
-              percentile(lat_ms, 50) * rtf);
+    rtf = double(lines.back().t_sim_us - first->t_sim_us) /
+          double(lines.back().t_mono_us - first->t_mono_us);
+  std::printf(
+      "{\"cmd_to_pwm_ms_p50\": %.3f, \"cmd_to_pwm_ms_p90\": %.3f, \"cmd_to_pwm_samples\": %zu, "
+      "\"simavr_real_time_factor\": %.3f, \"cmd_to_pwm_ms_p50_at_real_time\": %.3f}\n",
+      percentile(lat_ms, 50), percentile(lat_ms, 90), lat_ms.size(), rtf,
+      percentile(lat_ms, 50) * rtf);
   return lat_ms.empty() ? 1 : 0;
 }
 
@@ -212,7 +217,8 @@ int run_telemetry(const std::string &url, const std::string &vehicle, double sec
                   const std::string &key_suffix) {
   lcm::LCM lcm(url);
   StateWatch w;
-  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(lcm, vehicle + "_STATE", &w);
+  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
+      lcm, vehicle + "_STATE", &w);
   const int64_t give_up = clk::monotonic_us() + 60000000;
   while (w.states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
   w.states.clear();
@@ -226,14 +232,16 @@ int run_telemetry(const std::string &url, const std::string &vehicle, double sec
   std::vector<double> dt_ms;
   for (std::size_t i = 1; i < w.rx_mono_us.size(); ++i)
     dt_ms.push_back((w.rx_mono_us[i] - w.rx_mono_us[i - 1]) / 1000.0);
-  const double hz = (w.rx_mono_us.size() - 1) * 1e6 / double(w.rx_mono_us.back() - w.rx_mono_us.front());
+  const double hz =
+      (w.rx_mono_us.size() - 1) * 1e6 / double(w.rx_mono_us.back() - w.rx_mono_us.front());
   const double med = percentile(dt_ms, 50);
   std::vector<double> dev;
   for (double d : dt_ms) dev.push_back(std::fabs(d - med));
-  std::printf("{\"telemetry_hz%s\": %.2f, \"telemetry_jitter_ms%s\": %.3f, "
-              "\"telemetry_jitter_ms_p99%s\": %.3f, \"telemetry_period_ms_p50%s\": %.3f}\n",
-              key_suffix.c_str(), hz, key_suffix.c_str(), percentile(dev, 50), key_suffix.c_str(),
-              percentile(dev, 99), key_suffix.c_str(), med);
+  std::printf(
+      "{\"telemetry_hz%s\": %.2f, \"telemetry_jitter_ms%s\": %.3f, "
+      "\"telemetry_jitter_ms_p99%s\": %.3f, \"telemetry_period_ms_p50%s\": %.3f}\n",
+      key_suffix.c_str(), hz, key_suffix.c_str(), percentile(dev, 50), key_suffix.c_str(),
+      percentile(dev, 99), key_suffix.c_str(), med);
   return 0;
 }
 
@@ -243,7 +251,9 @@ struct Pose {
   double x, y, yaw;
 };
 
-double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+double wrap(double a) {
+  return std::atan2(std::sin(a), std::cos(a));
+}
 
 // Ground truth interpolated at t_us (host receive time); false outside the record.
 bool truth_at(const std::vector<Pose> &gt, int64_t t_us, Pose *out) {
@@ -276,11 +286,16 @@ struct EkfBench {
     if (eye && t >= next_eye_us) {
       next_eye_us = t + static_cast<int64_t>(eye_period_us);
       std::normal_distribution<double> nm(0, noise_m), nr(0, noise_rad);
-      eye_queue.push_back({t, m->position_m[0] + nm(rng), m->position_m[1] + nm(rng), wrap(m->yaw_rad + nr(rng))});
+      eye_queue.push_back(
+          {t, m->position_m[0] + nm(rng), m->position_m[1] + nm(rng), wrap(m->yaw_rad + nr(rng))});
     }
   }
-  void on_map(const autodrive::odometry_t *m) { map.push_back({m->utime, m->x_m, m->y_m, m->yaw_rad}); }
-  void on_odom(const autodrive::odometry_t *m) { odom.push_back({m->utime, m->x_m, m->y_m, m->yaw_rad}); }
+  void on_map(const autodrive::odometry_t *m) {
+    map.push_back({m->utime, m->x_m, m->y_m, m->yaw_rad});
+  }
+  void on_odom(const autodrive::odometry_t *m) {
+    odom.push_back({m->utime, m->x_m, m->y_m, m->yaw_rad});
+  }
   // Eye poses leave `eye_delay_us` after capture, stamped with the capture time (like the Eye).
   void flush_eye() {
     const int64_t now = clk::wall_us();
@@ -362,7 +377,8 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
     b.flush_eye();
   }
   if (b.odom.size() < 20 || b.gt.size() < 20) {
-    std::fprintf(stderr, "ekf: no %s_ODOM or ground truth (runtime/sim not running?)\n", vehicle.c_str());
+    std::fprintf(stderr, "ekf: no %s_ODOM or ground truth (runtime/sim not running?)\n",
+                 vehicle.c_str());
     return 1;
   }
   // Let the Eye place the map estimate, then drive the loop.
@@ -378,12 +394,14 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
   while (clk::monotonic_us() < end) {
     const int64_t now = clk::monotonic_us();
     if (now >= next_cmd) {
-      const auto c = make_cmd(seq++, static_cast<float>(throttle), static_cast<float>(steering), true);
+      const auto c =
+          make_cmd(seq++, static_cast<float>(throttle), static_cast<float>(steering), true);
       lcm.publish(vehicle + "_COMMAND", &c);
       next_cmd = now + 20000;
     }
     if (now >= next_progress) {
-      progress("ekf: %.0f s driven, %.0f map estimates\n", (now - (end - seconds * 1e6)) / 1e6, b.map.size());
+      progress("ekf: %.0f s driven, %.0f map estimates\n", (now - (end - seconds * 1e6)) / 1e6,
+               b.map.size());
       next_progress = now + 10000000;
     }
     lcm.handleTimeout(5);
@@ -408,12 +426,14 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
       if (first.first == 0) first = p;
       last = p;
     }
-  if (last.first > first.first) rtf = double(last.second - first.second) / double(last.first - first.first);
-  std::printf("{\"ekf_pos_rms_m\": %.4f, \"ekf_heading_rms_deg\": %.3f, "
-              "\"ekf_pos_rms_m_no_eye\": %.4f, \"ekf_heading_rms_deg_no_eye\": %.3f, "
-              "\"ekf_samples\": %d, \"ekf_path_m\": %.2f, \"ekf_collision\": %s, "
-              "\"ekf_sim_real_time_factor\": %.3f}\n",
-              pm, ym, po, yo, nm, path_m, b.collided ? "true" : "false", rtf);
+  if (last.first > first.first)
+    rtf = double(last.second - first.second) / double(last.first - first.first);
+  std::printf(
+      "{\"ekf_pos_rms_m\": %.4f, \"ekf_heading_rms_deg\": %.3f, "
+      "\"ekf_pos_rms_m_no_eye\": %.4f, \"ekf_heading_rms_deg_no_eye\": %.3f, "
+      "\"ekf_samples\": %d, \"ekf_path_m\": %.2f, \"ekf_collision\": %s, "
+      "\"ekf_sim_real_time_factor\": %.3f}\n",
+      pm, ym, po, yo, nm, path_m, b.collided ? "true" : "false", rtf);
   return nm > 0 ? 0 : 1;
 }
 
@@ -425,7 +445,8 @@ int main(int argc, char **argv) {
                     suffix;
   int samples = 500;
   double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50;
-  app.add_option("mode", mode, "serial | pwm | telemetry | ekf")->required()
+  app.add_option("mode", mode, "serial | pwm | telemetry | ekf")
+      ->required()
       ->check(CLI::IsMember({"serial", "pwm", "telemetry", "ekf"}));
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
   app.add_option("--vehicle", vehicle, "vehicle name")->capture_default_str();
@@ -435,7 +456,8 @@ int main(int argc, char **argv) {
   app.add_option("--seconds", seconds, "telemetry/ekf: duration [s]")->capture_default_str();
   app.add_option("--throttle", throttle, "ekf: loop throttle [-1, 1]")->capture_default_str();
   app.add_option("--steering", steering, "ekf: loop steering [-1, 1]")->capture_default_str();
-  app.add_option("--eye-delay-ms", eye_delay_ms, "ekf: Eye pose latency [ms]")->capture_default_str();
+  app.add_option("--eye-delay-ms", eye_delay_ms, "ekf: Eye pose latency [ms]")
+      ->capture_default_str();
   app.add_option("--key-suffix", suffix, "telemetry: suffix for the JSON keys");
   CLI11_PARSE(app, argc, argv);
   if (mode == "serial") return run_serial(url, vehicle, pty, samples);

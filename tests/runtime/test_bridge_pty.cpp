@@ -23,11 +23,14 @@
 namespace {
 
 std::string config_yaml(int port, const std::string &device) {
-  return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0\"\n"
+  return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+         "?ttl=0\"\n"
          "clock: wall\n"
          "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
          "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
-         "bridge: {device: " + device + ", baud: 500000, heartbeat_hz: 50,\n"
+         "bridge: {device: " +
+         device +
+         ", baud: 500000, heartbeat_hz: 50,\n"
          "         command_timeout_ms: 200, hello_retry_ms: 50, refused_retry_ms: 50,\n"
          "         reconnect_ms: 50, link_timeout_ms: 2000, telemetry_period_ms: 10,\n"
          "         imu: {gyro_var_rad2_s2: 0.0004}}\n";
@@ -43,7 +46,7 @@ class BridgeHarness {
     lcmsub::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
         lcm, "TESTCAR_STATE", this);
     lcmsub::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(lcm, "TESTCAR_IMU",
-                                                                              this);
+                                                                               this);
   }
   ~BridgeHarness() {
     stop_ = true;
@@ -61,8 +64,10 @@ class BridgeHarness {
   bool wait_for(const std::function<bool()> &pred, double max_s = 20.0) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(max_s);
     while (std::chrono::steady_clock::now() < end) {
-      if (nano.pty.is_open()) nano.pump(5);
-      else std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (nano.pty.is_open())
+        nano.pump(5);
+      else
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
       if (send_states && nano.hellos_sent > 0 && nano.pty.is_open()) {
         proto_state_t s{};
         s.nano_time_us = static_cast<uint32_t>(10000u * ++state_count_);
@@ -103,12 +108,8 @@ class BridgeHarness {
   std::vector<autodrive::imu_t> imus;
 
  private:
-  void on_state(const autodrive::vehicle_state_t *m) {
-    states.push_back(*m);
-  }
-  void on_imu(const autodrive::imu_t *m) {
-    imus.push_back(*m);
-  }
+  void on_state(const autodrive::vehicle_state_t *m) { states.push_back(*m); }
+  void on_imu(const autodrive::imu_t *m) { imus.push_back(*m); }
   std::unique_ptr<bridge::NanoBridge> bridge_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -209,7 +210,8 @@ TEST(BridgePty, StaleCommandsDisengage) {
   ASSERT_TRUE(h.wait_for(disengaged_after_mark));
   // Once disengaged it stays so while no command arrives.
   std::size_t first = mark;
-  while (first < h.nano.commands.size() && (h.nano.commands[first].flags & PROTO_CMD_ENGAGED)) ++first;
+  while (first < h.nano.commands.size() && (h.nano.commands[first].flags & PROTO_CMD_ENGAGED))
+    ++first;
   const std::size_t target = h.nano.commands.size() + 5;
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= target; }));
   EXPECT_EQ(count_engaged(h.nano.commands, first), 0);
@@ -247,7 +249,8 @@ TEST(BridgePty, ReconnectsAfterDeviceDisappears) {
   h.enc_left = 5000;
   h.nano.hellos_sent = 0;
   h.nano.open();
-  ASSERT_TRUE(h.wait_for([&] { return !h.states.empty() && h.states.back().encoder_counts[0] == 5000; }));
+  ASSERT_TRUE(
+      h.wait_for([&] { return !h.states.empty() && h.states.back().encoder_counts[0] == 5000; }));
   const bridge::Status st = h.status();
   EXPECT_EQ(st.state, bridge::LinkState::linked);
   EXPECT_GE(st.opens, 2u);

@@ -25,7 +25,8 @@
 
 namespace {
 std::string base_yaml(int port) {
-  return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0\"\n"
+  return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+         "?ttl=0\"\n"
          "clock: wall\n"
          "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
          "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n";
@@ -61,13 +62,16 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
     ASSERT_TRUE(w.isOpened());
     for (int i = 0; i < 20; ++i) w.write(cv::Mat(240, 320, CV_8UC3, cv::Scalar(200, 120, 10)));
   }
-  const cfg::Config c = cfg::parse(base_yaml(7774) +
-      "cameras:\n  - {source: " + video + ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
-      "     height_px: 120, jpeg_quality: 90}\n", "test config");
+  const cfg::Config c = cfg::parse(base_yaml(7774) + "cameras:\n  - {source: " + video +
+                                       ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
+                                       "     height_px: 120, jpeg_quality: 90}\n",
+                                   "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
-  lcmsub::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(lcm, "TESTCAR_CAM_FRONT", &sink);
-  lcmsub::subscribe<autodrive::camera_info_t, Sink, &Sink::on_info>(lcm, "TESTCAR_CAM_FRONT_INFO", &sink);
+  lcmsub::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(lcm, "TESTCAR_CAM_FRONT",
+                                                                          &sink);
+  lcmsub::subscribe<autodrive::camera_info_t, Sink, &Sink::on_info>(lcm, "TESTCAR_CAM_FRONT_INFO",
+                                                                    &sink);
   cam::CameraDriver driver(c, 0);
   ASSERT_EQ(driver.init_error(), "");
   std::atomic<bool> stop{false};
@@ -95,8 +99,10 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
 }
 
 TEST(CameraLcm, MissingSourceIsRetriedNotFatal) {
-  const cfg::Config c = cfg::parse(base_yaml(7775) +
-      "cameras:\n  - {source: /nonexistent/video.avi, channel: CAM_FRONT, rate_hz: 30}\n", "test config");
+  const cfg::Config c = cfg::parse(
+      base_yaml(7775) +
+          "cameras:\n  - {source: /nonexistent/video.avi, channel: CAM_FRONT, rate_hz: 30}\n",
+      "test config");
   cam::CameraDriver driver(c, 0);
   ASSERT_EQ(driver.init_error(), "");
   std::atomic<bool> stop{false};
@@ -138,14 +144,15 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
     ++k;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   };
-  const bool got = pump_until(lcm, [&] { return k >= 300 && sink.odom.size() > 200 && sink.map.size() > 50; }, 60, feed);
+  const bool got = pump_until(
+      lcm, [&] { return k >= 300 && sink.odom.size() > 200 && sink.map.size() > 50; }, 60, feed);
   stop = true;
   th.join();
   ASSERT_TRUE(got);
   const auto &o = sink.odom.back();
   EXPECT_EQ(o.frame_id, "odom");
   EXPECT_NEAR(o.vx_m_s, 2 * M_PI * 0.0325, 0.01);
-  EXPECT_GT(o.x_m, 0.3);           // drove forward in its own frame
+  EXPECT_GT(o.x_m, 0.3);  // drove forward in its own frame
   EXPECT_NEAR(o.y_m, 0.0, 0.01);
   const auto &m = sink.map.back();
   EXPECT_EQ(m.frame_id, "map");

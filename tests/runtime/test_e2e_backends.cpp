@@ -77,7 +77,8 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
         << "bridge: {device: " << nano_link_ << ", baud: 500000, heartbeat_hz: 50,\n"
         << "         command_timeout_ms: 200, reconnect_ms: 200}\n";
     if (b.has_lidar)
-      cfg << "lidar: {device: " << lidar_link_ << ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n";
+      cfg << "lidar: {device: " << lidar_link_
+          << ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n";
   }
   void TearDown() override {
     runtime_.reset();
@@ -100,13 +101,15 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     if (b.name == "sim")
       argv = {AUTODRIVE_SIM_EXE, "--run-dir", dir_, "--lcm-url", url_, "--quiet"};
 #endif
-    backend_ = std::make_unique<rtest::Child>(argv, dir_ + "/backend-" + std::to_string(++starts_) + ".log");
+    backend_ = std::make_unique<rtest::Child>(
+        argv, dir_ + "/backend-" + std::to_string(++starts_) + ".log");
     ASSERT_TRUE(wait_for([&] { return exists(nano_link_); }, 60)) << "no pty at " << nano_link_;
   }
   void start_runtime() {
     const std::string only = GetParam().has_lidar ? "bridge,lidar" : "bridge";
     runtime_ = std::make_unique<rtest::Child>(
-        std::vector<std::string>{AUTODRIVE_RUNTIME_EXE, "--config", dir_ + "/runtime.yaml", "--only", only},
+        std::vector<std::string>{AUTODRIVE_RUNTIME_EXE, "--config", dir_ + "/runtime.yaml",
+                                 "--only", only},
         dir_ + "/runtime.log");
   }
 
@@ -135,9 +138,15 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     return ss.str();
   }
 
-  void on_state(const autodrive::vehicle_state_t *m) { states_.push_back(*m); }
-  void on_scan(const autodrive::lidar_scan_t *m) { scans_.push_back(*m); }
-  void on_sim_scan(const autodrive::lidar_scan_t *m) { sim_scans_.push_back(*m); }
+  void on_state(const autodrive::vehicle_state_t *m) {
+    states_.push_back(*m);
+  }
+  void on_scan(const autodrive::lidar_scan_t *m) {
+    scans_.push_back(*m);
+  }
+  void on_sim_scan(const autodrive::lidar_scan_t *m) {
+    sim_scans_.push_back(*m);
+  }
 
   std::string dir_, url_, nano_link_, lidar_link_, pwm_log_;
   std::unique_ptr<lcm::LCM> lcm_;
@@ -184,8 +193,10 @@ TEST_P(BackendE2E, CommandInStateOutStaleDisengagesReconnects) {
       std::istringstream f(line);
       double t_sim, t_mono, servo, duty;
       if (!(f >> t_sim >> t_mono >> servo >> duty)) continue;
-      if (duty > 0) drove = true;
-      else if (drove) stopped_after = true;
+      if (duty > 0)
+        drove = true;
+      else if (drove)
+        stopped_after = true;
     }
     EXPECT_TRUE(drove) << log("pwm.log");
     EXPECT_TRUE(stopped_after);
@@ -216,10 +227,12 @@ TEST_P(LidarE2E, RplidarDriverAgainstEmulatedA1) {
   start_backend();
   // The simulator publishes NIGEL1_LIDAR itself only while no client scans its emulated A1:
   // take its scan first, then start the runtime's driver on the pty.
-  ASSERT_TRUE(wait_for([&] { return !sim_scans_.empty(); })) << "no NIGEL1_LIDAR from the simulator";
+  ASSERT_TRUE(wait_for([&] { return !sim_scans_.empty(); }))
+      << "no NIGEL1_LIDAR from the simulator";
   start_runtime();
   ASSERT_TRUE(wait_for([&] { return scans_.size() >= 5; }))
-      << "driver scans " << scans_.size() << "\n" << log("runtime.log");
+      << "driver scans " << scans_.size() << "\n"
+      << log("runtime.log");
   // The car stands still: every ray the driver reports must equal the simulator's own
   // published scan (to the protocol's quarter-millimetre quantisation). The emulated A1, like
   // the real one, sends a fixed number of samples per second, so at 7 Hz a turn has fewer
@@ -243,10 +256,13 @@ TEST_P(LidarE2E, RplidarDriverAgainstEmulatedA1) {
   for (int i = 0; i < 360; i += 15)
     diff << i << ": " << ours.ranges_m[static_cast<std::size_t>(i)] << " vs "
          << truth.ranges_m[static_cast<std::size_t>(i)] << "\n";
-  EXPECT_GE(match, ours_finite * 99 / 100) << "driver scan differs from the simulator's:\n" << diff.str();
+  EXPECT_GE(match, ours_finite * 99 / 100) << "driver scan differs from the simulator's:\n"
+                                           << diff.str();
 }
 
-std::string backend_name(const ::testing::TestParamInfo<Backend> &i) { return i.param.name; }
+std::string backend_name(const ::testing::TestParamInfo<Backend> &i) {
+  return i.param.name;
+}
 
 INSTANTIATE_TEST_SUITE_P(Backends, BackendE2E, ::testing::ValuesIn(backends()), backend_name);
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendE2E);

@@ -103,7 +103,7 @@ TEST(Ekf, CircleMatchesAckermannGeometry) {
 TEST(Ekf, EyePosesBoundBiasedOdometryDrift) {
   const double drift = run_loop(false, 1.05, 0, nullptr);
   const double fused = run_loop(true, 1.05, 0, nullptr);
-  EXPECT_GT(drift, 0.2);   // 5 % speed error and a gyro bias over 7.5 m
+  EXPECT_GT(drift, 0.2);  // 5 % speed error and a gyro bias over 7.5 m
   EXPECT_LT(fused, 0.03);
 }
 
@@ -165,8 +165,8 @@ TEST(Ekf, NonFiniteRejected) {
 TEST(Ekf, WheelSpeedFromEncodersAcrossClockWrap) {
   double v = 0;
   // One wheel revolution on both wheels in 0.1 s, across the Nano's 32-bit clock wrap.
-  ASSERT_TRUE(est::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000, 1920,
-                                             0.0325, &v));
+  ASSERT_TRUE(
+      est::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000, 1920, 0.0325, &v));
   EXPECT_NEAR(v, 2 * M_PI * 0.0325 / 0.1, 1e-9);
   EXPECT_FALSE(est::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
 }

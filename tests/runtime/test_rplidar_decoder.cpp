@@ -13,7 +13,9 @@ using Bytes = std::vector<uint8_t>;
 const Bytes kScanDescriptor = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
 
 // Range the synthetic room returns at a device angle [mm]: a smooth function of the angle.
-double room_mm(int deg_cw) { return 1000.0 + 5.0 * deg_cw; }
+double room_mm(int deg_cw) {
+  return 1000.0 + 5.0 * deg_cw;
+}
 
 // `turns` full turns of 360 nodes at whole degrees (cw), starting at 0 deg with the S flag.
 std::vector<Bytes> node_bytes(int turns) {
@@ -53,8 +55,10 @@ int matching_bins(const autodrive::lidar_scan_t &s) {
   for (int a = 0; a < 360; ++a) {
     const int bin = (360 - a) % 360;  // device clockwise -> REP-103 counter-clockwise
     const float r = s.ranges_m[static_cast<std::size_t>(bin)];
-    if (a % 45 == 7) ok += std::isinf(r) ? 1 : 0;
-    else ok += std::fabs(r - room_mm(a) / 1000.0) < 1e-3 ? 1 : 0;
+    if (a % 45 == 7)
+      ok += std::isinf(r) ? 1 : 0;
+    else
+      ok += std::fabs(r - room_mm(a) / 1000.0) < 1e-3 ? 1 : 0;
   }
   return ok;
 }
@@ -250,5 +254,6 @@ TEST(RplidarAssembler, DescendingAnglesAccepted) {
       d.feed(b, 5);
     }
   ASSERT_EQ(scans.size(), 2u);
-  for (int i = 0; i < 360; ++i) EXPECT_NEAR(scans[0].ranges_m[static_cast<std::size_t>(i)], 1.0 + i / 1000.0, 1e-6);
+  for (int i = 0; i < 360; ++i)
+    EXPECT_NEAR(scans[0].ranges_m[static_cast<std::size_t>(i)], 1.0 + i / 1000.0, 1e-6);
 }

@@ -21,7 +21,9 @@
 
 namespace {
 
-double room_m(int deg_cw) { return 0.5 + 0.01 * deg_cw; }
+double room_m(int deg_cw) {
+  return 0.5 + 0.01 * deg_cw;
+}
 
 // A1 emulation: answers GET_HEALTH with `health_status`, streams nodes after SCAN.
 struct FakeRplidar {
@@ -74,13 +76,16 @@ struct LidarHarness {
   explicit LidarHarness(int port)
       : link("/tmp/adr-rt-lidar-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         fake(link),
-        config(cfg::parse(
-            "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0\"\n"
-            "clock: wall\n"
-            "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
-            "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
-            "lidar: {device: " + link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
-            "test config")),
+        config(
+            cfg::parse("lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+                           "?ttl=0\"\n"
+                           "clock: wall\n"
+                           "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, "
+                           "wheel_radius_m: 0.0325,\n"
+                           "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
+                           "lidar: {device: " +
+                           link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
+                       "test config")),
         lcm(config.lcm_url) {
     lcmsub::subscribe<autodrive::lidar_scan_t, LidarHarness, &LidarHarness::on_scan>(
         lcm, "TESTCAR_LIDAR", this);
@@ -103,9 +108,7 @@ struct LidarHarness {
     }
     return pred();
   }
-  void on_scan(const autodrive::lidar_scan_t *m) {
-    scans.push_back(*m);
-  }
+  void on_scan(const autodrive::lidar_scan_t *m) { scans.push_back(*m); }
   int matching_bins(const autodrive::lidar_scan_t &s) const {
     int ok = 0;
     for (int a = 0; a < 360; ++a)

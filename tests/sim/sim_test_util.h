@@ -15,13 +15,17 @@ inline std::string temp_dir() {
   return d ? std::string(d) : std::string();
 }
 
-inline std::string params_path() { return std::string(SIM_DIR) + "/params/nigel.params"; }
+inline std::string params_path() {
+  return std::string(SIM_DIR) + "/params/nigel.params";
+}
 // A map name from sim/mujoco_hil/maps, or a path (with '/') as is.
 inline std::string map_path(const char *name) {
   if (std::string(name).find('/') != std::string::npos) return name;
   return std::string(SIM_DIR) + "/maps/" + name + ".xml";
 }
-inline std::string fixture(const char *file) { return std::string(SIM_TEST_DIR) + "/fixtures/" + file; }
+inline std::string fixture(const char *file) {
+  return std::string(SIM_TEST_DIR) + "/fixtures/" + file;
+}
 
 // A sim with the default parameters on the parking school, no ptys, optional script.
 struct Sim {

@@ -49,8 +49,10 @@ TEST(Cli, HelpListsTheOptions) {
 
 TEST(Cli, LockstepIsDeterministicForASeed) {
   const std::string dir = simtest::temp_dir();
-  const std::string common = " --lockstep --duration 3 --cars 2 --no-pty --quiet --lcm-url memq:// "
-                             "--script constant:throttle=0.7,steering=0.4 --run-dir " + dir;
+  const std::string common =
+      " --lockstep --duration 3 --cars 2 --no-pty --quiet --lcm-url memq:// "
+      "--script constant:throttle=0.7,steering=0.4 --run-dir " +
+      dir;
   const ProcResult a = run("--seed 7 --truth-log " + dir + "/a.bin" + common);
   ASSERT_EQ(a.status, 0) << a.out;
   const ProcResult b = run("--seed 7 --truth-log " + dir + "/b.bin" + common);
@@ -72,7 +74,7 @@ TEST(Cli, BadParameterFileIsRejectedNamingFileAndKey) {
   text.replace(text.find("wheel_radius_m = 0.0325"), 23, "wheel_radius_m = 3.25cm");
   std::ofstream(path) << text;
   const ProcResult r = run("--lockstep --duration 0.1 --no-pty --lcm-url memq:// --run-dir " + dir +
-                    " --params " + path);
+                           " --params " + path);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("broken.params"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("wheel_radius_m"), std::string::npos) << r.out;
@@ -83,7 +85,7 @@ TEST(Cli, BadParameterFileIsRejectedNamingFileAndKey) {
 TEST(Cli, BadMapFileIsRejectedNamingTheMap) {
   const std::string dir = simtest::temp_dir();
   ProcResult r = run("--lockstep --duration 0.1 --no-pty --lcm-url memq:// --run-dir " + dir +
-              " --map " + simtest::fixture("broken_map.xml"));
+                     " --map " + simtest::fixture("broken_map.xml"));
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("broken_map.xml"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("colour"), std::string::npos) << r.out;

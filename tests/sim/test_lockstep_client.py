@@ -31,9 +31,22 @@ def pump(wall_s):
 
 
 with tempfile.TemporaryDirectory(prefix="sim-lockstep-") as run_dir:
-    sim = subprocess.Popen([str(build / "bin" / "autodrive-sim"), "--lockstep-client", "--no-lidar",
-                            "--duration", "600", "--run-dir", run_dir, "--lcm-url", url],
-                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    sim = subprocess.Popen(
+        [
+            str(build / "bin" / "autodrive-sim"),
+            "--lockstep-client",
+            "--no-lidar",
+            "--duration",
+            "600",
+            "--run-dir",
+            run_dir,
+            "--lcm-url",
+            url,
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         pty = pathlib.Path(run_dir) / "nigel1-nano"
         for _ in range(300):
@@ -51,13 +64,17 @@ with tempfile.TemporaryDirectory(prefix="sim-lockstep-") as run_dir:
         t_write = pump(0.2)
         t_held = pump(1.0)
         # One byte buys at most 40 ms; the sim then waits for the silent client.
-        assert t_held - t_write <= 0.06, f"a silent client did not hold the sim: +{t_held - t_write:.3f} s"
+        assert (
+            t_held - t_write <= 0.06
+        ), f"a silent client did not hold the sim: +{t_held - t_write:.3f} s"
         end = time.time() + 1.0
         while time.time() < end:  # a client writing every 5 ms of wall time
             os.write(fd, b"\x00")
             pump(0.005)
         t_fed = pump(0.05)
-        assert t_fed - t_held >= 0.2, f"a writing client did not move the sim: +{t_fed - t_held:.3f} s"
+        assert (
+            t_fed - t_held >= 0.2
+        ), f"a writing client did not move the sim: +{t_fed - t_held:.3f} s"
         t_gone = pump(4.0)  # silent again: after 2 s wall the sim runs on without it
         assert t_gone - t_fed >= 1.0, f"the sim waited for a gone client: +{t_gone - t_fed:.3f} s"
         os.close(fd)
@@ -65,5 +82,7 @@ with tempfile.TemporaryDirectory(prefix="sim-lockstep-") as run_dir:
         sim.terminate()
         err = sim.communicate(timeout=10)[1]
     assert "no bytes from the client" in err, f"no message about the silent client:\n{err[-2000:]}"
-    print(f"lockstep client ok: real time {t1 - t0:.3f} s/s, held +{t_held - t_write:.3f} s, "
-          f"fed +{t_fed - t_held:.3f} s, released +{t_gone - t_fed:.3f} s")
+    print(
+        f"lockstep client ok: real time {t1 - t0:.3f} s/s, held +{t_held - t_write:.3f} s, "
+        f"fed +{t_fed - t_held:.3f} s, released +{t_gone - t_fed:.3f} s"
+    )

@@ -39,11 +39,12 @@ struct Client {
     uint8_t buf[1024];
     ssize_t n;
     while ((n = read(fd, buf, sizeof buf)) > 0)
-      proto_parser_feed(&parser, buf, (size_t)n,
-                        [](const proto_frame_t *f, void *ctx) {
-                          static_cast<Client *>(ctx)->frames.push_back(*f);
-                        },
-                        this);
+      proto_parser_feed(
+          &parser, buf, (size_t)n,
+          [](const proto_frame_t *f, void *ctx) {
+            static_cast<Client *>(ctx)->frames.push_back(*f);
+          },
+          this);
   }
   void send(uint8_t id, const uint8_t *payload, uint8_t len) {
     uint8_t out[PROTO_MAX_FRAME];

@@ -32,10 +32,12 @@
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kWallM = 3.975;        // parking school: inner faces of the walls at +-3.975 m
-constexpr double kCarSpacingM = 0.35;   // cars 2..N line up to car 1's right at this pitch
+constexpr double kWallM = 3.975;       // parking school: inner faces of the walls at +-3.975 m
+constexpr double kCarSpacingM = 0.35;  // cars 2..N line up to car 1's right at this pitch
 
-std::string url(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
+std::string url(int port) {
+  return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+}
 
 std::string slurp(const std::string &path) {
   std::ifstream f(path);
@@ -44,7 +46,9 @@ std::string slurp(const std::string &path) {
   return ss.str();
 }
 
-double wrap(double a) { return atan2(sin(a), cos(a)); }
+double wrap(double a) {
+  return atan2(sin(a), cos(a));
+}
 
 struct Truth {
   int64_t utime;
@@ -65,13 +69,15 @@ struct SimRun {
   int status = -1;
   bool no_route = false;
 
-  static void on_truth(const lcm_recv_buf_t *, const char *ch, const autodrive_ground_truth_t *m, void *u) {
+  static void on_truth(const lcm_recv_buf_t *, const char *ch, const autodrive_ground_truth_t *m,
+                       void *u) {
     const int car = ch[5] - '0';  // "NIGEL<car>_GROUND_TRUTH"
     if (car >= 1 && car <= 2)
       static_cast<SimRun *>(u)->truth[car].push_back(
           {m->utime, m->position_m[0], m->position_m[1], m->yaw_rad, m->in_collision != 0});
   }
-  static void on_scan(const lcm_recv_buf_t *, const char *, const autodrive_lidar_scan_t *m, void *u) {
+  static void on_scan(const lcm_recv_buf_t *, const char *, const autodrive_lidar_scan_t *m,
+                      void *u) {
     static_cast<SimRun *>(u)->scans.push_back(
         {m->utime, m->scan_time_s, std::vector<float>(m->ranges_m, m->ranges_m + m->num_ranges)});
   }
@@ -136,7 +142,8 @@ vp_params_t params() {
 }
 
 // Distance along the unit ray (ox, oy) + t (dx, dy) to an axis-aligned box, or -1.
-double ray_box(double ox, double oy, double dx, double dy, double cx, double cy, double hx, double hy) {
+double ray_box(double ox, double oy, double dx, double dy, double cx, double cy, double hx,
+               double hy) {
   double lo = 0.0, hi = 1e9;
   const double o[2] = {ox, oy}, d[2] = {dx, dy}, c[2] = {cx, cy}, h[2] = {hx, hy};
   for (int k = 0; k < 2; k++) {
@@ -180,7 +187,8 @@ TEST(Scenario, ParsesStartAndLateBoxValues) {
   EXPECT_DOUBLE_EQ(b.near_m, 0.0);
   ASSERT_EQ(scn_parse_late_box("0.5,0.6,10,0.06,0.06,0.4", &b, err, sizeof err), 0) << err;
   EXPECT_DOUBLE_EQ(b.near_m, 0.4);
-  for (const char *bad : {"", "1,2", "1,2,3,4", "1,,3", "1,2,3x", "nan,0,0", "0,0,361", "1e9,0,0"}) {
+  for (const char *bad :
+       {"", "1,2", "1,2,3,4", "1,,3", "1,2,3x", "nan,0,0", "0,0,361", "1e9,0,0"}) {
     EXPECT_EQ(scn_parse_start(bad, &p, err, sizeof err), -1) << bad;
     EXPECT_NE(std::string(err).find("--start"), std::string::npos) << err;
   }
@@ -198,15 +206,16 @@ TEST(Scenario, BadStartAndLateBoxValuesExit2NamingTheOption) {
       {"--start 1,2", "--start", "1,2"},
       {"--start north,0,0", "--start", "north"},
       {"--start", "--start", "missing"},
-      {"--start 1.5,0,0", "--start", "box_a"},                         // on the map's box
-      {"--start 3.9,0,0", "--start", "wall_e"},                        // through the east wall
-      {"--map driving_school --start 6,0,0", "--start", "floor"},      // off the floor
-      {"--cars 3 --start -1,-3.5,0", "--start", "NIGEL3"},             // car 3 through a wall
+      {"--start 1.5,0,0", "--start", "box_a"},                     // on the map's box
+      {"--start 3.9,0,0", "--start", "wall_e"},                    // through the east wall
+      {"--map driving_school --start 6,0,0", "--start", "floor"},  // off the floor
+      {"--cars 3 --start -1,-3.5,0", "--start", "NIGEL3"},         // car 3 through a wall
       {"--late-box 0.5,0.6", "--late-box", "0.5,0.6"},
       {"--late-box 0.5,0.6,-2", "--late-box", "T [s]"},
       {"--late-box 1.5,0,3", "--late-box", "box_a"},
       {"--late-box 0,3.95,1,0.1,0.1", "--late-box", "wall_n"},
-      {"--late-box 0,0,1 --late-box 0,0.5,1 --late-box 0,1,1 --late-box 0.5,0,1 --late-box 0.5,0.5,1",
+      {"--late-box 0,0,1 --late-box 0,0.5,1 --late-box 0,1,1 --late-box 0.5,0,1 --late-box "
+       "0.5,0.5,1",
        "--late-box", "at most 4"},
   };
   for (const Case &c : cases) {
@@ -287,9 +296,10 @@ TEST(Scenario, LidarSeesTheLateBoxOnlyAfterItsTime) {
       worst_after = fmax(worst_after, fabs(s.ranges[ray] - want_box));
     }
   }
-  printf("ray %d: wall %.3f m expected, %d scans before within %.1f mm; box %.3f m expected, "
-         "%d scans after within %.1f mm\n", ray, want_wall, before, worst_before * 1e3, want_box,
-         after, worst_after * 1e3);
+  printf(
+      "ray %d: wall %.3f m expected, %d scans before within %.1f mm; box %.3f m expected, "
+      "%d scans after within %.1f mm\n",
+      ray, want_wall, before, worst_before * 1e3, want_box, after, worst_after * 1e3);
   EXPECT_GE(before, 2) << "too few scans received before the box";
   EXPECT_GE(after, 2) << "too few scans received after the box";
 }
@@ -299,8 +309,9 @@ TEST(Scenario, DrivingIntoTheLateBoxSetsTheCollisionFlag) {
   // appears at 0.3 s, when the car has covered < 0.08 m
   const vp_params_t p = params();
   const double face_x = -0.6 - 0.06, t_box_s = 0.3;
-  SimRun r(7752, "--rtf 5 --duration 3 --start -1,-0.5,0 --late-box -0.6,-0.5,0.3 "
-                 "--script constant:throttle=1,steering=0");
+  SimRun r(7752,
+           "--rtf 5 --duration 3 --start -1,-0.5,0 --late-box -0.6,-0.5,0.3 "
+           "--script constant:throttle=1,steering=0");
   if (r.no_route) GTEST_SKIP() << "no multicast route for " << url(7752);
   ASSERT_EQ(r.status, 0) << r.out;
   ASSERT_FALSE(r.truth[1].empty());
@@ -313,8 +324,9 @@ TEST(Scenario, DrivingIntoTheLateBoxSetsTheCollisionFlag) {
     hits += t.collision;
     max_x = fmax(max_x, t.x);
   }
-  printf("%d of %zu ground-truth messages in collision; car front at most %.4f m, box face %.4f m\n",
-         hits, r.truth[1].size(), max_x + p.chassis_offset_m[0] + 0.5 * p.chassis_size_m[0], face_x);
+  printf(
+      "%d of %zu ground-truth messages in collision; car front at most %.4f m, box face %.4f m\n",
+      hits, r.truth[1].size(), max_x + p.chassis_offset_m[0] + 0.5 * p.chassis_size_m[0], face_x);
   EXPECT_GE(hits, 10) << "the chassis never touched the box";
   // the box stopped the car: its front (chassis box) never got past the box's face
   const double front = p.chassis_offset_m[0] + 0.5 * p.chassis_size_m[0];
@@ -383,7 +395,11 @@ TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   mj_resetData(m, d);
   EXPECT_LT(box_pos[2], -1000.0) << "mj_resetData parks mocap bodies";
   mj_forward(m, d);
-  const sim_truth_t t = [&] { sim_truth_t x; sim_get_truth(k.s, 1, &x); return x; }();
+  const sim_truth_t t = [&] {
+    sim_truth_t x;
+    sim_get_truth(k.s, 1, &x);
+    return x;
+  }();
   EXPECT_NEAR(t.pos_m[0], 0.4, 1e-9);
   EXPECT_NEAR(t.pos_m[1], -2.0, 1e-9);
   EXPECT_NEAR(wrap(t.yaw_rad - 90 * kDeg), 0.0, 1e-9);
@@ -401,7 +417,8 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   ASSERT_EQ(k.run_to(0.5), 0) << "appeared with the car 0.35 m away; " << k.err;
   mjData *d = sim_data(k.s);
   const mjModel *m = sim_model(k.s);
-  const mjtNum *box_pos = d->mocap_pos + 3 * m->body_mocapid[mj_name2id(m, mjOBJ_BODY, "scenario/late_box1")];
+  const mjtNum *box_pos =
+      d->mocap_pos + 3 * m->body_mocapid[mj_name2id(m, mjOBJ_BODY, "scenario/late_box1")];
   EXPECT_LT(box_pos[2], -1000.0) << "still parked out of sight";
   d->qpos[1] += 0.15;  // move the car 0.15 m towards it: 0.2 m away
   mj_forward(m, d);
@@ -423,7 +440,8 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   char err[1024] = "";
   sim_render_t *rd = sim_render_create(m, 640, 480, SIM_RENDER_AUTO, err, sizeof err);
   ASSERT_NE(rd, nullptr) << err;
-  sim_camera_t *cam = sim_camera_create(rd, m, "nigel1/cam_front", "camera_front", 640, 480, 85, err, sizeof err);
+  sim_camera_t *cam =
+      sim_camera_create(rd, m, "nigel1/cam_front", "camera_front", 640, 480, 85, err, sizeof err);
   ASSERT_NE(cam, nullptr) << err;
   auto centre_blue_excess = [&]() {  // blue minus red at the image centre (the box is blue)
     EXPECT_EQ(sim_camera_capture(cam, m, sim_data(s), sim_time_us(s)), 0);

@@ -59,8 +59,8 @@ void check_front_frame(sim_render_backend_t backend) {
   Scene s(backend);
   ASSERT_NE(s.r, nullptr);
   char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
-                                      90, err, sizeof err);
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
+                                      err, sizeof err);
   ASSERT_NE(c, nullptr) << err;
   ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
   const uint8_t *rgb = sim_camera_rgb(c);
@@ -73,7 +73,8 @@ void check_front_frame(sim_render_backend_t backend) {
   EXPECT_GT(levels, 20);
   // the blue pillar is straight ahead, the green floor at the bottom (rows are top-down), the
   // red front wall to the left of the pillar
-  Px centre = px(rgb, 640, 320, 240), bottom = px(rgb, 640, 320, 470), left = px(rgb, 640, 100, 240);
+  Px centre = px(rgb, 640, 320, 240), bottom = px(rgb, 640, 320, 470),
+     left = px(rgb, 640, 100, 240);
   EXPECT_GT(centre.b, centre.r + 40) << centre.r << "," << centre.g << "," << centre.b;
   EXPECT_GT(centre.b, centre.g + 40);
   EXPECT_GT(bottom.g, bottom.r + 40) << bottom.r << "," << bottom.g << "," << bottom.b;
@@ -83,7 +84,9 @@ void check_front_frame(sim_render_backend_t backend) {
   sim_camera_destroy(c);
 }
 
-TEST(SimCamera, FrontFrameShowsTheRoomTopDown) { check_front_frame(SIM_RENDER_AUTO); }
+TEST(SimCamera, FrontFrameShowsTheRoomTopDown) {
+  check_front_frame(SIM_RENDER_AUTO);
+}
 
 // ctest runs every test in its own process; run alone, OSMesa must not follow libEGL
 TEST(SimCamera, OsmesaBackendRendersTheSameRoom) {
@@ -102,8 +105,8 @@ TEST(SimCamera, JpegDecodesBackToTheFrame) {
   Scene s;
   ASSERT_NE(s.r, nullptr);
   char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
-                                      90, err, sizeof err);
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
+                                      err, sizeof err);
   ASSERT_NE(c, nullptr) << err;
   ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
   size_t n = 0;
@@ -270,8 +273,8 @@ TEST(SimCamera, PublishesJpegAndCameraInfoOnLcm) {
   Scene s;
   ASSERT_NE(s.r, nullptr);
   char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480,
-                                      85, err, sizeof err);
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 85,
+                                      err, sizeof err);
   ASSERT_NE(c, nullptr) << err;
   lcm_t *lcm = lcm_create("memq://");
   ASSERT_NE(lcm, nullptr);

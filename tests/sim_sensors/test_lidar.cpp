@@ -19,7 +19,9 @@ constexpr double kOx_m = 0.1445, kOy_m = 0.0;  // scanner origin in the room (ca
 double analytic_range_m(double angle_rad) {
   const double c = std::cos(angle_rad), s = std::sin(angle_rad);
   double best = INFINITY;
-  auto take = [&](double t) { if (t > 1e-9 && t < best) best = t; };
+  auto take = [&](double t) {
+    if (t > 1e-9 && t < best) best = t;
+  };
   // room interior walls
   if (c > 0) take((3.0 - kOx_m) / c);
   if (c < 0) take((-2.0 - kOx_m) / c);
@@ -104,8 +106,8 @@ TEST(SimLidar, OwnCarExcludedOtherCarSeen) {
   EXPECT_NEAR(fwd, 1.5 - 0.2 - kOx_m, 1e-6);
   EXPECT_GT(fwd, 0.6);
   // the other car's mast is seen: ray aimed at its centre
-  const double a = std::atan2(1.5 - 0.06 * std::sin(M_PI / 6) - kOy_m,
-                              -1.0 - 0.06 * std::cos(M_PI / 6) - kOx_m);
+  const double a =
+      std::atan2(1.5 - 0.06 * std::sin(M_PI / 6) - kOy_m, -1.0 - 0.06 * std::cos(M_PI / 6) - kOx_m);
   const double want = analytic_range_m(a);
   EXPECT_LT(want, 2.0);
   EXPECT_NEAR(sim_lidar_ray(r.m, r.d, l, a), want, 1e-4);

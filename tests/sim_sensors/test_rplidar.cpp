@@ -342,7 +342,8 @@ TEST(SimRplidar, StreamedRaysArriveWhileTheHeadSpins) {
   // The queue never holds more than about one ray's worth of lag beyond the wire's own
   // pace: every revolution start is on the wire within 20 ms of being measured [ms].
   for (size_t k = 1; k < start_seen_ms.size(); k++) {
-    const auto pushed = *std::prev(std::upper_bound(start_pushed_ms.begin(), start_pushed_ms.end(), start_seen_ms[k]));
+    const auto pushed = *std::prev(
+        std::upper_bound(start_pushed_ms.begin(), start_pushed_ms.end(), start_seen_ms[k]));
     EXPECT_LE(start_seen_ms[k] - pushed, 20) << "revolution " << k;
   }
 }

@@ -39,8 +39,10 @@ struct Xvfb {
     std::string sock = "/tmp/.X11-unix/X" + std::to_string(n);
     for (int i = 0; i < 300 && !ready; i++) {  // readiness wait, not a timing assertion
       struct stat st;
-      if (stat(sock.c_str(), &st) == 0) ready = true;
-      else usleep(50000);
+      if (stat(sock.c_str(), &st) == 0)
+        ready = true;
+      else
+        usleep(50000);
     }
     if (ready) setenv("DISPLAY", display.c_str(), 1);
   }
@@ -63,7 +65,8 @@ TEST(SimViewer, RendersViewsAndReportsKeysNextToHeadlessCameras) {
   char err[256] = "";
   sim_render_t *r = sim_render_create(room.m, 640, 480, SIM_RENDER_EGL, err, sizeof err);
   ASSERT_NE(r, nullptr) << err;
-  sim_camera_t *cam = sim_camera_create(r, room.m, "car_cam_front", "f", 640, 480, 90, err, sizeof err);
+  sim_camera_t *cam =
+      sim_camera_create(r, room.m, "car_cam_front", "f", 640, 480, 90, err, sizeof err);
   ASSERT_NE(cam, nullptr) << err;
   ASSERT_EQ(sim_camera_capture(cam, room.m, room.d, 0), 0);
   std::vector<uint8_t> before(sim_camera_rgb(cam), sim_camera_rgb(cam) + 640 * 480 * 3);
@@ -141,7 +144,8 @@ TEST(SimViewer, NoDisplayIsAClearError) {
   room::Room room;
   ASSERT_NE(room.m, nullptr);
   char err[256] = "";
-  EXPECT_EQ(sim_viewer_create(room.m, 1, "car", "car_cam_front", 640, 480, err, sizeof err), nullptr);
+  EXPECT_EQ(sim_viewer_create(room.m, 1, "car", "car_cam_front", 640, 480, err, sizeof err),
+            nullptr);
   EXPECT_NE(std::string(err).find("no display"), std::string::npos) << err;
   if (saved) setenv("DISPLAY", keep.c_str(), 1);
 }

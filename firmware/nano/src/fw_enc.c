@@ -10,9 +10,9 @@ static enc_t s_left, s_right;
 void fw_enc_init(void) {
   enc_init(&s_left, FW_ENC_LEFT_INVERT);
   enc_init(&s_right, FW_ENC_RIGHT_INVERT);
-  DDRD &= (uint8_t)~(_BV(PD2) | _BV(PD3) | _BV(PD4) | _BV(PD5));
+  DDRD &= (uint8_t) ~(_BV(PD2) | _BV(PD3) | _BV(PD4) | _BV(PD5));
   PORTD |= _BV(PD2) | _BV(PD3) | _BV(PD4) | _BV(PD5); /* pull-ups for open-collector encoders */
-  EICRA = _BV(ISC00) | _BV(ISC10);                     /* any logical change on INT0 and INT1 */
+  EICRA = _BV(ISC00) | _BV(ISC10);                    /* any logical change on INT0 and INT1 */
   EIFR = _BV(INTF0) | _BV(INTF1);
   EIMSK = _BV(INT0) | _BV(INT1);
 }

@@ -24,8 +24,12 @@ static uint32_t s_txn_start_us, s_last_ok_us, s_retry_at_us, s_sample_start_us;
 static uint8_t s_have_sample;
 static nigel_imu_raw_t s_sample;
 
-static int16_t be16(const uint8_t *p) { return (int16_t)((uint16_t)p[0] << 8 | p[1]); }
-static int16_t le16(const uint8_t *p) { return (int16_t)((uint16_t)p[1] << 8 | p[0]); }
+static int16_t be16(const uint8_t *p) {
+  return (int16_t)((uint16_t)p[0] << 8 | p[1]);
+}
+static int16_t le16(const uint8_t *p) {
+  return (int16_t)((uint16_t)p[1] << 8 | p[0]);
+}
 
 static void begin(uint8_t state, uint32_t now_us) {
   s_state = state;
@@ -35,9 +39,7 @@ static void begin(uint8_t state, uint32_t now_us) {
       s_reg = MPU_WHO_AM_I;
       fw_twi_start(MPU_ADDR, &s_reg, 1, s_buf, 1);
       break;
-    case ST_INIT:
-      fw_twi_start(k_init[s_step][0], &k_init[s_step][1], 2, 0, 0);
-      break;
+    case ST_INIT: fw_twi_start(k_init[s_step][0], &k_init[s_step][1], 2, 0, 0); break;
     case ST_ACCEL:
       s_sample_start_us = now_us;
       s_reg = 0x3Bu; /* ACCEL_XOUT_H .. GYRO_ZOUT_L, big-endian */
@@ -47,8 +49,7 @@ static void begin(uint8_t state, uint32_t now_us) {
       s_reg = 0x03u; /* HXL .. HZH, ST2 (reading ST2 releases the next sample) */
       fw_twi_start(AK_ADDR, &s_reg, 1, s_buf, 7);
       break;
-    default:
-      break;
+    default: break;
   }
 }
 
@@ -115,8 +116,7 @@ void fw_imu_poll(uint32_t now_us) {
       s_last_ok_us = now_us;
       s_state = ST_IDLE;
       break;
-    default:
-      break;
+    default: break;
   }
 }
 

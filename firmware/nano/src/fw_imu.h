@@ -12,7 +12,7 @@ extern "C" {
 #endif
 #define FW_IMU_TXN_TIMEOUT_US 2000ul /* a 14-byte read takes ~0.45 ms at 400 kHz */
 #define FW_IMU_RETRY_US 100000ul     /* [us] between re-initialisations of an absent IMU */
-#define FW_IMU_PERIOD_US 5000ul     /* [us] between samples: 200 Hz, above the 41 Hz DLPF */
+#define FW_IMU_PERIOD_US 5000ul      /* [us] between samples: 200 Hz, above the 41 Hz DLPF */
 #define FW_IMU_STALE_US 20000ul      /* [us] a sample older than this counts as lost */
 
 void fw_imu_init(uint32_t now_us);

@@ -13,12 +13,12 @@
 
 void fw_io_init(void) {
   /* motor: DIR D7 low, BRK D8 high (braked), PWM D6 duty 0 on Timer0 (set up by init()) */
-  PORTD &= (uint8_t)~(_BV(PD6) | _BV(PD7));
+  PORTD &= (uint8_t) ~(_BV(PD6) | _BV(PD7));
   DDRD |= _BV(PD6) | _BV(PD7);
   PORTB |= _BV(PB0);
   DDRB |= _BV(PB0);
   OCR0A = 0;
-  TCCR0A &= (uint8_t)~(_BV(COM0A1) | _BV(COM0A0)); /* pin held low by PORTD while duty 0 */
+  TCCR0A &= (uint8_t) ~(_BV(COM0A1) | _BV(COM0A0)); /* pin held low by PORTD while duty 0 */
 
   /* servo on OC1A (D9), centred */
   DDRB |= _BV(PB1);
@@ -28,9 +28,9 @@ void fw_io_init(void) {
   OCR1A = 1500u * SERVO_TICKS_PER_US;
 
   /* lamps: D10-D13 (PB2-PB5), D14-D15 (PC0-PC1), all off */
-  PORTB &= (uint8_t)~(_BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5));
+  PORTB &= (uint8_t) ~(_BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5));
   DDRB |= _BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5);
-  PORTC &= (uint8_t)~(_BV(PC0) | _BV(PC1));
+  PORTC &= (uint8_t) ~(_BV(PC0) | _BV(PC1));
   DDRC |= _BV(PC0) | _BV(PC1);
 
   /* battery ADC: AVcc reference, ADC7, prescaler 128 (125 kHz), first conversion started */
@@ -66,12 +66,12 @@ void fw_motor_set(uint8_t duty, uint8_t reverse, uint8_t brake) {
 }
 
 void fw_lamps_set(uint8_t lamps) {
-  uint8_t b = PORTB & (uint8_t)~(_BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5));
+  uint8_t b = PORTB & (uint8_t) ~(_BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5));
   if (lamps & NIGEL_LAMP_HEAD_LOW) b |= _BV(PB2);
   if (lamps & NIGEL_LAMP_HEAD_HIGH) b |= _BV(PB3);
   if (lamps & NIGEL_LAMP_TAIL) b |= _BV(PB4);
   if (lamps & NIGEL_LAMP_REVERSE) b |= _BV(PB5);
-  uint8_t c = PORTC & (uint8_t)~(_BV(PC0) | _BV(PC1));
+  uint8_t c = PORTC & (uint8_t) ~(_BV(PC0) | _BV(PC1));
   if (lamps & NIGEL_LAMP_IND_LEFT) c |= _BV(PC0);
   if (lamps & NIGEL_LAMP_IND_RIGHT) c |= _BV(PC1);
   uint8_t sreg = SREG; /* PORTB/PORTC are shared with no ISR, but keep the write atomic */
@@ -87,8 +87,8 @@ uint16_t fw_battery_read_mv(void) {
   if (!(ADCSRA & _BV(ADSC))) {
     uint32_t adc = ADC; /* 0..1023 */
     uint32_t mv_at_pin = adc * FW_ADC_REF_MV / 1023u;
-    s_battery_mv = (uint16_t)(mv_at_pin * (FW_BATT_R_TOP_OHM + FW_BATT_R_BOTTOM_OHM) /
-                              FW_BATT_R_BOTTOM_OHM);
+    s_battery_mv =
+        (uint16_t)(mv_at_pin * (FW_BATT_R_TOP_OHM + FW_BATT_R_BOTTOM_OHM) / FW_BATT_R_BOTTOM_OHM);
     ADCSRA |= _BV(ADSC);
   }
   return s_battery_mv;
@@ -104,8 +104,14 @@ void fw_io_capture_mcusr(void) {
   wdt_disable();
 }
 
-uint8_t fw_reset_cause(void) { return s_mcusr; }
+uint8_t fw_reset_cause(void) {
+  return s_mcusr;
+}
 
-void fw_wdt_start(void) { wdt_enable(WDTO_250MS); }
+void fw_wdt_start(void) {
+  wdt_enable(WDTO_250MS);
+}
 
-void fw_wdt_kick(void) { wdt_reset(); }
+void fw_wdt_kick(void) {
+  wdt_reset();
+}

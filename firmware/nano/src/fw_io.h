@@ -8,9 +8,9 @@ extern "C" {
 #endif
 /* Everything to the safe state: servo centred, motor duty 0 with brake on, lamps off. */
 void fw_io_init(void);
-void fw_servo_set_us(uint16_t pulse_us);            /* clamped to 1000..2000 us */
+void fw_servo_set_us(uint16_t pulse_us); /* clamped to 1000..2000 us */
 void fw_motor_set(uint8_t duty, uint8_t reverse, uint8_t brake);
-void fw_lamps_set(uint8_t lamps);                   /* NIGEL_LAMP_* bits */
+void fw_lamps_set(uint8_t lamps); /* NIGEL_LAMP_* bits */
 /* Battery: non-blocking, returns the last completed conversion [mV] and starts the next. */
 uint16_t fw_battery_read_mv(void);
 

@@ -14,8 +14,8 @@ static uint8_t s_nw, s_nr, s_iw, s_ir;
 
 void fw_twi_init(void) {
   PORTC |= _BV(PC4) | _BV(PC5); /* weak internal pull-ups; the IMU board has its own */
-  TWSR = 0;                      /* prescaler 1 */
-  TWBR = 12;                     /* 16 MHz / (16 + 2 * 12) = 400 kHz */
+  TWSR = 0;                     /* prescaler 1 */
+  TWBR = 12;                    /* 16 MHz / (16 + 2 * 12) = 400 kHz */
   TWCR = _BV(TWEN);
   s_status = FW_TWI_IDLE;
 }
@@ -34,7 +34,9 @@ int fw_twi_start(uint8_t addr7, const uint8_t *wr, uint8_t nw, uint8_t *rd, uint
   return 0;
 }
 
-uint8_t fw_twi_status(void) { return s_status; }
+uint8_t fw_twi_status(void) {
+  return s_status;
+}
 
 static void finish(uint8_t status) {
   TWCR = _BV(TWEN) | _BV(TWINT) | _BV(TWSTO);
@@ -68,9 +70,7 @@ ISR(TWI_vect) {
         finish(FW_TWI_DONE);
       }
       break;
-    case TW_MR_SLA_ACK:
-      TWCR = s_nr > 1 ? (TWCR_RUN | _BV(TWEA)) : TWCR_RUN;
-      break;
+    case TW_MR_SLA_ACK: TWCR = s_nr > 1 ? (TWCR_RUN | _BV(TWEA)) : TWCR_RUN; break;
     case TW_MR_DATA_ACK:
       s_rd[s_ir++] = TWDR;
       TWCR = (uint8_t)(s_ir + 1u < s_nr ? (TWCR_RUN | _BV(TWEA)) : TWCR_RUN);
@@ -79,8 +79,6 @@ ISR(TWI_vect) {
       s_rd[s_ir++] = TWDR;
       finish(FW_TWI_DONE);
       break;
-    default: /* NACK on address or data, arbitration lost, bus error */
-      finish(FW_TWI_ERROR);
-      break;
+    default: /* NACK on address or data, arbitration lost, bus error */ finish(FW_TWI_ERROR); break;
   }
 }

@@ -70,4 +70,6 @@ uint16_t fw_uart_rx_lost(void) {
   return v;
 }
 
-uint16_t fw_uart_tx_dropped(void) { return s_tx_dropped; }
+uint16_t fw_uart_tx_dropped(void) {
+  return s_tx_dropped;
+}

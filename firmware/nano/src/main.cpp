@@ -26,15 +26,25 @@ static uint32_t g_now_us; /* time of the current loop pass, for the HAL callback
 static void hal_motor_set(void *, uint8_t duty, uint8_t reverse, uint8_t brake) {
   fw_motor_set(duty, reverse, brake);
 }
-static void hal_servo_set_us(void *, uint16_t pulse_us) { fw_servo_set_us(pulse_us); }
-static void hal_lamps_set(void *, uint8_t lamps) { fw_lamps_set(lamps); }
-static int hal_imu_read(void *, nigel_imu_raw_t *out) { return fw_imu_read(g_now_us, out); }
-static uint16_t hal_battery_read_mv(void *) { return fw_battery_read_mv(); }
-static void hal_serial_write(void *, const uint8_t *data, uint8_t n) { fw_uart_write(data, n); }
+static void hal_servo_set_us(void *, uint16_t pulse_us) {
+  fw_servo_set_us(pulse_us);
+}
+static void hal_lamps_set(void *, uint8_t lamps) {
+  fw_lamps_set(lamps);
+}
+static int hal_imu_read(void *, nigel_imu_raw_t *out) {
+  return fw_imu_read(g_now_us, out);
+}
+static uint16_t hal_battery_read_mv(void *) {
+  return fw_battery_read_mv();
+}
+static void hal_serial_write(void *, const uint8_t *data, uint8_t n) {
+  fw_uart_write(data, n);
+}
 
 static const nigel_hal_t k_hal = {
-    nullptr,          hal_motor_set,       hal_servo_set_us, hal_lamps_set,
-    hal_imu_read,     hal_battery_read_mv, hal_serial_write,
+    nullptr,      hal_motor_set,       hal_servo_set_us, hal_lamps_set,
+    hal_imu_read, hal_battery_read_mv, hal_serial_write,
 };
 
 #ifdef NIGEL_FW_TEST_HOOKS
@@ -70,8 +80,9 @@ void setup() {
   fw_wdt_start();
   g_now_us = micros();
   fw_imu_init(g_now_us);
-  nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0),
-             NIGEL_BUILD_ID);
+  nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0), NIGEL_BUILD_ID);
 }
 
-void loop() { fw_loop_once(); }
+void loop() {
+  fw_loop_once();
+}

@@ -20,13 +20,16 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+void on_signal(int) {
+  g_stop = true;
+}
 }  // namespace
 
 int main(int argc, char **argv) {
-  CLI::App app{"autodrive-runtime: the Nigel Jetson runtime (Nano bridge, RPLIDAR, cameras, "
-               "EKF estimator) over LCM. The same binary drives the car, the simulator's ptys "
-               "and the firmware in simavr: only the device paths in the config change."};
+  CLI::App app{
+      "autodrive-runtime: the Nigel Jetson runtime (Nano bridge, RPLIDAR, cameras, "
+      "EKF estimator) over LCM. The same binary drives the car, the simulator's ptys "
+      "and the firmware in simavr: only the device paths in the config change."};
   std::string config_path, only, level = "info";
   app.add_option("--config", config_path, "YAML config (runtime/jetson/config/*.yaml)")->required();
   app.add_option("--only", only,
@@ -61,7 +64,8 @@ int main(int argc, char **argv) {
     }
   }
   if (want.empty()) {
-    spdlog::error("{}: no component to run (no bridge/lidar/cameras/estimator section)", config.file);
+    spdlog::error("{}: no component to run (no bridge/lidar/cameras/estimator section)",
+                  config.file);
     return 2;
   }
 
@@ -107,7 +111,8 @@ int main(int argc, char **argv) {
   std::signal(SIGTERM, on_signal);
   std::string names;
   for (const auto &w : want) names += (names.empty() ? "" : ",") + w;
-  spdlog::info("autodrive-runtime {}: running {} on {}", config.vehicle.name, names, config.lcm_url);
+  spdlog::info("autodrive-runtime {}: running {} on {}", config.vehicle.name, names,
+               config.lcm_url);
   std::vector<std::thread> threads;
   for (auto &r : runners) threads.emplace_back(r);
   for (auto &t : threads) t.join();

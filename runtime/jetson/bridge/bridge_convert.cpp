@@ -74,8 +74,7 @@ std::string command_problem(const autodrive::vehicle_command_t &c) {
   return "";
 }
 
-proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh,
-                             uint16_t seq) {
+proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh, uint16_t seq) {
   proto_command_t m{};
   m.seq = seq;
   if (latest) {

@@ -35,7 +35,6 @@ std::string command_problem(const autodrive::vehicle_command_t &c);
 
 // The COMMAND frame for the heartbeat. `fresh` is false when the LCM command stream is stale
 // (or absent): then throttle is 0, steering centred and engaged cleared; lights are kept.
-proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh,
-                             uint16_t seq);
+proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh, uint16_t seq);
 
 }  // namespace bridge

@@ -52,9 +52,9 @@ struct NanoBridge::Impl {
   int64_t latest_cmd_rx_us = 0;  // monotonic
   uint16_t cmd_seq = 0;
   uint8_t frame_seq = 0;
-  int64_t next_tx_us = 0;         // next heartbeat / hello [monotonic us]
+  int64_t next_tx_us = 0;  // next heartbeat / hello [monotonic us]
   int64_t next_open_us = 0;
-  int64_t last_rx_frame_us = 0;   // last good frame from the Nano
+  int64_t last_rx_frame_us = 0;  // last good frame from the Nano
   bool open_failure_logged = false;
   bool rejected_logged = false;
 
@@ -109,15 +109,16 @@ struct NanoBridge::Impl {
     uint8_t frame[PROTO_MAX_FRAME];
     const size_t n = proto_frame_encode(id, frame_seq++, payload, len, frame, sizeof frame);
     const int r = port.write_all(frame, n);
-    if (r < 0) lose_device(port.error());
-    else if (r == 0) spdlog::warn("{}{}", tag, port.error());
+    if (r < 0)
+      lose_device(port.error());
+    else if (r == 0)
+      spdlog::warn("{}{}", tag, port.error());
   }
 
   void send_command(int64_t now_us) {
     const bool fresh = latest_cmd.has_value() &&
                        now_us - latest_cmd_rx_us <= config.bridge.command_timeout_ms * 1000LL;
-    const proto_command_t c =
-        make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
+    const proto_command_t c = make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
     uint8_t payload[PROTO_LEN_COMMAND];
     proto_command_pack(&c, payload);
     write_frame(PROTO_ID_COMMAND, payload, PROTO_LEN_COMMAND);
@@ -168,8 +169,8 @@ struct NanoBridge::Impl {
 
   void lose_device(const std::string &why) {
     if (!port.is_open()) return;
-    spdlog::warn("{}lost the Nano: {}; reopening {} every {} ms", tag, why,
-                 config.bridge.device, config.bridge.reconnect_ms);
+    spdlog::warn("{}lost the Nano: {}; reopening {} every {} ms", tag, why, config.bridge.device,
+                 config.bridge.reconnect_ms);
     port.close();
     count([](Status &s) {
       ++s.disconnects;
@@ -191,13 +192,13 @@ struct NanoBridge::Impl {
     if (proto_hello_unpack(f.payload, f.len, &h) != 0) return;
     const uint32_t ours = proto_schema_hash();
     if (h.schema_hash != ours || h.proto_version != PROTO_VERSION) {
-      const std::string msg =
-          "schema mismatch on " + config.bridge.device + ": the Nano (firmware " +
-          std::to_string(h.fw_major) + "." + std::to_string(h.fw_minor) + "." +
-          std::to_string(h.fw_patch) + ") speaks protocol v" + std::to_string(h.proto_version) +
-          " schema " + hex32(h.schema_hash) + ", this runtime speaks protocol v" +
-          std::to_string(PROTO_VERSION) + " schema " + hex32(ours) +
-          "; link refused (flash matching firmware or rebuild the runtime)";
+      const std::string msg = "schema mismatch on " + config.bridge.device +
+                              ": the Nano (firmware " + std::to_string(h.fw_major) + "." +
+                              std::to_string(h.fw_minor) + "." + std::to_string(h.fw_patch) +
+                              ") speaks protocol v" + std::to_string(h.proto_version) + " schema " +
+                              hex32(h.schema_hash) + ", this runtime speaks protocol v" +
+                              std::to_string(PROTO_VERSION) + " schema " + hex32(ours) +
+                              "; link refused (flash matching firmware or rebuild the runtime)";
       spdlog::error("{}{}", tag, msg);
       count([&](Status &s) {
         ++s.refusals;
@@ -252,8 +253,8 @@ struct NanoBridge::Impl {
       proto_nack_t n{};
       if (proto_nack_unpack(f->payload, f->len, &n) == 0) {
         self->count([](Status &st2) { ++st2.nacks; });
-        spdlog::warn("{}Nano refused frame id 0x{:02x} seq {}: reason {}", self->tag,
-                     n.rejected_id, n.seq, n.reason);
+        spdlog::warn("{}Nano refused frame id 0x{:02x} seq {}: reason {}", self->tag, n.rejected_id,
+                     n.seq, n.reason);
       }
     }
   }
@@ -267,7 +268,8 @@ struct NanoBridge::Impl {
     fds[nfds++] = {lcm.getFileno(), POLLIN, 0};
     if (port.is_open()) fds[nfds++] = {port.fd(), POLLIN, 0};
     int64_t wait_us = 20000;
-    if (port.is_open()) wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
+    if (port.is_open())
+      wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
     if (stop) return;
     if (r > 0 && (fds[0].revents & POLLIN)) lcm.handleTimeout(0);
@@ -275,8 +277,10 @@ struct NanoBridge::Impl {
       if (fds[1].revents & POLLIN) {
         uint8_t buf[512];
         const long n = port.read_some(buf, sizeof buf);
-        if (n < 0) lose_device(port.error());
-        else if (n > 0) proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
+        if (n < 0)
+          lose_device(port.error());
+        else if (n > 0)
+          proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
       } else if (fds[1].revents & (POLLHUP | POLLERR | POLLNVAL)) {
         lose_device(config.bridge.device + ": hang-up (unplugged, or the peer closed it)");
       }
@@ -317,7 +321,8 @@ std::string NanoBridge::init_error() const {
   if (!impl_->config.has_bridge) return impl_->config.file + ": bridge: missing section";
   if (!impl_->lcm.good())
     return "LCM URL '" + impl_->config.lcm_url +
-           "' unusable (for udpm on a host with no multicast route: ip route add 239.0.0.0/8 dev lo)";
+           "' unusable (for udpm on a host with no multicast route: ip route add 239.0.0.0/8 dev "
+           "lo)";
   return "";
 }
 

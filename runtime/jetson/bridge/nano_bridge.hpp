@@ -20,18 +20,18 @@ const char *link_state_name(LinkState s);
 // Counters [count] and the current link state, for tests, logs and the benchmark.
 struct Status {
   LinkState state = LinkState::no_device;
-  uint64_t opens = 0;             // successful device opens
-  uint64_t disconnects = 0;       // device lost (hang-up, I/O error, removed)
+  uint64_t opens = 0;        // successful device opens
+  uint64_t disconnects = 0;  // device lost (hang-up, I/O error, removed)
   uint64_t hellos_sent = 0;
-  uint64_t handshakes = 0;        // HELLOs accepted
-  uint64_t refusals = 0;          // HELLOs refused (schema or version mismatch)
-  uint64_t commands_sent = 0;     // COMMAND frames written
-  uint64_t engaged_sent = 0;      // ... of which with the engaged flag
-  uint64_t commands_rejected = 0; // LCM commands with out-of-range fields
+  uint64_t handshakes = 0;         // HELLOs accepted
+  uint64_t refusals = 0;           // HELLOs refused (schema or version mismatch)
+  uint64_t commands_sent = 0;      // COMMAND frames written
+  uint64_t engaged_sent = 0;       // ... of which with the engaged flag
+  uint64_t commands_rejected = 0;  // LCM commands with out-of-range fields
   uint64_t states_published = 0;
   uint64_t imu_published = 0;
   uint64_t nacks = 0;
-  std::string last_refusal;       // the refusal message (names both schemas)
+  std::string last_refusal;  // the refusal message (names both schemas)
 };
 
 class NanoBridge {

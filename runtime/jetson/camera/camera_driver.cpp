@@ -20,11 +20,11 @@ SourceKind classify_source(const std::string &s) {
   return SourceKind::file;
 }
 
-std::vector<uint8_t> encode_jpeg(const void *bgr, int w, int h, int out_w, int out_h,
-                                 int quality) {
+std::vector<uint8_t> encode_jpeg(const void *bgr, int w, int h, int out_w, int out_h, int quality) {
   cv::Mat img(h, w, CV_8UC3, const_cast<void *>(bgr));
   cv::Mat sized = img;
-  if (w != out_w || h != out_h) cv::resize(img, sized, cv::Size(out_w, out_h), 0, 0, cv::INTER_AREA);
+  if (w != out_w || h != out_h)
+    cv::resize(img, sized, cv::Size(out_w, out_h), 0, 0, cv::INTER_AREA);
   std::vector<uint8_t> out;
   cv::imencode(".jpg", sized, out, {cv::IMWRITE_JPEG_QUALITY, quality});
   return out;
@@ -39,8 +39,7 @@ struct CameraDriver::Impl {
   std::atomic<uint64_t> published{0};
   std::string error;
 
-  Impl(const cfg::Config &c, std::size_t i)
-      : config(c), lcm(c.lcm_url), clock(c.clock) {
+  Impl(const cfg::Config &c, std::size_t i) : config(c), lcm(c.lcm_url), clock(c.clock) {
     if (i >= c.cameras.size()) {
       error = c.file + ": cameras[" + std::to_string(i) + "]: missing";
       return;
@@ -86,9 +85,11 @@ struct CameraDriver::Impl {
     while (!stop) {
       if (!cap.isOpened()) {
         if (!open(cap)) {
-          if (!failure_logged) spdlog::warn("{}cannot open '{}'; retrying every 1 s", tag, cam.source);
+          if (!failure_logged)
+            spdlog::warn("{}cannot open '{}'; retrying every 1 s", tag, cam.source);
           failure_logged = true;
-          for (int i = 0; i < 50 && !stop; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+          for (int i = 0; i < 50 && !stop; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
           continue;
         }
         failure_logged = false;
@@ -142,7 +143,11 @@ std::string CameraDriver::init_error() const {
   return "";
 }
 
-void CameraDriver::run(const std::atomic<bool> &stop) { impl_->run(stop); }
-uint64_t CameraDriver::frames_published() const { return impl_->published.load(); }
+void CameraDriver::run(const std::atomic<bool> &stop) {
+  impl_->run(stop);
+}
+uint64_t CameraDriver::frames_published() const {
+  return impl_->published.load();
+}
 
 }  // namespace cam

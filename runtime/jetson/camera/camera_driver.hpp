@@ -18,8 +18,8 @@ enum class SourceKind { v4l2, gstreamer, file };
 SourceKind classify_source(const std::string &source);
 
 // JPEG-encodes a BGR frame (resized to width x height if needed).
-std::vector<uint8_t> encode_jpeg(const void *bgr, int width_px, int height_px, int out_w,
-                                 int out_h, int quality);
+std::vector<uint8_t> encode_jpeg(const void *bgr, int width_px, int height_px, int out_w, int out_h,
+                                 int quality);
 
 class CameraDriver {
  public:

@@ -29,6 +29,8 @@ void Clock::attach(lcm::LCM &lcm) {
   lcm.subscribeFunction("SIM_CLOCK", &on_sim_clock, this);
 }
 
-int64_t Clock::now_us() const { return mode_ == cfg::ClockMode::sim ? sim_us_.load() : wall_us(); }
+int64_t Clock::now_us() const {
+  return mode_ == cfg::ClockMode::sim ? sim_us_.load() : wall_us();
+}
 
 }  // namespace clk

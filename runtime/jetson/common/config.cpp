@@ -181,9 +181,12 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   c.file = file;
   c.lcm_url = top.get<std::string>("lcm_url");
   const auto clock = top.get<std::string>("clock");
-  if (clock == "wall") c.clock = ClockMode::wall;
-  else if (clock == "sim") c.clock = ClockMode::sim;
-  else top.fail("clock", "must be 'wall' or 'sim', got '" + clock + "'");
+  if (clock == "wall")
+    c.clock = ClockMode::wall;
+  else if (clock == "sim")
+    c.clock = ClockMode::sim;
+  else
+    top.fail("clock", "must be 'wall' or 'sim', got '" + clock + "'");
   c.vehicle = parse_vehicle(top.child("vehicle"));
   if (!top.has("vehicle")) top.fail("vehicle", "missing key");
   if ((c.has_bridge = top.has("bridge"))) c.bridge = parse_bridge(top.child("bridge"));
@@ -195,7 +198,8 @@ Config from_node(const YAML::Node &root, const std::string &file) {
     top.get<YAML::Node>("cameras");
     if (!cams.IsSequence()) top.fail("cameras", "expected a list");
     for (std::size_t i = 0; i < cams.size(); ++i)
-      c.cameras.push_back(parse_camera(Section(cams[i], "cameras[" + std::to_string(i) + "]", file)));
+      c.cameras.push_back(
+          parse_camera(Section(cams[i], "cameras[" + std::to_string(i) + "]", file)));
   }
   top.reject_unknown();
   return c;

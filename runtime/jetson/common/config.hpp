@@ -18,7 +18,7 @@ struct Error : std::runtime_error {
 enum class ClockMode { wall, sim };
 
 struct Vehicle {
-  std::string name;              // e.g. "NIGEL1": channel prefix
+  std::string name;  // e.g. "NIGEL1": channel prefix
   double wheelbase_m = 0.14154;
   double track_m = 0.1530;
   double wheel_radius_m = 0.0325;
@@ -27,17 +27,17 @@ struct Vehicle {
 };
 
 struct Bridge {
-  std::string device;            // serial device or pty symlink
-  int baud = 500000;             // [bit/s]
-  double heartbeat_hz = 50.0;    // COMMAND frames per second
-  int command_timeout_ms = 200;  // older LCM command -> disengage
-  int hello_retry_ms = 200;      // HELLO_REQUEST period while handshaking
-  int refused_retry_ms = 5000;   // HELLO_REQUEST period after a schema mismatch
-  int reconnect_ms = 500;        // reopen period while the device is missing
-  int link_timeout_ms = 500;     // no frame for this long -> handshake again
-  int telemetry_period_ms = 10;  // sent to the Nano in CONFIG; 0 = do not send CONFIG
-  int failsafe_timeout_ms = 100; // sent in CONFIG
-  int servo_trim_us = 0;         // sent in CONFIG
+  std::string device;             // serial device or pty symlink
+  int baud = 500000;              // [bit/s]
+  double heartbeat_hz = 50.0;     // COMMAND frames per second
+  int command_timeout_ms = 200;   // older LCM command -> disengage
+  int hello_retry_ms = 200;       // HELLO_REQUEST period while handshaking
+  int refused_retry_ms = 5000;    // HELLO_REQUEST period after a schema mismatch
+  int reconnect_ms = 500;         // reopen period while the device is missing
+  int link_timeout_ms = 500;      // no frame for this long -> handshake again
+  int telemetry_period_ms = 10;   // sent to the Nano in CONFIG; 0 = do not send CONFIG
+  int failsafe_timeout_ms = 100;  // sent in CONFIG
+  int servo_trim_us = 0;          // sent in CONFIG
   std::string imu_frame_id = "imu_link";
   double imu_orientation_var_rad2 = 0.0;  // diagonal of the covariances
   double imu_gyro_var_rad2_s2 = 0.0;
@@ -48,29 +48,29 @@ struct Lidar {
   std::string device;
   int baud = 115200;
   std::string frame_id = "laser";
-  double mount_yaw_rad = 0.0;   // added to every ray angle (CCW)
+  double mount_yaw_rad = 0.0;  // added to every ray angle (CCW)
   double range_min_m = 0.15;
   double range_max_m = 12.0;
 };
 
 struct Camera {
-  std::string source;      // /dev/videoN, a GStreamer pipeline (contains '!') or a video file
-  std::string channel;     // e.g. "CAM_FRONT": published as <VEH>_<channel> and <...>_INFO
+  std::string source;   // /dev/videoN, a GStreamer pipeline (contains '!') or a video file
+  std::string channel;  // e.g. "CAM_FRONT": published as <VEH>_<channel> and <...>_INFO
   std::string frame_id = "camera_front";
   double rate_hz = 30.0;
   int width_px = 640;
   int height_px = 480;
   int jpeg_quality = 85;
-  std::array<double, 9> k{};           // camera matrix [px]
-  std::vector<double> d;               // plumb_bob k1 k2 p1 p2 k3
-  bool loop_file = true;               // restart a video file at its end
+  std::array<double, 9> k{};  // camera matrix [px]
+  std::vector<double> d;      // plumb_bob k1 k2 p1 p2 k3
+  bool loop_file = true;      // restart a video file at its end
 };
 
 struct Estimator {
-  double rate_hz = 100.0;             // ODOM / POSE_MAP publish rate
-  double odom_speed_std_m_s = 0.02;   // wheel speed noise
-  double yaw_rate_std_rad_s = 0.02;   // IMU gyro z noise
-  double eye_pos_std_m = 0.01;        // used when the Eye covariance is zero
+  double rate_hz = 100.0;            // ODOM / POSE_MAP publish rate
+  double odom_speed_std_m_s = 0.02;  // wheel speed noise
+  double yaw_rate_std_rad_s = 0.02;  // IMU gyro z noise
+  double eye_pos_std_m = 0.01;       // used when the Eye covariance is zero
   double eye_yaw_std_rad = 0.02;
   double process_pos_std_m = 0.01;    // per sqrt(s)
   double process_yaw_std_rad = 0.02;  // per sqrt(s)

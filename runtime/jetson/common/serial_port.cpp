@@ -22,8 +22,8 @@ std::string SerialPort::open(const std::string &path, int baud) {
     return why;
   }
   // Raw 8N1, no flow control, no echo, no line editing: every byte goes through untouched.
-  tio.c_iflag &= ~static_cast<tcflag_t>(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR |
-                                        ICRNL | IXON | IXOFF | IXANY);
+  tio.c_iflag &= ~static_cast<tcflag_t>(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR | ICRNL |
+                                        IXON | IXOFF | IXANY);
   tio.c_oflag &= ~static_cast<tcflag_t>(OPOST);
   tio.c_lflag &= ~static_cast<tcflag_t>(ECHO | ECHONL | ICANON | ISIG | IEXTEN);
   tio.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | CSTOPB | CRTSCTS | CBAUD);
@@ -33,8 +33,8 @@ std::string SerialPort::open(const std::string &path, int baud) {
   tio.c_cc[VMIN] = 0;
   tio.c_cc[VTIME] = 0;
   if (ioctl(fd, TCSETS2, &tio) != 0) {
-    const std::string why = path + ": cannot set " + std::to_string(baud) +
-                            " baud raw mode (" + std::strerror(errno) + ")";
+    const std::string why = path + ": cannot set " + std::to_string(baud) + " baud raw mode (" +
+                            std::strerror(errno) + ")";
     ::close(fd);
     return why;
   }
@@ -78,7 +78,9 @@ int SerialPort::write_all(const uint8_t *data, std::size_t n) {
         return 0;
       }
       // Output queue full (a slow UART or a pty nobody reads): wait a little for room.
-      struct pollfd p {fd_, POLLOUT, 0};
+      struct pollfd p {
+        fd_, POLLOUT, 0
+      };
       ::poll(&p, 1, 10);
       ++waits;
       continue;

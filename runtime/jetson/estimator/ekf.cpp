@@ -139,7 +139,8 @@ void Ekf::add(Event e) {
     auto it = events_.begin();
     while (it != events_.end() && it->t_us <= e.t_us) ++it;
     it = events_.insert(it, std::move(e));
-    for (auto j = it; j != events_.end(); ++j) apply(*j, j == events_.begin() ? base_ : (j - 1)->after);
+    for (auto j = it; j != events_.end(); ++j)
+      apply(*j, j == events_.begin() ? base_ : (j - 1)->after);
     cur_ = events_.back().after;
   }
   // Forget what is older than the history window.

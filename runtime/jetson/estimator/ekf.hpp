@@ -19,14 +19,14 @@ using Mat5 = Eigen::Matrix<double, 5, 5>;
 
 struct EkfParams {
   double wheelbase_m = 0.14154;
-  double q_pos_m = 0.01;          // position random walk [m/sqrt(s)]
-  double q_yaw_rad = 0.01;        // heading random walk [rad/sqrt(s)]
-  double q_accel_m_s2 = 1.0;      // speed change [m/s/sqrt(s)]
-  double q_yaw_accel_rad_s2 = 2.0;// yaw-rate change [rad/s/sqrt(s)]
-  double r_speed_m_s = 0.02;      // wheel-speed noise [m/s]
-  double r_ackermann_rad_s = 0.1; // Ackermann yaw-rate noise (slip, steering lag) [rad/s]
-  double r_gyro_rad_s = 0.02;     // gyro z noise [rad/s]
-  int64_t history_us = 1000000;   // how late a measurement may be [us]
+  double q_pos_m = 0.01;            // position random walk [m/sqrt(s)]
+  double q_yaw_rad = 0.01;          // heading random walk [rad/sqrt(s)]
+  double q_accel_m_s2 = 1.0;        // speed change [m/s/sqrt(s)]
+  double q_yaw_accel_rad_s2 = 2.0;  // yaw-rate change [rad/s/sqrt(s)]
+  double r_speed_m_s = 0.02;        // wheel-speed noise [m/s]
+  double r_ackermann_rad_s = 0.1;   // Ackermann yaw-rate noise (slip, steering lag) [rad/s]
+  double r_gyro_rad_s = 0.02;       // gyro z noise [rad/s]
+  int64_t history_us = 1000000;     // how late a measurement may be [us]
 };
 
 struct Estimate {
@@ -36,10 +36,10 @@ struct Estimate {
 };
 
 struct EkfStats {
-  uint64_t fused = 0;       // measurements applied
-  uint64_t replays = 0;     // late measurements inserted in the past and replayed
-  uint64_t too_old = 0;     // dropped: older than the history window
-  uint64_t rejected = 0;    // dropped: non-finite values
+  uint64_t fused = 0;     // measurements applied
+  uint64_t replays = 0;   // late measurements inserted in the past and replayed
+  uint64_t too_old = 0;   // dropped: older than the history window
+  uint64_t rejected = 0;  // dropped: non-finite values
 };
 
 double wrap_angle(double a_rad);  // to (-pi, pi]
@@ -55,8 +55,7 @@ class Ekf {
   void add_wheel(int64_t t_us, double speed_m_s, double steering_rad);
   void add_gyro(int64_t t_us, double yaw_rate_rad_s);
   // Absolute pose in the filter's frame, covariance x, y, yaw [m^2, rad^2].
-  void add_pose(int64_t t_us, double x_m, double y_m, double yaw_rad,
-                const Eigen::Matrix3d &cov);
+  void add_pose(int64_t t_us, double x_m, double y_m, double yaw_rad, const Eigen::Matrix3d &cov);
 
   // The latest estimate, predicted forward to t_us (no change to the filter).
   Estimate estimate_at(int64_t t_us) const;
@@ -68,9 +67,9 @@ class Ekf {
   struct Event {
     int64_t t_us;
     Kind kind;
-    Eigen::Matrix<double, 3, 1> z;   // wheel: speed, steering; gyro: rate; pose: x y yaw
-    Eigen::Matrix3d R;               // pose covariance
-    Estimate after;                  // the state right after this event
+    Eigen::Matrix<double, 3, 1> z;  // wheel: speed, steering; gyro: rate; pose: x y yaw
+    Eigen::Matrix3d R;              // pose covariance
+    Estimate after;                 // the state right after this event
   };
   void add(Event e);
   void apply(Event &e, const Estimate &before) const;
@@ -81,9 +80,9 @@ class Ekf {
 
   EkfParams p_;
   bool init_ = false;
-  Estimate base_;              // state before the oldest kept event
-  Estimate cur_;               // state after the newest event
-  std::deque<Event> events_;   // time-ordered
+  Estimate base_;             // state before the oldest kept event
+  Estimate cur_;              // state after the newest event
+  std::deque<Event> events_;  // time-ordered
   EkfStats stats_;
 };
 

@@ -59,9 +59,8 @@ struct EstimatorNode::Impl {
     if (have_prev) {
       double v = 0;
       if (wheel_speed_from_encoders(prev.encoder_counts[0], prev.encoder_counts[1],
-                                    prev.nano_time_us, m->encoder_counts[0],
-                                    m->encoder_counts[1], m->nano_time_us,
-                                    config.vehicle.encoder_counts_per_rev,
+                                    prev.nano_time_us, m->encoder_counts[0], m->encoder_counts[1],
+                                    m->nano_time_us, config.vehicle.encoder_counts_per_rev,
                                     config.vehicle.wheel_radius_m, &v)) {
         odom.add_wheel(m->utime, v, m->steering_angle_rad);
         map.add_wheel(m->utime, v, m->steering_angle_rad);
@@ -87,7 +86,8 @@ struct EstimatorNode::Impl {
   }
 
   void on_pose(const autodrive::pose2d_t *m) {
-    Eigen::Matrix3d cov = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m->covariance);
+    Eigen::Matrix3d cov =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m->covariance);
     // A zero covariance means "not given": use the configured Eye noise.
     if (cov.diagonal().minCoeff() <= 0.0) {
       cov = Eigen::Matrix3d::Zero();

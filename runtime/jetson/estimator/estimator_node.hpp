@@ -14,8 +14,8 @@ namespace est {
 
 // Converts two encoder samples to the mean rear-wheel speed [m/s]; dt from the Nano clock
 // (a u32 microsecond counter that wraps). Returns false if dt is not usable.
-bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano_us,
-                               int32_t l, int32_t r, int64_t nano_us, int counts_per_rev,
+bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano_us, int32_t l,
+                               int32_t r, int64_t nano_us, int counts_per_rev,
                                double wheel_radius_m, double *speed_m_s);
 
 EkfParams params_from_config(const cfg::Config &c);

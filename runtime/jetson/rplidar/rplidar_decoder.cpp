@@ -15,7 +15,9 @@ constexpr double kStartWindowDeg = 30.0;
 constexpr int kMinNodesPerTurn = 90;
 }  // namespace
 
-std::vector<uint8_t> request(uint8_t cmd) { return {kCmdSync, cmd}; }
+std::vector<uint8_t> request(uint8_t cmd) {
+  return {kCmdSync, cmd};
+}
 
 bool Decoder::decode_node(const uint8_t *b, Node *out) {
   const bool s = b[0] & 0x01;
@@ -46,8 +48,10 @@ void Decoder::reset() {
   mode_ = Mode::hunt;
   has_prev_ = false;
   // Called from a callback inside process(): let process() drop the buffer when it returns.
-  if (processing_) reset_requested_ = true;
-  else buf_.clear();
+  if (processing_)
+    reset_requested_ = true;
+  else
+    buf_.clear();
 }
 
 void Decoder::feed(const uint8_t *data, std::size_t n) {
@@ -72,7 +76,8 @@ void Decoder::process() {
       }
       if (avail < 7) break;
       const uint32_t word = static_cast<uint32_t>(b[2]) | (static_cast<uint32_t>(b[3]) << 8) |
-                            (static_cast<uint32_t>(b[4]) << 16) | (static_cast<uint32_t>(b[5]) << 24);
+                            (static_cast<uint32_t>(b[4]) << 16) |
+                            (static_cast<uint32_t>(b[5]) << 24);
       const std::size_t len = word & 0x3FFFFFFFu;
       const unsigned send_mode = word >> 30;
       const uint8_t type = b[6];
@@ -150,7 +155,9 @@ void Decoder::process() {
   buf_.erase(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(i));
 }
 
-ScanAssembler::ScanAssembler(ScanParams p) : p_(std::move(p)) { clear(-1); }
+ScanAssembler::ScanAssembler(ScanParams p) : p_(std::move(p)) {
+  clear(-1);
+}
 
 void ScanAssembler::clear(int64_t t_us) {
   ranges_.assign(360, std::numeric_limits<float>::infinity());

@@ -41,23 +41,23 @@ enum : uint8_t {
 std::vector<uint8_t> request(uint8_t cmd);
 
 struct Node {
-  bool start = false;       // first node of a new 360 deg turn
-  uint8_t quality = 0;      // [0, 63], 0 = no valid return
-  double angle_deg = 0.0;   // clockwise from the sensor's 0 [deg]
-  double distance_mm = 0.0; // 0 = no return [mm]
+  bool start = false;        // first node of a new 360 deg turn
+  uint8_t quality = 0;       // [0, 63], 0 = no valid return
+  double angle_deg = 0.0;    // clockwise from the sensor's 0 [deg]
+  double distance_mm = 0.0;  // 0 = no return [mm]
 };
 
 struct Health {
-  uint8_t status = 0;       // 0 good, 1 warning, 2 error
+  uint8_t status = 0;  // 0 good, 1 warning, 2 error
   uint16_t error_code = 0;
 };
 
 struct DecoderStats {
-  uint64_t nodes = 0;          // good measurement nodes
-  uint64_t bad_nodes = 0;      // 5-byte windows failing the S/!S, C or angle checks
-  uint64_t skipped_bytes = 0;  // bytes dropped while resyncing or hunting for a descriptor
-  uint64_t descriptors = 0;    // response descriptors parsed
-  uint64_t bad_descriptors = 0;// descriptors with an unexpected length/type
+  uint64_t nodes = 0;            // good measurement nodes
+  uint64_t bad_nodes = 0;        // 5-byte windows failing the S/!S, C or angle checks
+  uint64_t skipped_bytes = 0;    // bytes dropped while resyncing or hunting for a descriptor
+  uint64_t descriptors = 0;      // response descriptors parsed
+  uint64_t bad_descriptors = 0;  // descriptors with an unexpected length/type
 };
 
 // Byte-wise decoder of everything the device sends. Call feed() with any chunking.
@@ -84,10 +84,10 @@ class Decoder {
   std::size_t payload_len_ = 0;
   std::vector<uint8_t> buf_;
   DecoderStats stats_;
-  bool processing_ = false;      // inside process(): callbacks may call reset()
+  bool processing_ = false;  // inside process(): callbacks may call reset()
   bool reset_requested_ = false;
-  bool has_prev_ = false;       // a good node was accepted in this scan stream
-  double prev_angle_deg_ = 0.0; // its angle
+  bool has_prev_ = false;        // a good node was accepted in this scan stream
+  double prev_angle_deg_ = 0.0;  // its angle
 };
 
 // Encodes a node (for tests and synthetic streams).

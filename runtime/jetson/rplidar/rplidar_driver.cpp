@@ -25,14 +25,17 @@ struct Driver::Impl {
   mutable std::mutex mu;
   DriverStatus st;
   Phase phase = Phase::closed;
-  int64_t deadline_us = 0;    // current phase times out here [monotonic us]
+  int64_t deadline_us = 0;  // current phase times out here [monotonic us]
   int64_t next_open_us = 0;
   int64_t last_node_us = 0;
   int64_t next_report_us = 0;  // next statistics log line [monotonic us]
   bool open_failure_logged = false;
 
   explicit Impl(const cfg::Config &c)
-      : config(c), tag("[lidar " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock),
+      : config(c),
+        tag("[lidar " + c.vehicle.name + "] "),
+        lcm(c.lcm_url),
+        clock(c.clock),
         assembler(ScanParams{c.lidar.frame_id, c.lidar.mount_yaw_rad, c.lidar.range_min_m,
                              c.lidar.range_max_m}) {
     if (lcm.good()) clock.attach(lcm);
@@ -95,7 +98,8 @@ struct Driver::Impl {
     next_open_us = now + 1000000;
     const std::string why = port.open(config.lidar.device, config.lidar.baud);
     if (!why.empty()) {
-      if (!open_failure_logged) spdlog::warn("{}cannot open the RPLIDAR: {}; retrying every 1 s", tag, why);
+      if (!open_failure_logged)
+        spdlog::warn("{}cannot open the RPLIDAR: {}; retrying every 1 s", tag, why);
       open_failure_logged = true;
       return;
     }
@@ -134,8 +138,10 @@ struct Driver::Impl {
       if (fds[1].revents & POLLIN) {
         uint8_t buf[1024];
         const long n = port.read_some(buf, sizeof buf);
-        if (n < 0) lose(port.error());
-        else if (n > 0) decoder.feed(buf, static_cast<std::size_t>(n));
+        if (n < 0)
+          lose(port.error());
+        else if (n > 0)
+          decoder.feed(buf, static_cast<std::size_t>(n));
       } else if (fds[1].revents & (POLLHUP | POLLERR | POLLNVAL)) {
         lose(config.lidar.device + ": hang-up");
       }

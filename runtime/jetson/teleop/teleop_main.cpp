@@ -17,7 +17,9 @@
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
+void on_signal(int) {
+  g_stop = 1;
+}
 
 // Puts the terminal in raw mode for single key presses; restores it on destruction.
 class RawTerminal {
@@ -57,10 +59,14 @@ int main(int argc, char **argv) {
   app.add_option("--vehicle", vehicle, "vehicle name, channel prefix")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
   app.add_option("--joystick", js_path, "gamepad device, e.g. /dev/input/js0");
-  app.add_option("--rate-hz", rate_hz, "command publish rate [Hz]")->check(CLI::Range(1.0, 500.0))->capture_default_str();
+  app.add_option("--rate-hz", rate_hz, "command publish rate [Hz]")
+      ->check(CLI::Range(1.0, 500.0))
+      ->capture_default_str();
   app.add_option("--max-throttle", p.max_throttle, "throttle at full stick / top key level [0,1]")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  app.add_option("--deadman-button", p.deadman_button, "gamepad dead-man button number")->capture_default_str();
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--deadman-button", p.deadman_button, "gamepad dead-man button number")
+      ->capture_default_str();
   app.add_flag("--no-keyboard", no_keyboard, "do not read the terminal");
   CLI11_PARSE(app, argc, argv);
 
@@ -102,7 +108,8 @@ int main(int argc, char **argv) {
       if (fds[i].fd == STDIN_FILENO && (fds[i].revents & POLLIN)) {
         char buf[32];
         const ssize_t k = ::read(STDIN_FILENO, buf, sizeof buf);
-        for (ssize_t j = 0; j < k; ++j) running = mapper.key(buf[j], clk::monotonic_us()) && running;
+        for (ssize_t j = 0; j < k; ++j)
+          running = mapper.key(buf[j], clk::monotonic_us()) && running;
       } else if (fds[i].fd == js && fds[i].revents) {
         js_event e;
         ssize_t k;
@@ -112,7 +119,8 @@ int main(int argc, char **argv) {
           if (type == JS_EVENT_BUTTON) mapper.js_button(e.number, e.value != 0);
         }
         if (k < 0 && errno != EAGAIN) {
-          std::fprintf(stderr, "\rautodrive-teleop: gamepad %s lost; stopping the car\n", js_path.c_str());
+          std::fprintf(stderr, "\rautodrive-teleop: gamepad %s lost; stopping the car\n",
+                       js_path.c_str());
           mapper.js_lost();
           ::close(js);
           js = -1;

@@ -5,22 +5,52 @@
 
 namespace teleop {
 
-void Mapper::toggle_indicator(int8_t which) { indicators_ = indicators_ == which ? 0 : which; }
+void Mapper::toggle_indicator(int8_t which) {
+  indicators_ = indicators_ == which ? 0 : which;
+}
 
 bool Mapper::key(char c, int64_t t) {
   switch (c) {
-    case 'w': case 'W': key_drive_ = 1; drive_t_us_ = t; break;
-    case 's': case 'S': key_drive_ = -1; drive_t_us_ = t; break;
-    case 'a': case 'A': key_steer_ = 1; steer_t_us_ = t; break;   // + left
-    case 'd': case 'D': key_steer_ = -1; steer_t_us_ = t; break;
-    case ' ': key_drive_ = 0; key_steer_ = 0; drive_t_us_ = steer_t_us_ = -1; break;
-    case '+': case '=': level_ = std::min(p_.max_throttle, level_ + 0.05); break;
-    case '-': case '_': level_ = std::max(0.05, level_ - 0.05); break;
-    case 'h': case 'H': headlights_ = static_cast<int8_t>((headlights_ + 1) % 3); break;
-    case 'z': case 'Z': toggle_indicator(1); break;
-    case 'c': case 'C': toggle_indicator(2); break;
-    case 'x': case 'X': toggle_indicator(3); break;
-    case 'q': case 'Q': case 3 /* Ctrl-C in raw mode */: return false;
+    case 'w':
+    case 'W':
+      key_drive_ = 1;
+      drive_t_us_ = t;
+      break;
+    case 's':
+    case 'S':
+      key_drive_ = -1;
+      drive_t_us_ = t;
+      break;
+    case 'a':
+    case 'A':
+      key_steer_ = 1;
+      steer_t_us_ = t;
+      break;  // + left
+    case 'd':
+    case 'D':
+      key_steer_ = -1;
+      steer_t_us_ = t;
+      break;
+    case ' ':
+      key_drive_ = 0;
+      key_steer_ = 0;
+      drive_t_us_ = steer_t_us_ = -1;
+      break;
+    case '+':
+    case '=': level_ = std::min(p_.max_throttle, level_ + 0.05); break;
+    case '-':
+    case '_': level_ = std::max(0.05, level_ - 0.05); break;
+    case 'h':
+    case 'H': headlights_ = static_cast<int8_t>((headlights_ + 1) % 3); break;
+    case 'z':
+    case 'Z': toggle_indicator(1); break;
+    case 'c':
+    case 'C': toggle_indicator(2); break;
+    case 'x':
+    case 'X': toggle_indicator(3); break;
+    case 'q':
+    case 'Q':
+    case 3 /* Ctrl-C in raw mode */: return false;
     default: break;
   }
   return true;

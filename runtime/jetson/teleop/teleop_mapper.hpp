@@ -15,15 +15,15 @@
 namespace teleop {
 
 struct Params {
-  double max_throttle = 0.6;   // full stick / top key level [-]
-  double key_level = 0.4;      // initial keyboard drive level [-]
-  int64_t key_hold_us = 600000;// no repeat for this long = key released [us]
-  int deadman_button = 4;      // gamepad button (LB on most pads)
+  double max_throttle = 0.6;     // full stick / top key level [-]
+  double key_level = 0.4;        // initial keyboard drive level [-]
+  int64_t key_hold_us = 600000;  // no repeat for this long = key released [us]
+  int deadman_button = 4;        // gamepad button (LB on most pads)
   int headlight_button = 0;
   int left_button = 2, right_button = 1, hazard_button = 3;
-  int throttle_axis = 1;       // left stick Y (up is negative)
-  int steering_axis = 3;       // right stick X (right is positive)
-  double axis_deadzone = 0.08; // [-], fraction of full scale
+  int throttle_axis = 1;        // left stick Y (up is negative)
+  int steering_axis = 3;        // right stick X (right is positive)
+  double axis_deadzone = 0.08;  // [-], fraction of full scale
 };
 
 class Mapper {

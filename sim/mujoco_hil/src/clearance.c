@@ -37,8 +37,10 @@ static void cl_corners(const cl_prism_t *p, double out[4][2]) {
 
 static void cl_name(const mjModel *m, int g, char *out, size_t sz) {
   const char *n = mj_id2name(m, mjOBJ_GEOM, g);
-  if (n && *n) snprintf(out, sz, "'%s'", n);
-  else snprintf(out, sz, "#%d (unnamed)", g);
+  if (n && *n)
+    snprintf(out, sz, "'%s'", n);
+  else
+    snprintf(out, sz, "#%d (unnamed)", g);
 }
 
 /* An upright prism bounding static geom g (exact for upright boxes). */
@@ -47,31 +49,31 @@ static void cl_geom_prism(const mjModel *m, const mjData *d, int g, cl_prism_t *
   double ext[3];
   p->yaw_rad = 0.0;
   switch (m->geom_type[g]) {
-  case mjGEOM_BOX:
-    if (fabs(R[8]) > CL_UPRIGHT_COS) { /* upright: its own x-y rectangle */
-      p->yaw_rad = atan2(R[3], R[0]);
-      ext[0] = sz[0], ext[1] = sz[1], ext[2] = sz[2];
-    } else {
+    case mjGEOM_BOX:
+      if (fabs(R[8]) > CL_UPRIGHT_COS) { /* upright: its own x-y rectangle */
+        p->yaw_rad = atan2(R[3], R[0]);
+        ext[0] = sz[0], ext[1] = sz[1], ext[2] = sz[2];
+      } else {
+        for (int k = 0; k < 3; k++)
+          ext[k] = fabs(R[3 * k]) * sz[0] + fabs(R[3 * k + 1]) * sz[1] + fabs(R[3 * k + 2]) * sz[2];
+      }
+      break;
+    case mjGEOM_SPHERE: ext[0] = ext[1] = ext[2] = sz[0]; break;
+    case mjGEOM_CYLINDER:
+    case mjGEOM_CAPSULE:
+      for (int k = 0; k < 3; k++) { /* along the axis: half length; across: the radius */
+        const double a = fabs(R[3 * k + 2]);
+        ext[k] = a * sz[1] +
+                 sz[0] * (m->geom_type[g] == mjGEOM_CAPSULE ? 1.0 : sqrt(fmax(0.0, 1.0 - a * a)));
+      }
+      break;
+    case mjGEOM_ELLIPSOID:
       for (int k = 0; k < 3; k++)
-        ext[k] = fabs(R[3 * k]) * sz[0] + fabs(R[3 * k + 1]) * sz[1] + fabs(R[3 * k + 2]) * sz[2];
-    }
-    break;
-  case mjGEOM_SPHERE:
-    ext[0] = ext[1] = ext[2] = sz[0];
-    break;
-  case mjGEOM_CYLINDER:
-  case mjGEOM_CAPSULE:
-    for (int k = 0; k < 3; k++) { /* along the axis: half length; across: the radius */
-      const double a = fabs(R[3 * k + 2]);
-      ext[k] = a * sz[1] + sz[0] * (m->geom_type[g] == mjGEOM_CAPSULE ? 1.0 : sqrt(fmax(0.0, 1.0 - a * a)));
-    }
-    break;
-  case mjGEOM_ELLIPSOID:
-    for (int k = 0; k < 3; k++)
-      ext[k] = sqrt(pow(R[3 * k] * sz[0], 2) + pow(R[3 * k + 1] * sz[1], 2) + pow(R[3 * k + 2] * sz[2], 2));
-    break;
-  default: /* meshes, height fields: the bounding sphere */
-    ext[0] = ext[1] = ext[2] = m->geom_rbound[g];
+        ext[k] = sqrt(pow(R[3 * k] * sz[0], 2) + pow(R[3 * k + 1] * sz[1], 2) +
+                      pow(R[3 * k + 2] * sz[2], 2));
+      break;
+    default: /* meshes, height fields: the bounding sphere */
+      ext[0] = ext[1] = ext[2] = m->geom_rbound[g];
   }
   p->centre_m[0] = pos[0];
   p->centre_m[1] = pos[1];

@@ -10,8 +10,7 @@ double motor_torque_nm(const motor_model_t *m, uint8_t duty, uint8_t reverse, ui
   return m->stall_torque_nm * (u - wheel_speed_rad_s / m->noload_speed_rad_s);
 }
 
-double steer_command_rad(double pulse_us, double center_us, double us_per_full,
-                         double limit_rad) {
+double steer_command_rad(double pulse_us, double center_us, double us_per_full, double limit_rad) {
   double a = (pulse_us - center_us) / us_per_full * limit_rad;
   if (a > limit_rad) a = limit_rad;
   if (a < -limit_rad) a = -limit_rad;

@@ -19,8 +19,7 @@ double motor_torque_nm(const motor_model_t *m, uint8_t duty, uint8_t reverse, ui
                        double battery_v, double wheel_speed_rad_s);
 
 /* Servo: pulse [us] -> commanded centre angle [rad, + left], clamped to the limit. */
-double steer_command_rad(double pulse_us, double center_us, double us_per_full,
-                         double limit_rad);
+double steer_command_rad(double pulse_us, double center_us, double us_per_full, double limit_rad);
 /* Moves angle towards target by at most rate * dt. */
 double steer_rate_limit(double angle_rad, double target_rad, double rate_rad_s, double dt_s);
 /* Ackermann per-wheel angles from the centre angle (paper): tan d_l,r = 2 L tan d /

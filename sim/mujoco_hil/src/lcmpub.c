@@ -28,7 +28,8 @@ int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log) {
     uint8_t buf[512];
     const int n = autodrive_ground_truth_t_encode(buf, 0, sizeof buf, &msg);
     if (n > 0) {
-      const uint8_t len[4] = {(uint8_t)(n >> 24), (uint8_t)(n >> 16), (uint8_t)(n >> 8), (uint8_t)n};
+      const uint8_t len[4] = {(uint8_t)(n >> 24), (uint8_t)(n >> 16), (uint8_t)(n >> 8),
+                              (uint8_t)n};
       fwrite(len, 1, 4, log);
       fwrite(buf, 1, (size_t)n, log);
     }

@@ -20,66 +20,70 @@
 #endif
 
 #define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
-#define MAIN_TRUTH_EVERY 10   /* steps between ground-truth messages: 100 Hz */
-#define MAIN_CLOCK_EVERY 10   /* steps between SIM_CLOCK messages: 100 Hz */
-#define MAIN_PROGRESS_S 5.0   /* [s] wall time between progress lines */
+#define MAIN_TRUTH_EVERY 10 /* steps between ground-truth messages: 100 Hz */
+#define MAIN_CLOCK_EVERY 10 /* steps between SIM_CLOCK messages: 100 Hz */
+#define MAIN_PROGRESS_S 5.0 /* [s] wall time between progress lines */
 
 static volatile sig_atomic_t main_stop = 0;
 /* Largest lag behind the real-time schedule [s] before the schedule slips (see pacing). */
 #define MAIN_MAX_LAG_S 0.02
-static void main_on_signal(int sig) { (void)sig; main_stop = 1; }
+static void main_on_signal(int sig) {
+  (void)sig;
+  main_stop = 1;
+}
 
 static void main_usage(FILE *f) {
-  fprintf(f,
-          "usage: autodrive-sim [options]\n"
-          "MuJoCo 2.2 HIL simulator of the AutoDRIVE Nigel car. Each car's emulated Nano (the real\n"
-          "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
-          "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
-          "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
-          "  --params FILE       vehicle parameter file (default %s/params/nigel.params)\n"
-          "  --seed N            seed of IMU biases and noise (default 1)\n"
-          "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
-          "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
-          "                      cars line up to its right as usual. Refused when a car would\n"
-          "                      be off the floor or overlap a wall or obstacle\n"
-          "  --late-box X,Y,T[,SX,SY[,R]]\n"
-          "                      a box obstacle (half sizes SX, SY [m], default %g; %g m tall)\n"
-          "                      that appears at x, y [m] at sim time T [s]: a change to the\n"
-          "                      place after it was mapped. With R [m], not before car 1's\n"
-          "                      base_link is within R of it (one stepping out in front of\n"
-          "                      the car). Up to %d; LIDAR, cameras and the collision flag\n"
-          "                      see it once it is there\n"
-          "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
-          "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
-          "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
-          "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
-          "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
-          "                      (default: real time, 1 sim second per wall second)\n"
-          "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
-          "  --lcm-url URL       LCM provider (default %s)\n"
-          "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
-          "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
-          "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
-          "  --no-pty            do not open ptys (with --script)\n"
-          "  --no-lidar          do not simulate the LIDAR\n"
-          "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
-          "                      unless a client is scanning on the RPLIDAR pty)\n"
-          "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
-          "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
-          "  --camera-fps F      camera frame rate in sim time (default 30)\n"
-          "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
-          "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
-          "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
-          "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
-          "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
-          "  --quiet             no progress lines\n"
-          "  -h, --help          this text\n"
-          "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
-          "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n"
-          "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
-          "not fit the map); 1 any other error (files, map, LCM, physics).\n",
-          SIM_MAX_CARS, AUTODRIVE_SIM_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-          SCN_MAX_LATE_BOXES, MAIN_DEFAULT_URL);
+  fprintf(
+      f,
+      "usage: autodrive-sim [options]\n"
+      "MuJoCo 2.2 HIL simulator of the AutoDRIVE Nigel car. Each car's emulated Nano (the real\n"
+      "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
+      "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
+      "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
+      "  --params FILE       vehicle parameter file (default %s/params/nigel.params)\n"
+      "  --seed N            seed of IMU biases and noise (default 1)\n"
+      "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
+      "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
+      "                      cars line up to its right as usual. Refused when a car would\n"
+      "                      be off the floor or overlap a wall or obstacle\n"
+      "  --late-box X,Y,T[,SX,SY[,R]]\n"
+      "                      a box obstacle (half sizes SX, SY [m], default %g; %g m tall)\n"
+      "                      that appears at x, y [m] at sim time T [s]: a change to the\n"
+      "                      place after it was mapped. With R [m], not before car 1's\n"
+      "                      base_link is within R of it (one stepping out in front of\n"
+      "                      the car). Up to %d; LIDAR, cameras and the collision flag\n"
+      "                      see it once it is there\n"
+      "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
+      "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
+      "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
+      "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
+      "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
+      "                      (default: real time, 1 sim second per wall second)\n"
+      "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
+      "  --lcm-url URL       LCM provider (default %s)\n"
+      "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
+      "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
+      "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
+      "  --no-pty            do not open ptys (with --script)\n"
+      "  --no-lidar          do not simulate the LIDAR\n"
+      "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
+      "                      unless a client is scanning on the RPLIDAR pty)\n"
+      "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
+      "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
+      "  --camera-fps F      camera frame rate in sim time (default 30)\n"
+      "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
+      "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
+      "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
+      "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
+      "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
+      "  --quiet             no progress lines\n"
+      "  -h, --help          this text\n"
+      "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
+      "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n"
+      "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
+      "not fit the map); 1 any other error (files, map, LCM, physics).\n",
+      SIM_MAX_CARS, AUTODRIVE_SIM_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
+      SCN_MAX_LATE_BOXES, MAIN_DEFAULT_URL);
 }
 
 static double main_clock_s(clockid_t id) {
@@ -87,10 +91,14 @@ static double main_clock_s(clockid_t id) {
   clock_gettime(id, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
-static double main_wall_s(void) { return main_clock_s(CLOCK_MONOTONIC); }
+static double main_wall_s(void) {
+  return main_clock_s(CLOCK_MONOTONIC);
+}
 /* CPU time of this process [s]: on a shared, loaded machine it shows the cost without the
  * time spent waiting for a core */
-static double main_cpu_s(void) { return main_clock_s(CLOCK_PROCESS_CPUTIME_ID); }
+static double main_cpu_s(void) {
+  return main_clock_s(CLOCK_PROCESS_CPUTIME_ID);
+}
 
 /* --lockstep-client: the sim never runs more than MAIN_SYNC_HORIZON_US of sim time past the
  * last bytes a client wrote on a car's Nano pty. The runtime's bridge writes a COMMAND frame
@@ -99,7 +107,7 @@ static double main_cpu_s(void) { return main_clock_s(CLOCK_PROCESS_CPUTIME_ID); 
 #define MAIN_SYNC_HORIZON_US 40000
 #define MAIN_SYNC_LOST_S 2.0 /* [s] wall without bytes: the client is gone; stop waiting for it */
 typedef struct {
-  int started;                         /* a client has written at least once */
+  int started;                          /* a client has written at least once */
   int64_t lost_rx_us[SIM_MAX_CARS + 1]; /* host_rx of a client given up on (0: none) */
 } main_sync_t;
 
@@ -113,8 +121,10 @@ static void main_sync_wait(sim_t *s, main_sync_t *st) {
     const double t_give_up = main_wall_s() + MAIN_SYNC_LOST_S;
     while (!main_stop && !sim_nano_wait_input(s, c, 50)) {
       if (main_wall_s() > t_give_up) {
-        fprintf(stderr, "[autodrive-sim] NIGEL%d: no bytes from the client for %.1f s (wall): "
-                "running on without it\n", c, MAIN_SYNC_LOST_S);
+        fprintf(stderr,
+                "[autodrive-sim] NIGEL%d: no bytes from the client for %.1f s (wall): "
+                "running on without it\n",
+                c, MAIN_SYNC_LOST_S);
         st->lost_rx_us[c] = rx_us + 1;
         break;
       }
@@ -129,8 +139,8 @@ static int main_number(const char *opt, const char *v, double lo, double hi, dou
   errno = 0;
   const double x = v ? strtod(v, &end) : 0.0;
   if (!v || end == v || *end || errno || !isfinite(x) || x < lo || x > hi) {
-    fprintf(stderr, "autodrive-sim: %s '%s': expected a number in [%g, %g]\n", opt, v ? v : "",
-            lo, hi);
+    fprintf(stderr, "autodrive-sim: %s '%s': expected a number in [%g, %g]\n", opt, v ? v : "", lo,
+            hi);
     return -1;
   }
   *out = x;
@@ -180,7 +190,8 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
       k->cam[k->n] = sim_camera_create(k->render, m, name, frame, 640, 480, 85, err, err_sz);
       if (!k->cam[k->n]) return -1;
       k->cam_id[k->n] = mj_name2id(m, mjOBJ_CAMERA, name);
-      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d_CAM_%s", c, rear ? "REAR" : "FRONT");
+      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d_CAM_%s", c,
+               rear ? "REAR" : "FRONT");
       snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d_CAM_%s_INFO", c,
                rear ? "REAR" : "FRONT");
       k->n++;
@@ -199,7 +210,8 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   return 0;
 #else
   (void)s;
-  snprintf(err, err_sz, "--cameras/--eye: this build has no sensors library (sim/mujoco_hil/sensors)");
+  snprintf(err, err_sz,
+           "--cameras/--eye: this build has no sensors library (sim/mujoco_hil/sensors)");
   return -1;
 #endif
 }
@@ -327,8 +339,10 @@ int main(int argc, char **argv) {
       cfg.cars = (int)x;
       i++;
     } else if (!strcmp(a, "--map") && v) {
-      if (strchr(v, '/') || strstr(v, ".xml")) snprintf(map, sizeof map, "%s", v);
-      else snprintf(map, sizeof map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
+      if (strchr(v, '/') || strstr(v, ".xml"))
+        snprintf(map, sizeof map, "%s", v);
+      else
+        snprintf(map, sizeof map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
       i++;
     } else if (!strcmp(a, "--params") && v) {
       snprintf(params, sizeof params, "%s", v);
@@ -393,8 +407,10 @@ int main(int argc, char **argv) {
       if (main_number(a, v, 0.1, 1000, &camera_fps)) return 2;
       i++;
     } else if (!strcmp(a, "--tyre-model") && v) {
-      if (!strcmp(v, "paper")) cfg.tyre_model = 1;
-      else if (!strcmp(v, "mujoco")) cfg.tyre_model = 0;
+      if (!strcmp(v, "paper"))
+        cfg.tyre_model = 1;
+      else if (!strcmp(v, "mujoco"))
+        cfg.tyre_model = 0;
       else {
         fprintf(stderr, "autodrive-sim: --tyre-model '%s': expected paper or mujoco\n", v);
         return 2;
@@ -426,7 +442,8 @@ int main(int argc, char **argv) {
   if (!lcm) {
     fprintf(stderr,
             "autodrive-sim: cannot open LCM url '%s' (udpm:// needs a multicast route, e.g. "
-            "'ip route add 239.0.0.0/8 dev lo')\n", url);
+            "'ip route add 239.0.0.0/8 dev lo')\n",
+            url);
     return 1;
   }
   FILE *tlog = NULL;
@@ -480,7 +497,10 @@ int main(int argc, char **argv) {
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
   }
   printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
-         client_sync ? "lockstep with the client" : lockstep ? "lockstep" : (rtf_given ? "rtf" : "real time"), url);
+         client_sync ? "lockstep with the client"
+         : lockstep  ? "lockstep"
+                     : (rtf_given ? "rtf" : "real time"),
+         url);
   if (cfg.start)
     printf("NIGEL1 start (--start): x %.3f, y %.3f m, yaw %.1f deg\n", start.x_m, start.y_m,
            start.yaw_deg);
@@ -561,11 +581,12 @@ int main(int argc, char **argv) {
     const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
     double bare_cpu_s = 0.0;
     const double bare_s = sim_bare_mj_step_s(s, bare_steps, &bare_cpu_s);
-    printf("{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
-           "\"rtf_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f}\n",
-           sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
-           cpu_s > 0 ? sim_s / cpu_s : 0.0, bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
-           bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
+    printf(
+        "{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
+        "\"rtf_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f}\n",
+        sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
+        cpu_s > 0 ? sim_s / cpu_s : 0.0, bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
+        bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
   }
   main_view_close(&viewer);
   main_cams_close(&cams);

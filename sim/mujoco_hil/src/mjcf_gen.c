@@ -7,7 +7,9 @@
 
 #define MG_KNUCKLE_KG 0.005 /* steering knuckle mass [kg] */
 
-int mg_tag_id(int car) { return car; }
+int mg_tag_id(int car) {
+  return car;
+}
 
 /* MJCF <include>/<texture> paths are relative to the scene file's directory and MuJoCo 2.2
  * refuses absolute ones; "../" at "/" stays at "/", so enough of them reach any absolute path. */
@@ -85,19 +87,21 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
     const char *name;
     int front;
     double y_sign, y_frac; /* y = sign * (ly or iy) */
-  } lamp[] = {{"lamp_head_l", 1, 1, 0}, {"lamp_head_r", 1, -1, 0}, {"lamp_ind_fl", 1, 1, 1},
-              {"lamp_ind_fr", 1, -1, 1}, {"lamp_tail_l", 0, 1, 0}, {"lamp_tail_r", 0, -1, 0},
-              {"lamp_ind_rl", 0, 1, 1}, {"lamp_ind_rr", 0, -1, 1}, {"lamp_reverse", 0, 0, 0}};
+  } lamp[] = {{"lamp_head_l", 1, 1, 0},  {"lamp_head_r", 1, -1, 0}, {"lamp_ind_fl", 1, 1, 1},
+              {"lamp_ind_fr", 1, -1, 1}, {"lamp_tail_l", 0, 1, 0},  {"lamp_tail_r", 0, -1, 0},
+              {"lamp_ind_rl", 0, 1, 1},  {"lamp_ind_rr", 0, -1, 1}, {"lamp_reverse", 0, 0, 0}};
   for (size_t k = 0; k < sizeof lamp / sizeof lamp[0]; k++)
-    fprintf(f,
-            "   <geom name=\"nigel%d/%s\" type=\"box\" size=\"0.002 0.008 0.005\" pos=\"%.6g %.6g "
-            "%.6g\" contype=\"0\" conaffinity=\"0\" group=\"1\" mass=\"0\" rgba=\"0.2 0.2 0.2 1\"/>\n",
-            i, lamp[k].name, lamp[k].front ? fx : rx,
-            lamp[k].y_sign * (lamp[k].y_frac > 0 ? iy : ly), lz);
+    fprintf(
+        f,
+        "   <geom name=\"nigel%d/%s\" type=\"box\" size=\"0.002 0.008 0.005\" pos=\"%.6g %.6g "
+        "%.6g\" contype=\"0\" conaffinity=\"0\" group=\"1\" mass=\"0\" rgba=\"0.2 0.2 0.2 1\"/>\n",
+        i, lamp[k].name, lamp[k].front ? fx : rx, lamp[k].y_sign * (lamp[k].y_frac > 0 ? iy : ly),
+        lz);
 
-  const char *tyre_attr = p->tyre_model_paper
-                              ? "condim=\"1\" priority=\"1\"" /* normal force only, whatever the floor */
-                              : "condim=\"3\" friction=\"0.05 0 0\""; /* the floor's mu wins */
+  const char *tyre_attr =
+      p->tyre_model_paper
+          ? "condim=\"1\" priority=\"1\""         /* normal force only, whatever the floor */
+          : "condim=\"3\" friction=\"0.05 0 0\""; /* the floor's mu wins */
   static const char *names[4] = {"fl", "fr", "rl", "rr"};
   for (int w = 0; w < 4; w++) {
     const int front = w < 2;
@@ -106,16 +110,15 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
     if (front) {
       fprintf(f, "   <body name=\"nigel%d/knuckle_%s\" pos=\"%.6g %.6g %.6g\">\n", i, names[w], x,
               y, r);
-      fprintf(f, "    <inertial pos=\"0 0 0\" mass=\"%g\" diaginertia=\"1e-6 1e-6 1e-6\"/>\n",
-              mk);
+      fprintf(f, "    <inertial pos=\"0 0 0\" mass=\"%g\" diaginertia=\"1e-6 1e-6 1e-6\"/>\n", mk);
       fprintf(f,
               "    <joint name=\"nigel%d/steer_%s\" type=\"hinge\" axis=\"0 0 1\" range=\"-0.9 "
               "0.9\" armature=\"%.6g\" damping=\"0.01\"/>\n",
               i, names[w], p->knuckle_armature_kg_m2);
       fprintf(f, "    <body name=\"nigel%d/wheel_%s\">\n", i, names[w]);
     } else {
-      fprintf(f, "   <body name=\"nigel%d/wheel_%s\" pos=\"%.6g %.6g %.6g\">\n", i, names[w], x,
-              y, r);
+      fprintf(f, "   <body name=\"nigel%d/wheel_%s\" pos=\"%.6g %.6g %.6g\">\n", i, names[w], x, y,
+              r);
     }
     fprintf(f, "    <inertial pos=\"0 0 0\" mass=\"%.6g\" diaginertia=\"%.6g %.6g %.6g\"/>\n", mw,
             iw_diam, iw_spin, iw_diam);
@@ -173,7 +176,8 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
   fprintf(f, " <include file=\"%s\"/>\n", rel);
   if (o->tag_asset_xml) fprintf(f, " <asset>\n%s\n </asset>\n", o->tag_asset_xml);
   fprintf(f, " <worldbody>\n");
-  for (int i = 1; i <= o->cars; i++) mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL);
+  for (int i = 1; i <= o->cars; i++)
+    mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL);
   for (int k = 0; k < o->late_boxes; k++) mg_late_box(f, k + 1, &o->late_box[k]);
   fprintf(f, " </worldbody>\n <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */

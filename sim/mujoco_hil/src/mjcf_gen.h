@@ -23,12 +23,12 @@ extern "C" {
 #endif
 
 typedef struct mg_options {
-  int cars;                 /* >= 1 */
-  const char *map_path;     /* absolute path of the map MJCF */
-  const char *tag_asset_xml;        /* NULL, or <texture>/<material> elements of the roof tags */
-  const char *const *tag_geom_xml;  /* NULL, or per car the roof tag <geom> (NULL: plain plate) */
-  int late_boxes;                   /* 0..SCN_MAX_LATE_BOXES --late-box obstacles */
-  const scn_late_box_t *late_box;   /* their sizes (positions are set at run time) */
+  int cars;                        /* >= 1 */
+  const char *map_path;            /* absolute path of the map MJCF */
+  const char *tag_asset_xml;       /* NULL, or <texture>/<material> elements of the roof tags */
+  const char *const *tag_geom_xml; /* NULL, or per car the roof tag <geom> (NULL: plain plate) */
+  int late_boxes;                  /* 0..SCN_MAX_LATE_BOXES --late-box obstacles */
+  const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
 } mg_options_t;
 
 #define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */

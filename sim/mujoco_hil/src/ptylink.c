@@ -42,16 +42,14 @@ int ptylink_open(ptylink_t *p, const char *link_path, char *err, size_t err_sz) 
   struct stat st;
   if (lstat(link_path, &st) == 0) {
     if (!S_ISLNK(st.st_mode)) {
-      snprintf(err, err_sz, "'%s' exists and is not a symlink: refusing to replace it",
-               link_path);
+      snprintf(err, err_sz, "'%s' exists and is not a symlink: refusing to replace it", link_path);
       ptylink_close(p);
       return -1;
     }
     unlink(link_path);
   }
   if (symlink(p->slave_path, link_path) != 0) {
-    snprintf(err, err_sz, "symlink '%s' -> '%s': %s", link_path, p->slave_path,
-             strerror(errno));
+    snprintf(err, err_sz, "symlink '%s' -> '%s': %s", link_path, p->slave_path, strerror(errno));
     ptylink_close(p);
     return -1;
   }

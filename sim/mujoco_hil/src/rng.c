@@ -3,7 +3,9 @@
 
 #include <math.h>
 
-void rng_seed(rng_t *r, uint64_t seed) { r->state = seed; }
+void rng_seed(rng_t *r, uint64_t seed) {
+  r->state = seed;
+}
 
 static uint64_t rng_next(rng_t *r) {
   uint64_t z = (r->state += 0x9E3779B97F4A7C15ull);
@@ -12,7 +14,9 @@ static uint64_t rng_next(rng_t *r) {
   return z ^ (z >> 31);
 }
 
-double rng_uniform(rng_t *r) { return (rng_next(r) >> 11) * 0x1.0p-53; }
+double rng_uniform(rng_t *r) {
+  return (rng_next(r) >> 11) * 0x1.0p-53;
+}
 
 double rng_gauss(rng_t *r, double sigma) {
   if (sigma <= 0.0) return 0.0;

@@ -9,7 +9,7 @@ typedef struct rng {
 } rng_t;
 
 void rng_seed(rng_t *r, uint64_t seed);
-double rng_uniform(rng_t *r);              /* [0, 1) */
-double rng_gauss(rng_t *r, double sigma);  /* N(0, sigma^2) */
+double rng_uniform(rng_t *r);             /* [0, 1) */
+double rng_gauss(rng_t *r, double sigma); /* N(0, sigma^2) */
 
 #endif

@@ -56,7 +56,8 @@ int scn_parse_start(const char *text, scn_pose_t *out, char *err, size_t err_sz)
   if (n != 3) {
     snprintf(err, err_sz,
              "%s '%s': expected X,Y,YAW_DEG (x, y [m] of the rear-axle centre, yaw [deg]), "
-             "e.g. --start -1,0.6,90; got %d number(s)", opt, text, n);
+             "e.g. --start -1,0.6,90; got %d number(s)",
+             opt, text, n);
     return -1;
   }
   if (scn_in(opt, text, "x [m]", v[0], -SCN_COORD_MAX_M, SCN_COORD_MAX_M, err, err_sz) ||

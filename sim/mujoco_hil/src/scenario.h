@@ -15,11 +15,11 @@ extern "C" {
 #define SCN_LATE_BOX_HEIGHT_M 0.2        /* full height [m]: above the LIDAR at 0.1757 m */
 #define SCN_LATE_BOX_HALF_MIN_M 0.01     /* half size limits [m] */
 #define SCN_LATE_BOX_HALF_MAX_M 1.0
-#define SCN_COORD_MAX_M 1000.0           /* |x|, |y| bound before the map check [m] */
+#define SCN_COORD_MAX_M 1000.0 /* |x|, |y| bound before the map check [m] */
 
 typedef struct scn_pose {
-  double x_m, y_m;  /* base_link (rear-axle centre) in the world [m] */
-  double yaw_deg;   /* heading, counter-clockwise from world +x [deg] */
+  double x_m, y_m; /* base_link (rear-axle centre) in the world [m] */
+  double yaw_deg;  /* heading, counter-clockwise from world +x [deg] */
 } scn_pose_t;
 
 typedef struct scn_late_box {

@@ -15,8 +15,8 @@ static int script_num(const char *spec, const char *key, const char *val, double
   errno = 0;
   double v = strtod(val, &end);
   if (end == val || *end != '\0' || errno || !isfinite(v) || v < lo || v > hi) {
-    snprintf(err, err_sz, "--script '%s': %s='%s' is not a number in [%g, %g]", spec, key, val,
-             lo, hi);
+    snprintf(err, err_sz, "--script '%s': %s='%s' is not a number in [%g, %g]", spec, key, val, lo,
+             hi);
     return -1;
   }
   *out = v;
@@ -28,15 +28,13 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
   s->stop_us = -1;
   const char *prefix = "constant:";
   if (strncmp(spec, prefix, strlen(prefix)) != 0) {
-    snprintf(err, err_sz, "--script '%s': unknown kind (expected 'constant:key=value,...')",
-             spec);
+    snprintf(err, err_sz, "--script '%s': unknown kind (expected 'constant:key=value,...')", spec);
     return -1;
   }
   char buf[256];
   snprintf(buf, sizeof buf, "%s", spec + strlen(prefix));
   double start = 0.0, stop = -1.0;
-  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
-       tok = strtok_r(NULL, ",", &save)) {
+  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
     char *eq = strchr(tok, '=');
     if (!eq) {
       snprintf(err, err_sz, "--script '%s': '%s' is not key=value", spec, tok);
@@ -79,6 +77,5 @@ size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap) {
   uint8_t payload[PROTO_LEN_COMMAND];
   proto_command_pack(&c, payload);
   s->sent++;
-  return proto_frame_encode(PROTO_ID_COMMAND, s->frame_seq++, payload, PROTO_LEN_COMMAND, out,
-                            cap);
+  return proto_frame_encode(PROTO_ID_COMMAND, s->frame_seq++, payload, PROTO_LEN_COMMAND, out, cap);
 }

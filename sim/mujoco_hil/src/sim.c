@@ -47,8 +47,14 @@ static const struct {
   uint8_t bits;
   float on[3], off[3];
 } sim_lamp[SIM_LAMPS] = {
-    {"lamp_head_l", NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH, {1, 1, 0.85f}, {0.25f, 0.25f, 0.22f}},
-    {"lamp_head_r", NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH, {1, 1, 0.85f}, {0.25f, 0.25f, 0.22f}},
+    {"lamp_head_l",
+     NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH,
+     {1, 1, 0.85f},
+     {0.25f, 0.25f, 0.22f}},
+    {"lamp_head_r",
+     NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH,
+     {1, 1, 0.85f},
+     {0.25f, 0.25f, 0.22f}},
     {"lamp_ind_fl", NIGEL_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
     {"lamp_ind_fr", NIGEL_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
     {"lamp_tail_l", NIGEL_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
@@ -124,9 +130,13 @@ static void hal_motor_set(void *ctx, uint8_t duty, uint8_t reverse, uint8_t brak
   c->brake = brake;
 }
 
-static void hal_servo_set_us(void *ctx, uint16_t pulse_us) { ((sim_car_t *)ctx)->servo_us = pulse_us; }
+static void hal_servo_set_us(void *ctx, uint16_t pulse_us) {
+  ((sim_car_t *)ctx)->servo_us = pulse_us;
+}
 
-static void hal_lamps_set(void *ctx, uint8_t lamps) { ((sim_car_t *)ctx)->lamps = lamps; }
+static void hal_lamps_set(void *ctx, uint8_t lamps) {
+  ((sim_car_t *)ctx)->lamps = lamps;
+}
 
 static int16_t sim_sat16(double v) {
   if (v > 32767.0) return 32767;
@@ -141,8 +151,10 @@ static int hal_imu_read(void *ctx, nigel_imu_raw_t *out) {
   const sim_t *s = c->sim;
   const mjtNum *sd = s->d->sensordata;
   for (int k = 0; k < 3; k++) {
-    const double a = sd[c->accel_adr + k] + c->accel_bias[k] + rng_gauss(&c->rng, s->p.accel_noise_m_s2);
-    const double w = sd[c->gyro_adr + k] + c->gyro_bias[k] + rng_gauss(&c->rng, s->p.gyro_noise_rad_s);
+    const double a =
+        sd[c->accel_adr + k] + c->accel_bias[k] + rng_gauss(&c->rng, s->p.accel_noise_m_s2);
+    const double w =
+        sd[c->gyro_adr + k] + c->gyro_bias[k] + rng_gauss(&c->rng, s->p.gyro_noise_rad_s);
     const double b = sd[c->mag_adr + k] + rng_gauss(&c->rng, s->p.mag_noise_ut);
     out->accel[k] = sim_sat16(a / SIM_G_M_S2 * PROTO_ACCEL_LSB_PER_G);
     out->gyro[k] = sim_sat16(w * (180.0 / M_PI) * PROTO_GYRO_LSB_PER_DPS);
@@ -245,10 +257,12 @@ static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
   const vp_params_t *p = &s->p;
   const double *co = p->chassis_offset_m, *cs = p->chassis_size_m;
   const double r = p->wheel_radius_m, wy = 0.5 * (p->track_m + p->wheel_width_m);
-  const double x0 = fmin(co[0] - 0.5 * cs[0], -r), x1 = fmax(co[0] + 0.5 * cs[0], p->wheelbase_m + r);
+  const double x0 = fmin(co[0] - 0.5 * cs[0], -r),
+               x1 = fmax(co[0] + 0.5 * cs[0], p->wheelbase_m + r);
   const double y0 = fmin(co[1] - 0.5 * cs[1], -wy), y1 = fmax(co[1] + 0.5 * cs[1], wy);
   const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
-  const double yaw = atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
+  const double yaw =
+      atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
   const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1); /* in the car's frame */
   out->centre_m[0] = qp[0] + cos(yaw) * cx - sin(yaw) * cy;
   out->centre_m[1] = qp[1] + sin(yaw) * cx + cos(yaw) * cy;
@@ -271,7 +285,8 @@ static void sim_box_prism(const scn_late_box_t *b, cl_prism_t *out) {
 
 int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
   const mjModel *m = s->m;
-  const int ct = m->geom_contype[s->car[0].chassis_geom], ca = m->geom_conaffinity[s->car[0].chassis_geom];
+  const int ct = m->geom_contype[s->car[0].chassis_geom],
+            ca = m->geom_conaffinity[s->car[0].chassis_geom];
   char why[512];
   cl_prism_t pr;
   for (int i = 0; s->has_start && i < s->ncars; i++) {
@@ -303,7 +318,7 @@ static void sim_place_late_boxes(sim_t *s) {
     s->box_new[k] = 0;
     const scn_late_box_t *b = &s->box[k];
     if (s->time_us < (int64_t)llround(b->t_s * 1e6)) continue;
-    if (!s->box_placed[k] && b->near_m > 0) {  /* a box that steps out as the car comes near */
+    if (!s->box_placed[k] && b->near_m > 0) { /* a box that steps out as the car comes near */
       const mjtNum *car = s->d->qpos + s->car[0].root_qpos;
       if (hypot(car[0] - b->x_m, car[1] - b->y_m) > b->near_m) continue;
     }
@@ -344,7 +359,8 @@ static int sim_fail(char *err, size_t err_sz, const char *fmt, const char *a, co
 
 /* The map alone must compile: its errors then name the map file, not the generated scene. */
 static int sim_check_map(const char *path, char *err, size_t err_sz) {
-  if (access(path, R_OK) != 0) return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
+  if (access(path, R_OK) != 0)
+    return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
   char merr[1000] = "";
   mjModel *mm = mj_loadXML(path, NULL, merr, sizeof merr);
   if (!mm) return sim_fail(err, err_sz, "bad map file '%s': %s", path, merr);
@@ -354,7 +370,8 @@ static int sim_check_map(const char *path, char *err, size_t err_sz) {
 
 #ifdef SIM_HAVE_SENSORS
 /* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
-static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err, size_t err_sz) {
+static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err,
+                            size_t err_sz) {
   const size_t asz = 512;
   *asset = calloc((size_t)cars, asz);
   *geoms = calloc((size_t)cars, sizeof(char *));
@@ -399,14 +416,14 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   char merr[1000] = "";
   s->m = mj_loadXML(s->scene_path, NULL, merr, sizeof merr);
   if (!s->m)
-    return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path,
-                    merr);
+    return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path, merr);
   s->d = mj_makeData(s->m);
   if (!s->d) return sim_fail(err, err_sz, "%s%s", "mj_makeData failed (out of memory)", "");
   return 0;
 }
 
-static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err, size_t err_sz) {
+static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err,
+                         size_t err_sz) {
   c->sim = s;
   c->servo_us = 1500;
   c->brake = 1;
@@ -468,8 +485,12 @@ int sim_lidar_pty_scanning(const sim_t *s, int car) {
 #endif
 }
 
-int sim_late_boxes(const sim_t *s) { return s->nbox; }
-const scn_late_box_t *sim_late_box(const sim_t *s, int k) { return &s->box[k]; }
+int sim_late_boxes(const sim_t *s) {
+  return s->nbox;
+}
+const scn_late_box_t *sim_late_box(const sim_t *s, int k) {
+  return &s->box[k];
+}
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
   if (car_below) *car_below = s->box_car_below[k];
   return s->box_new[k];
@@ -528,8 +549,8 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
                           p->long_asymptote[1]};
   s->lat = (tyre_curve_t){p->lat_extremum[0], p->lat_extremum[1], p->lat_asymptote[0],
                           p->lat_asymptote[1]};
-  s->motor = (motor_model_t){p->motor_stall_torque_nm, p->motor_noload_speed_rad_s,
-                             p->motor_nominal_v};
+  s->motor =
+      (motor_model_t){p->motor_stall_torque_nm, p->motor_noload_speed_rad_s, p->motor_nominal_v};
   for (int i = 0; i < cfg->cars; i++) {
     s->car[i].index = i + 1;
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
@@ -762,15 +783,27 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
 }
 
 /* ---- queries ------------------------------------------------------------------------- */
-int64_t sim_time_us(const sim_t *s) { return s->time_us; }
-int sim_cars(const sim_t *s) { return s->ncars; }
-const mjModel *sim_model(const sim_t *s) { return s->m; }
-mjData *sim_data(const sim_t *s) { return s->d; }
+int64_t sim_time_us(const sim_t *s) {
+  return s->time_us;
+}
+int sim_cars(const sim_t *s) {
+  return s->ncars;
+}
+const mjModel *sim_model(const sim_t *s) {
+  return s->m;
+}
+mjData *sim_data(const sim_t *s) {
+  return s->d;
+}
 const char *sim_nano_link(const sim_t *s, int car) {
   return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : "";
 }
-const char *sim_lidar_link(const sim_t *s, int car) { return s->car[car - 1].lidar_link; }
-const nigel_t *sim_nano(const sim_t *s, int car) { return &s->car[car - 1].nano; }
+const char *sim_lidar_link(const sim_t *s, int car) {
+  return s->car[car - 1].lidar_link;
+}
+const nigel_t *sim_nano(const sim_t *s, int car) {
+  return &s->car[car - 1].nano;
+}
 
 int64_t sim_host_rx_us(const sim_t *s, int car) {
   const sim_car_t *c = &s->car[car - 1];
@@ -811,7 +844,8 @@ void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {
   memset(o, 0, sizeof *o);
   mju_copy3(o->pos_m, qp);
   mju_copy4(o->quat_wxyz, qp + 3);
-  o->yaw_rad = atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
+  o->yaw_rad =
+      atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
   /* free joint: linear velocity of the body origin in the world, angular in the body frame */
   mjtNum R[9];
   mju_quat2Mat(R, qp + 3);

@@ -38,14 +38,14 @@ typedef struct sim_config {
 typedef struct sim sim_t;
 
 typedef struct sim_truth {
-  double pos_m[3];        /* base_link in the world */
+  double pos_m[3]; /* base_link in the world */
   double quat_wxyz[4];
   double yaw_rad;
   double vel_body_m_s[3]; /* base_link origin velocity, body frame */
   double gyro_body_rad_s[3];
-  double steering_rad;    /* centre angle from the two knuckles (Ackermann inverse) */
+  double steering_rad;         /* centre angle from the two knuckles (Ackermann inverse) */
   double wheel_speed_rad_s[4]; /* fl fr rl rr, + forward */
-  int in_collision;       /* chassis touches anything */
+  int in_collision;            /* chassis touches anything */
 } sim_truth_t;
 
 /* Builds the world. Returns NULL with a message naming the bad input in err. */

@@ -24,8 +24,8 @@ static double tyre_clamp(double f, double limit) {
   return f;
 }
 
-void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_t *in,
-                double *fx_n, double *fy_n) {
+void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_t *in, double *fx_n,
+                double *fy_n) {
   *fx_n = 0.0;
   *fy_n = 0.0;
   if (in->fz_n <= 0.0) return;

@@ -21,12 +21,12 @@ typedef struct tyre_curve {
 double tyre_curve_eval(const tyre_curve_t *c, double slip);
 
 typedef struct tyre_in {
-  double v_x_m_s, v_y_m_s;  /* hub velocity in the wheel's heading frame */
-  double omega_r_m_s;       /* wheel spin times radius [m/s] */
-  double fz_n;              /* normal load [N] */
-  double mu;                /* surface friction */
+  double v_x_m_s, v_y_m_s; /* hub velocity in the wheel's heading frame */
+  double omega_r_m_s;      /* wheel spin times radius [m/s] */
+  double fz_n;             /* normal load [N] */
+  double mu;               /* surface friction */
   double v_min_m_s;
-  double rolling_resistance; /* [N/N] */
+  double rolling_resistance;  /* [N/N] */
   double m_long_kg, m_lat_kg; /* effective masses for the no-overshoot clamp */
   double dt_s;
 } tyre_in_t;
@@ -34,8 +34,8 @@ typedef struct tyre_in {
 /* Forces on the wheel at the contact [N] (+x forward, +y left) from the curves. Each force is
  * also limited to what stops the slip velocity within one step (never reverses it), which keeps
  * the explicit 1 ms integration stable at low speed. */
-void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_t *in,
-                double *fx_n, double *fy_n);
+void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_t *in, double *fx_n,
+                double *fy_n);
 
 #ifdef __cplusplus
 }

@@ -8,7 +8,9 @@ void uart_init(uart_queue_t *q, uint32_t baud) {
   q->dropped_bytes = 0;
 }
 
-size_t uart_space(const uart_queue_t *q) { return UART_QUEUE_BYTES - q->count; }
+size_t uart_space(const uart_queue_t *q) {
+  return UART_QUEUE_BYTES - q->count;
+}
 
 void uart_push(uart_queue_t *q, const uint8_t *data, size_t n) {
   for (size_t i = 0; i < n; i++) {

@@ -15,9 +15,9 @@ extern "C" {
 typedef struct uart_queue {
   uint8_t buf[UART_QUEUE_BYTES];
   size_t head, count;
-  double credit_bytes;     /* wire time earned but not yet used [bytes] */
-  double bytes_per_us;     /* baud / 10 / 1e6 */
-  uint64_t dropped_bytes;  /* bytes refused because the queue was full */
+  double credit_bytes;    /* wire time earned but not yet used [bytes] */
+  double bytes_per_us;    /* baud / 10 / 1e6 */
+  uint64_t dropped_bytes; /* bytes refused because the queue was full */
 } uart_queue_t;
 
 void uart_init(uart_queue_t *q, uint32_t baud);

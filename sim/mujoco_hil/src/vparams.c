@@ -16,23 +16,56 @@ typedef struct vp_key {
   int positive;  /* 1: every value must be > 0 */
 } vp_key_t;
 
-#define K(field, n, pos) {#field, offsetof(vp_params_t, field), n, pos}
+#define K(field, n, pos) \
+  { #field, offsetof(vp_params_t, field), n, pos }
 static const vp_key_t vp_keys[] = {
-    K(mass_kg, 1, 1), K(yaw_inertia_kg_m2, 1, 1), K(roll_pitch_inertia_kg_m2, 2, 1),
-    K(wheelbase_m, 1, 1), K(track_m, 1, 1), K(wheel_radius_m, 1, 1), K(wheel_width_m, 1, 1),
-    K(wheel_mass_kg, 1, 1), K(com_to_front_m, 1, 1), K(com_height_m, 1, 0),
-    K(chassis_size_m, 3, 1), K(chassis_offset_m, 3, 0), K(knuckle_armature_kg_m2, 1, 1),
-    K(wheel_armature_kg_m2, 1, 0), K(motor_stall_torque_nm, 1, 1),
-    K(motor_noload_speed_rad_s, 1, 1), K(motor_nominal_v, 1, 1), K(motor_armature_kg_m2, 1, 0),
-    K(gearbox_friction_nm, 1, 0), K(brake_hold_torque_nm, 1, 0), K(steer_limit_rad, 1, 1),
-    K(steer_rate_rad_s, 1, 1), K(servo_center_us, 1, 1), K(servo_us_per_full, 1, 1),
-    K(steer_kp_nm_rad, 1, 1), K(steer_kv_nms_rad, 1, 0), {"tyre_model", 0, 0, 0},
-    K(long_extremum, 2, 1), K(long_asymptote, 2, 1), K(lat_extremum, 2, 1),
-    K(lat_asymptote, 2, 1), K(tyre_v_min_m_s, 1, 1), K(tyre_rolling_resistance, 1, 0),
-    K(imu_pos_m, 3, 0), K(accel_noise_m_s2, 1, 0), K(gyro_noise_rad_s, 1, 0),
-    K(mag_noise_ut, 1, 0), K(accel_bias_m_s2, 1, 0), K(gyro_bias_rad_s, 1, 0),
-    K(mag_field_ut, 3, 0), K(battery_v, 1, 1), K(battery_noise_v, 1, 0), K(lidar_pos_m, 3, 0),
-    K(tag_pos_m, 3, 0), K(tag_size_m, 1, 1), K(cam_front_pos_m, 3, 0), K(cam_rear_pos_m, 3, 0),
+    K(mass_kg, 1, 1),
+    K(yaw_inertia_kg_m2, 1, 1),
+    K(roll_pitch_inertia_kg_m2, 2, 1),
+    K(wheelbase_m, 1, 1),
+    K(track_m, 1, 1),
+    K(wheel_radius_m, 1, 1),
+    K(wheel_width_m, 1, 1),
+    K(wheel_mass_kg, 1, 1),
+    K(com_to_front_m, 1, 1),
+    K(com_height_m, 1, 0),
+    K(chassis_size_m, 3, 1),
+    K(chassis_offset_m, 3, 0),
+    K(knuckle_armature_kg_m2, 1, 1),
+    K(wheel_armature_kg_m2, 1, 0),
+    K(motor_stall_torque_nm, 1, 1),
+    K(motor_noload_speed_rad_s, 1, 1),
+    K(motor_nominal_v, 1, 1),
+    K(motor_armature_kg_m2, 1, 0),
+    K(gearbox_friction_nm, 1, 0),
+    K(brake_hold_torque_nm, 1, 0),
+    K(steer_limit_rad, 1, 1),
+    K(steer_rate_rad_s, 1, 1),
+    K(servo_center_us, 1, 1),
+    K(servo_us_per_full, 1, 1),
+    K(steer_kp_nm_rad, 1, 1),
+    K(steer_kv_nms_rad, 1, 0),
+    {"tyre_model", 0, 0, 0},
+    K(long_extremum, 2, 1),
+    K(long_asymptote, 2, 1),
+    K(lat_extremum, 2, 1),
+    K(lat_asymptote, 2, 1),
+    K(tyre_v_min_m_s, 1, 1),
+    K(tyre_rolling_resistance, 1, 0),
+    K(imu_pos_m, 3, 0),
+    K(accel_noise_m_s2, 1, 0),
+    K(gyro_noise_rad_s, 1, 0),
+    K(mag_noise_ut, 1, 0),
+    K(accel_bias_m_s2, 1, 0),
+    K(gyro_bias_rad_s, 1, 0),
+    K(mag_field_ut, 3, 0),
+    K(battery_v, 1, 1),
+    K(battery_noise_v, 1, 0),
+    K(lidar_pos_m, 3, 0),
+    K(tag_pos_m, 3, 0),
+    K(tag_size_m, 1, 1),
+    K(cam_front_pos_m, 3, 0),
+    K(cam_rear_pos_m, 3, 0),
 };
 #undef K
 #define VP_NKEYS (sizeof vp_keys / sizeof vp_keys[0])
@@ -109,10 +142,13 @@ int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz) {
     }
     seen[k] = 1;
     if (vp_keys[k].count == 0) { /* tyre_model */
-      if (strcmp(val, "paper") == 0) p->tyre_model_paper = 1;
-      else if (strcmp(val, "mujoco") == 0) p->tyre_model_paper = 0;
-      else rc = vp_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'", path,
-                        lineno, key, val);
+      if (strcmp(val, "paper") == 0)
+        p->tyre_model_paper = 1;
+      else if (strcmp(val, "mujoco") == 0)
+        p->tyre_model_paper = 0;
+      else
+        rc = vp_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'", path, lineno,
+                     key, val);
       continue;
     }
     double *dst = (double *)((char *)p + vp_keys[k].offset);
@@ -122,16 +158,16 @@ int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz) {
       errno = 0;
       double v = strtod(cur, &end);
       if (end == cur || errno != 0 || !isfinite(v))
-        rc = vp_fail(err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'",
-                     path, lineno, key, vp_keys[k].count, i + 1, *cur ? cur : "(missing)");
+        rc = vp_fail(err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'", path,
+                     lineno, key, vp_keys[k].count, i + 1, *cur ? cur : "(missing)");
       else if (vp_keys[k].positive && v <= 0.0)
         rc = vp_fail(err, err_sz, "%s:%d: key '%s': must be > 0, got %g", path, lineno, key, v);
       dst[i] = v;
       cur = end;
     }
     if (rc == 0 && *vp_trim(cur) != '\0')
-      rc = vp_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path, lineno,
-                   key, vp_trim(cur));
+      rc = vp_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path, lineno, key,
+                   vp_trim(cur));
   }
   fclose(f);
   for (size_t k = 0; rc == 0 && k < VP_NKEYS; k++)

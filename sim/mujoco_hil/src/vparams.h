@@ -12,8 +12,8 @@ extern "C" {
 
 typedef struct vp_params {
   /* body */
-  double mass_kg;                /* whole car incl. wheels */
-  double yaw_inertia_kg_m2;      /* whole car about the CoM */
+  double mass_kg;           /* whole car incl. wheels */
+  double yaw_inertia_kg_m2; /* whole car about the CoM */
   double roll_pitch_inertia_kg_m2[2];
   double wheelbase_m, track_m, wheel_radius_m, wheel_width_m, wheel_mass_kg;
   double com_to_front_m;         /* CoM ahead of the rear axle = wheelbase - this */
@@ -26,24 +26,24 @@ typedef struct vp_params {
   double motor_stall_torque_nm;
   double motor_noload_speed_rad_s; /* at motor_nominal_v */
   double motor_nominal_v;
-  double motor_armature_kg_m2;   /* rotor inertia reflected through the gearbox */
-  double gearbox_friction_nm;    /* static friction of the gear train */
-  double brake_hold_torque_nm;   /* extra holding friction while the driver brakes */
+  double motor_armature_kg_m2; /* rotor inertia reflected through the gearbox */
+  double gearbox_friction_nm;  /* static friction of the gear train */
+  double brake_hold_torque_nm; /* extra holding friction while the driver brakes */
   /* steering */
   double steer_limit_rad, steer_rate_rad_s;
   double servo_center_us, servo_us_per_full; /* pulse [us] at straight, per full lock */
   double steer_kp_nm_rad, steer_kv_nms_rad;  /* knuckle position loop */
   /* tyres */
-  int tyre_model_paper;          /* 1: paper slip model, 0: plain MuJoCo contact friction */
+  int tyre_model_paper; /* 1: paper slip model, 0: plain MuJoCo contact friction */
   double long_extremum[2], long_asymptote[2]; /* (slip, value) */
   double lat_extremum[2], lat_asymptote[2];   /* (tan slip angle, value) */
-  double tyre_v_min_m_s;         /* slip denominator floor at standstill */
-  double tyre_rolling_resistance; /* [N/N] */
+  double tyre_v_min_m_s;                      /* slip denominator floor at standstill */
+  double tyre_rolling_resistance;             /* [N/N] */
   /* IMU (MPU-9250) */
   double imu_pos_m[3];
   double accel_noise_m_s2, gyro_noise_rad_s, mag_noise_ut;
   double accel_bias_m_s2, gyro_bias_rad_s; /* max |bias| per axis, drawn per car from seed */
-  double mag_field_ut[3];        /* world magnetic field */
+  double mag_field_ut[3];                  /* world magnetic field */
   /* battery */
   double battery_v, battery_noise_v;
   /* sensor mounts, for the sensors library */

@@ -12,9 +12,10 @@ int main(int argc, char **argv) {
   avr_t *avr;
   unsigned long res_addr, done_addr;
   unsigned long long guard = 0;
-  static const char *names[] = {"init", "step_idle", "step_imu_read", "step_battery",
-                                "step_telemetry", "rx_command_frame", "enc_edge_call",
-                                "step_idle_max", "schema_hash", "step_ahrs_gravity", "step_ahrs_mag", "step_ahrs_integrate"};
+  static const char *names[] = {
+      "init",           "step_idle",         "step_imu_read", "step_battery",
+      "step_telemetry", "rx_command_frame",  "enc_edge_call", "step_idle_max",
+      "schema_hash",    "step_ahrs_gravity", "step_ahrs_mag", "step_ahrs_integrate"};
   unsigned i;
   if (argc != 4) {
     fprintf(stderr, "usage: %s <core_cycles.elf> <core_results addr> <core_done addr>\n", argv[0]);

@@ -16,34 +16,127 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 LIB = os.path.join(ROOT, "firmware", "nano", "lib")
 TESTS = os.path.join(ROOT, "tests", "firmware_host")
 MODULES = ["nigel", "proto", "fs", "act", "lights", "batt", "wspd", "ahrs", "enc"]
-C_SOURCES = ["proto/proto.c", "nigel/nigel_core.c", "fs/fs.c", "act/act.c", "lights/lights.c",
-             "batt/batt.c", "wspd/wspd.c", "ahrs/ahrs.c"]
+C_SOURCES = [
+    "proto/proto.c",
+    "nigel/nigel_core.c",
+    "fs/fs.c",
+    "act/act.c",
+    "lights/lights.c",
+    "batt/batt.c",
+    "wspd/wspd.c",
+    "ahrs/ahrs.c",
+]
 
 # (file, exact text, replacement, what the bug means)
 MUTANTS = [
     ("fs/fs.c", "< f->timeout_us) return;", "<= f->timeout_us) return;", "timeout one tick late"),
     ("fs/fs.c", "    f->link_lost = 1;\n", "", "link loss not latched"),
-    ("fs/fs.c", "  fs_update(f, now_us);\n  f->last_cmd_us", "  f->last_cmd_us", "late command hides the gap"),
+    (
+        "fs/fs.c",
+        "  fs_update(f, now_us);\n  f->last_cmd_us",
+        "  f->last_cmd_us",
+        "late command hides the gap",
+    ),
     ("fs/fs.c", "  if (!f->prev_disengaged) return 0;", "", "arming without the engaged=0 edge"),
-    ("fs/fs.c", "  f->prev_disengaged = 0;\n  if (f->mode == PROTO_MODE_ENGAGED) {", "  if (f->mode == PROTO_MODE_ENGAGED) {", "stale engaged=0 still arms"),
-    ("fs/fs.c", "    if (f->mode == PROTO_MODE_ENGAGED) f->mode = PROTO_MODE_DISARMED;", "", "disengage ignored"),
+    (
+        "fs/fs.c",
+        "  f->prev_disengaged = 0;\n  if (f->mode == PROTO_MODE_ENGAGED) {",
+        "  if (f->mode == PROTO_MODE_ENGAGED) {",
+        "stale engaged=0 still arms",
+    ),
+    (
+        "fs/fs.c",
+        "    if (f->mode == PROTO_MODE_ENGAGED) f->mode = PROTO_MODE_DISARMED;",
+        "",
+        "disengage ignored",
+    ),
     ("fs/fs.c", "  f->link_lost = 0;\n  return 1;", "  return 1;", "re-arm keeps the fault"),
-    ("fs/fs.c", "    f->mode = PROTO_MODE_FAILSAFE;", "    f->mode = PROTO_MODE_DISARMED;", "link loss without failsafe mode"),
+    (
+        "fs/fs.c",
+        "    f->mode = PROTO_MODE_FAILSAFE;",
+        "    f->mode = PROTO_MODE_DISARMED;",
+        "link loss without failsafe mode",
+    ),
     ("nigel/nigel_core.c", "  if (!proto_command_valid(&c)) {", "  if (0) {", "no range check"),
-    ("nigel/nigel_core.c", "    n->faults_latched |= PROTO_FAULT_CMD_INVALID;\n", "", "invalid command not flagged"),
+    (
+        "nigel/nigel_core.c",
+        "    n->faults_latched |= PROTO_FAULT_CMD_INVALID;\n",
+        "",
+        "invalid command not flagged",
+    ),
     ("nigel/nigel_core.c", "  n->cmd = c;\n}", "}", "valid command not applied"),
-    ("nigel/nigel_core.c", "  if (n->batt.cutoff) act_flags |= ACT_STOP;", "", "battery cut-off ignored"),
-    ("nigel/nigel_core.c", "  if (!fs_may_drive(&n->fs)) act_flags = ACT_STOP | ACT_HOLD_STEERING;", "  if (!fs_may_drive(&n->fs)) act_flags = ACT_HOLD_STEERING;", "drives while not engaged"),
-    ("nigel/nigel_core.c", "n->fs.mode == PROTO_MODE_FAILSAFE ? 3u : n->cmd.indicators", "n->cmd.indicators", "no hazards in failsafe"),
-    ("nigel/nigel_core.c", "  fs_update(&n->fs, now_us);\n", "", "failsafe not checked in the loop"),
-    ("nigel/nigel_core.c", "  fs_set_timeout_ms(&n->fs, c.failsafe_timeout_ms);", "", "timeout config ignored"),
-    ("nigel/nigel_core.c", "  if (!proto_config_valid(&c)) {", "  if (0) {", "config not validated"),
-    ("act/act.c", "    a->throttle_u = 0; /* stopping is never slew-limited */", "    a->throttle_u = move_toward(a->throttle_u, 0, (int32_t)dt_us * 4);", "stop is slew-limited"),
-    ("act/act.c", "  a->brake = (uint8_t)(stop || a->duty == 0u);", "  a->brake = (uint8_t)(a->duty == 0u && !stop);", "no brake on stop"),
-    ("act/act.c", "(int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L)", "(int32_t)dt_us * 40", "slew limit 10x too loose"),
-    ("act/act.c", "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14)", "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 12)", "steering rate 4x too fast"),
-    ("act/act.c", "  if (pulse > ACT_SERVO_MAX_US) pulse = ACT_SERVO_MAX_US;", "", "no servo saturation"),
-    ("batt/batt.c", "  else if (mv > BATT_CUTOFF_CLEAR_MV) b->cutoff = 0;", "  else b->cutoff = 0;", "no cut-off hysteresis"),
+    (
+        "nigel/nigel_core.c",
+        "  if (n->batt.cutoff) act_flags |= ACT_STOP;",
+        "",
+        "battery cut-off ignored",
+    ),
+    (
+        "nigel/nigel_core.c",
+        "  if (!fs_may_drive(&n->fs)) act_flags = ACT_STOP | ACT_HOLD_STEERING;",
+        "  if (!fs_may_drive(&n->fs)) act_flags = ACT_HOLD_STEERING;",
+        "drives while not engaged",
+    ),
+    (
+        "nigel/nigel_core.c",
+        "n->fs.mode == PROTO_MODE_FAILSAFE ? 3u : n->cmd.indicators",
+        "n->cmd.indicators",
+        "no hazards in failsafe",
+    ),
+    (
+        "nigel/nigel_core.c",
+        "  fs_update(&n->fs, now_us);\n",
+        "",
+        "failsafe not checked in the loop",
+    ),
+    (
+        "nigel/nigel_core.c",
+        "  fs_set_timeout_ms(&n->fs, c.failsafe_timeout_ms);",
+        "",
+        "timeout config ignored",
+    ),
+    (
+        "nigel/nigel_core.c",
+        "  if (!proto_config_valid(&c)) {",
+        "  if (0) {",
+        "config not validated",
+    ),
+    (
+        "act/act.c",
+        "    a->throttle_u = 0; /* stopping is never slew-limited */",
+        "    a->throttle_u = move_toward(a->throttle_u, 0, (int32_t)dt_us * 4);",
+        "stop is slew-limited",
+    ),
+    (
+        "act/act.c",
+        "  a->brake = (uint8_t)(stop || a->duty == 0u);",
+        "  a->brake = (uint8_t)(a->duty == 0u && !stop);",
+        "no brake on stop",
+    ),
+    (
+        "act/act.c",
+        "(int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L)",
+        "(int32_t)dt_us * 40",
+        "slew limit 10x too loose",
+    ),
+    (
+        "act/act.c",
+        "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14)",
+        "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 12)",
+        "steering rate 4x too fast",
+    ),
+    (
+        "act/act.c",
+        "  if (pulse > ACT_SERVO_MAX_US) pulse = ACT_SERVO_MAX_US;",
+        "",
+        "no servo saturation",
+    ),
+    (
+        "batt/batt.c",
+        "  else if (mv > BATT_CUTOFF_CLEAR_MV) b->cutoff = 0;",
+        "  else b->cutoff = 0;",
+        "no cut-off hysteresis",
+    ),
     ("lights/lights.c", "  if (braking) lamps |= NIGEL_LAMP_TAIL;", "", "no taillights"),
     ("proto/proto.c", "    if (crc != crc_rx) {", "    if (0) {", "CRC not checked"),
 ]
@@ -65,8 +158,10 @@ def main():
     objs = []
     for t in ["test_codec.cpp", "test_core.cpp", "test_modules.cpp"]:
         o = os.path.join(work, t + ".o")
-        r = run(["g++", "-std=c++17", "-O1", "-c", os.path.join(TESTS, t), "-o", o, "-I" + TESTS] +
-                ["-I" + os.path.join(LIB, m) for m in MODULES])
+        r = run(
+            ["g++", "-std=c++17", "-O1", "-c", os.path.join(TESTS, t), "-o", o, "-I" + TESTS]
+            + ["-I" + os.path.join(LIB, m) for m in MODULES]
+        )
         if r.returncode != 0:
             print(r.stdout)
             return 2
@@ -83,14 +178,22 @@ def main():
         path = os.path.join(lib, f)
         src = open(path).read()
         if i >= 0 and src.count(old) != 1:
-            print("mutant %d (%s): text not found exactly once in %s: fix the mutant list" % (i, what, f))
+            print(
+                "mutant %d (%s): text not found exactly once in %s: fix the mutant list"
+                % (i, what, f)
+            )
             return 2
         if i >= 0:
             open(path, "w").write(src.replace(old, new))
         exe = os.path.join(work, "t%d" % i)
-        cmd = ["g++", "-O1", "-o", exe] + objs + ["-x", "c", "-std=c99"] + \
-              [os.path.join(lib, s) for s in C_SOURCES] + \
-              ["-I" + os.path.join(lib, m) for m in MODULES] + ["-x", "none", "-lgtest", "-lgtest_main", "-lpthread", "-lm"]
+        cmd = (
+            ["g++", "-O1", "-o", exe]
+            + objs
+            + ["-x", "c", "-std=c99"]
+            + [os.path.join(lib, s) for s in C_SOURCES]
+            + ["-I" + os.path.join(lib, m) for m in MODULES]
+            + ["-x", "none", "-lgtest", "-lgtest_main", "-lpthread", "-lm"]
+        )
         r = run(cmd)
         if r.returncode != 0:
             status = "killed (does not build)"
@@ -98,7 +201,11 @@ def main():
             r = run([exe, "--gtest_brief=1"])
             status = "killed" if r.returncode != 0 else "SURVIVED"
         if i < 0:
-            print("[baseline ] unmutated core: %s" % ("tests pass" if status == "SURVIVED" else "TESTS FAIL"), flush=True)
+            print(
+                "[baseline ] unmutated core: %s"
+                % ("tests pass" if status == "SURVIVED" else "TESTS FAIL"),
+                flush=True,
+            )
             if status != "SURVIVED":
                 return 2
             continue
@@ -107,7 +214,9 @@ def main():
         if "--keep" not in sys.argv:
             shutil.rmtree(lib)
     killed = sum(1 for r in results if r[2].startswith("killed"))
-    print(json.dumps({"mutants": len(results), "killed": killed, "survived": len(results) - killed}))
+    print(
+        json.dumps({"mutants": len(results), "killed": killed, "survived": len(results) - killed})
+    )
     return 0 if killed == len(results) else 1
 
 

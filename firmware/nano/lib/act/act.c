@@ -6,7 +6,9 @@ static int32_t move_toward(int32_t cur, int32_t target, int32_t max_step) {
   return (cur - target > max_step) ? cur - max_step : target;
 }
 
-static int32_t abs32(int32_t v) { return v < 0 ? -v : v; }
+static int32_t abs32(int32_t v) {
+  return v < 0 ? -v : v;
+}
 
 void act_init(act_t *a, uint32_t now_us) {
   a->throttle_u = 0;
@@ -38,23 +40,24 @@ void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_
   uint32_t dt_us = (uint32_t)(now_us - a->last_us);
   uint8_t stop = (uint8_t)(flags & ACT_STOP);
   int32_t thr_target = (int32_t)throttle_milli * 1000L;
-  int32_t steer_target = (flags & ACT_HOLD_STEERING) ? a->steering_u : (int32_t)steering_milli * 1000L;
+  int32_t steer_target =
+      (flags & ACT_HOLD_STEERING) ? a->steering_u : (int32_t)steering_milli * 1000L;
   int32_t pulse;
   a->last_us = now_us;
   if (dt_us > ACT_MAX_DT_US) dt_us = ACT_MAX_DT_US;
 
   if (stop) thr_target = 0;
   /* taillights: the driver asks for less drive than is applied (or the other direction) */
-  a->decelerating = (uint8_t)(stop || abs32(thr_target) < abs32(a->throttle_u) ||
-                              (thr_target < 0 && a->throttle_u > 0) ||
-                              (thr_target > 0 && a->throttle_u < 0));
+  a->decelerating =
+      (uint8_t)(stop || abs32(thr_target) < abs32(a->throttle_u) ||
+                (thr_target < 0 && a->throttle_u > 0) || (thr_target > 0 && a->throttle_u < 0));
   if (stop)
     a->throttle_u = 0; /* stopping is never slew-limited */
   else
-    a->throttle_u =
-        move_toward(a->throttle_u, thr_target, (int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L));
-  a->steering_u =
-      move_toward(a->steering_u, steer_target, (int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14));
+    a->throttle_u = move_toward(a->throttle_u, thr_target,
+                                (int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L));
+  a->steering_u = move_toward(a->steering_u, steer_target,
+                              (int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14));
 
   a->duty = duty_of(a->throttle_u);
   a->reverse = (uint8_t)(a->throttle_u < 0);
@@ -68,5 +71,9 @@ void act_update(act_t *a, int16_t throttle_milli, int16_t steering_milli, uint8_
   a->servo_us = (uint16_t)pulse;
 }
 
-int16_t act_throttle_milli(const act_t *a) { return (int16_t)(a->throttle_u / 1000L); }
-int16_t act_steering_milli(const act_t *a) { return (int16_t)(a->steering_u / 1000L); }
+int16_t act_throttle_milli(const act_t *a) {
+  return (int16_t)(a->throttle_u / 1000L);
+}
+int16_t act_steering_milli(const act_t *a) {
+  return (int16_t)(a->steering_u / 1000L);
+}

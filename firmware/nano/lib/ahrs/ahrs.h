@@ -10,23 +10,23 @@
 extern "C" {
 #endif
 
-#define AHRS_KP 1.0f          /* proportional gain [1/s] */
-#define AHRS_KI 0.02f         /* integral gain (gyro bias) [1/s^2] */
-#define AHRS_KP_SETTLE 10.0f  /* proportional gain for the first AHRS_SETTLE_US */
+#define AHRS_KP 1.0f         /* proportional gain [1/s] */
+#define AHRS_KI 0.02f        /* integral gain (gyro bias) [1/s^2] */
+#define AHRS_KP_SETTLE 10.0f /* proportional gain for the first AHRS_SETTLE_US */
 #define AHRS_SETTLE_US 2000000ul
 #define AHRS_MAX_DT_US 100000ul /* a longer gap between samples is treated as this [us] */
 
 typedef struct ahrs {
-  float q[4];        /* w x y z, unit */
-  float ei[3];       /* integral of the error [rad/s] (gyro bias estimate) */
-  float rate[3];     /* gyro rate of the pending sample [rad/s] */
-  float err[3];      /* direction error of the pending sample (gravity + field) */
-  float dt;          /* [s] to integrate; 0 when nothing is pending */
-  uint32_t last_us;  /* [us] time of the last sample */
-  uint32_t run_us;   /* [us] time since the first sample, saturating */
-  uint8_t have;      /* last_us is valid */
-  uint8_t have_acc;  /* the pending sample had a usable accelerometer reading */
-  uint8_t settled;   /* past AHRS_SETTLE_US: normal gain */
+  float q[4];       /* w x y z, unit */
+  float ei[3];      /* integral of the error [rad/s] (gyro bias estimate) */
+  float rate[3];    /* gyro rate of the pending sample [rad/s] */
+  float err[3];     /* direction error of the pending sample (gravity + field) */
+  float dt;         /* [s] to integrate; 0 when nothing is pending */
+  uint32_t last_us; /* [us] time of the last sample */
+  uint32_t run_us;  /* [us] time since the first sample, saturating */
+  uint8_t have;     /* last_us is valid */
+  uint8_t have_acc; /* the pending sample had a usable accelerometer reading */
+  uint8_t settled;  /* past AHRS_SETTLE_US: normal gain */
 } ahrs_t;
 
 void ahrs_init(ahrs_t *a);

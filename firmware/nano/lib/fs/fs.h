@@ -34,7 +34,9 @@ uint8_t fs_on_command(fs_t *f, uint8_t engaged, uint32_t now_us);
 /* Checks the timeout; call every loop pass (and it is called by fs_on_command first). */
 void fs_update(fs_t *f, uint32_t now_us);
 /* 1 when drive is allowed by the link (mode ENGAGED). */
-static inline uint8_t fs_may_drive(const fs_t *f) { return (uint8_t)(f->mode == 1u); }
+static inline uint8_t fs_may_drive(const fs_t *f) {
+  return (uint8_t)(f->mode == 1u);
+}
 
 #ifdef __cplusplus
 }

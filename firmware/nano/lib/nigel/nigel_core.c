@@ -71,21 +71,15 @@ static void on_config(nigel_t *n, const proto_frame_t *f) {
 static void on_frame(const proto_frame_t *f, void *ctx) {
   nigel_t *n = (nigel_t *)ctx;
   switch (f->id) {
-    case PROTO_ID_COMMAND:
-      on_command(n, f);
-      break;
-    case PROTO_ID_CONFIG:
-      on_config(n, f);
-      break;
+    case PROTO_ID_COMMAND: on_command(n, f); break;
+    case PROTO_ID_CONFIG: on_config(n, f); break;
     case PROTO_ID_HELLO_REQUEST:
       if (f->len != PROTO_LEN_HELLO_REQUEST)
         send_nack(n, f->id, PROTO_NACK_BAD_LENGTH, 0);
       else
         send_hello(n);
       break;
-    default:
-      send_nack(n, f->id, PROTO_NACK_UNKNOWN_ID, 0);
-      break;
+    default: send_nack(n, f->id, PROTO_NACK_UNKNOWN_ID, 0); break;
   }
 }
 

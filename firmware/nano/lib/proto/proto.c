@@ -13,12 +13,16 @@ static uint8_t *put_u16(uint8_t *o, uint16_t v) {
   o[1] = (uint8_t)(v >> 8);
   return o + 2;
 }
-static uint8_t *put_i16(uint8_t *o, int16_t v) { return put_u16(o, (uint16_t)v); }
+static uint8_t *put_i16(uint8_t *o, int16_t v) {
+  return put_u16(o, (uint16_t)v);
+}
 static uint8_t *put_u32(uint8_t *o, uint32_t v) {
   o = put_u16(o, (uint16_t)(v & 0xFFFFu));
   return put_u16(o, (uint16_t)(v >> 16));
 }
-static uint8_t *put_i32(uint8_t *o, int32_t v) { return put_u32(o, (uint32_t)v); }
+static uint8_t *put_i32(uint8_t *o, int32_t v) {
+  return put_u32(o, (uint32_t)v);
+}
 
 static const uint8_t *get_u8(const uint8_t *p, uint8_t *v) {
   *v = p[0];
@@ -237,11 +241,15 @@ uint32_t proto_schema_hash(void) {
   return cached;
 }
 #else
-uint32_t proto_schema_hash(void) { return schema_fnv1a(); }
+uint32_t proto_schema_hash(void) {
+  return schema_fnv1a();
+}
 #endif
 
 /* ---- parser ---------------------------------------------------------------------------- */
-void proto_parser_init(proto_parser_t *p) { memset(p, 0, sizeof *p); }
+void proto_parser_init(proto_parser_t *p) {
+  memset(p, 0, sizeof *p);
+}
 
 static void drop_front(proto_parser_t *p, uint8_t k) {
   memmove(p->buf, p->buf + k, (size_t)(p->n - k));

@@ -17,10 +17,10 @@ extern "C" {
 /* ---- framing ------------------------------------------------------------------------- */
 #define PROTO_SYNC0 0xA5u
 #define PROTO_SYNC1 0x5Au
-#define PROTO_MAX_PAYLOAD 64u        /* [bytes] */
-#define PROTO_OVERHEAD 7u            /* sync0 sync1 len id seq .. crc_lo crc_hi [bytes] */
+#define PROTO_MAX_PAYLOAD 64u /* [bytes] */
+#define PROTO_OVERHEAD 7u     /* sync0 sync1 len id seq .. crc_lo crc_hi [bytes] */
 #define PROTO_MAX_FRAME (PROTO_MAX_PAYLOAD + PROTO_OVERHEAD)
-#define PROTO_BAUD 500000ul          /* [bit/s], exact at 16 MHz (U2X, UBRR=3) */
+#define PROTO_BAUD 500000ul /* [bit/s], exact at 16 MHz (U2X, UBRR=3) */
 #define PROTO_VERSION 1u
 
 /* ---- message ids: 0x0_ Jetson -> Nano, 0x8_ Nano -> Jetson --------------------------- */
@@ -44,19 +44,19 @@ enum {
 /* The schema: every message's fields in wire order. The schema hash (FNV-1a 32 of this
  * string) is sent in HELLO; a host whose hash differs refuses the link. Change the string
  * whenever a layout changes (tests check it against the PROTO_LEN_* above). */
-#define PROTO_SCHEMA                                                                        \
-  "v1;"                                                                                     \
-  "01 command:u16 seq,i16 throttle_milli,i16 steering_milli,u8 headlights,u8 indicators,"   \
-  "u8 flags;"                                                                               \
+#define PROTO_SCHEMA                                                                       \
+  "v1;"                                                                                    \
+  "01 command:u16 seq,i16 throttle_milli,i16 steering_milli,u8 headlights,u8 indicators,"  \
+  "u8 flags;"                                                                              \
   "02 config:i16 servo_trim_us,u16 telemetry_period_ms,u16 failsafe_timeout_ms;"           \
-  "03 hello_request:;"                                                                      \
-  "81 hello:u8 fw_major,u8 fw_minor,u8 fw_patch,u8 proto_version,u32 schema_hash,"          \
-  "u32 build_id;"                                                                           \
-  "82 state:u32 nano_time_us,i32 enc_left,i32 enc_right,i16 speed_left_mrad_s,"             \
-  "i16 speed_right_mrad_s,i16 throttle_milli,i16 steering_milli,i16 accel_x,i16 accel_y,"   \
-  "i16 accel_z,i16 gyro_x,i16 gyro_y,i16 gyro_z,i16 mag_x,i16 mag_y,i16 mag_z,i16 quat_w,"  \
-  "i16 quat_x,i16 quat_y,i16 quat_z,u16 battery_mv,u8 lights,u8 mode,u16 faults,"            \
-  "u16 last_cmd_seq,u16 frames_ok,u16 frames_bad_crc,u16 frames_dropped;"                   \
+  "03 hello_request:;"                                                                     \
+  "81 hello:u8 fw_major,u8 fw_minor,u8 fw_patch,u8 proto_version,u32 schema_hash,"         \
+  "u32 build_id;"                                                                          \
+  "82 state:u32 nano_time_us,i32 enc_left,i32 enc_right,i16 speed_left_mrad_s,"            \
+  "i16 speed_right_mrad_s,i16 throttle_milli,i16 steering_milli,i16 accel_x,i16 accel_y,"  \
+  "i16 accel_z,i16 gyro_x,i16 gyro_y,i16 gyro_z,i16 mag_x,i16 mag_y,i16 mag_z,i16 quat_w," \
+  "i16 quat_x,i16 quat_y,i16 quat_z,u16 battery_mv,u8 lights,u8 mode,u16 faults,"          \
+  "u16 last_cmd_seq,u16 frames_ok,u16 frames_bad_crc,u16 frames_dropped;"                  \
   "84 nack:u8 rejected_id,u8 reason,u16 seq;"
 
 /* ---- scales of the fixed-point fields ------------------------------------------------ */
@@ -67,11 +67,11 @@ enum {
 #define PROTO_QUAT_ONE 16384        /* quaternion component 1.0 */
 
 /* ---- command flags, lights bits, modes, faults, nack reasons ------------------------- */
-#define PROTO_CMD_ENGAGED 0x01u     /* host wants the car to move */
+#define PROTO_CMD_ENGAGED 0x01u /* host wants the car to move */
 #define PROTO_CMD_KNOWN_FLAGS 0x01u
 
-#define PROTO_LIGHTS_HEAD_MASK 0x03u   /* bits 0-1: 0 off, 1 low, 2 high */
-#define PROTO_LIGHTS_IND_SHIFT 2u      /* bits 2-3: 0 off, 1 left, 2 right, 3 hazard */
+#define PROTO_LIGHTS_HEAD_MASK 0x03u /* bits 0-1: 0 off, 1 low, 2 high */
+#define PROTO_LIGHTS_IND_SHIFT 2u    /* bits 2-3: 0 off, 1 left, 2 right, 3 hazard */
 #define PROTO_LIGHTS_IND_MASK 0x0Cu
 #define PROTO_LIGHTS_TAIL 0x10u        /* brake/tail lamps lit */
 #define PROTO_LIGHTS_REVERSE 0x20u     /* reverse lamps lit */
@@ -90,7 +90,7 @@ enum { PROTO_MODE_DISARMED = 0, PROTO_MODE_ENGAGED = 1, PROTO_MODE_FAILSAFE = 2 
 #define PROTO_FAULT_LOOP_OVERRUN 0x0040u   /* a main loop pass took too long */
 
 enum {
-  PROTO_NACK_BAD_LENGTH = 1,  /* payload length wrong for the id */
+  PROTO_NACK_BAD_LENGTH = 1,   /* payload length wrong for the id */
   PROTO_NACK_OUT_OF_RANGE = 2, /* a field outside its range: not applied */
   PROTO_NACK_UNKNOWN_ID = 3
 };
@@ -119,19 +119,19 @@ typedef struct proto_hello {
 } proto_hello_t;
 
 typedef struct proto_state {
-  uint32_t nano_time_us;           /* Nano clock [us], wraps every ~71.6 min */
-  int32_t enc_counts[2];           /* left, right [counts], 1920 per wheel revolution */
-  int16_t wheel_speed_mrad_s[2];   /* filtered, left, right [mrad/s] */
-  int16_t throttle_milli;          /* applied [-1000, 1000] */
-  int16_t steering_milli;          /* applied [-1000, 1000] */
-  int16_t accel_raw[3];            /* [LSB], PROTO_ACCEL_LSB_PER_G */
-  int16_t gyro_raw[3];             /* [LSB], PROTO_GYRO_LSB_PER_DPS */
-  int16_t mag_raw[3];              /* [LSB], PROTO_MAG_UT_PER_LSB */
-  int16_t quat_q14[4];             /* AHRS w x y z, PROTO_QUAT_ONE = 1.0 */
-  uint16_t battery_mv;             /* [mV] */
-  uint8_t lights;                  /* PROTO_LIGHTS_* */
-  uint8_t mode;                    /* PROTO_MODE_* */
-  uint16_t faults;                 /* PROTO_FAULT_* */
+  uint32_t nano_time_us;         /* Nano clock [us], wraps every ~71.6 min */
+  int32_t enc_counts[2];         /* left, right [counts], 1920 per wheel revolution */
+  int16_t wheel_speed_mrad_s[2]; /* filtered, left, right [mrad/s] */
+  int16_t throttle_milli;        /* applied [-1000, 1000] */
+  int16_t steering_milli;        /* applied [-1000, 1000] */
+  int16_t accel_raw[3];          /* [LSB], PROTO_ACCEL_LSB_PER_G */
+  int16_t gyro_raw[3];           /* [LSB], PROTO_GYRO_LSB_PER_DPS */
+  int16_t mag_raw[3];            /* [LSB], PROTO_MAG_UT_PER_LSB */
+  int16_t quat_q14[4];           /* AHRS w x y z, PROTO_QUAT_ONE = 1.0 */
+  uint16_t battery_mv;           /* [mV] */
+  uint8_t lights;                /* PROTO_LIGHTS_* */
+  uint8_t mode;                  /* PROTO_MODE_* */
+  uint16_t faults;               /* PROTO_FAULT_* */
   uint16_t last_cmd_seq;
   uint16_t frames_ok, frames_bad_crc, frames_dropped; /* Nano's parser counts, wrap at 65536 */
 } proto_state_t;
@@ -179,11 +179,11 @@ typedef struct proto_frame {
 
 /* Cumulative parser counters [frames or bytes]. */
 typedef struct proto_stats {
-  uint32_t frames_ok;       /* frames with a good CRC */
-  uint32_t bad_crc;         /* frames whose CRC failed */
-  uint32_t bad_length;      /* length byte above PROTO_MAX_PAYLOAD */
-  uint32_t frames_dropped;  /* gaps in the sender's seq counter */
-  uint32_t skipped_bytes;   /* bytes discarded while hunting for sync */
+  uint32_t frames_ok;      /* frames with a good CRC */
+  uint32_t bad_crc;        /* frames whose CRC failed */
+  uint32_t bad_length;     /* length byte above PROTO_MAX_PAYLOAD */
+  uint32_t frames_dropped; /* gaps in the sender's seq counter */
+  uint32_t skipped_bytes;  /* bytes discarded while hunting for sync */
 } proto_stats_t;
 
 /* Called for each good frame. The frame is only valid during the call. */

@@ -36,7 +36,8 @@ void wspd_update(wspd_t *w, int32_t left_counts, int32_t right_counts, uint32_t 
   if (dt_us < WSPD_PERIOD_US) return;
   if (dt_us > 10ul * WSPD_PERIOD_US) dt_us = 10ul * WSPD_PERIOD_US; /* stalled loop */
   for (i = 0; i < 2u; ++i) {
-    int32_t v_x16 = raw_speed((int32_t)((uint32_t)counts[i] - (uint32_t)w->prev_counts[i]), dt_us) * 16L;
+    int32_t v_x16 =
+        raw_speed((int32_t)((uint32_t)counts[i] - (uint32_t)w->prev_counts[i]), dt_us) * 16L;
     /* arithmetic on the difference keeps the rounding symmetric for + and - speeds */
     int32_t d = v_x16 - w->speed_x16[i];
     w->speed_x16[i] += d / (1L << WSPD_FILTER_SHIFT);

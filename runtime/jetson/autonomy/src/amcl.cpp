@@ -33,10 +33,12 @@ void Amcl::motion_update(const Pose2 &from, const Pose2 &to) {
     backwards = true;
   }
   const double rot2 = angle_wrap_rad(to.yaw_rad - from.yaw_rad - rot1);
-  const double sr1 = std::sqrt(cfg_.alpha_rot_rot * rot1 * rot1 + cfg_.alpha_rot_trans * trans * trans);
+  const double sr1 =
+      std::sqrt(cfg_.alpha_rot_rot * rot1 * rot1 + cfg_.alpha_rot_trans * trans * trans);
   const double st = std::sqrt(cfg_.alpha_trans_trans * trans * trans +
                               cfg_.alpha_trans_rot * (rot1 * rot1 + rot2 * rot2));
-  const double sr2 = std::sqrt(cfg_.alpha_rot_rot * rot2 * rot2 + cfg_.alpha_rot_trans * trans * trans);
+  const double sr2 =
+      std::sqrt(cfg_.alpha_rot_rot * rot2 * rot2 + cfg_.alpha_rot_trans * trans * trans);
   std::normal_distribution<double> n(0.0, 1.0);
   for (auto &p : particles_) {
     const double r1 = rot1 + sr1 * n(rng_);
@@ -67,7 +69,8 @@ double Amcl::scan_log_likelihood(const Pose2 &pose, const std::vector<Eigen::Vec
 void Amcl::sensor_update(const Scan &scan) {
   const auto all = scan_points_base(scan, cfg_.lidar_in_base);
   std::vector<Eigen::Vector2d> pts;
-  const size_t step = std::max<size_t>(1, all.size() / static_cast<size_t>(std::max(1, cfg_.beams)));
+  const size_t step =
+      std::max<size_t>(1, all.size() / static_cast<size_t>(std::max(1, cfg_.beams)));
   for (size_t i = 0; i < all.size(); i += step) pts.push_back(all[i]);
   std::vector<double> ll(particles_.size());
   double best = -1e300;
@@ -98,12 +101,14 @@ void Amcl::kld_resample() {
   size_t needed = static_cast<size_t>(cfg_.min_particles);
   while (out.size() < static_cast<size_t>(cfg_.max_particles) &&
          (out.size() < needed || out.size() < static_cast<size_t>(cfg_.min_particles))) {
-    const size_t i = static_cast<size_t>(std::lower_bound(cdf.begin(), cdf.end(), u(rng_)) - cdf.begin());
+    const size_t i =
+        static_cast<size_t>(std::lower_bound(cdf.begin(), cdf.end(), u(rng_)) - cdf.begin());
     const Particle &p = particles_[std::min(i, particles_.size() - 1)];
     out.push_back({p.pose, 1.0});
-    const auto key = std::make_tuple(static_cast<int>(std::floor(p.pose.x_m / cfg_.bin_xy_m)),
-                                     static_cast<int>(std::floor(p.pose.y_m / cfg_.bin_xy_m)),
-                                     static_cast<int>(std::floor(p.pose.yaw_rad / cfg_.bin_yaw_rad)));
+    const auto key =
+        std::make_tuple(static_cast<int>(std::floor(p.pose.x_m / cfg_.bin_xy_m)),
+                        static_cast<int>(std::floor(p.pose.y_m / cfg_.bin_xy_m)),
+                        static_cast<int>(std::floor(p.pose.yaw_rad / cfg_.bin_yaw_rad)));
     if (bins.insert(key).second && bins.size() > 1) {
       // Wilson-Hilferty approximation of the chi-square quantile (Fox 2003, eq. 13).
       const double k1 = static_cast<double>(bins.size() - 1);

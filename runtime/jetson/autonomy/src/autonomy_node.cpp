@@ -21,8 +21,8 @@ MissionConfig mission_cfg(const NodeConfig &cfg) {
 std::string describe_plan(const PlanResult &r) {
   std::ostringstream d;
   d.precision(3);
-  d << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, " << r.expansions
-    << " expansions";
+  d << "path " << path_length_m(r.path) << " m, " << path_cusps(r.path) << " cusps, "
+    << r.expansions << " expansions";
   return d.str();
 }
 
@@ -64,18 +64,18 @@ double AutonomyNode::progress() const {
       return std::clamp((scans + legs) / steps, 0.0, 1.0);
     }
     case MissionState::kLocalising:
-      return std::min(1.0, static_cast<double>(localising_updates_) / std::max(1, cfg_.localising_min_updates));
-    case MissionState::kDriving:
-      return std::clamp(path_fraction(), 0.0, 1.0);
+      return std::min(
+          1.0, static_cast<double>(localising_updates_) / std::max(1, cfg_.localising_min_updates));
+    case MissionState::kDriving: return std::clamp(path_fraction(), 0.0, 1.0);
     case MissionState::kParked:
-    case MissionState::kFailed:
-      return 1.0;
-    default:
-      return 0.0;
+    case MissionState::kFailed: return 1.0;
+    default: return 0.0;
   }
 }
 
-Pose2 AutonomyNode::pose_map() const { return pose_compose(map_from_odom_, odom_); }
+Pose2 AutonomyNode::pose_map() const {
+  return pose_compose(map_from_odom_, odom_);
+}
 
 std::optional<Pose2> AutonomyNode::amcl_pose() const {
   if (!amcl_ || localising_updates_ == 0) return std::nullopt;
@@ -88,12 +88,14 @@ Eigen::Matrix3d AutonomyNode::amcl_covariance() const {
 
 void AutonomyNode::after_map_ready(double) {
   plan_map_ = std::make_unique<GridMap>(*map_);
-  checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+  checker_ =
+      std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
   amcl_field_m_ = grid_distance_field_m(*map_, false);
   amcl_ = std::make_unique<Amcl>(*map_, cfg_.amcl);
   // From SLAM: its pose is on this very map; otherwise the configured start guess.
   const Pose2 guess = slam_ ? slam_->pose() : cfg_.start_pose;
-  amcl_->init_gaussian(guess, cfg_.initial_sigma_xy_m, cfg_.initial_sigma_xy_m, cfg_.initial_sigma_yaw_rad);
+  amcl_->init_gaussian(guess, cfg_.initial_sigma_xy_m, cfg_.initial_sigma_xy_m,
+                       cfg_.initial_sigma_yaw_rad);
   localising_updates_ = 0;
 }
 
@@ -142,7 +144,8 @@ void AutonomyNode::judge_arrival(double t_s) {
 PlanResult AutonomyNode::plan_via_staging(const Pose2 &from) {
   // Back off against the direction the last path arrived in, then run straight in.
   const int arrive_dir = tracker_.path().empty() ? 1 : tracker_.path().back().direction;
-  const Pose2 staging = pose_compose(cfg_.goal, Pose2{-arrive_dir * cfg_.retry_backoff_m, 0.0, 0.0});
+  const Pose2 staging =
+      pose_compose(cfg_.goal, Pose2{-arrive_dir * cfg_.retry_backoff_m, 0.0, 0.0});
   PlanResult out;
   out.detail = "staging pose not reachable";
   if (!checker_->pose_free(staging)) return out;
@@ -162,9 +165,11 @@ PlanResult AutonomyNode::plan_via_staging(const Pose2 &from) {
 void AutonomyNode::localise(const Pose2 &odom_scan, const Scan &scan, int64_t scan_mid_us) {
   Pose2 est = amcl_->estimate();
   if (cfg_.refine_scan_match) {
-    const Pose2 refined = scan_match_level(*map_, scan_points_base(scan, cfg_.amcl.lidar_in_base), est, 10);
+    const Pose2 refined =
+        scan_match_level(*map_, scan_points_base(scan, cfg_.amcl.lidar_in_base), est, 10);
     const Pose2 d = pose_between(est, refined);
-    if (std::hypot(d.x_m, d.y_m) <= cfg_.refine_max_m && std::abs(d.yaw_rad) <= cfg_.refine_max_yaw_rad)
+    if (std::hypot(d.x_m, d.y_m) <= cfg_.refine_max_m &&
+        std::abs(d.yaw_rad) <= cfg_.refine_max_yaw_rad)
       est = refined;
   }
   map_from_odom_ = pose_compose(est, pose_inverse(odom_scan));
@@ -304,7 +309,8 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
       // Obstacles not on the map, in the map frame, seen from where the scan was taken.
       std::vector<Eigen::Vector2d> pts;
       const Pose2 base = pose_compose(map_from_odom_, odom_scan);
-      for (const auto &q : scan_points_base(scan, cfg_.amcl.lidar_in_base)) pts.push_back(pose_apply(base, q));
+      for (const auto &q : scan_points_base(scan, cfg_.amcl.lidar_in_base))
+        pts.push_back(pose_apply(base, q));
       const auto unmapped = lp_unmapped_points(*map_, amcl_field_m_, pts, cfg_.unmapped_min_dist_m);
       const LocalCheck lc = lp_check_path(tracker_.path(), tracker_.progress_index(),
                                           cfg_.obstacle_horizon_m, unmapped, cfg_.footprint);
@@ -315,7 +321,8 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
         for (const auto &u : unmapped)
           if ((u - lc.obstacle_m).norm() <= cfg_.obstacle_cluster_m) blocking.push_back(u);
         grid_mark_occupied(*plan_map_, blocking, cfg_.obstacle_inflation_m);
-        checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint, cfg_.unknown_is_obstacle);
+        checker_ = std::make_unique<CollisionChecker>(*plan_map_, cfg_.footprint,
+                                                      cfg_.unknown_is_obstacle);
         std::ostringstream why;
         why.precision(3);
         why << "unmapped obstacle at (" << lc.obstacle_m.x() << ", " << lc.obstacle_m.y() << ") "
@@ -326,8 +333,7 @@ void AutonomyNode::on_scan(const Scan &scan, int64_t utime_us) {
       }
       break;
     }
-    default:
-      break;
+    default: break;
   }
 }
 

@@ -14,7 +14,8 @@ struct Reader {
     throw std::runtime_error("config '" + file + "': " + what);
   }
   // Rejects keys of node (at path) that are not in allowed.
-  void only(const YAML::Node &node, const std::string &path, const std::set<std::string> &allowed) const {
+  void only(const YAML::Node &node, const std::string &path,
+            const std::set<std::string> &allowed) const {
     if (!node.IsMap()) fail("'" + path + "' must be a mapping");
     for (const auto &kv : node) {
       const auto k = kv.first.as<std::string>();
@@ -56,11 +57,34 @@ ProgramConfig cfg_load(const std::string &path) {
   }
   ProgramConfig c;
   NodeConfig &n = c.node;
-  r.only(root, "", {"vehicle", "lcm_url", "out_dir", "command_rate_hz", "exit_after_finish_s", "map",
-                    "start", "goal", "lidar_in_base", "mapping_scans", "mapping_route", "goal_tolerance_m",
-                    "goal_tolerance_yaw_rad", "obstacle_horizon_m", "obstacle_inflation_m", "obstacle_cluster_m",
-                    "unknown_is_obstacle", "settle_s", "retry_backoff_m", "refine_scan_match", "footprint", "slam", "laser_odom", "amcl",
-                    "planner", "tracker", "mission"});
+  r.only(root, "",
+         {"vehicle",
+          "lcm_url",
+          "out_dir",
+          "command_rate_hz",
+          "exit_after_finish_s",
+          "map",
+          "start",
+          "goal",
+          "lidar_in_base",
+          "mapping_scans",
+          "mapping_route",
+          "goal_tolerance_m",
+          "goal_tolerance_yaw_rad",
+          "obstacle_horizon_m",
+          "obstacle_inflation_m",
+          "obstacle_cluster_m",
+          "unknown_is_obstacle",
+          "settle_s",
+          "retry_backoff_m",
+          "refine_scan_match",
+          "footprint",
+          "slam",
+          "laser_odom",
+          "amcl",
+          "planner",
+          "tracker",
+          "mission"});
   r.get(root, "", "vehicle", c.vehicle);
   r.get(root, "", "lcm_url", c.lcm_url);
   r.get(root, "", "out_dir", c.out_dir);
@@ -106,7 +130,8 @@ ProgramConfig cfg_load(const std::string &path) {
     r.get(f, "footprint", "margin_m", n.footprint.margin_m);
   }
   if (const auto s = root["slam"]) {
-    r.only(s, "slam", {"resolution_m", "levels", "width_m", "height_m", "origin_x_m", "origin_y_m"});
+    r.only(s, "slam",
+           {"resolution_m", "levels", "width_m", "height_m", "origin_x_m", "origin_y_m"});
     r.get(s, "slam", "resolution_m", n.slam.resolution_m);
     r.get(s, "slam", "levels", n.slam.levels);
     r.get(s, "slam", "width_m", n.slam.width_m);
@@ -115,8 +140,9 @@ ProgramConfig cfg_load(const std::string &path) {
     r.get(s, "slam", "origin_y_m", n.slam.origin_y_m);
   }
   if (const auto l = root["laser_odom"]) {
-    r.only(l, "laser_odom", {"max_rms_m", "min_inliers", "max_disagree_m", "max_disagree_rad",
-                             "keyframe_dist_m", "keyframe_angle_rad"});
+    r.only(l, "laser_odom",
+           {"max_rms_m", "min_inliers", "max_disagree_m", "max_disagree_rad", "keyframe_dist_m",
+            "keyframe_angle_rad"});
     r.get(l, "laser_odom", "max_rms_m", n.laser_odom.max_rms_m);
     r.get(l, "laser_odom", "min_inliers", n.laser_odom.min_inliers);
     r.get(l, "laser_odom", "max_disagree_m", n.laser_odom.max_disagree_m);
@@ -144,15 +170,17 @@ ProgramConfig cfg_load(const std::string &path) {
   n.tracker.wheelbase_m = n.planner.wheelbase_m;
   n.tracker.max_steer_rad = n.planner.max_steer_rad;
   if (const auto t = root["tracker"]) {
-    r.only(t, "tracker", {"top_speed_m_s", "cruise_speed_m_s", "lookahead_min_m", "lookahead_time_s"});
+    r.only(t, "tracker",
+           {"top_speed_m_s", "cruise_speed_m_s", "lookahead_min_m", "lookahead_time_s"});
     r.get(t, "tracker", "top_speed_m_s", n.tracker.top_speed_m_s);
     r.get(t, "tracker", "cruise_speed_m_s", n.tracker.cruise_speed_m_s);
     r.get(t, "tracker", "lookahead_min_m", n.tracker.lookahead_min_m);
     r.get(t, "tracker", "lookahead_time_s", n.tracker.lookahead_time_s);
   }
   if (const auto m = root["mission"]) {
-    r.only(m, "mission", {"max_replans", "timeout_mapping_s", "timeout_localising_s",
-                          "timeout_planning_s", "timeout_driving_s"});
+    r.only(m, "mission",
+           {"max_replans", "timeout_mapping_s", "timeout_localising_s", "timeout_planning_s",
+            "timeout_driving_s"});
     r.get(m, "mission", "max_replans", n.mission.max_replans);
     r.get(m, "mission", "timeout_mapping_s", n.mission.timeout_mapping_s);
     r.get(m, "mission", "timeout_localising_s", n.mission.timeout_localising_s);

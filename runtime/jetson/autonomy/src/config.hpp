@@ -12,7 +12,7 @@ struct ProgramConfig {
   std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
   std::string out_dir = "out/autonomy";  // path.csv, route.csv, trajectory.csv
   double command_rate_hz = 50.0;
-  double exit_after_finish_s = 1.0;      // keep publishing the stop this long, then exit
+  double exit_after_finish_s = 1.0;  // keep publishing the stop this long, then exit
   NodeConfig node;
 };
 

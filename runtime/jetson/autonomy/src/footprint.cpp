@@ -5,7 +5,8 @@
 
 namespace autonomy {
 
-CollisionChecker::CollisionChecker(const GridMap &map, const Footprint &fp, bool unknown_is_obstacle)
+CollisionChecker::CollisionChecker(const GridMap &map, const Footprint &fp,
+                                   bool unknown_is_obstacle)
     : map_(map), fp_(fp), field_m_(grid_distance_field_m(map, unknown_is_obstacle)) {
   const double seg_m = fp.length_m / fp.discs;
   disc_radius_m_ = std::hypot(0.5 * seg_m, 0.5 * fp.width_m);
@@ -27,7 +28,8 @@ double CollisionChecker::clearance_m(const Pose2 &base) const {
 }
 
 bool CollisionChecker::path_free(const Path &path) const {
-  return std::all_of(path.begin(), path.end(), [&](const PathPoint &p) { return pose_free(p.pose); });
+  return std::all_of(path.begin(), path.end(),
+                     [&](const PathPoint &p) { return pose_free(p.pose); });
 }
 
 }  // namespace autonomy

@@ -8,8 +8,12 @@
 namespace autonomy {
 
 GridMap::GridMap(int width, int height, double resolution, double origin_x, double origin_y)
-    : width_cells(width), height_cells(height), resolution_m(resolution), origin_x_m(origin_x),
-      origin_y_m(origin_y), log_odds(static_cast<size_t>(width) * height, 0.0f) {}
+    : width_cells(width),
+      height_cells(height),
+      resolution_m(resolution),
+      origin_x_m(origin_x),
+      origin_y_m(origin_y),
+      log_odds(static_cast<size_t>(width) * height, 0.0f) {}
 
 bool GridMap::world_to_cell(double x_m, double y_m, int &cx, int &cy) const {
   cx = static_cast<int>(std::floor((x_m - origin_x_m) / resolution_m));
@@ -30,8 +34,8 @@ CellState GridMap::state(int cx, int cy) const {
   return CellState::kUnknown;
 }
 
-void GridMap::update_ray(double sx_m, double sy_m, double ex_m, double ey_m, bool hit,
-                         float l_free, float l_occ, float l_min, float l_max) {
+void GridMap::update_ray(double sx_m, double sy_m, double ex_m, double ey_m, bool hit, float l_free,
+                         float l_occ, float l_min, float l_max) {
   int x0, y0, x1, y1;
   world_to_cell(sx_m, sy_m, x0, y0);
   world_to_cell(ex_m, ey_m, x1, y1);
@@ -45,8 +49,14 @@ void GridMap::update_ray(double sx_m, double sy_m, double ex_m, double ey_m, boo
       l = std::clamp(l + l_free, l_min, l_max);
     }
     const int e2 = 2 * err;
-    if (e2 >= dy) { err += dy; x += stepx; }
-    if (e2 <= dx) { err += dx; y += stepy; }
+    if (e2 >= dy) {
+      err += dy;
+      x += stepx;
+    }
+    if (e2 <= dx) {
+      err += dx;
+      y += stepy;
+    }
   }
   if (hit && in_bounds(x1, y1)) {
     float &l = log_odds[index(x1, y1)];
@@ -84,7 +94,8 @@ void grid_mark_occupied(GridMap &g, const std::vector<Eigen::Vector2d> &points_m
     for (int dy = -rc; dy <= rc; ++dy) {
       for (int dx = -rc; dx <= rc; ++dx) {
         if (!g.in_bounds(cx + dx, cy + dy)) continue;
-        if ((g.cell_center_m(cx + dx, cy + dy) - p).norm() > radius_m + 0.5 * g.resolution_m) continue;
+        if ((g.cell_center_m(cx + dx, cy + dy) - p).norm() > radius_m + 0.5 * g.resolution_m)
+          continue;
         g.log_odds[g.index(cx + dx, cy + dy)] = 10.0f;
       }
     }

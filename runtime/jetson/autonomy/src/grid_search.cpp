@@ -17,7 +17,8 @@ using QItem = std::pair<double, int>;  // (priority, cell index)
 }  // namespace
 
 std::vector<Eigen::Vector2d> astar_route(const GridMap &map, const std::vector<uint8_t> &passable,
-                                         const Eigen::Vector2d &start_m, const Eigen::Vector2d &goal_m) {
+                                         const Eigen::Vector2d &start_m,
+                                         const Eigen::Vector2d &goal_m) {
   int sx, sy, gx, gy;
   if (!map.world_to_cell(start_m.x(), start_m.y(), sx, sy) ||
       !map.world_to_cell(goal_m.x(), goal_m.y(), gx, gy))
@@ -53,7 +54,8 @@ std::vector<Eigen::Vector2d> astar_route(const GridMap &map, const std::vector<u
   }
   if (!std::isfinite(g[goal])) return {};
   std::vector<Eigen::Vector2d> route;
-  for (int c = goal; c != -1; c = parent[c]) route.push_back(map.cell_center_m(c % map.width_cells, c / map.width_cells));
+  for (int c = goal; c != -1; c = parent[c])
+    route.push_back(map.cell_center_m(c % map.width_cells, c / map.width_cells));
   std::reverse(route.begin(), route.end());
   return route;
 }

@@ -25,7 +25,9 @@ struct Node {
 double ha_max_curvature_1pm(const HybridAStarConfig &cfg) {
   return std::tan(cfg.max_steer_rad * cfg.steer_use_fraction) / cfg.wheelbase_m;
 }
-double ha_min_turn_radius_m(const HybridAStarConfig &cfg) { return 1.0 / ha_max_curvature_1pm(cfg); }
+double ha_min_turn_radius_m(const HybridAStarConfig &cfg) {
+  return 1.0 / ha_max_curvature_1pm(cfg);
+}
 
 PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, const Pose2 &goal,
                              const HybridAStarConfig &cfg) {
@@ -54,9 +56,12 @@ PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, con
     return cfg.heuristic_weight * std::max(hg, rs_shortest_length_m(p, goal, R));
   };
   auto key_of = [&](const Pose2 &p) -> long long {
-    const long long ix = static_cast<long long>(std::floor((p.x_m - map.origin_x_m) / cfg.xy_bin_m));
-    const long long iy = static_cast<long long>(std::floor((p.y_m - map.origin_y_m) / cfg.xy_bin_m));
-    long long iyaw = static_cast<long long>(std::floor((p.yaw_rad + kPi) / (2 * kPi) * cfg.yaw_bins));
+    const long long ix =
+        static_cast<long long>(std::floor((p.x_m - map.origin_x_m) / cfg.xy_bin_m));
+    const long long iy =
+        static_cast<long long>(std::floor((p.y_m - map.origin_y_m) / cfg.xy_bin_m));
+    long long iyaw =
+        static_cast<long long>(std::floor((p.yaw_rad + kPi) / (2 * kPi) * cfg.yaw_bins));
     iyaw = ((iyaw % cfg.yaw_bins) + cfg.yaw_bins) % cfg.yaw_bins;
     return (ix * 100000LL + iy) * 1000LL + iyaw;
   };
@@ -108,8 +113,10 @@ PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, con
           if (!rs_free(RsPath{{{'S', d}}}, pre)) continue;
         }
         const auto cands = rs_paths(nodes[ci].pose, pre, R);
-        for (size_t k = 0; k < cands.size() && k < static_cast<size_t>(cfg.analytic_candidates); ++k) {
-          const double len = cands[k].length_m() + std::abs(d) + (approach == 0 ? cfg.final_straight_m : 0.0);
+        for (size_t k = 0; k < cands.size() && k < static_cast<size_t>(cfg.analytic_candidates);
+             ++k) {
+          const double len =
+              cands[k].length_m() + std::abs(d) + (approach == 0 ? cfg.final_straight_m : 0.0);
           if (len >= best_len) break;
           if (!rs_free(cands[k], nodes[ci].pose)) continue;
           RsPath full = cands[k];
@@ -124,8 +131,9 @@ PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, con
     }
     for (int dir : {1, -1}) {
       for (int si = 0; si < cfg.steer_samples; ++si) {
-        const double steer = cfg.max_steer_rad * cfg.steer_use_fraction *
-                             (cfg.steer_samples == 1 ? 0.0 : -1.0 + 2.0 * si / (cfg.steer_samples - 1));
+        const double steer =
+            cfg.max_steer_rad * cfg.steer_use_fraction *
+            (cfg.steer_samples == 1 ? 0.0 : -1.0 + 2.0 * si / (cfg.steer_samples - 1));
         const double k = std::tan(steer) / cfg.wheelbase_m;
         Node n;
         n.parent = ci;
@@ -137,7 +145,10 @@ PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, con
         for (int s = 0; s < subs; ++s) {
           n.segment.push_back({p, dir, k});
           p = arc_step(p, dir * cfg.step_m / subs, k);
-          if (!cc.pose_free(p)) { ok = false; break; }
+          if (!cc.pose_free(p)) {
+            ok = false;
+            break;
+          }
         }
         if (!ok) continue;
         n.pose = p;
@@ -146,7 +157,8 @@ PlanResult hybrid_astar_plan(const CollisionChecker &cc, const Pose2 &start, con
         const Node &par = nodes[ci];
         n.g = par.g + cfg.step_m * (dir < 0 ? cfg.reverse_cost : 1.0) +
               (ci != 0 && dir != par.direction ? cfg.switch_cost_m : 0.0) +
-              cfg.steer_cost_m * std::abs(steer) + cfg.steer_change_cost_m * std::abs(steer - par.steer_rad);
+              cfg.steer_cost_m * std::abs(steer) +
+              cfg.steer_change_cost_m * std::abs(steer - par.steer_rad);
         const auto it = best.find(nk);
         if (it != best.end() && nodes[it->second].g <= n.g) continue;
         const double f = n.g + heuristic(p);

@@ -39,7 +39,10 @@ IcpResult icp_match(const std::vector<Eigen::Vector2d> &ref,
       size_t bj = 0;
       for (size_t j = 0; j < ref.size(); ++j) {
         const double d2 = (ref[j] - w).squaredNorm();
-        if (d2 < best) { best = d2; bj = j; }
+        if (d2 < best) {
+          best = d2;
+          bj = j;
+        }
       }
       if (best > gate_m * gate_m) continue;
       const Eigen::Vector2d dw_dth(-s * q.x() - c * q.y(), c * q.x() - s * q.y());

@@ -11,7 +11,8 @@ LocalCheck lp_check_path(const Path &path, size_t from_index, double horizon_m,
   double s = 0.0;
   for (size_t i = from_index; i < path.size(); ++i) {
     if (i > from_index)
-      s += std::hypot(path[i].pose.x_m - path[i - 1].pose.x_m, path[i].pose.y_m - path[i - 1].pose.y_m);
+      s += std::hypot(path[i].pose.x_m - path[i - 1].pose.x_m,
+                      path[i].pose.y_m - path[i - 1].pose.y_m);
     if (s > horizon_m) break;
     const Pose2 &p = path[i].pose;
     const double c = std::cos(p.yaw_rad), sn = std::sin(p.yaw_rad);
@@ -29,7 +30,8 @@ LocalCheck lp_check_path(const Path &path, size_t from_index, double horizon_m,
   return out;
 }
 
-std::vector<Eigen::Vector2d> lp_unmapped_points(const GridMap &map, const std::vector<float> &field_m,
+std::vector<Eigen::Vector2d> lp_unmapped_points(const GridMap &map,
+                                                const std::vector<float> &field_m,
                                                 const std::vector<Eigen::Vector2d> &points_map,
                                                 double min_dist_m) {
   std::vector<Eigen::Vector2d> out;

@@ -1,6 +1,7 @@
 // autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
-// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM, <VEH>_PATH and <VEH>_MISSION, and prints each mission state
-// change. Writes path.csv, route.csv and trajectory.csv into out_dir for tools/plot-parking.
+// publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM, <VEH>_PATH and <VEH>_MISSION, and
+// prints each mission state change. Writes path.csv, route.csv and trajectory.csv into out_dir for
+// tools/plot-parking.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -23,7 +24,9 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
+void on_signal(int) {
+  g_stop = 1;
+}
 
 using namespace autonomy;
 
@@ -190,16 +193,20 @@ class App {
   std::ofstream traj_;
   int32_t seq_ = 0;
   Pose2 last_lo_pose_;
-  int64_t last_lo_us_ = -1, last_loc_us_ = -1, last_cmd_us_ = 0, last_traj_us_ = 0, last_status_us_ = -1000000000, last_utime_ = 0;
+  int64_t last_lo_us_ = -1, last_loc_us_ = -1, last_cmd_us_ = 0, last_traj_us_ = 0,
+          last_status_us_ = -1000000000, last_utime_ = 0;
   size_t printed_ = 0;
 };
 
 }  // namespace
 
 int main(int argc, char **argv) {
-  CLI::App cli{"autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on LCM"};
+  CLI::App cli{
+      "autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on "
+      "LCM"};
   std::string config_path, url_override, vehicle_override;
-  cli.add_option("--config", config_path, "YAML configuration (see runtime/jetson/autonomy/config/)")
+  cli.add_option("--config", config_path,
+                 "YAML configuration (see runtime/jetson/autonomy/config/)")
       ->required();
   cli.add_option("--lcm-url", url_override, "override lcm_url of the config");
   cli.add_option("--vehicle", vehicle_override, "override vehicle (e.g. NIGEL1)");
@@ -238,7 +245,8 @@ int main(int argc, char **argv) {
     lcm.handleTimeout(100);
     if (app.finished()) {
       if (finished_at < 0) finished_at = app.last_utime();
-      if (app.last_utime() - finished_at >= static_cast<int64_t>(cfg.exit_after_finish_s * 1e6)) break;
+      if (app.last_utime() - finished_at >= static_cast<int64_t>(cfg.exit_after_finish_s * 1e6))
+        break;
     }
   }
   app.publish_command(app.last_utime(), true);  // a final stop, also when interrupted mid-drive

@@ -23,7 +23,8 @@ std::string pgm_token(std::istream &in, const std::string &file) {
   int c;
   while ((c = in.get()) != EOF) {
     if (c == '#') {
-      while ((c = in.get()) != EOF && c != '\n') {}
+      while ((c = in.get()) != EOF && c != '\n') {
+      }
       continue;
     }
     if (std::isspace(c)) {
@@ -74,7 +75,9 @@ void map_save(const GridMap &map, const std::string &yaml_path) {
     for (int cy = map.height_cells - 1; cy >= 0; --cy) {  // PGM top row = max y
       for (int cx = 0; cx < map.width_cells; ++cx) {
         const CellState s = map.state(cx, cy);
-        row[cx] = static_cast<char>(s == CellState::kFree ? 254 : s == CellState::kOccupied ? 0 : 205);
+        row[cx] = static_cast<char>(s == CellState::kFree       ? 254
+                                    : s == CellState::kOccupied ? 0
+                                                                : 205);
       }
       out.write(row.data(), static_cast<std::streamsize>(row.size()));
     }
@@ -112,11 +115,13 @@ GridMap map_load(const std::string &yaml_path) {
       root["occupied_thresh"] ? yaml_get<double>(root, "occupied_thresh", yaml_path) : 0.65;
   const double free_th =
       root["free_thresh"] ? yaml_get<double>(root, "free_thresh", yaml_path) : 0.196;
-  const std::string mode = root["mode"] ? yaml_get<std::string>(root, "mode", yaml_path) : "trinary";
+  const std::string mode =
+      root["mode"] ? yaml_get<std::string>(root, "mode", yaml_path) : "trinary";
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     map_fail(yaml_path, "resolution must be a positive number of metres");
   if (origin.size() != 3) map_fail(yaml_path, "origin must be [x_m, y_m, yaw_rad]");
-  if (std::abs(origin[2]) > 1e-9) map_fail(yaml_path, "rotated origins (yaw != 0) are not supported");
+  if (std::abs(origin[2]) > 1e-9)
+    map_fail(yaml_path, "rotated origins (yaw != 0) are not supported");
   if (!(free_th >= 0.0 && free_th < occ_th && occ_th <= 1.0))
     map_fail(yaml_path, "thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1");
   if (mode != "trinary" && mode != "scale")
@@ -128,7 +133,8 @@ GridMap map_load(const std::string &yaml_path) {
   std::ifstream in(pgm, std::ios::binary);
   if (!in) map_fail(pf, "cannot be opened (named by " + yaml_path + ")");
   const std::string magic = pgm_token(in, pf);
-  if (magic != "P5" && magic != "P2") map_fail(pf, "not a PGM (magic '" + magic + "', want P5 or P2)");
+  if (magic != "P5" && magic != "P2")
+    map_fail(pf, "not a PGM (magic '" + magic + "', want P5 or P2)");
   const int w = pgm_int(in, pf, "width"), h = pgm_int(in, pf, "height");
   const int maxval = pgm_int(in, pf, "maxval");
   if (maxval > 255) map_fail(pf, "16-bit PGM not supported");
@@ -157,9 +163,12 @@ GridMap map_load(const std::string &yaml_path) {
       double p = static_cast<double>(v) / maxval;
       if (!negate) p = 1.0 - p;  // dark = occupied
       float l = 0.0f;
-      if (p > occ_th) l = kLoadedLogOdds;
-      else if (p < free_th) l = -kLoadedLogOdds;
-      else if (mode == "scale") l = static_cast<float>(std::log(p / (1.0 - p)));
+      if (p > occ_th)
+        l = kLoadedLogOdds;
+      else if (p < free_th)
+        l = -kLoadedLogOdds;
+      else if (mode == "scale")
+        l = static_cast<float>(std::log(p / (1.0 - p)));
       map.log_odds[map.index(cx, h - 1 - r)] = l;
     }
   }

@@ -22,7 +22,8 @@ Mission::Mission(const MissionConfig &cfg, double now_s)
       entered_s_(now_s) {}
 
 void Mission::go(MissionState to, const std::string &why, double now_s) {
-  history_.push_back(std::string(mission_state_name(state_)) + " -> " + mission_state_name(to) + ": " + why);
+  history_.push_back(std::string(mission_state_name(state_)) + " -> " + mission_state_name(to) +
+                     ": " + why);
   state_ = to;
   detail_ = why;
   entered_s_ = now_s;

@@ -7,7 +7,8 @@ namespace autonomy {
 void OdomHistory::add(int64_t utime_us, const Pose2 &odom) {
   if (!samples_.empty() && utime_us < samples_.back().utime_us) samples_.clear();
   samples_.push_back({utime_us, odom});
-  while (samples_.size() > 2 && samples_.front().utime_us < utime_us - keep_us_) samples_.pop_front();
+  while (samples_.size() > 2 && samples_.front().utime_us < utime_us - keep_us_)
+    samples_.pop_front();
 }
 
 std::optional<Pose2> OdomHistory::at(int64_t utime_us) const {

@@ -7,7 +7,8 @@ namespace autonomy {
 double path_length_m(const Path &path) {
   double s = 0.0;
   for (size_t i = 1; i < path.size(); ++i)
-    s += std::hypot(path[i].pose.x_m - path[i - 1].pose.x_m, path[i].pose.y_m - path[i - 1].pose.y_m);
+    s += std::hypot(path[i].pose.x_m - path[i - 1].pose.x_m,
+                    path[i].pose.y_m - path[i - 1].pose.y_m);
   return s;
 }
 

@@ -55,7 +55,10 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
   double best_d = (pt(best) - pos).norm();
   for (size_t i = nearest_; i < seg.size() && i < nearest_ + 60; ++i) {
     const double d = (pt(i) - pos).norm();
-    if (d < best_d) { best_d = d; best = i; }
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
   }
   nearest_ = best;
   // Distance still to drive on this segment: along the samples, then the signed projection
@@ -83,7 +86,8 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
   }
   // Speed profile.
   double v = cfg_.cruise_speed_m_s;
-  v = std::min(v, std::sqrt(2.0 * cfg_.decel_m_s2 * std::max(0.0, remaining_m - cfg_.stop_tolerance_m)));
+  v = std::min(
+      v, std::sqrt(2.0 * cfg_.decel_m_s2 * std::max(0.0, remaining_m - cfg_.stop_tolerance_m)));
   const double k_here = std::abs(seg[nearest_].curvature_1pm);
   if (k_here > 1e-6) v = std::min(v, std::sqrt(cfg_.lateral_accel_m_s2 / k_here));
   // Slow down ahead of curvature changes so the steering (rate limited) gets there in time.
@@ -91,7 +95,8 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
     double d_ahead = 0.0;
     for (size_t j = nearest_ + 1; j < seg.size() && d_ahead < cfg_.steer_preview_m; ++j) {
       d_ahead += (pt(j) - pt(j - 1)).norm();
-      const double delta_rad = std::abs(std::atan(seg[j].curvature_1pm * cfg_.wheelbase_m) - last_steer_rad_);
+      const double delta_rad =
+          std::abs(std::atan(seg[j].curvature_1pm * cfg_.wheelbase_m) - last_steer_rad_);
       if (delta_rad > 0.02)
         v = std::min(v, cfg_.steer_rate_rad_s * 0.6 * (d_ahead + 0.01) / delta_rad);
     }
@@ -126,7 +131,8 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
   const double yv = -s * d.x() + c * d.y();
   const double d2 = std::max(1e-6, d.squaredNorm());
   const double k = 2.0 * yv / d2;
-  cmd.steer_rad = std::clamp(std::atan(k * cfg_.wheelbase_m), -cfg_.max_steer_rad, cfg_.max_steer_rad);
+  cmd.steer_rad =
+      std::clamp(std::atan(k * cfg_.wheelbase_m), -cfg_.max_steer_rad, cfg_.max_steer_rad);
   cmd.steering = cmd.steer_rad / cfg_.max_steer_rad;
   last_steer_rad_ = cmd.steer_rad;
   cmd.speed_m_s = dir * v;
@@ -144,7 +150,8 @@ void PurePursuit::update_stall_boost(double along_m_s, double target_m_s, double
   }
   if (along_m_s >= cfg_.stall_fraction * target_m_s) return;  // slow, not stuck: hold
   stalled_s_ += dt_s;
-  if (stalled_s_ >= cfg_.stall_s) boost_ = std::min(cfg_.boost_max, boost_ + cfg_.boost_rate_per_s * dt_s);
+  if (stalled_s_ >= cfg_.stall_s)
+    boost_ = std::min(cfg_.boost_max, boost_ + cfg_.boost_rate_per_s * dt_s);
 }
 
 }  // namespace autonomy

@@ -13,7 +13,9 @@ struct Word {
   int n;
 };
 
-double mod2pi(double a) { return angle_wrap_rad(a); }
+double mod2pi(double a) {
+  return angle_wrap_rad(a);
+}
 void polar(double x, double y, double &r, double &th) {
   r = std::hypot(x, y);
   th = std::atan2(y, x);
@@ -118,8 +120,8 @@ struct Words {
 };
 
 template <typename LenFn>
-void add_variants(Words &out, Family f, const char *types, int n, double x, double y,
-                  double phi, LenFn lens) {
+void add_variants(Words &out, Family f, const char *types, int n, double x, double y, double phi,
+                  LenFn lens) {
   for (int flip = 0; flip < 2; ++flip) {
     for (int refl = 0; refl < 2; ++refl) {
       const double xx = flip ? -x : x, yy = refl ? -y : y, pp = (flip ^ refl) ? -phi : phi;
@@ -142,26 +144,57 @@ void add_variants(Words &out, Family f, const char *types, int n, double x, doub
 
 Words rs_words(double x, double y, double phi) {
   Words w;
-  auto tuv = [](double t, double u, double v, double *l) { l[0] = t; l[1] = u; l[2] = v; };
-  auto vut = [](double t, double u, double v, double *l) { l[0] = v; l[1] = u; l[2] = t; };
+  auto tuv = [](double t, double u, double v, double *l) {
+    l[0] = t;
+    l[1] = u;
+    l[2] = v;
+  };
+  auto vut = [](double t, double u, double v, double *l) {
+    l[0] = v;
+    l[1] = u;
+    l[2] = t;
+  };
   add_variants(w, LpSpLp, "LSL", 3, x, y, phi, tuv);
   add_variants(w, LpSpRp, "LSR", 3, x, y, phi, tuv);
   add_variants(w, LpRmL, "LRL", 3, x, y, phi, tuv);
   // CCC backwards: solve in the goal's frame, read the word in reverse order.
-  const double xb = x * std::cos(phi) + y * std::sin(phi), yb = x * std::sin(phi) - y * std::cos(phi);
+  const double xb = x * std::cos(phi) + y * std::sin(phi),
+               yb = x * std::sin(phi) - y * std::cos(phi);
   add_variants(w, LpRmL, "LRL", 3, xb, yb, phi, vut);
-  add_variants(w, LpRupLumRm, "LRLR", 4, x, y, phi,
-               [](double t, double u, double v, double *l) { l[0] = t; l[1] = u; l[2] = -u; l[3] = v; });
-  add_variants(w, LpRumLumRp, "LRLR", 4, x, y, phi,
-               [](double t, double u, double v, double *l) { l[0] = t; l[1] = u; l[2] = u; l[3] = v; });
-  auto ccsc = [](double t, double u, double v, double *l) { l[0] = t; l[1] = -kPi / 2; l[2] = u; l[3] = v; };
-  auto cscc = [](double t, double u, double v, double *l) { l[0] = v; l[1] = u; l[2] = -kPi / 2; l[3] = t; };
+  add_variants(w, LpRupLumRm, "LRLR", 4, x, y, phi, [](double t, double u, double v, double *l) {
+    l[0] = t;
+    l[1] = u;
+    l[2] = -u;
+    l[3] = v;
+  });
+  add_variants(w, LpRumLumRp, "LRLR", 4, x, y, phi, [](double t, double u, double v, double *l) {
+    l[0] = t;
+    l[1] = u;
+    l[2] = u;
+    l[3] = v;
+  });
+  auto ccsc = [](double t, double u, double v, double *l) {
+    l[0] = t;
+    l[1] = -kPi / 2;
+    l[2] = u;
+    l[3] = v;
+  };
+  auto cscc = [](double t, double u, double v, double *l) {
+    l[0] = v;
+    l[1] = u;
+    l[2] = -kPi / 2;
+    l[3] = t;
+  };
   add_variants(w, LpRmSmLm, "LRSL", 4, x, y, phi, ccsc);
   add_variants(w, LpRmSmRm, "LRSR", 4, x, y, phi, ccsc);
   add_variants(w, LpRmSmLm, "LSRL", 4, xb, yb, phi, cscc);
   add_variants(w, LpRmSmRm, "RSRL", 4, xb, yb, phi, cscc);
   add_variants(w, LpRmSLmRp, "LRSLR", 5, x, y, phi, [](double t, double u, double v, double *l) {
-    l[0] = t; l[1] = -kPi / 2; l[2] = u; l[3] = -kPi / 2; l[4] = v;
+    l[0] = t;
+    l[1] = -kPi / 2;
+    l[2] = u;
+    l[3] = -kPi / 2;
+    l[4] = v;
   });
   return w;
 }
@@ -202,7 +235,8 @@ bool word_reaches(const Word &w, double x, double y, double phi) {
     const double k = w.types[i] == 'L' ? 1.0 : w.types[i] == 'R' ? -1.0 : 0.0;
     e = arc_step(e, w.len[i], k);
   }
-  return std::hypot(e.x_m - x, e.y_m - y) < 1e-7 && std::abs(angle_wrap_rad(e.yaw_rad - phi)) < 1e-7;
+  return std::hypot(e.x_m - x, e.y_m - y) < 1e-7 &&
+         std::abs(angle_wrap_rad(e.yaw_rad - phi)) < 1e-7;
 }
 
 double word_length(const Word &w) {

@@ -100,7 +100,8 @@ void HectorSlam::integrate(const std::vector<Eigen::Vector2d> &, const Pose2 &po
     std::vector<int> end_cells;
     for (size_t i = 0; i < ends.size(); ++i) {
       int cx, cy;
-      if (hit[i] && m.world_to_cell(ends[i].x(), ends[i].y(), cx, cy)) end_cells.push_back(m.index(cx, cy));
+      if (hit[i] && m.world_to_cell(ends[i].x(), ends[i].y(), cx, cy))
+        end_cells.push_back(m.index(cx, cy));
     }
     for (int c : end_cells) before.push_back(m.log_odds[c]);
     // Hit rays clear space only up to 1.5 cells short of the hit, so rays grazing a wall do
@@ -112,12 +113,14 @@ void HectorSlam::integrate(const std::vector<Eigen::Vector2d> &, const Pose2 &po
         const double r = d.norm();
         e = sensor + d * (std::max(0.0, r - 1.5 * m.resolution_m) / std::max(r, 1e-9));
       }
-      m.update_ray(sensor.x(), sensor.y(), e.x(), e.y(), false, cfg_.l_free, 0.0f, cfg_.l_min, cfg_.l_max);
+      m.update_ray(sensor.x(), sensor.y(), e.x(), e.y(), false, cfg_.l_free, 0.0f, cfg_.l_min,
+                   cfg_.l_max);
     }
     for (size_t k = 0; k < end_cells.size(); ++k) m.log_odds[end_cells[k]] = before[k];
     std::sort(end_cells.begin(), end_cells.end());
     end_cells.erase(std::unique(end_cells.begin(), end_cells.end()), end_cells.end());
-    for (int c : end_cells) m.log_odds[c] = std::clamp(m.log_odds[c] + cfg_.l_occ, cfg_.l_min, cfg_.l_max);
+    for (int c : end_cells)
+      m.log_odds[c] = std::clamp(m.log_odds[c] + cfg_.l_occ, cfg_.l_min, cfg_.l_max);
   }
   ++scans_integrated_;
 }
@@ -134,7 +137,8 @@ Pose2 HectorSlam::update(const Scan &scan, const Pose2 &motion_guess, bool match
   if (match) pose_ = scan_match(levels_, pts, pose_, cfg_.iterations_per_level);
   const Pose2 d = pose_between(last_update_pose_, pose_);
   if (std::hypot(d.x_m, d.y_m) >= cfg_.update_min_dist_m ||
-      std::abs(d.yaw_rad) >= cfg_.update_min_angle_rad || scans_integrated_ < cfg_.initial_integrations) {
+      std::abs(d.yaw_rad) >= cfg_.update_min_angle_rad ||
+      scans_integrated_ < cfg_.initial_integrations) {
     integrate(pts, pose_, scan);
     last_update_pose_ = pose_;
   }

@@ -46,33 +46,39 @@ static int write_scene(const char *path, const char *map) {
               * main file), with the 4 bench cars added in a second worldbody */
     fprintf(f, "<mujoco model=\"sim_sensors_bench\">\n<include file=\"map.xml\"/>\n<worldbody>\n");
   } else
-  fprintf(f, "<mujoco model=\"sim_sensors_bench\">\n<compiler angle=\"degree\"/>\n"
-             "<statistic extent=\"8\" center=\"0 0 0.5\"/>\n<visual><map znear=\"0.005\"/></visual>\n"
-             "<asset><texture name=\"grid\" type=\"2d\" builtin=\"checker\" width=\"256\" "
-             "height=\"256\" rgb1=\"0.3 0.3 0.3\" rgb2=\"0.4 0.4 0.4\"/>\n<material name=\"floor\" "
-             "texture=\"grid\" texrepeat=\"12 10\"/></asset>\n<worldbody>\n"
-             "<light pos=\"0 0 4\" dir=\"0 0 -1\" directional=\"true\"/>\n"
-             "<geom type=\"plane\" size=\"3 2.5 0.1\" material=\"floor\"/>\n"
-             "<geom type=\"box\" pos=\"3 0 0.25\" size=\"0.05 2.5 0.25\"/>\n"
-             "<geom type=\"box\" pos=\"-3 0 0.25\" size=\"0.05 2.5 0.25\"/>\n"
-             "<geom type=\"box\" pos=\"0 2.5 0.25\" size=\"3 0.05 0.25\"/>\n"
-             "<geom type=\"box\" pos=\"0 -2.5 0.25\" size=\"3 0.05 0.25\"/>\n");
+    fprintf(
+        f,
+        "<mujoco model=\"sim_sensors_bench\">\n<compiler angle=\"degree\"/>\n"
+        "<statistic extent=\"8\" center=\"0 0 0.5\"/>\n<visual><map znear=\"0.005\"/></visual>\n"
+        "<asset><texture name=\"grid\" type=\"2d\" builtin=\"checker\" width=\"256\" "
+        "height=\"256\" rgb1=\"0.3 0.3 0.3\" rgb2=\"0.4 0.4 0.4\"/>\n<material name=\"floor\" "
+        "texture=\"grid\" texrepeat=\"12 10\"/></asset>\n<worldbody>\n"
+        "<light pos=\"0 0 4\" dir=\"0 0 -1\" directional=\"true\"/>\n"
+        "<geom type=\"plane\" size=\"3 2.5 0.1\" material=\"floor\"/>\n"
+        "<geom type=\"box\" pos=\"3 0 0.25\" size=\"0.05 2.5 0.25\"/>\n"
+        "<geom type=\"box\" pos=\"-3 0 0.25\" size=\"0.05 2.5 0.25\"/>\n"
+        "<geom type=\"box\" pos=\"0 2.5 0.25\" size=\"3 0.05 0.25\"/>\n"
+        "<geom type=\"box\" pos=\"0 -2.5 0.25\" size=\"3 0.05 0.25\"/>\n");
   for (int i = 0; i < (map ? 0 : 40); i++) {
     double x = -2.6 + 0.65 * (i % 9), y = -2.0 + 1.0 * (i / 9);
     if (map || (fabs(x) < 0.5 && fabs(y) < 0.5)) continue;
-    fprintf(f, "<geom type=\"box\" pos=\"%.2f %.2f 0.1\" size=\"0.1 0.1 0.1\" euler=\"0 0 %d\" "
-               "rgba=\"0.9 0.5 0.1 1\"/>\n", x, y, 17 * i);
+    fprintf(f,
+            "<geom type=\"box\" pos=\"%.2f %.2f 0.1\" size=\"0.1 0.1 0.1\" euler=\"0 0 %d\" "
+            "rgba=\"0.9 0.5 0.1 1\"/>\n",
+            x, y, 17 * i);
   }
   for (int c = 1; c <= 4; c++) {
-    fprintf(f, "<body name=\"nigel%d\" pos=\"%.2f %.2f 0.05\" quat=\"%.6f 0 0 %.6f\"><freejoint/>\n"
-               "<geom type=\"box\" size=\"0.12 0.08 0.04\" rgba=\"0.8 0.8 0.8 1\"/>\n"
-               "<geom type=\"cylinder\" pos=\"0.1445 0 0.16\" size=\"0.035 0.02\"/>\n"
-               "<camera name=\"nigel%d_cam_front\" pos=\"0.15 0 0.1\" xyaxes=\"0 -1 0 0 0 1\" "
-               "fovy=\"48.67\"/>\n",
+    fprintf(f,
+            "<body name=\"nigel%d\" pos=\"%.2f %.2f 0.05\" quat=\"%.6f 0 0 %.6f\"><freejoint/>\n"
+            "<geom type=\"box\" size=\"0.12 0.08 0.04\" rgba=\"0.8 0.8 0.8 1\"/>\n"
+            "<geom type=\"cylinder\" pos=\"0.1445 0 0.16\" size=\"0.035 0.02\"/>\n"
+            "<camera name=\"nigel%d_cam_front\" pos=\"0.15 0 0.1\" xyaxes=\"0 -1 0 0 0 1\" "
+            "fovy=\"48.67\"/>\n",
             c, -1.0 + 0.6 * c, 0.3 * (c % 2), cos(M_PI / 4 * c), sin(M_PI / 4 * c), c);
     for (int w = 0; w < 4; w++)
-      fprintf(f, "<body pos=\"%.3f %.3f 0\"><joint type=\"hinge\" axis=\"0 1 0\"/>"
-                 "<geom type=\"sphere\" size=\"0.0325\"/></body>\n",
+      fprintf(f,
+              "<body pos=\"%.3f %.3f 0\"><joint type=\"hinge\" axis=\"0 1 0\"/>"
+              "<geom type=\"sphere\" size=\"0.0325\"/></body>\n",
               w < 2 ? 0.07 : -0.07, w % 2 ? 0.0765 : -0.0765);
     fprintf(f, "</body>\n");
   }
@@ -114,14 +120,11 @@ int main(int argc, char **argv) {
   int scans = 300, frames = 200, w = 640, h = 480;
   sim_render_backend_t backend = SIM_RENDER_AUTO;
   char *map = NULL; /* realpath of --map, or NULL for the built-in scene */
-  static const struct option opts[] = {{"scans", required_argument, 0, 's'},
-                                       {"frames", required_argument, 0, 'f'},
-                                       {"width", required_argument, 0, 'w'},
-                                       {"height", required_argument, 0, 'H'},
-                                       {"backend", required_argument, 0, 'b'},
-                                       {"map", required_argument, 0, 'm'},
-                                       {"help", no_argument, 0, 'h'},
-                                       {0, 0, 0, 0}};
+  static const struct option opts[] = {
+      {"scans", required_argument, 0, 's'},   {"frames", required_argument, 0, 'f'},
+      {"width", required_argument, 0, 'w'},   {"height", required_argument, 0, 'H'},
+      {"backend", required_argument, 0, 'b'}, {"map", required_argument, 0, 'm'},
+      {"help", no_argument, 0, 'h'},          {0, 0, 0, 0}};
   int o;
   while ((o = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
     switch (o) {
@@ -130,9 +133,12 @@ int main(int argc, char **argv) {
       case 'w': w = atoi(optarg); break;
       case 'H': h = atoi(optarg); break;
       case 'b':
-        if (!strcmp(optarg, "auto")) backend = SIM_RENDER_AUTO;
-        else if (!strcmp(optarg, "egl")) backend = SIM_RENDER_EGL;
-        else if (!strcmp(optarg, "osmesa")) backend = SIM_RENDER_OSMESA;
+        if (!strcmp(optarg, "auto"))
+          backend = SIM_RENDER_AUTO;
+        else if (!strcmp(optarg, "egl"))
+          backend = SIM_RENDER_EGL;
+        else if (!strcmp(optarg, "osmesa"))
+          backend = SIM_RENDER_OSMESA;
         else {
           fprintf(stderr, "sim-sensors-bench: --backend '%s' is not auto, egl or osmesa\n", optarg);
           return 2;
@@ -239,11 +245,12 @@ int main(int argc, char **argv) {
   double jpeg_us = median(t, frames);
   fprintf(stderr, "jpeg: median %.0f us, %zu bytes\n", jpeg_us, jpg_len);
 
-  printf("{\"lidar_scan_us\": %.1f, \"lidar_scan_cpu_us\": %.1f, \"lidar_step_us\": %.2f, "
-         "\"camera_fps_%dx%d\": %.1f, \"camera_cpu_us\": %.0f, \"jpeg_encode_us\": %.0f, "
-         "\"camera_jpeg_fps\": %.1f, \"jpeg_bytes\": %zu, \"render_backend\": \"%s\"}\n",
-         lidar_scan_us, lidar_scan_cpu_us, lidar_step_us, w, h, 1e6 / render_us, render_cpu_us,
-         jpeg_us, 1e6 / (render_us + jpeg_us), jpg_len, sim_render_backend_name(r));
+  printf(
+      "{\"lidar_scan_us\": %.1f, \"lidar_scan_cpu_us\": %.1f, \"lidar_step_us\": %.2f, "
+      "\"camera_fps_%dx%d\": %.1f, \"camera_cpu_us\": %.0f, \"jpeg_encode_us\": %.0f, "
+      "\"camera_jpeg_fps\": %.1f, \"jpeg_bytes\": %zu, \"render_backend\": \"%s\"}\n",
+      lidar_scan_us, lidar_scan_cpu_us, lidar_step_us, w, h, 1e6 / render_us, render_cpu_us,
+      jpeg_us, 1e6 / (render_us + jpeg_us), jpg_len, sim_render_backend_name(r));
   sim_jpeg_destroy(j);
   free(rgb);
   free(t);

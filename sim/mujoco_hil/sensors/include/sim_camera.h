@@ -3,8 +3,9 @@
  *
  * MuJoCo 2.2 cameras take a vertical field of view only (fovy). Nigel's 62.2 deg horizontal
  * FOV at 4:3 is fovy = 2 atan(tan(31.1 deg) * 3/4) = 48.67 deg: put fovy="48.67" on the MJCF
- * <camera> (the often quoted 48.8 gives 62.33 deg). The intrinsics are derived from the model's fovy: fy = fx = (h/2) / tan(fovy/2),
- * cx = (w-1)/2, cy = (h-1)/2 (OpenCV pixel-centre convention), no distortion.
+ * <camera> (the often quoted 48.8 gives 62.33 deg). The intrinsics are derived from the model's
+ * fovy: fy = fx = (h/2) / tan(fovy/2), cx = (w-1)/2, cy = (h-1)/2 (OpenCV pixel-centre convention),
+ * no distortion.
  */
 #ifndef SIM_CAMERA_H
 #define SIM_CAMERA_H
@@ -35,8 +36,8 @@ typedef struct sim_camera sim_camera_t;
  * missing camera or a bad size. Caller owns the result (sim_camera_destroy); the renderer
  * must outlive it. */
 sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *cam_name,
-                                const char *frame_id, int width_px, int height_px,
-                                int jpeg_quality, char *err, size_t err_len);
+                                const char *frame_id, int width_px, int height_px, int jpeg_quality,
+                                char *err, size_t err_len);
 void sim_camera_destroy(sim_camera_t *c);
 
 /* Renders the current state d and JPEG-encodes it. Returns 0, or -1 on failure. */
@@ -50,8 +51,7 @@ int sim_camera_width(const sim_camera_t *c);
 int sim_camera_height(const sim_camera_t *c);
 
 /* Camera matrix K (row-major, [px]) of camera cam_id at width_px x height_px, from its fovy. */
-void sim_camera_intrinsics(const mjModel *m, int cam_id, int width_px, int height_px,
-                           double k[9]);
+void sim_camera_intrinsics(const mjModel *m, int cam_id, int width_px, int height_px, double k[9]);
 
 /* Publishes the last frame as compressed_image_t ("jpeg") on channel. Returns lcm_publish's
  * result (0 on success). */

@@ -23,13 +23,13 @@ extern "C" {
 #endif
 
 typedef struct sim_lidar_config {
-  int num_rays;            /* rays per revolution (360 -> 1 deg) */
-  double range_min_m;      /* closer hits read +inf (0.15 m on the A1) */
-  double range_max_m;      /* farther hits read +inf (12 m on the A1) */
-  double rate_hz;          /* revolutions per second (~7 Hz) */
-  double mount_pos_m[3];   /* scanner origin in the base body frame [m] */
-  double noise_std_m;      /* Gaussian range noise, standard deviation [m]; 0 = exact */
-  uint64_t seed;           /* noise seed: same seed, same noise sequence */
+  int num_rays;                /* rays per revolution (360 -> 1 deg) */
+  double range_min_m;          /* closer hits read +inf (0.15 m on the A1) */
+  double range_max_m;          /* farther hits read +inf (12 m on the A1) */
+  double rate_hz;              /* revolutions per second (~7 Hz) */
+  double mount_pos_m[3];       /* scanner origin in the base body frame [m] */
+  double noise_std_m;          /* Gaussian range noise, standard deviation [m]; 0 = exact */
+  uint64_t seed;               /* noise seed: same seed, same noise sequence */
   mjtByte geomgroup[mjNGROUP]; /* geom groups the rays see (1 = visible), as mjvOption */
 } sim_lidar_config_t;
 
@@ -42,15 +42,15 @@ typedef struct sim_lidar sim_lidar_t;
 /* One completed scan. Arrays are owned by the sim_lidar_t and stay valid until the next
  * completed scan or sim_lidar_destroy. */
 typedef struct sim_lidar_scan {
-  int64_t utime;              /* sim time of the first ray [us] */
+  int64_t utime; /* sim time of the first ray [us] */
   int num_rays;
-  float angle_min_rad;        /* 0 */
-  float angle_increment_rad;  /* 2 pi / num_rays */
-  float time_increment_s;     /* between rays [s] */
-  float scan_time_s;          /* between scans [s] */
+  float angle_min_rad;       /* 0 */
+  float angle_increment_rad; /* 2 pi / num_rays */
+  float time_increment_s;    /* between rays [s] */
+  float scan_time_s;         /* between scans [s] */
   float range_min_m, range_max_m;
-  const float *ranges_m;      /* num_rays; +INFINITY = no return */
-  const float *intensities;   /* num_rays; RPLIDAR-like quality 0..63, 0 = no return */
+  const float *ranges_m;    /* num_rays; +INFINITY = no return */
+  const float *intensities; /* num_rays; RPLIDAR-like quality 0..63, 0 = no return */
 } sim_lidar_scan_t;
 
 /* Creates a scanner on body base_body (e.g. "nigel1/base_link") of model m.
@@ -75,8 +75,9 @@ void sim_lidar_scan_now(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now
 const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l);
 
 /* The rays [from, to) the last sim_lidar_update cast (from == to: none) of num_rays per
- * revolution, indexed like a scan (CCW angle i * 360 / num_rays deg); ranges_m / quality are borrowed, valid until the next
- * update. An emulated RPLIDAR streams these as they are measured, like the real device. */
+ * revolution, indexed like a scan (CCW angle i * 360 / num_rays deg); ranges_m / quality are
+ * borrowed, valid until the next update. An emulated RPLIDAR streams these as they are measured,
+ * like the real device. */
 void sim_lidar_last_cast(const sim_lidar_t *l, int *from, int *to, int *num_rays,
                          const float **ranges_m, const float **quality);
 

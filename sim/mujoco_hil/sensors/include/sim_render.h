@@ -21,7 +21,7 @@ extern "C" {
 typedef struct sim_render sim_render_t;
 
 typedef enum sim_render_backend {
-  SIM_RENDER_AUTO = 0,   /* EGL surfaceless, else OSMesa */
+  SIM_RENDER_AUTO = 0, /* EGL surfaceless, else OSMesa */
   SIM_RENDER_EGL,
   SIM_RENDER_OSMESA,
 } sim_render_backend_t;

@@ -36,18 +36,17 @@ extern "C" {
 typedef struct sim_rplidar sim_rplidar_t;
 
 typedef struct sim_rplidar_stats {
-  uint64_t bytes_tx;        /* bytes written to the pty */
-  uint64_t nodes_tx;        /* measurement nodes sent */
-  uint64_t nodes_dropped;   /* nodes dropped because the wire was too slow or the pty full */
-  uint64_t requests_rx;     /* well-formed requests received */
-  uint64_t bad_requests;    /* bad checksum or unknown command */
+  uint64_t bytes_tx;      /* bytes written to the pty */
+  uint64_t nodes_tx;      /* measurement nodes sent */
+  uint64_t nodes_dropped; /* nodes dropped because the wire was too slow or the pty full */
+  uint64_t requests_rx;   /* well-formed requests received */
+  uint64_t bad_requests;  /* bad checksum or unknown command */
 } sim_rplidar_stats_t;
 
 /* Opens a pty and points the symlink link_path at its slave (replacing an old symlink there;
  * refuses to replace a non-symlink). baud is the emulated wire rate (SIM_RPLIDAR_BAUD).
  * Returns NULL with a message in err on failure. Caller owns the result. */
-sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *err,
-                                  size_t err_len);
+sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *err, size_t err_len);
 /* Closes the pty and removes the symlink. */
 void sim_rplidar_destroy(sim_rplidar_t *r);
 
@@ -63,8 +62,8 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
 /* Streams rays [from, to) of the revolution being measured, as a real A1 sends nodes while it
  * spins (a whole-revolution push delays every node by up to one revolution, ~143 ms at 7 Hz).
  * Ray 0 starts a revolution (the S flag). Same node subset and encoding as push_scan. */
-void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality,
-                           int from, int to, int num_rays);
+void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality, int from,
+                           int to, int num_rays);
 
 /* Reads and answers requests and writes the bytes the wire could carry up to now_us (sim or
  * wall clock, monotonic, [us]). Never blocks. Call often (e.g. every physics step).

@@ -24,10 +24,10 @@
 extern "C" {
 #endif
 
-#define SIM_TAGS_SIZE_M 0.08          /* black-square edge [m] */
-#define SIM_TAGS_OFFSET_X_M 0.035125  /* tag plate centre from base_link [m] */
+#define SIM_TAGS_SIZE_M 0.08         /* black-square edge [m] */
+#define SIM_TAGS_OFFSET_X_M 0.035125 /* tag plate centre from base_link [m] */
 #define SIM_TAGS_OFFSET_Y_M 0.0
-#define SIM_TAGS_OFFSET_Z_M 0.129165  /* top face height above base_link [m] */
+#define SIM_TAGS_OFFSET_Z_M 0.129165 /* top face height above base_link [m] */
 #define SIM_TAGS_PLATE_THICKNESS_M 0.002
 /* MuJoCo maps a 2D texture onto a box's top face with the image's up along the box's +y;
  * the plate is yawed -90 deg in its body (quat below) so the tag's up is the car's +x. */

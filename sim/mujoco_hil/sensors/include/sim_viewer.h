@@ -21,18 +21,18 @@ extern "C" {
 #endif
 
 typedef enum sim_viewer_view {
-  SIM_VIEW_DRIVER = 0,  /* the car's front camera */
-  SIM_VIEW_BIRD,        /* tracking the car from behind and above */
-  SIM_VIEW_GOD,         /* the map's "eye" camera, else a free overview */
+  SIM_VIEW_DRIVER = 0, /* the car's front camera */
+  SIM_VIEW_BIRD,       /* tracking the car from behind and above */
+  SIM_VIEW_GOD,        /* the map's "eye" camera, else a free overview */
 } sim_viewer_view_t;
 
 typedef struct sim_viewer_input {
-  int quit;                /* 1 once Esc was pressed or the window closed */
-  int reset_requested;     /* R pressed since the previous frame (edge, cleared each frame) */
-  int paused;              /* Space toggles: while 1 the sim should not step */
-  int day;                 /* N toggles: 1 day, 0 night */
-  int car;                 /* shown car, 1-based (Tab cycles) */
-  sim_viewer_view_t view;  /* 1/2/3 */
+  int quit;               /* 1 once Esc was pressed or the window closed */
+  int reset_requested;    /* R pressed since the previous frame (edge, cleared each frame) */
+  int paused;             /* Space toggles: while 1 the sim should not step */
+  int day;                /* N toggles: 1 day, 0 night */
+  int car;                /* shown car, 1-based (Tab cycles) */
+  sim_viewer_view_t view; /* 1/2/3 */
 } sim_viewer_input_t;
 
 typedef struct sim_viewer sim_viewer_t;

@@ -24,8 +24,8 @@ struct sim_camera {
 };
 
 sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *cam_name,
-                                const char *frame_id, int width_px, int height_px,
-                                int jpeg_quality, char *err, size_t err_len) {
+                                const char *frame_id, int width_px, int height_px, int jpeg_quality,
+                                char *err, size_t err_len) {
   if (!r || !m || !cam_name || !frame_id) {
     if (err && err_len) snprintf(err, err_len, "sim_camera: null argument");
     return NULL;
@@ -40,7 +40,8 @@ sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *c
     if (err && err_len)
       snprintf(err, err_len,
                "sim_camera: bad size %dx%d px (must fit the renderer's buffer) or JPEG quality "
-               "%d (1..100) for '%s'", width_px, height_px, jpeg_quality, cam_name);
+               "%d (1..100) for '%s'",
+               width_px, height_px, jpeg_quality, cam_name);
     return NULL;
   }
   sim_camera_t *c = calloc(1, sizeof *c);
@@ -74,16 +75,21 @@ int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t uti
   return 0;
 }
 
-const uint8_t *sim_camera_rgb(const sim_camera_t *c) { return c->rgb; }
+const uint8_t *sim_camera_rgb(const sim_camera_t *c) {
+  return c->rgb;
+}
 const uint8_t *sim_camera_jpeg(const sim_camera_t *c, size_t *size_bytes) {
   if (size_bytes) *size_bytes = c->jpg_len;
   return c->jpg;
 }
-int sim_camera_width(const sim_camera_t *c) { return c->w; }
-int sim_camera_height(const sim_camera_t *c) { return c->h; }
+int sim_camera_width(const sim_camera_t *c) {
+  return c->w;
+}
+int sim_camera_height(const sim_camera_t *c) {
+  return c->h;
+}
 
-void sim_camera_intrinsics(const mjModel *m, int cam_id, int width_px, int height_px,
-                           double k[9]) {
+void sim_camera_intrinsics(const mjModel *m, int cam_id, int width_px, int height_px, double k[9]) {
   double fovy_rad = m->cam_fovy[cam_id] * M_PI / 180.0;
   double f = 0.5 * height_px / tan(0.5 * fovy_rad);
   memset(k, 0, 9 * sizeof(double));

@@ -16,8 +16,8 @@ struct sim_jpeg {
   struct jpeg_compress_struct cinfo;
   struct sim_jpeg_err jerr;
   int quality;
-  unsigned char *buf;   /* jpeg_mem_dest output, reused across frames */
-  unsigned long cap;    /* its usable size [bytes] */
+  unsigned char *buf; /* jpeg_mem_dest output, reused across frames */
+  unsigned long cap;  /* its usable size [bytes] */
 };
 
 static void jpeg_error_exit(j_common_ptr c) {

@@ -8,22 +8,22 @@
 
 struct sim_lidar {
   sim_lidar_config_t cfg;
-  int base_body;           /* body carrying the scanner */
-  int root_body;           /* its root: geoms under it are the car itself */
-  int *cand;               /* candidate geoms for this scan (not the car's, in a seen group) */
-  int *cand_lo, *cand_n;   /* per candidate: first ray index of its sector and its ray count */
+  int base_body;         /* body carrying the scanner */
+  int root_body;         /* its root: geoms under it are the car itself */
+  int *cand;             /* candidate geoms for this scan (not the car's, in a seen group) */
+  int *cand_lo, *cand_n; /* per candidate: first ray index of its sector and its ray count */
   int ncand;
-  int *bucket_start;       /* rays [from, to): candidates of ray from+j are */
-  int *bucket;             /*   bucket[bucket_start[j] .. bucket_start[j+1]) */
+  int *bucket_start; /* rays [from, to): candidates of ray from+j are */
+  int *bucket;       /*   bucket[bucket_start[j] .. bucket_start[j+1]) */
   size_t bucket_cap;
-  float *ranges_m, *quality;          /* revolution being filled */
-  float *out_ranges_m, *out_quality;  /* last completed revolution */
+  float *ranges_m, *quality;         /* revolution being filled */
+  float *out_ranges_m, *out_quality; /* last completed revolution */
   sim_lidar_scan_t last;
-  int64_t rev_start_us;    /* sim time at which the current revolution started [us] */
-  int next_ray;            /* next ray index of the current revolution */
-  int cast_from, cast_to;  /* rays [from, to) cast by the last update, in ranges_m */
+  int64_t rev_start_us;   /* sim time at which the current revolution started [us] */
+  int next_ray;           /* next ray index of the current revolution */
+  int cast_from, cast_to; /* rays [from, to) cast by the last update, in ranges_m */
   int started;
-  uint64_t rng;            /* xorshift64* state for the noise */
+  uint64_t rng; /* xorshift64* state for the noise */
 };
 
 static void err_set(char *err, size_t n, const char *msg, const char *arg) {
@@ -53,8 +53,10 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   if (cfg->num_rays < 1 || cfg->num_rays > 100000 || !(cfg->rate_hz > 0) ||
       !(cfg->range_min_m >= 0) || !(cfg->range_max_m > cfg->range_min_m) ||
       !(cfg->noise_std_m >= 0)) {
-    err_set(err, err_len, "bad config (need 1..100000 rays, rate_hz > 0, "
-                          "0 <= range_min_m < range_max_m, noise_std_m >= 0)", NULL);
+    err_set(err, err_len,
+            "bad config (need 1..100000 rays, rate_hz > 0, "
+            "0 <= range_min_m < range_max_m, noise_std_m >= 0)",
+            NULL);
     return NULL;
   }
   int body = mj_name2id(m, mjOBJ_BODY, base_body);
@@ -77,7 +79,8 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->quality = calloc(n, sizeof(float));
   l->out_ranges_m = calloc(n, sizeof(float));
   l->out_quality = calloc(n, sizeof(float));
-  if (!l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality || !l->out_ranges_m || !l->out_quality) {
+  if (!l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality ||
+      !l->out_ranges_m || !l->out_quality) {
     sim_lidar_destroy(l);
     err_set(err, err_len, "out of memory", NULL);
     return NULL;
@@ -104,8 +107,8 @@ void sim_lidar_destroy(sim_lidar_t *l) {
 }
 
 /* Scanner origin in world and its x/y axes (the car body's, as the scanner is fixed). */
-static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
-                        mjtNum ax[3], mjtNum ay[3]) {
+static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3], mjtNum ax[3],
+                        mjtNum ay[3]) {
   const mjtNum *xm = d->xmat + 9 * l->base_body;
   const mjtNum *xp = d->xpos + 3 * l->base_body;
   const double *p = l->cfg.mount_pos_m;
@@ -121,8 +124,8 @@ static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
  * cross the scan plane (exact slab for boxes, bounding sphere otherwise) within range. Each
  * candidate gets the sector of rays that can reach it, from the circle in which its bounding
  * sphere cuts the scan plane; unbounded geoms (planes) and geoms around the origin get all. */
-static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l,
-                         const mjtNum origin[3], const mjtNum ax[3], const mjtNum ay[3]) {
+static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l, const mjtNum origin[3],
+                         const mjtNum ax[3], const mjtNum ay[3]) {
   mjtNum nrm[3];
   mju_cross(nrm, ax, ay);
   const int n = l->cfg.num_rays;
@@ -135,11 +138,11 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l,
     if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue;
     int lo = 0, cnt = n;
     mjtNum rb = m->geom_rbound[g];
-    if (rb > 0) {  /* rbound 0 means unbounded (planes) */
+    if (rb > 0) { /* rbound 0 means unbounded (planes) */
       mjtNum rel[3];
       mju_sub3(rel, d->geom_xpos + 3 * g, origin);
       mjtNum dz = mju_dot3(rel, nrm);
-      if (fabs(dz) > rb) continue;                                  /* off the scan plane */
+      if (fabs(dz) > rb) continue;         /* off the scan plane */
       if (m->geom_type[g] == mjGEOM_BOX) { /* the box's half thickness along the normal */
         const mjtNum *xm = d->geom_xmat + 9 * g, *sz = m->geom_size + 3 * g;
         mjtNum hz = 0;
@@ -147,16 +150,16 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l,
           hz += fabs(xm[k] * nrm[0] + xm[3 + k] * nrm[1] + xm[6 + k] * nrm[2]) * sz[k];
         if (fabs(dz) > hz) continue;
       }
-      mjtNum r_plane = sqrt(rb * rb - dz * dz);      /* sphere cut by the scan plane [m] */
+      mjtNum r_plane = sqrt(rb * rb - dz * dz); /* sphere cut by the scan plane [m] */
       mjtNum px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
       mjtNum dist = sqrt(px * px + py * py);
-      if (dist - r_plane > l->cfg.range_max_m) continue;            /* out of range */
+      if (dist - r_plane > l->cfg.range_max_m) continue; /* out of range */
       if (dist > r_plane) {
         double centre = atan2(py, px), half = asin(r_plane / dist);
         lo = (int)ceil((centre - half) / inc - 1e-9);
         int hi = (int)floor((centre + half) / inc + 1e-9);
         cnt = hi - lo + 1;
-        if (cnt <= 0) continue;  /* falls between two rays */
+        if (cnt <= 0) continue; /* falls between two rays */
         if (cnt > n) cnt = n;
         lo = ((lo % n) + n) % n;
       }
@@ -181,16 +184,20 @@ static int lidar_bucket(sim_lidar_t *l, int from, int to) {
           int off = i - lo;
           if (off < 0) off += n;
           if (off >= cnt) continue;
-          if (pass == 0) start[i - from + 1]++;
-          else l->bucket[start[i - from]++] = k;
+          if (pass == 0)
+            start[i - from + 1]++;
+          else
+            l->bucket[start[i - from]++] = k;
         }
       } else { /* many rays: walk the candidate's sector */
         for (int j = 0; j < cnt; j++) {
           int i = lo + j;
           if (i >= n) i -= n;
           if (i < from || i >= to) continue;
-          if (pass == 0) start[i - from + 1]++;
-          else l->bucket[start[i - from]++] = k;
+          if (pass == 0)
+            start[i - from + 1]++;
+          else
+            l->bucket[start[i - from]++] = k;
         }
       }
     }
@@ -213,13 +220,12 @@ static int lidar_bucket(sim_lidar_t *l, int from, int to) {
 
 /* Nearest hit along unit vec from origin over candidates list[0..count), or -1. */
 static mjtNum lidar_cast(const mjModel *m, const mjData *d, const sim_lidar_t *l,
-                         const mjtNum origin[3], const mjtNum vec[3], const int *list,
-                         int count) {
+                         const mjtNum origin[3], const mjtNum vec[3], const int *list, int count) {
   mjtNum best = -1;
   for (int k = 0; k < count; k++) {
     int g = l->cand[list ? list[k] : k];
     mjtNum rb = m->geom_rbound[g];
-    if (rb > 0) {  /* cheap sphere test first: skip geoms the ray passes by or lies behind */
+    if (rb > 0) { /* cheap sphere test first: skip geoms the ray passes by or lies behind */
       mjtNum rel[3];
       mju_sub3(rel, d->geom_xpos + 3 * g, origin);
       mjtNum along = mju_dot3(rel, vec);
@@ -235,8 +241,8 @@ static mjtNum lidar_cast(const mjModel *m, const mjData *d, const sim_lidar_t *l
     } else if (type == mjGEOM_HFIELD) {
       x = mj_rayHfield(m, d, g, origin, vec);
     } else {
-      x = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g, m->geom_size + 3 * g, origin,
-                      vec, type);
+      x = mju_rayGeom(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g, m->geom_size + 3 * g, origin, vec,
+                      type);
     }
     if (x >= 0 && (best < 0 || x < best)) best = x;
   }
@@ -345,7 +351,9 @@ int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us
   return 0;
 }
 
-const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l) { return &l->last; }
+const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l) {
+  return &l->last;
+}
 
 void sim_lidar_last_cast(const sim_lidar_t *l, int *from, int *to, int *num_rays,
                          const float **ranges_m, const float **quality) {

@@ -43,17 +43,17 @@ struct sim_render {
   EGLDisplay egl_dpy;
   EGLContext egl_ctx;
   OSMesaContext osm_ctx;
-  void *osm_buf;            /* OSMesa's default framebuffer (unused by MuJoCo's offscreen) */
-  mjModel *mcopy;           /* shallow copy of the model with our render settings */
+  void *osm_buf;  /* OSMesa's default framebuffer (unused by MuJoCo's offscreen) */
+  mjModel *mcopy; /* shallow copy of the model with our render settings */
   mjrContext con;
   mjvScene scn;
   mjvOption opt;
   mjvCamera cam;
   int maxw, maxh;
-  uint8_t *rgba;            /* RGBA readback: Mesa's fast glReadPixels path (RGB is ~30 % slower) */
+  uint8_t *rgba; /* RGBA readback: Mesa's fast glReadPixels path (RGB is ~30 % slower) */
   void (*ReadPixels)(GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, void *);
   void (*BindFramebuffer)(GLenum, GLuint);
-  float light_k;            /* day 1, night < 1: scales every scene light */
+  float light_k; /* day 1, night < 1: scales every scene light */
 };
 
 static int render_make_current(sim_render_t *r);
@@ -73,9 +73,10 @@ static int sym(void *lib, const char *name, void *fnptr) {
 static int egl_load(egl_api_t *e) {
   e->lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_GLOBAL);
   if (!e->lib) return -1;
-  if (sym(e->lib, "eglGetProcAddress", &e->GetProcAddress) || sym(e->lib, "eglInitialize", &e->Initialize) ||
-      sym(e->lib, "eglTerminate", &e->Terminate) || sym(e->lib, "eglChooseConfig", &e->ChooseConfig) ||
-      sym(e->lib, "eglBindAPI", &e->BindAPI) || sym(e->lib, "eglCreateContext", &e->CreateContext) ||
+  if (sym(e->lib, "eglGetProcAddress", &e->GetProcAddress) ||
+      sym(e->lib, "eglInitialize", &e->Initialize) || sym(e->lib, "eglTerminate", &e->Terminate) ||
+      sym(e->lib, "eglChooseConfig", &e->ChooseConfig) || sym(e->lib, "eglBindAPI", &e->BindAPI) ||
+      sym(e->lib, "eglCreateContext", &e->CreateContext) ||
       sym(e->lib, "eglDestroyContext", &e->DestroyContext) ||
       sym(e->lib, "eglMakeCurrent", &e->MakeCurrent) ||
       sym(e->lib, "eglGetCurrentContext", &e->GetCurrentContext))
@@ -144,8 +145,7 @@ static int osmesa_init(sim_render_t *r) {
 
 sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_height_px,
                                 sim_render_backend_t backend, char *err, size_t err_len) {
-  if (!m || max_width_px < 1 || max_height_px < 1 || max_width_px > 8192 ||
-      max_height_px > 8192) {
+  if (!m || max_width_px < 1 || max_height_px < 1 || max_width_px > 8192 || max_height_px > 8192) {
     err_set(err, err_len, "null model or bad buffer size (1..8192 px)");
     return NULL;
   }
@@ -160,14 +160,16 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
     ok = osmesa_init(r);
   if (ok == -2) {
     free(r);
-    err_set(err, err_len, "OSMesa cannot be used in a process that already loaded libEGL "
-                          "(MuJoCo would bind its GL calls to EGL): use one backend per process");
+    err_set(err, err_len,
+            "OSMesa cannot be used in a process that already loaded libEGL "
+            "(MuJoCo would bind its GL calls to EGL): use one backend per process");
     return NULL;
   }
   if (ok != 0) {
     free(r);
-    err_set(err, err_len, "no headless OpenGL context (tried EGL surfaceless and/or OSMesa; "
-                          "are Mesa's libegl-mesa0 / libosmesa6 installed?)");
+    err_set(err, err_len,
+            "no headless OpenGL context (tried EGL surfaceless and/or OSMesa; "
+            "are Mesa's libegl-mesa0 / libosmesa6 installed?)");
     return NULL;
   }
   /* fast settings on a private shallow copy: the arrays stay shared, only vis changes */
@@ -255,7 +257,9 @@ int sim_render_fits(const sim_render_t *r, int width_px, int height_px) {
   return width_px >= 1 && height_px >= 1 && width_px <= r->maxw && height_px <= r->maxh;
 }
 
-mjvOption *sim_render_options(sim_render_t *r) { return &r->opt; }
+mjvOption *sim_render_options(sim_render_t *r) {
+  return &r->opt;
+}
 
 /* Makes the renderer's context current again if something else (a viewer window) took the
  * thread's current context since the last frame. */

@@ -21,8 +21,8 @@
 #define RPL_CMD_GET_HEALTH 0x52
 #define RPL_CMD_GET_SAMPLERATE 0x59
 #define RPL_NODE_BYTES 5
-#define RPL_OUT_CAP 8192          /* bytes of responses waiting for the wire */
-#define RPL_QUALITY_HIT 47        /* 6-bit quality of a return */
+#define RPL_OUT_CAP 8192   /* bytes of responses waiting for the wire */
+#define RPL_QUALITY_HIT 47 /* 6-bit quality of a return */
 
 /* Request parser states. */
 enum { RX_SYNC, RX_CMD, RX_SIZE, RX_PAYLOAD, RX_CHECKSUM };
@@ -38,15 +38,15 @@ struct sim_rplidar {
   /* response bytes (descriptors and data) go first; then nodes */
   uint8_t out[RPL_OUT_CAP];
   size_t out_len;
-  uint8_t *nodes;           /* queued measurement nodes, RPL_NODE_BYTES each */
+  uint8_t *nodes;                        /* queued measurement nodes, RPL_NODE_BYTES each */
   size_t nodes_len, nodes_cap, node_off; /* bytes queued, capacity, bytes of the head sent */
   int scanning;
-  int connected;            /* a client has the slave open (reads did not return EIO) */
-  int64_t wire_us;          /* wire time up to which bytes were allowed [us] */
-  double credit_bytes;      /* bytes the wire may still carry now */
+  int connected;       /* a client has the slave open (reads did not return EIO) */
+  int64_t wire_us;     /* wire time up to which bytes were allowed [us] */
+  double credit_bytes; /* bytes the wire may still carry now */
   int clock_started;
-  int64_t last_push_us;     /* wire clock at the previous revolution's start, -1 before the first */
-  int rev_send;             /* nodes sent in the current streamed revolution (0: not started) */
+  int64_t last_push_us; /* wire clock at the previous revolution's start, -1 before the first */
+  int rev_send;         /* nodes sent in the current streamed revolution (0: not started) */
   sim_rplidar_stats_t stats;
 };
 
@@ -60,8 +60,7 @@ static void err_set(char *err, size_t n, const char *what, const char *arg) {
   }
 }
 
-sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *err,
-                                  size_t err_len) {
+sim_rplidar_t *sim_rplidar_create(const char *link_path, uint32_t baud, char *err, size_t err_len) {
   errno = 0;
   if (!link_path || !*link_path || strlen(link_path) >= sizeof(((sim_rplidar_t *)0)->link_path) ||
       baud < 1200 || baud > 4000000) {
@@ -131,9 +130,15 @@ void sim_rplidar_destroy(sim_rplidar_t *r) {
   free(r);
 }
 
-const char *sim_rplidar_slave_path(const sim_rplidar_t *r) { return r->slave_path; }
-int sim_rplidar_scanning(const sim_rplidar_t *r) { return r->scanning; }
-void sim_rplidar_get_stats(const sim_rplidar_t *r, sim_rplidar_stats_t *out) { *out = r->stats; }
+const char *sim_rplidar_slave_path(const sim_rplidar_t *r) {
+  return r->slave_path;
+}
+int sim_rplidar_scanning(const sim_rplidar_t *r) {
+  return r->scanning;
+}
+void sim_rplidar_get_stats(const sim_rplidar_t *r, sim_rplidar_stats_t *out) {
+  *out = r->stats;
+}
 
 void sim_rplidar_encode_node(uint8_t out[5], int start, uint8_t quality, double angle_deg,
                              double distance_mm) {
@@ -142,7 +147,7 @@ void sim_rplidar_encode_node(uint8_t out[5], int start, uint8_t quality, double 
   long a = lround(angle_deg * 64.0);
   if (a >= 360 * 64) a -= 360 * 64;
   long dq2 = (isfinite(distance_mm) && distance_mm > 0) ? lround(distance_mm * 4.0) : 0;
-  if (dq2 > 0xFFFF) dq2 = 0;  /* beyond what the field holds: no return */
+  if (dq2 > 0xFFFF) dq2 = 0; /* beyond what the field holds: no return */
   uint8_t s = start ? 1 : 0;
   out[0] = (uint8_t)(((quality & 0x3F) << 2) | ((!s) << 1) | s);
   out[1] = (uint8_t)(((a & 0x7F) << 1) | 1);
@@ -160,8 +165,8 @@ static void out_put(sim_rplidar_t *r, const uint8_t *b, size_t n) {
 /* Response descriptor: A5 5A, 30-bit length | 2-bit send mode << 30 (LE), data type. */
 static void out_descriptor(sim_rplidar_t *r, uint32_t len, uint8_t mode, uint8_t type) {
   uint32_t v = (len & 0x3FFFFFFFu) | ((uint32_t)mode << 30);
-  uint8_t b[7] = {RPL_SYNC, RPL_SYNC2, (uint8_t)v, (uint8_t)(v >> 8), (uint8_t)(v >> 16),
-                  (uint8_t)(v >> 24), type};
+  uint8_t b[7] = {RPL_SYNC,           RPL_SYNC2,          (uint8_t)v, (uint8_t)(v >> 8),
+                  (uint8_t)(v >> 16), (uint8_t)(v >> 24), type};
   out_put(r, b, sizeof b);
 }
 
@@ -248,8 +253,7 @@ static void rpl_rx_byte(sim_rplidar_t *r, uint8_t b) {
         r->stats.bad_requests++;
       r->rx_state = RX_SYNC;
       break;
-    default:
-      r->rx_state = RX_SYNC;
+    default: r->rx_state = RX_SYNC;
   }
 }
 
@@ -261,7 +265,8 @@ static int rpl_queue_reserve(sim_rplidar_t *r, size_t need, size_t keep_bytes) {
     size_t drop = queued + need - keep_bytes;
     drop -= drop % RPL_NODE_BYTES;
     /* never cut the node that is half on the wire: drop from after it */
-    size_t keep_head = (r->node_off % RPL_NODE_BYTES) ? RPL_NODE_BYTES - r->node_off % RPL_NODE_BYTES : 0;
+    size_t keep_head =
+        (r->node_off % RPL_NODE_BYTES) ? RPL_NODE_BYTES - r->node_off % RPL_NODE_BYTES : 0;
     size_t from = r->node_off + keep_head;
     if (drop > r->nodes_len - from) drop = r->nodes_len - from;
     memmove(r->nodes + from, r->nodes + from + drop, r->nodes_len - from - drop);
@@ -289,8 +294,8 @@ static int rpl_queue_reserve(sim_rplidar_t *r, size_t need, size_t keep_bytes) {
 static int rpl_nodes_per_rev(sim_rplidar_t *r, int num_rays) {
   int send = num_rays;
   if (r->last_push_us >= 0 && r->wire_us > r->last_push_us) {
-    double per_rev = (double)(r->wire_us - r->last_push_us) * 1e-6 * r->baud / 10.0 /
-                     RPL_NODE_BYTES * 0.97;
+    double per_rev =
+        (double)(r->wire_us - r->last_push_us) * 1e-6 * r->baud / 10.0 / RPL_NODE_BYTES * 0.97;
     if (per_rev < send) send = per_rev < 1 ? 1 : (int)per_rev;
   }
   r->last_push_us = r->wire_us;
@@ -323,8 +328,8 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
     rpl_queue_node(r, ranges_m, quality, (int)((int64_t)k * num_rays / send), num_rays, k == 0);
 }
 
-void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality,
-                           int from, int to, int num_rays) {
+void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality, int from,
+                           int to, int num_rays) {
   if (!r->scanning || num_rays <= 0 || !ranges_m || from >= to) return;
   if (from == 0 || r->rev_send <= 0) r->rev_send = rpl_nodes_per_rev(r, num_rays);
   const int64_t send = r->rev_send;
@@ -337,7 +342,8 @@ void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float 
     /* ray i is sent when it is one of floor(k * num_rays / send), k = 0..send-1: the same
      * evenly spread subset as a whole-revolution push */
     int64_t k = ((int64_t)i * send + num_rays - 1) / num_rays;
-    if (k < send && k * num_rays / send == i) rpl_queue_node(r, ranges_m, quality, i, num_rays, i == 0);
+    if (k < send && k * num_rays / send == i)
+      rpl_queue_node(r, ranges_m, quality, i, num_rays, i == 0);
   }
 }
 

@@ -36,7 +36,8 @@ int sim_tags_write_png(const char *path, int tag_id, int px_per_cell, char *err,
   int side = cells->width * px_per_cell;
   FILE *f = fopen(path, "wb");
   if (!f) {
-    if (err && err_len) snprintf(err, err_len, "sim_tags: cannot write '%s': %s", path, strerror(errno));
+    if (err && err_len)
+      snprintf(err, err_len, "sim_tags: cannot write '%s': %s", path, strerror(errno));
     image_u8_destroy(cells);
     return -1;
   }
@@ -61,13 +62,14 @@ int sim_tags_write_png(const char *path, int tag_id, int px_per_cell, char *err,
   free(row);
   image_u8_destroy(cells);
   if (fclose(f) != 0) rc = -1;
-  if (rc != 0 && err && err_len) snprintf(err, err_len, "sim_tags: PNG write failed for '%s'", path);
+  if (rc != 0 && err && err_len)
+    snprintf(err, err_len, "sim_tags: PNG write failed for '%s'", path);
   return rc;
 }
 
 int sim_tags_mjcf(const char *prefix, const char *png_path, double tag_size_m, char *asset_out,
                   size_t asset_len, char *geom_out, size_t geom_len) {
-  double half_m = 0.5 * tag_size_m * 10.0 / 8.0;  /* plate = whole 10-cell image */
+  double half_m = 0.5 * tag_size_m * 10.0 / 8.0; /* plate = whole 10-cell image */
   double t_m = SIM_TAGS_PLATE_THICKNESS_M;
   int n = snprintf(asset_out, asset_len,
                    "<texture name=\"%stag_tex\" type=\"2d\" file=\"%s\"/>\n"

@@ -15,14 +15,14 @@ struct sim_viewer {
   mjvOption opt;
   mjvCamera cam;
   int ncars;
-  int *car_body;           /* base body id per car (index car-1), -1 if missing */
-  int *car_cam;            /* front camera id per car, -1 if missing */
-  int eye_cam;             /* the map's "eye" camera, -1 if none */
+  int *car_body; /* base body id per car (index car-1), -1 if missing */
+  int *car_cam;  /* front camera id per car, -1 if missing */
+  int eye_cam;   /* the map's "eye" camera, -1 if none */
   int w, h;
   sim_viewer_input_t in;
   int capture;
-  unsigned char *rgb;      /* last captured frame, top-down */
-  size_t rgb_px;           /* its capacity [px] */
+  unsigned char *rgb; /* last captured frame, top-down */
+  size_t rgb_px;      /* its capacity [px] */
   int have_rgb;
 };
 
@@ -57,15 +57,19 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
                                 const char *cam_fmt, int width_px, int height_px, char *err,
                                 size_t err_len) {
   if (!m || ncars < 1 || !body_fmt || !cam_fmt || width_px < 64 || height_px < 64) {
-    if (err && err_len) snprintf(err, err_len, "sim_viewer: bad arguments (need a model, >= 1 car, size >= 64 px)");
+    if (err && err_len)
+      snprintf(err, err_len, "sim_viewer: bad arguments (need a model, >= 1 car, size >= 64 px)");
     return NULL;
   }
   if (!sim_viewer_display_available()) {
-    if (err && err_len) snprintf(err, err_len, "sim_viewer: no display (DISPLAY / WAYLAND_DISPLAY unset)");
+    if (err && err_len)
+      snprintf(err, err_len, "sim_viewer: no display (DISPLAY / WAYLAND_DISPLAY unset)");
     return NULL;
   }
   if (glfw_users == 0 && !glfwInit()) {
-    if (err && err_len) snprintf(err, err_len, "sim_viewer: glfwInit failed (display '%s')", getenv("DISPLAY") ? getenv("DISPLAY") : "");
+    if (err && err_len)
+      snprintf(err, err_len, "sim_viewer: glfwInit failed (display '%s')",
+               getenv("DISPLAY") ? getenv("DISPLAY") : "");
     return NULL;
   }
   glfw_users++;
@@ -76,7 +80,8 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   glfwWindowHint(GLFW_DOUBLEBUFFER, GLFW_TRUE);
   v->win = glfwCreateWindow(width_px, height_px, "AutoDRIVE Nigel sim", NULL, NULL);
   if (!v->win) {
-    if (err && err_len) snprintf(err, err_len, "sim_viewer: cannot open a %dx%d EGL window", width_px, height_px);
+    if (err && err_len)
+      snprintf(err, err_len, "sim_viewer: cannot open a %dx%d EGL window", width_px, height_px);
     sim_viewer_destroy(v);
     return NULL;
   }
@@ -132,7 +137,9 @@ void sim_viewer_destroy(sim_viewer_t *v) {
   if (--glfw_users == 0) glfwTerminate();
 }
 
-void sim_viewer_capture(sim_viewer_t *v, int on) { v->capture = on; }
+void sim_viewer_capture(sim_viewer_t *v, int on) {
+  v->capture = on;
+}
 
 void sim_viewer_size(const sim_viewer_t *v, int *width_px, int *height_px) {
   *width_px = v->w;
@@ -155,9 +162,9 @@ static void viewer_camera(sim_viewer_t *v, const mjModel *m) {
   } else if (v->in.view == SIM_VIEW_BIRD && v->car_body[car] >= 0) {
     c->type = mjCAMERA_TRACKING;
     c->trackbodyid = v->car_body[car];
-    c->distance = 0.9;   /* [m] behind and above the car */
-    c->elevation = -30;  /* [deg] */
-    c->azimuth = 180;    /* [deg] looking along +x of the world; follows position, not yaw */
+    c->distance = 0.9;  /* [m] behind and above the car */
+    c->elevation = -30; /* [deg] */
+    c->azimuth = 180;   /* [deg] looking along +x of the world; follows position, not yaw */
   } else if (v->in.view == SIM_VIEW_GOD && v->eye_cam >= 0) {
     c->type = mjCAMERA_FIXED;
     c->fixedcamid = v->eye_cam;

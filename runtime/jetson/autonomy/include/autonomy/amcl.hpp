@@ -16,8 +16,8 @@ namespace autonomy {
 struct AmclConfig {
   int min_particles = 300;
   int max_particles = 5000;
-  double kld_err = 0.02;   // KL bound epsilon
-  double kld_z = 2.326;    // upper 1 - delta quantile of N(0,1) (delta = 0.01)
+  double kld_err = 0.02;  // KL bound epsilon
+  double kld_z = 2.326;   // upper 1 - delta quantile of N(0,1) (delta = 0.01)
   double bin_xy_m = 0.05, bin_yaw_rad = 0.0873;  // KLD histogram bins
   // Odometry motion noise (Thrun's alpha1..4): rot<-rot, rot<-trans [rad/m], trans<-trans,
   // trans<-rot [m/rad].

@@ -23,7 +23,7 @@ struct NodeConfig {
   std::string map_yaml_in;  // non-empty: load this map, skip MAPPING and SAVING
   Pose2 start_pose;         // map-frame pose at start (SLAM origin / AMCL initial guess)
   double initial_sigma_xy_m = 0.05, initial_sigma_yaw_rad = 0.05;
-  Pose2 goal;               // parking pose of the base (rear axle) in the map frame
+  Pose2 goal;              // parking pose of the base (rear axle) in the map frame
   int mapping_scans = 15;  // scans standing still at the start before anything else
   // Then the car drives these map-frame poses in turn (Hybrid A* on the map so far, SLAM
   // localising), mapping as it goes, and the map is saved where the route ends. Empty: the
@@ -131,8 +131,8 @@ class AutonomyNode {
   OdomHistory odom_history_;
   LaserOdometry laser_odom_;
   int64_t lo_utime_us_ = -1;
-  bool settling_ = false;       // stopped at the path's end, waiting for a standstill scan
-  int64_t settled_at_us_ = 0;   // scans that start after this were taken at standstill
+  bool settling_ = false;      // stopped at the path's end, waiting for a standstill scan
+  int64_t settled_at_us_ = 0;  // scans that start after this were taken at standstill
   Pose2 loc_pose_;
   int64_t loc_utime_us_ = -1;
   Pose2 map_from_odom_;  // T_map_odom

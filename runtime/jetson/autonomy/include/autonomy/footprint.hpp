@@ -13,10 +13,10 @@ namespace autonomy {
 struct Footprint {
   // Nigel's envelope (sim/mujoco_hil/params/nigel.params): the 0.24 m chassis box, centred
   // 0.07 m ahead of the rear axle, and the wheels: track 0.153 m + tyre width 0.025 m.
-  double length_m = 0.24;          // bumper to bumper
-  double width_m = 0.178;          // tyre to tyre
-  double center_ahead_m = 0.07;    // rectangle centre ahead of the base (rear axle) [m]
-  double margin_m = 0.015;         // extra clearance kept from obstacles [m]
+  double length_m = 0.24;        // bumper to bumper
+  double width_m = 0.178;        // tyre to tyre
+  double center_ahead_m = 0.07;  // rectangle centre ahead of the base (rear axle) [m]
+  double margin_m = 0.015;       // extra clearance kept from obstacles [m]
   int discs = 6;  // 4 cm apart along the 0.24 m: radius 9.1 cm, 0.2 cm wider than the car
 };
 

@@ -45,8 +45,8 @@ struct GridMap {
 
   // Ray update from a sensor at (sx, sy) to a hit at (ex, ey) [m]: cells on the ray become
   // freer, the end cell more occupied (when hit is true; false = max-range ray, no end cell).
-  void update_ray(double sx_m, double sy_m, double ex_m, double ey_m, bool hit,
-                  float l_free, float l_occ, float l_min, float l_max);
+  void update_ray(double sx_m, double sy_m, double ex_m, double ey_m, bool hit, float l_free,
+                  float l_occ, float l_min, float l_max);
 };
 
 // grid_ helpers.

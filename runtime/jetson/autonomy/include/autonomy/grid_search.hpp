@@ -13,7 +13,8 @@ namespace autonomy {
 // passable[i]: cell i may be crossed (row-major like the map).
 // Returns the route as cell-centre points [m], start to goal; empty when there is none.
 std::vector<Eigen::Vector2d> astar_route(const GridMap &map, const std::vector<uint8_t> &passable,
-                                         const Eigen::Vector2d &start_m, const Eigen::Vector2d &goal_m);
+                                         const Eigen::Vector2d &start_m,
+                                         const Eigen::Vector2d &goal_m);
 
 // Shortest 8-connected distance [m] from every cell to the goal; +inf where unreachable.
 std::vector<float> dijkstra_cost_to_goal_m(const GridMap &map, const std::vector<uint8_t> &passable,

@@ -22,14 +22,14 @@ struct HybridAStarConfig {
   double sample_m = 0.01;           // path sample / collision check spacing
   double xy_bin_m = 0.04;
   int yaw_bins = 72;
-  double reverse_cost = 1.5;        // multiplier on reversing length
-  double switch_cost_m = 0.3;       // per change of direction
-  double steer_cost_m = 0.02;       // per rad of steering, per step
+  double reverse_cost = 1.5;          // multiplier on reversing length
+  double switch_cost_m = 0.3;         // per change of direction
+  double steer_cost_m = 0.02;         // per rad of steering, per step
   double steer_change_cost_m = 0.05;  // per rad of steering change
-  int analytic_every = 2;           // expansions between Reeds-Shepp shots per metre to go
-  int analytic_candidates = 8;      // shortest candidates tried per shot
-  double final_straight_m = 0.15;   // preferred straight run into the goal
-  double heuristic_weight = 1.5;    // > 1: weighted A*, far fewer expansions, paths a bit longer
+  int analytic_every = 2;             // expansions between Reeds-Shepp shots per metre to go
+  int analytic_candidates = 8;        // shortest candidates tried per shot
+  double final_straight_m = 0.15;     // preferred straight run into the goal
+  double heuristic_weight = 1.5;      // > 1: weighted A*, far fewer expansions, paths a bit longer
   int max_expansions = 60000;
 };
 

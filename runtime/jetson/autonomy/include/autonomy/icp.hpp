@@ -17,8 +17,8 @@ struct IcpConfig {
 };
 
 struct IcpResult {
-  Pose2 motion;        // pose of the current scan's frame in the reference scan's frame
-  double rms_m = 0;    // point-to-line residual of the inliers [m]
+  Pose2 motion;      // pose of the current scan's frame in the reference scan's frame
+  double rms_m = 0;  // point-to-line residual of the inliers [m]
   int inliers = 0;
   bool failed = false;  // false = healthy (enough inliers, finite solution)
 };

@@ -12,17 +12,17 @@ namespace autonomy {
 struct LaserOdomConfig {
   IcpConfig icp;
   Pose2 lidar_in_base{0.1445, 0.0, 0.0};
-  double max_rms_m = 0.03;          // a registration worse than this is not trusted [m]
-  int min_inliers = 60;             // of the ~360 returns of an A1 revolution
-  double max_disagree_m = 0.05;     // ICP vs odometry motion since the keyframe [m]
-  double max_disagree_rad = 0.1;    // [rad]
-  double keyframe_dist_m = 0.10;    // a new keyframe after this much motion [m]
-  double keyframe_angle_rad = 0.15; // [rad]
+  double max_rms_m = 0.03;           // a registration worse than this is not trusted [m]
+  int min_inliers = 60;              // of the ~360 returns of an A1 revolution
+  double max_disagree_m = 0.05;      // ICP vs odometry motion since the keyframe [m]
+  double max_disagree_rad = 0.1;     // [rad]
+  double keyframe_dist_m = 0.10;     // a new keyframe after this much motion [m]
+  double keyframe_angle_rad = 0.15;  // [rad]
 };
 
 struct LaserOdomStep {
-  Pose2 motion;          // base motion since the previous scan, in the previous base frame
-  bool from_icp = false; // false: the odometry guess was used (first scan or ICP rejected)
+  Pose2 motion;           // base motion since the previous scan, in the previous base frame
+  bool from_icp = false;  // false: the odometry guess was used (first scan or ICP rejected)
   double rms_m = 0;
   int inliers = 0;
 };

@@ -9,7 +9,15 @@
 
 namespace autonomy {
 
-enum class MissionState : int { kMapping = 0, kSaving, kLocalising, kPlanning, kDriving, kParked, kFailed };
+enum class MissionState : int {
+  kMapping = 0,
+  kSaving,
+  kLocalising,
+  kPlanning,
+  kDriving,
+  kParked,
+  kFailed
+};
 
 const char *mission_state_name(MissionState s);
 
@@ -24,7 +32,9 @@ class Mission {
  public:
   explicit Mission(const MissionConfig &cfg, double now_s = 0.0);
   MissionState state() const { return state_; }
-  bool finished() const { return state_ == MissionState::kParked || state_ == MissionState::kFailed; }
+  bool finished() const {
+    return state_ == MissionState::kParked || state_ == MissionState::kFailed;
+  }
   const std::string &detail() const { return detail_; }
   int replans() const { return replans_; }
   double entered_s() const { return entered_s_; }

@@ -10,8 +10,8 @@ namespace autonomy {
 
 struct PathPoint {
   Pose2 pose;
-  int direction = 1;            // +1 forward, -1 reverse
-  double curvature_1pm = 0.0;   // signed, + = turning left (tan(steer)/wheelbase) [1/m]
+  int direction = 1;           // +1 forward, -1 reverse
+  double curvature_1pm = 0.0;  // signed, + = turning left (tan(steer)/wheelbase) [1/m]
 };
 using Path = std::vector<PathPoint>;
 

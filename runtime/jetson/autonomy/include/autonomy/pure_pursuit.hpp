@@ -13,10 +13,10 @@ namespace autonomy {
 
 struct TrackerConfig {
   double wheelbase_m = 0.14154;
-  double max_steer_rad = 0.5236;    // steering 1.0 = this angle
-  double top_speed_m_s = 0.267;     // speed at throttle 1.0
+  double max_steer_rad = 0.5236;  // steering 1.0 = this angle
+  double top_speed_m_s = 0.267;   // speed at throttle 1.0
   double cruise_speed_m_s = 0.2;
-  double min_speed_m_s = 0.025;     // creep speed just before a stop
+  double min_speed_m_s = 0.025;  // creep speed just before a stop
   double accel_m_s2 = 0.4, decel_m_s2 = 0.3;
   double lateral_accel_m_s2 = 0.25;  // slows in tight arcs
   double lookahead_min_m = 0.07, lookahead_time_s = 0.4;
@@ -33,11 +33,11 @@ struct TrackerConfig {
 };
 
 struct TrackerCommand {
-  double throttle = 0.0;     // [-1, 1]
-  double steering = 0.0;     // [-1, 1], + left
-  double speed_m_s = 0.0;    // signed target speed
+  double throttle = 0.0;   // [-1, 1]
+  double steering = 0.0;   // [-1, 1], + left
+  double speed_m_s = 0.0;  // signed target speed
   double steer_rad = 0.0;
-  bool done = false;         // the last segment has been completed: hold still
+  bool done = false;  // the last segment has been completed: hold still
 };
 
 class PurePursuit {
@@ -61,7 +61,7 @@ class PurePursuit {
   std::vector<Path> segments_;  // split at cusps
   std::vector<size_t> offsets_;
   size_t seg_ = 0, seg_offset_ = 0, nearest_ = 0;
-  double speed_m_s_ = 0.0;      // magnitude of the last commanded speed
+  double speed_m_s_ = 0.0;  // magnitude of the last commanded speed
   double last_steer_rad_ = 0.0;
   double pause_left_s_ = 0.0;
   double stalled_s_ = 0.0, boost_ = 0.0;

@@ -16,9 +16,9 @@ struct SlamConfig {
   double origin_x_m = -6.0, origin_y_m = -6.0;
   float l_free = -0.4f, l_occ = 0.9f, l_min = -6.0f, l_max = 6.0f;  // log-odds update/clamp
   int iterations_per_level = 12;
-  double update_min_dist_m = 0.03;   // map is rewritten only after this much motion [m]
+  double update_min_dist_m = 0.03;  // map is rewritten only after this much motion [m]
   double update_min_angle_rad = 0.05;
-  int initial_integrations = 5;      // scans written regardless of motion, to seed the map
+  int initial_integrations = 5;  // scans written regardless of motion, to seed the map
   Pose2 lidar_in_base{0.1445, 0.0, 0.0};
 };
 
