@@ -16,7 +16,7 @@ inline std::string temp_dir() {
 }
 
 inline std::string params_path() {
-  return std::string(SIM_DIR) + "/params/nigel.params";
+  return std::string(SIM_DIR) + "/../../vehicle/nigel.params";
 }
 // A map name from sim/mujoco_hil/maps, or a path (with '/') as is.
 inline std::string map_path(const char *name) {

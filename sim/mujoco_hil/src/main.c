@@ -40,7 +40,7 @@ static void main_usage(FILE *f) {
       "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
       "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
       "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
-      "  --params FILE       vehicle parameter file (default %s/params/nigel.params)\n"
+      "  --params FILE       vehicle description (default %s/vehicle/nigel.params)\n"
       "  --seed N            seed of IMU biases and noise (default 1)\n"
       "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
       "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
@@ -82,7 +82,7 @@ static void main_usage(FILE *f) {
       "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n"
       "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
-      SIM_MAX_CARS, AUTODRIVE_SIM_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
+      SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
       SCN_MAX_LATE_BOXES, MAIN_DEFAULT_URL);
 }
 
@@ -310,7 +310,7 @@ static void main_view_close(main_view_t *w) {
 int main(int argc, char **argv) {
   sim_config_t cfg = {0};
   char params[1024], map[1024];
-  snprintf(params, sizeof params, "%s/params/nigel.params", AUTODRIVE_SIM_DIR);
+  snprintf(params, sizeof params, "%s/vehicle/nigel.params", AUTODRIVE_ROOT_DIR);
   snprintf(map, sizeof map, "%s/maps/parking_school.xml", AUTODRIVE_SIM_DIR);
   cfg.params_path = params;
   cfg.map_path = map;

@@ -11,7 +11,7 @@
 namespace autonomy {
 
 struct Footprint {
-  // Nigel's envelope (sim/mujoco_hil/params/nigel.params): the 0.24 m chassis box, centred
+  // Nigel's envelope (vehicle/nigel.params): the 0.24 m chassis box, centred
   // 0.07 m ahead of the rear axle, and the wheels: track 0.153 m + tyre width 0.025 m.
   double length_m = 0.24;        // bumper to bumper
   double width_m = 0.178;        // tyre to tyre
