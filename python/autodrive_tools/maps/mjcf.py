@@ -1,0 +1,226 @@
+"""Writes a map's MJCF scene (sim/mujoco_hil/maps/<map>.xml) from its description.
+
+Angles in the file are radians: the simulator includes it in a scene with
+<compiler angle="radian"/>. World geoms use contype 1 / conaffinity 6 (src/mjcf_gen.h). Terrain
+patches are thin boxes on the floor; a surface's friction is the geom's first friction value, read
+by the tyre model and by MuJoCo contacts alike. Markings and roads are visual-only boxes just
+above the floor. Walls are planes at their inner face: plane contacts are far cheaper than box
+contacts, and nothing can be behind a boundary wall. Cones and boxes are world-body geoms, not
+bodies: static bodies cost MuJoCo 2.2 broadphase time every step.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable, Sequence
+
+from . import geometry
+from .description import MapDescription
+from .model import ParkingSlot, Vec2
+
+WORLD = 'contype="1" conaffinity="6"'
+VIS = 'contype="0" conaffinity="0" mass="0"'
+
+
+def num(v: float) -> str:
+    """A number as MJCF text: shortest form, 10 significant digits, no '-0'."""
+    return "0" if v == 0 else format(v, ".10g")
+
+
+def nums(vs: Iterable[float]) -> str:
+    return " ".join(num(v) for v in vs)
+
+
+def _axis_yaw(yaw: float) -> float:
+    """A symmetric box's yaw folded into (-pi/2, pi/2]: the same box, one way to write it."""
+    y = math.atan2(math.sin(yaw), math.cos(yaw))
+    if y <= -math.pi / 2 + 1e-12:
+        y += math.pi
+    elif y > math.pi / 2 + 1e-12:
+        y -= math.pi
+    return y
+
+
+def _same_line(p: Vec2, yaw_p: float, q: Vec2, yaw_q: float) -> bool:
+    """Same point and same line direction (either way)."""
+    return math.dist(p, q) < 1e-9 and abs(_axis_yaw(yaw_p - yaw_q)) < 1e-9
+
+
+class _Writer:
+    def __init__(self, m: MapDescription) -> None:
+        assert m.kit is not None
+        self.m, self.kit = m, m.kit
+        self.lines: list[str] = []
+        c = self.kit.contact
+        self.contact = f"{num(c.torsional_friction_m)} {num(c.rolling_friction_m)}"
+
+    def add(self, text: str) -> None:
+        self.lines.append("    " + text)
+
+    def friction(self, mu: float) -> str:
+        return f'friction="{num(mu)} {self.contact}"'
+
+    def mark(
+        self, name: str, pos: Vec2, length: float, yaw: float, width: float, road: bool = False
+    ) -> None:
+        """A visual strip: a painted line, or with road=True a piece of tarmac."""
+        k = self.kit.road if road else self.kit.marking
+        self.add(
+            f'<geom name="{name}" type="box" pos="{nums((*pos, k.height_m))}" '
+            f'size="{nums((length / 2, width / 2, k.thickness_m / 2))}" '
+            f'euler="0 0 {num(_axis_yaw(yaw))}" {VIS} rgba="{nums(k.rgba)}"/>'
+        )
+
+    def header(self) -> None:
+        m, eye = self.m, self.kit.eye_camera
+        floor = self.kit.surfaces[m.floor_surface]
+        h = m.floor_half_size_m
+        self.lines += [
+            f'<mujoco model="{m.name}">',
+            f"  <!-- generated from {m.name}.yaml and kit.yaml by tools/gen-maps; edit those -->",
+            "  <asset>",
+            '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.6 0.7 0.9" '
+            'rgb2="0.2 0.25 0.3" width="64" height="64"/>',
+            "  </asset>",
+            "  <worldbody>",
+        ]
+        self.add(
+            '<light name="sun" directional="true" pos="0 0 5" dir="0 0 -1" '
+            'diffuse="0.8 0.8 0.8" castshadow="false"/>'
+        )
+        self.add(
+            f'<camera name="eye" pos="0 0 {num(eye.height_m)}" xyaxes="1 0 0 0 1 0" '
+            f'fovy="{num(eye.fovy_deg)}"/>'
+        )
+        self.add(
+            f'<geom name="floor" type="plane" size="{nums((h, h))} 0.1" {WORLD} '
+            f'{self.friction(floor.friction)} rgba="{nums(floor.rgba)}"/>'
+        )
+        sp = m.spawn.pose
+        self.add(
+            f'<site name="spawn" pos="{nums((sp.x_m, sp.y_m))} 0" euler="0 0 {num(sp.yaw_rad)}" '
+            'size="0.02"/>'
+        )
+
+    def slots(self, slots: Sequence[ParkingSlot]) -> None:
+        """Each slot's two side lines and its back line; a line shared with a neighbour is drawn
+        once, and back lines in one row are joined into one."""
+        w = self.kit.marking.line_width_m
+        sides: list[tuple[Vec2, float, float]] = []  # centre, length, yaw
+        backs: list[tuple[Vec2, Vec2, float]] = []  # ends, yaw
+        for s in slots:
+            yaw = s.yaw_rad
+            c, si = math.cos(yaw), math.sin(yaw)
+            half_w, half_d = s.size_m[0] / 2, s.size_m[1] / 2
+            right = (si, -c)  # unit vector to the parked car's right
+            for side in (-half_w, half_w):  # left side first
+                p = (s.centre_m[0] + side * right[0], s.centre_m[1] + side * right[1])
+                if not any(_same_line(p, yaw, q, y) for q, _, y in sides):
+                    sides.append((p, s.size_m[1], yaw))
+            bc = (s.centre_m[0] + half_d * c, s.centre_m[1] + half_d * si)
+            a = (bc[0] - half_w * right[0], bc[1] - half_w * right[1])  # left end
+            b = (bc[0] + half_w * right[0], bc[1] + half_w * right[1])
+            if backs and _same_line(backs[-1][1], backs[-1][2], a, yaw):
+                backs[-1] = (backs[-1][0], b, yaw)  # the row continues to the right
+            elif backs and _same_line(backs[-1][0], backs[-1][2], b, yaw):
+                backs[-1] = (a, backs[-1][1], yaw)  # ... or to the left
+            else:
+                backs.append((a, b, yaw))
+        for k, (p, length, yaw) in enumerate(sides):
+            self.mark(f"slot_line_{k}", p, length, yaw, w)
+        for k, (a, b, yaw) in enumerate(backs):
+            mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+            self.mark("slot_back" + (f"_{k}" if k else ""), mid, math.dist(a, b), yaw - math.pi / 2, w)
+
+    def box(self, name: str, centre: Vec2, size: Sequence[float], yaw: float) -> None:
+        ob = self.kit.obstacle
+        self.add(
+            f'<geom name="{name}" type="box" pos="{nums((*centre, size[2] / 2))}" '
+            f'size="{nums(v / 2 for v in size)}" euler="0 0 {num(yaw)}" {WORLD} '
+            f'{self.friction(ob.friction)} rgba="{nums(ob.box_rgba)}"/>'
+        )
+
+    def cone(self, name: str, p: Vec2) -> None:
+        k = self.kit.cone
+        self.add(
+            f'<geom name="{name}" type="cylinder" pos="{nums((*p, k.height_m / 2))}" '
+            f'size="{nums((k.radius_m, k.height_m / 2))}" {WORLD} '
+            f'{self.friction(self.kit.obstacle.friction)} rgba="{nums(k.rgba)}"/>'
+        )
+        b = k.base_size_m / 2
+        t = k.base_thickness_m / 2
+        self.add(
+            f'<geom name="{name}_base" type="box" pos="{nums((*p, t))}" size="{nums((b, b, t))}" '
+            f'{VIS} rgba="{nums(k.base_rgba)}"/>'
+        )
+
+    def roads(self) -> None:
+        rk, mk = self.kit.road, self.kit.marking
+        dash = 0
+        for r in self.m.roads:
+            arcs = [p for p in r.pieces if p.arc is not None]
+            lines = [p for p in r.pieces if p.line is not None]
+            for p in arcs:
+                assert p.arc is not None
+                seg = max(1, round(abs(p.arc.sweep_deg) / 90 * rk.arc_segments_per_90deg))
+                ln = geometry.piece_length_m(p) / seg * (1 + rk.arc_segment_overlap)
+                for k in range(seg):
+                    (x, y), yaw = geometry.piece_point(p, (k + 0.5) / seg)
+                    self.mark(f"road_{p.name}_{k}", (x, y), ln, yaw, r.width_m, road=True)
+                    if r.centre_marking == "dashed" and k % 2 == 0:
+                        self.mark(f"mark_c{dash}", (x, y), ln, yaw, mk.centre_dash_width_m)
+                        dash += 1
+            for p in lines:
+                (x, y), yaw = geometry.piece_point(p, 0.5)
+                length = geometry.piece_length_m(p)
+                self.mark(f"road_{p.name}", (x, y), length, yaw, r.width_m, road=True)
+                if r.centre_marking != "dashed":
+                    continue
+                n = max(1, round(length / mk.centre_dash_pitch_m))
+                ay = _axis_yaw(yaw)  # dashes in the same order whichever way the piece runs
+                for k in range(n):
+                    t = -length / 2 + (k + 0.5) * length / n
+                    px, py = x + t * math.cos(ay), y + t * math.sin(ay)
+                    self.mark(
+                        f"mark_{p.name}{k}", (px, py), mk.centre_dash_length_m, ay,
+                        mk.centre_dash_width_m,
+                    )  # fmt: skip
+
+    def write(self) -> str:
+        m, kit = self.m, self.kit
+        self.header()
+        self.slots(m.parking_slots)
+        self.roads()
+        for s in m.stop_lines:
+            self.mark(s.name, s.centre_m, s.length_m, m.stop_line_yaw_rad(s), kit.marking.stop_line_width_m)
+        for b in m.boxes:
+            self.box(b.name, b.centre_m, b.size_m, b.yaw_rad)
+        for c in m.cones:
+            self.cone(c.name, c.position_m)
+        t = kit.terrain_patch_thickness_m
+        for p in m.terrain_patches:
+            s = kit.surfaces[p.surface]
+            self.add(
+                f'<geom name="{p.name}" type="box" pos="{nums((*p.centre_m, t / 2))}" '
+                f'size="{nums((p.size_m[0] / 2, p.size_m[1] / 2, t / 2))}" {WORLD} '
+                f'{self.friction(s.friction)} rgba="{nums(s.rgba)}"/>'
+            )
+        hz = kit.obstacle.wall_height_m / 2
+        for w in m.walls:
+            nx, ny = w.normal
+            # planes size only bounds drawing and rays; the local vertical axis is x for walls
+            # facing +-x and y for walls facing +-y
+            hx, hy = (hz, w.length_m / 2) if nx else (w.length_m / 2, hz)
+            self.add(
+                f'<geom name="{w.name}" type="plane" pos="{nums((*w.face_centre_m, hz))}" '
+                f'size="{nums((hx, hy))} 0.05" zaxis="{nums((nx, ny))} 0" {WORLD} '
+                f'{self.friction(kit.obstacle.friction)} rgba="{nums(kit.obstacle.wall_rgba)}"/>'
+            )
+        self.lines += ["  </worldbody>", "</mujoco>", ""]
+        return "\n".join(self.lines)
+
+
+def generate(m: MapDescription) -> str:
+    """The map's MJCF text."""
+    return _Writer(m).write()
+
