@@ -11,12 +11,12 @@ from .loader import MAPS_DIR, load, names
 from .model import MapDescriptionError
 
 
-def outputs(name: str) -> dict[Path, str]:
-    """The generated files of one map and their content."""
-    m = load(name)
+def outputs(name: str, maps_dir: Path = MAPS_DIR) -> dict[Path, str]:
+    """The generated files of one map (beside its description) and their content."""
+    m = load(maps_dir / f"{name}.yaml", maps_dir / "kit.yaml")
     return {
-        MAPS_DIR / f"{name}.xml": mjcf.generate(m),
-        MAPS_DIR / f"{name}.json": sidecar.generate(m),
+        maps_dir / f"{name}.xml": mjcf.generate(m),
+        maps_dir / f"{name}.json": sidecar.generate(m),
     }
 
 
@@ -31,11 +31,19 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="write nothing; exit 1 naming every generated file that is stale or missing",
     )
+    p.add_argument(
+        "--dir",
+        type=Path,
+        default=MAPS_DIR,
+        help="folder with kit.yaml and the map descriptions (default: %(default)s)",
+    )
     args = p.parse_args(argv)
     stale = []
     try:
-        for name in names():
-            for path, text in outputs(name).items():
+        if not (args.dir / "kit.yaml").is_file():
+            raise MapDescriptionError(f"{args.dir}: no kit.yaml in this folder")
+        for name in names(args.dir):
+            for path, text in outputs(name, args.dir).items():
                 old = path.read_text() if path.is_file() else None
                 if old == text:
                     continue

@@ -23,9 +23,9 @@ JOIN_TOLERANCE_M = 1e-6  # road pieces must meet end to start within this
 ON_LANE_TOLERANCE_M = 0.01  # a stop line's centre must be this close to its lane's centre line
 
 
-def names() -> list[str]:
-    """The shipped maps: every maps/<name>.yaml but the kit."""
-    return sorted(p.stem for p in MAPS_DIR.glob("*.yaml") if p != KIT_FILE)
+def names(maps_dir: Path = MAPS_DIR) -> list[str]:
+    """The maps in a folder (default: the shipped ones): every <name>.yaml but kit.yaml."""
+    return sorted(p.stem for p in Path(maps_dir).glob("*.yaml") if p.name != KIT_FILE.name)
 
 
 def _read_yaml(source: Path) -> Any:
@@ -74,7 +74,9 @@ def load(name_or_path: Union[str, Path], kit_path: Union[Path, str, None] = None
     text = str(name_or_path)
     source = Path(text) if ("/" in text or text.endswith(".yaml")) else MAPS_DIR / f"{text}.yaml"
     if not source.is_file():
-        raise MapDescriptionError(f"{source}: no such map description (shipped: {names()})")
+        raise MapDescriptionError(
+            f"{source}: no such map description (shipped maps: {', '.join(names())})"
+        )
     kit = load_kit(kit_path)
     data = _read_yaml(source)
     desc = build(MapFile, data, source)
