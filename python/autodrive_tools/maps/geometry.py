@@ -7,11 +7,13 @@ import math
 from .model import Lane, Piece, Vec2
 
 
-def piece_length_m(p: Piece) -> float:
+def piece_length_m(p: Piece, offset_m: float = 0.0) -> float:
+    """Length of a piece, or of its parallel offset_m to the left."""
     if p.line is not None:
         return math.dist(p.line.from_m, p.line.to_m)
     assert p.arc is not None
-    return p.arc.radius_m * abs(math.radians(p.arc.sweep_deg))
+    radius_m = p.arc.radius_m - offset_m * math.copysign(1.0, p.arc.sweep_deg)
+    return abs(radius_m * math.radians(p.arc.sweep_deg))
 
 
 def piece_point(p: Piece, s: float, offset_m: float = 0.0) -> tuple[Vec2, float]:
@@ -41,7 +43,7 @@ def centre_line(lane: Lane, step_m: float = 0.05) -> list[tuple[float, float, fl
         raise ValueError(f"centre_line: step_m must be > 0, got {step_m}")
     pts: list[tuple[float, float, float]] = []
     for p in lane.road.pieces:
-        n = max(1, math.ceil(piece_length_m(p) / step_m))
+        n = max(1, math.ceil(piece_length_m(p, lane.offset_m) / step_m - 1e-9))
         for k in range(0 if not pts else 1, n + 1):
             (x, y), yaw = piece_point(p, k / n, lane.offset_m)
             pts.append((x, y, yaw))

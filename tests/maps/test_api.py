@@ -1,0 +1,233 @@
+"""maps.api: what autodrive_tools.maps answers (spawn, slots, slot goals, obstacles, terrain,
+walls, lanes, stop lines) agrees with the generated MJCF, parsed with a real XML parser, and with
+the JSON sidecar; slot goals put the car's envelope (autodrive_tools.vehicle) inside the slot."""
+import json
+import math
+import pathlib
+import sys
+import unittest
+import xml.etree.ElementTree as ET
+
+ROOT = pathlib.Path(sys.argv[1])
+MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
+
+from autodrive_tools import maps, vehicle  # noqa: E402
+from autodrive_tools.maps import geometry  # noqa: E402
+
+TOL_M = 1e-9
+
+
+def floats(text: str) -> list[float]:
+    return [float(v) for v in text.split()]
+
+
+def geoms(name: str) -> dict[str, ET.Element]:
+    root = ET.parse(MAPS / f"{name}.xml").getroot()
+    return {g.get("name"): g for g in root.iter("geom")} | {
+        "site:" + s.get("name"): s for s in root.iter("site")
+    }
+
+
+def box_contains(g: ET.Element, p: tuple[float, float], margin: float = 1e-9) -> bool:
+    """Whether p lies within a box geom's footprint (its pos, half sizes and euler yaw)."""
+    cx, cy, _ = floats(g.get("pos"))
+    hx, hy, _ = floats(g.get("size"))
+    yaw = floats(g.get("euler", "0 0 0"))[2]
+    dx, dy = p[0] - cx, p[1] - cy
+    lx = math.cos(yaw) * dx + math.sin(yaw) * dy
+    ly = -math.sin(yaw) * dx + math.cos(yaw) * dy
+    return abs(lx) <= hx + margin and abs(ly) <= hy + margin
+
+
+def same_axis(a: float, b: float) -> bool:
+    return abs(math.remainder(a - b, math.pi)) < 1e-9
+
+
+class Api(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        cls.v = vehicle.load()
+        cls.maps = {n: maps.load(n) for n in maps.names()}
+        cls.xml = {n: geoms(n) for n in maps.names()}
+        cls.json = {n: json.loads((MAPS / f"{n}.json").read_text()) for n in maps.names()}
+
+    def test_spawn_is_the_mjcf_site_and_the_sidecar(self) -> None:
+        for n, m in self.maps.items():
+            site = self.xml[n]["site:spawn"]
+            p = m.spawn_pose()
+            self.assertEqual(floats(site.get("pos"))[:2], [p.x_m, p.y_m], n)
+            self.assertAlmostEqual(floats(site.get("euler"))[2], p.yaw_rad, places=9)
+            js = self.json[n]["spawn"]
+            self.assertEqual((js["x_m"], js["y_m"]), (p.x_m, p.y_m))
+        self.assertEqual(self.maps["parking_school"].spawn_pose(), maps.Pose(-1.0, 0.6, 0.0))
+
+    def test_slots_are_the_painted_rectangles(self) -> None:
+        m, g = self.maps["parking_school"], self.xml["parking_school"]
+        self.assertEqual([s.name for s in m.parking_slots], [f"s{k}" for k in range(6)])
+        lines = [e for k, e in g.items() if k.startswith("slot_line_")]
+        backs = [e for k, e in g.items() if k.startswith("slot_back")]
+        self.assertEqual(len(lines), 7)  # shared side lines drawn once
+        for k, s in enumerate(m.parking_slots):
+            self.assertIs(m.slot(k), s)
+            self.assertIs(m.slot(s.name), s)
+            c = s.corners_m()  # front-left, rear-left, rear-right, front-right (yaw frame)
+            # both side edges are a painted line: its centre at the edge's middle, along yaw,
+            # as long as the slot is deep
+            for a, b in ((c[0], c[1]), (c[2], c[3])):
+                mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+                hit = [
+                    e
+                    for e in lines
+                    if math.dist(floats(e.get("pos"))[:2], mid) < 1e-9
+                    and same_axis(floats(e.get("euler"))[2], s.yaw_rad)
+                    and abs(floats(e.get("size"))[0] - s.size_m[1] / 2) < 1e-9
+                ]
+                self.assertEqual(len(hit), 1, (s.name, mid))
+            # the back (front, in the yaw direction) edge lies on a back line
+            for p in (c[0], c[3]):
+                self.assertTrue(any(box_contains(e, p) for e in backs), (s.name, p))
+            # the open side has no line
+            mid_open = ((c[1][0] + c[2][0]) / 2, (c[1][1] + c[2][1]) / 2)
+            self.assertFalse(any(box_contains(e, mid_open) for e in lines + backs), s.name)
+        # the drawn row: lines at x = -1.2 + 0.3 k, y = 1.25 (the layout demo_parking copied)
+        xs = sorted(floats(e.get("pos"))[0] for e in lines)
+        for k, x in enumerate(xs):
+            self.assertAlmostEqual(x, -1.2 + 0.3 * k, places=9)
+        js = self.json["parking_school"]["parking_slots"]
+        for s, j in zip(m.parking_slots, js):
+            self.assertEqual(j["name"], s.name)
+            self.assertEqual(j["centre_m"], list(s.centre_m))
+            self.assertAlmostEqual(j["yaw_rad"], s.yaw_rad, places=9)
+
+    def test_slot_goal_centres_the_envelope(self) -> None:
+        m = self.maps["parking_school"]
+        ahead = self.v.envelope_center_ahead_m
+        length, width = self.v.envelope_length_m, self.v.envelope_width_m
+        for s in m.parking_slots:
+            for direction in ("forward", "reverse"):
+                g = m.slot_goal(s, self.v, direction)
+                cx, cy = g.x_m + ahead * math.cos(g.yaw_rad), g.y_m + ahead * math.sin(g.yaw_rad)
+                self.assertAlmostEqual(cx, s.centre_m[0], places=9)
+                self.assertAlmostEqual(cy, s.centre_m[1], places=9)
+                want = s.yaw_rad if direction == "forward" else s.yaw_rad + math.pi
+                self.assertAlmostEqual(math.remainder(g.yaw_rad - want, 2 * math.pi), 0, places=9)
+                car = maps.model.rect_corners((cx, cy), (length, width), g.yaw_rad)
+                slot = s.corners_m()
+                for p in car:  # inside the slot rectangle
+                    self.assertTrue(self._inside(p, slot), (s.name, direction, p))
+        g = m.slot_goal(2, self.v)  # the demo's slot: base_link behind the slot centre
+        self.assertAlmostEqual(g.x_m, -0.45, places=9)
+        self.assertAlmostEqual(g.y_m, 1.25 - ahead, places=9)
+        self.assertAlmostEqual(g.yaw_rad, math.pi / 2, places=9)
+
+    @staticmethod
+    def _inside(p, poly) -> bool:
+        sign = 0.0
+        for i in range(len(poly)):
+            (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % len(poly)]
+            cross = (x1 - x0) * (p[1] - y0) - (y1 - y0) * (p[0] - x0)
+            if abs(cross) < 1e-12:
+                continue
+            if sign and (cross > 0) != (sign > 0):
+                return False
+            sign = cross
+        return True
+
+    def test_obstacles_are_the_collidable_props(self) -> None:
+        for n, m in self.maps.items():
+            g = self.xml[n]
+            props = {
+                k: e
+                for k, e in g.items()
+                if e.get("contype") == "1" and e.get("type") in ("box", "cylinder")
+                and not k.startswith("terrain_")
+            }
+            rects = m.obstacles()
+            self.assertEqual(len(rects), len(props), n)
+            for e in props.values():
+                x, y, z = floats(e.get("pos"))
+                size = floats(e.get("size"))
+                if e.get("type") == "box":
+                    hx, hy, hz = size
+                    yaw = floats(e.get("euler"))[2]
+                    self.assertAlmostEqual(z, hz, places=12)  # stands on the floor
+                else:
+                    hx = hy = size[0]
+                    yaw = 0.0
+                want = maps.Rect(x, y, hx, hy, yaw)
+                self.assertTrue(
+                    any(all(abs(a - b) < TOL_M for a, b in zip(vars(r).values(), vars(want).values())) for r in rects),
+                    (n, e.get("name"), want),
+                )
+
+    def test_terrain_and_walls_match_the_mjcf(self) -> None:
+        for n, m in self.maps.items():
+            g = self.xml[n]
+            self.assertEqual(
+                floats(g["floor"].get("friction"))[0], m.kit.surfaces[m.floor_surface].friction
+            )
+            for p in m.terrain_patches:
+                e = g[p.name]
+                self.assertEqual(floats(e.get("friction"))[0], m.kit.surfaces[p.surface].friction)
+                self.assertEqual(floats(e.get("pos"))[:2], list(p.centre_m))
+                self.assertEqual(floats(e.get("size"))[:2], [p.size_m[0] / 2, p.size_m[1] / 2])
+                j = next(t for t in self.json[n]["terrain_patches"] if t["name"] == p.name)
+                self.assertEqual(j["friction"], m.kit.surfaces[p.surface].friction)
+            for w in m.walls:
+                e = g[w.name]
+                self.assertEqual(e.get("type"), "plane")
+                self.assertEqual(floats(e.get("pos"))[:2], list(w.face_centre_m))
+                self.assertEqual(floats(e.get("zaxis"))[:2], list(w.normal))
+        self.assertEqual(len(self.maps["parking_school"].walls), 4)
+
+    def test_lanes_run_on_the_drawn_roads(self) -> None:
+        m, g = self.maps["driving_school"], self.xml["driving_school"]
+        roads = [e for k, e in g.items() if k.startswith("road_")]
+        names = [lane.name for lane in m.lanes()]
+        self.assertEqual(names, ["loop_ccw", "loop_cw", "x_east", "x_west", "y_north", "y_south"])
+        for lane in m.lanes():
+            pts = m.centre_line(lane, 0.05)
+            self.assertGreater(len(pts), 10)
+            for (x, y, h), (x2, y2, _) in zip(pts, pts[1:]):
+                # on the tarmac (arcs are drawn as chords: thin wedges between them outside 1 m)
+                self.assertTrue(any(box_contains(e, (x, y), 0.005) for e in roads), (lane.name, x, y))
+                self.assertLessEqual(math.dist((x, y), (x2, y2)), 0.05 + 1e-9)
+                # headings point to the next point
+                self.assertLess(abs(math.remainder(math.atan2(y2 - y, x2 - x) - h, 2 * math.pi)), 0.1)
+            j = next(l for l in self.json["driving_school"]["lanes"] if l["name"] == lane.name)
+            self.assertEqual(len(j["centre_line"]), len(pts))
+            self.assertAlmostEqual(j["centre_line"][3]["x_m"], pts[3][0], places=8)
+        # right-hand traffic: x_east runs +x on the south side of the x road
+        east = m.centre_line("x_east")
+        self.assertAlmostEqual(east[0][1], -0.12)
+        self.assertLess(east[0][0], east[-1][0])
+        self.assertAlmostEqual(m.centre_line("x_west")[0][2], math.pi)
+        # the loop lanes are closed
+        ccw = m.centre_line("loop_ccw")
+        self.assertLess(math.dist(ccw[0][:2], ccw[-1][:2]), 1e-9)
+        # the spawn stands in x_east, facing along it
+        sp = m.spawn_pose()
+        d, heading = geometry.nearest_on_polyline((sp.x_m, sp.y_m), east)
+        self.assertLess(d, 1e-9)
+        self.assertAlmostEqual(heading, sp.yaw_rad)
+
+    def test_stop_lines_cross_their_lanes(self) -> None:
+        m, g = self.maps["driving_school"], self.xml["driving_school"]
+        self.assertEqual(len(m.stop_lines), 4)
+        for s in m.stop_lines:
+            e = g[s.name]
+            self.assertEqual(floats(e.get("pos"))[:2], list(s.centre_m))
+            self.assertAlmostEqual(floats(e.get("size"))[0], s.length_m / 2)
+            d, heading = geometry.nearest_on_polyline(s.centre_m, m.centre_line(s.lane, 0.01))
+            self.assertLess(d, 1e-9)
+            self.assertTrue(same_axis(floats(e.get("euler"))[2], heading + math.pi / 2))
+            # before the intersection (the origin): the lane heads towards it
+            to_origin = math.atan2(-s.centre_m[1], -s.centre_m[0])
+            self.assertLess(abs(math.remainder(to_origin - heading, 2 * math.pi)), math.pi / 2)
+        self.assertEqual(m.traffic_lights, [])
+        self.assertEqual(m.signs, [])
+        self.assertEqual(self.json["driving_school"]["traffic_lights"], [])
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1], verbosity=2)
