@@ -14,7 +14,10 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,8 +35,33 @@
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kWallM = 3.975;       // parking school: inner faces of the walls at +-3.975 m
 constexpr double kCarSpacingM = 0.35;  // cars 2..N line up to car 1's right at this pitch
+
+// A map's facts from its JSON sidecar (generated from sim/mujoco_hil/maps/<map>.yaml).
+const nlohmann::json &map_facts(const std::string &name) {
+  static std::map<std::string, nlohmann::json> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) {
+    const std::string path = std::string(SIM_DIR) + "/maps/" + name + ".json";
+    std::ifstream f(path);
+    if (!f) throw std::runtime_error(path + ": cannot read the map sidecar");
+    it = cache.emplace(name, nlohmann::json::parse(f)).first;
+  }
+  return it->second;
+}
+
+// The named entry of a list in the parking school's sidecar (walls, boxes...).
+const nlohmann::json &parking(const char *list, const char *name) {
+  for (const auto &e : map_facts("parking_school").at(list))
+    if (e.at("name") == name) return e;
+  throw std::runtime_error(std::string("parking_school.json: no ") + list + " '" + name + "'");
+}
+
+std::string xy(double x, double y) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%g,%g", x, y);
+  return buf;
+}
 
 std::string url(int port) {
   return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
@@ -159,12 +187,14 @@ double ray_box(double ox, double oy, double dx, double dy, double cx, double cy,
   return lo <= hi ? lo : -1;
 }
 
-// Distance along the ray to the parking school's walls (the square at +-kWallM).
+// Distance along the ray to the parking school's walls (planes at their inner faces).
 double ray_walls(double ox, double oy, double dx, double dy) {
   double best = 1e9;
-  for (double w : {-kWallM, kWallM}) {
-    if (fabs(dx) > 1e-12 && (w - ox) / dx > 0) best = fmin(best, (w - ox) / dx);
-    if (fabs(dy) > 1e-12 && (w - oy) / dy > 0) best = fmin(best, (w - oy) / dy);
+  for (const auto &w : map_facts("parking_school").at("walls")) {
+    const double cx = w["face_centre_m"][0], cy = w["face_centre_m"][1];
+    const double nx = w["normal"][0], ny = w["normal"][1];
+    const double towards = dx * nx + dy * ny;  // < 0: the ray runs into the face
+    if (towards < -1e-12) best = fmin(best, ((cx - ox) * nx + (cy - oy) * ny) / towards);
   }
   return best;
 }
@@ -201,19 +231,29 @@ TEST(Scenario, ParsesStartAndLateBoxValues) {
 
 TEST(Scenario, BadStartAndLateBoxValuesExit2NamingTheOption) {
   struct Case {
-    const char *args, *option, *detail;
-  } cases[] = {
+    std::string args;
+    const char *option, *detail;
+  };
+  // map facts from the sidecar: poses on a box, through a wall, off the floor
+  const auto &box_a = parking("boxes", "box_a")["centre_m"];
+  const double wall_e_x = parking("walls", "wall_e")["face_centre_m"][0];
+  const double wall_n_y = parking("walls", "wall_n")["face_centre_m"][1];
+  const double wall_s_y = parking("walls", "wall_s")["face_centre_m"][1];
+  const double driving_half_m = map_facts("driving_school")["floor"]["half_size_m"];
+  const Case cases[] = {
       {"--start 1,2", "--start", "1,2"},
       {"--start north,0,0", "--start", "north"},
       {"--start", "--start", "missing"},
-      {"--start 1.5,0,0", "--start", "box_a"},                     // on the map's box
-      {"--start 3.9,0,0", "--start", "wall_e"},                    // through the east wall
-      {"--map driving_school --start 6,0,0", "--start", "floor"},  // off the floor
-      {"--cars 3 --start -1,-3.5,0", "--start", "NIGEL3"},         // car 3 through a wall
+      {"--start " + xy(box_a[0], box_a[1]) + ",0", "--start", "box_a"},    // on the map's box
+      {"--start " + xy(wall_e_x - 0.075, 0) + ",0", "--start", "wall_e"},  // nose through it
+      {"--map driving_school --start " + xy(driving_half_m + 1, 0) + ",0", "--start", "floor"},
+      // car 3 (2 pitches to car 1's right) through the south wall
+      {"--cars 3 --start " + xy(-1, wall_s_y + 2 * kCarSpacingM - 0.225) + ",0", "--start",
+       "NIGEL3"},
       {"--late-box 0.5,0.6", "--late-box", "0.5,0.6"},
       {"--late-box 0.5,0.6,-2", "--late-box", "T [s]"},
-      {"--late-box 1.5,0,3", "--late-box", "box_a"},
-      {"--late-box 0,3.95,1,0.1,0.1", "--late-box", "wall_n"},
+      {"--late-box " + xy(box_a[0], box_a[1]) + ",3", "--late-box", "box_a"},
+      {"--late-box " + xy(0, wall_n_y - 0.025) + ",1,0.1,0.1", "--late-box", "wall_n"},
       {"--late-box 0,0,1 --late-box 0,0.5,1 --late-box 0,1,1 --late-box 0.5,0,1 --late-box "
        "0.5,0.5,1",
        "--late-box", "at most 4"},
