@@ -139,7 +139,8 @@ class Api(unittest.TestCase):
             props = {
                 k: e
                 for k, e in g.items()
-                if e.get("contype") == "1" and e.get("type") in ("box", "cylinder")
+                if e.get("contype") == "1"
+                and e.get("type") in ("box", "cylinder")
                 and not k.startswith("terrain_")
             }
             rects = m.obstacles()
@@ -156,7 +157,13 @@ class Api(unittest.TestCase):
                     yaw = 0.0
                 want = maps.Rect(x, y, hx, hy, yaw)
                 self.assertTrue(
-                    any(all(abs(a - b) < TOL_M for a, b in zip(vars(r).values(), vars(want).values())) for r in rects),
+                    any(
+                        all(
+                            abs(a - b) < TOL_M
+                            for a, b in zip(vars(r).values(), vars(want).values())
+                        )
+                        for r in rects
+                    ),
                     (n, e.get("name"), want),
                 )
 
@@ -190,10 +197,14 @@ class Api(unittest.TestCase):
             self.assertGreater(len(pts), 10)
             for (x, y, h), (x2, y2, _) in zip(pts, pts[1:]):
                 # on the tarmac (arcs are drawn as chords: thin wedges between them outside 1 m)
-                self.assertTrue(any(box_contains(e, (x, y), 0.005) for e in roads), (lane.name, x, y))
+                self.assertTrue(
+                    any(box_contains(e, (x, y), 0.005) for e in roads), (lane.name, x, y)
+                )
                 self.assertLessEqual(math.dist((x, y), (x2, y2)), 0.05 + 1e-9)
                 # headings point to the next point
-                self.assertLess(abs(math.remainder(math.atan2(y2 - y, x2 - x) - h, 2 * math.pi)), 0.1)
+                self.assertLess(
+                    abs(math.remainder(math.atan2(y2 - y, x2 - x) - h, 2 * math.pi)), 0.1
+                )
             j = next(l for l in self.json["driving_school"]["lanes"] if l["name"] == lane.name)
             self.assertEqual(len(j["centre_line"]), len(pts))
             self.assertAlmostEqual(j["centre_line"][3]["x_m"], pts[3][0], places=8)

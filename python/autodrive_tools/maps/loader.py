@@ -128,7 +128,10 @@ class _Checker:
             key = f"walls[{i}]"
             self.unique(w.name, f"{key}.name")
             if w.normal not in ((1, 0), (-1, 0), (0, 1), (0, -1)):
-                raise self.err(f"{key}.normal", f"must be [1, 0], [-1, 0], [0, 1] or [0, -1], got {list(w.normal)}")
+                raise self.err(
+                    f"{key}.normal",
+                    f"must be [1, 0], [-1, 0], [0, 1] or [0, -1], got {list(w.normal)}",
+                )
             self.positive(w.length_m, f"{key}.length_m")
         for i, b in enumerate(m.boxes):
             key = f"boxes[{i}]"
@@ -206,7 +209,11 @@ class _Checker:
                     )
                 prev_end = end
                 n = 16
-                pts = [geometry.piece_point(p, k / n, s * r.width_m / 2)[0] for k in range(n + 1) for s in (-1, 1)]
+                pts = [
+                    geometry.piece_point(p, k / n, s * r.width_m / 2)[0]
+                    for k in range(n + 1)
+                    for s in (-1, 1)
+                ]
                 self.on_floor(pts, pk)
             for j, lane in enumerate(r.lanes):
                 lk = f"{key}.lanes[{j}]"
@@ -214,7 +221,10 @@ class _Checker:
                     raise self.err(f"{lk}.name", f"lane '{lane.name}' is given twice")
                 lanes.add(lane.name)
                 if not abs(lane.offset_m) < r.width_m / 2:
-                    raise self.err(f"{lk}.offset_m", f"{lane.offset_m:g} m is off the road (width {r.width_m:g} m)")
+                    raise self.err(
+                        f"{lk}.offset_m",
+                        f"{lane.offset_m:g} m is off the road (width {r.width_m:g} m)",
+                    )
 
     def stop_lines(self) -> None:
         lanes = {lane.name: lane for lane in self.m.lanes()}
@@ -224,6 +234,8 @@ class _Checker:
             self.positive(s.length_m, f"{key}.length_m")
             if s.lane not in lanes:
                 raise self.err(f"{key}.lane", f"no lane '{s.lane}' (lanes: {sorted(lanes)})")
-            d, _ = geometry.nearest_on_polyline(s.centre_m, geometry.centre_line(lanes[s.lane], 0.01))
+            d, _ = geometry.nearest_on_polyline(
+                s.centre_m, geometry.centre_line(lanes[s.lane], 0.01)
+            )
             if d > ON_LANE_TOLERANCE_M:
                 raise self.err(f"{key}.centre_m", f"{d:.3f} m off lane '{s.lane}' centre line")

@@ -130,7 +130,9 @@ class _Writer:
             self.mark(f"slot_line_{k}", p, length, yaw, w)
         for k, (a, b, yaw) in enumerate(backs):
             mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
-            self.mark("slot_back" + (f"_{k}" if k else ""), mid, math.dist(a, b), yaw - math.pi / 2, w)
+            self.mark(
+                "slot_back" + (f"_{k}" if k else ""), mid, math.dist(a, b), yaw - math.pi / 2, w
+            )
 
     def box(self, name: str, centre: Vec2, size: Sequence[float], yaw: float) -> None:
         ob = self.kit.obstacle
@@ -192,7 +194,13 @@ class _Writer:
         self.slots(m.parking_slots)
         self.roads()
         for s in m.stop_lines:
-            self.mark(s.name, s.centre_m, s.length_m, m.stop_line_yaw_rad(s), kit.marking.stop_line_width_m)
+            self.mark(
+                s.name,
+                s.centre_m,
+                s.length_m,
+                m.stop_line_yaw_rad(s),
+                kit.marking.stop_line_width_m,
+            )
         for b in m.boxes:
             self.box(b.name, b.centre_m, b.size_m, b.yaw_rad)
         for c in m.cones:
@@ -223,4 +231,3 @@ class _Writer:
 def generate(m: MapDescription) -> str:
     """The map's MJCF text."""
     return _Writer(m).write()
-

@@ -75,8 +75,12 @@ def _value(tp: Any, value: Any, source: Path, key: str) -> Any:
         return value
     if origin is tuple:
         if not isinstance(value, list) or len(value) != len(args):
-            raise fail(source, key, f"expected a list of {len(args)} numbers, got {_describe(value)}")
-        return tuple(_value(a, v, source, f"{key}[{i}]") for i, (a, v) in enumerate(zip(args, value)))
+            raise fail(
+                source, key, f"expected a list of {len(args)} numbers, got {_describe(value)}"
+            )
+        return tuple(
+            _value(a, v, source, f"{key}[{i}]") for i, (a, v) in enumerate(zip(args, value))
+        )
     if origin is list:
         if not isinstance(value, list):
             raise fail(source, key, f"expected a list, got {_describe(value)}")

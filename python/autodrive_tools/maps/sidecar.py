@@ -58,7 +58,12 @@ def document(m: MapDescription) -> dict[str, Any]:
             for w in m.walls
         ],
         "boxes": [
-            {"name": b.name, "centre_m": _xy(b.centre_m), "size_m": list(b.size_m), "yaw_rad": b.yaw_rad}
+            {
+                "name": b.name,
+                "centre_m": _xy(b.centre_m),
+                "size_m": list(b.size_m),
+                "yaw_rad": b.yaw_rad,
+            }
             for b in m.boxes
         ],
         "cones": [
@@ -148,7 +153,11 @@ def _dump(v: Any, indent: str = "") -> str:
     file stays short and diffs stay readable."""
     inner = indent + " "
     if isinstance(v, dict):
-        if all(_scalar(x) or (isinstance(x, list) and all(map(_scalar, x))) for x in v.values()) and len(v) <= 6 and indent:
+        if (
+            all(_scalar(x) or (isinstance(x, list) and all(map(_scalar, x))) for x in v.values())
+            and len(v) <= 6
+            and indent
+        ):
             return json.dumps(v, separators=(", ", ": "))
         items = [f"{inner}{json.dumps(k)}: {_dump(x, inner)}" for k, x in v.items()]
         return "{\n" + ",\n".join(items) + "\n" + indent + "}" if items else "{}"
