@@ -30,11 +30,10 @@ def names(maps_dir: Path = MAPS_DIR) -> list[str]:
 
 def _read_yaml(source: Path) -> Any:
     try:
-        text = source.read_text()
+        with source.open() as f:  # a stream with a name: YAML errors then name the file
+            return yaml.safe_load(f)
     except OSError as err:
         raise MapDescriptionError(f"{source}: cannot read ({err.strerror})") from err
-    try:
-        return yaml.safe_load(text)
     except yaml.YAMLError as err:
         raise MapDescriptionError(f"{source}: not valid YAML ({err})") from err
 
