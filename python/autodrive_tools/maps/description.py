@@ -8,8 +8,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal, Union
 
 from . import geometry
-from .model import Kit, Lane, MapDescriptionError, MapFile, ParkingSlot, Pose, Rect, StopLine
-from .model import Fixture, Road
+from .model import Fixture, Kit, Lane, MapDescriptionError, MapFile, ParkingSlot, Pose, Rect
+from .model import Road, StopLine
 
 if TYPE_CHECKING:
     from ..vehicle import Vehicle
@@ -19,9 +19,9 @@ if TYPE_CHECKING:
 class MapDescription(MapFile):
     """A map as described in sim/mujoco_hil/maps/<name>.yaml, with the kit it is built from."""
 
-    name: str = ""
-    source: Path = Path()
-    kit: Kit | None = None
+    name: str
+    source: Path
+    kit: Kit
 
     # --- poses and places ---------------------------------------------------------------------
 
@@ -63,7 +63,6 @@ class MapDescription(MapFile):
     def obstacles(self) -> list[Rect]:
         """Collidable props (boxes, cones as their bounding squares) as footprint rectangles;
         walls are not included (see walls)."""
-        assert self.kit is not None
         out = [
             Rect(b.centre_m[0], b.centre_m[1], b.size_m[0] / 2, b.size_m[1] / 2, b.yaw_rad)
             for b in self.boxes

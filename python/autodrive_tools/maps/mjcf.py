@@ -48,7 +48,6 @@ def _same_line(p: Vec2, yaw_p: float, q: Vec2, yaw_q: float) -> bool:
 
 class _Writer:
     def __init__(self, m: MapDescription) -> None:
-        assert m.kit is not None
         self.m, self.kit = m, m.kit
         self.lines: list[str] = []
         c = self.kit.contact

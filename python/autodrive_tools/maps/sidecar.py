@@ -25,7 +25,6 @@ def _r(v: float) -> float:
 def document(m: MapDescription) -> dict[str, Any]:
     """The sidecar's content as plain JSON types."""
     kit = m.kit
-    assert kit is not None
     sp = m.spawn_pose()
     return {
         "name": m.name,
