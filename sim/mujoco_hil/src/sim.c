@@ -42,6 +42,8 @@ enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
 
 /* Lamp geoms and the NIGEL_LAMP_* bit and colours that drive each. */
 #define SIM_LAMPS 9
+/* 115200 baud moves 11.5 bytes/ms: 100 ms of Nano output fits, so a batch never drops */
+#define SIM_TX_PENDING_BYTES 1152
 static const struct {
   const char *name;
   uint8_t bits;
@@ -88,6 +90,9 @@ typedef struct sim_car {
   ptylink_t pty;
   int has_pty, has_script;
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
+  /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */
+  uint8_t tx_pending[SIM_TX_PENDING_BYTES];
+  size_t tx_pending_n;
   script_t script;
   rng_t rng;
   double accel_bias[3], gyro_bias[3];
@@ -110,8 +115,9 @@ struct sim {
   tyre_curve_t lon, lat;
   motor_model_t motor;
   int tyre_paper;
-  int *geom_tyre; /* per geom: car * W_N + wheel, or -1 */
-  int ntag_files; /* roof tag PNGs that may exist in scene_dir */
+  int host_io_period_steps; /* >= 1: ptys serviced every this many steps */
+  int *geom_tyre;           /* per geom: car * W_N + wheel, or -1 */
+  int ntag_files;           /* roof tag PNGs that may exist in scene_dir */
   int has_start;
   scn_pose_t start;
   int nbox;
@@ -525,6 +531,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
   if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
   s->tyre_paper = s->p.tyre_model_paper;
+  s->host_io_period_steps = cfg->host_io_period_ms > 1 ? cfg->host_io_period_ms : 1;
   if (mkdir(cfg->run_dir, 0755) != 0 && errno != EEXIST) {
     snprintf(err, err_sz, "run dir '%s': %s", cfg->run_dir, strerror(errno));
     goto fail;
@@ -593,9 +600,14 @@ void sim_destroy(sim_t *s) {
 }
 
 /* ---- per step ------------------------------------------------------------------------- */
-static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
+/* Is the host link (ptys) serviced in the step that ends at s->time_us + SIM_STEP_US? */
+static int sim_host_io_due(const sim_t *s) {
+  return (s->time_us / SIM_STEP_US + 1) % s->host_io_period_steps == 0;
+}
+
+static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err_sz) {
   uint8_t buf[512];
-  if (c->has_pty) {
+  if (c->has_pty && io_due) {
     const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
     const size_t n = ptylink_read(&c->pty, buf, room);
     uart_push(&c->rx, buf, n);
@@ -612,8 +624,16 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   const int32_t enc_l = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RL]] * k);
   const int32_t enc_r = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RR]] * k);
   nigel_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);
-  n = uart_pop(&c->tx, SIM_STEP_US, buf, sizeof buf);
-  if (c->has_pty) ptylink_write(&c->pty, buf, n); /* a full pty drops bytes, like a UART */
+  if (!c->has_pty) {
+    uart_pop(&c->tx, SIM_STEP_US, buf, sizeof buf); /* nobody listens: the wire just drains */
+  } else {
+    const size_t room = sizeof c->tx_pending - c->tx_pending_n;
+    c->tx_pending_n += uart_pop(&c->tx, SIM_STEP_US, c->tx_pending + c->tx_pending_n, room);
+    if (io_due || c->tx_pending_n == sizeof c->tx_pending) {
+      ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n); /* a full pty drops bytes */
+      c->tx_pending_n = 0;
+    }
+  }
   (void)err;
   (void)err_sz;
   return 0;
@@ -658,16 +678,36 @@ static void sim_actuate(sim_t *s, sim_car_t *c) {
   }
 }
 
+/* Adds to qfrc_applied the generalized force of a world-frame force f [N] acting at point p [m]
+ * on body b: the sum mj_applyFT forms, taken over the dofs of b's own chain (Jacobian columns
+ * from cdof about the root's subtree centre of mass, as mj_jac builds them). Through
+ * xfrc_applied, MuJoCo built an nv-wide dense Jacobian per wheel: with 16 cars that was a
+ * fifth of the run. Needs the kinematics of mj_step1. */
+static void sim_apply_point_force(const mjModel *m, mjData *d, int b, const mjtNum p[3],
+                                  const mjtNum f[3]) {
+  mjtNum offset[3];
+  mju_sub3(offset, p, d->subtree_com + 3 * m->body_rootid[b]);
+  while (b && !m->body_dofnum[b]) b = m->body_parentid[b];
+  if (!b) return;
+  for (int i = m->body_dofadr[b] + m->body_dofnum[b] - 1; i >= 0; i = m->dof_parentid[i]) {
+    const mjtNum *cdof = d->cdof + 6 * i; /* [angular, linear] motion of dof i */
+    mjtNum cross[3], jacp[3];
+    mju_cross(cross, cdof, offset);
+    mju_add3(jacp, cdof + 3, cross);
+    d->qfrc_applied[i] += mju_dot3(jacp, f);
+  }
+}
+
 /* Paper tyre forces from the contacts recorded after the previous step, applied at each
- * contact point through xfrc_applied of the wheel body. */
+ * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
+ * forces for this step; the free joint's are the tyres' alone. */
 static void sim_tyres(sim_t *s, sim_car_t *c) {
   const vp_params_t *p = &s->p;
   const mjModel *m = s->m;
   mjData *d = s->d;
+  mju_zero(d->qfrc_applied + c->root_dof, 6);
   for (int w = 0; w < W_N; w++) {
     const int b = c->wheel_body[w];
-    mjtNum *xf = d->xfrc_applied + 6 * b;
-    mju_zero(xf, 6);
     if (c->fz_n[w] <= 0.0) continue;
     const mjtNum *R = d->xmat + 9 * b;
     const double axis[3] = {R[1], R[4], R[7]}; /* wheel y axis (spin axis) in the world */
@@ -697,12 +737,9 @@ static void sim_tyres(sim_t *s, sim_car_t *c) {
     in.dt_s = m->opt.timestep;
     double fx, fy;
     tyre_force(&s->lon, &s->lat, &in, &fx, &fy);
-    double f[3], arm[3], t[3];
+    double f[3];
     for (int k = 0; k < 3; k++) f[k] = fx * fwd[k] + fy * lat[k];
-    mju_sub3(arm, c->contact_pos[w], d->xipos + 3 * b);
-    mju_cross(t, arm, f);
-    mju_copy3(xf, f);
-    mju_copy3(xf + 3, t);
+    sim_apply_point_force(m, d, b, c->contact_pos[w], f);
   }
 }
 
@@ -749,9 +786,10 @@ static void sim_record_contacts(sim_t *s) {
 int sim_step(sim_t *s, char *err, size_t err_sz) {
   sim_place_late_boxes(s); /* before mj_step1: its kinematics, contacts and rays see them */
   mj_step1(s->m, s->d);
+  const int io_due = sim_host_io_due(s);
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
-    if (sim_nano_io(s, c, err, err_sz) != 0) return -1;
+    if (sim_nano_io(s, c, io_due, err, err_sz) != 0) return -1;
     sim_actuate(s, c);
     sim_draw_lamps(s, c);
     if (s->tyre_paper) sim_tyres(s, c);
@@ -772,7 +810,8 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
       sim_lidar_last_cast(c->lidar, &from, &to, &num_rays, &ranges_m, &quality);
       sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
-    if (c->rplidar && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0) return -1;
+    if (c->rplidar && io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
+      return -1;
   }
 #endif
   if (s->d->warning[mjWARN_BADQACC].number > 0) {
