@@ -33,7 +33,10 @@
 #define SIM_G_M_S2 9.80665
 #define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
 #define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
-#define SIM_SPAWN_Z_M 0.002      /* base_link starts this high and settles on its tyres */
+#define SIM_CAR_ROW_PITCH_M 0.45 /* and in rows this far behind one another */
+#define SIM_PLACES_PER_ROW 16
+#define SIM_PLACE_ROWS 8
+#define SIM_SPAWN_Z_M 0.002 /* base_link starts this high and settles on its tyres */
 /* Parts of the map lower than this are driven over (terrain patches 1 mm, markings), not
  * obstacles, when checking a start pose or a late box [m] */
 #define SIM_GROUND_CLEARANCE_M 0.005
@@ -230,10 +233,27 @@ static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   return 0;
 }
 
+static void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row, int col) {
+  mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+  const double right = -SIM_CAR_SPACING_M * col, back = -SIM_CAR_ROW_PITCH_M * row;
+  qp[0] = base[0] + back * cos(yaw) - right * sin(yaw);
+  qp[1] = base[1] + back * sin(yaw) + right * cos(yaw);
+  qp[2] = SIM_SPAWN_Z_M;
+  qp[3] = cos(0.5 * yaw);
+  qp[4] = qp[5] = 0.0;
+  qp[6] = sin(0.5 * yaw);
+  mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
+}
+
+static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out);
+
 /* Car 1 stands at --start, else at the map's "spawn" site (or the origin); the others side
- * by side to its right. The model's qpos0 gets the same poses, so a reset (mj_resetData, the
- * viewer's R) puts the cars back where they started. */
-static void sim_place_cars(sim_t *s) {
+ * by side to its right. With --start they stay in that one row and sim_check_scenario judges
+ * it; at the spawn site a car that would stand on a wall, an obstacle or off the floor takes
+ * the next free place, in rows behind car 1 when a row is full. The model's qpos0 gets the
+ * same poses, so a reset (mj_resetData, the viewer's R) puts the cars back where they
+ * started. Returns 0, or -1 when a car finds no place. */
+static int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
   double base[3] = {0, 0, 0}, yaw = 0.0;
   const int site = mj_name2id(s->m, mjOBJ_SITE, "spawn");
   if (s->has_start) {
@@ -245,17 +265,33 @@ static void sim_place_cars(sim_t *s) {
     const mjtNum *q = s->m->site_quat + 4 * site;
     yaw = atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
   }
-  for (int i = 0; i < s->ncars; i++) {
-    mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
-    const double off = -SIM_CAR_SPACING_M * i;
-    qp[0] = base[0] - off * sin(yaw);
-    qp[1] = base[1] + off * cos(yaw);
-    qp[2] = SIM_SPAWN_Z_M;
-    qp[3] = cos(0.5 * yaw);
-    qp[4] = qp[5] = 0.0;
-    qp[6] = sin(0.5 * yaw);
-    mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
+  if (s->has_start) {
+    for (int i = 0; i < s->ncars; i++) sim_set_car_pose(s, i, base, yaw, 0, i);
+    return 0;
   }
+  mj_kinematics(s->m, s->d); /* the static geoms' poses, for the clearance check */
+  const mjModel *m = s->m;
+  const int ct = m->geom_contype[s->car[0].chassis_geom],
+            ca = m->geom_conaffinity[s->car[0].chassis_geom];
+  int place = 0; /* next place to try: row place / SIM_PLACES_PER_ROW, column the rest */
+  for (int i = 0; i < s->ncars; i++) {
+    for (;; place++) {
+      if (place >= SIM_PLACES_PER_ROW * SIM_PLACE_ROWS) {
+        snprintf(err, err_sz,
+                 "no room for NIGEL%d: %d rows of %d places from the map's spawn site are taken "
+                 "or blocked (fewer --cars, or --start elsewhere)",
+                 i + 1, SIM_PLACE_ROWS, SIM_PLACES_PER_ROW);
+        return -1;
+      }
+      sim_set_car_pose(s, i, base, yaw, place / SIM_PLACES_PER_ROW, place % SIM_PLACES_PER_ROW);
+      cl_prism_t pr;
+      sim_car_prism(s, i, &pr);
+      char why[512];
+      if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) break;
+    }
+    place++;
+  }
+  return 0;
 }
 
 /* The upright prism around car i's chassis and wheels at its current pose. */
@@ -563,7 +599,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
   }
   if (sim_bind_late_boxes(s, err, err_sz) != 0) goto fail;
-  sim_place_cars(s);
+  if (sim_place_cars(s, err, err_sz) != 0) goto fail;
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
     if (sim_setup_car(s, cfg, &s->car[i], err, err_sz) != 0) goto fail;
