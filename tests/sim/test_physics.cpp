@@ -119,7 +119,9 @@ TEST(Physics, EncodersCount1920PerWheelRevolution) {
       sim_model(s.s), mjOBJ_JOINT, "nigel1/wheel_rl")]];
   const nigel_t *n = sim_nano(s.s, 1);
   EXPECT_GT(n->enc[0], 1000);
-  EXPECT_NEAR(n->enc[0], wheel_rad / (2 * M_PI) * 1920.0, 2.0);
+  // the firmware sampled the wheel one 1 ms step before the end of the run (about one count
+  // at this speed) and floors its angle (under one count): 2.5 counts bound both
+  EXPECT_NEAR(n->enc[0], wheel_rad / (2 * M_PI) * 1920.0, 2.5);
   // the distance travelled matches the counts (rolling without much slip)
   const double dist = s.truth().pos_m[0] - x0;
   EXPECT_NEAR(n->enc[0] / 1920.0 * 2 * M_PI * 0.0325, dist, 0.03 * dist);

@@ -7,7 +7,7 @@
 #include "autodrive_ground_truth_t.h"
 #include "autodrive_sim_clock_t.h"
 
-int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log) {
+int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
@@ -24,22 +24,28 @@ int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log) {
   memcpy(msg.angular_velocity_rad_s, t.gyro_body_rad_s, sizeof msg.angular_velocity_rad_s);
   msg.steering_angle_rad = t.steering_rad;
   msg.in_collision = (int8_t)t.in_collision;
+  uint8_t buf[512];
+  const int n = autodrive_ground_truth_t_encode(buf, 0, sizeof buf, &msg);
+  if (n <= 0) return -1;
   if (log) {
-    uint8_t buf[512];
-    const int n = autodrive_ground_truth_t_encode(buf, 0, sizeof buf, &msg);
-    if (n > 0) {
-      const uint8_t len[4] = {(uint8_t)(n >> 24), (uint8_t)(n >> 16), (uint8_t)(n >> 8),
-                              (uint8_t)n};
-      fwrite(len, 1, 4, log);
-      fwrite(buf, 1, (size_t)n, log);
-    }
+    const uint8_t len[4] = {(uint8_t)(n >> 24), (uint8_t)(n >> 16), (uint8_t)(n >> 8), (uint8_t)n};
+    fwrite(len, 1, 4, log);
+    fwrite(buf, 1, (size_t)n, log);
   }
-  if (!lcm) return 0;
-  return autodrive_ground_truth_t_publish(lcm, channel, &msg) == 0 ? 0 : -1;
+  if (!q) return 0;
+  uint8_t *out = lcmq_reserve(q, channel, (size_t)n);
+  if (!out) return -1;
+  memcpy(out, buf, (size_t)n);
+  lcmq_commit(q);
+  return 0;
 }
 
-int lcmpub_clock(lcm_t *lcm, int64_t utime, double rtf, int paused) {
-  if (!lcm) return 0;
+int lcmpub_clock(lcmq_t *q, int64_t utime, double rtf, int paused) {
+  if (!q) return 0;
   autodrive_sim_clock_t msg = {utime, rtf, (int8_t)paused};
-  return autodrive_sim_clock_t_publish(lcm, "SIM_CLOCK", &msg) == 0 ? 0 : -1;
+  const int n = autodrive_sim_clock_t_encoded_size(&msg);
+  uint8_t *out = lcmq_reserve(q, "SIM_CLOCK", (size_t)n);
+  if (!out || autodrive_sim_clock_t_encode(out, 0, n, &msg) != n) return -1;
+  lcmq_commit(q);
+  return 0;
 }

@@ -9,11 +9,12 @@
 
 #include <lcm/lcm.h>
 
+#include "lcmq.h"
 #include "sim.h"
 
-/* Publishes car's ground truth on NIGEL<car>_GROUND_TRUTH; appends it to log if non-NULL.
- * Returns 0, or -1 when LCM refused the message. */
-int lcmpub_truth(lcm_t *lcm, const sim_t *s, int car, FILE *log);
-int lcmpub_clock(lcm_t *lcm, int64_t utime, double rtf, int paused);
+/* Queues car's ground truth for NIGEL<car>_GROUND_TRUTH on q (NULL: no LCM); appends it to
+ * log if non-NULL. Returns 0, or -1 when the message could not be encoded. */
+int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log);
+int lcmpub_clock(lcmq_t *q, int64_t utime, double rtf, int paused);
 
 #endif

@@ -22,7 +22,12 @@
 #define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
 #define MAIN_TRUTH_EVERY 10 /* steps between ground-truth messages: 100 Hz */
 #define MAIN_CLOCK_EVERY 10 /* steps between SIM_CLOCK messages: 100 Hz */
-#define MAIN_PROGRESS_S 5.0 /* [s] wall time between progress lines */
+/* free lockstep serves the ptys every 10 ms of sim time: a client there sees the sim run
+ * tens of times faster than real time anyway, and an idle pty then costs no system call in
+ * nine steps of ten (tools/bench sim: overhead_ratio) */
+#define MAIN_FREE_LOCKSTEP_IO_MS 10
+#define MAIN_LCM_FLUSH_S 0.001 /* [s] wall: longest a queued LCM message waits */
+#define MAIN_PROGRESS_S 5.0    /* [s] wall time between progress lines */
 
 static volatile sig_atomic_t main_stop = 0;
 /* Largest lag behind the real-time schedule [s] before the schedule slips (see pacing). */
@@ -45,7 +50,8 @@ static void main_usage(FILE *f) {
       "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
       "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
       "                      cars line up to its right as usual. Refused when a car would\n"
-      "                      be off the floor or overlap a wall or obstacle\n"
+      "                      be off the floor or overlap a wall or obstacle (at the spawn\n"
+      "                      site such a car takes the next free place, in rows behind)\n"
       "  --late-box X,Y,T[,SX,SY[,R]]\n"
       "                      a box obstacle (half sizes SX, SY [m], default %g; %g m tall)\n"
       "                      that appears at x, y [m] at sim time T [s]: a change to the\n"
@@ -59,6 +65,9 @@ static void main_usage(FILE *f) {
       "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
       "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
       "                      (default: real time, 1 sim second per wall second)\n"
+      "  --host-io-ms N      serve the ptys every N ms of sim time, like a USB-serial\n"
+      "                      adapter's latency timer (default: %d with --lockstep, else 1:\n"
+      "                      every step)\n"
       "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
       "  --lcm-url URL       LCM provider (default %s)\n"
       "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
@@ -83,7 +92,7 @@ static void main_usage(FILE *f) {
       "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
       SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-      SCN_MAX_LATE_BOXES, MAIN_DEFAULT_URL);
+      SCN_MAX_LATE_BOXES, MAIN_FREE_LOCKSTEP_IO_MS, MAIN_DEFAULT_URL);
 }
 
 static double main_clock_s(clockid_t id) {
@@ -326,6 +335,7 @@ int main(int argc, char **argv) {
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
+  int host_io_ms = 0; /* 0: the mode's default */
   scn_pose_t start;
   scn_late_box_t late_box[SCN_MAX_LATE_BOXES];
   char perr[512];
@@ -391,6 +401,10 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--script") && v) {
       cfg.script = v;
       i++;
+    } else if (!strcmp(a, "--host-io-ms")) {
+      if (main_number(a, v, 1, 100, &x)) return 2;
+      host_io_ms = (int)x;
+      i++;
     } else if (!strcmp(a, "--no-pty")) {
       cfg.open_ptys = 0;
     } else if (!strcmp(a, "--no-lidar")) {
@@ -453,6 +467,9 @@ int main(int argc, char **argv) {
     return 1;
   }
   char err[2048] = "";
+  cfg.host_io_period_ms = host_io_ms                   ? host_io_ms
+                          : (lockstep && !client_sync) ? MAIN_FREE_LOCKSTEP_IO_MS
+                                                       : 1;
   sim_t *s = sim_create(&cfg, err, sizeof err);
   if (!s) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
@@ -492,6 +509,17 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
+  /* ground truth and SIM_CLOCK leave through a worker thread (lcmq.h) */
+  lcmq_t *pubq = lcmq_create(lcm, err, sizeof err);
+  if (!pubq) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    main_view_close(&viewer);
+    main_cams_close(&cams);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
   for (int c = 1; c <= sim_cars(s); c++) {
     if (sim_nano_link(s, c)[0]) printf("NIGEL%d nano: %s\n", c, sim_nano_link(s, c));
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
@@ -508,14 +536,17 @@ int main(int argc, char **argv) {
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
   double t0 = main_wall_s(); /* moved forward by the time spent paused in the viewer */
-  const double cpu0 = main_cpu_s();
-  double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0;
+  const double cpu0 = main_cpu_s(), step_cpu0 = main_clock_s(CLOCK_THREAD_CPUTIME_ID);
+  double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0, next_flush = t0;
   int64_t last_progress_us = 0;
   int rc = 0;
   long step = 0, slips = 0;
   main_sync_t sync = {0};
   while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
-    if (client_sync) main_sync_wait(s, &sync);
+    if (client_sync) {
+      lcmq_flush(pubq); /* the client may be waiting for the SIM_CLOCK we queued */
+      main_sync_wait(s, &sync);
+    }
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
@@ -525,7 +556,7 @@ int main(int argc, char **argv) {
     const int64_t now_us = sim_time_us(s);
     main_report_late_boxes(s);
     if (step % MAIN_TRUTH_EVERY == 0)
-      for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(lcm, s, c, tlog);
+      for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(pubq, s, c, tlog);
 #ifdef SIM_HAVE_SENSORS
     for (int c = 1; c <= sim_cars(s); c++) {
       const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
@@ -546,11 +577,15 @@ int main(int argc, char **argv) {
     }
     if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) {
       const double since = main_wall_s() - t0; /* average rtf of the run so far */
-      lcmpub_clock(lcm, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
+      lcmpub_clock(pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
     }
     if (viewer.v && main_view_frame(&viewer, s, &t0) != 0) break;
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
+    if (wall >= next_flush) { /* queued LCM messages leave at least every millisecond */
+      lcmq_flush(pubq);
+      next_flush = wall + MAIN_LCM_FLUSH_S;
+    }
     /* --lockstep-client runs in real time until a client first writes, then in step with it */
     if (!lockstep || (client_sync && !sync.started)) {
       const double ahead = t0 + now_us * 1e-6 / rtf - wall;
@@ -575,7 +610,14 @@ int main(int argc, char **argv) {
       slips = 0;
     }
   }
+  /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
+  const double step_cpu_s = main_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0;
+  const uint64_t lcm_failures = lcmq_failures(pubq);
+  lcmq_destroy(pubq); /* sends what is still queued: part of the run's time */
   const double wall_s = main_wall_s() - t0, cpu_s = main_cpu_s() - cpu0;
+  if (lcm_failures)
+    fprintf(stderr, "autodrive-sim: LCM refused %llu ground-truth/clock message(s) on '%s'\n",
+            (unsigned long long)lcm_failures, url);
   const double sim_s = sim_time_us(s) * 1e-6;
   if (bench) {
     const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
@@ -583,9 +625,11 @@ int main(int argc, char **argv) {
     const double bare_s = sim_bare_mj_step_s(s, bare_steps, &bare_cpu_s);
     printf(
         "{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
-        "\"rtf_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f}\n",
+        "\"rtf_cpu\": %.3f, \"rtf_step_thread_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, "
+        "\"bare_mj_step_rtf_cpu\": %.3f}\n",
         sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
-        cpu_s > 0 ? sim_s / cpu_s : 0.0, bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
+        cpu_s > 0 ? sim_s / cpu_s : 0.0, step_cpu_s > 0 ? sim_s / step_cpu_s : 0.0,
+        bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
         bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
   }
   main_view_close(&viewer);

@@ -33,7 +33,10 @@
 #define SIM_G_M_S2 9.80665
 #define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
 #define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
-#define SIM_SPAWN_Z_M 0.002      /* base_link starts this high and settles on its tyres */
+#define SIM_CAR_ROW_PITCH_M 0.45 /* and in rows this far behind one another */
+#define SIM_PLACES_PER_ROW 16
+#define SIM_PLACE_ROWS 8
+#define SIM_SPAWN_Z_M 0.002 /* base_link starts this high and settles on its tyres */
 /* Parts of the map lower than this are driven over (terrain patches 1 mm, markings), not
  * obstacles, when checking a start pose or a late box [m] */
 #define SIM_GROUND_CLEARANCE_M 0.005
@@ -42,6 +45,8 @@ enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
 
 /* Lamp geoms and the NIGEL_LAMP_* bit and colours that drive each. */
 #define SIM_LAMPS 9
+/* 115200 baud moves 11.5 bytes/ms: 100 ms of Nano output fits, so a batch never drops */
+#define SIM_TX_PENDING_BYTES 1152
 static const struct {
   const char *name;
   uint8_t bits;
@@ -88,6 +93,9 @@ typedef struct sim_car {
   ptylink_t pty;
   int has_pty, has_script;
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
+  /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */
+  uint8_t tx_pending[SIM_TX_PENDING_BYTES];
+  size_t tx_pending_n;
   script_t script;
   rng_t rng;
   double accel_bias[3], gyro_bias[3];
@@ -110,8 +118,9 @@ struct sim {
   tyre_curve_t lon, lat;
   motor_model_t motor;
   int tyre_paper;
-  int *geom_tyre; /* per geom: car * W_N + wheel, or -1 */
-  int ntag_files; /* roof tag PNGs that may exist in scene_dir */
+  int host_io_period_steps; /* >= 1: ptys serviced every this many steps */
+  int *geom_tyre;           /* per geom: car * W_N + wheel, or -1 */
+  int ntag_files;           /* roof tag PNGs that may exist in scene_dir */
   int has_start;
   scn_pose_t start;
   int nbox;
@@ -224,10 +233,27 @@ static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   return 0;
 }
 
+static void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row, int col) {
+  mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+  const double right = -SIM_CAR_SPACING_M * col, back = -SIM_CAR_ROW_PITCH_M * row;
+  qp[0] = base[0] + back * cos(yaw) - right * sin(yaw);
+  qp[1] = base[1] + back * sin(yaw) + right * cos(yaw);
+  qp[2] = SIM_SPAWN_Z_M;
+  qp[3] = cos(0.5 * yaw);
+  qp[4] = qp[5] = 0.0;
+  qp[6] = sin(0.5 * yaw);
+  mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
+}
+
+static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out);
+
 /* Car 1 stands at --start, else at the map's "spawn" site (or the origin); the others side
- * by side to its right. The model's qpos0 gets the same poses, so a reset (mj_resetData, the
- * viewer's R) puts the cars back where they started. */
-static void sim_place_cars(sim_t *s) {
+ * by side to its right. With --start they stay in that one row and sim_check_scenario judges
+ * it; at the spawn site a car that would stand on a wall, an obstacle or off the floor takes
+ * the next free place, in rows behind car 1 when a row is full. The model's qpos0 gets the
+ * same poses, so a reset (mj_resetData, the viewer's R) puts the cars back where they
+ * started. Returns 0, or -1 when a car finds no place. */
+static int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
   double base[3] = {0, 0, 0}, yaw = 0.0;
   const int site = mj_name2id(s->m, mjOBJ_SITE, "spawn");
   if (s->has_start) {
@@ -239,17 +265,33 @@ static void sim_place_cars(sim_t *s) {
     const mjtNum *q = s->m->site_quat + 4 * site;
     yaw = atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
   }
-  for (int i = 0; i < s->ncars; i++) {
-    mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
-    const double off = -SIM_CAR_SPACING_M * i;
-    qp[0] = base[0] - off * sin(yaw);
-    qp[1] = base[1] + off * cos(yaw);
-    qp[2] = SIM_SPAWN_Z_M;
-    qp[3] = cos(0.5 * yaw);
-    qp[4] = qp[5] = 0.0;
-    qp[6] = sin(0.5 * yaw);
-    mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
+  if (s->has_start) {
+    for (int i = 0; i < s->ncars; i++) sim_set_car_pose(s, i, base, yaw, 0, i);
+    return 0;
   }
+  mj_kinematics(s->m, s->d); /* the static geoms' poses, for the clearance check */
+  const mjModel *m = s->m;
+  const int ct = m->geom_contype[s->car[0].chassis_geom],
+            ca = m->geom_conaffinity[s->car[0].chassis_geom];
+  int place = 0; /* next place to try: row place / SIM_PLACES_PER_ROW, column the rest */
+  for (int i = 0; i < s->ncars; i++) {
+    for (;; place++) {
+      if (place >= SIM_PLACES_PER_ROW * SIM_PLACE_ROWS) {
+        snprintf(err, err_sz,
+                 "no room for NIGEL%d: %d rows of %d places from the map's spawn site are taken "
+                 "or blocked (fewer --cars, or --start elsewhere)",
+                 i + 1, SIM_PLACE_ROWS, SIM_PLACES_PER_ROW);
+        return -1;
+      }
+      sim_set_car_pose(s, i, base, yaw, place / SIM_PLACES_PER_ROW, place % SIM_PLACES_PER_ROW);
+      cl_prism_t pr;
+      sim_car_prism(s, i, &pr);
+      char why[512];
+      if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) break;
+    }
+    place++;
+  }
+  return 0;
 }
 
 /* The upright prism around car i's chassis and wheels at its current pose. */
@@ -525,6 +567,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
   if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
   s->tyre_paper = s->p.tyre_model_paper;
+  s->host_io_period_steps = cfg->host_io_period_ms > 1 ? cfg->host_io_period_ms : 1;
   if (mkdir(cfg->run_dir, 0755) != 0 && errno != EEXIST) {
     snprintf(err, err_sz, "run dir '%s': %s", cfg->run_dir, strerror(errno));
     goto fail;
@@ -556,7 +599,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
   }
   if (sim_bind_late_boxes(s, err, err_sz) != 0) goto fail;
-  sim_place_cars(s);
+  if (sim_place_cars(s, err, err_sz) != 0) goto fail;
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
     if (sim_setup_car(s, cfg, &s->car[i], err, err_sz) != 0) goto fail;
@@ -593,9 +636,14 @@ void sim_destroy(sim_t *s) {
 }
 
 /* ---- per step ------------------------------------------------------------------------- */
-static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
+/* Is the host link (ptys) serviced in the step that ends at s->time_us + SIM_STEP_US? */
+static int sim_host_io_due(const sim_t *s) {
+  return (s->time_us / SIM_STEP_US + 1) % s->host_io_period_steps == 0;
+}
+
+static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err_sz) {
   uint8_t buf[512];
-  if (c->has_pty) {
+  if (c->has_pty && io_due) {
     const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
     const size_t n = ptylink_read(&c->pty, buf, room);
     uart_push(&c->rx, buf, n);
@@ -612,8 +660,16 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   const int32_t enc_l = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RL]] * k);
   const int32_t enc_r = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RR]] * k);
   nigel_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);
-  n = uart_pop(&c->tx, SIM_STEP_US, buf, sizeof buf);
-  if (c->has_pty) ptylink_write(&c->pty, buf, n); /* a full pty drops bytes, like a UART */
+  if (!c->has_pty) {
+    uart_pop(&c->tx, SIM_STEP_US, buf, sizeof buf); /* nobody listens: the wire just drains */
+  } else {
+    const size_t room = sizeof c->tx_pending - c->tx_pending_n;
+    c->tx_pending_n += uart_pop(&c->tx, SIM_STEP_US, c->tx_pending + c->tx_pending_n, room);
+    if (io_due || c->tx_pending_n == sizeof c->tx_pending) {
+      ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n); /* a full pty drops bytes */
+      c->tx_pending_n = 0;
+    }
+  }
   (void)err;
   (void)err_sz;
   return 0;
@@ -658,16 +714,36 @@ static void sim_actuate(sim_t *s, sim_car_t *c) {
   }
 }
 
+/* Adds to qfrc_applied the generalized force of a world-frame force f [N] acting at point p [m]
+ * on body b: the sum mj_applyFT forms, taken over the dofs of b's own chain (Jacobian columns
+ * from cdof about the root's subtree centre of mass, as mj_jac builds them). Through
+ * xfrc_applied, MuJoCo built an nv-wide dense Jacobian per wheel: with 16 cars that was a
+ * fifth of the run. Needs the kinematics of mj_step1. */
+static void sim_apply_point_force(const mjModel *m, mjData *d, int b, const mjtNum p[3],
+                                  const mjtNum f[3]) {
+  mjtNum offset[3];
+  mju_sub3(offset, p, d->subtree_com + 3 * m->body_rootid[b]);
+  while (b && !m->body_dofnum[b]) b = m->body_parentid[b];
+  if (!b) return;
+  for (int i = m->body_dofadr[b] + m->body_dofnum[b] - 1; i >= 0; i = m->dof_parentid[i]) {
+    const mjtNum *cdof = d->cdof + 6 * i; /* [angular, linear] motion of dof i */
+    mjtNum cross[3], jacp[3];
+    mju_cross(cross, cdof, offset);
+    mju_add3(jacp, cdof + 3, cross);
+    d->qfrc_applied[i] += mju_dot3(jacp, f);
+  }
+}
+
 /* Paper tyre forces from the contacts recorded after the previous step, applied at each
- * contact point through xfrc_applied of the wheel body. */
+ * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
+ * forces for this step; the free joint's are the tyres' alone. */
 static void sim_tyres(sim_t *s, sim_car_t *c) {
   const vp_params_t *p = &s->p;
   const mjModel *m = s->m;
   mjData *d = s->d;
+  mju_zero(d->qfrc_applied + c->root_dof, 6);
   for (int w = 0; w < W_N; w++) {
     const int b = c->wheel_body[w];
-    mjtNum *xf = d->xfrc_applied + 6 * b;
-    mju_zero(xf, 6);
     if (c->fz_n[w] <= 0.0) continue;
     const mjtNum *R = d->xmat + 9 * b;
     const double axis[3] = {R[1], R[4], R[7]}; /* wheel y axis (spin axis) in the world */
@@ -697,12 +773,9 @@ static void sim_tyres(sim_t *s, sim_car_t *c) {
     in.dt_s = m->opt.timestep;
     double fx, fy;
     tyre_force(&s->lon, &s->lat, &in, &fx, &fy);
-    double f[3], arm[3], t[3];
+    double f[3];
     for (int k = 0; k < 3; k++) f[k] = fx * fwd[k] + fy * lat[k];
-    mju_sub3(arm, c->contact_pos[w], d->xipos + 3 * b);
-    mju_cross(t, arm, f);
-    mju_copy3(xf, f);
-    mju_copy3(xf + 3, t);
+    sim_apply_point_force(m, d, b, c->contact_pos[w], f);
   }
 }
 
@@ -749,9 +822,10 @@ static void sim_record_contacts(sim_t *s) {
 int sim_step(sim_t *s, char *err, size_t err_sz) {
   sim_place_late_boxes(s); /* before mj_step1: its kinematics, contacts and rays see them */
   mj_step1(s->m, s->d);
+  const int io_due = sim_host_io_due(s);
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
-    if (sim_nano_io(s, c, err, err_sz) != 0) return -1;
+    if (sim_nano_io(s, c, io_due, err, err_sz) != 0) return -1;
     sim_actuate(s, c);
     sim_draw_lamps(s, c);
     if (s->tyre_paper) sim_tyres(s, c);
@@ -772,7 +846,8 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
       sim_lidar_last_cast(c->lidar, &from, &to, &num_rays, &ranges_m, &quality);
       sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
-    if (c->rplidar && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0) return -1;
+    if (c->rplidar && io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
+      return -1;
   }
 #endif
   if (s->d->warning[mjWARN_BADQACC].number > 0) {

@@ -33,6 +33,11 @@ typedef struct sim_config {
   const scn_pose_t *start; /* NULL: car 1 at the map's "spawn" site; else at this pose */
   int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run */
   const scn_late_box_t *late_box;
+  /* Host link service period [ms of sim time, = steps]: the ptys are read and written every
+   * this many steps. 0 or 1: every step (real time, --rtf, --lockstep-client). Larger batches
+   * the bytes the way a USB-serial adapter's latency timer does; free lockstep uses it so an
+   * idle pty costs no system call per step. Wire timing inside the Nano's UART is unchanged. */
+  int host_io_period_ms;
 } sim_config_t;
 
 typedef struct sim sim_t;

@@ -6,11 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define LIDAR_FEW_RAYS 8 /* rays per step up to which lidar_select_few is the cheaper path */
+
 struct sim_lidar {
   sim_lidar_config_t cfg;
-  int base_body;         /* body carrying the scanner */
-  int root_body;         /* its root: geoms under it are the car itself */
-  int *cand;             /* candidate geoms for this scan (not the car's, in a seen group) */
+  int base_body; /* body carrying the scanner */
+  int root_body; /* its root: geoms under it are the car itself */
+  int *seen;     /* geoms the scanner can ever see: in a seen group, not the car's */
+  int nseen;
+  int *cand;             /* candidates for this scan: seen, visible, crossing the scan plane */
   int *cand_lo, *cand_n; /* per candidate: first ray index of its sector and its ray count */
   int ncand;
   int *bucket_start; /* rays [from, to): candidates of ray from+j are */
@@ -70,6 +74,7 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->base_body = body;
   l->root_body = m->body_rootid[body];
   size_t ng = (size_t)(m->ngeom ? m->ngeom : 1);
+  l->seen = calloc(ng, sizeof *l->seen);
   l->cand = calloc(ng, sizeof *l->cand);
   l->cand_lo = calloc(ng, sizeof *l->cand_lo);
   l->cand_n = calloc(ng, sizeof *l->cand_n);
@@ -79,11 +84,17 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->quality = calloc(n, sizeof(float));
   l->out_ranges_m = calloc(n, sizeof(float));
   l->out_quality = calloc(n, sizeof(float));
-  if (!l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality ||
-      !l->out_ranges_m || !l->out_quality) {
+  if (!l->seen || !l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m ||
+      !l->quality || !l->out_ranges_m || !l->out_quality) {
     sim_lidar_destroy(l);
     err_set(err, err_len, "out of memory", NULL);
     return NULL;
+  }
+  for (int g = 0; g < m->ngeom; g++) {
+    const int grp = m->geom_group[g];
+    if (grp < 0 || grp >= mjNGROUP || !cfg->geomgroup[grp]) continue;
+    if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue; /* the car itself */
+    l->seen[l->nseen++] = g;
   }
   l->rng = cfg->seed ? cfg->seed : 0x9E3779B97F4A7C15ull;
   l->last.num_rays = 0;
@@ -97,6 +108,7 @@ void sim_lidar_destroy(sim_lidar_t *l) {
   free(l->cand);
   free(l->cand_lo);
   free(l->cand_n);
+  free(l->seen);
   free(l->bucket_start);
   free(l->bucket);
   free(l->ranges_m);
@@ -119,6 +131,33 @@ static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
   }
 }
 
+/* Where visible geom g meets the scan plane through origin (normal nrm, axes ax, ay): 0 not
+ * within range; 1 its bounding sphere cuts the plane in a circle of radius *r_plane around
+ * (*px, *py) in the scanner's axes; 2 it may meet every ray (unbounded, or around origin). */
+static int lidar_in_plane(const mjModel *m, const mjData *d, const sim_lidar_t *l, int g,
+                          const mjtNum origin[3], const mjtNum nrm[3], const mjtNum ax[3],
+                          const mjtNum ay[3], mjtNum *px, mjtNum *py, mjtNum *r_plane) {
+  const mjtNum rb = m->geom_rbound[g];
+  if (rb <= 0) return 2; /* rbound 0 means unbounded (planes) */
+  mjtNum rel[3];
+  mju_sub3(rel, d->geom_xpos + 3 * g, origin);
+  const mjtNum dz = mju_dot3(rel, nrm);
+  if (fabs(dz) > rb) return 0;         /* off the scan plane */
+  if (m->geom_type[g] == mjGEOM_BOX) { /* the box's half thickness along the normal */
+    const mjtNum *xm = d->geom_xmat + 9 * g, *sz = m->geom_size + 3 * g;
+    mjtNum hz = 0;
+    for (int k = 0; k < 3; k++)
+      hz += fabs(xm[k] * nrm[0] + xm[3 + k] * nrm[1] + xm[6 + k] * nrm[2]) * sz[k];
+    if (fabs(dz) > hz) return 0;
+  }
+  *r_plane = sqrt(rb * rb - dz * dz); /* sphere cut by the scan plane [m] */
+  *px = mju_dot3(rel, ax);
+  *py = mju_dot3(rel, ay);
+  const mjtNum dist = sqrt(*px * *px + *py * *py);
+  if (dist - *r_plane > l->cfg.range_max_m) return 0; /* out of range */
+  return dist > *r_plane ? 1 : 2;
+}
+
 /* Selects the geoms a ray from origin may hit: visible group, alpha > 0, not the car itself
  * (the same filters as mj_ray plus the root-body exclusion), and culls the rest: a geom must
  * cross the scan plane (exact slab for boxes, bounding sphere otherwise) within range. Each
@@ -131,43 +170,78 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l, cons
   const int n = l->cfg.num_rays;
   const double inc = 2.0 * M_PI / n;
   l->ncand = 0;
-  for (int g = 0; g < m->ngeom; g++) {
-    int grp = m->geom_group[g];
-    if (grp < 0 || grp >= mjNGROUP || !l->cfg.geomgroup[grp]) continue;
-    if (m->geom_rgba[4 * g + 3] == 0) continue;
-    if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue;
+  for (int s_i = 0; s_i < l->nseen; s_i++) { /* group and body never change: filtered once */
+    const int g = l->seen[s_i];
+    if (m->geom_rgba[4 * g + 3] == 0) continue; /* alpha does: late boxes appear */
     int lo = 0, cnt = n;
-    mjtNum rb = m->geom_rbound[g];
-    if (rb > 0) { /* rbound 0 means unbounded (planes) */
-      mjtNum rel[3];
-      mju_sub3(rel, d->geom_xpos + 3 * g, origin);
-      mjtNum dz = mju_dot3(rel, nrm);
-      if (fabs(dz) > rb) continue;         /* off the scan plane */
-      if (m->geom_type[g] == mjGEOM_BOX) { /* the box's half thickness along the normal */
-        const mjtNum *xm = d->geom_xmat + 9 * g, *sz = m->geom_size + 3 * g;
-        mjtNum hz = 0;
-        for (int k = 0; k < 3; k++)
-          hz += fabs(xm[k] * nrm[0] + xm[3 + k] * nrm[1] + xm[6 + k] * nrm[2]) * sz[k];
-        if (fabs(dz) > hz) continue;
-      }
-      mjtNum r_plane = sqrt(rb * rb - dz * dz); /* sphere cut by the scan plane [m] */
-      mjtNum px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
-      mjtNum dist = sqrt(px * px + py * py);
-      if (dist - r_plane > l->cfg.range_max_m) continue; /* out of range */
-      if (dist > r_plane) {
-        double centre = atan2(py, px), half = asin(r_plane / dist);
-        lo = (int)ceil((centre - half) / inc - 1e-9);
-        int hi = (int)floor((centre + half) / inc + 1e-9);
-        cnt = hi - lo + 1;
-        if (cnt <= 0) continue; /* falls between two rays */
-        if (cnt > n) cnt = n;
-        lo = ((lo % n) + n) % n;
-      }
+    mjtNum px, py, r_plane;
+    const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
+    if (where == 0) continue;
+    if (where == 1) {
+      const double centre = atan2(py, px), half = asin(r_plane / sqrt(px * px + py * py));
+      lo = (int)ceil((centre - half) / inc - 1e-9);
+      const int hi = (int)floor((centre + half) / inc + 1e-9);
+      cnt = hi - lo + 1;
+      if (cnt <= 0) continue; /* falls between two rays */
+      if (cnt > n) cnt = n;
+      lo = ((lo % n) + n) % n;
     }
     l->cand_lo[l->ncand] = lo;
     l->cand_n[l->ncand] = cnt;
     l->cand[l->ncand++] = g;
   }
+}
+
+/* The spinning update casts a few rays per step: for those, lidar_select's sectors (an atan2
+ * and an asin per geom) and the bucket sort cost more than testing each ray against each
+ * geom's circle directly. Fills cand and the per-ray buckets for rays [from, to). Returns -1
+ * on no memory. */
+static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
+                            const mjtNum origin[3], const mjtNum ax[3], const mjtNum ay[3],
+                            int from, int to) {
+  mjtNum nrm[3];
+  mju_cross(nrm, ax, ay);
+  const int span = to - from;
+  const double inc = 2.0 * M_PI / l->cfg.num_rays;
+  double ux[LIDAR_FEW_RAYS], uy[LIDAR_FEW_RAYS];
+  for (int j = 0; j < span; j++) {
+    ux[j] = cos((from + j) * inc);
+    uy[j] = sin((from + j) * inc);
+  }
+  const size_t need = (size_t)span * (size_t)(l->nseen > 0 ? l->nseen : 1);
+  if (need > l->bucket_cap) {
+    int *b = realloc(l->bucket, (need + 64) * sizeof *b);
+    if (!b) return -1;
+    l->bucket = b;
+    l->bucket_cap = need + 64;
+  }
+  /* ray j's candidates go to bucket[j * nseen ...]; compacted below */
+  int count[LIDAR_FEW_RAYS] = {0};
+  l->ncand = 0;
+  for (int s_i = 0; s_i < l->nseen; s_i++) {
+    const int g = l->seen[s_i];
+    if (m->geom_rgba[4 * g + 3] == 0) continue;
+    mjtNum px, py, r_plane;
+    const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
+    if (where == 0) continue;
+    int used = 0;
+    for (int j = 0; j < span; j++) {
+      /* the ray's line passes within r_plane of the circle's centre, which lies ahead */
+      if (where == 1 && (px * ux[j] + py * uy[j] <= 0 || fabs(px * uy[j] - py * ux[j]) > r_plane))
+        continue;
+      l->bucket[j * l->nseen + count[j]++] = l->ncand;
+      used = 1;
+    }
+    if (used) l->cand[l->ncand++] = g;
+  }
+  int at = 0;
+  for (int j = 0; j < span; j++) {
+    l->bucket_start[j] = at;
+    memmove(l->bucket + at, l->bucket + j * l->nseen, (size_t)count[j] * sizeof *l->bucket);
+    at += count[j];
+  }
+  l->bucket_start[span] = at;
+  return 0;
 }
 
 /* Sorts the candidates into per-ray buckets for rays [from, to), so each ray tests only the
@@ -286,8 +360,14 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
   if (from >= to) return;
   mjtNum o[3], ax[3], ay[3], vec[3];
   lidar_frame(d, l, o, ax, ay);
-  lidar_select(m, d, l, o, ax, ay);
-  const int bucketed = lidar_bucket(l, from, to) == 0;
+  int bucketed;
+  if (to - from <= LIDAR_FEW_RAYS) {
+    bucketed = lidar_select_few(m, d, l, o, ax, ay, from, to) == 0;
+    if (!bucketed) lidar_select(m, d, l, o, ax, ay); /* no memory: every candidate per ray */
+  } else {
+    lidar_select(m, d, l, o, ax, ay);
+    bucketed = lidar_bucket(l, from, to) == 0;
+  }
   double inc = 2.0 * M_PI / l->cfg.num_rays;
   for (int i = from; i < to; i++) {
     ray_dir(ax, ay, i * inc, vec);
