@@ -229,5 +229,48 @@ def sweep(
     _save(fig, path, dpi=DPI)
 
 
-def nan_or(v: str) -> float:
-    return float(v) if v else math.nan
+def eye_sim(path: Path, truth: XY, eye: XY, t_s: Floats, err_mm: Floats) -> None:
+    """The Eye on the simulator's overhead camera: path and position error over time."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5))
+    a1.plot(truth[0], truth[1], "-", color="0.6", lw=3, label="sim ground truth (base_link)")
+    a1.plot(eye[0], eye[1], ".", ms=3, label="Eye")
+    a1.set_aspect("equal")
+    a1.set_xlabel("map x [m]")
+    a1.set_ylabel("map y [m]")
+    a1.set_title("autodrive-sim overhead camera (1280x960), NIGEL1")
+    a1.legend(fontsize=8)
+    a2.plot(t_s, err_mm, lw=1)
+    a2.set_xlabel("sim time [s]")
+    a2.set_ylabel("position error [mm]")
+    a2.set_title("Eye vs ground truth")
+    fig.tight_layout()
+    _save(fig, path, dpi=DPI)
+
+
+def eye_bench(path: Path, truth: XY, eye: XY, peer: XY) -> None:
+    """The Eye benchmark's synthesised drive: truth, the Eye and the OpenCV aruco peer, and
+    the position error per frame."""
+    err_eye = [
+        1000 * math.hypot(a - b, c - d) for a, b, c, d in zip(eye[0], truth[0], eye[1], truth[1])
+    ]
+    err_peer = [
+        1000 * math.hypot(a - b, c - d) for a, b, c, d in zip(peer[0], truth[0], peer[1], truth[1])
+    ]
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [1.4, 1]})
+    a1.plot(truth[0], truth[1], "-", color="0.6", lw=3, label="truth (base_link)")
+    a1.plot(eye[0], eye[1], ".", color="tab:blue", ms=3, label="Eye (libapriltag, roof plane)")
+    a1.plot(peer[0], peer[1], "x", color="tab:red", ms=2, alpha=0.5, label="peer (OpenCV aruco)")
+    a1.set_xlabel("map x [m]")
+    a1.set_ylabel("map y [m]")
+    a1.set_aspect("equal")
+    a1.set_title("Synthesised drive across the 3.0 x 2.0 m map, 1280x720")
+    a1.legend(loc="upper right", fontsize=8)
+    a2.plot(err_eye, color="tab:blue", lw=1, label="Eye")
+    a2.plot(err_peer, color="tab:red", lw=1, alpha=0.6, label="peer (aruco)")
+    a2.set_yscale("log")
+    a2.set_xlabel("frame")
+    a2.set_ylabel("position error [mm]")
+    a2.set_title("Position error per frame")
+    a2.legend(fontsize=8)
+    fig.tight_layout()
+    _save(fig, path, dpi=DPI)

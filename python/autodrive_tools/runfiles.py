@@ -16,8 +16,11 @@ import yaml
 Column = npt.NDArray[np.float64]
 
 
-def read_columns(path: Path | str, need: list[str]) -> dict[str, Column]:
-    """The named numeric columns of a CSV with a header."""
+def read_columns(
+    path: Path | str, need: list[str], missing: float | None = None
+) -> dict[str, Column]:
+    """The named numeric columns of a CSV with a header; empty cells are `missing` when it is
+    given, an error otherwise."""
     if not os.path.isfile(path):
         raise ValueError(f"'{path}' does not exist")
     with open(path, newline="") as f:
@@ -25,7 +28,12 @@ def read_columns(path: Path | str, need: list[str]) -> dict[str, Column]:
     if rows and any(k not in rows[0] for k in need):
         raise ValueError(f"'{path}' lacks columns {need} (has {list(rows[0].keys())})")
     try:
-        return {k: np.array([float(r[k]) for r in rows]) for k in need}
+        return {
+            k: np.array(
+                [missing if missing is not None and not r[k] else float(r[k]) for r in rows]
+            )
+            for k in need
+        }
     except ValueError as e:
         raise ValueError(f"'{path}': non-numeric value ({e})") from None
 

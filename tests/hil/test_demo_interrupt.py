@@ -1,4 +1,4 @@
-"""HIL: Ctrl-C on tools/demo.py mid-mission. While the car drives its mapping route, SIGINT
+"""HIL: Ctrl-C on tools/demo (autodrive_tools.demo) mid-mission. While the car drives its mapping route, SIGINT
 must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable report and
 LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is timed: the
 test waits for the demo's own progress lines."""
@@ -10,10 +10,11 @@ import sys
 import tempfile
 import time
 
+from autodrive_tools import lcmtypes
+from autodrive_tools.channels import channel
+
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
-sys.path.insert(0, str(pathlib.Path(build) / "lcm_types" / "gen" / "python"))
-import lcm  # noqa: E402
-from autodrive import vehicle_command_t  # noqa: E402
+types = lcmtypes.load(build)
 
 
 def alive(pattern):
@@ -25,7 +26,8 @@ with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
     demo = subprocess.Popen(
         [
             sys.executable,
-            str(root / "tools" / "demo.py"),
+            "-m",
+            "autodrive_tools.demo",
             "--build",
             build,
             "--out",
@@ -61,9 +63,9 @@ with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
     assert not report.get("ok"), "an interrupted mission must not report ok"
     assert report.get("gt_samples", 0) > 100, "the LCM log lost what was recorded"
     last = None
-    for ev in lcm.EventLog(str(pathlib.Path(tmp) / "run.lcmlog"), "r"):
-        if ev.channel == "NIGEL1_COMMAND":
-            last = vehicle_command_t.decode(ev.data)
+    for ev in lcmtypes.events(pathlib.Path(tmp) / "run.lcmlog"):
+        if ev.channel == channel("COMMAND", "NIGEL1"):
+            last = types.vehicle_command_t.decode(ev.data)
     assert last is not None, "no command in the log"
     assert (
         not last.engaged and last.throttle == 0.0

@@ -1,4 +1,4 @@
-"""HIL integration: the full default demo (tools/demo.py: Parking School, the simulator in
+"""HIL integration: the full default demo (tools/demo (autodrive_tools.demo): Parking School, the simulator in
 lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping route, a box that
 steps out after mapping). It must map, localise, see the box and replan, park without a collision, and meet
 issue 7's bounds by the simulator's ground truth. Lockstep makes the run independent of how
@@ -14,7 +14,8 @@ with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
     r = subprocess.run(
         [
             sys.executable,
-            str(root / "tools" / "demo.py"),
+            "-m",
+            "autodrive_tools.demo",
             "--build",
             build,
             "--out",

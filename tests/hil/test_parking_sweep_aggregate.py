@@ -1,4 +1,4 @@
-"""tools/parking_sweep.py --aggregate-only on synthetic per-seed reports (no demo runs): a good
+"""autodrive_tools.sweep --aggregate-only (tools/bench parking) on synthetic per-seed reports (no demo runs): a good
 run, a run without report.json, a collision, a run whose demo exited non-zero with an ok
 report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
 per-seed arrays, summary.json == the last stdout line, and that the plot is written."""
@@ -9,7 +9,6 @@ import sys
 import tempfile
 
 root = pathlib.Path(sys.argv[1])
-SWEEP = root / "tools" / "parking_sweep.py"
 
 
 def report(pos_m, head_deg, loc_m, wall_s, collisions=0, success=True, clearance_m=0.3):
@@ -45,7 +44,8 @@ def sweep(out, seeds, first=1):
     r = subprocess.run(
         [
             sys.executable,
-            str(SWEEP),
+            "-m",
+            "autodrive_tools.sweep",
             "--aggregate-only",
             "--first-seed",
             str(first),
