@@ -115,7 +115,10 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
 
     bad = subprocess.run(
-        [sys.executable, str(SWEEP), "--seeds", "0"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", "autodrive_tools.sweep", "--seeds", "0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert bad.returncode == 2 and "--seeds 0" in bad.stderr, bad.stderr
 print("parking sweep aggregate ok")
