@@ -1,13 +1,15 @@
-"""HIL: Ctrl-C on tools/demo (autodrive_tools.demo) mid-mission. While the car drives its mapping route, SIGINT
-must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable report and
-LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is timed: the
-test waits for the demo's own progress lines."""
+"""HIL: Ctrl-C on tools/demo (autodrive_tools.demo) mid-mission. While the car drives its mapping
+route, SIGINT must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable
+report and LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is
+timed: the test waits for the demo's own progress lines."""
 import json
 import pathlib
 import signal
 import subprocess
 import sys
 import tempfile
+
+from hil_demo import demo_command
 import time
 
 from autodrive_tools import lcmtypes
@@ -24,20 +26,7 @@ def alive(pattern):
 
 with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
     demo = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "autodrive_tools.demo",
-            "--build",
-            build,
-            "--out",
-            tmp,
-            "--headless",
-            "--timeout",
-            "200",
-            "--lcm-url",
-            f"udpm://239.255.76.67:{port}?ttl=0",
-        ],
+        demo_command(build, tmp, port, "--timeout", "200"),
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,

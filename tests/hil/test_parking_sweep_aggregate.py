@@ -1,6 +1,6 @@
-"""autodrive_tools.sweep --aggregate-only (tools/bench parking) on synthetic per-seed reports (no demo runs): a good
-run, a run without report.json, a collision, a run whose demo exited non-zero with an ok
-report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
+"""autodrive_tools.sweep --aggregate-only (tools/bench parking) on synthetic per-seed reports (no
+demo runs): a good run, a run without report.json, a collision, a run whose demo exited non-zero
+with an ok report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
 per-seed arrays, summary.json == the last stdout line, and that the plot is written."""
 import json
 import pathlib
@@ -9,6 +9,15 @@ import sys
 import tempfile
 
 root = pathlib.Path(sys.argv[1])
+
+
+GOALS = (
+    "goal_all_success_no_collisions",
+    "goal_final_pose",
+    "goal_localization_rms",
+    "goal_wall_s",
+    "goals_met",
+)
 
 
 def report(pos_m, head_deg, loc_m, wall_s, collisions=0, success=True, clearance_m=0.3):
@@ -87,13 +96,7 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     assert s["per_seed"]["error"][1] == "no report.json, demo exit 1"
     assert s["per_seed"]["error"][2] == "2 collision(s), demo exit 1"
     assert s["per_seed"]["error"][3] == "demo exit 1"
-    for goal in (
-        "goal_all_success_no_collisions",
-        "goal_final_pose",
-        "goal_localization_rms",
-        "goal_wall_s",
-        "goals_met",
-    ):
+    for goal in GOALS:
         assert s[goal] is False, goal
     assert "[parking 2/4] seed 2: FAILED (no report.json, demo exit 1)\n" in err, err
 
@@ -103,13 +106,7 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     s, _ = sweep(good, 10, first=5)
     assert s["runs"] == 10 and s["successes"] == 10 and s["collisions_total"] == 0, s
     assert s["final_pos_error_m_max"] == 0.019 and s["final_pos_error_m_median"] == 0.0145
-    for goal in (
-        "goal_all_success_no_collisions",
-        "goal_final_pose",
-        "goal_localization_rms",
-        "goal_wall_s",
-        "goals_met",
-    ):
+    for goal in GOALS:
         assert s[goal] is True, goal
     s, _ = sweep(good, 2, first=5)  # the first two of them: every goal but the ten runs
     assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
