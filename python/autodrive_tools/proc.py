@@ -9,7 +9,7 @@ import subprocess
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 # How long a child gets to act on SIGINT (flush its log, publish its last command), then on
 # SIGTERM, before SIGKILL.
@@ -20,7 +20,7 @@ Log = Callable[[str], None]
 
 
 def stop(
-    proc: subprocess.Popen[bytes],
+    proc: subprocess.Popen[Any],
     name: str,
     log: Log,
     sigint_grace_s: float = SIGINT_GRACE_S,

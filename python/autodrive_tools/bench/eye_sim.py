@@ -23,8 +23,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from .. import lcmtypes, plots
+from .. import lcmtypes, plots, proc
 from ..channels import channel
+from ..geometry import wrap
 from ..scoring import rms
 from . import Progress
 
@@ -111,8 +112,7 @@ def run_eye_and_sim(build: Path, duration_s: float, tmp: Path, url: str) -> int:
         text=True,
     )
     if sim.returncode != 0:
-        eye.kill()
-        eye.wait()
+        proc.stop(eye, "autodrive-eye", log)
         raise RuntimeError(f"autodrive-sim failed: {sim.stderr[-2000:]}")
     _, eye_err = eye.communicate(timeout=120)
     frames = 0
@@ -140,7 +140,7 @@ def match(truth: list[Any], poses: list[Any]) -> list[Row]:
         s = (p.utime - a.utime) / max(1, b.utime - a.utime)
         x = a.position_m[0] + s * (b.position_m[0] - a.position_m[0])
         y = a.position_m[1] + s * (b.position_m[1] - a.position_m[1])
-        yaw = a.yaw_rad + s * math.remainder(b.yaw_rad - a.yaw_rad, 2 * math.pi)
+        yaw = a.yaw_rad + s * wrap(b.yaw_rad - a.yaw_rad)
         rows.append((p.utime, x, y, yaw, p.x_m, p.y_m, p.yaw_rad))
     return rows
 
@@ -170,7 +170,7 @@ def measure(build: Path, duration_s: float, prefix: str | None) -> dict[str, flo
             f"{len(rec.truth)} truth, {frames} frames)"
         )
     errs_mm = [1000 * math.hypot(r[4] - r[1], r[5] - r[2]) for r in rows]
-    errs_deg = [math.degrees(abs(math.remainder(r[6] - r[3], 2 * math.pi))) for r in rows]
+    errs_deg = [math.degrees(abs(wrap(r[6] - r[3]))) for r in rows]
     xs, ys = [r[1] for r in rows], [r[2] for r in rows]
     fig = {
         "sim_frames": frames,
