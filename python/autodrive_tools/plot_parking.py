@@ -6,9 +6,7 @@ autodrive-autonomy writes into its out_dir. CLI: tools/plot-parking --help."""
 from __future__ import annotations
 
 import argparse
-import math
 import sys
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
