@@ -1,5 +1,6 @@
 # Shared helpers for the tools/ entry points (sourced, not run).
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+PY="$ROOT/.venv/bin/python"
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*"; }
 die() { printf '[%s] ERROR: %s\n' "$(basename "$0")" "$*" >&2; exit 1; }
 # Configures (once) and builds a preset of the host build: dev, release or asan.
@@ -24,4 +25,9 @@ build_avr() {
     log "building AVR firmware"
     cmake --build "$ROOT/build/avr" || die "AVR firmware build failed"
   fi
+}
+# Makes sure the project venv with autodrive_tools exists (tools/setup creates it).
+need_venv() {
+  "$PY" -c 'import autodrive_tools' 2>/dev/null || "$ROOT/tools/setup" >&2 \
+    || die "tools/setup failed"
 }

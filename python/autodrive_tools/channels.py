@@ -90,18 +90,14 @@ def load(path: Path | str | None = None) -> ChannelTable:
     try:
         doc = yaml.safe_load(source.read_text())
     except (OSError, yaml.YAMLError) as err:
-        raise ChannelTableError(
-            f"{source}: cannot read the channel table ({err})"
-        ) from err
+        raise ChannelTableError(f"{source}: cannot read the channel table ({err})") from err
     if not isinstance(doc, dict) or not isinstance(doc.get("channels"), list):
         raise ChannelTableError(f"{source}: expected a mapping with a 'channels' list")
     out = []
     for i, entry in enumerate(doc["channels"]):
         missing = [f for f in _FIELDS if not isinstance(entry, dict) or f not in entry]
         if missing:
-            raise ChannelTableError(
-                f"{source}: channels[{i}] lacks {', '.join(missing)}"
-            )
+            raise ChannelTableError(f"{source}: channels[{i}] lacks {', '.join(missing)}")
         if entry["status"] not in ("live", "planned"):
             raise ChannelTableError(
                 f"{source}: channels[{i}] ({entry['name']}): status must be live or planned"

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Union
 
+from .geometry import Footprint
 from .paths import VEHICLE_FILE
 
 Figure = Union[float, tuple[float, ...], str]
@@ -27,7 +28,7 @@ class Vehicle:
     figures: dict[str, Figure] = field(default_factory=dict)
 
     def __getattr__(self, key: str) -> Figure:
-        figures = object.__getattribute__(self, "figures")
+        figures: dict[str, Figure] = object.__getattribute__(self, "figures")
         if key in figures:
             return figures[key]
         raise AttributeError(f"{self.source}: no figure '{key}'")
@@ -36,18 +37,14 @@ class Vehicle:
         """A one-number figure, e.g. number('wheelbase_m')."""
         value = self.figures.get(key)
         if not isinstance(value, float):
-            raise VehicleFileError(
-                f"{self.source}: '{key}' is not a single number ({value!r})"
-            )
+            raise VehicleFileError(f"{self.source}: '{key}' is not a single number ({value!r})")
         return value
 
     def vector(self, key: str) -> tuple[float, ...]:
         """A figure of several numbers, e.g. vector('chassis_size_m')."""
         value = self.figures.get(key)
         if not isinstance(value, tuple):
-            raise VehicleFileError(
-                f"{self.source}: '{key}' is not a list of numbers ({value!r})"
-            )
+            raise VehicleFileError(f"{self.source}: '{key}' is not a list of numbers ({value!r})")
         return value
 
     # The envelope (chassis box and wheels) that planners, scoring and plots use.
@@ -67,6 +64,12 @@ class Vehicle:
         """Centre of the envelope ahead of the rear axle (base_link)."""
         return self.vector("chassis_offset_m")[0]
 
+    @property
+    def envelope(self) -> Footprint:
+        return Footprint(
+            self.envelope_length_m, self.envelope_width_m, self.envelope_center_ahead_m
+        )
+
 
 def _parse_value(text: str) -> Figure:
     words = text.split()
@@ -85,9 +88,7 @@ def load(path: Path | str | None = None) -> Vehicle:
     try:
         lines = source.read_text().splitlines()
     except OSError as err:
-        raise VehicleFileError(
-            f"{source}: cannot read the vehicle description ({err})"
-        ) from err
+        raise VehicleFileError(f"{source}: cannot read the vehicle description ({err})") from err
     figures: dict[str, Figure] = {}
     for number, raw in enumerate(lines, start=1):
         line = raw.split("#", 1)[0].strip()

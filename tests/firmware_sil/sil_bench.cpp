@@ -1,6 +1,6 @@
 // nano-sil-bench: the firmware benchmark figures, all on the real ELF in simavr and in
 // simulated time (so they do not depend on the machine's load). Progress on stderr, the last
-// line of stdout is one JSON object. Used by tools/bench.d/firmware.
+// line of stdout is one JSON object. Used by tools/bench firmware.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>

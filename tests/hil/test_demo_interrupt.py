@@ -1,19 +1,22 @@
-"""HIL: Ctrl-C on tools/demo.py mid-mission. While the car drives its mapping route, SIGINT
-must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable report and
-LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is timed: the
-test waits for the demo's own progress lines."""
+"""HIL: Ctrl-C on tools/demo (autodrive_tools.demo) mid-mission. While the car drives its mapping
+route, SIGINT must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable
+report and LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is
+timed: the test waits for the demo's own progress lines."""
 import json
 import pathlib
 import signal
 import subprocess
 import sys
 import tempfile
+
+from hil_demo import demo_command
 import time
 
+from autodrive_tools import lcmtypes
+from autodrive_tools.channels import channel
+
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
-sys.path.insert(0, str(pathlib.Path(build) / "lcm_types" / "gen" / "python"))
-import lcm  # noqa: E402
-from autodrive import vehicle_command_t  # noqa: E402
+types = lcmtypes.load(build)
 
 
 def alive(pattern):
@@ -23,19 +26,7 @@ def alive(pattern):
 
 with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
     demo = subprocess.Popen(
-        [
-            sys.executable,
-            str(root / "tools" / "demo.py"),
-            "--build",
-            build,
-            "--out",
-            tmp,
-            "--headless",
-            "--timeout",
-            "200",
-            "--lcm-url",
-            f"udpm://239.255.76.67:{port}?ttl=0",
-        ],
+        demo_command(build, tmp, port, "--timeout", "200"),
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -61,9 +52,9 @@ with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
     assert not report.get("ok"), "an interrupted mission must not report ok"
     assert report.get("gt_samples", 0) > 100, "the LCM log lost what was recorded"
     last = None
-    for ev in lcm.EventLog(str(pathlib.Path(tmp) / "run.lcmlog"), "r"):
-        if ev.channel == "NIGEL1_COMMAND":
-            last = vehicle_command_t.decode(ev.data)
+    for ev in lcmtypes.events(pathlib.Path(tmp) / "run.lcmlog"):
+        if ev.channel == channel("COMMAND", "NIGEL1"):
+            last = types.vehicle_command_t.decode(ev.data)
     assert last is not None, "no command in the log"
     assert (
         not last.engaged and last.throttle == 0.0

@@ -1,32 +1,19 @@
-"""HIL integration: tools/demo.py runs the simulator (Parking School), the unchanged runtime on
-its ptys and the pure-pursuit driver over real LCM UDP multicast; the run's report must show a
-real drive: the car moved along the track, no collision, telemetry at 100 Hz of Nano time, and
-the runtime's EKF close to the simulator's ground truth."""
+"""HIL integration: tools/demo (autodrive_tools.demo) runs the simulator (Parking School), the
+unchanged runtime on its ptys and the pure-pursuit driver over real LCM UDP multicast; the run's
+report must show a real drive: the car moved along the track, no collision, telemetry at 100 Hz
+of Nano time, and the runtime's EKF close to the simulator's ground truth."""
 import json
 import pathlib
 import subprocess
 import sys
 import tempfile
 
+from hil_demo import demo_command
+
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 with tempfile.TemporaryDirectory(prefix="hil-drive-") as tmp:
     r = subprocess.run(
-        [
-            sys.executable,
-            str(root / "tools" / "demo.py"),
-            "--build",
-            build,
-            "--out",
-            tmp,
-            "--mission",
-            "loop",
-            "--duration",
-            "20",
-            "--realtime",
-            "--headless",
-            "--lcm-url",
-            f"udpm://239.255.76.67:{port}?ttl=0",
-        ],
+        demo_command(build, tmp, port, "--mission", "loop", "--duration", "20", "--realtime"),
         timeout=240,
     )
     report = json.loads((pathlib.Path(tmp) / "report.json").read_text())

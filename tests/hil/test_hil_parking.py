@@ -1,32 +1,21 @@
-"""HIL integration: the full default demo (tools/demo.py: Parking School, the simulator in
-lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping route, a box that
-steps out after mapping). It must map, localise, see the box and replan, park without a collision, and meet
-issue 7's bounds by the simulator's ground truth. Lockstep makes the run independent of how
-loaded the machine is (the sim waits for the runtime), so the bounds are the issue's own."""
+"""HIL integration: the full default demo (autodrive_tools.demo: Parking School, the simulator in
+lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping route, a box
+that steps out after mapping). It must map, localise, see the box and replan, park without a
+collision, and meet issue 7's bounds by the simulator's ground truth. Lockstep makes the run
+independent of how loaded the machine is (the sim waits for the runtime), so the bounds are the
+issue's own."""
 import json
 import pathlib
 import subprocess
 import sys
 import tempfile
 
+from hil_demo import demo_command
+
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
     r = subprocess.run(
-        [
-            sys.executable,
-            str(root / "tools" / "demo.py"),
-            "--build",
-            build,
-            "--out",
-            tmp,
-            "--mission",
-            "parking",
-            "--headless",
-            "--timeout",
-            "200",
-            "--lcm-url",
-            f"udpm://239.255.76.67:{port}?ttl=0",
-        ],
+        demo_command(build, tmp, port, "--mission", "parking", "--timeout", "200"),
         timeout=280,
     )
     report = json.loads((pathlib.Path(tmp) / "report.json").read_text())

@@ -1,6 +1,6 @@
-"""tools/parking_sweep.py --aggregate-only on synthetic per-seed reports (no demo runs): a good
-run, a run without report.json, a collision, a run whose demo exited non-zero with an ok
-report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
+"""autodrive_tools.sweep --aggregate-only (tools/bench parking) on synthetic per-seed reports (no
+demo runs): a good run, a run without report.json, a collision, a run whose demo exited non-zero
+with an ok report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
 per-seed arrays, summary.json == the last stdout line, and that the plot is written."""
 import json
 import pathlib
@@ -9,7 +9,15 @@ import sys
 import tempfile
 
 root = pathlib.Path(sys.argv[1])
-SWEEP = root / "tools" / "parking_sweep.py"
+
+
+GOALS = (
+    "goal_all_success_no_collisions",
+    "goal_final_pose",
+    "goal_localization_rms",
+    "goal_wall_s",
+    "goals_met",
+)
 
 
 def report(pos_m, head_deg, loc_m, wall_s, collisions=0, success=True, clearance_m=0.3):
@@ -45,7 +53,8 @@ def sweep(out, seeds, first=1):
     r = subprocess.run(
         [
             sys.executable,
-            str(SWEEP),
+            "-m",
+            "autodrive_tools.sweep",
             "--aggregate-only",
             "--first-seed",
             str(first),
@@ -87,13 +96,7 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     assert s["per_seed"]["error"][1] == "no report.json, demo exit 1"
     assert s["per_seed"]["error"][2] == "2 collision(s), demo exit 1"
     assert s["per_seed"]["error"][3] == "demo exit 1"
-    for goal in (
-        "goal_all_success_no_collisions",
-        "goal_final_pose",
-        "goal_localization_rms",
-        "goal_wall_s",
-        "goals_met",
-    ):
+    for goal in GOALS:
         assert s[goal] is False, goal
     assert "[parking 2/4] seed 2: FAILED (no report.json, demo exit 1)\n" in err, err
 
@@ -103,19 +106,16 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     s, _ = sweep(good, 10, first=5)
     assert s["runs"] == 10 and s["successes"] == 10 and s["collisions_total"] == 0, s
     assert s["final_pos_error_m_max"] == 0.019 and s["final_pos_error_m_median"] == 0.0145
-    for goal in (
-        "goal_all_success_no_collisions",
-        "goal_final_pose",
-        "goal_localization_rms",
-        "goal_wall_s",
-        "goals_met",
-    ):
+    for goal in GOALS:
         assert s[goal] is True, goal
     s, _ = sweep(good, 2, first=5)  # the first two of them: every goal but the ten runs
     assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
 
     bad = subprocess.run(
-        [sys.executable, str(SWEEP), "--seeds", "0"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", "autodrive_tools.sweep", "--seeds", "0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert bad.returncode == 2 and "--seeds 0" in bad.stderr, bad.stderr
 print("parking sweep aggregate ok")

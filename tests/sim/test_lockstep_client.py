@@ -10,15 +10,16 @@ import sys
 import tempfile
 import time
 
+from autodrive_tools import lcmtypes
+from autodrive_tools.channels import channel
+
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
-sys.path.insert(0, str(build / "lcm_types" / "gen" / "python"))
-import lcm  # noqa: E402
-from autodrive import sim_clock_t  # noqa: E402
+types = lcmtypes.load(build)
 
 url = f"udpm://239.255.76.67:{port}?ttl=0"
-lc = lcm.LCM(url)
+lc = lcmtypes.bus(url)
 clock = {"us": None}
-lc.subscribe("SIM_CLOCK", lambda _c, d: clock.update(us=sim_clock_t.decode(d).utime))
+lc.subscribe(channel("SIM_CLOCK"), lambda _c, d: clock.update(us=types.sim_clock_t.decode(d).utime))
 
 
 def pump(wall_s):

@@ -1,23 +1,34 @@
-#!/usr/bin/env python3
-"""Parking sweep: runs the HIL parking demo (tools/demo.py) once per seed, sequentially, each
-into OUT/seed<N>/, then aggregates the reports against the goals of issue 7 and writes
-OUT/summary.json and OUT/parking_sweep.png. Progress on stderr; the last stdout line is the
-summary as one JSON object. Does not build: run it through `tools/bench parking`, which does.
+"""Parking sweep: runs the HIL parking demo (autodrive_tools.demo, in this process) once per
+seed, sequentially, each into OUT/seed<N>/, then aggregates the reports against the goals of
+issue 7 and writes OUT/summary.json and OUT/parking_sweep.png. Progress on stderr; the last
+stdout line is the summary as one JSON object. Does not build: run it through
+`tools/bench parking`, which does.
 
-A run counts as ok when demo.py exited 0 and its report says ok (success and 0 collisions); a
-run whose demo exits non-zero or leaves no report.json is a failure, and the sweep goes on."""
+A run counts as ok when the demo returned 0 and its report says ok (success and 0 collisions);
+a run whose demo returns non-zero or leaves no report.json is a failure, and the sweep goes
+on."""
+
+from __future__ import annotations
+
 import argparse
 import json
 import math
 import os
-import pathlib
 import signal
 import statistics
-import subprocess
 import sys
 import time
+import traceback
+from pathlib import Path
+from types import FrameType
+from typing import Any
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+from . import demo, plots
+from .geometry import to_world
+from .mapfacts import parking_school
+from .paths import OUT_DIR, RELEASE_BUILD
+from .runfiles import read_columns
+
 # The hil port range of docs/INTERFACES.md (tests take 7830/7832): a sweep does not hear a
 # tools/demo that someone runs on the default port 7667 meanwhile, nor the HIL tests.
 DEFAULT_LCM_URL = "udpm://239.255.76.67:7846?ttl=0"
@@ -38,43 +49,50 @@ MEDIAN_MAX_KEYS = (
     "ekf_odom_drift_pct",
 )
 PER_SEED_KEYS = MEDIAN_MAX_KEYS + ("min_clearance_m", "collisions", "path_length_m")
-EXIT_FILE = "demo_exit_code"  # per seed dir: demo.py's exit code, kept for --aggregate-only
+EXIT_FILE = "demo_exit_code"  # per seed dir: the demo's exit code, kept for --aggregate-only
+
+Run = dict[str, Any]
 
 
-def log(msg):
+def log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def parse_args(argv):
-    # Everything after --extra goes to demo.py verbatim (it may start with "--").
-    extra = []
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    # Everything after --extra goes to the demo verbatim (it may start with "--").
+    extra: list[str] = []
     if "--extra" in argv:
         i = argv.index("--extra")
         argv, extra = argv[:i], argv[i + 1 :]
         if not extra:
-            sys.exit("parking_sweep: --extra needs at least one argument for demo.py")
+            sys.exit("parking_sweep: --extra needs at least one argument for the demo")
+    slots = parking_school().slots
     p = argparse.ArgumentParser(
-        prog="tools/parking_sweep.py",
-        description="Run the HIL parking demo (tools/demo.py) over several seeds and aggregate "
+        prog="tools/bench parking",
+        description="Run the HIL parking demo (tools/demo) over several seeds and aggregate "
         "success, final pose error [m, deg], localisation RMS [m], clearance [m] and wall time "
         "[s] against the goals of issue 7. Writes OUT/seed<N>/ (each run), OUT/summary.json and "
         "OUT/parking_sweep.png; prints the summary JSON as the last stdout line. Exit code 0 "
         "when the sweep ran (whether or not the goals are met), 2 bad input, 130 interrupted.",
-        epilog="example: tools/parking_sweep.py --seeds 2 --out /tmp/sweep --extra --realtime",
+        epilog="example: python -m autodrive_tools.sweep --seeds 2 --out /tmp/sweep "
+        "--extra --realtime",
     )
     p.add_argument("--seeds", type=int, default=10, help="number of seeds to run (default 10)")
     p.add_argument("--first-seed", type=int, default=1, help="first seed (default 1)")
     p.add_argument(
-        "--slot", type=int, default=None, help="parking slot 0..5 (default: the demo's default)"
+        "--slot",
+        type=int,
+        default=None,
+        help=f"parking slot 0..{slots - 1} (default: the demo's default)",
     )
     p.add_argument(
         "--out",
-        default=str(ROOT / "out" / "bench" / "parking"),
+        default=str(OUT_DIR / "bench" / "parking"),
         help="output folder (default out/bench/parking)",
     )
     p.add_argument(
         "--build",
-        default=os.environ.get("AUTODRIVE_BUILD", str(ROOT / "build" / "release")),
+        default=os.environ.get("AUTODRIVE_BUILD", str(RELEASE_BUILD)),
         help="host build dir (default $AUTODRIVE_BUILD or build/release)",
     )
     p.add_argument(
@@ -99,82 +117,67 @@ def parse_args(argv):
         metavar="ARG",
         nargs="*",
         default=[],
-        help="must come last: every following argument is passed to demo.py "
+        help="must come last: every following argument is passed to the demo "
         "(e.g. --extra --realtime)",
     )
     args = p.parse_args(argv)
     args.extra = extra
     if args.seeds < 1:
         p.error(f"--seeds {args.seeds}: need at least 1 seed")
-    if args.slot is not None and not 0 <= args.slot <= 5:
-        p.error(f"--slot {args.slot}: Parking School has slots 0..5")
+    if args.slot is not None and not 0 <= args.slot < slots:
+        p.error(f"--slot {args.slot}: Parking School has slots 0..{slots - 1}")
     if args.run_timeout <= 0:
         p.error(f"--run-timeout {args.run_timeout}: must be > 0 s")
     return args
 
 
-def seed_dir(out, seed):
-    return pathlib.Path(out) / f"seed{seed}"
+def seed_dir(out: Path | str, seed: int) -> Path:
+    return Path(out) / f"seed{seed}"
 
 
-def stop_demo(proc):
-    """SIGINT (demo.py then stops its children and writes its report), SIGKILL after 30 s."""
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGINT)
-    try:
-        proc.wait(timeout=30)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
-
-
-def on_stop_signal(signum, _frame):
-    # Also when SIGINT was ignored at start (a background job) and for a SIGTERM sent to the
-    # sweep alone: stop the running demo, then summarise what ran.
+def on_stop_signal(signum: int, _frame: FrameType | None) -> None:
+    # Between runs (a run handles its own signals): summarise what ran.
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
-def run_demo(args, seed):
-    """One demo.py run into OUT/seed<N>/; returns its exit code (None when it timed out)."""
+def demo_argv(args: argparse.Namespace, seed: int) -> list[str]:
+    argv = ["--build", str(args.build), "--out", str(seed_dir(args.out, seed))]
+    argv += ["--seed", str(seed), "--headless", "--lcm-url", args.lcm_url]
+    if args.slot is not None:
+        argv += ["--slot", str(args.slot)]
+    extra: list[str] = args.extra
+    return argv + extra
+
+
+def run_demo(args: argparse.Namespace, seed: int) -> int | None:
+    """One demo run into OUT/seed<N>/; returns its exit code (None when it timed out)."""
     d = seed_dir(args.out, seed)
     d.mkdir(parents=True, exist_ok=True)
     for stale in ("report.json", "gt.csv", EXIT_FILE):  # a failed run must not reuse old figures
         (d / stale).unlink(missing_ok=True)
-    argv = [
-        sys.executable,
-        str(ROOT / "tools" / "demo.py"),
-        "--build",
-        str(args.build),
-        "--out",
-        str(d),
-        "--seed",
-        str(seed),
-        "--headless",
-        "--lcm-url",
-        args.lcm_url,
-    ]
-    if args.slot is not None:
-        argv += ["--slot", str(args.slot)]
-    argv += args.extra
-    with open(d / "demo.log", "w") as logf:  # demo.py talks on stdout: keep ours for the JSON
-        proc = subprocess.Popen(argv, stdout=logf, stderr=subprocess.STDOUT, cwd=ROOT)
+    deadline: float = time.monotonic() + args.run_timeout
+
+    def timed_out() -> bool:
+        return time.monotonic() > deadline
+
+    code: int | None
+    with open(d / "demo.log", "w") as console:  # the demo talks a lot: stdout is for the JSON
         try:
-            code = proc.wait(timeout=args.run_timeout)
-        except subprocess.TimeoutExpired:
-            log(f"[parking] seed {seed}: still running after {args.run_timeout:.0f} s: stopping it")
-            stop_demo(proc)
-            code = None
-        except KeyboardInterrupt:
-            stop_demo(proc)
-            raise
+            code = demo.run(demo.parse_args(demo_argv(args, seed)), console, timed_out)
+        except Exception:  # a crashed run is a failed run; the sweep goes on
+            traceback.print_exc(file=console)
+            code = 1
+    if code == demo.EXIT_INTERRUPTED and timed_out():
+        log(f"[parking] seed {seed}: still running after {args.run_timeout:.0f} s: stopped it")
+        code = None
     (d / EXIT_FILE).write_text(f"{'timeout' if code is None else code}\n")
     return code
 
 
-def load_run(out, seed):
+def load_run(out: Path, seed: int) -> Run:
     """The run of one seed as {seed, exit_code, report (dict or None), ok, error}."""
     d = seed_dir(out, seed)
-    exit_code = None
+    exit_code: int | str | None = None
     if (d / EXIT_FILE).exists():
         text = (d / EXIT_FILE).read_text().strip()
         exit_code = int(text) if text.lstrip("-").isdigit() else text
@@ -208,22 +211,27 @@ def load_run(out, seed):
     return {"seed": seed, "exit_code": exit_code, "report": report, "ok": ok, "error": error}
 
 
-def _number(report, key):
+def _number(report: dict[str, Any] | None, key: str) -> float | None:
     v = (report or {}).get(key)
-    return (
-        v if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) else None
-    )
+    ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    return v if ok else None
 
 
-def _all_within(values, bound):
+def _all_within(values: list[float | None], bound: float) -> bool:
     return all(v is not None and v <= bound for v in values)
 
 
-def aggregate(runs):
+def _median_max(s: dict[str, Any], key: str, values: list[float | None]) -> None:
+    vals = [v for v in values if v is not None]
+    s[f"{key}_median"] = round(statistics.median(vals), 4) if vals else None
+    s[f"{key}_max"] = round(max(vals), 4) if vals else None
+
+
+def aggregate(runs: list[Run]) -> dict[str, Any]:
     """Summary figures of the runs (each from load_run), goals as booleans."""
     reps = [r["report"] for r in runs]
     per = {k: [_number(rep, k) for rep in reps] for k in PER_SEED_KEYS}
-    s = {
+    s: dict[str, Any] = {
         "runs": len(runs),
         "successes": sum(r["ok"] for r in runs),
         "reports": sum(rep is not None for rep in reps),
@@ -232,10 +240,8 @@ def aggregate(runs):
     slots = {rep.get("slot") for rep in reps if rep and rep.get("slot") is not None}
     s["slot"] = slots.pop() if len(slots) == 1 else sorted(slots) or None
     for k in MEDIAN_MAX_KEYS:
-        vals = [v for v in per[k] if v is not None]
-        s[f"{k}_median"] = round(statistics.median(vals), 4) if vals else None
-        s[f"{k}_max"] = round(max(vals), 4) if vals else None
-    # Laser odometry against its peer, the EKF's wheel/IMU odometry, over the same span of each run.
+        _median_max(s, k, per[k])
+    # Laser odometry against its peer, the EKF's wheel/IMU odometry, over the same span.
     ratios = [
         a / b
         for a, b in zip(per["laser_odom_drift_pct"], per["ekf_odom_drift_pct"])
@@ -275,7 +281,7 @@ def aggregate(runs):
     return s
 
 
-def progress_line(i, n, run, measured_wall_s):
+def progress_line(i: int, n: int, run: Run, measured_wall_s: float | None) -> str:
     rep = run["report"] or {}
     parts = ["ok" if run["ok"] else f"FAILED ({run['error']})"]
     pos, head = _number(rep, "final_pos_error_m"), _number(rep, "final_heading_error_deg")
@@ -290,162 +296,101 @@ def progress_line(i, n, run, measured_wall_s):
     return f"[parking {i}/{n}] seed {run['seed']}: {', '.join(parts)}"
 
 
-def _read_gt(path):
-    xs, ys = [], []
+def _sweep_run(out: Path, run: Run) -> plots.SweepRun:
+    """A run's ground truth in the world (gt.csv is in the run's start frame, and each seed
+    starts elsewhere) and its goal, for the plot."""
+    rep = run["report"] or {}
+    st, g = rep.get("start_world"), rep.get("goal_world")
+    if not (isinstance(st, list) and isinstance(g, list) and len(st) == 3 and len(g) == 3):
+        return plots.SweepRun(run["seed"], run["ok"], None, None)
     try:
-        with open(path) as f:
-            header = f.readline().strip().split(",")
-            ix, iy = header.index("x_m"), header.index("y_m")
-            for line in f:
-                cols = line.split(",")
-                xs.append(float(cols[ix]))
-                ys.append(float(cols[iy]))
-    except (OSError, ValueError, IndexError):
-        return None
-    return xs, ys
+        gt = read_columns(seed_dir(out, run["seed"]) / "gt.csv", ["x_m", "y_m"])
+    except (OSError, ValueError):
+        return plots.SweepRun(run["seed"], run["ok"], None, None)
+    world = [to_world(st, (x, y, 0.0)) for x, y in zip(gt["x_m"], gt["y_m"])]
+    track = ([p[0] for p in world], [p[1] for p in world])
+    return plots.SweepRun(run["seed"], run["ok"], track, (g[0], g[1]))
 
 
-def _start_and_goal(rep):
-    """The run's world start and goal poses [m, m, rad], or None."""
-    st, g = (rep or {}).get("start_world"), (rep or {}).get("goal_world")
-    if isinstance(st, list) and isinstance(g, list) and len(st) == 3 and len(g) == 3:
-        return st, g
-    return None
-
-
-def _to_world(start, xs, ys):
-    """gt.csv is in the run's start frame: each seed starts elsewhere, so plot in the world."""
-    c, s = math.cos(start[2]), math.sin(start[2])
-    return (
-        [start[0] + c * x - s * y for x, y in zip(xs, ys)],
-        [start[1] + s * x + c * y for x, y in zip(xs, ys)],
-    )
-
-
-def plot(summary, runs, out, png):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def plot(summary: dict[str, Any], runs: list[Run], out: Path, png: Path) -> None:
     per = summary["per_seed"]
-    seeds = per["seed"]
-    x = list(range(len(seeds)))
-    colours = ["tab:blue" if ok else "tab:red" for ok in per["ok"]]
-    fig, axs = plt.subplots(2, 2, figsize=(12, 9))
-    bars = (
-        (
-            axs[0][0],
-            "final_pos_error_m",
-            100.0,
-            "final position error",
-            "cm",
-            100 * GOAL_POS_ERROR_M,
-        ),
-        (
-            axs[0][1],
-            "final_heading_error_deg",
-            1.0,
-            "final heading error",
-            "deg",
-            GOAL_HEADING_ERROR_DEG,
-        ),
-        (
-            axs[1][0],
-            "localization_rms_m",
-            100.0,
-            "localisation RMS",
-            "cm",
-            100 * GOAL_LOCALIZATION_RMS_M,
-        ),
-    )
-    for ax, key, scale, label, unit, goal in bars:
-        vals = [scale * v if v is not None else 0.0 for v in per[key]]
-        ax.bar(x, vals, color=colours)
-        for xi, v in zip(x, per[key]):
-            if v is None:
-                ax.text(xi, 0, "no data", rotation=90, ha="center", va="bottom", fontsize=8)
-        ax.axhline(goal, color="tab:green", ls="--", lw=1.2, label=f"goal <= {goal:g} {unit}")
-        ax.set_xticks(x, [str(s) for s in seeds])
-        ax.set_xlabel("seed")
-        ax.set_ylabel(f"{label} [{unit}]")
-        ax.legend(loc="upper right", fontsize=8)
-    ax = axs[1][1]
-    goals = set()
-    for r in runs:
-        gt = _read_gt(seed_dir(out, r["seed"]) / "gt.csv")
-        sg = _start_and_goal(r["report"])
-        if gt and sg:
-            ax.plot(
-                *_to_world(sg[0], *gt),
-                "-",
-                lw=1,
-                color=None if r["ok"] else "tab:red",
-                label=f"seed {r['seed']}" + ("" if r["ok"] else " (failed)"),
-            )
-            goals.add(tuple(round(v, 4) for v in sg[1][:2]))
-    for i, g in enumerate(sorted(goals)):
-        ax.plot([g[0]], [g[1]], "kx", ms=10, label="goal (rear axle)" if i == 0 else None)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m] (world)")
-    ax.set_ylabel("y [m] (world)")
-    ax.set_title("ground-truth trajectories")
-    if ax.lines:
-        ax.legend(loc="best", fontsize=7)
-    fig.suptitle(
+    slot = summary["slot"] if summary["slot"] is not None else "?"
+    plots.sweep(
+        png,
         f"parking sweep: {summary['successes']}/{summary['runs']} parked without collision"
-        f" (slot {summary['slot'] if summary['slot'] is not None else '?'}; red = failed)"
+        f" (slot {slot}; red = failed)",
+        per["seed"],
+        per["ok"],
+        per,
+        (
+            plots.SweepBar(
+                "final_pos_error_m", 100.0, "final position error", "cm", 100 * GOAL_POS_ERROR_M
+            ),
+            plots.SweepBar(
+                "final_heading_error_deg",
+                1.0,
+                "final heading error",
+                "deg",
+                GOAL_HEADING_ERROR_DEG,
+            ),
+            plots.SweepBar(
+                "localization_rms_m", 100.0, "localisation RMS", "cm", 100 * GOAL_LOCALIZATION_RMS_M
+            ),
+        ),
+        [_sweep_run(out, r) for r in runs],
     )
-    fig.tight_layout()
-    tmp = png.with_name(png.name + ".tmp")
-    fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    os.replace(tmp, png)
 
 
-def write_json_atomic(path, obj):
+def write_json_atomic(path: Path, obj: Any) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text(json.dumps(obj, indent=2) + "\n")
     os.replace(tmp, path)
 
 
-def main(argv):
-    args = parse_args(argv)
-    out = pathlib.Path(args.out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        log(f"[parking] ERROR: --out {out}: {e.strerror}")
-        return 2
-    if not args.aggregate_only:
-        for prog in ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy"):
-            if not (pathlib.Path(args.build) / "bin" / prog).exists():
-                log(
-                    f"[parking] ERROR: --build {args.build}: bin/{prog} is missing "
-                    "(tools/bench parking builds the release preset)"
-                )
-                return 2
-    signal.signal(signal.SIGINT, on_stop_signal)
-    signal.signal(signal.SIGTERM, on_stop_signal)
+def run_seeds(args: argparse.Namespace, out: Path) -> tuple[list[Run], bool]:
+    """Runs (or only loads) every seed; (runs, interrupted)."""
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    runs, interrupted = [], False
+    runs: list[Run] = []
     for i, seed in enumerate(seeds, 1):
+        measured = None
         if not args.aggregate_only:
             log(
                 f"[parking {i}/{len(seeds)}] seed {seed}: running (log {seed_dir(out, seed)}/demo.log)"
             )
             t0 = time.monotonic()
             try:
-                run_demo(args, seed)
+                code = run_demo(args, seed)
             except KeyboardInterrupt:
-                log("[parking] interrupted: summarising the runs so far")
-                interrupted = True
-                break
+                code = demo.EXIT_INTERRUPTED
             measured = time.monotonic() - t0
-        else:
-            measured = None
+            if code == demo.EXIT_INTERRUPTED:
+                log("[parking] interrupted: summarising the runs so far")
+                return runs, True
         runs.append(load_run(out, seed))
         log(progress_line(i, len(seeds), runs[-1], measured))
+    return runs, False
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    out = Path(args.out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        log(f"[parking] ERROR: --out {out}: {e.strerror}")
+        return 2
+    if not args.aggregate_only:
+        for prog in demo.PROGRAMS:
+            if not (Path(args.build) / "bin" / prog).exists():
+                log(
+                    f"[parking] ERROR: --build {args.build}: bin/{prog} is missing "
+                    "(tools/bench parking builds the release preset)"
+                )
+                return 2
+        demo.parse_args(demo_argv(args, args.first_seed))  # a bad --extra fails here, once
+    signal.signal(signal.SIGINT, on_stop_signal)
+    signal.signal(signal.SIGTERM, on_stop_signal)
+    runs, interrupted = run_seeds(args, out)
     if not runs:
         log("[parking] no run to summarise")
         return 130 if interrupted else 2
@@ -472,4 +417,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

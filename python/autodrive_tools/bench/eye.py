@@ -1,0 +1,81 @@
+"""tools/bench eye: the Eye's whole pipeline (JPEG decode, libapriltag detection, roof-plane
+pose, LCM publish) on one thread, and OpenCV's aruco (DICT_APRILTAG_36h11) as the peer on the
+same frames, over a synthesised drive across the whole map (bin/eye_bench); then, when
+autodrive-sim is built, the Eye on the simulator's overhead camera against its ground truth
+(sim_* keys, autodrive_tools.bench.eye_sim). Speeds are medians over passes; *_cpu divide by
+thread CPU time instead of wall time (the machine is shared). Writes out/bench/eye_trajectory
+{.csv,.png} and eye_sim_trajectory{.csv,.png}. Progress on stderr; last line one JSON object.
+Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3), EYE_BENCH_SIM_S (30, 0: skip)."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+from pathlib import Path
+
+from .. import plots
+from ..runfiles import read_columns
+from . import Progress, build_dir, eye_sim, out_dir, print_figures
+
+INT_KEYS = ("frames", "repeats")
+log = Progress("eye")
+
+
+def key_values(text: str) -> dict[str, float]:
+    """ "key value" lines as a dict."""
+    out = {}
+    for line in text.splitlines():
+        if line.strip():
+            k, v = line.split()
+            out[k] = float(v)
+    return out
+
+
+def plot(csv: Path, png: Path) -> None:
+    cols = ["true_x_m", "true_y_m", "eye_x_m", "eye_y_m", "peer_x_m", "peer_y_m"]
+    c = read_columns(csv, cols, missing=math.nan)
+    plots.eye_bench(
+        png,
+        (c["true_x_m"], c["true_y_m"]),
+        (c["eye_x_m"], c["eye_y_m"]),
+        (c["peer_x_m"], c["peer_y_m"]),
+    )
+
+
+def main(argv: list[str]) -> int:
+    if argv:
+        print(__doc__.strip())
+        return 0 if argv[0] in ("-h", "--help") else 2
+    build = build_dir("eye")
+    out = out_dir()
+    csv, png = out / "eye_trajectory.csv", out / "eye_trajectory.png"
+    frames, repeats = os.environ.get("EYE_BENCH_FRAMES", "240"), os.environ.get(
+        "EYE_BENCH_REPEATS", "3"
+    )
+    log(f"eye_bench: {frames} frames, {repeats} passes")
+    text = subprocess.run(
+        [build / "bin" / "eye_bench", "--frames", frames, "--repeats", repeats, "--csv", csv],
+        check=True,
+        stdout=subprocess.PIPE,
+        text=True,
+    ).stdout
+    figures = key_values(text)
+    sim_s = float(os.environ.get("EYE_BENCH_SIM_S", "30"))
+    if sim_s != 0 and os.access(build / "bin" / "autodrive-sim", os.X_OK):
+        log(f"simulator overhead camera, {sim_s:g} s")
+        try:
+            figures.update(eye_sim.measure(build, sim_s, str(out / "eye_sim_trajectory")))
+        except RuntimeError as e:
+            log(f"simulator check failed: {e}")
+    elif sim_s != 0:
+        log("autodrive-sim not built: no simulator figures")
+    for k, v in figures.items():
+        print(f"{k} {v}")
+    try:
+        plot(csv, png)
+        log(f"plot {png}")
+    except ValueError as e:
+        log(f"plot failed: {e}")
+    print_figures({k: int(v) if k in INT_KEYS else v for k, v in figures.items()})
+    return 0

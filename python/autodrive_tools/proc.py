@@ -1,0 +1,84 @@
+"""Child processes: the one process stopper (SIGINT, then SIGTERM, then SIGKILL) and a group
+runner that starts named programs with their own log files and stops them in reverse order."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import IO, Any
+
+# How long a child gets to act on SIGINT (flush its log, publish its last command), then on
+# SIGTERM, before SIGKILL.
+SIGINT_GRACE_S = 5.0
+SIGTERM_GRACE_S = 3.0
+
+Log = Callable[[str], None]
+
+
+def stop(
+    proc: subprocess.Popen[Any],
+    name: str,
+    log: Log,
+    sigint_grace_s: float = SIGINT_GRACE_S,
+    sigterm_grace_s: float = SIGTERM_GRACE_S,
+) -> int:
+    """Stops proc (SIGINT, SIGTERM, SIGKILL, each after its grace time); returns its exit code."""
+    for sig, grace_s in ((signal.SIGINT, sigint_grace_s), (signal.SIGTERM, sigterm_grace_s)):
+        if proc.poll() is not None:
+            return proc.returncode
+        proc.send_signal(sig)
+        try:
+            return proc.wait(timeout=grace_s)
+        except subprocess.TimeoutExpired:
+            log(f"{name} did not stop on {sig.name} within {grace_s:g} s")
+    log(f"killing {name}")
+    proc.kill()
+    return proc.wait()
+
+
+class ProcessGroup:
+    """Named child processes, each in its own session (a Ctrl-C on the terminal reaches only
+    us, and we stop them in order), stdout and stderr into one log file each."""
+
+    def __init__(self, log: Log) -> None:
+        self.log = log
+        self.items: list[tuple[str, subprocess.Popen[bytes], IO[str]]] = []
+
+    def start(self, name: str, argv: Sequence[object], logfile: Path) -> subprocess.Popen[bytes]:
+        self.log(f"starting {name}: {' '.join(map(str, argv))}")
+        f = open(logfile, "w")
+        proc = subprocess.Popen(
+            [str(a) for a in argv], stdout=f, stderr=subprocess.STDOUT, start_new_session=True
+        )
+        self.items.append((name, proc, f))
+        return proc
+
+    def check(self, besides: str | None = None, clean_exit_fails: bool = False) -> None:
+        """Raises RuntimeError when a child (other than `besides`) has exited with an error, or
+        at all with clean_exit_fails (a service that must outlive the mission)."""
+        for name, proc, f in self.items:
+            if name == besides:
+                continue
+            code = proc.poll()
+            if code is not None and (code != 0 or clean_exit_fails):
+                raise RuntimeError(f"{name} exited with code {code} (log: {f.name})")
+
+    def stop_all(self) -> None:
+        for name, proc, f in reversed(self.items):
+            stop(proc, name, self.log)
+            f.close()
+        self.items.clear()
+
+
+def wait_for_path(path: Path, timeout_s: float, procs: ProcessGroup) -> None:
+    """Waits until path exists (a pty a child creates), failing early if a child died."""
+    t0 = time.monotonic()
+    while not os.path.exists(path):
+        procs.check()
+        if time.monotonic() - t0 > timeout_s:
+            raise RuntimeError(f"{path} did not appear within {timeout_s} s")
+        time.sleep(0.05)

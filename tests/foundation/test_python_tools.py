@@ -1,0 +1,65 @@
+"""Unit checks of autodrive_tools' pure parts: the one angle wrap, frame changes and their
+inverse, the alignment of a dead-reckoned track, clearances, the map facts and the slot goal,
+the runtime config the demo writes, and bad input named in the error."""
+
+import math
+import tempfile
+from pathlib import Path
+
+from autodrive_tools import geometry, mapfacts, scoring, vehicle
+from autodrive_tools.missions import parking
+from autodrive_tools.runfiles import read_columns
+
+
+def raises(fn, exc, *texts):
+    """fn() raises exc with every text in its message."""
+    try:
+        fn()
+    except exc as e:
+        assert all(t in str(e) for t in texts), e
+        return
+    raise AssertionError(f"no {exc.__name__}")
+
+
+for a in (-7.0, -math.pi, 0.0, 3.0, math.pi, 9.5):
+    w = geometry.wrap(a)
+    assert -math.pi <= w < math.pi and abs(math.remainder(w - a, 2 * math.pi)) < 1e-12, (a, w)
+
+origin, p = (0.5, -1.2, 2.0), (1.0, 2.0, -2.5)
+back = geometry.to_world(origin, geometry.to_frame(origin, p))
+assert all(abs(x - y) < 1e-12 for x, y in zip(back, p)), back
+
+align = geometry.Alignment((1.0, 1.0, 0.0), (0.0, 0.0, math.pi / 2))
+x, y = align.point(2.0, 1.0)  # 1 m ahead of the estimate's start: 1 m along the truth's +y
+assert abs(x) < 1e-12 and abs(y - 1.0) < 1e-12, (x, y)
+
+car = vehicle.load()
+square = geometry.rect_corners((0.0, 0.0, 0.5, 0.5, 0.0))
+far = geometry.rect_corners((2.0, 0.0, 0.5, 0.5, 0.0))
+assert abs(geometry.polygon_distance(square, far) - 1.0) < 1e-12
+env = car.envelope
+assert env.length_m == car.vector("chassis_size_m")[0]
+assert env.width_m >= car.number("track_m") + car.number("wheel_width_m")
+clear = scoring.min_clearance([(0.0, 0.0, 0.0)], car, [(1.0, 0.0, 0.1, 0.1, 0.0)], stride=1)
+expect = 1.0 - 0.1 - (env.centre_ahead_m + env.length_m / 2)
+assert abs(clear - expect) < 1e-9, (clear, expect)
+assert scoring.rms([3.0, 4.0]) == math.sqrt(12.5)
+
+lot = mapfacts.parking_school()
+assert lot.obstacles and lot.slots > 0
+assert parking.start_pose(None, 0) == lot.spawn, "seed 0 starts exactly at the spawn"
+s1 = parking.start_pose(None, 1)
+assert s1 == parking.start_pose(None, 1) and s1 != lot.spawn, "a seed draws one start"
+goal = parking.slot_goal_world(2)
+# The envelope's centre, not the rear axle, is in the slot's centre.
+centre = env.at(goal)
+assert abs(centre[1] - lot.slot_y_m) < 1e-9 and abs(centre[4] - lot.slot_yaw_rad) < 1e-12
+raises(lambda: parking.slot_goal_world(lot.slots), RuntimeError, "slots 0..")
+raises(lambda: parking.mapping_route("1,2"), ValueError, "leg '1,2'")
+
+with tempfile.TemporaryDirectory() as tmp:
+    csv = Path(tmp) / "t.csv"
+    csv.write_text("x_m,y_m\n1,2\n3,x\n")
+    raises(lambda: read_columns(csv, ["x_m", "y_m"]), ValueError, str(csv), "non-numeric")
+    raises(lambda: read_columns(csv, ["z_m"]), ValueError, "lacks columns")
+print("python tools ok")
