@@ -15,8 +15,8 @@ Rect = tuple[float, float, float, float, float]
 
 
 def wrap(angle_rad: float) -> float:
-    """The angle in [-pi, pi)."""
-    return (angle_rad + math.pi) % (2 * math.pi) - math.pi
+    """The angle in [-pi, pi] (atan2's range)."""
+    return math.atan2(math.sin(angle_rad), math.cos(angle_rad))
 
 
 def to_frame(origin: Sequence[float], p: Sequence[float]) -> Pose:

@@ -5,7 +5,6 @@ from pathlib import Path
 REPO_ROOT: Path = Path(__file__).resolve().parents[2]
 VEHICLE_FILE: Path = REPO_ROOT / "vehicle" / "nigel.params"
 CHANNEL_TABLE: Path = REPO_ROOT / "lcm_types" / "channels.yaml"
-PARKING_SCHOOL_MJCF: Path = REPO_ROOT / "sim" / "mujoco_hil" / "maps" / "parking_school.xml"
 RUNTIME_HIL_CONFIG: Path = REPO_ROOT / "runtime" / "jetson" / "config" / "nigel_hil.yaml"
 RUNTIME_CAR_CONFIG: Path = REPO_ROOT / "runtime" / "jetson" / "config" / "nigel_car.yaml"
 AUTONOMY_EXAMPLE_CONFIG: Path = (

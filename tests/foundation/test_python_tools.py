@@ -23,7 +23,7 @@ def raises(fn, exc, *texts):
 
 for a in (-7.0, -math.pi, 0.0, 3.0, math.pi, 9.5):
     w = geometry.wrap(a)
-    assert -math.pi <= w < math.pi and abs(math.remainder(w - a, 2 * math.pi)) < 1e-12, (a, w)
+    assert abs(w) <= math.pi and abs(math.remainder(w - a, 2 * math.pi)) < 1e-12, (a, w)
 
 origin, p = (0.5, -1.2, 2.0), (1.0, 2.0, -2.5)
 back = geometry.to_world(origin, geometry.to_frame(origin, p))
@@ -53,7 +53,9 @@ assert s1 == parking.start_pose(None, 1) and s1 != lot.spawn, "a seed draws one 
 goal = parking.slot_goal_world(2)
 # The envelope's centre, not the rear axle, is in the slot's centre.
 centre = env.at(goal)
-assert abs(centre[1] - lot.slot_y_m) < 1e-9 and abs(centre[4] - lot.slot_yaw_rad) < 1e-12
+slot_x, slot_y, slot_yaw = lot.slot_centres[2]
+assert abs(centre[0] - slot_x) < 1e-9 and abs(centre[1] - slot_y) < 1e-9, (centre, lot.slot_centres)
+assert abs(centre[4] - slot_yaw) < 1e-12
 raises(lambda: parking.slot_goal_world(lot.slots), RuntimeError, "slots 0..")
 raises(lambda: parking.mapping_route("1,2"), ValueError, "leg '1,2'")
 

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal, Union
 
 from . import geometry
+from ..geometry import wrap
 from .model import Fixture, Kit, Lane, MapDescriptionError, MapFile, ParkingSlot, Pose, Rect
 from .model import Road, StopLine
 
@@ -55,7 +56,7 @@ class MapDescription(MapFile):
         s = slot if isinstance(slot, ParkingSlot) else self.slot(slot)
         yaw = s.yaw_rad if direction == "forward" else s.yaw_rad + math.pi
         ahead = vehicle.envelope_center_ahead_m
-        yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+        yaw = wrap(yaw)
         return Pose(
             s.centre_m[0] - ahead * math.cos(yaw), s.centre_m[1] - ahead * math.sin(yaw), yaw
         )

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ..geometry import wrap
+
 from .model import Lane, Piece, Vec2
 
 
@@ -48,12 +50,8 @@ def centre_line(lane: Lane, step_m: float = 0.05) -> list[tuple[float, float, fl
             (x, y), yaw = piece_point(p, k / n, lane.offset_m)
             pts.append((x, y, yaw))
     if lane.direction == "backward":
-        pts = [(x, y, _wrap(yaw + math.pi)) for x, y, yaw in reversed(pts)]
+        pts = [(x, y, wrap(yaw + math.pi)) for x, y, yaw in reversed(pts)]
     return pts
-
-
-def _wrap(a: float) -> float:
-    return math.atan2(math.sin(a), math.cos(a))
 
 
 def seg_dist_m(p: Vec2, a: Vec2, b: Vec2) -> float:

@@ -15,6 +15,7 @@ import math
 from typing import Iterable, Sequence
 
 from . import geometry
+from ..geometry import wrap
 from .description import MapDescription
 from .model import ParkingSlot, Vec2
 
@@ -33,7 +34,7 @@ def nums(vs: Iterable[float]) -> str:
 
 def _axis_yaw(yaw: float) -> float:
     """A symmetric box's yaw folded into (-pi/2, pi/2]: the same box, one way to write it."""
-    y = math.atan2(math.sin(yaw), math.cos(yaw))
+    y = wrap(yaw)
     if y <= -math.pi / 2 + 1e-12:
         y += math.pi
     elif y > math.pi / 2 + 1e-12:
@@ -205,12 +206,12 @@ class _Writer:
         for c in m.cones:
             self.cone(c.name, c.position_m)
         t = kit.terrain_patch_thickness_m
-        for p in m.terrain_patches:
-            s = kit.surfaces[p.surface]
+        for patch in m.terrain_patches:
+            surface = kit.surfaces[patch.surface]
             self.add(
-                f'<geom name="{p.name}" type="box" pos="{nums((*p.centre_m, t / 2))}" '
-                f'size="{nums((p.size_m[0] / 2, p.size_m[1] / 2, t / 2))}" {WORLD} '
-                f'{self.friction(s.friction)} rgba="{nums(s.rgba)}"/>'
+                f'<geom name="{patch.name}" type="box" pos="{nums((*patch.centre_m, t / 2))}" '
+                f'size="{nums((patch.size_m[0] / 2, patch.size_m[1] / 2, t / 2))}" {WORLD} '
+                f'{self.friction(surface.friction)} rgba="{nums(surface.rgba)}"/>'
             )
         hz = kit.obstacle.wall_height_m / 2
         for w in m.walls:

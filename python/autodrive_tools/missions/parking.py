@@ -78,12 +78,7 @@ def slot_goal_world(slot: int) -> Pose:
     lot = parking_school()
     if not 0 <= slot < lot.slots:
         raise RuntimeError(f"--slot {slot}: Parking School has slots 0..{lot.slots - 1}")
-    ahead_m = vehicle.load().envelope_center_ahead_m
-    return (
-        lot.slot_x0_m + lot.slot_pitch_m * slot,
-        lot.slot_y_m - ahead_m * math.sin(lot.slot_yaw_rad),
-        lot.slot_yaw_rad,
-    )
+    return lot.slot_goals[slot]
 
 
 def mapping_route(text: str) -> list[Pose]:
