@@ -2,9 +2,12 @@
 
 #include <cmath>
 
-#include "eye_render.hpp"
-
 namespace eye {
+
+std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m) {
+  const double h = size_m / 2;
+  return {cv::Vec2d(-h, h), cv::Vec2d(-h, -h), cv::Vec2d(h, -h), cv::Vec2d(h, h)};
+}
 
 double fit_rigid2d(const std::vector<cv::Vec2d> &src, const std::vector<cv::Vec2d> &dst,
                    cv::Vec2d *t_m, double *yaw_rad) {

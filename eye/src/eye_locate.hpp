@@ -37,6 +37,11 @@ struct CarPose {
   std::array<cv::Point2d, 4> corners_px;  // for annotation
 };
 
+// Tag-frame corners [m] of a tag with black border size_m, in libapriltag order (bottom-left,
+// bottom-right, top-right, top-left of the print). Tag frame: x towards the top of the print,
+// y towards its left, z up out of the print.
+std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m);
+
 // The pose of the car carrying detection d, or nothing if the geometry is unusable (a corner
 // ray misses the roof plane, or the four corners do not fit a square of the tag's size).
 std::optional<CarPose> locate_car(const Intrinsics &in, const CameraPose &pose,

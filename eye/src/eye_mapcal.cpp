@@ -9,7 +9,7 @@
 #include <set>
 
 #include "eye_error.hpp"
-#include "eye_render.hpp"
+#include "eye_locate.hpp"
 #include "eye_yaml.hpp"
 
 namespace eye {

@@ -205,10 +205,9 @@ TEST(Sensors, RoofTagAndMountsAreInTheModel) {
   ASSERT_GE(lidar, 0);
   EXPECT_NEAR(m->site_pos[3 * lidar], 0.1445, 1e-9);
   EXPECT_NEAR(m->site_pos[3 * lidar + 2], 0.1757, 1e-9);
-  if (sim_has_sensors()) {  // real tag36h11 textures, one per car
-    EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
-    EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);
-  }
+  // real tag36h11 textures, one per car
+  EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);
 }
 
 }  // namespace

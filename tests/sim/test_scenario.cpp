@@ -27,10 +27,8 @@
 #include "sim_test_util.h"
 #include "vparams.h"
 
-#ifdef SIM_TEST_HAVE_SENSORS
 #include "sim_camera.h"
 #include "sim_render.h"
-#endif
 
 namespace {
 
@@ -470,7 +468,6 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
 }
 
-#ifdef SIM_TEST_HAVE_SENSORS
 TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   // in-process: the sim core with a late box 0.5 m ahead of car 1, appearing at 0.2 s
   ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0});
@@ -500,6 +497,5 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   sim_camera_destroy(cam);
   sim_render_destroy(rd);
 }
-#endif
 
 }  // namespace

@@ -1,6 +1,6 @@
 """tools/bench firmware: firmware figures, all on the real ELF in simavr (simulated time, so
 they do not depend on how busy this machine is). Sizes from avr-size, then bin/nano-sil-bench
-on nano_avr/nigel_nano.elf (see tests/firmware_sil/README.md). tools/bench builds the release
+on nano_avr/nigel_nano.elf (see firmware/nano/simavr/README.md). tools/bench builds the release
 preset (that builds the ELF too, in $AUTODRIVE_BUILD/nano_avr). Progress and the detailed
 figures on stderr; the last stdout line is JSON."""
 

@@ -2,8 +2,7 @@
 last line one JSON object. Needs AUTODRIVE_BUILD (a release build).
 
 rtf_N: median real-time factor of `autodrive-sim --lockstep` with N cars (1 kHz physics, the
-emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty when the sensors library is
-built, ground truth on LCM), bare_mj_step_rtf_1: a bare mj_step loop on the same model in the
+emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty, ground truth on LCM), bare_mj_step_rtf_1: a bare mj_step loop on the same model in the
 same process, overhead_ratio = bare / rtf_1. The *_cpu variants divide by the process's CPU
 time instead of wall time: on a shared, loaded machine they show the cost without the waits.
 rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JPEG-published

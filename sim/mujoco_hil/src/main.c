@@ -12,12 +12,10 @@
 #include "lcmpub.h"
 #include "sim.h"
 
-#ifdef SIM_HAVE_SENSORS
 #include "sim_camera.h"
 #include "sim_lidar_lcm.h"
 #include "sim_render.h"
 #include "sim_viewer.h"
-#endif
 
 #define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
 #define MAIN_TRUTH_EVERY 10 /* steps between ground-truth messages: 100 Hz */
@@ -174,20 +172,17 @@ static void main_report_late_boxes(const sim_t *s) {
 #define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
 typedef struct main_cams {
   int n;
-#ifdef SIM_HAVE_SENSORS
   sim_render_t *render;
   sim_camera_t *cam[MAIN_MAX_CAMS];
   int cam_id[MAIN_MAX_CAMS];
   char channel[MAIN_MAX_CAMS][48], info_channel[MAIN_MAX_CAMS][48];
   int64_t next_info_us;
-#endif
 } main_cams_t;
 
 static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, char *err,
                           size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
-#ifdef SIM_HAVE_SENSORS
   const mjModel *m = sim_model(s);
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
@@ -217,17 +212,10 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
     k->n++;
   }
   return 0;
-#else
-  (void)s;
-  snprintf(err, err_sz,
-           "--cameras/--eye: this build has no sensors library (sim/mujoco_hil/sensors)");
-  return -1;
-#endif
 }
 
 static int main_cams_publish(main_cams_t *k, const sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
                              size_t err_sz) {
-#ifdef SIM_HAVE_SENSORS
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
   for (int i = 0; i < k->n; i++) {
@@ -238,30 +226,24 @@ static int main_cams_publish(main_cams_t *k, const sim_t *s, lcm_t *lcm, int64_t
     sim_camera_publish_image(k->cam[i], lcm, k->channel[i]);
     if (info) sim_camera_publish_info(k->cam[i], sim_model(s), lcm, k->info_channel[i], now_us);
   }
-#else
-  (void)k, (void)s, (void)lcm, (void)now_us, (void)err, (void)err_sz;
-#endif
   return 0;
 }
 
 static void main_cams_close(main_cams_t *k) {
-#ifdef SIM_HAVE_SENSORS
   for (int i = 0; i < k->n; i++) sim_camera_destroy(k->cam[i]);
   if (k->render) sim_render_destroy(k->render);
-#endif
   k->n = 0;
 }
 
 /* The optional window (sensors library, EGL context): drawn at ~30 Hz of wall time. */
 typedef struct main_view {
-  void *v; /* sim_viewer_t*, NULL when off */
+  sim_viewer_t *v; /* NULL when off */
   double next_frame_s;
 } main_view_t;
 
 static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, size_t err_sz) {
   memset(w, 0, sizeof *w);
   if (!want) return 0;
-#ifdef SIM_HAVE_SENSORS
   if (!sim_viewer_display_available()) {
     snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
     return -1;
@@ -269,23 +251,17 @@ static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, s
   w->v = sim_viewer_create(sim_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
                            1024, 768, err, err_sz);
   return w->v ? 0 : -1;
-#else
-  (void)s;
-  snprintf(err, err_sz, "this build has no sensors library (sim/mujoco_hil/sensors)");
-  return -1;
-#endif
 }
 
 /* Draws a frame when one is due; blocks while paused (shifting *t0_s so pacing resumes
  * smoothly). Returns 1 when the user quit. */
 static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
-#ifdef SIM_HAVE_SENSORS
   sim_viewer_input_t in;
   double now = main_wall_s();
   if (now < w->next_frame_s) return 0;
   do {
     w->next_frame_s = now + 1.0 / 30.0;
-    if (sim_viewer_frame((sim_viewer_t *)w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
+    if (sim_viewer_frame(w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
     if (in.quit || main_stop) return 1;
     if (in.reset_requested) {
       /* back to the start poses (qpos0, sim.c); late boxes that appeared come back on the next
@@ -303,16 +279,10 @@ static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
     }
   } while (in.paused);
   return 0;
-#else
-  (void)w, (void)s, (void)t0_s;
-  return 0;
-#endif
 }
 
 static void main_view_close(main_view_t *w) {
-#ifdef SIM_HAVE_SENSORS
-  if (w->v) sim_viewer_destroy((sim_viewer_t *)w->v);
-#endif
+  if (w->v) sim_viewer_destroy(w->v);
   w->v = NULL;
 }
 
@@ -557,7 +527,6 @@ int main(int argc, char **argv) {
     main_report_late_boxes(s);
     if (step % MAIN_TRUTH_EVERY == 0)
       for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(pubq, s, c, tlog);
-#ifdef SIM_HAVE_SENSORS
     for (int c = 1; c <= sim_cars(s); c++) {
       const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
       /* while the runtime's RPLIDAR driver scans on the pty it publishes <VEH>_LIDAR itself:
@@ -568,7 +537,6 @@ int main(int argc, char **argv) {
         sim_lidar_publish(lcm, ch, "laser", scan);
       }
     }
-#endif
     if (cams.n > 0 && now_us % cam_period_us < SIM_STEP_US &&
         main_cams_publish(&cams, s, lcm, now_us, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);

@@ -23,11 +23,9 @@
 #include "uart.h"
 #include "vparams.h"
 
-#ifdef SIM_HAVE_SENSORS
 #include "sim_lidar.h"
 #include "sim_rplidar.h"
 #include "sim_tags.h"
-#endif
 
 #define SIM_ENC_COUNTS_PER_REV 1920.0
 #define SIM_G_M_S2 9.80665
@@ -99,11 +97,9 @@ typedef struct sim_car {
   script_t script;
   rng_t rng;
   double accel_bias[3], gyro_bias[3];
-#ifdef SIM_HAVE_SENSORS
   sim_lidar_t *lidar;
   sim_rplidar_t *rplidar;
   int lidar_new;
-#endif
   char lidar_link[512];
 } sim_car_t;
 
@@ -410,7 +406,6 @@ static int sim_check_map(const char *path, char *err, size_t err_sz) {
   return 0;
 }
 
-#ifdef SIM_HAVE_SENSORS
 /* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
 static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err,
                             size_t err_sz) {
@@ -433,7 +428,6 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
   }
   return 0;
 }
-#endif
 
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
   mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box};
@@ -443,12 +437,9 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   if (sim_check_map(map_abs, err, err_sz) != 0) return -1;
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;
-  int rc = 0;
-#ifdef SIM_HAVE_SENSORS
-  rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);
+  int rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);
   o.tag_asset_xml = asset;
   o.tag_geom_xml = (const char *const *)geoms;
-#endif
   if (rc == 0) rc = mg_write_scene(s->scene_path, &s->p, &o, err, err_sz);
   if (geoms)
     for (int i = 0; i < cfg->cars; i++) free(geoms[i]);
@@ -488,7 +479,6 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
     c->has_pty = 1;
     c->host_rx_us = -1;
   }
-#ifdef SIM_HAVE_SENSORS
   if (cfg->lidar) {
     sim_lidar_config_t lc;
     sim_lidar_config_default(&lc);
@@ -504,7 +494,6 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
       if (!c->rplidar) return -1;
     }
   }
-#endif
   c->hal.ctx = c;
   c->hal.motor_set = hal_motor_set;
   c->hal.servo_set_us = hal_servo_set_us;
@@ -517,14 +506,8 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
 }
 
 int sim_lidar_pty_scanning(const sim_t *s, int car) {
-#ifdef SIM_HAVE_SENSORS
   const sim_car_t *c = &s->car[car - 1];
   return c->rplidar ? sim_rplidar_scanning(c->rplidar) : 0;
-#else
-  (void)s;
-  (void)car;
-  return 0;
-#endif
 }
 
 int sim_late_boxes(const sim_t *s) {
@@ -536,14 +519,6 @@ const scn_late_box_t *sim_late_box(const sim_t *s, int k) {
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
   if (car_below) *car_below = s->box_car_below[k];
   return s->box_new[k];
-}
-
-int sim_has_sensors(void) {
-#ifdef SIM_HAVE_SENSORS
-  return 1;
-#else
-  return 0;
-#endif
 }
 
 sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
@@ -613,10 +588,8 @@ void sim_destroy(sim_t *s) {
   if (!s) return;
   for (int i = 0; s->car && i < s->ncars; i++) {
     if (s->car[i].has_pty) ptylink_close(&s->car[i].pty);
-#ifdef SIM_HAVE_SENSORS
     sim_rplidar_destroy(s->car[i].rplidar);
     sim_lidar_destroy(s->car[i].lidar);
-#endif
   }
   if (s->d) mj_deleteData(s->d);
   if (s->m) mj_deleteModel(s->m);
@@ -833,7 +806,6 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
   mj_step2(s->m, s->d);
   sim_record_contacts(s);
   s->time_us += SIM_STEP_US;
-#ifdef SIM_HAVE_SENSORS
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
     c->lidar_new = 0;
@@ -849,7 +821,6 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
     if (c->rplidar && io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
       return -1;
   }
-#endif
   if (s->d->warning[mjWARN_BADQACC].number > 0) {
     snprintf(err, err_sz, "physics diverged (bad qacc) at t = %.3f s", s->time_us * 1e-6);
     return -1;
@@ -902,14 +873,8 @@ void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse,
 }
 
 const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car) {
-#ifdef SIM_HAVE_SENSORS
   const sim_car_t *c = &s->car[car - 1];
   return (c->lidar && c->lidar_new) ? sim_lidar_last_scan(c->lidar) : NULL;
-#else
-  (void)s;
-  (void)car;
-  return NULL;
-#endif
 }
 
 void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {

@@ -28,7 +28,7 @@ typedef struct sim_config {
   uint64_t seed;           /* IMU biases and noise */
   int open_ptys;           /* 1: Nano (and LIDAR) ptys with symlinks */
   const char *script;      /* NULL, or the scripted driver spec for every car (script.h) */
-  int lidar;               /* 1: simulate the LIDAR (when the sensors library is built) */
+  int lidar;               /* 1: simulate the LIDAR */
   int tyre_model;          /* -1: as the parameter file says, 0: MuJoCo friction, 1: paper */
   const scn_pose_t *start; /* NULL: car 1 at the map's "spawn" site; else at this pose */
   int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run */
@@ -98,8 +98,6 @@ int sim_lidar_pty_scanning(const sim_t *s, int car);
 int sim_late_boxes(const sim_t *s);
 const scn_late_box_t *sim_late_box(const sim_t *s, int k);
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below);
-/* 1 when built with the sensors library. */
-int sim_has_sensors(void);
 
 /* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
  * (and its CPU time in *cpu_s if non-NULL); the benchmark's measure of MuJoCo alone. */

@@ -13,7 +13,7 @@
  *   a car with yaw psi shows the tag rotated by psi - 90 deg. libapriltag returns corners
  *   p[0..3] = bottom-left, bottom-right, top-right, top-left of the printed tag, so the car's
  *   heading is the direction from the mean of (p[0], p[1]) to the mean of (p[3], p[2]).
- * - libapriltag corners are +0.5 px off OpenCV's pixel-centre convention (ARCHITECTURE.md).
+ * - libapriltag corners are +0.5 px off OpenCV's pixel-centre convention (eye/README.md).
  */
 #ifndef SIM_TAGS_H
 #define SIM_TAGS_H

@@ -118,11 +118,6 @@ void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uin
                  texture_homography(in, pose, 1, 1, length_m, width_m, x_m, y_m, z_m, yaw_rad), ss);
 }
 
-std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m) {
-  const double h = size_m / 2;
-  return {cv::Vec2d(-h, h), cv::Vec2d(-h, -h), cv::Vec2d(h, -h), cv::Vec2d(h, h)};
-}
-
 CameraPose camera_look_at(const cv::Vec3d &eye_m, const cv::Vec3d &target_m,
                           const cv::Vec3d &up_m) {
   const cv::Vec3d z = cv::normalize(target_m - eye_m);

@@ -6,8 +6,6 @@
 #pragma once
 #include <opencv2/core.hpp>
 
-#include <array>
-
 #include "eye_camera.hpp"
 
 namespace eye {
@@ -32,11 +30,6 @@ void render_tag(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, int 
 void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uint8_t grey,
                  double length_m, double width_m, double x_m, double y_m, double z_m,
                  double yaw_rad, int ss);
-
-// Tag-frame corners [m] of a tag with black border size_m, in libapriltag order (bottom-left,
-// bottom-right, top-right, top-left of the print). Tag frame: x towards the top of the print,
-// y towards its left, z up out of the print.
-std::array<cv::Vec2d, 4> tag_corners_tagframe(double size_m);
 
 // A camera at eye_m looking at target_m, with image "up" towards +up_m (REP-103 map frame).
 CameraPose camera_look_at(const cv::Vec3d &eye_m, const cv::Vec3d &target_m, const cv::Vec3d &up_m);

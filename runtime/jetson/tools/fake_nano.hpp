@@ -1,5 +1,6 @@
-// Test peers on real pseudo-terminals: the test holds the master side, the component under
-// test opens the slave through a symlink, exactly as it opens the simulator's ptys.
+// Peers on real pseudo-terminals for the runtime's tests and runtime-link-bench: the peer holds
+// the master side, the component under test opens the slave through a symlink, exactly as it
+// opens the simulator's ptys.
 #pragma once
 
 #include <cstdint>
