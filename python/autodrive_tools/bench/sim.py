@@ -2,9 +2,12 @@
 last line one JSON object. Needs AUTODRIVE_BUILD (a release build).
 
 rtf_N: median real-time factor of `autodrive-sim --lockstep` with N cars (1 kHz physics, the
-emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty, ground truth on LCM), bare_mj_step_rtf_1: a bare mj_step loop on the same model in the
-same process, overhead_ratio = bare / rtf_1. The *_cpu variants divide by the process's CPU
-time instead of wall time: on a shared, loaded machine they show the cost without the waits.
+emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty, ground truth on LCM);
+bare_mj_step_rtf_N: a bare mj_step loop on the same model in the same process;
+overhead_ratio = bare / rtf_1 and rtf_N_over_bare = rtf_N / bare, each taken
+within one run, medians over the runs. The *_cpu variants divide by CPU time instead of wall
+time (the stepping thread's for the ratios: the LCM sender has a thread of its own); on a
+shared, loaded machine they show the cost without the waits.
 rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JPEG-published
 at 30 Hz. turn_radius_error_pct: circle fitted to the ground truth at steering 0.6 vs
 L/tan(delta); *_mujoco_friction: the same with plain MuJoCo contact friction instead of the
@@ -118,11 +121,20 @@ def speed(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
             runs.append(r)
         res[f"rtf_{cars}"] = median([r["rtf"] for r in runs])
         res[f"rtf_cpu_{cars}"] = median([r["rtf_cpu"] for r in runs])
+        res[f"rtf_step_thread_cpu_{cars}"] = median([r["rtf_step_thread_cpu"] for r in runs])
+        res[f"bare_mj_step_rtf_{cars}"] = median([r["bare_mj_step_rtf"] for r in runs])
+        res[f"bare_mj_step_rtf_cpu_{cars}"] = median([r["bare_mj_step_rtf_cpu"] for r in runs])
+        # ratios within one run (the same load on the machine), then their median
+        ratios = [r["bare_mj_step_rtf"] / r["rtf"] for r in runs]
+        ratios_cpu = [r["bare_mj_step_rtf_cpu"] / r["rtf_step_thread_cpu"] for r in runs]
         if cars == 1:
-            res["bare_mj_step_rtf_1"] = median([r["bare_mj_step_rtf"] for r in runs])
-            res["overhead_ratio"] = round(res["bare_mj_step_rtf_1"] / res["rtf_1"], 3)
-            res["bare_mj_step_rtf_cpu_1"] = median([r["bare_mj_step_rtf_cpu"] for r in runs])
-            res["overhead_ratio_cpu"] = round(res["bare_mj_step_rtf_cpu_1"] / res["rtf_cpu_1"], 3)
+            res["overhead_ratio"] = round(statistics.median(ratios), 3)
+            res["overhead_ratio_cpu"] = round(statistics.median(ratios_cpu), 3)
+        else:
+            res[f"rtf_{cars}_over_bare"] = round(statistics.median([1 / q for q in ratios]), 3)
+            res[f"rtf_{cars}_over_bare_cpu"] = round(
+                statistics.median([1 / q for q in ratios_cpu]), 3
+            )
     try:
         args = ["--lockstep", "--cameras", "--duration", "3", "--script", DRIVE_SCRIPT]
         rtfs = [bench.run(args, url)["rtf"] for _ in range(repeats)]
