@@ -7,6 +7,7 @@
 #include <string.h>
 
 #define LIDAR_FEW_RAYS 8 /* rays per step up to which lidar_select_few is the cheaper path */
+#define LIDAR_GROUP_MARGIN_M 0.05 /* added to a moving group's bounding sphere */
 
 struct sim_lidar {
   sim_lidar_config_t cfg;
@@ -14,8 +15,16 @@ struct sim_lidar {
   int root_body; /* its root: geoms under it are the car itself */
   int *seen;     /* geoms the scanner can ever see: in a seen group, not the car's */
   int nseen;
-  int *cand;             /* candidates for this scan: seen, visible, crossing the scan plane */
-  int *cand_lo, *cand_n; /* per candidate: first ray index of its sector and its ray count */
+  /* seen geoms grouped by root body: group k is seen[group_first[k] .. group_first[k + 1]).
+   * A group that moves as one (another car, a late box) is culled as a whole by a sphere
+   * around its root body (group_radius_m; < 0: never culled, e.g. the static world) */
+  int *group_first, *group_root;
+  double *group_radius_m;
+  int ngroup;
+  int groups_sized;          /* radii measured (needs kinematics: the first update) */
+  int few_n[LIDAR_FEW_RAYS]; /* lidar_select_few: ray j's list is bucket[j * nseen..] */
+  int *cand;                 /* candidates for this scan: seen, visible, crossing the scan plane */
+  int *cand_lo, *cand_n;     /* per candidate: first ray index of its sector and its ray count */
   int ncand;
   int *bucket_start; /* rays [from, to): candidates of ray from+j are */
   int *bucket;       /*   bucket[bucket_start[j] .. bucket_start[j+1]) */
@@ -48,6 +57,47 @@ void sim_lidar_config_default(sim_lidar_config_t *cfg) {
   for (int g = 0; g < mjNGROUP; g++) cfg->geomgroup[g] = g < 3;
 }
 
+/* Orders seen by root body (then geom id) and records the groups. */
+static void lidar_group(const mjModel *m, sim_lidar_t *l) {
+  for (int i = 1; i < l->nseen; i++) { /* insertion sort: once, a few hundred geoms */
+    const int g = l->seen[i], root = m->body_rootid[m->geom_bodyid[g]];
+    int j = i - 1;
+    while (j >= 0 && m->body_rootid[m->geom_bodyid[l->seen[j]]] > root) {
+      l->seen[j + 1] = l->seen[j];
+      j--;
+    }
+    l->seen[j + 1] = g;
+  }
+  l->ngroup = 0;
+  for (int i = 0; i < l->nseen; i++) {
+    const int root = m->body_rootid[m->geom_bodyid[l->seen[i]]];
+    if (l->ngroup == 0 || l->group_root[l->ngroup - 1] != root) {
+      l->group_root[l->ngroup] = root;
+      l->group_first[l->ngroup++] = i;
+    }
+  }
+  l->group_first[l->ngroup] = l->nseen;
+}
+
+/* Each moving group's bounding sphere around its root body: the farthest geom's bounding
+ * sphere from the root's origin, plus a margin for the joints inside the group (steering,
+ * wheel spin move geoms by far less). The world's geoms are never culled as a group. */
+static void lidar_size_groups(const mjModel *m, const mjData *d, sim_lidar_t *l) {
+  for (int k = 0; k < l->ngroup; k++) {
+    const int root = l->group_root[k];
+    double r = root == 0 ? -1.0 : 0.0;
+    for (int i = l->group_first[k]; r >= 0 && i < l->group_first[k + 1]; i++) {
+      const int g = l->seen[i];
+      if (m->geom_rbound[g] <= 0)
+        r = -1.0; /* unbounded */
+      else
+        r = fmax(r, mju_dist3(d->geom_xpos + 3 * g, d->xpos + 3 * root) + m->geom_rbound[g]);
+    }
+    l->group_radius_m[k] = r >= 0 ? r + LIDAR_GROUP_MARGIN_M : -1.0;
+  }
+  l->groups_sized = 1;
+}
+
 sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
                               const sim_lidar_config_t *cfg, char *err, size_t err_len) {
   if (!m || !base_body || !cfg) {
@@ -75,6 +125,9 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->root_body = m->body_rootid[body];
   size_t ng = (size_t)(m->ngeom ? m->ngeom : 1);
   l->seen = calloc(ng, sizeof *l->seen);
+  l->group_first = calloc(ng + 1, sizeof *l->group_first);
+  l->group_root = calloc(ng, sizeof *l->group_root);
+  l->group_radius_m = calloc(ng, sizeof *l->group_radius_m);
   l->cand = calloc(ng, sizeof *l->cand);
   l->cand_lo = calloc(ng, sizeof *l->cand_lo);
   l->cand_n = calloc(ng, sizeof *l->cand_n);
@@ -84,8 +137,9 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->quality = calloc(n, sizeof(float));
   l->out_ranges_m = calloc(n, sizeof(float));
   l->out_quality = calloc(n, sizeof(float));
-  if (!l->seen || !l->cand || !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m ||
-      !l->quality || !l->out_ranges_m || !l->out_quality) {
+  if (!l->seen || !l->group_first || !l->group_root || !l->group_radius_m || !l->cand ||
+      !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality ||
+      !l->out_ranges_m || !l->out_quality) {
     sim_lidar_destroy(l);
     err_set(err, err_len, "out of memory", NULL);
     return NULL;
@@ -96,6 +150,7 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
     if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue; /* the car itself */
     l->seen[l->nseen++] = g;
   }
+  lidar_group(m, l);
   l->rng = cfg->seed ? cfg->seed : 0x9E3779B97F4A7C15ull;
   l->last.num_rays = 0;
   l->last.ranges_m = l->out_ranges_m;
@@ -109,6 +164,9 @@ void sim_lidar_destroy(sim_lidar_t *l) {
   free(l->cand_lo);
   free(l->cand_n);
   free(l->seen);
+  free(l->group_first);
+  free(l->group_root);
+  free(l->group_radius_m);
   free(l->bucket_start);
   free(l->bucket);
   free(l->ranges_m);
@@ -192,13 +250,44 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l, cons
   }
 }
 
+/* Does any of the span rays (unit directions ux, uy in the scanner's axes) pass within
+ * r_plane of the point (px, py), which lies ahead of it? */
+static int lidar_circle_on_rays(mjtNum px, mjtNum py, mjtNum r_plane, const double *ux,
+                                const double *uy, int span, int *hit) {
+  int any = 0;
+  for (int j = 0; j < span; j++) {
+    hit[j] = px * ux[j] + py * uy[j] > 0 && fabs(px * uy[j] - py * ux[j]) <= r_plane;
+    any |= hit[j];
+  }
+  return any;
+}
+
+/* May a ray of the span reach group k at all? Its sphere against the scan plane and rays. */
+static int lidar_group_reachable(const mjData *d, const sim_lidar_t *l, int k,
+                                 const mjtNum origin[3], const mjtNum nrm[3], const mjtNum ax[3],
+                                 const mjtNum ay[3], const double *ux, const double *uy, int span) {
+  const double r = l->group_radius_m[k];
+  if (r < 0) return 1;
+  mjtNum rel[3];
+  mju_sub3(rel, d->xpos + 3 * l->group_root[k], origin);
+  const mjtNum dz = mju_dot3(rel, nrm);
+  if (fabs(dz) > r) return 0;
+  const mjtNum r_plane = sqrt(r * r - dz * dz), px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
+  const mjtNum dist = sqrt(px * px + py * py);
+  if (dist - r_plane > l->cfg.range_max_m) return 0;
+  int hit[LIDAR_FEW_RAYS];
+  return dist <= r_plane || lidar_circle_on_rays(px, py, r_plane, ux, uy, span, hit);
+}
+
 /* The spinning update casts a few rays per step: for those, lidar_select's sectors (an atan2
  * and an asin per geom) and the bucket sort cost more than testing each ray against each
- * geom's circle directly. Fills cand and the per-ray buckets for rays [from, to). Returns -1
- * on no memory. */
+ * geom's circle directly, and other cars are skipped whole when their sphere misses the
+ * rays. Fills cand and, for ray from + j, the list bucket[j * nseen ..] of few_n[j]
+ * candidates. Returns -1 on no memory. */
 static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
                             const mjtNum origin[3], const mjtNum ax[3], const mjtNum ay[3],
                             int from, int to) {
+  if (!l->groups_sized) lidar_size_groups(m, d, l);
   mjtNum nrm[3];
   mju_cross(nrm, ax, ay);
   const int span = to - from;
@@ -207,6 +296,7 @@ static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
   for (int j = 0; j < span; j++) {
     ux[j] = cos((from + j) * inc);
     uy[j] = sin((from + j) * inc);
+    l->few_n[j] = 0;
   }
   const size_t need = (size_t)span * (size_t)(l->nseen > 0 ? l->nseen : 1);
   if (need > l->bucket_cap) {
@@ -215,32 +305,25 @@ static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
     l->bucket = b;
     l->bucket_cap = need + 64;
   }
-  /* ray j's candidates go to bucket[j * nseen ...]; compacted below */
-  int count[LIDAR_FEW_RAYS] = {0};
   l->ncand = 0;
-  for (int s_i = 0; s_i < l->nseen; s_i++) {
-    const int g = l->seen[s_i];
-    if (m->geom_rgba[4 * g + 3] == 0) continue;
-    mjtNum px, py, r_plane;
-    const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
-    if (where == 0) continue;
-    int used = 0;
-    for (int j = 0; j < span; j++) {
-      /* the ray's line passes within r_plane of the circle's centre, which lies ahead */
-      if (where == 1 && (px * ux[j] + py * uy[j] <= 0 || fabs(px * uy[j] - py * ux[j]) > r_plane))
+  for (int k = 0; k < l->ngroup; k++) {
+    if (!lidar_group_reachable(d, l, k, origin, nrm, ax, ay, ux, uy, span)) continue;
+    for (int s_i = l->group_first[k]; s_i < l->group_first[k + 1]; s_i++) {
+      const int g = l->seen[s_i];
+      if (m->geom_rgba[4 * g + 3] == 0) continue; /* alpha changes: late boxes appear */
+      mjtNum px, py, r_plane;
+      const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
+      if (where == 0) continue;
+      int hit[LIDAR_FEW_RAYS];
+      if (where == 2)
+        for (int j = 0; j < span; j++) hit[j] = 1;
+      else if (!lidar_circle_on_rays(px, py, r_plane, ux, uy, span, hit))
         continue;
-      l->bucket[j * l->nseen + count[j]++] = l->ncand;
-      used = 1;
+      for (int j = 0; j < span; j++)
+        if (hit[j]) l->bucket[j * l->nseen + l->few_n[j]++] = l->ncand;
+      l->cand[l->ncand++] = g;
     }
-    if (used) l->cand[l->ncand++] = g;
   }
-  int at = 0;
-  for (int j = 0; j < span; j++) {
-    l->bucket_start[j] = at;
-    memmove(l->bucket + at, l->bucket + j * l->nseen, (size_t)count[j] * sizeof *l->bucket);
-    at += count[j];
-  }
-  l->bucket_start[span] = at;
   return 0;
 }
 
@@ -360,9 +443,9 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
   if (from >= to) return;
   mjtNum o[3], ax[3], ay[3], vec[3];
   lidar_frame(d, l, o, ax, ay);
-  int bucketed;
+  int bucketed, few = 0;
   if (to - from <= LIDAR_FEW_RAYS) {
-    bucketed = lidar_select_few(m, d, l, o, ax, ay, from, to) == 0;
+    few = bucketed = lidar_select_few(m, d, l, o, ax, ay, from, to) == 0;
     if (!bucketed) lidar_select(m, d, l, o, ax, ay); /* no memory: every candidate per ray */
   } else {
     lidar_select(m, d, l, o, ax, ay);
@@ -371,9 +454,11 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
   double inc = 2.0 * M_PI / l->cfg.num_rays;
   for (int i = from; i < to; i++) {
     ray_dir(ax, ay, i * inc, vec);
-    mjtNum x = bucketed ? lidar_cast(m, d, l, o, vec, l->bucket + l->bucket_start[i - from],
-                                     l->bucket_start[i - from + 1] - l->bucket_start[i - from])
-                        : lidar_cast(m, d, l, o, vec, NULL, l->ncand);
+    const int j = i - from;
+    mjtNum x = few        ? lidar_cast(m, d, l, o, vec, l->bucket + j * l->nseen, l->few_n[j])
+               : bucketed ? lidar_cast(m, d, l, o, vec, l->bucket + l->bucket_start[j],
+                                       l->bucket_start[j + 1] - l->bucket_start[j])
+                          : lidar_cast(m, d, l, o, vec, NULL, l->ncand);
     double r = lidar_range(l, x);
     if (isfinite(r) && l->cfg.noise_std_m > 0) {
       r += l->cfg.noise_std_m * lidar_gauss(l);
