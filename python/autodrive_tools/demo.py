@@ -22,6 +22,7 @@ from typing import Any, TextIO
 import yaml
 
 from . import channels, report
+from .inspect import export_mcap
 from .missions import MissionContext, loop, parking
 from .paths import OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
 from .proc import ProcessGroup, wait_for_path
@@ -50,7 +51,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         prog="tools/demo",
         description="Run the Nigel HIL demo: autodrive-sim (Parking School) + the unchanged "
         "autodrive-runtime on its ptys + a driver, recorded with lcm-logger. Writes "
-        "out/demo/{report.json,*.png,run.lcmlog}.",
+        "out/demo/{report.json,*.png,run.lcmlog,run.mcap}.",
     )
     p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
     p.add_argument("--out", default=str(OUT_DIR / "demo"), help="output folder")
@@ -179,6 +180,19 @@ def parking_plan(args: argparse.Namespace) -> parking.ParkingPlan:
     )
 
 
+def write_mcap(lcm_log: Path, out: Path, build: Path, say: Callable[[str], None]) -> None:
+    """run.mcap beside the LCM log, for Foxglove and ros2 bag; a failed export is reported and
+    does not fail the run (the LCM log stays the record)."""
+    saved_map = out / "map.yaml"
+    try:
+        counts = export_mcap.export_mcap(
+            lcm_log, out / "run.mcap", build, saved_map if saved_map.is_file() else None
+        )
+        say(f"wrote {out / 'run.mcap'} ({sum(counts.values())} messages, {len(counts)} topics)")
+    except (ValueError, RuntimeError, OSError) as e:
+        say(f"run.mcap not written: {e}")
+
+
 def run(
     args: argparse.Namespace,
     console: TextIO = sys.stdout,
@@ -266,6 +280,7 @@ def run(
     say(f"report: {json.dumps(rep)}")
     pngs = ", ".join(p.name for p in sorted(out.glob("*.png")))
     say(f"wrote {out}/report.json, plots {pngs}, log {lcm_log}")
+    write_mcap(lcm_log, out, build, say)
     if interrupted:
         return EXIT_INTERRUPTED
     if not rep.get("ok"):

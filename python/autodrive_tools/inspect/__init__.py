@@ -1,0 +1,1 @@
+"""Inspection of runs in the tools robotics people use: MCAP export for Foxglove and ros2 bag."""
