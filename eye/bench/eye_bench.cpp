@@ -8,12 +8,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
-#include <optional>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <memory>
+#include <optional>
 
 #include "eye_detect.hpp"
 #include "eye_mapcal.hpp"
@@ -102,18 +103,18 @@ Scene make_scene(int w, int h, int frames, double tag_size_m,
   return sc;
 }
 
-// The Eye: decode, detect, locate, publish.
-RunResult run_eye(const Scene &sc, lcm::LCM &lcm, int repeats, bool roi) {
+// Times `repeats` passes over the scene's frames: decode, detect (start_pass() gives a fresh
+// detector for each pass, a function of the grey frame to its car poses), publish.
+template <typename StartPass>
+RunResult time_passes(const Scene &sc, lcm::LCM &lcm, int repeats, StartPass start_pass) {
   RunResult r;
-  eye::RunConfig cfg = sc.cfg;
-  cfg.tracking.roi = roi;
   for (int rep = 0; rep < repeats; ++rep) {
-    eye::Tracker tr(cfg);  // fresh: every pass starts with a full scan
+    auto detect = start_pass();
     const auto t0 = clock_type::now();
     const double c0 = thread_cpu_s();
     for (size_t i = 0; i < sc.jpeg.size(); ++i) {
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
-      const auto poses = tr.process(g);
+      const std::vector<eye::CarPose> poses = detect(g);
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
       if (rep == 0)
         r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
@@ -125,43 +126,42 @@ RunResult run_eye(const Scene &sc, lcm::LCM &lcm, int repeats, bool roi) {
   return r;
 }
 
+// The Eye: decode, detect, locate, publish.
+RunResult run_eye(const Scene &sc, lcm::LCM &lcm, int repeats, bool roi) {
+  eye::RunConfig cfg = sc.cfg;
+  cfg.tracking.roi = roi;
+  return time_passes(sc, lcm, repeats, [&cfg] {
+    auto tr = std::make_shared<eye::Tracker>(cfg);  // fresh: every pass starts with a full scan
+    return [tr](const cv::Mat &g) { return tr->process(g); };
+  });
+}
+
 // The peer: the same pipeline with OpenCV aruco's detector in place of libapriltag.
 RunResult run_peer(const Scene &sc, lcm::LCM &lcm, int repeats) {
-  RunResult r;
   auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
   auto params = cv::aruco::DetectorParameters::create();
   params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
-  for (int rep = 0; rep < repeats; ++rep) {
-    const auto t0 = clock_type::now();
-    const double c0 = thread_cpu_s();
-    for (size_t i = 0; i < sc.jpeg.size(); ++i) {
-      const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
-      std::vector<int> ids;
-      std::vector<std::vector<cv::Point2f>> corners;
-      cv::aruco::detectMarkers(g, dict, corners, ids, params);
-      std::vector<eye::CarPose> poses;
-      for (size_t k = 0; k < ids.size(); ++k) {
-        if (ids[k] != 1) continue;
-        // aruco's bitmap is AprilTag's turned 180 deg; its corners (TL, TR, BR, BL of its
-        // bitmap) are our BR, BL, TL, TR: reorder to libapriltag's BL, BR, TR, TL.
-        eye::Detection d;
-        d.id = ids[k];
-        const auto &c = corners[k];
-        // No half-pixel shift: with CORNER_REFINE_SUBPIX the marker corners follow OpenCV's
-        // convention (shifting them by -0.5 px measured worse: 2.9 vs 2.0 mm RMS).
-        d.corners_px = {cv::Point2d(c[1]), cv::Point2d(c[0]), cv::Point2d(c[3]), cv::Point2d(c[2])};
-        if (auto p = eye::locate_car(sc.cfg.in, sc.cfg.pose, sc.cfg.locate, sc.cfg.vehicles[0], d))
-          poses.push_back(*p);
-      }
-      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
-      if (rep == 0)
-        r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
+  const auto detect = [&](const cv::Mat &g) {
+    std::vector<int> ids;
+    std::vector<std::vector<cv::Point2f>> corners;
+    cv::aruco::detectMarkers(g, dict, corners, ids, params);
+    std::vector<eye::CarPose> poses;
+    for (size_t k = 0; k < ids.size(); ++k) {
+      if (ids[k] != 1) continue;
+      // aruco's bitmap is AprilTag's turned 180 deg; its corners (TL, TR, BR, BL of its
+      // bitmap) are our BR, BL, TL, TR: reorder to libapriltag's BL, BR, TR, TL.
+      eye::Detection d;
+      d.id = ids[k];
+      const auto &c = corners[k];
+      // No half-pixel shift: with CORNER_REFINE_SUBPIX the marker corners follow OpenCV's
+      // convention (shifting them by -0.5 px measured worse: 2.9 vs 2.0 mm RMS).
+      d.corners_px = {cv::Point2d(c[1]), cv::Point2d(c[0]), cv::Point2d(c[3]), cv::Point2d(c[2])};
+      if (auto p = eye::locate_car(sc.cfg.in, sc.cfg.pose, sc.cfg.locate, sc.cfg.vehicles[0], d))
+        poses.push_back(*p);
     }
-    const double n = static_cast<double>(sc.jpeg.size());
-    r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
-    r.pass_fps_cpu.push_back(n / (thread_cpu_s() - c0));
-  }
-  return r;
+    return poses;
+  };
+  return time_passes(sc, lcm, repeats, [&detect] { return detect; });
 }
 
 struct Accuracy {
