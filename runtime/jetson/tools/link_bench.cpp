@@ -137,17 +137,22 @@ struct StateWatch {
     states.push_back(*m);
     rx_mono_us.push_back(clk::monotonic_us());
   }
+  // Subscribes to the vehicle's STATE and waits (up to 60 s) for the first 10 messages.
+  // Returns whether they came.
+  bool attach(lcm::LCM &lcm, const std::string &vehicle) {
+    lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
+        lcm, vehicle + "_STATE", this);
+    const int64_t give_up = clk::monotonic_us() + 60000000;
+    while (states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
+    return states.size() >= 10;
+  }
 };
 
 int run_pwm(const std::string &url, const std::string &vehicle, const std::string &log_path,
             int samples) {
   lcm::LCM lcm(url);
   StateWatch w;
-  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
-      lcm, vehicle + "_STATE", &w);
-  const int64_t give_up = clk::monotonic_us() + 60000000;
-  while (w.states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
-  if (w.states.size() < 10) {
+  if (!w.attach(lcm, vehicle)) {
     std::fprintf(stderr, "pwm: no %s_STATE (bridge not linked to nano-simavr?)\n", vehicle.c_str());
     return 1;
   }
@@ -217,10 +222,7 @@ int run_telemetry(const std::string &url, const std::string &vehicle, double sec
                   const std::string &key_suffix) {
   lcm::LCM lcm(url);
   StateWatch w;
-  lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
-      lcm, vehicle + "_STATE", &w);
-  const int64_t give_up = clk::monotonic_us() + 60000000;
-  while (w.states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
+  w.attach(lcm, vehicle);  // the rate below counts whatever arrives after this
   w.states.clear();
   w.rx_mono_us.clear();
   const int64_t end = clk::monotonic_us() + static_cast<int64_t>(seconds * 1e6);
