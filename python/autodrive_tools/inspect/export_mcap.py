@@ -30,16 +30,9 @@ from mcap_ros2.writer import Writer as Ros2Writer
 from .. import channels, lcmtypes, vehicle
 from ..paths import RELEASE_BUILD
 from ..runfiles import read_occupancy
-from . import ros2_schemas
+from . import frames, ros2_schemas
+from .frames import MAP_FRAME, SENSOR_MOUNTS
 
-# base_link -> sensor frames, from the vehicle description's mount keys
-SENSOR_MOUNTS = {
-    "laser": "lidar_pos_m",
-    "imu_link": "imu_pos_m",
-    "camera_front": "cam_front_pos_m",
-    "camera_rear": "cam_rear_pos_m",
-}
-MAP_FRAME = "map"  # the simulator's world frame is the map's
 
 Msg = dict[str, Any]
 
@@ -79,22 +72,6 @@ def _transform(
         "child_frame_id": child,
         "transform": {"translation": {"x": x, "y": y, "z": z}, "rotation": _quat_yaw(yaw)},
     }
-
-
-def _lcm_fields(msg: Any) -> Msg:
-    """An LCM message's fields as JSON-able values (bytes as a length: images are not JSON)."""
-    out: Msg = {}
-    for name in msg.__slots__:
-        v = getattr(msg, name)
-        if isinstance(v, (bytes, bytearray)):
-            out[name + "_bytes"] = len(v)
-        elif isinstance(v, (list, tuple)):
-            out[name] = [x if isinstance(x, (int, float, str, bool)) else str(x) for x in v]
-        elif hasattr(v, "__slots__"):
-            out[name] = _lcm_fields(v)
-        else:
-            out[name] = v
-    return out
 
 
 def _json_schema(fields: Msg, title: str) -> Msg:
@@ -170,26 +147,24 @@ class Converter:
             "path2d_t": self.path,
         }
 
-    @staticmethod
-    def frame(veh: str, name: str) -> str:
-        return name if name == MAP_FRAME or not veh else f"{veh.lower()}/{name}"
+    frame = staticmethod(frames.frame)
 
     def event(self, types: Any, channel: str, data: bytes, log_us: int) -> None:
-        ch = self.table.match(channel)
-        if ch is None:
+        found = frames.resolve(self.table, channel)
+        if found is None:
             self.unknown[channel] += 1
             return
-        veh = channel[: -len(ch.name) + len(channels.VEH)] if ch.per_vehicle else ""
+        ch, veh = found
         msg = getattr(types, ch.type).decode(data)
         utime = int(getattr(msg, "utime", 0)) or log_us
-        topic = "/" + (veh.lower() + "/" if veh else "") + ch.id.lower()
+        topic = frames.topic(ch, veh)
         if veh and veh not in self.static_sent:
             self.static_tf(veh, utime)
         handler = self.handlers.get(ch.type)
         if handler:
             handler(topic, veh, msg, utime)
         else:
-            self.out.json(topic, f"autodrive.{ch.type}", _lcm_fields(msg), utime * 1000)
+            self.out.json(topic, f"autodrive.{ch.type}", frames.lcm_fields(msg), utime * 1000)
 
     def static_tf(self, veh: str, utime: int) -> None:
         tfs = []
@@ -265,10 +240,7 @@ class Converter:
             tf = _transform(utime, parent, child, m.x_m, m.y_m, 0.0, m.yaw_rad)
             self.out.ros2("/tf", "tf2_msgs/TFMessage", {"transforms": [tf]}, utime * 1000)
         elif m.frame_id == MAP_FRAME and veh in self.latest_odom:
-            ox, oy, oyaw = self.latest_odom[veh]
-            yaw = m.yaw_rad - oyaw  # map_T_odom = map_T_base * inverse(odom_T_base)
-            c, s = math.cos(yaw), math.sin(yaw)
-            x, y = m.x_m - (c * ox - s * oy), m.y_m - (s * ox + c * oy)
+            x, y, yaw = frames.map_to_odom((m.x_m, m.y_m, m.yaw_rad), self.latest_odom[veh])
             tf = _transform(utime, MAP_FRAME, self.frame(veh, "odom"), x, y, 0.0, yaw)
             self.out.ros2("/tf", "tf2_msgs/TFMessage", {"transforms": [tf]}, utime * 1000)
 
