@@ -22,10 +22,16 @@ RunConfig runconfig_load(const std::string &path) {
   c.intrinsics_path = resolve(path, yaml_string(n, "intrinsics", path));
   c.map_path = resolve(path, yaml_string(n, "map", path));
   if (n["lcm_url"]) c.lcm_url = yaml_string(n, "lcm_url", path);
-  c.locate.tag_size_m = yaml_double(n, "tag_size_m", path);
+  // Default: the simulated Nigel's tag (vehicle/nigel.params); a lab gives its printed size.
+  c.locate.tag_size_m = AUTODRIVE_VEHICLE_TAG_SIZE_M;
+  if (n["tag_size_m"]) c.locate.tag_size_m = yaml_double(n, "tag_size_m", path);
   if (!(c.locate.tag_size_m > 0)) throw Error(path + ": field 'tag_size_m' must be positive");
-  const auto off = yaml_doubles(n, "tag_offset_m", path, 3);
-  c.locate.tag_offset_m = cv::Vec3d(off[0], off[1], off[2]);
+  // Nigel's roof tag offset comes from vehicle/nigel.params (tag_pos_m); a config gives it only
+  // for a car of another kind.
+  if (n["tag_offset_m"]) {
+    const auto off = yaml_doubles(n, "tag_offset_m", path, 3);
+    c.locate.tag_offset_m = cv::Vec3d(off[0], off[1], off[2]);
+  }
   if (n["base_link_height_m"])
     c.locate.base_link_height_m = yaml_double(n, "base_link_height_m", path);
   if (n["corner_sigma_px"]) c.locate.corner_sigma_px = yaml_double(n, "corner_sigma_px", path);

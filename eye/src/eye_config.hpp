@@ -1,5 +1,7 @@
 // The `run` configuration file: calibration files, tag geometry, vehicles, detector, LCM.
 #pragma once
+#include <autodrive_channels.h>
+
 #include <string>
 #include <vector>
 
@@ -19,7 +21,7 @@ struct RunConfig {
   std::string path;             // the config file itself
   std::string intrinsics_path;  // resolved against the config file's folder
   std::string map_path;
-  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  std::string lcm_url = AUTODRIVE_LCM_URL_DEFAULT;
   Intrinsics in;
   CameraPose pose;
   LocateParams locate;

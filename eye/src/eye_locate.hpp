@@ -2,6 +2,8 @@
 // height above the floor, not the floor: no parallax), fit a 2D rigid transform to the tag's
 // known corners, then step from the tag back to the car's base_link.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <opencv2/core.hpp>
 
 #include <array>
@@ -21,11 +23,12 @@ struct VehicleTag {
 };
 
 struct LocateParams {
-  double tag_size_m = 0.09;                          // black border edge length [m]
-  cv::Vec3d tag_offset_m = {0.035125, 0, 0.129165};  // tag centre in base_link [m]
-  double base_link_height_m = 0.0;                   // base_link above the floor [m]
-  double corner_sigma_px = 0.15;                     // corner noise for the covariance [px]
-  double max_fit_rms_m = 0.01;                       // reject a fit worse than this [m]
+  double tag_size_m = AUTODRIVE_VEHICLE_TAG_SIZE_M;  // black border edge length [m]
+  cv::Vec3d tag_offset_m = {AUTODRIVE_VEHICLE_TAG_POS_M_X, AUTODRIVE_VEHICLE_TAG_POS_M_Y,
+                            AUTODRIVE_VEHICLE_TAG_POS_M_Z};  // tag centre in base_link [m]
+  double base_link_height_m = 0.0;                           // base_link above the floor [m]
+  double corner_sigma_px = 0.15;                             // corner noise for the covariance [px]
+  double max_fit_rms_m = 0.01;                               // reject a fit worse than this [m]
 };
 
 struct CarPose {

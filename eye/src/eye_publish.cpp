@@ -1,3 +1,4 @@
+#include <autodrive_channels.h>
 #include "eye_publish.hpp"
 
 #include <autodrive/pose2d_t.hpp>
@@ -16,7 +17,7 @@ int publish_poses(lcm::LCM &lcm, const std::vector<CarPose> &poses, int64_t utim
     m.y_m = p.y_m;
     m.yaw_rad = p.yaw_rad;
     for (int i = 0; i < 9; ++i) m.covariance[i] = p.cov[static_cast<size_t>(i)];
-    if (lcm.publish(p.vehicle + "_POSE_EYE", &m) == 0) ++n;
+    if (lcm.publish(p.vehicle + AUTODRIVE_CH_POSE_EYE_SUFFIX, &m) == 0) ++n;
   }
   return n;
 }

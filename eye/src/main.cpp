@@ -1,4 +1,5 @@
 // autodrive-eye: overhead AprilTag localisation of every car, and its calibration tools.
+#include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -133,7 +134,7 @@ int main(int argc, char **argv) {
 
   // run
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
-  std::string rn_config, rn_source = "lcm:EYE_IMAGE", rn_debug, rn_url;
+  std::string rn_config, rn_source = std::string("lcm:") + AUTODRIVE_CH_EYE_IMAGE, rn_debug, rn_url;
   double rn_fps = 30.0, rn_idle_s = 0.0;
   int rn_max_frames = 0, rn_debug_every = 1;
   bool rn_quiet = false;

@@ -18,7 +18,7 @@ SynthScene synth_scene(int w, int h, double tag_size_m) {
   s.in.k = cv::Matx33d(f, 0, (w - 1) / 2.0, 0, f, (h - 1) / 2.0, 0, 0, 1);
   s.pose = camera_look_at({1.52, 0.93, 2.5}, {1.5, 1.0, 0.0}, {0, 1, 0});
   s.car.tag_size_m = tag_size_m;
-  s.car.tag_offset_m = {0.035125, 0, 0.129165};
+  s.car.tag_offset_m = eye::LocateParams{}.tag_offset_m;  // Nigel's (vehicle/nigel.params)
   s.car.base_link_height_m = 0.0;
   // Floor: mid grey with a smooth gradient and soft blobs, so thresholds see texture.
   s.floor = cv::Mat(h, w, CV_8UC1);

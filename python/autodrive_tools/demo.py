@@ -24,7 +24,7 @@ import yaml
 from . import channels, report
 from .inspect import export_mcap
 from .missions import MissionContext, loop, parking
-from .paths import OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
+from .paths import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
 from .proc import ProcessGroup, wait_for_path
 
 VEHICLE = "NIGEL1"
@@ -117,8 +117,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument(
         "--rtf", type=float, help="pace the simulator at this real-time factor instead of lockstep"
     )
+    p.add_argument(
+        "--cameras",
+        type=float,
+        default=0.0,
+        metavar="FPS",
+        help="render every camera (front, rear, the overhead Eye) at FPS [Hz of sim time] and run "
+        "autodrive-eye on the overhead one, whose poses the runtime fuses (default 0: off)",
+    )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if args.cameras < 0:
+        p.error(f"--cameras {args.cameras}: the frame rate must be >= 0 Hz")
+    return args
 
 
 def write_runtime_config(out: Path, run_dir: Path, url: str) -> Path:
@@ -146,6 +157,8 @@ def sim_argv(
     argv: list[object] = [build / "bin" / "autodrive-sim", "--map", "parking_school"]
     argv += ["--run-dir", run_dir, "--seed", args.seed, "--lcm-url", args.lcm_url]
     argv += ["--duration", duration_s]
+    if args.cameras > 0:
+        argv += ["--cameras", "--eye", "--camera-fps", args.cameras]
     if plan is not None:
         argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
         s = plan.start
@@ -248,6 +261,10 @@ def run(
         procs.start("lcm-logger", [*logger_argv, lcm_log], out / "lcm-logger.log")
         procs.start("autodrive-sim", sim_argv(args, build, run_dir, rtf, plan), out / "sim.log")
         wait_for_path(run_dir / "nigel1-nano", PTY_TIMEOUT_S, procs)
+        if args.cameras > 0:
+            eye_argv = [build / "bin" / "autodrive-eye", "run", "-c", EYE_SIM_CONFIG, "-q"]
+            eye_argv += ["--source", f"lcm:{channels.channel('EYE_IMAGE')}"]
+            procs.start("autodrive-eye", [*eye_argv, "--lcm-url", args.lcm_url], out / "eye.log")
         runtime = build / "bin" / "autodrive-runtime"
         procs.start("autodrive-runtime", [runtime, "--config", cfg_path], out / "runtime.log")
         if plan is None:

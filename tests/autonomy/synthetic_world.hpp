@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <autodrive_vehicle.h>
 
 #include "autonomy/grid_map.hpp"
 #include "autonomy/path.hpp"
@@ -103,7 +104,8 @@ struct World {
 struct Bicycle {
   Pose2 pose;
   double speed_m_s = 0.0, steer_rad = 0.0;
-  double wheelbase_m = 0.14154, speed_tau_s = 0.1, steer_rate_rad_s = 0.805;
+  double wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M, speed_tau_s = 0.1,
+         steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;
   void step(double cmd_speed_m_s, double cmd_steer_rad, double dt_s) {
     speed_m_s += (cmd_speed_m_s - speed_m_s) * std::min(1.0, dt_s / speed_tau_s);
     const double ds =

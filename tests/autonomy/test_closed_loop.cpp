@@ -49,7 +49,7 @@ double body_clearance_m(const synth::World &w, const Pose2 &base, const Footprin
 Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose2> &route = {},
                     double yaw_tolerance_rad = -1.0, double retry_backoff_m = 0.0) {
   synth::World world = synth::World::parking_lot();
-  const Pose2 lidar{0.1445, 0.0, 0.0};
+  const Pose2 lidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0.0, 0.0};
   NodeConfig cfg;
   const fs::path dir = fs::temp_directory_path() /
                        ("autonomy_closed_loop_" + tag + "_" + std::to_string(::getpid()));
@@ -103,7 +103,7 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
     mp = std::max(mp, pr);
     const TrackerCommand &c = node.command();
     const Pose2 before = car.pose;
-    car.step(c.throttle * 0.267, c.steering * 0.5236, dt);
+    car.step(c.throttle * 0.267, c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, dt);
     Pose2 d = pose_between(before, car.pose);
     d.x_m *= 1.02;      // wheel odometry scale error
     d.yaw_rad += 1e-5;  // gyro bias, 1 mrad/s

@@ -9,7 +9,7 @@
 using namespace autonomy;
 
 namespace {
-const Pose2 kLidar{0.1445, 0.0, 0.0};
+const Pose2 kLidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0.0, 0.0};
 
 LaserOdomConfig lo_config() {
   LaserOdomConfig c;

@@ -10,7 +10,8 @@ using namespace autonomy;
 
 namespace {
 
-const double kMaxCurvature = std::tan(0.5236) / 0.14154;  // Nigel's steering limit [1/m]
+const double kMaxCurvature = std::tan(AUTODRIVE_VEHICLE_STEER_LIMIT_RAD) /
+                             AUTODRIVE_VEHICLE_WHEELBASE_M;  // Nigel's steering limit [1/m]
 
 // Checks every sample's curvature and, numerically, the curvature traced between samples.
 void expect_feasible(const Path &path) {

@@ -88,7 +88,16 @@ TEST(Program, HelpAndBadConfig) {
   std::ofstream(bad) << "goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nplanner: {wheelbase: 0.1}\n";
   out.clear();
   EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2);
-  EXPECT_NE(out.find("unknown key 'planner.wheelbase'"), std::string::npos) << out;
+  EXPECT_NE(out.find(bad.string() + ": planner.wheelbase: unknown key"), std::string::npos) << out;
+  // A figure of the car is refused with where it comes from instead.
+  std::ofstream(bad) << "goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nplanner: {wheelbase_m: 0.1}\n";
+  out.clear();
+  EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2);
+  EXPECT_NE(out.find("planner.wheelbase_m: is a figure of the car"), std::string::npos) << out;
+  std::ofstream(bad) << "goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nslam: {levels: many}\n";
+  out.clear();
+  EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2);
+  EXPECT_NE(out.find("slam.levels: bad value 'many'"), std::string::npos) << out;
   fs::remove(bad);
 }
 
@@ -125,7 +134,7 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
           static_cast<char *>(nullptr));
     _exit(127);
   }
-  const Pose2 lidar{0.1445, 0, 0};
+  const Pose2 lidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0, 0};
   // The car stands still: odometry at its origin, scans from the true pose, 100 Hz / 7 Hz of
   // message time; a bounded number of steps, never a wall-time assert.
   for (int i = 0; i < 6000 && !(l.max_state >= 4 && l.engaged_motion && l.have_amcl && l.have_path);

@@ -60,7 +60,7 @@ RunResult run(const Path &path, const Pose2 &start, double settle_m = 0.0) {
     }
     // Throttle -> speed through the documented linear map (1.0 = 0.267 m/s).
     const Pose2 before = car.pose;
-    car.step(c.throttle * 0.267, c.steering * 0.5236, dt);
+    car.step(c.throttle * 0.267, c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, dt);
     travelled += std::hypot(car.pose.x_m - before.x_m, car.pose.y_m - before.y_m);
     if (travelled > settle_m)
       r.max_cross_track_m = std::max(r.max_cross_track_m,
@@ -98,7 +98,8 @@ TEST(PurePursuit, FollowsACurveWithinABound) {
 }
 
 TEST(PurePursuit, FollowsATightCurveAtTheSteeringLimit) {
-  const double k = std::tan(0.8 * 0.5236) / 0.14154;  // the planner's tightest arc
+  const double k = std::tan(0.8 * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD) /
+                   AUTODRIVE_VEHICLE_WHEELBASE_M;  // the planner's tightest arc
   Path p = arc({0, 0, 0}, 0.8, k, 1);
   const Path tail = straight(p.back().pose, 0.3, 1);
   p.insert(p.end(), tail.begin() + 1, tail.end());
@@ -121,7 +122,8 @@ TEST(PurePursuit, ReversesAlongACurve) {
 }
 
 TEST(PurePursuit, DrivesAReedsSheppParkingManoeuvreWithCusps) {
-  const double R = 1.0 / (std::tan(0.8 * 0.5236) / 0.14154);
+  const double R =
+      1.0 / (std::tan(0.8 * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD) / AUTODRIVE_VEHICLE_WHEELBASE_M);
   const Pose2 start{0, 0, 0}, goal{0.3, -0.45, kPi / 2};
   const auto paths = rs_paths(start, goal, R);
   ASSERT_FALSE(paths.empty());
@@ -147,7 +149,7 @@ TEST(PurePursuit, SpeedProfileSlowsToAStopAndRespectsTopSpeed) {
     peak = std::max(peak, c.speed_m_s);
     if (car.pose.x_m > 1.49) last_speed_near_end = std::min(last_speed_near_end, c.speed_m_s);
     EXPECT_NEAR(c.throttle, c.speed_m_s / 0.267, 1e-9);  // the documented linear map
-    car.step(c.throttle * 0.267, c.steering * 0.5236, 0.02);
+    car.step(c.throttle * 0.267, c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, 0.02);
   }
   EXPECT_LE(peak, 0.267);
   EXPECT_GT(peak, 0.15);
@@ -170,7 +172,8 @@ TEST(PurePursuit, StallBoostGetsAStickyCarToTheEnd) {
       const TrackerCommand c = pp.step(car.pose, 0.02, feedback ? car.speed_m_s : std::nan(""));
       max_boost = std::max(max_boost, pp.boost());
       if (c.done) break;
-      car.step(std::abs(c.throttle) < 0.5 ? 0.0 : c.throttle * 0.267, c.steering * 0.5236, 0.02);
+      car.step(std::abs(c.throttle) < 0.5 ? 0.0 : c.throttle * 0.267,
+               c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, 0.02);
     }
     return std::make_pair(pp.done(), std::make_pair(car.pose.x_m, max_boost));
   };
@@ -192,7 +195,7 @@ TEST(PurePursuit, NoBoostWhileTheCarKeepsUp) {
   for (int i = 0; i < 3000 && !pp.done(); ++i) {
     const TrackerCommand c = pp.step(car.pose, 0.02, car.speed_m_s);
     EXPECT_EQ(pp.boost(), 0.0) << "at step " << i;
-    car.step(c.throttle * 0.267, c.steering * 0.5236, 0.02);
+    car.step(c.throttle * 0.267, c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, 0.02);
   }
   EXPECT_TRUE(pp.done());
 }

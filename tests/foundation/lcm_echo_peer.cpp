@@ -16,7 +16,8 @@ struct Echo {
 };
 
 // subscribeFunction, not the member-function subscribe(): LCM 1.3.1's member-function path
-// hands its callback a null subscription under UBSan (see runtime/jetson/common/lcm_sub.hpp).
+// hands its callback a null subscription under UBSan (see
+// lcm_types/include/autodrive_lcm/subscribe.hpp).
 void on_command(const lcm::ReceiveBuffer *, const std::string &,
                 const autodrive::vehicle_command_t *m, Echo *echo) {
   autodrive::vehicle_command_t r = *m;

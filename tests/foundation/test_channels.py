@@ -1,5 +1,6 @@
-"""Checks lcm_types/CHANNELS.md against lcm_types/autodrive/*.lcm: every listed channel has an
-existing type and a unique name, and every type starts with int64_t utime."""
+"""Checks the channel table lcm_types/channels.yaml against lcm_types/autodrive/*.lcm: every
+channel has an existing type, a unique name and id, and every type starts with int64_t utime.
+(CHANNELS.md is generated from the table; foundation.single_source checks it is fresh.)"""
 import pathlib
 import re
 import sys
@@ -23,31 +24,36 @@ for f in sorted(types_dir.glob("*_t.lcm")):
         errors.append(f"{f.name}: first field must be 'int64_t utime;', found {fields[:1]}")
     types[f.stem] = f
 
+sys.path.insert(0, str(root / "python"))
+from autodrive_tools import channels as channel_table  # noqa: E402
+
+table = channel_table.load(root / "lcm_types" / "channels.yaml")
 channels = {}
+ids = set()
 rows = 0
-for ln in (root / "lcm_types" / "CHANNELS.md").read_text().splitlines():
-    cells = [c.strip() for c in ln.strip().strip("|").split("|")]
-    if len(cells) < 4 or not cells[0].startswith("`"):
-        continue
+for ch in table.channels:
     rows += 1
-    name, typ = cells[0].strip("`"), cells[1].strip("`")
+    name, typ = ch.name, ch.type
     if not re.fullmatch(r"(<VEH>_)?[A-Z0-9_]+", name):
         errors.append(f"channel {name}: not UPPER_CASE (with optional <VEH>_ prefix)")
     if name in channels:
         errors.append(f"channel {name}: listed twice")
+    if ch.id in ids:
+        errors.append(f"channel {name}: id {ch.id} used twice")
+    if name.replace("<VEH>_", "") != ch.id:
+        errors.append(f"channel {name}: id {ch.id} does not match the name")
+    ids.add(ch.id)
     channels[name] = typ
-    if typ.split(".")[-1] not in types:
-        errors.append(
-            f"channel {name}: type {typ} has no lcm_types/autodrive/{typ.split('.')[-1]}.lcm"
-        )
-    if not cells[2] or not cells[3]:
-        errors.append(f"channel {name}: rate and publisher must be given")
+    if typ not in types:
+        errors.append(f"channel {name}: type {typ} has no lcm_types/autodrive/{typ}.lcm")
+    if not ch.rate or (ch.status == "live" and not ch.publishers):
+        errors.append(f"channel {name}: rate and (when live) a publisher must be given")
 
 unused = set(types) - {t.split(".")[-1] for t in channels.values()}
 if unused:
     errors.append(f"types no channel uses: {sorted(unused)}")
 if rows == 0:
-    errors.append("CHANNELS.md lists no channels")
+    errors.append("channels.yaml lists no channels")
 for e in errors:
     print("ERROR:", e)
 print(f"{rows} channels, {len(types)} types, {len(errors)} errors")

@@ -3,19 +3,26 @@ lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping
 that steps out after mapping). It must map, localise, see the box and replan, park without a
 collision, and meet issue 7's bounds by the simulator's ground truth. Lockstep makes the run
 independent of how loaded the machine is (the sim waits for the runtime), so the bounds are the
-issue's own."""
+issue's own.
+
+The run renders every camera at 2 Hz (sim time) and runs the Eye, so that every live channel of
+lcm_types/channels.yaml is on the bus: the recorded log is checked against the table both ways."""
 import json
 import pathlib
 import subprocess
 import sys
 import tempfile
 
+from autodrive_tools.inspect import channel_audit
+
 from hil_demo import demo_command
 
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
     r = subprocess.run(
-        demo_command(build, tmp, port, "--mission", "parking", "--timeout", "200"),
+        demo_command(
+            build, tmp, port, "--mission", "parking", "--timeout", "200", "--cameras", "2"
+        ),
         timeout=280,
     )
     report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
@@ -35,4 +42,9 @@ with tempfile.TemporaryDirectory(prefix="hil-park-") as tmp:
         "unmapped obstacle" in log
     ), f"the box that appeared after mapping was not seen ({appeared[0]}); autonomy:\n{log}"
     assert (pathlib.Path(tmp) / "parking.png").stat().st_size > 1000, "parking plot missing"
+    problems, seen = channel_audit.audit(
+        pathlib.Path(tmp) / "run.lcmlog", pathlib.Path(build), ["NIGEL1"]
+    )
+    print(f"channels on the bus: {dict(sorted(seen.items()))}")
+    assert not problems, "the bus and lcm_types/channels.yaml disagree:\n" + "\n".join(problems)
 print("hil parking ok")

@@ -17,7 +17,7 @@
 
 #include "bridge/nano_bridge.hpp"
 #include "common/config.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 #include "fake_nano.hpp"
 
 namespace {
@@ -26,8 +26,7 @@ std::string config_yaml(int port, const std::string &device) {
   return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
          "?ttl=0\"\n"
          "clock: wall\n"
-         "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
-         "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
+         "vehicle: {name: TESTCAR}\n"
          "bridge: {device: " +
          device +
          ", baud: 500000, heartbeat_hz: 50,\n"
@@ -43,10 +42,10 @@ class BridgeHarness {
         nano(link_, hash),
         config(cfg::parse(config_yaml(port, link_), "test config")),
         lcm(config.lcm_url) {
-    lcmsub::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
+    autodrive_lcm::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
         lcm, "TESTCAR_STATE", this);
-    lcmsub::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(lcm, "TESTCAR_IMU",
-                                                                               this);
+    autodrive_lcm::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(
+        lcm, "TESTCAR_IMU", this);
   }
   ~BridgeHarness() {
     stop_ = true;

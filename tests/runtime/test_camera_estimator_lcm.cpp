@@ -20,7 +20,7 @@
 
 #include "camera/camera_driver.hpp"
 #include "common/config.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 #include "estimator/estimator_node.hpp"
 
 namespace {
@@ -28,8 +28,7 @@ std::string base_yaml(int port) {
   return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
          "?ttl=0\"\n"
          "clock: wall\n"
-         "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
-         "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n";
+         "vehicle: {name: TESTCAR}\n";
 }
 
 bool pump_until(lcm::LCM &lcm, const std::function<bool()> &pred, double max_s = 30.0,
@@ -68,10 +67,10 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
                                    "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
-  lcmsub::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(lcm, "TESTCAR_CAM_FRONT",
-                                                                          &sink);
-  lcmsub::subscribe<autodrive::camera_info_t, Sink, &Sink::on_info>(lcm, "TESTCAR_CAM_FRONT_INFO",
-                                                                    &sink);
+  autodrive_lcm::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(
+      lcm, "TESTCAR_CAM_FRONT", &sink);
+  autodrive_lcm::subscribe<autodrive::camera_info_t, Sink, &Sink::on_info>(
+      lcm, "TESTCAR_CAM_FRONT_INFO", &sink);
   cam::CameraDriver driver(c, 0);
   ASSERT_EQ(driver.init_error(), "");
   std::atomic<bool> stop{false};
@@ -117,8 +116,9 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
   const cfg::Config c = cfg::parse(base_yaml(7776) + "estimator: {rate_hz: 100}\n", "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
-  lcmsub::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
-  lcmsub::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP", &sink);
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP",
+                                                                       &sink);
   est::EstimatorNode node(c);
   ASSERT_EQ(node.init_error(), "");
   std::atomic<bool> stop{false};

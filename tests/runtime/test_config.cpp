@@ -9,8 +9,7 @@ namespace {
 const char *kGood = R"(
 lcm_url: "udpm://239.255.76.67:7667?ttl=0"
 clock: wall
-vehicle: {name: NIGEL1, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,
-          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}
+vehicle: {name: NIGEL1}
 bridge: {device: /dev/ttyUSB0, baud: 500000, heartbeat_hz: 50, command_timeout_ms: 200}
 )";
 
@@ -56,6 +55,21 @@ TEST(Config, NegativeRateRefused) {
             std::string::npos);
 }
 
+TEST(Config, CarFigureInConfigRefused) {
+  // The car's figures come from vehicle/nigel.params; a config that restates one is refused.
+  const std::string e = error_of(replace(kGood, "name: NIGEL1", "name: NIGEL1, wheelbase_m: 0.2"));
+  EXPECT_NE(e.find("test.yaml: vehicle.wheelbase_m: is a figure of the car"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("vehicle/nigel.params"), std::string::npos) << e;
+}
+
+TEST(Config, VehicleFiguresComeFromTheDescription) {
+  const cfg::Config c = cfg::parse(kGood, "test.yaml");
+  EXPECT_DOUBLE_EQ(c.vehicle.wheelbase_m, AUTODRIVE_VEHICLE_WHEELBASE_M);
+  EXPECT_DOUBLE_EQ(c.vehicle.wheel_radius_m, AUTODRIVE_VEHICLE_WHEEL_RADIUS_M);
+  EXPECT_GT(c.vehicle.encoder_counts_per_rev, 0);
+}
+
 TEST(Config, UnknownKeyRefused) {
   EXPECT_EQ(error_of(replace(kGood, "baud: 500000", "baud: 500000, devcie: x")),
             "test.yaml: bridge.devcie: unknown key");
@@ -67,7 +81,7 @@ TEST(Config, BadClockRefused) {
 }
 
 TEST(Config, MalformedYamlRefused) {
-  EXPECT_NE(error_of("vehicle: [unclosed").find("test.yaml: not valid YAML"), std::string::npos);
+  EXPECT_NE(error_of("vehicle: [unclosed").find("test.yaml: is not valid YAML"), std::string::npos);
 }
 
 TEST(Config, MissingFileNamed) {
@@ -75,7 +89,7 @@ TEST(Config, MissingFileNamed) {
     cfg::load("/nonexistent/runtime.yaml");
     FAIL() << "no error";
   } catch (const cfg::Error &e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/runtime.yaml: cannot open the config file");
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/runtime.yaml: cannot be opened");
   }
 }
 

@@ -25,7 +25,7 @@
 #include <thread>
 
 #include "child_process.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 
 namespace {
 
@@ -63,17 +63,16 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     pwm_log_ = dir_ + "/pwm.log";
     lcm_ = std::make_unique<lcm::LCM>(url_);
     ASSERT_TRUE(lcm_->good());
-    lcmsub::subscribe<autodrive::vehicle_state_t, BackendE2E, &BackendE2E::on_state>(
+    autodrive_lcm::subscribe<autodrive::vehicle_state_t, BackendE2E, &BackendE2E::on_state>(
         *lcm_, "E2E1_STATE", this);
-    lcmsub::subscribe<autodrive::lidar_scan_t, BackendE2E, &BackendE2E::on_scan>(
+    autodrive_lcm::subscribe<autodrive::lidar_scan_t, BackendE2E, &BackendE2E::on_scan>(
         *lcm_, "E2E1_LIDAR", this);
-    lcmsub::subscribe<autodrive::lidar_scan_t, BackendE2E, &BackendE2E::on_sim_scan>(
+    autodrive_lcm::subscribe<autodrive::lidar_scan_t, BackendE2E, &BackendE2E::on_sim_scan>(
         *lcm_, "NIGEL1_LIDAR", this);
     // The runtime's config: only the device paths and the LCM URL differ from the car's.
     std::ofstream cfg(dir_ + "/runtime.yaml");
     cfg << "lcm_url: \"" << url_ << "\"\nclock: wall\n"
-        << "vehicle: {name: E2E1, wheelbase_m: 0.14154, track_m: 0.153, wheel_radius_m: 0.0325,\n"
-        << "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
+        << "vehicle: {name: E2E1}\n"
         << "bridge: {device: " << nano_link_ << ", baud: 500000, heartbeat_hz: 50,\n"
         << "         command_timeout_ms: 200, reconnect_ms: 200}\n";
     if (b.has_lidar)

@@ -9,7 +9,7 @@
 #include "estimator/estimator_node.hpp"
 
 namespace {
-constexpr double kL = 0.14154;  // wheelbase [m]
+constexpr double kL = AUTODRIVE_VEHICLE_WHEELBASE_M;  // wheelbase [m]
 
 struct Truth {
   double x = 0, y = 0, yaw = 0;

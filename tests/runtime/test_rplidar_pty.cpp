@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "common/config.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 #include "fake_nano.hpp"
 #include "rplidar/rplidar_decoder.hpp"
 #include "rplidar/rplidar_driver.hpp"
@@ -76,18 +76,15 @@ struct LidarHarness {
   explicit LidarHarness(int port)
       : link("/tmp/adr-rt-lidar-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         fake(link),
-        config(
-            cfg::parse("lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
-                           "?ttl=0\"\n"
-                           "clock: wall\n"
-                           "vehicle: {name: TESTCAR, wheelbase_m: 0.14154, track_m: 0.153, "
-                           "wheel_radius_m: 0.0325,\n"
-                           "          steering_limit_rad: 0.5236, encoder_counts_per_rev: 1920}\n"
-                           "lidar: {device: " +
-                           link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
-                       "test config")),
+        config(cfg::parse("lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+                              "?ttl=0\"\n"
+                              "clock: wall\n"
+                              "vehicle: {name: TESTCAR}\n"
+                              "lidar: {device: " +
+                              link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
+                          "test config")),
         lcm(config.lcm_url) {
-    lcmsub::subscribe<autodrive::lidar_scan_t, LidarHarness, &LidarHarness::on_scan>(
+    autodrive_lcm::subscribe<autodrive::lidar_scan_t, LidarHarness, &LidarHarness::on_scan>(
         lcm, "TESTCAR_LIDAR", this);
   }
   ~LidarHarness() {

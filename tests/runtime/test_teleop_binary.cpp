@@ -14,7 +14,7 @@
 #include <functional>
 
 #include "child_process.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 
 namespace {
 struct Commands {
@@ -49,8 +49,8 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   const std::string url = "udpm://239.255.76.67:7777?ttl=0";
   lcm::LCM lcm(url);
   Commands cmds;
-  lcmsub::subscribe<autodrive::vehicle_command_t, Commands, &Commands::on>(lcm, "JS1_COMMAND",
-                                                                           &cmds);
+  autodrive_lcm::subscribe<autodrive::vehicle_command_t, Commands, &Commands::on>(
+      lcm, "JS1_COMMAND", &cmds);
   rtest::Child teleop({AUTODRIVE_TELEOP_EXE, "--vehicle", "JS1", "--lcm-url", url, "--joystick",
                        fifo, "--no-keyboard", "--max-throttle", "0.5"},
                       fifo + ".log");

@@ -6,6 +6,8 @@
 
 #include "sim_test_util.h"
 
+#include <autodrive_vehicle.h>
+
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 
@@ -48,9 +50,9 @@ TEST(Eye, RoofTagsDecodeAtTheirIdsAndPositions) {
     seen[d->id]++;
     // project the car's tag centre (ground truth + roof offset) through the camera
     const sim_truth_t t = s.truth(d->id);
-    const double tx = t.pos_m[0] + 0.035125 * cos(t.yaw_rad),
-                 ty = t.pos_m[1] + 0.035125 * sin(t.yaw_rad);
-    const double depth = cam_h - (t.pos_m[2] + 0.129165);
+    const double tx = t.pos_m[0] + AUTODRIVE_VEHICLE_TAG_POS_M_X * cos(t.yaw_rad),
+                 ty = t.pos_m[1] + AUTODRIVE_VEHICLE_TAG_POS_M_X * sin(t.yaw_rad);
+    const double depth = cam_h - (t.pos_m[2] + AUTODRIVE_VEHICLE_TAG_POS_M_Z);
     const double u = k[2] + k[0] * tx / depth, v = k[5] - k[4] * ty / depth;  // image up = +y
     // libapriltag's pixel centres are +0.5 px off OpenCV's
     EXPECT_NEAR(d->c[0] - 0.5, u, 2.0) << "tag " << d->id;

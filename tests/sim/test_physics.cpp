@@ -8,9 +8,12 @@
 
 #include "sim_test_util.h"
 
+#include <autodrive_vehicle.h>
+
 namespace {
 
-const double kWheelbase_m = 0.14154, kSteerLimit_rad = 0.5236;
+const double kWheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M,
+             kSteerLimit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
 
 // Least-squares circle through points (Kasa fit): returns the radius [m].
 double fit_radius(const std::vector<double> &x, const std::vector<double> &y) {
@@ -105,7 +108,7 @@ TEST(Physics, SteeringRateIs0805RadPerS) {
   ASSERT_GT(t20, 0);
   ASSERT_GT(t80, 0);
   const double rate = 0.6 * kSteerLimit_rad / (t80 - t20);
-  EXPECT_NEAR(rate, 0.805, 0.03 * 0.805);
+  EXPECT_NEAR(rate, AUTODRIVE_VEHICLE_STEER_RATE_RAD_S, 0.03 * AUTODRIVE_VEHICLE_STEER_RATE_RAD_S);
   ASSERT_TRUE(s.run_to(1.5)) << s.err;
   EXPECT_NEAR(s.truth().steering_rad, kSteerLimit_rad, 0.01 * kSteerLimit_rad);
 }
@@ -124,7 +127,7 @@ TEST(Physics, EncodersCount1920PerWheelRevolution) {
   EXPECT_NEAR(n->enc[0], wheel_rad / (2 * M_PI) * 1920.0, 2.5);
   // the distance travelled matches the counts (rolling without much slip)
   const double dist = s.truth().pos_m[0] - x0;
-  EXPECT_NEAR(n->enc[0] / 1920.0 * 2 * M_PI * 0.0325, dist, 0.03 * dist);
+  EXPECT_NEAR(n->enc[0] / 1920.0 * 2 * M_PI * AUTODRIVE_VEHICLE_WHEEL_RADIUS_M, dist, 0.03 * dist);
 }
 
 TEST(Physics, ImuAtRestReadsGravityWithinBias) {
@@ -203,8 +206,8 @@ TEST(Sensors, RoofTagAndMountsAreInTheModel) {
     EXPECT_GE(mj_name2id(m, mjOBJ_CAMERA, name), 0) << name;
   const int lidar = mj_name2id(m, mjOBJ_SITE, "nigel1/lidar");
   ASSERT_GE(lidar, 0);
-  EXPECT_NEAR(m->site_pos[3 * lidar], 0.1445, 1e-9);
-  EXPECT_NEAR(m->site_pos[3 * lidar + 2], 0.1757, 1e-9);
+  EXPECT_NEAR(m->site_pos[3 * lidar], AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 1e-9);
+  EXPECT_NEAR(m->site_pos[3 * lidar + 2], AUTODRIVE_VEHICLE_LIDAR_POS_M_Z, 1e-9);
   // real tag36h11 textures, one per car
   EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
   EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);

@@ -12,7 +12,8 @@ extern "C" {
 
 namespace {
 
-constexpr double kOx_m = 0.1445, kOy_m = 0.0;  // scanner origin in the room (car at origin)
+constexpr double kOx_m = AUTODRIVE_VEHICLE_LIDAR_POS_M_X,
+                 kOy_m = 0.0;  // scanner origin in the room (car at origin)
 
 // Nearest positive t of the 2D ray o + t (c, s) against the room's walls, pillar and the other
 // car's mast, all of which span the scan height.

@@ -22,4 +22,15 @@ lcm::Subscription *subscribe(lcm::LCM &lcm, const std::string &channel, Obj *obj
   return lcm.subscribeFunction(channel, &member_thunk<Msg, Obj, Method>, obj);
 }
 
+template <class Msg, class Obj, void (Obj::*Method)(const Msg *)>
+void message_thunk(const lcm::ReceiveBuffer *, const std::string &, const Msg *m, Obj *o) {
+  (o->*Method)(m);
+}
+
+// The same for a handler that needs only the message: void Obj::on_msg(const msg_t *).
+template <class Msg, class Obj, void (Obj::*Method)(const Msg *)>
+lcm::Subscription *subscribe(lcm::LCM &lcm, const std::string &channel, Obj *obj) {
+  return lcm.subscribeFunction(channel, &message_thunk<Msg, Obj, Method>, obj);
+}
+
 }  // namespace autodrive_lcm

@@ -58,7 +58,6 @@ def write_eye_config(tmp: Path, url: str) -> Path:
     )
     (tmp / "eye.yaml").write_text(
         f'intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: "{url}"\n'
-        "tag_size_m: 0.08\ntag_offset_m: [0.035125, 0.0, 0.129165]\n"
         f"base_link_height_m: 0.0\nvehicles:\n - {{name: {VEHICLE}, tag_id: {TAG_ID}}}\n"
     )
     return tmp / "eye.yaml"

@@ -1,3 +1,4 @@
+#include <autodrive_channels.h>
 #include "bridge/nano_bridge.hpp"
 
 #include <autodrive/imu_t.hpp>
@@ -14,7 +15,7 @@
 
 #include "bridge/bridge_convert.hpp"
 #include "common/clock.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 #include "common/serial_port.hpp"
 #include "proto.h"
 
@@ -62,8 +63,8 @@ struct NanoBridge::Impl {
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
     proto_parser_init(&parser);
     if (lcm.good()) {
-      lcmsub::subscribe<autodrive::vehicle_command_t, Impl, &Impl::on_command>(
-          lcm, c.vehicle.name + "_COMMAND", this);
+      autodrive_lcm::subscribe<autodrive::vehicle_command_t, Impl, &Impl::on_command>(
+          lcm, c.vehicle.name + AUTODRIVE_CH_COMMAND_SUFFIX, this);
       clock.attach(lcm);
     }
   }
@@ -226,12 +227,12 @@ struct NanoBridge::Impl {
     const int64_t t = clock.now_us();
     autodrive::vehicle_state_t vs{};
     fill_state(s, config.vehicle, host_stats(), t, &vs);
-    lcm.publish(config.vehicle.name + "_STATE", &vs);
+    lcm.publish(config.vehicle.name + AUTODRIVE_CH_STATE_SUFFIX, &vs);
     bool imu = (s.faults & PROTO_FAULT_IMU_LOST) == 0;
     if (imu) {
       autodrive::imu_t m{};
       fill_imu(s, config.bridge, t, &m);
-      lcm.publish(config.vehicle.name + "_IMU", &m);
+      lcm.publish(config.vehicle.name + AUTODRIVE_CH_IMU_SUFFIX, &m);
     }
     count([&](Status &st2) {
       ++st2.states_published;

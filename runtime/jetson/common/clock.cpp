@@ -1,3 +1,4 @@
+#include <autodrive_channels.h>
 #include "common/clock.hpp"
 
 #include <autodrive/sim_clock_t.hpp>
@@ -26,7 +27,7 @@ void on_sim_clock(const lcm::ReceiveBuffer *, const std::string &, const autodri
 
 void Clock::attach(lcm::LCM &lcm) {
   if (mode_ != cfg::ClockMode::sim) return;
-  lcm.subscribeFunction("SIM_CLOCK", &on_sim_clock, this);
+  lcm.subscribeFunction(AUTODRIVE_CH_SIM_CLOCK, &on_sim_clock, this);
 }
 
 int64_t Clock::now_us() const {

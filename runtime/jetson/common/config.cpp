@@ -1,90 +1,23 @@
 #include "common/config.hpp"
 
 #include <cmath>
-#include <fstream>
-#include <set>
-#include <sstream>
 
 namespace cfg {
 namespace {
 
-// Reads section keys with the dotted path kept for error messages.
-class Section {
- public:
-  Section(const YAML::Node &node, std::string path, const std::string &file)
-      : node_(node), path_(std::move(path)), file_(file) {
-    if (node_ && !node_.IsMap()) fail(path_, "expected a mapping");
-  }
-
-  [[noreturn]] void fail(const std::string &key, const std::string &what) const {
-    throw Error(file_ + ": " + key + ": " + what);
-  }
-
-  std::string key(const std::string &k) const { return path_.empty() ? k : path_ + "." + k; }
-  bool has(const std::string &k) const { return node_ && node_[k]; }
-
-  template <typename T>
-  T get(const std::string &k) const {
-    used_.insert(k);
-    if (!has(k)) fail(key(k), "missing key");
-    return convert<T>(k);
-  }
-  template <typename T>
-  T get(const std::string &k, T fallback) const {
-    used_.insert(k);
-    return has(k) ? convert<T>(k) : fallback;
-  }
-  double positive(const std::string &k, double fallback, bool required = false) const {
-    double v = required ? get<double>(k) : get<double>(k, fallback);
-    if (!(v > 0.0) || !std::isfinite(v)) fail(key(k), "must be a finite number > 0");
-    return v;
-  }
-  int positive_int(const std::string &k, int fallback, bool required = false) const {
-    int v = required ? get<int>(k) : get<int>(k, fallback);
-    if (v <= 0) fail(key(k), "must be an integer > 0");
-    return v;
-  }
-  Section child(const std::string &k) const {
-    used_.insert(k);
-    return Section(node_[k], key(k), file_);
-  }
-  // Any key not read is a typo or an unsupported option: refuse it rather than ignore it.
-  void reject_unknown() const {
-    if (!node_) return;
-    for (const auto &kv : node_) {
-      const std::string k = kv.first.as<std::string>();
-      if (!used_.count(k)) fail(key(k), "unknown key");
-    }
-  }
-  const YAML::Node &node() const { return node_; }
-
- private:
-  template <typename T>
-  T convert(const std::string &k) const {
-    try {
-      return node_[k].template as<T>();
-    } catch (const YAML::Exception &) {
-      std::ostringstream s;
-      s << "bad value";
-      if (node_[k].IsScalar()) s << " '" << node_[k].Scalar() << "'";
-      fail(key(k), s.str());
-    }
-  }
-  YAML::Node node_;
-  std::string path_;
-  const std::string &file_;
-  mutable std::set<std::string> used_;
-};
+using autodrive::yaml::Section;
 
 Vehicle parse_vehicle(const Section &s) {
   Vehicle v;
   v.name = s.get<std::string>("name");
   if (v.name.empty()) s.fail(s.key("name"), "must not be empty");
-  v.wheelbase_m = s.positive("wheelbase_m", 0, true);
-  v.track_m = s.positive("track_m", 0, true);
-  v.wheel_radius_m = s.positive("wheel_radius_m", 0, true);
-  v.steering_limit_rad = s.positive("steering_limit_rad", 0, true);
-  v.encoder_counts_per_rev = s.positive_int("encoder_counts_per_rev", 0, true);
+  // The car's figures have one place: a config that sets one would silently disagree with it.
+  for (const char *k :
+       {"wheelbase_m", "track_m", "wheel_radius_m", "steering_limit_rad", "encoder_counts_per_rev"})
+    if (s.has(k))
+      s.fail(s.key(k),
+             "is a figure of the car: it comes from vehicle/nigel.params (and the firmware's "
+             "encoder resolution), not from a config");
   s.reject_unknown();
   return v;
 }
@@ -194,9 +127,7 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   if ((c.has_estimator = top.has("estimator")))
     c.estimator = parse_estimator(top.child("estimator"));
   if (top.has("cameras")) {
-    const YAML::Node cams = root["cameras"];
-    top.get<YAML::Node>("cameras");
-    if (!cams.IsSequence()) top.fail("cameras", "expected a list");
+    const YAML::Node cams = top.list("cameras", "expected a list");
     for (std::size_t i = 0; i < cams.size(); ++i)
       c.cameras.push_back(
           parse_camera(Section(cams[i], "cameras[" + std::to_string(i) + "]", file)));
@@ -208,21 +139,11 @@ Config from_node(const YAML::Node &root, const std::string &file) {
 }  // namespace
 
 Config parse(const std::string &yaml_text, const std::string &name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception &e) {
-    throw Error(name + ": not valid YAML: " + e.what());
-  }
-  return from_node(root, name);
+  return from_node(autodrive::yaml::load_string(yaml_text, name), name);
 }
 
 Config load(const std::string &path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the config file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path);
+  return from_node(autodrive::yaml::load_file(path), path);
 }
 
 }  // namespace cfg

@@ -2,7 +2,11 @@
 // missing or malformed key throws cfg::Error naming the file and the dotted key.
 #pragma once
 
+#include <autodrive/strict_yaml.hpp>
+#include <autodrive_vehicle.h>
 #include <yaml-cpp/yaml.h>
+
+#include "enc.h"
 
 #include <array>
 #include <stdexcept>
@@ -11,19 +15,19 @@
 
 namespace cfg {
 
-struct Error : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using Error = autodrive::yaml::Error;
 
 enum class ClockMode { wall, sim };
 
+// The car: its name from the config, its figures from vehicle/nigel.params (generated
+// <autodrive_vehicle.h>) and the firmware's encoder resolution; a config cannot change them.
 struct Vehicle {
   std::string name;  // e.g. "NIGEL1": channel prefix
-  double wheelbase_m = 0.14154;
-  double track_m = 0.1530;
-  double wheel_radius_m = 0.0325;
-  double steering_limit_rad = 0.5236;  // steering = 1.0 maps to this angle
-  int encoder_counts_per_rev = 1920;
+  double wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
+  double track_m = AUTODRIVE_VEHICLE_TRACK_M;
+  double wheel_radius_m = AUTODRIVE_VEHICLE_WHEEL_RADIUS_M;
+  double steering_limit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;  // steering = 1.0 maps to this
+  int encoder_counts_per_rev = ENC_COUNTS_PER_REV;
 };
 
 struct Bridge {

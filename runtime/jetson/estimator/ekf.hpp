@@ -7,6 +7,7 @@
 // history -> dropped and counted. Missing measurements simply let the covariance grow.
 #pragma once
 
+#include <autodrive_vehicle.h>
 #include <Eigen/Dense>
 
 #include <cstdint>
@@ -18,7 +19,7 @@ using Vec5 = Eigen::Matrix<double, 5, 1>;
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 
 struct EkfParams {
-  double wheelbase_m = 0.14154;
+  double wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
   double q_pos_m = 0.01;            // position random walk [m/sqrt(s)]
   double q_yaw_rad = 0.01;          // heading random walk [rad/sqrt(s)]
   double q_accel_m_s2 = 1.0;        // speed change [m/s/sqrt(s)]

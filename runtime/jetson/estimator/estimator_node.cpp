@@ -1,3 +1,4 @@
+#include <autodrive_channels.h>
 #include "estimator/estimator_node.hpp"
 
 #include <autodrive/imu_t.hpp>
@@ -9,7 +10,7 @@
 
 #include <cmath>
 
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 
 namespace est {
 
@@ -49,9 +50,12 @@ struct EstimatorNode::Impl {
       : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
     if (!lcm.good()) return;
     const std::string v = c.vehicle.name;
-    lcmsub::subscribe<autodrive::vehicle_state_t, Impl, &Impl::on_state>(lcm, v + "_STATE", this);
-    lcmsub::subscribe<autodrive::imu_t, Impl, &Impl::on_imu>(lcm, v + "_IMU", this);
-    lcmsub::subscribe<autodrive::pose2d_t, Impl, &Impl::on_pose>(lcm, v + "_POSE_EYE", this);
+    autodrive_lcm::subscribe<autodrive::vehicle_state_t, Impl, &Impl::on_state>(
+        lcm, v + AUTODRIVE_CH_STATE_SUFFIX, this);
+    autodrive_lcm::subscribe<autodrive::imu_t, Impl, &Impl::on_imu>(
+        lcm, v + AUTODRIVE_CH_IMU_SUFFIX, this);
+    autodrive_lcm::subscribe<autodrive::pose2d_t, Impl, &Impl::on_pose>(
+        lcm, v + AUTODRIVE_CH_POSE_EYE_SUFFIX, this);
   }
 
   void on_state(const autodrive::vehicle_state_t *m) {
@@ -74,8 +78,9 @@ struct EstimatorNode::Impl {
     if (next_pub_us == 0 || m->utime >= next_pub_us - period_us / 4) {
       next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
       if (next_pub_us < m->utime) next_pub_us = m->utime + period_us;  // fell behind
-      publish(odom.estimate_at(m->utime), "odom", "_ODOM");
-      if (map.initialised()) publish(map.estimate_at(m->utime), "map", "_POSE_MAP");
+      publish(odom.estimate_at(m->utime), "odom", AUTODRIVE_CH_ODOM_SUFFIX);
+      if (map.initialised())
+        publish(map.estimate_at(m->utime), "map", AUTODRIVE_CH_POSE_MAP_SUFFIX);
     }
   }
 

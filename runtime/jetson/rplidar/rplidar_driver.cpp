@@ -1,3 +1,4 @@
+#include <autodrive_channels.h>
 #include "rplidar/rplidar_driver.hpp"
 
 #include <lcm/lcm-cpp.hpp>
@@ -87,7 +88,7 @@ struct Driver::Impl {
     last_node_us = now;
     autodrive::lidar_scan_t scan;
     if (assembler.add(n, clock.now_us(), &scan)) {
-      lcm.publish(config.vehicle.name + "_LIDAR", &scan);
+      lcm.publish(config.vehicle.name + AUTODRIVE_CH_LIDAR_SUFFIX, &scan);
       std::lock_guard<std::mutex> g(mu);
       ++st.scans_published;
     }

@@ -1,5 +1,6 @@
 // autodrive-teleop: drive a car from a terminal keyboard and/or a gamepad (Linux joystick
 // API), publishing <VEH>_COMMAND at a steady rate. Dead-man: release stops the car.
+#include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
 #include <lcm/lcm-cpp.hpp>
@@ -52,7 +53,7 @@ int main(int argc, char **argv) {
       "level, h headlights, z/c/x left/right/hazard indicators, q quit.\n"
       "Gamepad: hold the dead-man button (LB) and use left stick Y (throttle), right stick X\n"
       "(steering); A headlights, X/B/Y left/right/hazard indicators."};
-  std::string vehicle = "NIGEL1", url = "udpm://239.255.76.67:7667?ttl=0", js_path;
+  std::string vehicle = "NIGEL1", url = AUTODRIVE_LCM_URL_DEFAULT, js_path;
   double rate_hz = 50.0;
   bool no_keyboard = false;
   teleop::Params p;
@@ -93,7 +94,7 @@ int main(int argc, char **argv) {
   if (!no_keyboard && !term.active())
     std::fprintf(stderr, "autodrive-teleop: stdin is not a terminal; keyboard disabled\n");
   teleop::Mapper mapper(p);
-  const std::string channel = vehicle + "_COMMAND";
+  const std::string channel = vehicle + AUTODRIVE_CH_COMMAND_SUFFIX;
   const int64_t period_us = static_cast<int64_t>(1e6 / rate_hz);
   int64_t next_us = clk::monotonic_us();
   bool running = true;

@@ -8,6 +8,7 @@
 //   ekf       : drives a loop through <VEH>_COMMAND, publishes Eye poses made from the sim's
 //               ground truth (noise + latency), compares <VEH>_POSE_MAP and <VEH>_ODOM with
 //               ground truth (ekf_*_rms)
+#include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
@@ -27,7 +28,7 @@
 #include <thread>
 
 #include "common/clock.hpp"
-#include "common/lcm_sub.hpp"
+#include <autodrive_lcm/subscribe.hpp>
 #include "fake_nano.hpp"
 
 namespace {
@@ -91,7 +92,7 @@ int run_serial(const std::string &url, const std::string &vehicle, const std::st
     const std::size_t mark = nano.commands.size();
     const auto c = make_cmd(seq++, milli / 1000.0f, 0.0f, true);
     const int64_t t0 = clk::monotonic_us();
-    lcm.publish(vehicle + "_COMMAND", &c);
+    lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
     bool seen = false;
     while (!seen && clk::monotonic_us() < t0 + 1000000) {
       nano.pump(1);
@@ -140,8 +141,8 @@ struct StateWatch {
   // Subscribes to the vehicle's STATE and waits (up to 60 s) for the first 10 messages.
   // Returns whether they came.
   bool attach(lcm::LCM &lcm, const std::string &vehicle) {
-    lcmsub::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
-        lcm, vehicle + "_STATE", this);
+    autodrive_lcm::subscribe<autodrive::vehicle_state_t, StateWatch, &StateWatch::on>(
+        lcm, vehicle + AUTODRIVE_CH_STATE_SUFFIX, this);
     const int64_t give_up = clk::monotonic_us() + 60000000;
     while (states.size() < 10 && clk::monotonic_us() < give_up) lcm.handleTimeout(20);
     return states.size() >= 10;
@@ -163,7 +164,7 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
   auto hold = [&](int64_t until_us) {
     while (clk::monotonic_us() < until_us) {
       const auto c = make_cmd(seq++, throttle, 0.0f, true);
-      lcm.publish(vehicle + "_COMMAND", &c);
+      lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
       lcm.handleTimeout(20);
     }
   };
@@ -173,14 +174,14 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
     throttle = (k % 2 == 0) ? 0.4f : 0.2f;
     const auto c = make_cmd(seq++, throttle, 0.0f, true);
     const int64_t t0 = clk::monotonic_us();
-    lcm.publish(vehicle + "_COMMAND", &c);
+    lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
     step_t0.push_back(t0);
     hold(t0 + 700000 + static_cast<int64_t>((k * 7919) % 20000));
     if (k % 5 == 0) progress("pwm: %.0f steps\n", k);
   }
   throttle = 0.0f;
   const auto stop = make_cmd(seq++, 0.0f, 0.0f, false);
-  lcm.publish(vehicle + "_COMMAND", &stop);
+  lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &stop);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const auto lines = read_pwm_log(log_path);
   std::vector<double> lat_ms;
@@ -313,7 +314,7 @@ struct EkfBench {
       e.yaw_rad = p.yaw;
       e.covariance[0] = e.covariance[4] = noise_m * noise_m;
       e.covariance[8] = noise_rad * noise_rad;
-      lcm->publish(vehicle + "_POSE_EYE", &e);
+      lcm->publish(vehicle + AUTODRIVE_CH_POSE_EYE_SUFFIX, &e);
       eye_queue.pop_front();
     }
   }
@@ -367,12 +368,12 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
   b.vehicle = vehicle;
   b.lcm = &lcm;
   b.eye_delay_us = eye_delay_ms * 1000.0;
-  lcm.subscribeFunction(vehicle + "_GROUND_TRUTH",
-                        &lcmsub::thunk<autodrive::ground_truth_t, EkfBench, &EkfBench::on_gt>, &b);
-  lcm.subscribeFunction(vehicle + "_POSE_MAP",
-                        &lcmsub::thunk<autodrive::odometry_t, EkfBench, &EkfBench::on_map>, &b);
-  lcm.subscribeFunction(vehicle + "_ODOM",
-                        &lcmsub::thunk<autodrive::odometry_t, EkfBench, &EkfBench::on_odom>, &b);
+  autodrive_lcm::subscribe<autodrive::ground_truth_t, EkfBench, &EkfBench::on_gt>(
+      lcm, vehicle + AUTODRIVE_CH_GROUND_TRUTH_SUFFIX, &b);
+  autodrive_lcm::subscribe<autodrive::odometry_t, EkfBench, &EkfBench::on_map>(
+      lcm, vehicle + AUTODRIVE_CH_POSE_MAP_SUFFIX, &b);
+  autodrive_lcm::subscribe<autodrive::odometry_t, EkfBench, &EkfBench::on_odom>(
+      lcm, vehicle + AUTODRIVE_CH_ODOM_SUFFIX, &b);
   const int64_t give_up = clk::monotonic_us() + 60000000;
   while ((b.odom.size() < 20 || b.gt.size() < 20) && clk::monotonic_us() < give_up) {
     lcm.handleTimeout(20);
@@ -398,7 +399,7 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
     if (now >= next_cmd) {
       const auto c =
           make_cmd(seq++, static_cast<float>(throttle), static_cast<float>(steering), true);
-      lcm.publish(vehicle + "_COMMAND", &c);
+      lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
       next_cmd = now + 20000;
     }
     if (now >= next_progress) {
@@ -411,7 +412,7 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
   }
   const int64_t t1 = clk::wall_us();
   const auto stop = make_cmd(seq++, 0.0f, 0.0f, false);
-  lcm.publish(vehicle + "_COMMAND", &stop);
+  lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &stop);
   double pm, ym, po, yo;
   int nm, no;
   rms(b.map, b.gt, t0, t1, false, &pm, &ym, &nm);

@@ -1,4 +1,5 @@
 /* LCM publishing (see lcmpub.h). */
+#include <autodrive_channels.h>
 #include "lcmpub.h"
 
 #include <stdlib.h>
@@ -12,7 +13,7 @@ int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
   snprintf(vehicle, sizeof vehicle, "NIGEL%d", car);
-  snprintf(channel, sizeof channel, "%s_GROUND_TRUTH", vehicle);
+  snprintf(channel, sizeof channel, "%s" AUTODRIVE_CH_GROUND_TRUTH_SUFFIX, vehicle);
   autodrive_ground_truth_t msg;
   memset(&msg, 0, sizeof msg);
   msg.utime = sim_time_us(s);
@@ -44,7 +45,7 @@ int lcmpub_clock(lcmq_t *q, int64_t utime, double rtf, int paused) {
   if (!q) return 0;
   autodrive_sim_clock_t msg = {utime, rtf, (int8_t)paused};
   const int n = autodrive_sim_clock_t_encoded_size(&msg);
-  uint8_t *out = lcmq_reserve(q, "SIM_CLOCK", (size_t)n);
+  uint8_t *out = lcmq_reserve(q, AUTODRIVE_CH_SIM_CLOCK, (size_t)n);
   if (!out || autodrive_sim_clock_t_encode(out, 0, n, &msg) != n) return -1;
   lcmq_commit(q);
   return 0;

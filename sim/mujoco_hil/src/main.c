@@ -1,4 +1,5 @@
 /* autodrive-sim: the MuJoCo 2.2 HIL simulator of Nigel. See --help and README.md. */
+#include <autodrive_channels.h>
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -17,7 +18,7 @@
 #include "sim_render.h"
 #include "sim_viewer.h"
 
-#define MAIN_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
+#define MAIN_DEFAULT_URL AUTODRIVE_LCM_URL_DEFAULT
 #define MAIN_TRUTH_EVERY 10 /* steps between ground-truth messages: 100 Hz */
 #define MAIN_CLOCK_EVERY 10 /* steps between SIM_CLOCK messages: 100 Hz */
 /* free lockstep serves the ptys every 10 ms of sim time: a client there sees the sim run
@@ -194,10 +195,10 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
       k->cam[k->n] = sim_camera_create(k->render, m, name, frame, 640, 480, 85, err, err_sz);
       if (!k->cam[k->n]) return -1;
       k->cam_id[k->n] = mj_name2id(m, mjOBJ_CAMERA, name);
-      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d_CAM_%s", c,
-               rear ? "REAR" : "FRONT");
-      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d_CAM_%s_INFO", c,
-               rear ? "REAR" : "FRONT");
+      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d%s", c,
+               rear ? AUTODRIVE_CH_CAM_REAR_SUFFIX : AUTODRIVE_CH_CAM_FRONT_SUFFIX);
+      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d%s", c,
+               rear ? AUTODRIVE_CH_CAM_REAR_INFO_SUFFIX : AUTODRIVE_CH_CAM_FRONT_INFO_SUFFIX);
       k->n++;
     }
   if (eye) {
@@ -207,8 +208,8 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
     }
     k->cam[k->n] = sim_camera_create(k->render, m, "eye", "eye", 1280, 960, 90, err, err_sz);
     if (!k->cam[k->n]) return -1;
-    snprintf(k->channel[k->n], sizeof k->channel[0], "EYE_IMAGE");
-    snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "EYE_CAMERA_INFO");
+    snprintf(k->channel[k->n], sizeof k->channel[0], "%s", AUTODRIVE_CH_EYE_IMAGE);
+    snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "%s", AUTODRIVE_CH_EYE_CAMERA_INFO);
     k->n++;
   }
   return 0;
@@ -533,7 +534,7 @@ int main(int argc, char **argv) {
        * the sim then stays off the channel so that nobody sees every scan twice */
       if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
-        snprintf(ch, sizeof ch, "NIGEL%d_LIDAR", c);
+        snprintf(ch, sizeof ch, "NIGEL%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
         sim_lidar_publish(lcm, ch, "laser", scan);
       }
     }

@@ -12,8 +12,8 @@ extern "C" {
 
 #define SCN_MAX_LATE_BOXES 4
 #define SCN_LATE_BOX_HALF_DEFAULT_M 0.06 /* default half size in x and y [m] */
-#define SCN_LATE_BOX_HEIGHT_M 0.2        /* full height [m]: above the LIDAR at 0.1757 m */
-#define SCN_LATE_BOX_HALF_MIN_M 0.01     /* half size limits [m] */
+#define SCN_LATE_BOX_HEIGHT_M 0.2    /* full height [m]: above the LIDAR's mount (lidar_pos_m) */
+#define SCN_LATE_BOX_HALF_MIN_M 0.01 /* half size limits [m] */
 #define SCN_LATE_BOX_HALF_MAX_M 1.0
 #define SCN_COORD_MAX_M 1000.0 /* |x|, |y| bound before the map check [m] */
 

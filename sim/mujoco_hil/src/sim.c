@@ -15,6 +15,7 @@
 
 #include "clearance.h"
 #include "drive.h"
+#include "enc.h"
 #include "mjcf_gen.h"
 #include "ptylink.h"
 #include "rng.h"
@@ -27,7 +28,6 @@
 #include "sim_rplidar.h"
 #include "sim_tags.h"
 
-#define SIM_ENC_COUNTS_PER_REV 1920.0
 #define SIM_G_M_S2 9.80665
 #define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
 #define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
@@ -629,7 +629,7 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err
   /* bytes that finished crossing the wire during this step reach the firmware now */
   size_t n = uart_pop(&c->rx, SIM_STEP_US, buf, 255);
   if (n > 0) nigel_rx(&c->nano, buf, (uint8_t)n, (uint32_t)s->time_us);
-  const double k = SIM_ENC_COUNTS_PER_REV / (2.0 * M_PI);
+  const double k = (double)ENC_COUNTS_PER_REV / (2.0 * M_PI);
   const int32_t enc_l = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RL]] * k);
   const int32_t enc_r = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RR]] * k);
   nigel_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);

@@ -6,20 +6,15 @@
 
 #include <stdint.h>
 
+#include "act_vehicle.h" /* servo figures, generated from vehicle/nigel.params */
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 #define ACT_FULL 1000000L                /* internal full scale [1e-6 of 1.0] */
 #define ACT_THROTTLE_SLEW_PER_S 4000000L /* [1e-6/s]: 0 -> full throttle in 250 ms */
-/* Steering rate: 0.805 rad/s over a 0.5236 rad (30 deg) full scale = 1.5374 full scale/s.
- * Step [1e-6 full scale] = dt [us] * ACT_STEER_RATE_Q14 >> 14 (no division on the AVR). */
-#define ACT_STEER_RATE_Q14 25189L /* 1.5374 * 2^14 */
-#define ACT_SERVO_CENTER_US 1500
-#define ACT_SERVO_HALF_RANGE_US 500 /* pulse change at full steering [us] */
-#define ACT_SERVO_MIN_US 1000
-#define ACT_SERVO_MAX_US 2000
-#define ACT_MAX_DT_US 50000ul /* a longer gap is treated as this [us] */
+#define ACT_MAX_DT_US 50000ul            /* a longer gap is treated as this [us] */
 
 /* act_update flags */
 #define ACT_STOP 0x01u          /* throttle to 0 at once (no slew), brake on */

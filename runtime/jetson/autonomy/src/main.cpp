@@ -2,6 +2,7 @@
 // publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM, <VEH>_PATH and <VEH>_MISSION, and
 // prints each mission state change. Writes path.csv, route.csv and trajectory.csv into out_dir for
 // tools/plot-parking.
+#include <autodrive_channels.h>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -91,7 +92,7 @@ class App {
     c.headlights = 0;
     c.indicators = node_.mission().state() == MissionState::kParked ? 3 : 0;
     c.engaged = !stop && node_.engaged();
-    lcm_.publish(cfg_.vehicle + "_COMMAND", &c);
+    lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
   }
 
  private:
@@ -106,7 +107,7 @@ class App {
     m.yaw_rad = p.yaw_rad;
     const Eigen::Matrix3d c = node_.amcl_covariance();
     for (int i = 0; i < 9; ++i) m.covariance[i] = c(i / 3, i % 3);
-    lcm_.publish(cfg_.vehicle + "_POSE_AMCL", &m);
+    lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_POSE_AMCL_SUFFIX, &m);
   }
 
   void publish_path(int64_t utime) {
@@ -124,7 +125,7 @@ class App {
       m.curvature_1pm.push_back(q.curvature_1pm);
     }
     m.num_poses = static_cast<int32_t>(m.x_m.size());
-    lcm_.publish(cfg_.vehicle + "_PATH", &m);
+    lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_PATH_SUFFIX, &m);
   }
 
   // Laser odometry in its own frame (the base pose at the first scan), at the scan's mid-time;
@@ -149,7 +150,7 @@ class App {
     }
     last_lo_us_ = t;
     last_lo_pose_ = p;
-    lcm_.publish(cfg_.vehicle + "_LASER_ODOM", &m);
+    lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_LASER_ODOM_SUFFIX, &m);
   }
 
   // Publishes on every state change and at 2 Hz; prints state changes.
@@ -167,7 +168,7 @@ class App {
     m.state = static_cast<int8_t>(ms.state());
     m.progress = static_cast<float>(node_.progress());
     m.detail = ms.detail();
-    lcm_.publish(cfg_.vehicle + "_MISSION", &m);
+    lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_MISSION_SUFFIX, &m);
   }
 
   // path.csv keeps every plan of the run (column plan = 1, 2, ...: replans and retries), so a
@@ -232,9 +233,9 @@ int main(int argc, char **argv) {
   std::signal(SIGTERM, on_signal);
   App app(cfg, lcm);
   auto *s1 = autodrive_lcm::subscribe<autodrive::lidar_scan_t, App, &App::on_scan>(
-      lcm, cfg.vehicle + "_LIDAR", &app);
+      lcm, cfg.vehicle + AUTODRIVE_CH_LIDAR_SUFFIX, &app);
   auto *s2 = autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_odom>(
-      lcm, cfg.vehicle + "_ODOM", &app);
+      lcm, cfg.vehicle + AUTODRIVE_CH_ODOM_SUFFIX, &app);
   s1->setQueueCapacity(10);
   s2->setQueueCapacity(200);
   std::printf("[autonomy] %s on %s: listening to %s_LIDAR, %s_ODOM\n", cfg.vehicle.c_str(),

@@ -8,6 +8,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <autodrive_vehicle.h>
+
 #include "sim_camera.h"
 #include "sim_jpeg.h"
 #include "sim_lidar.h"
@@ -71,15 +73,17 @@ static int write_scene(const char *path, const char *map) {
     fprintf(f,
             "<body name=\"nigel%d\" pos=\"%.2f %.2f 0.05\" quat=\"%.6f 0 0 %.6f\"><freejoint/>\n"
             "<geom type=\"box\" size=\"0.12 0.08 0.04\" rgba=\"0.8 0.8 0.8 1\"/>\n"
-            "<geom type=\"cylinder\" pos=\"0.1445 0 0.16\" size=\"0.035 0.02\"/>\n"
+            "<geom type=\"cylinder\" pos=\"%g 0 0.16\" size=\"0.035 0.02\"/>\n"
             "<camera name=\"nigel%d_cam_front\" pos=\"0.15 0 0.1\" xyaxes=\"0 -1 0 0 0 1\" "
             "fovy=\"48.67\"/>\n",
-            c, -1.0 + 0.6 * c, 0.3 * (c % 2), cos(M_PI / 4 * c), sin(M_PI / 4 * c), c);
+            c, -1.0 + 0.6 * c, 0.3 * (c % 2), cos(M_PI / 4 * c), sin(M_PI / 4 * c),
+            AUTODRIVE_VEHICLE_LIDAR_POS_M_X, c);
     for (int w = 0; w < 4; w++)
       fprintf(f,
               "<body pos=\"%.3f %.3f 0\"><joint type=\"hinge\" axis=\"0 1 0\"/>"
-              "<geom type=\"sphere\" size=\"0.0325\"/></body>\n",
-              w < 2 ? 0.07 : -0.07, w % 2 ? 0.0765 : -0.0765);
+              "<geom type=\"sphere\" size=\"%g\"/></body>\n",
+              w < 2 ? 0.07 : -0.07, (w % 2 ? 0.5 : -0.5) * AUTODRIVE_VEHICLE_TRACK_M,
+              AUTODRIVE_VEHICLE_WHEEL_RADIUS_M);
     fprintf(f, "</body>\n");
   }
   fprintf(f, "</worldbody>\n</mujoco>\n");

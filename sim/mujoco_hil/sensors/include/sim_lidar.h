@@ -33,8 +33,9 @@ typedef struct sim_lidar_config {
   mjtByte geomgroup[mjNGROUP]; /* geom groups the rays see (1 = visible), as mjvOption */
 } sim_lidar_config_t;
 
-/* Fills cfg with the RPLIDAR A1 figures on Nigel: 360 rays, 0.15-12 m, 7 Hz, mount
- * (0.1445, 0, 0.1757) m, no noise, seed 1, groups 0-2 visible (MuJoCo's default). */
+/* Fills cfg with the RPLIDAR A1 figures on Nigel: 360 rays, 0.15-12 m, 7 Hz, mounted at
+ * lidar_pos_m of vehicle/nigel.params, no noise, seed 1, groups 0-2 visible (MuJoCo's
+ * default). */
 void sim_lidar_config_default(sim_lidar_config_t *cfg);
 
 typedef struct sim_lidar sim_lidar_t;

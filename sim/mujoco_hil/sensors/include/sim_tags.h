@@ -4,9 +4,9 @@
  * - A tag36h11 image is 10 x 10 cells: a 1-cell white outer border, a 1-cell black border, a
  *   6 x 6 data grid. The AprilTag "tag size" is the edge of the black square = 8 cells.
  *   The roof box top face carries the whole 10-cell image, so the box is 10/8 * tag_size_m
- *   wide and long. Default tag_size_m = SIM_TAGS_SIZE_M (0.08 m -> a 0.10 m roof plate).
- * - The plate's centre sits at the IPS tag offset (0.035125, 0, 0.129165) m from base_link
- *   (SIM_TAGS_OFFSET_*), top face at that height.
+ *   wide and long. Default tag_size_m = SIM_TAGS_SIZE_M.
+ * - The plate's centre sits at the roof tag offset from base_link (SIM_TAGS_OFFSET_*), top
+ *   face at that height.
  * - Orientation: seen from above, the tag's image "up" (its top row as printed by
  *   apriltag_to_image) points along the car's +x (forward), its image "right" along the car's
  *   -y (the car's right). So for a camera looking straight down with image up = world +y,
@@ -20,14 +20,18 @@
 
 #include <stddef.h>
 
+#include <autodrive_vehicle.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define SIM_TAGS_SIZE_M 0.08         /* black-square edge [m] */
-#define SIM_TAGS_OFFSET_X_M 0.035125 /* tag plate centre from base_link [m] */
-#define SIM_TAGS_OFFSET_Y_M 0.0
-#define SIM_TAGS_OFFSET_Z_M 0.129165 /* top face height above base_link [m] */
+/* from vehicle/nigel.params: tag_size_m (black-square edge) and tag_pos_m (plate centre from
+ * base_link, top face at its z) [m] */
+#define SIM_TAGS_SIZE_M AUTODRIVE_VEHICLE_TAG_SIZE_M
+#define SIM_TAGS_OFFSET_X_M AUTODRIVE_VEHICLE_TAG_POS_M_X
+#define SIM_TAGS_OFFSET_Y_M AUTODRIVE_VEHICLE_TAG_POS_M_Y
+#define SIM_TAGS_OFFSET_Z_M AUTODRIVE_VEHICLE_TAG_POS_M_Z
 #define SIM_TAGS_PLATE_THICKNESS_M 0.002
 /* MuJoCo maps a 2D texture onto a box's top face with the image's up along the box's +y;
  * the plate is yawed -90 deg in its body (quat below) so the tag's up is the car's +x. */

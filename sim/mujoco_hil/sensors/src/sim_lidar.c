@@ -1,6 +1,8 @@
 /* sim_lidar: see sim_lidar.h. */
 #include "sim_lidar.h"
 
+#include <autodrive_vehicle.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,9 +51,9 @@ void sim_lidar_config_default(sim_lidar_config_t *cfg) {
   cfg->range_min_m = 0.15;
   cfg->range_max_m = 12.0;
   cfg->rate_hz = 7.0;
-  cfg->mount_pos_m[0] = 0.1445;
-  cfg->mount_pos_m[1] = 0.0;
-  cfg->mount_pos_m[2] = 0.1757;
+  cfg->mount_pos_m[0] = AUTODRIVE_VEHICLE_LIDAR_POS_M_X;
+  cfg->mount_pos_m[1] = AUTODRIVE_VEHICLE_LIDAR_POS_M_Y;
+  cfg->mount_pos_m[2] = AUTODRIVE_VEHICLE_LIDAR_POS_M_Z;
   cfg->noise_std_m = 0.0;
   cfg->seed = 1;
   for (int g = 0; g < mjNGROUP; g++) cfg->geomgroup[g] = g < 3;

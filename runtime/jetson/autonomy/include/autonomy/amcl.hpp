@@ -3,6 +3,8 @@
 // as many particles as the KL-distance bound needs for the bins it occupies. Odometry motion
 // model fed by the EKF's odom-frame pose; likelihood-field sensor model.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -30,7 +32,7 @@ struct AmclConfig {
   int beams = 60;            // rays used per update, evenly spread over the scan
   double beam_weight = 0.4;  // exponent on each ray's likelihood (rays are not independent)
   double update_min_dist_m = 0.02, update_min_angle_rad = 0.03;  // filter update trigger
-  Pose2 lidar_in_base{0.1445, 0.0, 0.0};
+  Pose2 lidar_in_base{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, AUTODRIVE_VEHICLE_LIDAR_POS_M_Y, 0.0};
   uint32_t seed = 1;
 };
 

@@ -3,6 +3,8 @@
 // cell at least (disc radius + margin) from the nearest obstacle (unknown counts as obstacle),
 // i.e. on a grid inflated by that amount.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <vector>
 
 #include "autonomy/grid_map.hpp"
@@ -11,13 +13,13 @@
 namespace autonomy {
 
 struct Footprint {
-  // Nigel's envelope (vehicle/nigel.params): the 0.24 m chassis box, centred
-  // 0.07 m ahead of the rear axle, and the wheels: track 0.153 m + tyre width 0.025 m.
-  double length_m = 0.24;        // bumper to bumper
-  double width_m = 0.178;        // tyre to tyre
-  double center_ahead_m = 0.07;  // rectangle centre ahead of the base (rear axle) [m]
-  double margin_m = 0.015;       // extra clearance kept from obstacles [m]
-  int discs = 6;  // 4 cm apart along the 0.24 m: radius 9.1 cm, 0.2 cm wider than the car
+  // Nigel's envelope, derived from vehicle/nigel.params (chassis box and wheels): the car's,
+  // not a setting.
+  double length_m = AUTODRIVE_VEHICLE_ENVELOPE_LENGTH_M;              // bumper to bumper
+  double width_m = AUTODRIVE_VEHICLE_ENVELOPE_WIDTH_M;                // tyre to tyre
+  double center_ahead_m = AUTODRIVE_VEHICLE_ENVELOPE_CENTER_AHEAD_M;  // ahead of the rear axle
+  double margin_m = 0.015;  // extra clearance kept from obstacles [m]
+  int discs = 6;            // 4 cm apart along the length: each disc a little wider than the car
 };
 
 class CollisionChecker {

@@ -58,7 +58,7 @@ struct Scan {
 };
 
 // Endpoints of the valid rays, in the frame of the vehicle base: the LIDAR sits at
-// lidar_in_base (forward offset 0.1445 m on Nigel).
+// lidar_in_base (on Nigel: lidar_pos_m of vehicle/nigel.params).
 std::vector<Eigen::Vector2d> scan_points_base(const Scan &scan, const Pose2 &lidar_in_base);
 
 }  // namespace autonomy

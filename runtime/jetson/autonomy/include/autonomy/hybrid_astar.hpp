@@ -5,6 +5,8 @@
 // Reeds-Shepp shot to the goal is tried (analytic expansion) and accepted if collision-free,
 // which lands the path exactly on the goal pose.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <string>
 #include <vector>
 
@@ -14,8 +16,8 @@
 namespace autonomy {
 
 struct HybridAStarConfig {
-  double wheelbase_m = 0.14154;
-  double max_steer_rad = 0.5236;
+  double wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
+  double max_steer_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
   double steer_use_fraction = 0.8;  // plan at 80% of the limit: tracking needs headroom
   int steer_samples = 5;            // odd, from -max to +max
   double step_m = 0.06;             // arc length of one expansion

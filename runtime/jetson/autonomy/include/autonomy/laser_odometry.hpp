@@ -3,6 +3,8 @@
 // by more than a wheel could slip. Keyframes (not the previous scan) keep standstill noise from
 // adding up: the reference only moves on after real motion.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <vector>
 
 #include "autonomy/icp.hpp"
@@ -11,7 +13,7 @@ namespace autonomy {
 
 struct LaserOdomConfig {
   IcpConfig icp;
-  Pose2 lidar_in_base{0.1445, 0.0, 0.0};
+  Pose2 lidar_in_base{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, AUTODRIVE_VEHICLE_LIDAR_POS_M_Y, 0.0};
   double max_rms_m = 0.03;           // a registration worse than this is not trusted [m]
   int min_inliers = 60;              // of the ~360 returns of an A1 revolution
   double max_disagree_m = 0.05;      // ICP vs odometry motion since the keyframe [m]

@@ -5,6 +5,8 @@
 // Throttle-to-speed map (assumed, linear, no deadband): throttle 1.0 -> top_speed_m_s
 // (0.267 m/s, Nigel's top speed), so throttle = speed / top_speed_m_s, sign = direction.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <cmath>
 
 #include "autonomy/path.hpp"
@@ -12,9 +14,9 @@
 namespace autonomy {
 
 struct TrackerConfig {
-  double wheelbase_m = 0.14154;
-  double max_steer_rad = 0.5236;  // steering 1.0 = this angle
-  double top_speed_m_s = 0.267;   // speed at throttle 1.0
+  double wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
+  double max_steer_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;  // steering 1.0 = this angle
+  double top_speed_m_s = 0.267;                              // speed at throttle 1.0
   double cruise_speed_m_s = 0.2;
   double min_speed_m_s = 0.025;  // creep speed just before a stop
   double accel_m_s2 = 0.4, decel_m_s2 = 0.3;
@@ -22,7 +24,7 @@ struct TrackerConfig {
   double lookahead_min_m = 0.07, lookahead_time_s = 0.4;
   double stop_tolerance_m = 0.004;  // a segment ends when less than this remains
   double cusp_pause_s = 0.4;        // standstill between direction changes
-  double steer_rate_rad_s = 0.805;  // Nigel's servo: slow down before curvature changes
+  double steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;  // slow before curvature changes
   double steer_preview_m = 0.25;
   // Stall recovery: the throttle map is open loop, and at creep speed with the wheels on full
   // lock the drivetrain's friction can hold the car. Moving slower than stall_fraction of the

@@ -3,6 +3,8 @@
 // bilinearly interpolated occupancy probability, coarse to fine over 2-3 map resolutions,
 // then written into every resolution level.
 #pragma once
+
+#include <autodrive_vehicle.h>
 #include <vector>
 
 #include "autonomy/grid_map.hpp"
@@ -19,7 +21,7 @@ struct SlamConfig {
   double update_min_dist_m = 0.03;  // map is rewritten only after this much motion [m]
   double update_min_angle_rad = 0.05;
   int initial_integrations = 5;  // scans written regardless of motion, to seed the map
-  Pose2 lidar_in_base{0.1445, 0.0, 0.0};
+  Pose2 lidar_in_base{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, AUTODRIVE_VEHICLE_LIDAR_POS_M_Y, 0.0};
 };
 
 // scan_match_: one Gauss-Newton refinement of a pose guess on one map level.

@@ -1,0 +1,148 @@
+// The one strict YAML config reader of the runtime, the autonomy and the Eye. Every error
+// names the file and the dotted key ("nigel_car.yaml: bridge.baud: missing key"), a key no
+// reader asked for is refused as a typo (reject_unknown), and a value of the wrong kind is
+// refused with its text, never read as a default.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <initializer_list>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace autodrive::yaml {
+
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The file's top-level node; Error naming the file if it cannot be read or parsed.
+inline YAML::Node load_file(const std::string &path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile &) {
+    throw Error(path + ": cannot be opened");
+  } catch (const YAML::Exception &e) {
+    throw Error(path + ": is not valid YAML: " + e.what());
+  }
+}
+
+inline YAML::Node load_string(const std::string &text, const std::string &name) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception &e) {
+    throw Error(name + ": is not valid YAML: " + e.what());
+  }
+}
+
+// A mapping (or an absent one: every key then reads as missing) with its dotted path.
+class Section {
+ public:
+  Section(const YAML::Node &node, std::string path, std::string file)
+      : node_(node),
+        path_(std::move(path)),
+        file_(std::make_shared<const std::string>(std::move(file))),
+        used_(std::make_shared<std::set<std::string>>()) {
+    if (node_ && !node_.IsMap()) fail(path_.empty() ? "(top level)" : path_, "expected a mapping");
+  }
+
+  [[noreturn]] void fail(const std::string &dotted_key, const std::string &what) const {
+    throw Error(*file_ + ": " + dotted_key + ": " + what);
+  }
+  // fail() for a key of this section.
+  [[noreturn]] void fail_key(const std::string &k, const std::string &what) const {
+    fail(key(k), what);
+  }
+
+  std::string key(const std::string &k) const { return path_.empty() ? k : path_ + "." + k; }
+  const std::string &path() const { return path_; }
+  const std::string &file() const { return *file_; }
+  bool present() const { return static_cast<bool>(node_); }
+  bool has(const std::string &k) const { return node_ && node_[k]; }
+
+  template <typename T>
+  T get(const std::string &k) const {
+    used_->insert(k);
+    if (!has(k)) fail_key(k, "missing key");
+    return convert<T>(k);
+  }
+  template <typename T>
+  T get(const std::string &k, T fallback) const {
+    used_->insert(k);
+    return has(k) ? convert<T>(k) : fallback;
+  }
+  // Reads k into out if present; out keeps its default otherwise.
+  template <typename T>
+  void read(const std::string &k, T &out) const {
+    out = get<T>(k, out);
+  }
+  double positive(const std::string &k, double fallback, bool required = false) const {
+    const double v = required ? get<double>(k) : get<double>(k, fallback);
+    if (!(v > 0.0) || !std::isfinite(v)) fail_key(k, "must be a finite number > 0");
+    return v;
+  }
+  int positive_int(const std::string &k, int fallback, bool required = false) const {
+    const int v = required ? get<int>(k) : get<int>(k, fallback);
+    if (v <= 0) fail_key(k, "must be an integer > 0");
+    return v;
+  }
+  // Exactly n numbers, e.g. a position [x, y, z].
+  std::vector<double> numbers(const std::string &k, size_t n) const {
+    const auto v = get<std::vector<double>>(k);
+    if (v.size() != n) fail_key(k, "expected " + std::to_string(n) + " numbers");
+    return v;
+  }
+  Section child(const std::string &k) const {
+    used_->insert(k);
+    return Section(node_ ? node_[k] : YAML::Node(), key(k), *file_);
+  }
+  // The list under k (marked as read; each entry is then read as its own Section); fails with
+  // `expected` unless it is a sequence.
+  YAML::Node list(const std::string &k, const std::string &expected) const {
+    used_->insert(k);
+    if (!has(k)) fail_key(k, "missing key");
+    const YAML::Node n = node_[k];
+    if (!n.IsSequence()) fail_key(k, expected);
+    return n;
+  }
+  // Keys that must not be here, each with the reason (e.g. a figure of the car).
+  void reject_keys(std::initializer_list<const char *> keys, const std::string &why) const {
+    for (const char *k : keys)
+      if (has(k)) fail_key(k, why);
+  }
+  // Any key not read is a typo or an unsupported option: refuse it rather than ignore it.
+  void reject_unknown() const {
+    if (!node_) return;
+    for (const auto &kv : node_) {
+      const std::string k = kv.first.as<std::string>();
+      if (!used_->count(k)) fail_key(k, "unknown key");
+    }
+  }
+  const YAML::Node &node() const { return node_; }
+
+ private:
+  template <typename T>
+  T convert(const std::string &k) const {
+    try {
+      return node_[k].template as<T>();
+    } catch (const YAML::Exception &) {
+      std::ostringstream s;
+      s << "bad value";
+      if (node_[k].IsScalar()) s << " '" << node_[k].Scalar() << "'";
+      fail_key(k, s.str());
+    }
+  }
+  YAML::Node node_;
+  std::string path_;
+  std::shared_ptr<const std::string> file_;
+  std::shared_ptr<std::set<std::string>> used_;
+};
+
+}  // namespace autodrive::yaml

@@ -1,0 +1,33 @@
+"""lcm_types/channels.yaml -> <autodrive_channels.h>: the channel names for C and C++.
+
+A per-vehicle channel "<VEH>_ODOM" becomes AUTODRIVE_CH_ODOM_SUFFIX "_ODOM" (appended to the
+vehicle name: `vehicle + AUTODRIVE_CH_ODOM_SUFFIX`, or "%s" AUTODRIVE_CH_ODOM_SUFFIX in C); a
+global one becomes AUTODRIVE_CH_<ID> with its whole name. Planned channels are generated too,
+marked as such, so that work in progress spells them from the table as well."""
+
+from __future__ import annotations
+
+from .. import channels
+
+GUARD = "AUTODRIVE_CHANNELS_H"
+
+
+def render(table: channels.ChannelTable, source_name: str) -> str:
+    lines = [
+        f"/* Generated from {source_name} by autodrive_tools.codegen.channels_header: do not edit.",
+        " * LCM channel names; CHANNELS.md describes each. */",
+        f"#ifndef {GUARD}",
+        f"#define {GUARD}",
+        "",
+        f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"',
+        "",
+    ]
+    for ch in table.channels:
+        note = f"/* {ch.type}, {ch.rate}" + (", planned */" if ch.status == "planned" else " */")
+        if ch.per_vehicle:
+            suffix = ch.name[len(channels.VEH) :]
+            lines.append(f'#define AUTODRIVE_CH_{ch.id}_SUFFIX "{suffix}" {note}')
+        else:
+            lines.append(f'#define AUTODRIVE_CH_{ch.id} "{ch.name}" {note}')
+    lines += ["", f"#endif /* {GUARD} */", ""]
+    return "\n".join(lines)
