@@ -6,7 +6,6 @@
 #include <fstream>
 
 #include "eye_error.hpp"
-#include "eye_yaml.hpp"
 
 namespace eye {
 
@@ -15,24 +14,22 @@ cv::Vec3d CameraPose::centre_map() const {
 }
 
 Intrinsics intrinsics_load(const std::string &path) {
-  YAML::Node n = yaml_load_file(path);
+  const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
   Intrinsics in;
-  in.width_px = yaml_int(n, "width_px", path);
-  in.height_px = yaml_int(n, "height_px", path);
-  if (in.width_px <= 0 || in.height_px <= 0)
-    throw Error(path + ": fields 'width_px'/'height_px' must be positive");
-  std::vector<double> k = yaml_doubles(n, "k", path, 9);
+  in.width_px = n.positive_int("width_px", 0, true);
+  in.height_px = n.positive_int("height_px", 0, true);
+  std::vector<double> k = n.numbers("k", 9);
   for (int i = 0; i < 9; ++i) in.k(i / 3, i % 3) = k[static_cast<size_t>(i)];
   if (!(in.k(0, 0) > 0 && in.k(1, 1) > 0) || in.k(2, 2) != 1.0 || in.k(1, 0) != 0 ||
       in.k(2, 0) != 0 || in.k(2, 1) != 0)
-    throw Error(path +
-                ": field 'k' is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0");
-  in.dist = yaml_doubles(n, "dist", path, -1);
+    n.fail_key("k", "is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0");
+  in.dist = n.numbers("dist", 0);
   if (in.dist.size() != 4 && in.dist.size() != 5 && in.dist.size() != 8)
-    throw Error(path +
-                ": field 'dist' must have 4, 5 or 8 coefficients (plumb_bob k1 k2 p1 p2 [k3])");
-  in.rms_px = n["rms_px"] ? yaml_double(n, "rms_px", path) : 0.0;
-  in.views = n["views"] ? yaml_int(n, "views", path) : 0;
+    n.fail_key("dist", "must have 4, 5 or 8 coefficients (plumb_bob k1 k2 p1 p2 [k3])");
+  in.rms_px = n.number("rms_px", 0.0);
+  in.views = n.get<int>("views", 0);
+  n.allow({"pixel_convention"});  // a note for people, written by intrinsics_save
+  n.reject_unknown();
   return in;
 }
 

@@ -10,32 +10,28 @@
 
 #include "eye_error.hpp"
 #include "eye_locate.hpp"
-#include "eye_yaml.hpp"
 
 namespace eye {
 
 std::vector<RefTag> reftags_load(const std::string &path) {
-  YAML::Node n = yaml_load_file(path);
-  YAML::Node tags = yaml_need(n, "tags", path);
-  if (!tags.IsSequence() || tags.size() == 0)
-    throw Error(path + ": field 'tags' must be a non-empty list");
+  const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
+  const YAML::Node tags = n.list("tags", "must be a non-empty list");
+  if (tags.size() == 0) n.fail_key("tags", "must be a non-empty list");
+  n.reject_unknown();
   std::vector<RefTag> out;
   std::set<int> ids;
   for (size_t i = 0; i < tags.size(); ++i) {
-    const std::string where = path + " (tags[" + std::to_string(i) + "])";
-    const YAML::Node t = tags[i];
-    if (!t.IsMap()) throw Error(where + ": each tag must be a mapping");
+    const autodrive::yaml::Section t(tags[i], "tags[" + std::to_string(i) + "]", path);
     RefTag r;
-    r.id = yaml_int(t, "id", where);
-    r.x_m = yaml_double(t, "x_m", where);
-    r.y_m = yaml_double(t, "y_m", where);
-    r.z_m = t["z_m"] ? yaml_double(t, "z_m", where) : 0.0;
-    r.yaw_rad = t["yaw_rad"] ? yaml_double(t, "yaw_rad", where) : 0.0;
-    r.size_m = yaml_double(t, "size_m", where);
-    if (r.id < 0 || r.id > 586) throw Error(where + ": field 'id' must be a tag36h11 id 0..586");
-    if (!(r.size_m > 0)) throw Error(where + ": field 'size_m' must be positive");
-    if (!ids.insert(r.id).second)
-      throw Error(where + ": field 'id' " + std::to_string(r.id) + " is listed twice");
+    r.id = t.get<int>("id");
+    r.x_m = t.number("x_m");
+    r.y_m = t.number("y_m");
+    r.z_m = t.number("z_m", 0.0);
+    r.yaw_rad = t.number("yaw_rad", 0.0);
+    r.size_m = t.positive("size_m", 0, true);
+    t.reject_unknown();
+    if (r.id < 0 || r.id > 586) t.fail_key("id", "must be a tag36h11 id 0..586");
+    if (!ids.insert(r.id).second) t.fail_key("id", std::to_string(r.id) + " is listed twice");
     out.push_back(r);
   }
   return out;
@@ -140,19 +136,22 @@ void mapcal_save(const std::string &path, const MapCalib &m) {
 }
 
 MapCalib mapcal_load(const std::string &path) {
-  YAML::Node n = yaml_load_file(path);
+  const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
   MapCalib m;
-  m.width_px = yaml_int(n, "width_px", path);
-  m.height_px = yaml_int(n, "height_px", path);
-  const auto r = yaml_doubles(n, "r_cam_map", path, 9);
-  const auto t = yaml_doubles(n, "t_cam_map_m", path, 3);
+  m.width_px = n.positive_int("width_px", 0, true);
+  m.height_px = n.positive_int("height_px", 0, true);
+  const auto r = n.numbers("r_cam_map", 9);
+  const auto t = n.numbers("t_cam_map_m", 3);
   for (int i = 0; i < 9; ++i) m.pose.r_cam_map(i / 3, i % 3) = r[static_cast<size_t>(i)];
   m.pose.t_cam_map = cv::Vec3d(t[0], t[1], t[2]);
   const cv::Matx33d should_be_i = m.pose.r_cam_map * m.pose.r_cam_map.t();
   if (cv::norm(should_be_i - cv::Matx33d::eye()) > 1e-6 || cv::determinant(m.pose.r_cam_map) < 0)
-    throw Error(path + ": field 'r_cam_map' is not a rotation matrix");
-  m.rms_mm = n["residual_rms_mm"] ? yaml_double(n, "residual_rms_mm", path) : 0.0;
-  m.max_mm = n["residual_max_mm"] ? yaml_double(n, "residual_max_mm", path) : 0.0;
+    n.fail_key("r_cam_map", "is not a rotation matrix");
+  m.rms_mm = n.number("residual_rms_mm", 0.0);
+  m.max_mm = n.number("residual_max_mm", 0.0);
+  // What map_calibrate found, kept in the file for people: not needed to run.
+  n.allow({"camera_centre_map_m", "tags", "missing_ids"});
+  n.reject_unknown();
   return m;
 }
 

@@ -83,7 +83,7 @@ TEST(Cli, HelpForEveryCommand) {
 TEST(Cli, BadInputGivesClearErrorNotCrash) {
   std::string out;
   EXPECT_EQ(run(std::string(EYE_BIN) + " run -c /nonexistent/eye.yaml", &out), 1);
-  EXPECT_NE(out.find("/nonexistent/eye.yaml: cannot open file"), std::string::npos) << out;
+  EXPECT_NE(out.find("/nonexistent/eye.yaml: cannot be opened"), std::string::npos) << out;
   const std::string d = fresh_dir("eye_cli_bad");
   std::ofstream(d + "/broken.png") << "not a png";
   EXPECT_EQ(

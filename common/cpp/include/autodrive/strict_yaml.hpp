@@ -16,12 +16,21 @@
 #include <utility>
 #include <vector>
 
-namespace autodrive::yaml {
+namespace autodrive {
 
-class Error : public std::runtime_error {
+// Bad input from a user: a config, a calibration, a map, a device. The message names the input
+// and what is wrong; programs print it and exit non-zero. The runtime's cfg::Error and the
+// Eye's eye::Error are this type.
+class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+}  // namespace autodrive
+
+namespace autodrive::yaml {
+
+using Error = autodrive::InputError;
 
 // The file's top-level node; Error naming the file if it cannot be read or parsed.
 inline YAML::Node load_file(const std::string &path) {
@@ -88,16 +97,31 @@ class Section {
     if (!(v > 0.0) || !std::isfinite(v)) fail_key(k, "must be a finite number > 0");
     return v;
   }
+  // A finite number (yaml-cpp reads .inf and .nan as numbers).
+  double number(const std::string &k) const { return finite(k, get<double>(k)); }
+  double number(const std::string &k, double fallback) const {
+    return finite(k, get<double>(k, fallback));
+  }
   int positive_int(const std::string &k, int fallback, bool required = false) const {
     const int v = required ? get<int>(k) : get<int>(k, fallback);
     if (v <= 0) fail_key(k, "must be an integer > 0");
     return v;
   }
-  // Exactly n numbers, e.g. a position [x, y, z].
+  // Exactly n finite numbers, e.g. a position [x, y, z]; n = 0: any number of them.
   std::vector<double> numbers(const std::string &k, size_t n) const {
-    const auto v = get<std::vector<double>>(k);
-    if (v.size() != n) fail_key(k, "expected " + std::to_string(n) + " numbers");
+    const std::string expected =
+        n ? "expected a list of " + std::to_string(n) + " numbers" : "expected a list of numbers";
+    used_->insert(k);
+    if (!has(k)) fail_key(k, "missing key");
+    if (!node_[k].IsSequence() || (n && node_[k].size() != n)) fail_key(k, expected);
+    const auto v = convert<std::vector<double>>(k);
+    for (const double x : v)
+      if (!std::isfinite(x)) fail_key(k, "has a non-finite entry");
     return v;
+  }
+  // Keys a reader knows and does not need (e.g. notes a calibration file carries for people).
+  void allow(std::initializer_list<const char *> keys) const {
+    for (const char *k : keys) used_->insert(k);
   }
   Section child(const std::string &k) const {
     used_->insert(k);
@@ -128,6 +152,10 @@ class Section {
   const YAML::Node &node() const { return node_; }
 
  private:
+  double finite(const std::string &k, double v) const {
+    if (!std::isfinite(v)) fail_key(k, "must be a finite number");
+    return v;
+  }
   template <typename T>
   T convert(const std::string &k) const {
     try {
