@@ -3,6 +3,7 @@
 // truth; and OpenCV's aruco (DICT_APRILTAG_36h11) as the peer on the same frames.
 // Progress on stderr; the figures as "key value" lines on stdout; a CSV of the trajectory.
 #include <CLI/CLI.hpp>
+#include <autodrive/angles.hpp>
 #include <opencv2/aruco.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -176,7 +177,7 @@ Accuracy accuracy(const Scene &sc, const RunResult &r) {
     if (!r.est[i]) continue;
     const auto &t = sc.path[i];
     const double ep = 1000 * std::hypot(r.est[i]->x_m - t.x_m, r.est[i]->y_m - t.y_m);
-    const double eh = std::remainder(r.est[i]->yaw_rad - t.yaw_rad, 2 * M_PI) * 180 / M_PI;
+    const double eh = autodrive::angle_wrap_rad(r.est[i]->yaw_rad - t.yaw_rad) * 180 / M_PI;
     ss_p += ep * ep;
     ss_h += eh * eh;
     e.push_back(ep);

@@ -1,5 +1,6 @@
 #include "eye_locate.hpp"
 
+#include <autodrive/angles.hpp>
 #include <cmath>
 
 namespace eye {
@@ -58,7 +59,7 @@ std::optional<CarPose> locate_car(const Intrinsics &in, const CameraPose &pose,
   out.tag_id = d.id;
   out.corners_px = d.corners_px;
   out.fit_rms_m = rms;
-  const double yaw = std::remainder(tag_yaw - v.tag_yaw_rad, 2 * M_PI);
+  const double yaw = autodrive::angle_wrap_rad(tag_yaw - v.tag_yaw_rad);
   // The tag sits at tag_offset in base_link: base = tag - R(yaw) offset.
   const double c = std::cos(yaw), s = std::sin(yaw);
   const double ox = p.tag_offset_m[0], oy = p.tag_offset_m[1];

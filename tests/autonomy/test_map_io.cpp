@@ -103,7 +103,7 @@ TEST(MapIo, BadFilesGiveClearErrors) {
   expect_load_error(d / "missing.yaml", "missing.yaml", "cannot be opened");
 
   write(d / "a.yaml", "image: m.pgm\norigin: [0, 0, 0]\n");
-  expect_load_error(d / "a.yaml", "a.yaml", "missing key 'resolution'");
+  expect_load_error(d / "a.yaml", "a.yaml", "resolution: missing key");
 
   write(d / "b.yaml", "image: m.pgm\nresolution: -1\norigin: [0, 0, 0]\n");
   expect_load_error(d / "b.yaml", "b.yaml", "resolution must be a positive");

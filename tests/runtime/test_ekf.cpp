@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include <autodrive/angles.hpp>
+
 #include "estimator/ekf.hpp"
 #include "estimator/estimator_node.hpp"
 
@@ -18,7 +20,7 @@ struct Truth {
 // Drives a bicycle model at speed v [m/s] and steering delta [rad] for dt [s].
 void step(Truth &t, double v, double delta, double dt) {
   const double w = v * std::tan(delta) / kL;
-  t.yaw = est::wrap_angle(t.yaw + w * dt);
+  t.yaw = autodrive::angle_wrap_rad(t.yaw + w * dt);
   t.x += v * std::cos(t.yaw) * dt;
   t.y += v * std::sin(t.yaw) * dt;
 }
@@ -64,10 +66,10 @@ double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us, est::Ek
 }  // namespace
 
 TEST(Ekf, WrapAngle) {
-  EXPECT_NEAR(est::wrap_angle(3 * M_PI / 2), -M_PI / 2, 1e-12);
-  EXPECT_NEAR(est::wrap_angle(-3 * M_PI / 2), M_PI / 2, 1e-12);
-  EXPECT_NEAR(est::wrap_angle(M_PI), M_PI, 1e-12);
-  EXPECT_NEAR(est::wrap_angle(0.1), 0.1, 1e-12);
+  EXPECT_NEAR(autodrive::angle_wrap_rad(3 * M_PI / 2), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(autodrive::angle_wrap_rad(-3 * M_PI / 2), M_PI / 2, 1e-12);
+  EXPECT_NEAR(autodrive::angle_wrap_rad(M_PI), M_PI, 1e-12);
+  EXPECT_NEAR(autodrive::angle_wrap_rad(0.1), 0.1, 1e-12);
 }
 
 TEST(Ekf, StraightLineFromOdometry) {
@@ -96,7 +98,7 @@ TEST(Ekf, CircleMatchesAckermannGeometry) {
   const est::Estimate e = ekf.latest();
   EXPECT_NEAR(e.x(0), t.x, 0.01);
   EXPECT_NEAR(e.x(1), t.y, 0.01);
-  EXPECT_NEAR(est::wrap_angle(e.x(2) - t.yaw), 0.0, 0.01);
+  EXPECT_NEAR(autodrive::angle_wrap_rad(e.x(2) - t.yaw), 0.0, 0.01);
   EXPECT_NEAR(e.x(4), v * std::tan(delta) / kL, 1e-3);
 }
 

@@ -1,14 +1,10 @@
 #include "estimator/ekf.hpp"
 
+#include <autodrive/angles.hpp>
+
 #include <cmath>
 
 namespace est {
-
-double wrap_angle(double a) {
-  a = std::fmod(a + M_PI, 2.0 * M_PI);
-  if (a <= 0) a += 2.0 * M_PI;
-  return a - M_PI;
-}
 
 Ekf::Ekf(EkfParams p) : p_(p) {
   // Until reset or a pose arrives: at the origin with a huge pose uncertainty, so the first
@@ -24,7 +20,7 @@ void Ekf::reset(int64_t t_us, double x_m, double y_m, double yaw_rad, double pos
   events_.clear();
   base_ = Estimate{};
   base_.t_us = t_us;
-  base_.x << x_m, y_m, wrap_angle(yaw_rad), 0.0, 0.0;
+  base_.x << x_m, y_m, autodrive::angle_wrap_rad(yaw_rad), 0.0, 0.0;
   base_.P = Mat5::Zero();
   base_.P(0, 0) = base_.P(1, 1) = pos_var_m2;
   base_.P(2, 2) = yaw_var_rad2;
@@ -42,7 +38,7 @@ void Ekf::predict(Estimate &s, int64_t t_us, const EkfParams &p) {
   const double ym = yaw + 0.5 * w * dt;
   s.x(0) += v * std::cos(ym) * dt;
   s.x(1) += v * std::sin(ym) * dt;
-  s.x(2) = wrap_angle(yaw + w * dt);
+  s.x(2) = autodrive::angle_wrap_rad(yaw + w * dt);
   Mat5 F = Mat5::Identity();
   F(0, 2) = -v * std::sin(ym) * dt;
   F(0, 3) = std::cos(ym) * dt;
@@ -65,7 +61,7 @@ void Ekf::update(Estimate &s, const Eigen::Matrix<double, M, 1> &innov,
   const Eigen::Matrix<double, M, M> S = H * s.P * H.transpose() + R;
   const Eigen::Matrix<double, 5, M> K = s.P * H.transpose() * S.inverse();
   s.x += K * innov;
-  s.x(2) = wrap_angle(s.x(2));
+  s.x(2) = autodrive::angle_wrap_rad(s.x(2));
   // Joseph form keeps P symmetric positive definite.
   const Mat5 I_KH = Mat5::Identity() - K * H;
   s.P = I_KH * s.P * I_KH.transpose() + K * R * K.transpose();
@@ -105,7 +101,7 @@ void Ekf::apply(Event &e, const Estimate &before) const {
       Eigen::Matrix<double, 3, 5> H = Eigen::Matrix<double, 3, 5>::Zero();
       H(0, 0) = H(1, 1) = H(2, 2) = 1.0;
       Eigen::Matrix<double, 3, 1> innov;
-      innov << e.z(0) - s.x(0), e.z(1) - s.x(1), wrap_angle(e.z(2) - s.x(2));
+      innov << e.z(0) - s.x(0), e.z(1) - s.x(1), autodrive::angle_wrap_rad(e.z(2) - s.x(2));
       update<3>(s, innov, H, e.R);
       break;
     }

@@ -43,8 +43,6 @@ struct EkfStats {
   uint64_t rejected = 0;  // dropped: non-finite values
 };
 
-double wrap_angle(double a_rad);  // to (-pi, pi]
-
 class Ekf {
  public:
   explicit Ekf(EkfParams p = {});

@@ -8,6 +8,7 @@
 //   ekf       : drives a loop through <VEH>_COMMAND, publishes Eye poses made from the sim's
 //               ground truth (noise + latency), compares <VEH>_POSE_MAP and <VEH>_ODOM with
 //               ground truth (ekf_*_rms)
+#include <autodrive/angles.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -254,10 +255,6 @@ struct Pose {
   double x, y, yaw;
 };
 
-double wrap(double a) {
-  return std::atan2(std::sin(a), std::cos(a));
-}
-
 // Ground truth interpolated at t_us (host receive time); false outside the record.
 bool truth_at(const std::vector<Pose> &gt, int64_t t_us, Pose *out) {
   auto it = std::lower_bound(gt.begin(), gt.end(), t_us,
@@ -265,7 +262,8 @@ bool truth_at(const std::vector<Pose> &gt, int64_t t_us, Pose *out) {
   if (it == gt.begin() || it == gt.end()) return false;
   const Pose &b = *it, &a = *(it - 1);
   const double f = double(t_us - a.t_us) / double(b.t_us - a.t_us);
-  *out = {t_us, a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap(b.yaw - a.yaw)};
+  *out = {t_us, a.x + f * (b.x - a.x), a.y + f * (b.y - a.y),
+          a.yaw + f * autodrive::angle_wrap_rad(b.yaw - a.yaw)};
   return true;
 }
 
@@ -289,8 +287,8 @@ struct EkfBench {
     if (eye && t >= next_eye_us) {
       next_eye_us = t + static_cast<int64_t>(eye_period_us);
       std::normal_distribution<double> nm(0, noise_m), nr(0, noise_rad);
-      eye_queue.push_back(
-          {t, m->position_m[0] + nm(rng), m->position_m[1] + nm(rng), wrap(m->yaw_rad + nr(rng))});
+      eye_queue.push_back({t, m->position_m[0] + nm(rng), m->position_m[1] + nm(rng),
+                           autodrive::angle_wrap_rad(m->yaw_rad + nr(rng))});
     }
   }
   void on_map(const autodrive::odometry_t *m) {
@@ -330,7 +328,7 @@ void rms(const std::vector<Pose> &est, const std::vector<Pose> &gt, int64_t t0, 
     for (const auto &e : est) {
       Pose g;
       if (e.t_us >= t0 && truth_at(gt, e.t_us, &g)) {
-        dth = wrap(g.yaw - e.yaw);
+        dth = autodrive::angle_wrap_rad(g.yaw - e.yaw);
         ox = e.x;
         oy = e.y;
         dx0 = g.x;
@@ -353,7 +351,7 @@ void rms(const std::vector<Pose> &est, const std::vector<Pose> &gt, int64_t t0, 
       yaw = e.yaw + dth;
     }
     se += (x - g.x) * (x - g.x) + (y - g.y) * (y - g.y);
-    const double dyaw = wrap(yaw - g.yaw) * 180.0 / M_PI;
+    const double dyaw = autodrive::angle_wrap_rad(yaw - g.yaw) * 180.0 / M_PI;
     sy += dyaw * dyaw;
     ++*n;
   }

@@ -1,5 +1,7 @@
 #include "autonomy/map_io.hpp"
 
+#include <autodrive/strict_yaml.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -49,16 +51,6 @@ int pgm_int(std::istream &in, const std::string &file, const char *what) {
   }
 }
 
-template <typename T>
-T yaml_get(const YAML::Node &root, const char *key, const std::string &file) {
-  if (!root[key]) map_fail(file, std::string("missing key '") + key + "'");
-  try {
-    return root[key].as<T>();
-  } catch (const YAML::Exception &) {
-    map_fail(file, std::string("key '") + key + "' has the wrong type");
-  }
-}
-
 }  // namespace
 
 void map_save(const GridMap &map, const std::string &yaml_path) {
@@ -98,25 +90,16 @@ void map_save(const GridMap &map, const std::string &yaml_path) {
 
 GridMap map_load(const std::string &yaml_path) {
   namespace fs = std::filesystem;
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::BadFile &) {
-    map_fail(yaml_path, "cannot be opened");
-  } catch (const YAML::Exception &e) {
-    map_fail(yaml_path, std::string("is not valid YAML: ") + e.what());
-  }
-  if (!root.IsMap()) map_fail(yaml_path, "is not a YAML mapping");
-  const auto image = yaml_get<std::string>(root, "image", yaml_path);
-  const auto resolution = yaml_get<double>(root, "resolution", yaml_path);
-  const auto origin = yaml_get<std::vector<double>>(root, "origin", yaml_path);
-  const int negate = root["negate"] ? yaml_get<int>(root, "negate", yaml_path) : 0;
-  const double occ_th =
-      root["occupied_thresh"] ? yaml_get<double>(root, "occupied_thresh", yaml_path) : 0.65;
-  const double free_th =
-      root["free_thresh"] ? yaml_get<double>(root, "free_thresh", yaml_path) : 0.196;
-  const std::string mode =
-      root["mode"] ? yaml_get<std::string>(root, "mode", yaml_path) : "trinary";
+  // The ROS map_server format (image, resolution, origin, negate, thresholds, mode).
+  const autodrive::yaml::Section root(autodrive::yaml::load_file(yaml_path), "", yaml_path);
+  const auto image = root.get<std::string>("image");
+  const auto resolution = root.get<double>("resolution");
+  const auto origin = root.get<std::vector<double>>("origin");
+  const int negate = root.get<int>("negate", 0);
+  const double occ_th = root.get<double>("occupied_thresh", 0.65);
+  const double free_th = root.get<double>("free_thresh", 0.196);
+  const std::string mode = root.get<std::string>("mode", "trinary");
+  root.reject_unknown();
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     map_fail(yaml_path, "resolution must be a positive number of metres");
   if (origin.size() != 3) map_fail(yaml_path, "origin must be [x_m, y_m, yaw_rad]");

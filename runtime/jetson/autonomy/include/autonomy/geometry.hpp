@@ -4,10 +4,12 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <autodrive/angles.hpp>
 
 namespace autonomy {
 
-constexpr double kPi = 3.14159265358979323846;
+using autodrive::angle_wrap_rad;
+using autodrive::kPi;
 
 // Pose of a frame on the plane: position [m] and heading [rad], CCW from x.
 struct Pose2 {
@@ -15,13 +17,6 @@ struct Pose2 {
   double y_m = 0.0;
   double yaw_rad = 0.0;
 };
-
-// Wraps an angle to (-pi, pi] [rad].
-inline double angle_wrap_rad(double a_rad) {
-  a_rad = std::fmod(a_rad + kPi, 2.0 * kPi);
-  if (a_rad <= 0.0) a_rad += 2.0 * kPi;
-  return a_rad - kPi;
-}
 
 // a (+) b: b expressed in a's frame, moved into a's parent frame.
 inline Pose2 pose_compose(const Pose2 &a, const Pose2 &b) {
