@@ -40,14 +40,16 @@ EkfParams params_from_config(const cfg::Config &c) {
 
 struct EstimatorNode::Impl {
   cfg::Config config;
-  lcm::LCM lcm;
+  lcm::LCM lcm;                   // inputs (and outputs, unless a separate output bus is given)
+  std::unique_ptr<lcm::LCM> out;  // replay: the outputs go to their own bus (e.g. a log file)
   Ekf odom, map;
   bool have_prev = false;
   autodrive::vehicle_state_t prev{};
   int64_t next_pub_us = 0;  // next ODOM/POSE_MAP due [us, message time]
 
-  explicit Impl(const cfg::Config &c)
+  Impl(const cfg::Config &c, const std::string &output_url)
       : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
+    if (!output_url.empty()) out = std::make_unique<lcm::LCM>(output_url);
     if (!lcm.good()) return;
     const std::string v = c.vehicle.name;
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, Impl, &Impl::on_state>(
@@ -119,21 +121,31 @@ struct EstimatorNode::Impl {
     for (double &v : o.twist_covariance) v = 0.0;
     o.twist_covariance[0] = e.P(3, 3);
     o.twist_covariance[8] = e.P(4, 4);
-    lcm.publish(config.vehicle.name + suffix, &o);
+    (out ? *out : lcm).publish(config.vehicle.name + suffix, &o);
   }
 };
 
-EstimatorNode::EstimatorNode(const cfg::Config &config) : impl_(std::make_unique<Impl>(config)) {}
+EstimatorNode::EstimatorNode(const cfg::Config &config, const std::string &output_url)
+    : impl_(std::make_unique<Impl>(config, output_url)) {}
 EstimatorNode::~EstimatorNode() = default;
 
 std::string EstimatorNode::init_error() const {
   if (!impl_->config.has_estimator) return impl_->config.file + ": estimator: missing section";
   if (!impl_->lcm.good()) return "LCM URL '" + impl_->config.lcm_url + "' unusable";
+  if (impl_->out && !impl_->out->good()) return "the output LCM URL is unusable";
   return "";
 }
 
 void EstimatorNode::run(const std::atomic<bool> &stop) {
   while (!stop) impl_->lcm.handleTimeout(20);
+}
+
+long EstimatorNode::replay() {
+  // A file:// input in read mode: handle() delivers the next logged message and fails at the
+  // end of the log. Time is the messages' own stamps, so a replay computes what the run did.
+  long n = 0;
+  while (impl_->lcm.handle() == 0) ++n;
+  return n;
 }
 
 }  // namespace est

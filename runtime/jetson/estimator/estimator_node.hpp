@@ -1,6 +1,8 @@
 // State estimator component: <VEH>_STATE (encoders, applied steering) + <VEH>_IMU (gyro z)
 // + <VEH>_POSE_EYE -> <VEH>_ODOM (odometry only, continuous) and <VEH>_POSE_MAP (with the
 // Eye, in the map frame). Publishes at each STATE, at most at estimator.rate_hz.
+// Its only clock is the messages' stamps (wall or SIM_CLOCK time, given by the bridge's
+// clk::Clock), so an LCM log replayed through file:// gives the outputs of the run again.
 #pragma once
 
 #include <atomic>
@@ -22,10 +24,14 @@ EkfParams params_from_config(const cfg::Config &c);
 
 class EstimatorNode {
  public:
-  explicit EstimatorNode(const cfg::Config &config);
+  // Inputs from config.lcm_url; outputs there too, or to output_url if given (replay).
+  explicit EstimatorNode(const cfg::Config &config, const std::string &output_url = "");
   ~EstimatorNode();
   std::string init_error() const;
   void run(const std::atomic<bool> &stop);
+  // Feeds every message of a file:// input (the config's lcm_url) through the estimator, as
+  // fast as it goes; returns the number of messages handled.
+  long replay();
 
  private:
   struct Impl;
