@@ -1,13 +1,16 @@
 // autodrive-autonomy: the parking mission on LCM. Subscribes <VEH>_LIDAR and <VEH>_ODOM,
 // publishes <VEH>_COMMAND, <VEH>_POSE_AMCL, <VEH>_LASER_ODOM, <VEH>_PATH and <VEH>_MISSION, and
 // prints each mission state change. Writes path.csv, route.csv and trajectory.csv into out_dir for
-// tools/plot-parking.
+// tools/plot-parking. With --replay LOG it reads <VEH>_LIDAR and <VEH>_ODOM from a recorded LCM
+// log instead (file://, as fast as it goes) and writes what it publishes to --replay-out: its
+// only clock is the messages' stamps, so a replay computes what the run did.
 #include <autodrive_channels.h>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -205,13 +208,21 @@ int main(int argc, char **argv) {
   CLI::App cli{
       "autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on "
       "LCM"};
-  std::string config_path, url_override, vehicle_override;
+  std::string config_path, url_override, vehicle_override, replay_in, replay_out;
   cli.add_option("--config", config_path,
                  "YAML configuration (see runtime/jetson/autonomy/config/)")
       ->required();
   cli.add_option("--lcm-url", url_override, "override lcm_url of the config");
   cli.add_option("--vehicle", vehicle_override, "override vehicle (e.g. NIGEL1)");
+  cli.add_option("--replay", replay_in, "read LIDAR and ODOM from this recorded LCM log")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--replay-out", replay_out, "with --replay: the LCM log to publish into");
   CLI11_PARSE(cli, argc, argv);
+  if (replay_in.empty() != replay_out.empty()) {
+    std::fprintf(stderr, "autodrive-autonomy: --replay and --replay-out go together\n");
+    return 2;
+  }
+  const bool replay = !replay_in.empty();
 
   ProgramConfig cfg;
   try {
@@ -223,15 +234,21 @@ int main(int argc, char **argv) {
   if (!url_override.empty()) cfg.lcm_url = url_override;
   if (!vehicle_override.empty()) cfg.vehicle = vehicle_override;
 
+  if (replay) {
+    cfg.lcm_url = "file://" + std::filesystem::absolute(replay_in).string() + "?speed=0";
+    replay_out = "file://" + std::filesystem::absolute(replay_out).string() + "?mode=w";
+  }
   lcm::LCM lcm(cfg.lcm_url);
-  if (!lcm.good()) {
+  std::unique_ptr<lcm::LCM> replay_lcm;  // replay: what the autonomy publishes goes here
+  if (replay) replay_lcm = std::make_unique<lcm::LCM>(replay_out);
+  if (!lcm.good() || (replay_lcm && !replay_lcm->good())) {
     std::fprintf(stderr, "autodrive-autonomy: cannot open LCM at '%s' (multicast route missing?)\n",
-                 cfg.lcm_url.c_str());
+                 (lcm.good() ? replay_out : cfg.lcm_url).c_str());
     return 2;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  App app(cfg, lcm);
+  App app(cfg, replay_lcm ? *replay_lcm : lcm);
   auto *s1 = autodrive_lcm::subscribe<autodrive::lidar_scan_t, App, &App::on_scan>(
       lcm, cfg.vehicle + AUTODRIVE_CH_LIDAR_SUFFIX, &app);
   auto *s2 = autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_odom>(
@@ -243,7 +260,11 @@ int main(int argc, char **argv) {
   std::fflush(stdout);
   int64_t finished_at = -1;
   while (!g_stop) {
-    lcm.handleTimeout(100);
+    if (replay) {
+      if (lcm.handle() != 0) break;  // the end of the log
+    } else {
+      lcm.handleTimeout(100);
+    }
     if (app.finished()) {
       if (finished_at < 0) finished_at = app.last_utime();
       if (app.last_utime() - finished_at >= static_cast<int64_t>(cfg.exit_after_finish_s * 1e6))
@@ -251,6 +272,7 @@ int main(int argc, char **argv) {
     }
   }
   app.publish_command(app.last_utime(), true);  // a final stop, also when interrupted mid-drive
+  if (replay) return 0;
   if (!app.finished()) return 130;
   return app.parked() ? 0 : 1;
 }
