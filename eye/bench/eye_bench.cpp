@@ -214,13 +214,19 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "eye_bench: cannot open LCM %s\n", url.c_str());
     return 1;
   }
-  std::fprintf(stderr, "[eye_bench] rendering %d frames at 1280x720\n", frames);
-  const Scene hd = make_scene(1280, 720, frames, tag_size_m, nullptr);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720, %d passes\n", repeats);
-  const RunResult e720 = run_eye(hd, lcm, repeats, true);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1280x720 without window tracking, %d passes\n",
-               repeats);
-  const RunResult e720full = run_eye(hd, lcm, repeats, false);
+  // One resolution: its rendered scene, then the Eye with and without window tracking.
+  const auto at_size = [&](int w, int h, Scene *scene, RunResult *tracked, RunResult *full) {
+    std::fprintf(stderr, "[eye_bench] rendering %d frames at %dx%d\n", frames, w, h);
+    *scene = make_scene(w, h, frames, tag_size_m, nullptr);
+    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d, %d passes\n", w, h, repeats);
+    *tracked = run_eye(*scene, lcm, repeats, true);
+    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d without window tracking, %d passes\n", w,
+                 h, repeats);
+    *full = run_eye(*scene, lcm, repeats, false);
+  };
+  Scene hd, fhd;
+  RunResult e720, e720full, e1080, e1080full;
+  at_size(1280, 720, &hd, &e720, &e720full);
   std::fprintf(stderr, "[eye_bench] peer (OpenCV aruco) 1280x720, %d passes\n", repeats);
   const RunResult p720 = run_peer(hd, lcm, repeats);
   const Accuracy a = accuracy(hd, e720), pa = accuracy(hd, p720), afull = accuracy(hd, e720full);
@@ -230,7 +236,7 @@ int main(int argc, char **argv) {
          "yaw_rad\n";
     for (size_t i = 0; i < hd.path.size(); ++i) {
       f << i << "," << hd.path[i].x_m << "," << hd.path[i].y_m << "," << hd.path[i].yaw_rad;
-      for (const auto *r : {&e720, &p720}) {
+      for (const RunResult *r : std::initializer_list<const RunResult *>{&e720, &p720}) {
         if (r->est[i])
           f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
         else
@@ -239,13 +245,7 @@ int main(int argc, char **argv) {
       f << "\n";
     }
   }
-  std::fprintf(stderr, "[eye_bench] rendering %d frames at 1920x1080\n", frames);
-  const Scene fhd = make_scene(1920, 1080, frames, tag_size_m, nullptr);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080, %d passes\n", repeats);
-  const RunResult e1080 = run_eye(fhd, lcm, repeats, true);
-  std::fprintf(stderr, "[eye_bench] Eye pipeline 1920x1080 without window tracking, %d passes\n",
-               repeats);
-  const RunResult e1080full = run_eye(fhd, lcm, repeats, false);
+  at_size(1920, 1080, &fhd, &e1080, &e1080full);
   const Accuracy a1080 = accuracy(fhd, e1080);
 
   const double jpeg_kb = static_cast<double>(hd.jpeg[0].size()) / 1024.0;

@@ -8,20 +8,13 @@ marked as such, so that work in progress spells them from the table as well."""
 from __future__ import annotations
 
 from .. import channels
+from . import c_header
 
 GUARD = "AUTODRIVE_CHANNELS_H"
 
 
 def render(table: channels.ChannelTable, source_name: str) -> str:
-    lines = [
-        f"/* Generated from {source_name} by autodrive_tools.codegen.channels_header: do not edit.",
-        " * LCM channel names; CHANNELS.md describes each. */",
-        f"#ifndef {GUARD}",
-        f"#define {GUARD}",
-        "",
-        f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"',
-        "",
-    ]
+    lines = [f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"', ""]
     for ch in table.channels:
         note = f"/* {ch.type}, {ch.rate}" + (", planned */" if ch.status == "planned" else " */")
         if ch.per_vehicle:
@@ -29,5 +22,10 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
             lines.append(f'#define AUTODRIVE_CH_{ch.id}_SUFFIX "{suffix}" {note}')
         else:
             lines.append(f'#define AUTODRIVE_CH_{ch.id} "{ch.name}" {note}')
-    lines += ["", f"#endif /* {GUARD} */", ""]
-    return "\n".join(lines)
+    return c_header.wrap(
+        GUARD,
+        source_name,
+        "autodrive_tools.codegen.channels_header",
+        "LCM channel names; CHANNELS.md describes each.",
+        lines,
+    )

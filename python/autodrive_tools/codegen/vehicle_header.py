@@ -7,6 +7,7 @@ planners and scoring use (autodrive_tools.vehicle) is derived here once too."""
 from __future__ import annotations
 
 from .. import vehicle
+from . import c_header
 
 GUARD = "AUTODRIVE_VEHICLE_H"
 PREFIX = "AUTODRIVE_VEHICLE_"
@@ -18,13 +19,7 @@ def _number(v: float) -> str:
 
 
 def render(car: vehicle.Vehicle, source_name: str) -> str:
-    lines = [
-        f"/* Generated from {source_name} by autodrive_tools.codegen.vehicle_header: do not edit.",
-        " * The car's figures, SI units named in each key. */",
-        f"#ifndef {GUARD}",
-        f"#define {GUARD}",
-        "",
-    ]
+    lines = []
     for key, value in car.figures.items():
         name = PREFIX + key.upper()
         if isinstance(value, str):
@@ -43,8 +38,11 @@ def render(car: vehicle.Vehicle, source_name: str) -> str:
         f"#define {PREFIX}ENVELOPE_LENGTH_M {_number(car.envelope_length_m)}",
         f"#define {PREFIX}ENVELOPE_WIDTH_M {_number(car.envelope_width_m)}",
         f"#define {PREFIX}ENVELOPE_CENTER_AHEAD_M {_number(car.envelope_center_ahead_m)}",
-        "",
-        f"#endif /* {GUARD} */",
-        "",
     ]
-    return "\n".join(lines)
+    return c_header.wrap(
+        GUARD,
+        source_name,
+        "autodrive_tools.codegen.vehicle_header",
+        "The car's figures, SI units named in each key.",
+        lines,
+    )

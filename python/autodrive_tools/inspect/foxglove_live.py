@@ -140,12 +140,7 @@ class Bridge:
         self.log(topic, fc.CompressedImageChannel, img, utime)
 
     def odometry(self, topic: str, veh: str, m: Any, utime: int) -> None:
-        pose = fm.PoseInFrame(
-            timestamp=_ts(utime),
-            frame_id=frames.frame(veh, m.frame_id),
-            pose=_pose(m.x_m, m.y_m, m.yaw_rad),
-        )
-        self.log(topic, fc.PoseInFrameChannel, pose, utime)
+        self.pose2d(topic, veh, m, utime)  # the pose; the twist is not shown
         if m.frame_id == "odom":
             self.latest_odom[veh] = (m.x_m, m.y_m, m.yaw_rad)
             base = frames.frame(veh, m.child_frame_id)

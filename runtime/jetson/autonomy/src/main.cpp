@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include <autodrive_lcm/pose2d.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 
 #include <autodrive/lidar_scan_t.hpp>
@@ -100,16 +101,12 @@ class App {
 
  private:
   void publish_amcl(const Pose2 &p, int64_t utime) {
-    autodrive::pose2d_t m{};
-    m.utime = utime;
-    m.vehicle = cfg_.vehicle;
-    m.frame_id = "map";
-    m.source = autodrive::pose2d_t::SOURCE_AMCL;
-    m.x_m = p.x_m;
-    m.y_m = p.y_m;
-    m.yaw_rad = p.yaw_rad;
     const Eigen::Matrix3d c = node_.amcl_covariance();
-    for (int i = 0; i < 9; ++i) m.covariance[i] = c(i / 3, i % 3);
+    std::array<double, 9> cov{};
+    for (size_t i = 0; i < cov.size(); ++i)
+      cov[i] = c(static_cast<int>(i / 3), static_cast<int>(i % 3));
+    const autodrive::pose2d_t m = autodrive_lcm::map_pose2d(
+        utime, cfg_.vehicle, autodrive::pose2d_t::SOURCE_AMCL, p.x_m, p.y_m, p.yaw_rad, cov);
     lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_POSE_AMCL_SUFFIX, &m);
   }
 
