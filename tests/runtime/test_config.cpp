@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include <autodrive_channels.h>
+
 #include "common/config.hpp"
 
 namespace {
@@ -68,6 +70,20 @@ TEST(Config, VehicleFiguresComeFromTheDescription) {
   EXPECT_DOUBLE_EQ(c.vehicle.wheelbase_m, AUTODRIVE_VEHICLE_WHEELBASE_M);
   EXPECT_DOUBLE_EQ(c.vehicle.wheel_radius_m, AUTODRIVE_VEHICLE_WHEEL_RADIUS_M);
   EXPECT_GT(c.vehicle.encoder_counts_per_rev, 0);
+}
+
+TEST(Config, CameraChannelComesFromTheTable) {
+  const cfg::Config c = cfg::parse(
+      std::string(kGood) + "cameras:\n  - {source: v.avi, channel: CAM_REAR, rate_hz: 30}\n",
+      "test.yaml");
+  ASSERT_EQ(c.cameras.size(), 1u);
+  EXPECT_EQ(c.cameras[0].channel, std::string(AUTODRIVE_CH_CAM_REAR_SUFFIX));
+  EXPECT_EQ(c.cameras[0].info_channel, std::string(AUTODRIVE_CH_CAM_REAR_INFO_SUFFIX));
+  const std::string e = error_of(std::string(kGood) +
+                                 "cameras:\n  - {source: v.avi, channel: CAM_SIDE, rate_hz: 30}\n");
+  EXPECT_NE(e.find("test.yaml: cameras[0].channel: must be CAM_FRONT or CAM_REAR"),
+            std::string::npos)
+      << e;
 }
 
 TEST(Config, UnknownKeyRefused) {

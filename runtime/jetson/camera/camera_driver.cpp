@@ -45,7 +45,7 @@ struct CameraDriver::Impl {
       return;
     }
     cam = c.cameras[i];
-    tag = "[camera " + c.vehicle.name + "_" + cam.channel + "] ";
+    tag = "[camera " + c.vehicle.name + cam.channel + "] ";
     if (lcm.good()) clock.attach(lcm);
   }
 
@@ -73,7 +73,7 @@ struct CameraDriver::Impl {
     info.distortion_model = "plumb_bob";
     info.num_d = static_cast<int32_t>(cam.d.size());
     info.d = cam.d;
-    lcm.publish(config.vehicle.name + "_" + cam.channel + "_INFO", &info);
+    lcm.publish(config.vehicle.name + cam.info_channel, &info);
   }
 
   void run(const std::atomic<bool> &stop) {
@@ -123,7 +123,7 @@ struct CameraDriver::Impl {
       img.data = encode_jpeg(cont.data, cont.cols, cont.rows, cam.width_px, cam.height_px,
                              cam.jpeg_quality);
       img.size_bytes = static_cast<int32_t>(img.data.size());
-      lcm.publish(config.vehicle.name + "_" + cam.channel, &img);
+      lcm.publish(config.vehicle.name + cam.channel, &img);
       ++published;
       if (clk::monotonic_us() >= next_info_us) {
         publish_info();

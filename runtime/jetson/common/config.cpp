@@ -1,5 +1,7 @@
 #include "common/config.hpp"
 
+#include <autodrive_channels.h>
+
 #include <cmath>
 
 namespace cfg {
@@ -71,7 +73,18 @@ Lidar parse_lidar(const Section &s) {
 Camera parse_camera(const Section &s) {
   Camera c;
   c.source = s.get<std::string>("source");
-  c.channel = s.get<std::string>("channel");
+  // The camera's channel pair comes from the channel table: image and its _INFO.
+  const std::string channel = s.get<std::string>("channel");
+  if ("_" + channel == AUTODRIVE_CH_CAM_FRONT_SUFFIX) {
+    c.channel = AUTODRIVE_CH_CAM_FRONT_SUFFIX;
+    c.info_channel = AUTODRIVE_CH_CAM_FRONT_INFO_SUFFIX;
+  } else if ("_" + channel == AUTODRIVE_CH_CAM_REAR_SUFFIX) {
+    c.channel = AUTODRIVE_CH_CAM_REAR_SUFFIX;
+    c.info_channel = AUTODRIVE_CH_CAM_REAR_INFO_SUFFIX;
+  } else {
+    s.fail(s.key("channel"),
+           "must be CAM_FRONT or CAM_REAR (lcm_types/channels.yaml), got '" + channel + "'");
+  }
   c.frame_id = s.get<std::string>("frame_id", c.frame_id);
   c.rate_hz = s.positive("rate_hz", 0, true);
   c.width_px = s.positive_int("width_px", c.width_px);

@@ -58,8 +58,9 @@ struct Lidar {
 };
 
 struct Camera {
-  std::string source;   // /dev/videoN, a GStreamer pipeline (contains '!') or a video file
-  std::string channel;  // e.g. "CAM_FRONT": published as <VEH>_<channel> and <...>_INFO
+  std::string source;        // /dev/videoN, a GStreamer pipeline (contains '!') or a video file
+  std::string channel;       // suffix of the image channel, e.g. "_CAM_FRONT" (<VEH>_CAM_FRONT)
+  std::string info_channel;  // suffix of its intrinsics channel, e.g. "_CAM_FRONT_INFO"
   std::string frame_id = "camera_front";
   double rate_hz = 30.0;
   int width_px = 640;
