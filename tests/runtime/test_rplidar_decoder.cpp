@@ -235,25 +235,36 @@ TEST(RplidarAssembler, FakeStartFlagMidTurnIgnored) {
   EXPECT_NEAR(s.scan_time_s, 0.36, 1e-6);
 }
 
-TEST(RplidarAssembler, DescendingAnglesAccepted) {
-  // Nodes counting down (as some emulations send them) still make whole turns.
+// Three turns of an A1 whose angle steps by step_deg per node (+1: clockwise, as the device
+// turns); node k carries 1000 + k mm.
+struct Turns {
   rplidar::Decoder d;
-  rplidar::ScanAssembler a(rplidar::ScanParams{});
+  rplidar::ScanAssembler a{rplidar::ScanParams{}};
   std::vector<autodrive::lidar_scan_t> scans;
   int64_t t = 0;
-  d.on_node = [&](const rplidar::Node &n) {
-    autodrive::lidar_scan_t s;
-    if (a.add(n, t += 1000, &s)) scans.push_back(s);
-  };
-  const uint8_t desc[7] = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
-  d.feed(desc, 7);
-  for (int turn = 0; turn < 3; ++turn)
-    for (int i = 0; i < 360; ++i) {
-      uint8_t b[5];
-      rplidar::encode_node({i == 0, 10, double((360 - i) % 360), 1000.0 + i}, b);
-      d.feed(b, 5);
-    }
-  ASSERT_EQ(scans.size(), 2u);
-  for (int i = 0; i < 360; ++i)
-    EXPECT_NEAR(scans[0].ranges_m[static_cast<std::size_t>(i)], 1.0 + i / 1000.0, 1e-6);
+  explicit Turns(int step_deg) {
+    d.on_node = [this](const rplidar::Node &n) {
+      autodrive::lidar_scan_t s;
+      if (a.add(n, t += 1000, &s)) scans.push_back(s);
+    };
+    const uint8_t desc[7] = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
+    d.feed(desc, 7);
+    for (int turn = 0; turn < 3; ++turn)
+      for (int k = 0; k < 360; ++k) {
+        uint8_t b[5];
+        rplidar::encode_node({k == 0, 10, double((360 + step_deg * k) % 360), 1000.0 + k}, b);
+        d.feed(b, 5);
+      }
+  }
+};
+
+TEST(RplidarAssembler, ClockwiseTurnsBecomeCounterClockwiseScans) {
+  // The device's angle grows clockwise; the scan (REP-103) counts counter-clockwise: the node
+  // at device angle k deg lands in bin (360 - k) % 360.
+  Turns turns(+1);
+  ASSERT_EQ(turns.scans.size(), 2u);
+  for (int k = 0; k < 360; ++k)
+    EXPECT_NEAR(turns.scans[0].ranges_m[static_cast<std::size_t>((360 - k) % 360)],
+                1.0 + k / 1000.0, 1e-6)
+        << "device angle " << k;
 }

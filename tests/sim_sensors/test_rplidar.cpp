@@ -168,9 +168,10 @@ TEST(SimRplidar, ScanNodesDecodeToTheLidarScanAndStop) {
       ASSERT_EQ(n[1] & 1, 1) << "check bit, node " << k;
       const double angle_deg = ((n[1] >> 1) | (n[2] << 7)) / 64.0;
       const double dist_mm = (n[3] | (n[4] << 8)) / 4.0;
-      // device angles are clockwise: node k carries the ray at CCW angle k deg
-      EXPECT_NEAR(angle_deg, std::fmod(360.0 - k, 360.0), 1.0 / 64) << "node " << k;
-      EXPECT_NEAR(dist_mm, s->ranges_m[k] * 1000.0, 0.125 + 1e-3) << "node " << k;
+      // the head turns clockwise like a real A1: node k is at device angle k deg, which is the
+      // scan's ray at CCW angle (360 - k) % 360 deg
+      EXPECT_NEAR(angle_deg, k, 1.0 / 64) << "node " << k;
+      EXPECT_NEAR(dist_mm, s->ranges_m[(360 - k) % 360] * 1000.0, 0.125 + 1e-3) << "node " << k;
       EXPECT_EQ(q, 47) << "node " << k;
     }
   }
@@ -212,8 +213,9 @@ TEST(SimRplidar, SevenHertzScansAreThinnedEvenlyNotCut) {
       prev_ray = -1;
     }
     if (!rev_sizes.empty()) rev_sizes.back()++;
-    if (prev_ray >= 0) max_gap_rays = std::max(max_gap_rays, ray - prev_ray);
-    prev_ray = ray;
+    const int step = (360 - ray) % 360;  // clockwise sweep step of this ray
+    if (prev_ray >= 0) max_gap_rays = std::max(max_gap_rays, step - prev_ray);
+    prev_ray = step;
   }
   ASSERT_GE(rev_sizes.size(), 15u);
   // after the first (full) revolution: 97 % of 2304 nodes/s over 1/7 s, i.e. ~319..322 nodes

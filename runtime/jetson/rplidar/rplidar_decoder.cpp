@@ -120,8 +120,9 @@ void Decoder::process() {
       continue;
     }
     if (avail < 10) break;
-    // Neighbouring nodes are a small step apart (either direction: the real A1 counts up,
-    // some emulations count down).
+    // Neighbouring nodes are a small step apart. The A1 turns clockwise and its angle grows
+    // (the simulator's emulated A1 too); either direction is accepted, since a check on the
+    // direction alone does not reject misaligned windows any better.
     auto follows = [](double from_deg, double to_deg) {
       const double d = std::fmod(to_deg - from_deg + 360.0, 360.0);
       return std::min(d, 360.0 - d) < kMaxStepDeg;

@@ -75,10 +75,18 @@ void sim_lidar_scan_now(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now
 /* The last completed scan (num_rays == 0 before the first). Borrowed pointer. */
 const sim_lidar_scan_t *sim_lidar_last_scan(const sim_lidar_t *l);
 
-/* The rays [from, to) the last sim_lidar_update cast (from == to: none) of num_rays per
- * revolution, indexed like a scan (CCW angle i * 360 / num_rays deg); ranges_m / quality are
- * borrowed, valid until the next update. An emulated RPLIDAR streams these as they are measured,
- * like the real device. */
+/* The head turns clockwise seen from above, like a real RPLIDAR A1: sweep step k of a
+ * revolution (k = 0 .. num_rays-1, in time order) measures the ray at CW angle k * 360 /
+ * num_rays deg, which a scan (REP-103, counter-clockwise) indexes as ray (num_rays - k) %
+ * num_rays. The one place of that mapping. */
+static inline int sim_lidar_sweep_ray(int k, int num_rays) {
+  return (num_rays - k) % num_rays;
+}
+
+/* The sweep steps [from, to) the last sim_lidar_update cast (from == to: none) of num_rays per
+ * revolution; step k's range is ranges_m[sim_lidar_sweep_ray(k, num_rays)] (ranges_m /
+ * quality are indexed like a scan, borrowed, valid until the next update). An emulated RPLIDAR
+ * streams these as they are measured, like the real device. */
 void sim_lidar_last_cast(const sim_lidar_t *l, int *from, int *to, int *num_rays,
                          const float **ranges_m, const float **quality);
 

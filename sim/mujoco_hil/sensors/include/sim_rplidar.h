@@ -53,15 +53,17 @@ void sim_rplidar_destroy(sim_rplidar_t *r);
 /* The pty slave path (/dev/pts/N). Borrowed string. */
 const char *sim_rplidar_slave_path(const sim_rplidar_t *r);
 
-/* Queues one revolution for sending if the device is scanning (ignored otherwise).
+/* Queues one revolution for sending if the device is scanning (ignored otherwise), in the
+ * real A1's order: clockwise, device angles growing (sim_lidar_sweep_ray).
  * ranges_m[i] is the ray at CCW angle i * 360 / num_rays deg (as sim_lidar_scan_t),
  * +inf / out of range -> distance 0 and quality 0; quality may be NULL (then 47 on a return). */
 void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float *quality,
                            int num_rays);
 
-/* Streams rays [from, to) of the revolution being measured, as a real A1 sends nodes while it
- * spins (a whole-revolution push delays every node by up to one revolution, ~143 ms at 7 Hz).
- * Ray 0 starts a revolution (the S flag). Same node subset and encoding as push_scan. */
+/* Streams sweep steps [from, to) of the revolution being measured (sim_lidar_last_cast), as a
+ * real A1 sends nodes while it spins (a whole-revolution push delays every node by up to one
+ * revolution, ~143 ms at 7 Hz). Step 0 starts a revolution (the S flag). Same node subset and
+ * encoding as push_scan. */
 void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality, int from,
                            int to, int num_rays);
 

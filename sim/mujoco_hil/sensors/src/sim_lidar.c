@@ -35,8 +35,8 @@ struct sim_lidar {
   float *out_ranges_m, *out_quality; /* last completed revolution */
   sim_lidar_scan_t last;
   int64_t rev_start_us;   /* sim time at which the current revolution started [us] */
-  int next_ray;           /* next ray index of the current revolution */
-  int cast_from, cast_to; /* rays [from, to) cast by the last update, in ranges_m */
+  int next_ray;           /* next sweep step of the current revolution */
+  int cast_from, cast_to; /* sweep steps [from, to) cast by the last update */
   int started;
   uint64_t rng; /* xorshift64* state for the noise */
 };
@@ -471,6 +471,18 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
   }
 }
 
+/* Casts the rays of sweep steps [from, to) (clockwise: see sim_lidar_sweep_ray): step 0 is
+ * ray 0, steps 1.. are rays num_rays-1, num_rays-2, ..., a contiguous range of ray indices. */
+static void lidar_cast_sweep(const mjModel *m, const mjData *d, sim_lidar_t *l, int from, int to) {
+  const int n = l->cfg.num_rays;
+  if (from >= to) return;
+  if (from == 0) {
+    lidar_cast_rays(m, d, l, 0, 1);
+    from = 1;
+  }
+  if (from < to) lidar_cast_rays(m, d, l, n - to + 1, n - from + 1);
+}
+
 static void lidar_publish(sim_lidar_t *l, int64_t start_us) {
   size_t n = (size_t)l->cfg.num_rays;
   memcpy(l->out_ranges_m, l->ranges_m, n * sizeof(float));
@@ -499,11 +511,11 @@ int sim_lidar_update(const mjModel *m, mjData *d, sim_lidar_t *l, int64_t now_us
     l->next_ray = 0;
   }
   double period_us = 1e6 / l->cfg.rate_hz;
-  /* ray i is due at rev_start + i * period / num_rays */
+  /* sweep step k is due at rev_start + k * period / num_rays */
   double phase = (double)(now_us - l->rev_start_us) / period_us;
   int due = (int)floor(phase * l->cfg.num_rays) + 1;
   if (due > l->cfg.num_rays) due = l->cfg.num_rays;
-  lidar_cast_rays(m, d, l, l->next_ray, due);
+  lidar_cast_sweep(m, d, l, l->next_ray, due);
   l->cast_from = l->next_ray;
   l->cast_to = due > l->next_ray ? due : l->next_ray;
   if (due > l->next_ray) l->next_ray = due;

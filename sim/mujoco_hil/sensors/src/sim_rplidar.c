@@ -1,6 +1,8 @@
 /* sim_rplidar: see sim_rplidar.h for the wire format. */
 #include "sim_rplidar.h"
 
+#include "sim_lidar.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -324,8 +326,10 @@ void sim_rplidar_push_scan(sim_rplidar_t *r, const float *ranges_m, const float 
   /* Send what the wire carries in one revolution, spread evenly over the circle, instead of
    * a backlog that must later be cut. */
   int send = rpl_nodes_per_rev(r, num_rays);
-  for (int k = 0; k < send; k++)
-    rpl_queue_node(r, ranges_m, quality, (int)((int64_t)k * num_rays / send), num_rays, k == 0);
+  for (int k = 0; k < send; k++) {
+    const int step = (int)((int64_t)k * num_rays / send);
+    rpl_queue_node(r, ranges_m, quality, sim_lidar_sweep_ray(step, num_rays), num_rays, k == 0);
+  }
 }
 
 void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float *quality, int from,
@@ -338,12 +342,13 @@ void sim_rplidar_push_rays(sim_rplidar_t *r, const float *ranges_m, const float 
     r->stats.nodes_dropped += (uint64_t)(to - from);
     return;
   }
-  for (int i = from; i < to; i++) {
-    /* ray i is sent when it is one of floor(k * num_rays / send), k = 0..send-1: the same
-     * evenly spread subset as a whole-revolution push */
-    int64_t k = ((int64_t)i * send + num_rays - 1) / num_rays;
-    if (k < send && k * num_rays / send == i)
-      rpl_queue_node(r, ranges_m, quality, i, num_rays, i == 0);
+  for (int step = from; step < to; step++) {
+    /* sweep step `step` is sent when it is one of floor(k * num_rays / send), k = 0..send-1:
+     * the same evenly spread subset as a whole-revolution push */
+    int64_t k = ((int64_t)step * send + num_rays - 1) / num_rays;
+    if (k < send && k * num_rays / send == step)
+      rpl_queue_node(r, ranges_m, quality, sim_lidar_sweep_ray(step, num_rays), num_rays,
+                     step == 0);
   }
 }
 
