@@ -86,6 +86,15 @@ TEST(Config, CameraChannelComesFromTheTable) {
       << e;
 }
 
+TEST(Config, SyncToSimClockNeedsTheSimClock) {
+  const std::string sync =
+      replace(kGood, "command_timeout_ms: 200", "command_timeout_ms: 200, sync_to_sim_clock: true");
+  EXPECT_EQ(error_of(sync),
+            "test.yaml: bridge.sync_to_sim_clock: needs clock: sim (it sends on SIM_CLOCK ticks)");
+  EXPECT_TRUE(
+      cfg::parse(replace(sync, "clock: wall", "clock: sim"), "test.yaml").bridge.sync_to_sim_clock);
+}
+
 TEST(Config, UnknownKeyRefused) {
   EXPECT_EQ(error_of(replace(kGood, "baud: 500000", "baud: 500000, devcie: x")),
             "test.yaml: bridge.devcie: unknown key");

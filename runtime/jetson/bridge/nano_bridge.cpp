@@ -50,10 +50,15 @@ struct NanoBridge::Impl {
   Status st;
 
   std::optional<autodrive::vehicle_command_t> latest_cmd;
+  // sync_to_sim_clock: a command stamped later than the sim clock waits here for its tick
+  std::optional<autodrive::vehicle_command_t> scheduled_cmd;
+  int64_t scheduled_rx_us = 0;
   int64_t latest_cmd_rx_us = 0;  // monotonic
   uint16_t cmd_seq = 0;
   uint8_t frame_seq = 0;
-  int64_t next_tx_us = 0;  // next heartbeat / hello [monotonic us]
+  int64_t next_tx_us = 0;       // next heartbeat / hello [monotonic us]
+  int64_t last_tick = -1;       // sync_to_sim_clock: the SIM_CLOCK tick last answered
+  bool config_pending = false;  // sync_to_sim_clock: CONFIG goes out as the next tick's frame
   int64_t next_open_us = 0;
   int64_t last_rx_frame_us = 0;  // last good frame from the Nano
   bool open_failure_logged = false;
@@ -97,10 +102,18 @@ struct NanoBridge::Impl {
       return;
     }
     rejected_logged = false;
+    if (config.bridge.sync_to_sim_clock && m->utime > clock.now_us()) {
+      // In step with SIM_CLOCK a command stamped in the future applies from that sim time, so
+      // a scripted sender acts at the same tick in every run.
+      scheduled_cmd = *m;
+      scheduled_rx_us = clk::monotonic_us();
+      return;
+    }
     latest_cmd = *m;
     latest_cmd_rx_us = clk::monotonic_us();
-    // Forward at once (latency), then keep the heartbeat going from here.
-    if (state() == LinkState::linked) {
+    // Forward at once (latency), then keep the heartbeat going from here. In step with
+    // SIM_CLOCK every frame waits for its tick instead.
+    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock) {
       send_command(latest_cmd_rx_us);
       next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
     }
@@ -143,6 +156,40 @@ struct NanoBridge::Impl {
     uint8_t payload[PROTO_LEN_CONFIG];
     proto_config_pack(&c, payload);
     write_frame(PROTO_ID_CONFIG, payload, PROTO_LEN_CONFIG);
+  }
+
+  // sync_to_sim_clock: one frame per SIM_CLOCK tick (the heartbeat period of sim time), sent
+  // after everything the Nano wrote before the tick is read, so that with the simulator in
+  // --lockstep-frames every frame reaches the firmware at the same sim step in every run.
+  // Command freshness stays on the monotonic clock: a frozen sim still fails safe.
+  void send_on_tick(int64_t now_us) {
+    const int64_t tick = clock.now_us() / heartbeat_period_us();
+    if (tick == last_tick) return;
+    last_tick = tick;
+    uint8_t buf[512];
+    long n;
+    while ((n = port.read_some(buf, sizeof buf)) > 0)
+      proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
+    if (n < 0) lose_device(port.error());
+    if (!port.is_open()) return;
+    if (scheduled_cmd && scheduled_cmd->utime <= clock.now_us()) {
+      latest_cmd = scheduled_cmd;
+      latest_cmd_rx_us = scheduled_rx_us;
+      scheduled_cmd.reset();
+    }
+    switch (state()) {
+      case LinkState::linked:
+        if (config_pending) {
+          send_config();
+          config_pending = false;
+        } else {
+          send_command(now_us);
+        }
+        break;
+      case LinkState::handshaking:
+      case LinkState::refused: send_hello_request(); break;
+      case LinkState::no_device: break;
+    }
   }
 
   void try_open(int64_t now_us) {
@@ -217,7 +264,10 @@ struct NanoBridge::Impl {
       ++s.handshakes;
       s.state = LinkState::linked;
     });
-    send_config();
+    if (config.bridge.sync_to_sim_clock)
+      config_pending = true;
+    else
+      send_config();
     next_tx_us = now_us;
   }
 
@@ -295,6 +345,10 @@ struct NanoBridge::Impl {
                    config.bridge.link_timeout_ms);
       set_state(LinkState::handshaking);
       next_tx_us = t;
+    }
+    if (config.bridge.sync_to_sim_clock) {
+      send_on_tick(t);
+      return;
     }
     if (t < next_tx_us) return;
     switch (state()) {

@@ -41,6 +41,7 @@ Bridge parse_bridge(const Section &s) {
   if (b.failsafe_timeout_ms < 20 || b.failsafe_timeout_ms > 150)
     s.fail(s.key("failsafe_timeout_ms"), "must be 20..150 (firmware range)");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
+  b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
   if (b.servo_trim_us < -200 || b.servo_trim_us > 200)
     s.fail(s.key("servo_trim_us"), "must be -200..200");
   if (s.has("imu")) {
@@ -136,6 +137,8 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   c.vehicle = parse_vehicle(top.child("vehicle"));
   if (!top.has("vehicle")) top.fail("vehicle", "missing key");
   if ((c.has_bridge = top.has("bridge"))) c.bridge = parse_bridge(top.child("bridge"));
+  if (c.has_bridge && c.bridge.sync_to_sim_clock && c.clock != ClockMode::sim)
+    top.fail("bridge.sync_to_sim_clock", "needs clock: sim (it sends on SIM_CLOCK ticks)");
   if ((c.has_lidar = top.has("lidar"))) c.lidar = parse_lidar(top.child("lidar"));
   if ((c.has_estimator = top.has("estimator")))
     c.estimator = parse_estimator(top.child("estimator"));

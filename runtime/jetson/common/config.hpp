@@ -42,6 +42,9 @@ struct Bridge {
   int telemetry_period_ms = 10;   // sent to the Nano in CONFIG; 0 = do not send CONFIG
   int failsafe_timeout_ms = 100;  // sent in CONFIG
   int servo_trim_us = 0;          // sent in CONFIG
+  // clock sim: one frame per SIM_CLOCK tick, and a command stamped later than the sim clock
+  // applies from that sim time (repeatable HIL with autodrive-sim --lockstep-frames)
+  bool sync_to_sim_clock = false;
   std::string imu_frame_id = "imu_link";
   double imu_orientation_var_rad2 = 0.0;  // diagonal of the covariances
   double imu_gyro_var_rad2_s2 = 0.0;

@@ -62,6 +62,10 @@ static void main_usage(FILE *f) {
       "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
       "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
       "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
+      "  --lockstep-frames   lockstep frame by frame (repeatable HIL): at 0 and every 20 ms\n"
+      "                      of sim time the sim waits for one more frame from the client\n"
+      "                      on each Nano pty (a runtime with bridge.sync_to_sim_clock);\n"
+      "                      publish SIM_CLOCK\n"
       "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
       "                      (default: real time, 1 sim second per wall second)\n"
       "  --host-io-ms N      serve the ptys every N ms of sim time, like a USB-serial\n"
@@ -117,6 +121,7 @@ static double main_cpu_s(void) {
 typedef struct {
   int started;                          /* a client has written at least once */
   int64_t lost_rx_us[SIM_MAX_CARS + 1]; /* host_rx of a client given up on (0: none) */
+  uint32_t frames[SIM_MAX_CARS + 1];    /* --lockstep-frames: the client's frames so far */
 } main_sync_t;
 
 static void main_sync_wait(sim_t *s, main_sync_t *st) {
@@ -139,6 +144,38 @@ static void main_sync_wait(sim_t *s, main_sync_t *st) {
       struct timespec ts = {0, 1000000}; /* a hung-up pty polls ready at once: 1 ms pause */
       nanosleep(&ts, NULL);
     }
+  }
+}
+
+/* --lockstep-frames: at every MAIN_FRAME_TICK_US of sim time (0 included) the sim waits until
+ * the client on each car's Nano pty has written one more whole frame, and hands it to the
+ * emulated Nano at that step. A runtime whose bridge sends one frame per SIM_CLOCK tick
+ * (bridge.sync_to_sim_clock) then reaches the firmware at the same sim steps in every run, so
+ * a HIL run with a seed gives the same ground truth twice. A client silent for MAIN_SYNC_LOST_S
+ * of wall time (MAIN_FRAME_FIRST_S before its first frame) is given up, as --lockstep-client
+ * does. */
+#define MAIN_FRAME_TICK_US 20000
+#define MAIN_FRAME_FIRST_S 60.0
+static void main_frame_wait(sim_t *s, main_sync_t *st) {
+  for (int c = 1; c <= sim_cars(s); c++) {
+    if (st->lost_rx_us[c] != 0) continue;
+    const uint32_t before = st->frames[c];
+    const double t_give_up = main_wall_s() + (before ? MAIN_SYNC_LOST_S : MAIN_FRAME_FIRST_S);
+    while (!main_stop && (st->frames[c] = sim_host_frames(s, c)) == before) {
+      if (main_wall_s() > t_give_up) {
+        fprintf(stderr,
+                "[autodrive-sim] NIGEL%d: no frame from the client for %.1f s (wall): "
+                "running on without it\n",
+                c, before ? MAIN_SYNC_LOST_S : MAIN_FRAME_FIRST_S);
+        st->lost_rx_us[c] = 1;
+        break;
+      }
+      if (!sim_nano_wait_input(s, c, 50)) {
+        struct timespec ts = {0, 1000000}; /* a hung-up pty polls ready at once: 1 ms pause */
+        nanosleep(&ts, NULL);
+      }
+    }
+    st->started = 1;
   }
 }
 
@@ -301,8 +338,8 @@ int main(int argc, char **argv) {
   cfg.lidar = 1;
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
-  int lockstep = 0, client_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0, lidar_lcm = 1,
-      view = 0;
+  int lockstep = 0, client_sync = 0, frame_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0,
+      lidar_lcm = 1, view = 0;
   double camera_fps = 30.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -356,6 +393,8 @@ int main(int argc, char **argv) {
       lockstep = 1;
     } else if (!strcmp(a, "--lockstep-client")) {
       lockstep = client_sync = 1;
+    } else if (!strcmp(a, "--lockstep-frames")) {
+      lockstep = client_sync = frame_sync = 1;
     } else if (!strcmp(a, "--rtf")) {
       if (main_number(a, v, 0.01, 1e6, &rtf)) return 2;
       rtf_given = 1;
@@ -496,9 +535,10 @@ int main(int argc, char **argv) {
     if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
   }
   printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
-         client_sync ? "lockstep with the client"
-         : lockstep  ? "lockstep"
-                     : (rtf_given ? "rtf" : "real time"),
+         frame_sync    ? "lockstep with the client, frame by frame"
+         : client_sync ? "lockstep with the client"
+         : lockstep    ? "lockstep"
+                       : (rtf_given ? "rtf" : "real time"),
          url);
   if (cfg.start)
     printf("NIGEL1 start (--start): x %.3f, y %.3f m, yaw %.1f deg\n", start.x_m, start.y_m,
@@ -513,8 +553,14 @@ int main(int argc, char **argv) {
   int rc = 0;
   long step = 0, slips = 0;
   main_sync_t sync = {0};
+  if (frame_sync) lcmpub_clock(pubq, 0, 0.0, 0); /* the client's first tick */
   while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
-    if (client_sync) {
+    if (frame_sync) {
+      if (sim_time_us(s) % MAIN_FRAME_TICK_US == 0) {
+        lcmq_flush(pubq); /* this tick's SIM_CLOCK: the client answers it with a frame */
+        main_frame_wait(s, &sync);
+      }
+    } else if (client_sync) {
       lcmq_flush(pubq); /* the client may be waiting for the SIM_CLOCK we queued */
       main_sync_wait(s, &sync);
     }

@@ -91,6 +91,8 @@ typedef struct sim_car {
   ptylink_t pty;
   int has_pty, has_script;
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
+  proto_parser_t host_parser; /* frames the pty's client wrote, counted as they arrive */
+  uint32_t host_frames;
   /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */
   uint8_t tx_pending[SIM_TX_PENDING_BYTES];
   size_t tx_pending_n;
@@ -478,6 +480,7 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
     if (ptylink_open(&c->pty, link, err, err_sz) != 0) return -1;
     c->has_pty = 1;
     c->host_rx_us = -1;
+    proto_parser_init(&c->host_parser);
   }
   if (cfg->lidar) {
     sim_lidar_config_t lc;
@@ -614,14 +617,25 @@ static int sim_host_io_due(const sim_t *s) {
   return (s->time_us / SIM_STEP_US + 1) % s->host_io_period_steps == 0;
 }
 
+static void sim_count_host_frame(const proto_frame_t *f, void *ctx) {
+  (void)f;
+  ((sim_car_t *)ctx)->host_frames++;
+}
+
+/* Moves what the client wrote on the pty onto the Nano's RX wire, now; counts its frames. */
+static void sim_read_host(sim_t *s, sim_car_t *c) {
+  uint8_t buf[512];
+  const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
+  const size_t n = ptylink_read(&c->pty, buf, room);
+  if (n == 0) return;
+  uart_push(&c->rx, buf, n);
+  c->host_rx_us = s->time_us;
+  proto_parser_feed(&c->host_parser, buf, n, sim_count_host_frame, c);
+}
+
 static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err_sz) {
   uint8_t buf[512];
-  if (c->has_pty && io_due) {
-    const size_t room = uart_space(&c->rx) < sizeof buf ? uart_space(&c->rx) : sizeof buf;
-    const size_t n = ptylink_read(&c->pty, buf, room);
-    uart_push(&c->rx, buf, n);
-    if (n > 0) c->host_rx_us = s->time_us;
-  }
+  if (c->has_pty && io_due) sim_read_host(s, c);
   if (c->has_script) {
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
     uart_push(&c->rx, buf, n);
@@ -854,6 +868,13 @@ const nigel_t *sim_nano(const sim_t *s, int car) {
 int64_t sim_host_rx_us(const sim_t *s, int car) {
   const sim_car_t *c = &s->car[car - 1];
   return c->has_pty ? c->host_rx_us : -1;
+}
+
+uint32_t sim_host_frames(sim_t *s, int car) {
+  sim_car_t *c = &s->car[car - 1];
+  if (!c->has_pty) return 0;
+  sim_read_host(s, c);
+  return c->host_frames;
 }
 
 int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms) {

@@ -82,6 +82,10 @@ int sim_nano_wait_input(const sim_t *s, int car, int timeout_ms);
 /* Sim time at which the client on car's Nano pty last wrote bytes [us]; -1 before the first
  * (or without a pty). --lockstep-client paces the sim by it. */
 int64_t sim_host_rx_us(const sim_t *s, int car);
+/* Reads what the client on car's Nano pty wrote so far onto the Nano's wire, at the current
+ * sim time, and returns how many good frames it has written in all (0 without a pty).
+ * --lockstep-frames holds the sim until this grows. */
+uint32_t sim_host_frames(sim_t *s, int car);
 /* The emulated Nano's firmware state (read-only use, for tests). */
 const nigel_t *sim_nano(const sim_t *s, int car);
 /* Last motor outputs the firmware set through the HAL. */
