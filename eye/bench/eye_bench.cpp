@@ -4,6 +4,7 @@
 // Progress on stderr; the figures as "key value" lines on stdout; a CSV of the trajectory.
 #include <CLI/CLI.hpp>
 #include <autodrive/angles.hpp>
+#include <autodrive_channels.h>
 #include <opencv2/aruco.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -90,7 +91,7 @@ Scene make_scene(int w, int h, int frames, double tag_size_m,
   sc.cfg.in = sc.s.in;
   sc.cfg.pose = m.pose;
   sc.cfg.locate = sc.s.car;
-  sc.cfg.vehicles = {{"NIGEL1", 1, 0.0}};
+  sc.cfg.vehicles = {{AUTODRIVE_VEHICLE_DEFAULT, 1, 0.0}};
   sc.path = trajectory(sc.s, frames);
   for (int i = 0; i < frames; ++i) {
     std::vector<uchar> buf;

@@ -48,6 +48,7 @@ class Channel:
 class ChannelTable:
     source: Path
     url_default: str
+    vehicle_prefix: str
     channels: tuple[Channel, ...]
 
     def by_id(self, channel_id: str) -> Channel:
@@ -115,10 +116,18 @@ def load(path: Path | str | None = None) -> ChannelTable:
             )
         )
     return ChannelTable(
-        source=source, url_default=str(doc.get("url_default", "")), channels=tuple(out)
+        source=source,
+        url_default=str(doc.get("url_default", "")),
+        vehicle_prefix=str(doc.get("vehicle_prefix", "")),
+        channels=tuple(out),
     )
 
 
 def channel(channel_id: str, vehicle: str | None = None) -> str:
     """The concrete name of a channel by its id, e.g. channel("ODOM", "NIGEL1")."""
     return load().by_id(channel_id).resolve(vehicle)
+
+
+def vehicle_name(car: int = 1) -> str:
+    """The name of the simulator's car number car (1, 2, ...), e.g. "NIGEL1"."""
+    return f"{load().vehicle_prefix}{car}"

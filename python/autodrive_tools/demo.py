@@ -27,7 +27,7 @@ from .missions import MissionContext, loop, parking
 from .paths import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
 from .proc import ProcessGroup, wait_for_path
 
-VEHICLE = "NIGEL1"
+VEHICLE = channels.vehicle_name(1)
 PROGRAMS = ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy")
 # The default scenario's unmapped box (x, y [m], T [s], half sizes [m], R [m]), on the direct
 # way from the spawn to slot 2. After a mapping route it steps out once the car comes back

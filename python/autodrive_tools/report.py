@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from . import lcmtypes, plots
+from . import channels
 from .channels import channel
 from .geometry import Alignment, wrap
 from .paths import RELEASE_BUILD
@@ -107,7 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("log", type=Path, help="the LCM log (run.lcmlog)")
     p.add_argument("out", type=Path, help="folder for the plots")
-    p.add_argument("vehicle", nargs="?", default="NIGEL1", help="vehicle name (default NIGEL1)")
+    p.add_argument(
+        "vehicle", nargs="?", default=channels.vehicle_name(1), help="vehicle name (default car 1)"
+    )
     p.add_argument("--build", type=Path, default=RELEASE_BUILD, help="build dir with the LCM types")
     a = p.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)

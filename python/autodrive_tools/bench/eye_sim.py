@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import lcmtypes, plots, proc
-from ..channels import channel
+from ..channels import channel, vehicle_name
 from ..geometry import wrap
 from ..scoring import rms
 from . import Progress
@@ -32,7 +32,7 @@ from . import Progress
 # eye's port range 7790-7809: 7798 for the benchmark, EYE_SIM_PORT=7797 for the test
 DEFAULT_PORT = "7798"
 W_PX, H_PX, FOVY_DEG, CAM_Z_M = 1280, 960, 60.0, 2.5
-VEHICLE = "NIGEL1"
+VEHICLE = vehicle_name(1)
 TAG_ID = 1
 RECV_BUF_BYTES = 4194304  # the socket also gets the JPEG frames
 EYE_START_S = 1.0

@@ -17,7 +17,8 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         "# LCM channels",
         "",
         f"Every channel on the bus, from the one channel table `{source_name}`. `<VEH>` is the",
-        "vehicle name in capitals (`NIGEL1`, `NIGEL2`, ...), so many cars share one network. All",
+        f"vehicle name in capitals (`{table.vehicle_prefix}1`, `{table.vehicle_prefix}2`, ...: the "
+        "simulator's cars), so many cars share one network. All",
         "types are in package `autodrive` (`lcm_types/autodrive/`). Units are SI unless the field",
         "name says otherwise. C and C++ spell the names through the generated",
         "`<autodrive_channels.h>` (`AUTODRIVE_CH_<ID>`, `AUTODRIVE_CH_<ID>_SUFFIX` for per-vehicle",

@@ -14,7 +14,13 @@ GUARD = "AUTODRIVE_CHANNELS_H"
 
 
 def render(table: channels.ChannelTable, source_name: str) -> str:
-    lines = [f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"', ""]
+    lines = [
+        f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"',
+        "/* the simulator's cars are <prefix><i>; one-car programs default to car 1 */",
+        f'#define AUTODRIVE_VEHICLE_PREFIX "{table.vehicle_prefix}"',
+        f'#define AUTODRIVE_VEHICLE_DEFAULT "{table.vehicle_prefix}1"',
+        "",
+    ]
     for ch in table.channels:
         note = f"/* {ch.type}, {ch.rate}" + (", planned */" if ch.status == "planned" else " */")
         if ch.per_vehicle:

@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.log.is_file():
         print(f"channel_audit: {args.log}: no such log", file=sys.stderr)
         return 2
-    problems, seen = audit(args.log, args.build, args.vehicle or ["NIGEL1"])
+    problems, seen = audit(args.log, args.build, args.vehicle or [channels.vehicle_name(1)])
     for name, n in sorted(seen.items()):
         print(f"{name:24s} {n:8d} messages")
     for problem in problems:

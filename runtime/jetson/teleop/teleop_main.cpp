@@ -53,7 +53,7 @@ int main(int argc, char **argv) {
       "level, h headlights, z/c/x left/right/hazard indicators, q quit.\n"
       "Gamepad: hold the dead-man button (LB) and use left stick Y (throttle), right stick X\n"
       "(steering); A headlights, X/B/Y left/right/hazard indicators."};
-  std::string vehicle = "NIGEL1", url = AUTODRIVE_LCM_URL_DEFAULT, js_path;
+  std::string vehicle = AUTODRIVE_VEHICLE_DEFAULT, url = AUTODRIVE_LCM_URL_DEFAULT, js_path;
   double rate_hz = 50.0;
   bool no_keyboard = false;
   teleop::Params p;

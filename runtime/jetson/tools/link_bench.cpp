@@ -442,8 +442,8 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
 
 int main(int argc, char **argv) {
   CLI::App app{"runtime-link-bench: measuring side of tools/bench link (see the file header)."};
-  std::string mode, url = "udpm://239.255.76.67:7786?ttl=0", vehicle = "NIGEL1", pty, pwm_log,
-                    suffix;
+  std::string mode, url = "udpm://239.255.76.67:7786?ttl=0", vehicle = AUTODRIVE_VEHICLE_DEFAULT,
+                    pty, pwm_log, suffix;
   int samples = 500;
   double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50;
   app.add_option("mode", mode, "serial | pwm | telemetry | ekf")

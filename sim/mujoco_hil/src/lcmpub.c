@@ -12,7 +12,7 @@ int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
-  snprintf(vehicle, sizeof vehicle, "NIGEL%d", car);
+  snprintf(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX "%d", car);
   snprintf(channel, sizeof channel, "%s" AUTODRIVE_CH_GROUND_TRUTH_SUFFIX, vehicle);
   autodrive_ground_truth_t msg;
   memset(&msg, 0, sizeof msg);

@@ -135,7 +135,8 @@ static void main_sync_wait(sim_t *s, main_sync_t *st) {
     while (!main_stop && !sim_nano_wait_input(s, c, 50)) {
       if (main_wall_s() > t_give_up) {
         fprintf(stderr,
-                "[autodrive-sim] NIGEL%d: no bytes from the client for %.1f s (wall): "
+                "[autodrive-sim] " AUTODRIVE_VEHICLE_PREFIX
+                "%d: no bytes from the client for %.1f s (wall): "
                 "running on without it\n",
                 c, MAIN_SYNC_LOST_S);
         st->lost_rx_us[c] = rx_us + 1;
@@ -164,7 +165,8 @@ static void main_frame_wait(sim_t *s, main_sync_t *st) {
     while (!main_stop && (st->frames[c] = sim_host_frames(s, c)) == before) {
       if (main_wall_s() > t_give_up) {
         fprintf(stderr,
-                "[autodrive-sim] NIGEL%d: no frame from the client for %.1f s (wall): "
+                "[autodrive-sim] " AUTODRIVE_VEHICLE_PREFIX
+                "%d: no frame from the client for %.1f s (wall): "
                 "running on without it\n",
                 c, before ? MAIN_SYNC_LOST_S : MAIN_FRAME_FIRST_S);
         st->lost_rx_us[c] = 1;
@@ -232,9 +234,9 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
       k->cam[k->n] = sim_camera_create(k->render, m, name, frame, 640, 480, 85, err, err_sz);
       if (!k->cam[k->n]) return -1;
       k->cam_id[k->n] = mj_name2id(m, mjOBJ_CAMERA, name);
-      snprintf(k->channel[k->n], sizeof k->channel[0], "NIGEL%d%s", c,
+      snprintf(k->channel[k->n], sizeof k->channel[0], AUTODRIVE_VEHICLE_PREFIX "%d%s", c,
                rear ? AUTODRIVE_CH_CAM_REAR_SUFFIX : AUTODRIVE_CH_CAM_FRONT_SUFFIX);
-      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "NIGEL%d%s", c,
+      snprintf(k->info_channel[k->n], sizeof k->info_channel[0], AUTODRIVE_VEHICLE_PREFIX "%d%s", c,
                rear ? AUTODRIVE_CH_CAM_REAR_INFO_SUFFIX : AUTODRIVE_CH_CAM_FRONT_INFO_SUFFIX);
       k->n++;
     }
@@ -531,8 +533,10 @@ int main(int argc, char **argv) {
     return 1;
   }
   for (int c = 1; c <= sim_cars(s); c++) {
-    if (sim_nano_link(s, c)[0]) printf("NIGEL%d nano: %s\n", c, sim_nano_link(s, c));
-    if (sim_lidar_link(s, c)[0]) printf("NIGEL%d lidar: %s\n", c, sim_lidar_link(s, c));
+    if (sim_nano_link(s, c)[0])
+      printf(AUTODRIVE_VEHICLE_PREFIX "%d nano: %s\n", c, sim_nano_link(s, c));
+    if (sim_lidar_link(s, c)[0])
+      printf(AUTODRIVE_VEHICLE_PREFIX "%d lidar: %s\n", c, sim_lidar_link(s, c));
   }
   printf("map: %s, cars: %d, mode: %s, lcm: %s\n", cfg.map_path, cfg.cars,
          frame_sync    ? "lockstep with the client, frame by frame"
@@ -541,8 +545,8 @@ int main(int argc, char **argv) {
                        : (rtf_given ? "rtf" : "real time"),
          url);
   if (cfg.start)
-    printf("NIGEL1 start (--start): x %.3f, y %.3f m, yaw %.1f deg\n", start.x_m, start.y_m,
-           start.yaw_deg);
+    printf(AUTODRIVE_VEHICLE_DEFAULT " start (--start): x %.3f, y %.3f m, yaw %.1f deg\n",
+           start.x_m, start.y_m, start.yaw_deg);
   fflush(stdout);
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
@@ -580,7 +584,7 @@ int main(int argc, char **argv) {
        * the sim then stays off the channel so that nobody sees every scan twice */
       if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
-        snprintf(ch, sizeof ch, "NIGEL%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
+        snprintf(ch, sizeof ch, AUTODRIVE_VEHICLE_PREFIX "%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
         sim_lidar_publish(lcm, ch, "laser", scan);
       }
     }

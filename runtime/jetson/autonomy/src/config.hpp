@@ -10,7 +10,7 @@
 namespace autonomy {
 
 struct ProgramConfig {
-  std::string vehicle = "NIGEL1";
+  std::string vehicle = AUTODRIVE_VEHICLE_DEFAULT;
   std::string lcm_url = AUTODRIVE_LCM_URL_DEFAULT;
   std::string out_dir = "out/autonomy";  // path.csv, route.csv, trajectory.csv
   double command_rate_hz = 50.0;

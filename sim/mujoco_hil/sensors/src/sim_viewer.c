@@ -1,6 +1,7 @@
 /* sim_viewer: see sim_viewer.h. */
 #include "sim_viewer.h"
 
+#include <autodrive_channels.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -194,8 +195,8 @@ int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_in
   mjr_render(vp, &v->scn, &v->con);
   static const char *names[3] = {"driver", "bird", "god"};
   char text[128];
-  snprintf(text, sizeof text, "NIGEL%d %s view  t=%.2f s%s%s", v->in.car, names[v->in.view],
-           d->time, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night");
+  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d %s view  t=%.2f s%s%s", v->in.car,
+           names[v->in.view], d->time, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night");
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, vp, text,
               "1/2/3 view  Tab car  N day/night  Space pause  R reset  Esc quit", &v->con);
   v->have_rgb = 0;
