@@ -42,7 +42,7 @@ def build(cls: type[T], data: Any, source: Path, key: str = "") -> T:
     for f in fields:
         sub = _join(key, f.name)
         if f.name not in data:
-            if f.default is dataclasses.MISSING:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise fail(source, sub, "missing key")
             continue
         values[f.name] = _value(hints[f.name], data[f.name], source, sub)
