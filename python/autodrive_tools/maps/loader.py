@@ -198,8 +198,6 @@ class _Checker:
                 self.unique(lane.name, f"tiles[{i}] lane")
             for s in c.stop_lines:
                 self.unique(s.name, f"tiles[{i}] stop line")
-            for s in c.slots:
-                self.unique(s.name, f"tiles[{i}] parking slot")
             for lane, end, p, yaw in c.ports:
                 others = ends if end == "start" else starts
                 if not any(

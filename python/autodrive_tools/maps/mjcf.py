@@ -19,6 +19,7 @@ from ..geometry import wrap
 from .description import MapDescription
 from .model import ParkingSlot, Vec2
 
+NUMERIC_MAX_VALUES = 500  # MuJoCo 2.2's limit per <numeric>: longer data goes on in <name>.partK
 CUSTOM_STEP_M = 0.05  # spacing of the lane and route centre lines in <custom> numerics
 LAMPS = ("red", "yellow", "green")  # top to bottom
 # light_level -> the look at light level 1 (MuJoCo's default headlight, the sun) scaled down
@@ -224,12 +225,10 @@ class _Writer:
             out.append(f'    <numeric name="tl_conflicts" data="{nums(flat)}"/>')
         for lane in m.lanes():
             pts = [v for x, y, _ in m.centre_line(lane, CUSTOM_STEP_M) for v in (x, y)]
-            data = nums([lane.half_width_m] + [round(v, 6) for v in pts])
-            out.append(f'    <numeric name="lane_{lane.name}" data="{data}"/>')
+            out += _numeric_parts(f"lane_{lane.name}", [lane.half_width_m], pts)
         for r in m.named_routes():
-            pts = [round(v, 6) for p in r.polyline_m for v in p]
-            data = nums([1.0 if r.loop else 0.0, r.half_width_m] + pts)
-            out.append(f'    <numeric name="route_{r.name}" data="{data}"/>')
+            pts = [v for p in r.polyline_m for v in p]
+            out += _numeric_parts(f"route_{r.name}", [1.0 if r.loop else 0.0, r.half_width_m], pts)
         for sign in m.placed_signs():
             out.append(f'    <text name="{sign.name}_kind" data="{sign.kind}"/>')
         if out:
@@ -367,6 +366,22 @@ class _Writer:
         self.custom()
         self.lines += ["</mujoco>", ""]
         return "\n".join(self.lines)
+
+
+def _numeric_parts(name: str, head: list[float], points: list[float]) -> list[str]:
+    """<numeric> lines of head + points: the first named name, the rest name.part1, .part2 ...
+    (at most NUMERIC_MAX_VALUES values each; parts hold whole x y pairs)."""
+    values = head + [round(v, 6) for v in points]
+    first = NUMERIC_MAX_VALUES - (NUMERIC_MAX_VALUES - len(head)) % 2
+    chunks = [values[:first]]
+    rest = values[first:]
+    while rest:
+        chunks.append(rest[:NUMERIC_MAX_VALUES])
+        rest = rest[NUMERIC_MAX_VALUES:]
+    return [
+        f'    <numeric name="{name}{f".part{k}" if k else ""}" data="{nums(c)}"/>'
+        for k, c in enumerate(chunks)
+    ]
 
 
 def generate(m: MapDescription) -> str:
