@@ -78,6 +78,7 @@ class NamedSpawn:
     pose: Pose
     route: str | None
 
+
 if TYPE_CHECKING:
     from ..vehicle import Vehicle
 
@@ -301,4 +302,3 @@ class MapDescription(MapFile):
         """Direction of the painted stop line: across its lane."""
         _, heading = geometry.nearest_on_polyline(stop.centre_m, self.centre_line(stop.lane))
         return heading + math.pi / 2
-

@@ -201,13 +201,13 @@ class _Writer:
             c, s = math.cos(sign.yaw_rad), math.sin(sign.yaw_rad)
             off = sk.post_radius_m + sk.face_thickness_m / 2
             f = sk.face_size_m / 2
-            # the face box's local z is its normal (the way it points), local x is up: MuJoCo
-            # paints a box's 2d texture on its +-z faces
+            # the face box's local z is its normal (the way it points), local y is up: MuJoCo
+            # paints a box's 2d texture on its +-z faces, image up = local +y
             self.add(
                 f'<geom name="{sign.name}_face" type="box" '
                 f'pos="{nums((x + c * off, y + s * off, ph + f * 0.6))}" '
                 f'size="{nums((f, f, sk.face_thickness_m / 2))}" '
-                f'zaxis="{nums((round(c, 12), round(s, 12)))} 0" {VIS} '
+                f'xyaxes="{nums((round(-s, 12), round(c, 12)))} 0 0 0 1" {VIS} '
                 f'material="{textures.sign_texture_name(sign.kind, sign.speed_limit_m_s)}_mat"/>'
             )
 

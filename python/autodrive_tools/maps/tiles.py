@@ -280,7 +280,10 @@ class _Builder:
         cx, cy = self.spec.centre_m
         for lane in self.out.lanes:
             first, last = lane.road.pieces[0], lane.road.pieces[-1]
-            for end, (p, yaw) in (("start", piece_point(first, 0.0)), ("end", piece_point(last, 1.0))):
+            for end, (p, yaw) in (
+                ("start", piece_point(first, 0.0)),
+                ("end", piece_point(last, 1.0)),
+            ):
                 if max(abs(p[0] - cx), abs(p[1] - cy)) > self.half - 1e-9:
                     self.out.ports.append((lane.name, end, p, yaw))
 
