@@ -204,7 +204,7 @@ class RoadKit(unittest.TestCase):
             mats = {e.get("name"): e for e in root.iter("material")}
             js = json.loads((MAPS / f"{n}.json").read_text())
             for name, e in g.items():  # visual-only parts neither collide nor weigh
-                if name.startswith("tile_") or re.search(r"_(housing|lamp_\w+|face)$", name):
+                if name.startswith("tile_") or re.search(r"_(housing|lamp_\w+|face|back)$", name):
                     self.assertEqual((e.get("contype"), e.get("conaffinity")), ("0", "0"), name)
                 if re.search(r"_(pole|post)$", name):
                     self.assertEqual(e.get("contype"), "1", name)
