@@ -4,6 +4,7 @@ lines, traffic lights, signs and spawns, all from the description."""
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
@@ -19,14 +20,22 @@ from . import textures  # noqa: E402
 from .description import MapDescription  # noqa: E402
 from .loader import MAPS_DIR  # noqa: E402
 from .model import rect_corners  # noqa: E402
+from .tiles import TileContent  # noqa: E402
 
 LIGHT_COLOUR = "#d62728"
 SIGN_COLOUR = "#1f77b4"
 SPAWN_COLOUR = "#9467bd"
 
 
-def _texture(name: str, maps_dir: Path) -> np.ndarray:
-    return np.asarray(Image.open(maps_dir / textures.DIR_NAME / f"{name}.png").convert("RGB"))
+def _texture(m: MapDescription, tile: TileContent, maps_dir: Path) -> np.ndarray:
+    """A tile's texture: the generated file, or painted now (a map not yet generated)."""
+    path = maps_dir / textures.DIR_NAME / f"{tile.texture}.png"
+    if path.is_file():
+        data = path.read_bytes()
+    else:
+        key = (tile.spec.type, tile.spec.lanes)
+        data = textures.generate(m.kit, {key}, set())[tile.texture]
+    return np.asarray(Image.open(io.BytesIO(data)).convert("RGB"))
 
 
 def draw(m: MapDescription, out: Path, maps_dir: Path = MAPS_DIR, dpi: int = 110) -> None:
@@ -37,7 +46,7 @@ def draw(m: MapDescription, out: Path, maps_dir: Path = MAPS_DIR, dpi: int = 110
     floor = kit.surfaces[m.floor_surface].rgba
     ax.add_patch(Rectangle((-h, -h), 2 * h, 2 * h, color=floor[:3], zorder=0))
     for t in m.tile_contents():
-        img = np.rot90(_texture(t.texture, maps_dir), k=round(t.spec.rotation_deg / 90) % 4)
+        img = np.rot90(_texture(m, t, maps_dir), k=round(t.spec.rotation_deg / 90) % 4)
         cx, cy = t.spec.centre_m
         s = t.size_m / 2
         ax.imshow(img, extent=(cx - s, cx + s, cy - s, cy + s), zorder=1, interpolation="nearest")
