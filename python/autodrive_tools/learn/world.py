@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -121,7 +122,7 @@ class World:
         """Advances the world by period_ms physics steps of 1 ms."""
         self._check(self._lib.ad_world_step(self._w, period_ms, self._err, ERR_BYTES), "step")
 
-    def observe_raw(self, car: int) -> object:
+    def observe_raw(self, car: int) -> Any:
         """car's observation as the C struct (ad_obs_t *, overwritten by the next call)."""
         if self._lib.ad_world_observe(self._w, car, self._obs) != 0:
             raise SimError(f"observe: car {car}: the world has cars 0..{self.cars - 1}")
