@@ -23,8 +23,15 @@ def episode(w: World, seed: int, steps: int = 40) -> np.ndarray:
             o = w.observe(car)
             rows.append(
                 np.concatenate(
-                    [o.pos_m, o.quat_wxyz, o.vel_body_m_s, o.wheel_speed_rad_s, o.imu_gyro_rad_s,
-                     o.imu_accel_m_s2, w.lidar(car).astype(np.float64)]
+                    [
+                        o.pos_m,
+                        o.quat_wxyz,
+                        o.vel_body_m_s,
+                        o.wheel_speed_rad_s,
+                        o.imu_gyro_rad_s,
+                        o.imu_accel_m_s2,
+                        w.lidar(car).astype(np.float64),
+                    ]
                 )
             )
     return np.asarray(rows)

@@ -23,10 +23,23 @@ def hil_truth() -> list[tuple[int, np.ndarray]]:
     types = lcmtypes.load(BUILD)
     with tempfile.TemporaryDirectory(prefix="learn-truth-") as d:
         log = os.path.join(d, "truth.bin")
-        argv = [str(BUILD / "bin" / "autodrive-sim"), "--quiet", "--lockstep", "--lcm-url",
-                "memq://", "--run-dir", d, "--seed", str(SEED), "--duration", str(DURATION_S),
-                "--script", f"constant:throttle={THROTTLE},steering={STEERING}",
-                "--truth-log", log]
+        argv = [
+            str(BUILD / "bin" / "autodrive-sim"),
+            "--quiet",
+            "--lockstep",
+            "--lcm-url",
+            "memq://",
+            "--run-dir",
+            d,
+            "--seed",
+            str(SEED),
+            "--duration",
+            str(DURATION_S),
+            "--script",
+            f"constant:throttle={THROTTLE},steering={STEERING}",
+            "--truth-log",
+            log,
+        ]
         subprocess.run(argv, check=True, capture_output=True)
         data = open(log, "rb").read()
     out, i = [], 0
@@ -50,8 +63,10 @@ def main() -> None:
     travel = float(np.linalg.norm(truth[-1][1] - truth[0][1]))
     assert travel > 0.3, f"the car moved only {travel:.3f} m: nothing compared"
     assert worst < TOLERANCE_M, f"world vs HIL: {worst * 1e3:.3f} mm apart (limit 1 mm)"
-    print(f"learn.truth: {len(truth)} messages over {DURATION_S} s, car {travel:.2f} m from its "
-          f"start, largest difference {worst * 1e3:.6f} mm")
+    print(
+        f"learn.truth: {len(truth)} messages over {DURATION_S} s, car {travel:.2f} m from its "
+        f"start, largest difference {worst * 1e3:.6f} mm"
+    )
 
 
 if __name__ == "__main__":

@@ -245,4 +245,10 @@ class ParkingEnv(_CarEnv):
             reward -= 10.0
         terminated = bool(parked or o.in_collision)
         truncated = self.steps >= self.max_steps
-        return obs, reward, terminated, truncated, {"parked": parked, "in_collision": bool(o.in_collision)}
+        return (
+            obs,
+            reward,
+            terminated,
+            truncated,
+            {"parked": parked, "in_collision": bool(o.in_collision)},
+        )

@@ -37,8 +37,12 @@ class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):
     metadata: dict[str, Any] = {"name": "autodrive_intersection_v0", "render_modes": []}
 
     def __init__(
-        self, cars: int = 4, map_name: str | None = None, control_hz: float = CONTROL_HZ,
-        max_steps: int = 400, render_mode: str | None = None,
+        self,
+        cars: int = 4,
+        map_name: str | None = None,
+        control_hz: float = CONTROL_HZ,
+        max_steps: int = 400,
+        render_mode: str | None = None,
     ) -> None:
         self.map_name = map_name or tasks.multi_car_map()
         self.render_mode = render_mode
@@ -87,7 +91,10 @@ class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):
         for other, (ox, oy, _) in enumerate(poses):
             if other != car:
                 dx, dy = ox - x, oy - y
-                rel += [(c * dx + s * dy) / NEIGHBOUR_SCALE_M, (-s * dx + c * dy) / NEIGHBOUR_SCALE_M]
+                rel += [
+                    (c * dx + s * dy) / NEIGHBOUR_SCALE_M,
+                    (-s * dx + c * dy) / NEIGHBOUR_SCALE_M,
+                ]
         return np.asarray(head + v + rel, dtype=np.float32)
 
     def _poses(self) -> list[tuple[float, float, float]]:
@@ -118,7 +125,9 @@ class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):
         obs = {a: self._obs(self._car(a), poses) for a in self.agents}
         return obs, {a: {} for a in self.agents}
 
-    def step(self, actions: dict[str, ObsArray]) -> tuple[
+    def step(
+        self, actions: dict[str, ObsArray]
+    ) -> tuple[
         dict[str, ObsArray],
         dict[str, float],
         dict[str, bool],
