@@ -93,6 +93,7 @@ typedef struct sim_car {
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
   proto_parser_t host_parser; /* frames the pty's client wrote, counted as they arrive */
   uint32_t host_frames;
+  int host_idle; /* free lockstep: nothing read and the pty refused our bytes last service */
   /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */
   uint8_t tx_pending[SIM_TX_PENDING_BYTES];
   size_t tx_pending_n;
@@ -475,6 +476,7 @@ static int sim_car_boot(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   c->steer_rad = 0.0;
   c->lamps_shown = 0xFF; /* draw on the first step */
   c->tx_pending_n = 0;
+  c->host_idle = 0;
   c->lidar_new = 0;
   uart_init(&c->rx, PROTO_BAUD);
   uart_init(&c->tx, PROTO_BAUD);
@@ -668,8 +670,21 @@ static void sim_read_host(sim_t *s, sim_car_t *c) {
   proto_parser_feed(&c->host_parser, buf, n, sim_count_host_frame, c);
 }
 
-static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err_sz) {
+/* Free lockstep (a host I/O period > 1 ms): while nobody is on the pty (nothing read, and the
+ * pty's buffer full so our last bytes were refused) it is served only every
+ * SIM_HOST_IDLE_PERIOD_MS, saving two system calls per period; a client's first bytes are then
+ * seen within that time, and the next service that moves bytes ends the idle state. */
+#define SIM_HOST_IDLE_PERIOD_MS 100
+static int sim_host_io_due_car(const sim_t *s, const sim_car_t *c, int io_due) {
+  if (!io_due || !c->host_idle) return io_due;
+  return (s->time_us / SIM_STEP_US + 1) % SIM_HOST_IDLE_PERIOD_MS == 0;
+}
+
+static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due_all, char *err, size_t err_sz) {
   uint8_t buf[512];
+  const int io_due = c->has_pty && sim_host_io_due_car(s, c, io_due_all);
+  const uint32_t frames_before = c->host_frames;
+  const int64_t rx_before = c->host_rx_us;
   if (c->has_pty && io_due) sim_read_host(s, c);
   if (c->has_script) {
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
@@ -688,7 +703,11 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err
     const size_t room = sizeof c->tx_pending - c->tx_pending_n;
     c->tx_pending_n += uart_pop(&c->tx, SIM_STEP_US, c->tx_pending + c->tx_pending_n, room);
     if (io_due || c->tx_pending_n == sizeof c->tx_pending) {
-      ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n); /* a full pty drops bytes */
+      /* a full pty drops bytes */
+      const size_t sent = ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n);
+      const int read_any = c->host_rx_us != rx_before || c->host_frames != frames_before;
+      if (s->host_io_period_steps > 1)
+        c->host_idle = !read_any && c->tx_pending_n > 0 && sent == 0;
       c->tx_pending_n = 0;
     }
   }
@@ -867,7 +886,11 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
       sim_lidar_last_cast(c->lidar, &from, &to, &num_rays, &ranges_m, &quality);
       sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
-    if (c->rplidar && io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
+    /* free lockstep: an RPLIDAR pty nobody scans on is served at the idle period, too */
+    const int lidar_io_due = c->rplidar && io_due && (s->host_io_period_steps == 1 ||
+                                        sim_rplidar_scanning(c->rplidar) ||
+                                        (s->time_us / SIM_STEP_US) % SIM_HOST_IDLE_PERIOD_MS == 0);
+    if (c->rplidar && lidar_io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
       return -1;
   }
   if (s->d->warning[mjWARN_BADQACC].number > 0) {
