@@ -25,7 +25,7 @@ ROUTE_END_M = 0.1  # an open route is done this close to its end [m]
 ObsArray = npt.NDArray[np.float32]
 
 
-class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):
+class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):  # type: ignore[misc]
     """N cars (agents "nigel1".."nigelN"). With the map's routes (Intersection School), car i
     drives routes[i * len(routes) // N] from its start; observation: offset over the half
     width, heading error [rad], progress fraction, forward and lateral speed [m/s], yaw rate

@@ -90,15 +90,14 @@ int ad_world_observe(const ad_world_t *w, int car, ad_obs_t *out);
 int ad_world_lidar(ad_world_t *w, int car, float *ranges_m, int n, char *err, size_t err_sz);
 /* Renders car's front camera now into rgb (height x width x 3, rows top-down); n_bytes must
  * be width * height * 3 of the world's config. Needs EGL or OSMesa (Mesa). */
-int ad_world_camera(ad_world_t *w, int car, uint8_t *rgb, size_t n_bytes, char *err,
-                    size_t err_sz);
+int ad_world_camera(ad_world_t *w, int car, uint8_t *rgb, size_t n_bytes, char *err, size_t err_sz);
 
 /* car follows route name: the map's MJCF numeric route_<name> (else lane_<name>) of the maps
  * contract. NULL clears it. */
 int ad_world_set_route(ad_world_t *w, int car, const char *name, char *err, size_t err_sz);
 /* car follows a route given as n points (x, y [m]) in driving order, closed when loop. */
-int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n,
-                              double half_width_m, int loop, char *err, size_t err_sz);
+int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n, double half_width_m,
+                              int loop, char *err, size_t err_sz);
 
 /* Benchmark: wall time [s] of a bare mj_step loop of steps steps on a copy of the world's
  * model and state (MuJoCo alone, the baseline of api_overhead_ratio). */

@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-int route_from_points(route_t *r, const double *xy, int n, double half_width_m, int loop,
-                      char *err, size_t err_sz) {
+int route_from_points(route_t *r, const double *xy, int n, double half_width_m, int loop, char *err,
+                      size_t err_sz) {
   memset(r, 0, sizeof *r);
   if (n < 2 || !(half_width_m > 0.0) || !isfinite(half_width_m)) {
     snprintf(err, err_sz, "route: %d points, half width %g m (need >= 2 points, width > 0)", n,

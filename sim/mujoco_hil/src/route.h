@@ -14,10 +14,10 @@ extern "C" {
 #endif
 
 typedef struct route {
-  int n;          /* points; 0: no route */
-  int loop;       /* 1: the last point joins the first */
-  double *xy;     /* n points [m] */
-  double *s_m;    /* arc length at each point [m] */
+  int n;       /* points; 0: no route */
+  int loop;    /* 1: the last point joins the first */
+  double *xy;  /* n points [m] */
+  double *s_m; /* arc length at each point [m] */
   double length_m;
   double half_width_m;
 } route_t;
@@ -29,8 +29,8 @@ typedef struct route_where {
 } route_where_t;
 
 /* From n >= 2 points; half_width_m > 0. Returns 0, or -1 with a message in err. */
-int route_from_points(route_t *r, const double *xy, int n, double half_width_m, int loop,
-                      char *err, size_t err_sz);
+int route_from_points(route_t *r, const double *xy, int n, double half_width_m, int loop, char *err,
+                      size_t err_sz);
 /* From numeric id of m: with_loop 1 for route_* (leading loop flag), 0 for lane_*. */
 int route_from_numeric(route_t *r, const mjModel *m, int id, int with_loop, char *err,
                        size_t err_sz);

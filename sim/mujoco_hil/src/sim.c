@@ -706,8 +706,7 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due_all, char *err, size_t
       /* a full pty drops bytes */
       const size_t sent = ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n);
       const int read_any = c->host_rx_us != rx_before || c->host_frames != frames_before;
-      if (s->host_io_period_steps > 1)
-        c->host_idle = !read_any && c->tx_pending_n > 0 && sent == 0;
+      if (s->host_io_period_steps > 1) c->host_idle = !read_any && c->tx_pending_n > 0 && sent == 0;
       c->tx_pending_n = 0;
     }
   }
@@ -887,9 +886,9 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
       sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
     /* free lockstep: an RPLIDAR pty nobody scans on is served at the idle period, too */
-    const int lidar_io_due = c->rplidar && io_due && (s->host_io_period_steps == 1 ||
-                                        sim_rplidar_scanning(c->rplidar) ||
-                                        (s->time_us / SIM_STEP_US) % SIM_HOST_IDLE_PERIOD_MS == 0);
+    const int lidar_io_due = c->rplidar && io_due &&
+                             (s->host_io_period_steps == 1 || sim_rplidar_scanning(c->rplidar) ||
+                              (s->time_us / SIM_STEP_US) % SIM_HOST_IDLE_PERIOD_MS == 0);
     if (c->rplidar && lidar_io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
       return -1;
   }
@@ -998,13 +997,14 @@ double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s) {
 int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t err_sz) {
   if (poses) {
     mjtNum saved[7 * SIM_MAX_CARS]; /* the old start poses, back in place on a refusal */
-    for (int i = 0; i < s->ncars; i++) mju_copy(saved + 7 * i, s->m->qpos0 + s->car[i].root_qpos, 7);
+    for (int i = 0; i < s->ncars; i++)
+      mju_copy(saved + 7 * i, s->m->qpos0 + s->car[i].root_qpos, 7);
     for (int i = 0; i < s->ncars; i++) {
       const double *p = poses + 3 * i;
       if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]) || fabs(p[0]) > SCN_COORD_MAX_M ||
           fabs(p[1]) > SCN_COORD_MAX_M) {
-        snprintf(err, err_sz, "reset pose of car %d (%g, %g, %g): not a finite pose on the map",
-                 i, p[0], p[1], p[2]);
+        snprintf(err, err_sz, "reset pose of car %d (%g, %g, %g): not a finite pose on the map", i,
+                 p[0], p[1], p[2]);
         return -1;
       }
       sim_set_car_pose(s, i, p, p[2], 0, 0); /* and qpos0: the new start pose */

@@ -275,8 +275,8 @@ int ad_world_set_route(ad_world_t *w, int car, const char *name, char *err, size
   return route_from_numeric(&w->route[car], m, id, is_route, err, err_sz);
 }
 
-int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n,
-                              double half_width_m, int loop, char *err, size_t err_sz) {
+int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n, double half_width_m,
+                              int loop, char *err, size_t err_sz) {
   if (!api_car_ok(w, car, err, err_sz)) return -1;
   route_free(&w->route[car]);
   return route_from_points(&w->route[car], xy, n, half_width_m, loop, err, err_sz);
