@@ -420,6 +420,7 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
   *geoms = calloc((size_t)cars, sizeof(char *));
   if (!*asset || !*geoms) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
   for (int i = 1; i <= cars; i++) {
+    /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder */
     char png[700], file[64], prefix[32], a[asz];
     snprintf(file, sizeof file, "tag36h11_%d.png", mg_tag_id(i));
     snprintf(png, sizeof png, "%s/%s", s->scene_dir, file);
@@ -427,7 +428,7 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
     snprintf(prefix, sizeof prefix, "nigel%d/", i);
     (*geoms)[i - 1] = malloc(1024);
     if (!(*geoms)[i - 1] ||
-        sim_tags_mjcf(prefix, file, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
+        sim_tags_mjcf(prefix, png, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
       return sim_fail(err, err_sz, "%s%s", "roof tag MJCF did not fit its buffer", "");
     strcat(*asset, a);
     strcat(*asset, "\n");
