@@ -103,6 +103,13 @@ def test_lane_flag() -> None:
     w.set_route(0, None)
     plain = World("parking_school", seed=1)
     assert not plain.observe(0).off_lane  # no lanes on the map: never off lane
+    if tasks.map_exists(tasks.INTERSECTION_MAP):  # no route: off every lane_* numeric's width
+        x = World(tasks.INTERSECTION_MAP, seed=1)
+        spawn = tasks.sidecar(tasks.INTERSECTION_MAP)["spawns"][0]
+        x.reset(1, [(spawn["x_m"], spawn["y_m"], spawn["yaw_rad"])])
+        assert not x.observe(0).off_lane, "a car at a spawn on its lane is off lane"
+        x.reset(1, [(2.0, 2.0, 0.0)])  # a corner block of the crossroads, off every lane
+        assert x.observe(0).off_lane, "a car off every lane is not flagged"
     print(f"lane flag: off lane to the left after {left + 1} control periods")
 
 

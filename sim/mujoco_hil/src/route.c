@@ -41,15 +41,39 @@ int route_from_points(route_t *r, const double *xy, int n, double half_width_m, 
 int route_from_numeric(route_t *r, const mjModel *m, int id, int with_loop, char *err,
                        size_t err_sz) {
   const char *name = m->names + m->name_numericadr[id];
-  const int size = m->numeric_size[id], head = with_loop ? 2 : 1;
+  const int head = with_loop ? 2 : 1;
   const mjtNum *d = m->numeric_data + m->numeric_adr[id];
-  if (size < head + 4 || (size - head) % 2 != 0) {
-    snprintf(err, err_sz, "map numeric '%s': %d values, expected %s then x y pairs", name, size,
-             with_loop ? "loop half_width_m" : "half_width_m");
+  /* the points go on in <name>.part1, .part2 ... (MuJoCo 2.2 holds 500 values per numeric) */
+  int total = m->numeric_size[id] - head, parts = 0;
+  char part[160];
+  for (int k = 1;; k++, parts++) {
+    snprintf(part, sizeof part, "%s.part%d", name, k);
+    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
+    if (pid < 0) break;
+    total += m->numeric_size[pid];
+  }
+  if (m->numeric_size[id] < head || total < 4 || total % 2 != 0) {
+    snprintf(err, err_sz, "map numeric '%s': %d values in %d part(s), expected %s then x y pairs",
+             name, total + head, parts + 1, with_loop ? "loop half_width_m" : "half_width_m");
     return -1;
   }
-  const int rc = route_from_points(r, d + head, (size - head) / 2, d[head - 1],
-                                   with_loop ? d[0] != 0.0 : 0, err, err_sz);
+  double *xy = malloc(sizeof(double) * (size_t)total);
+  if (!xy) {
+    snprintf(err, err_sz, "map numeric '%s': out of memory", name);
+    return -1;
+  }
+  int n = m->numeric_size[id] - head;
+  memcpy(xy, d + head, sizeof(double) * (size_t)n);
+  for (int k = 1; k <= parts; k++) {
+    snprintf(part, sizeof part, "%s.part%d", name, k);
+    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
+    memcpy(xy + n, m->numeric_data + m->numeric_adr[pid],
+           sizeof(double) * (size_t)m->numeric_size[pid]);
+    n += m->numeric_size[pid];
+  }
+  const int rc =
+      route_from_points(r, xy, total / 2, d[head - 1], with_loop ? d[0] != 0.0 : 0, err, err_sz);
+  free(xy);
   if (rc != 0) {
     char why[256];
     snprintf(why, sizeof why, "%s", err);

@@ -31,7 +31,8 @@ typedef struct route_where {
 /* From n >= 2 points; half_width_m > 0. Returns 0, or -1 with a message in err. */
 int route_from_points(route_t *r, const double *xy, int n, double half_width_m, int loop, char *err,
                       size_t err_sz);
-/* From numeric id of m: with_loop 1 for route_* (leading loop flag), 0 for lane_*. */
+/* From numeric id of m and its continuations <name>.part1, .part2 ... (whole x y pairs):
+ * with_loop 1 for route_* (leading loop flag), 0 for lane_*. */
 int route_from_numeric(route_t *r, const mjModel *m, int id, int with_loop, char *err,
                        size_t err_sz);
 void route_free(route_t *r);

@@ -45,7 +45,7 @@ static int api_load_lanes(ad_world_t *w, char *err, size_t err_sz) {
   }
   for (int i = 0; i < m->nnumeric; i++) {
     const char *name = m->names + m->name_numericadr[i];
-    if (strncmp(name, "lane_", 5) != 0) continue;
+    if (strncmp(name, "lane_", 5) != 0 || strstr(name, ".part")) continue; /* parts: below */
     if (route_from_numeric(&w->lanes[w->nlanes], m, i, 0, err, err_sz) != 0) return -1;
     w->nlanes++;
   }
