@@ -113,6 +113,14 @@ def test_lane_flag() -> None:
     print(f"lane flag: off lane to the left after {left + 1} control periods")
 
 
+def test_camera() -> None:
+    w = World("parking_school", seed=1, camera_px=(64, 48))
+    img = w.camera(0)
+    assert img.shape == (48, 64, 3) and img.dtype == np.uint8
+    assert img.std() > 5.0, "the front camera rendered a blank frame"
+    print(f"front camera: 64 x 48 RGB, mean {img.mean():.1f}, std {img.std():.1f}")
+
+
 def refused(fn: object, words: str) -> None:
     try:
         fn()  # type: ignore[operator]
@@ -143,4 +151,5 @@ if __name__ == "__main__":
     test_firmware_path()
     test_lane_flag()
     test_bad_input()
+    test_camera()
     print("learn.api: all passed")
