@@ -18,6 +18,7 @@ from .world import SimError, World
 CONTROL_HZ = 20
 LIDAR_MAX_M = 12.0  # observation scale of a LIDAR range (the RPLIDAR A1's range) [m]
 START_TRIES = 20  # random start poses drawn until one is clear of obstacles
+ROUTE_END_M = 0.1  # an open route is done this close to its end [m]
 
 ObsArray = npt.NDArray[np.float32]
 
@@ -99,7 +100,8 @@ class LaneKeepingEnv(_CarEnv):
     heading error [rad], forward and lateral speed [m/s], yaw rate [rad/s], steering angle
     [rad], the Nano's engaged flag, then optional LIDAR ranges over 12 m. Reward: metres of
     progress along the route minus 0.05 per step times the squared offset ratio. Ends when
-    the car leaves the lane or collides; truncated after max_steps."""
+    the car leaves the lane, collides or reaches the end of an open route (e.g. Intersection
+    School's "north_to_east"); truncated after max_steps."""
 
     BASE_OBS = 7
 
@@ -163,9 +165,14 @@ class LaneKeepingEnv(_CarEnv):
             ds = math.remainder(ds, float(o.route_length_m))
         self.progress_m = float(o.route_progress_m)
         reward = ds - 0.05 * float(obs[0]) ** 2
-        terminated = bool(o.off_lane or o.in_collision)
+        arrived = not self.route.loop and self.progress_m > float(o.route_length_m) - ROUTE_END_M
+        terminated = bool(o.off_lane or o.in_collision or arrived)
         truncated = self.steps >= self.max_steps
-        info = {"off_lane": bool(o.off_lane), "in_collision": bool(o.in_collision)}
+        info = {
+            "off_lane": bool(o.off_lane),
+            "in_collision": bool(o.in_collision),
+            "arrived": arrived,
+        }
         return obs, reward, terminated, truncated, info
 
 
