@@ -14,7 +14,9 @@ within one run, median of the runs (*_cpu: thread CPU time instead of wall time)
 batch_cost_ratio: one step_worlds call over 8 worlds against 8 single World.step calls
 (thread CPU time).
 physics_steps_per_s_1car and bare_mj_step_per_s_1car: the figures behind the ratio.
-Options: LEARN_BENCH_SECONDS (5) per figure, LEARN_BENCH_REPEATS (3)."""
+goals_met: the issue's goals (>= 1000 env steps/s, >= 800 agent steps/s, ratio <= 1.15), by
+wall time and by CPU time. Options: LEARN_BENCH_SECONDS (5) per figure, LEARN_BENCH_REPEATS
+(3)."""
 
 from __future__ import annotations
 
@@ -190,6 +192,14 @@ def main(argv: list[str]) -> int:
     for key, values in runs.items():
         digits = 3 if "ratio" in key else 1
         res[key] = round(statistics.median(values), digits)
+    res["goals_met"] = {
+        "env_steps_per_s_1car": res["env_steps_per_s_1car"] >= 1000,
+        "env_steps_per_s_1car_cpu": res["env_steps_per_s_1car_cpu"] >= 1000,
+        "agent_steps_per_s_4cars": res["agent_steps_per_s_4cars"] >= 800,
+        "agent_steps_per_s_4cars_cpu": res["agent_steps_per_s_4cars_cpu"] >= 800,
+        "api_overhead_ratio": res["api_overhead_ratio"] <= 1.15,
+        "api_overhead_ratio_cpu": res["api_overhead_ratio_cpu"] <= 1.15,
+    }
     res["multi_car_map"] = map_name
     res["control_period_ms"] = CONTROL_MS
     res["physics_step_ms"] = 1
