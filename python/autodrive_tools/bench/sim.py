@@ -5,15 +5,16 @@ rtf_N: median real-time factor of `autodrive-sim --lockstep` with N cars (1 kHz 
 emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty, ground truth on LCM);
 bare_mj_step_rtf_N: a bare mj_step loop on the same model in the same process;
 overhead_ratio = bare / rtf_1 (goal <= 1.11) and rtf_N_over_bare = rtf_N / bare (goal for 16
-cars >= 0.85; rtf_16 >= 3), each taken within one run, medians over the runs. The *_cpu variants divide by CPU time instead of wall
-time (the stepping thread's for the ratios: the LCM sender has a thread of its own); on a
-shared, loaded machine they show the cost without the waits.
+cars >= 0.85; rtf_16 >= 3), each taken within one run, medians over the runs. The *_cpu
+variants divide by CPU time instead of wall time (the stepping thread's for the ratios: the
+LCM sender has a thread of its own); on a shared, loaded machine they show the cost without
+the waits.
 rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JPEG-published
 at 30 Hz. turn_radius_error_pct: circle fitted to the ground truth at steering 0.6 vs
 L/tan(delta); *_mujoco_friction: the same with plain MuJoCo contact friction instead of the
 paper tyre model. goals_met: each goal by wall time and by CPU time. lidar_scan_us,
-camera_fps_640x480: from the sensors library's
-sim-sensors-bench. Options: SIM_BENCH_REPEATS (3).
+camera_fps_640x480: from the sensors library's sim-sensors-bench. Options: SIM_BENCH_REPEATS
+(3).
 """
 
 from __future__ import annotations
