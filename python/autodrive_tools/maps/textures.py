@@ -154,7 +154,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
         cv.rgb[:] = tk.asphalt_rgb
         return cv.png()
     w, half_w = tk.lane_width_m, content.road_width_m / 2
-    lw = tk.line_width_m / 2
+    lw = tk.paint_width_m / 2
     edge_off = tk.shoulder_m / 2  # edge lines this far inside the road's edge
     offsets = tiles.lane_offsets_m(tk, lanes)
     k = len(offsets)
@@ -195,7 +195,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
             yellow[(cv.seg(pa, pb) <= lw) & (np.mod(cv.along(pa, pb), tk.dash_length_m + tk.dash_gap_m) < tk.dash_length_m)] = True  # fmt: skip
         elif lanes > 2:
             for s in (-1, 1):
-                yellow[cv.seg(*off(s * 1.5 * tk.line_width_m)) <= lw] = True
+                yellow[cv.seg(*off(s * 1.5 * tk.paint_width_m)) <= lw] = True
 
     if tile_type in ("tee", "cross"):
         for i in arms:
@@ -245,7 +245,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
                 if i == 0 and lanes == 2 and first_arm:  # one direction draws the shared line
                     yellow |= _dashes(cv, prims, w / 2) & (_dist(cv, prims, w / 2) <= lw)
                 if i == 0 and lanes > 2:
-                    yellow |= _dist(cv, prims, w / 2 - 1.5 * tk.line_width_m) <= lw
+                    yellow |= _dist(cv, prims, w / 2 - 1.5 * tk.paint_width_m) <= lw
     # stop lines (a dead end's and a lot aisle's end bars too)
     for s in content.stop_lines:
         lane = by_name[s.lane]
