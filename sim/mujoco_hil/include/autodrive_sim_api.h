@@ -69,7 +69,8 @@ double ad_world_time_s(const ad_world_t *w);
 
 /* Back to sim time 0 with seed. poses_xy_yaw: NULL keeps the start poses, else 3 values per
  * car (x [m], y [m], yaw [rad] of base_link) that become the start poses; a pose off the
- * floor or on an obstacle is refused. The same seed and poses give the same episode. */
+ * floor or on an obstacle is refused (the start poses stay; reset again before stepping).
+ * The same seed and poses give the same episode. */
 int ad_world_reset(ad_world_t *w, uint64_t seed, const double *poses_xy_yaw, char *err,
                    size_t err_sz);
 /* What car's driver sends from its next COMMAND frame on: throttle and steering in [-1, 1]
