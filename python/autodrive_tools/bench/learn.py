@@ -2,12 +2,13 @@
 Progress on stderr; figures on stdout, the last line one JSON object. Needs AUTODRIVE_BUILD.
 
 env_steps_per_s_1car: ParkingEnv (Gymnasium, Parking School) at a 20 Hz control period (50
-physics steps per env step), random actions, resets included; *_lidar360: the same with a
-360-ray LIDAR scan in every observation; *_lane_keeping: LaneKeepingEnv (Driving School,
-loop_ccw). bare_env_steps_per_s_*: the bound MuJoCo alone sets, bare mj_step steps per second
-on that map / 50. *_cpu: per second of this process's CPU time (a loaded, shared machine). agent_steps_per_s_4cars: IntersectionEnv
-(PettingZoo; Intersection School, or Parking School until that map exists), 4 cars, agent
-steps per second; *_2proc: the sum of two such processes running at once.
+physics steps per env step), random actions drawn beforehand, resets included; *_lidar360:
+the same with a 360-ray LIDAR scan in every observation; *_lane_keeping: LaneKeepingEnv
+(Driving School, loop_ccw). bare_env_steps_per_s_*: the bound MuJoCo alone sets, bare mj_step
+steps per second on that map / 50. *_cpu: per second of this process's CPU time (a loaded,
+shared machine). agent_steps_per_s_4cars: IntersectionEnv (PettingZoo; Intersection School,
+or Parking School until that map exists), 4 cars, agent steps per second; *_2proc: the sum of
+two such processes running at once.
 api_overhead_ratio: wall time of the batch API (step_worlds) stepping 4 one-car worlds by 50 ms
 over a bare mj_step loop on the same model and state for the same number of steps, taken
 within one run, median of the runs (*_cpu: thread CPU time instead of wall time).
@@ -37,6 +38,7 @@ log = Progress("learn")
 CONTROL_MS = 50  # 20 Hz
 BATCH_WORLDS = 4
 BATCH_COMPARE_WORLDS = 8
+ACTIONS = 997  # pre-drawn random actions, cycled
 
 
 def rate(step: Callable[[], int], seconds: float) -> tuple[float, float]:
@@ -54,10 +56,14 @@ def gym_rate(seconds: float, lidar_rays: int, lane_keeping: bool) -> tuple[float
         LaneKeepingEnv(lidar_rays=lidar_rays) if lane_keeping else ParkingEnv(lidar_rays=lidar_rays)
     )
     env.reset(seed=0)
-    env.action_space.seed(0)
+    # random actions drawn beforehand: the agent's cost (Box.sample is ~20 us) is not the env's
+    actions = np.random.default_rng(0).uniform(-1, 1, (ACTIONS, 2)).astype(np.float32)
+    k = 0
 
     def one() -> int:
-        _, _, term, trunc, _ = env.step(env.action_space.sample())
+        nonlocal k
+        _, _, term, trunc, _ = env.step(actions[k % ACTIONS])
+        k += 1
         if term or trunc:
             env.reset()
         return 1
@@ -72,10 +78,13 @@ def pz_rate(seconds: float, cars: int = 4) -> tuple[tuple[float, float], str]:
 
     env = IntersectionEnv(cars=cars)
     env.reset(seed=0)
-    rng = np.random.default_rng(0)
+    actions = np.random.default_rng(0).uniform(-1, 1, (ACTIONS, 2)).astype(np.float32)
+    k = 0
 
     def one() -> int:
-        acts = {a: rng.uniform(-1, 1, 2).astype(np.float32) for a in env.agents}
+        nonlocal k
+        acts = {a: actions[(k + i) % ACTIONS] for i, a in enumerate(env.agents)}
+        k += len(acts) + 1
         env.step(acts)
         if not env.agents:
             env.reset()
