@@ -39,6 +39,16 @@ def test_gym() -> None:
         print(f"{type(env).__name__}: check_env passed, seeded episodes repeat")
 
 
+def test_render() -> None:
+    env = LaneKeepingEnv(render_mode="rgb_array")  # the front camera, 160 x 120
+    check_env(env)  # with gymnasium's render check
+    env.reset(seed=0)
+    img = env.render()
+    assert img.shape == (120, 160, 3) and img.std() > 5.0, "blank or misshapen camera frame"
+    env.close()
+    print("LaneKeepingEnv rgb_array: check_env with render passed")
+
+
 def test_lane_keeper() -> None:
     """The observation means what it says: steering against the offset and heading error keeps
     the car in its lane for 10 s while the reward counts the metres it made."""
@@ -77,6 +87,7 @@ def test_pettingzoo() -> None:
 
 if __name__ == "__main__":
     test_gym()
+    test_render()
     test_lane_keeper()
     test_pettingzoo()
     print("learn.envs: all passed")
