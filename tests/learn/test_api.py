@@ -50,19 +50,28 @@ def test_repeatable() -> None:
 
 
 def test_batch_equals_single() -> None:
-    single = [World("parking_school", seed=s) for s in (1, 2, 3)]
-    batch = [World("parking_school", seed=s) for s in (1, 2, 3)]
-    for ws in (single, batch):
+    seeds = (1, 2, 3, 4)
+    single = [World("parking_school", seed=s) for s in seeds]
+    batch = [World("parking_school", seed=s) for s in seeds]
+    threaded = [World("parking_school", seed=s) for s in seeds]
+    for ws in (single, batch, threaded):
         for i, w in enumerate(ws):
-            w.command(0, 0.3 + 0.2 * i, -0.5 + 0.4 * i)
+            w.command(0, 0.3 + 0.2 * i, -0.5 + 0.3 * i)
     for _ in range(20):
         for w in single:
             w.step(PERIOD_MS)
         step_worlds(batch, PERIOD_MS)
-    for s, b in zip(single, batch):
+        step_worlds(threaded, PERIOD_MS, threads=3)
+    for s, b, t in zip(single, batch, threaded):
         assert np.array_equal(s.observe(0).pos_m, b.observe(0).pos_m)
-        assert s.time_s == b.time_s == 1.0
-    print("batch step equals single steps")
+        assert np.array_equal(s.observe(0).pos_m, t.observe(0).pos_m)
+        assert s.time_s == b.time_s == t.time_s == 1.0
+    try:
+        step_worlds(batch, 0, threads=2)
+        raise AssertionError("a bad period was not refused")
+    except SimError as e:
+        assert "world 0" in str(e) and "period 0" in str(e), str(e)
+    print("batch step, also on 3 threads, equals single steps")
 
 
 def test_firmware_path() -> None:

@@ -13,7 +13,8 @@ api_overhead_ratio: wall time of the batch API (step_worlds) stepping 4 one-car 
 over a bare mj_step loop on the same model and state for the same number of steps, taken
 within one run, median of the runs (*_cpu: thread CPU time instead of wall time).
 batch_cost_ratio: one step_worlds call over 8 worlds against 8 single World.step calls
-(thread CPU time).
+(thread CPU time); batch_speedup_2threads: wall time of that batch on one thread over the same
+on two (step_worlds(..., threads=2)).
 physics_steps_per_s_1car and bare_mj_step_per_s_1car: the figures behind the ratio.
 goals_met: the issue's goals (>= 1000 env steps/s, >= 800 agent steps/s, ratio <= 1.15), by
 wall time and by CPU time. Options: LEARN_BENCH_SECONDS (5) per figure, LEARN_BENCH_REPEATS
@@ -129,22 +130,27 @@ def api_overhead(seconds: float) -> dict[str, float]:
     }
 
 
-def batch_cost(seconds: float) -> float:
-    """One step_worlds call over K worlds / K single steps (same worlds, alternating)."""
+def batch_cost(seconds: float) -> tuple[float, float]:
+    """One step_worlds call over K worlds / K single steps (same worlds, alternating, thread
+    CPU time); and the wall-time speed-up of the same batch on 2 threads."""
     from ..learn.world import World, step_worlds
 
     worlds = [World("parking_school", seed=k) for k in range(BATCH_COMPARE_WORLDS)]
     rounds = max(1, int(seconds * 2))
-    single = batch = 0.0
+    single = batch = batch_wall = threaded_wall = 0.0
     for _ in range(rounds):  # thread CPU time: the machine's load does not enter the ratio
         t0 = time.thread_time()
         for w in worlds:
             w.step(CONTROL_MS)
         single += time.thread_time() - t0
-        t0 = time.thread_time()
+        t0, w0 = time.thread_time(), time.perf_counter()
         step_worlds(worlds, CONTROL_MS)
         batch += time.thread_time() - t0
-    return batch / single
+        batch_wall += time.perf_counter() - w0
+        w0 = time.perf_counter()
+        step_worlds(worlds, CONTROL_MS, threads=2)
+        threaded_wall += time.perf_counter() - w0
+    return batch / single, batch_wall / threaded_wall
 
 
 def two_processes(seconds: float) -> float:
@@ -195,7 +201,9 @@ def main(argv: list[str]) -> int:
         keep("api_overhead_ratio_cpu", o["ratio_cpu"])
         keep("physics_steps_per_s_1car", o["api_steps_per_s"])
         keep("bare_mj_step_per_s_1car", o["bare_steps_per_s"])
-        keep("batch_cost_ratio", batch_cost(seconds))
+        cost, speedup = batch_cost(seconds)
+        keep("batch_cost_ratio", cost)
+        keep("batch_speedup_2threads", speedup)
         keep("agent_steps_per_s_4cars_2proc", two_processes(seconds))
         log(f"run {k + 1}/{repeats}: " + ", ".join(f"{key} {v[-1]:.3g}" for key, v in runs.items()))
     for key, values in runs.items():

@@ -194,12 +194,13 @@ class World:
         return float(self._lib.ad_world_bare_mj_step_s(self._w, steps))
 
 
-def step_worlds(worlds: Sequence[World], period_ms: int) -> None:
-    """Steps every world by period_ms in one call (the batch API)."""
+def step_worlds(worlds: Sequence[World], period_ms: int, threads: int = 1) -> None:
+    """Steps every world by period_ms in one call (the batch API), on up to threads threads
+    (worlds are independent: the same result as one by one)."""
     if not worlds:
         return
     ffi, lib = _lib.load()
     arr = ffi.new("ad_world_t *[]", [w.handle for w in worlds])
     err = ffi.new("char[]", ERR_BYTES)
-    if lib.ad_worlds_step(arr, len(worlds), period_ms, err, ERR_BYTES) != 0:
+    if lib.ad_worlds_step_threads(arr, len(worlds), period_ms, threads, err, ERR_BYTES) != 0:
         raise SimError(f"batch step: {ffi.string(err).decode(errors='replace')}")

@@ -22,6 +22,7 @@ extern "C" {
 /* CFFI-BEGIN */
 #define AD_MAX_CARS 32
 #define AD_PHYSICS_STEP_US 1000
+#define AD_MAX_THREADS 64
 
 typedef struct ad_world ad_world_t;
 
@@ -83,6 +84,12 @@ int ad_world_step(ad_world_t *w, int period_ms, char *err, size_t err_sz);
 /* Advances each of k worlds by period_ms: the batch step (no more than k single steps). On
  * an error, stops and names the world's index. */
 int ad_worlds_step(ad_world_t *const *worlds, int k, int period_ms, char *err, size_t err_sz);
+
+/* The same on up to `threads` threads (the calling one included; 1: ad_worlds_step): worlds
+ * are independent, so the result is the same as stepping them one by one. On an error the
+ * message names the lowest failing world's index. */
+int ad_worlds_step_threads(ad_world_t *const *worlds, int k, int period_ms, int threads, char *err,
+                           size_t err_sz);
 
 /* car's observation now (0 / -1 for a bad car). */
 int ad_world_observe(const ad_world_t *w, int car, ad_obs_t *out);

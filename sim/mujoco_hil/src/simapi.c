@@ -4,6 +4,7 @@
 #include "autodrive_sim_api.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,6 +165,57 @@ int ad_worlds_step(ad_world_t *const *worlds, int k, int period_ms, char *err, s
       snprintf(err, err_sz, "world %d: %s", i, why);
       return -1;
     }
+  }
+  return 0;
+}
+
+/* A threaded batch step: workers take the next world from a shared counter. */
+typedef struct api_batch {
+  ad_world_t *const *worlds;
+  int k, period_ms, next, failed; /* failed: lowest failing world, or k */
+  pthread_mutex_t mu;
+  char err[1024];
+} api_batch_t;
+
+static void *api_batch_worker(void *arg) {
+  api_batch_t *b = arg;
+  for (;;) {
+    pthread_mutex_lock(&b->mu);
+    const int i = b->failed < b->k ? b->k : b->next++;
+    pthread_mutex_unlock(&b->mu);
+    if (i >= b->k) return NULL;
+    char err[1024];
+    if (ad_world_step(b->worlds[i], b->period_ms, err, sizeof err) != 0) {
+      pthread_mutex_lock(&b->mu);
+      if (i < b->failed) {
+        b->failed = i;
+        snprintf(b->err, sizeof b->err, "%s", err);
+      }
+      pthread_mutex_unlock(&b->mu);
+    }
+  }
+}
+
+int ad_worlds_step_threads(ad_world_t *const *worlds, int k, int period_ms, int threads, char *err,
+                           size_t err_sz) {
+  if (threads < 1 || threads > AD_MAX_THREADS) {
+    snprintf(err, err_sz, "batch step: %d threads, must be 1..%d", threads, AD_MAX_THREADS);
+    return -1;
+  }
+  if (threads > k) threads = k;
+  if (threads <= 1) return ad_worlds_step(worlds, k, period_ms, err, err_sz);
+  api_batch_t b = {.worlds = worlds, .k = k, .period_ms = period_ms, .next = 0, .failed = k};
+  pthread_mutex_init(&b.mu, NULL);
+  pthread_t t[AD_MAX_THREADS];
+  int started = 0;
+  for (; started < threads - 1; started++)
+    if (pthread_create(&t[started], NULL, api_batch_worker, &b) != 0) break; /* fewer is fine */
+  api_batch_worker(&b);
+  for (int i = 0; i < started; i++) pthread_join(t[i], NULL);
+  pthread_mutex_destroy(&b.mu);
+  if (b.failed < k) {
+    snprintf(err, err_sz, "world %d: %s", b.failed, b.err);
+    return -1;
   }
   return 0;
 }
