@@ -82,8 +82,9 @@ struct sim_lidar_scan;
 /* Casts car's whole LIDAR scan at the current state (stamped now) and returns it; NULL
  * without a LIDAR. For sim_config_t.lidar_on_request. */
 const struct sim_lidar_scan *sim_lidar_scan_at_once(sim_t *s, int car);
-/* The noisy IMU the firmware reads (accelerometer [m/s^2], gyro [rad/s], car axes) without
- * drawing noise: MuJoCo's sensors at the IMU site plus the car's biases. */
+/* The IMU the firmware reads less its white noise (drawing none, so observing changes
+ * nothing): MuJoCo's accelerometer [m/s^2] and gyro [rad/s] at the IMU site, car axes, plus
+ * the car's biases. */
 void sim_imu(const sim_t *s, int car, double accel_m_s2[3], double gyro_rad_s[3]);
 /* Closes ptys, removes symlinks and the generated scene. NULL is fine. */
 void sim_destroy(sim_t *s);
