@@ -39,6 +39,16 @@ def test_gym() -> None:
         print(f"{type(env).__name__}: check_env passed, seeded episodes repeat")
 
 
+def test_taken_slot_refused() -> None:
+    try:
+        ParkingEnv(slot=0)  # Parking School's slot 0 holds a parked stand-in car
+    except ValueError as e:
+        assert "parked car" in str(e) and "free slots" in str(e), str(e)
+        print(f"ParkingEnv refuses a taken slot: {e}")
+        return
+    raise AssertionError("a slot with a parked car was accepted")
+
+
 def test_render() -> None:
     env = LaneKeepingEnv(render_mode="rgb_array")  # the front camera, 160 x 120
     check_env(env)  # with gymnasium's render check
@@ -87,6 +97,7 @@ def test_pettingzoo() -> None:
 
 if __name__ == "__main__":
     test_gym()
+    test_taken_slot_refused()
     test_render()
     test_lane_keeper()
     test_pettingzoo()

@@ -177,7 +177,7 @@ class LaneKeepingEnv(_CarEnv):
 
 
 class ParkingEnv(_CarEnv):
-    """Park in a slot of Parking School, forward in. Observation: the goal pose in the car's
+    """Park in a free slot of Parking School (default 2, the demo's), forward in. Observation: the goal pose in the car's
     frame (x, y [m], cos and sin of the yaw difference), forward and lateral speed [m/s], yaw
     rate [rad/s], steering angle [rad], then optional LIDAR ranges over 12 m. Reward: the
     decrease of the pose error (distance [m] + 0.2 m/rad * |yaw error|); +10 and done when
@@ -189,7 +189,7 @@ class ParkingEnv(_CarEnv):
 
     def __init__(
         self,
-        slot: int = 0,
+        slot: int = 2,
         control_hz: float = CONTROL_HZ,
         lidar_rays: int = 0,
         max_steps: int = 600,
@@ -201,6 +201,12 @@ class ParkingEnv(_CarEnv):
         lot = mapfacts.parking_school()
         if not 0 <= slot < lot.slots:
             raise ValueError(f"slot {slot}: Parking School has slots 0..{lot.slots - 1}")
+        side = tasks.sidecar(mapfacts.PARKING_SCHOOL)
+        taken = {p["slot"] for p in side.get("parked", [])}
+        name = side["parking_slots"][slot]["name"]
+        if name in taken:
+            free = [k for k, sl in enumerate(side["parking_slots"]) if sl["name"] not in taken]
+            raise ValueError(f"slot {slot} ('{name}') holds a parked car; free slots: {free}")
         self.goal = lot.slot_goals[slot]
         self.spawn = lot.spawn
         self.error = 0.0
