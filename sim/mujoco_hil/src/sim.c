@@ -93,6 +93,7 @@ typedef struct sim_car {
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
   proto_parser_t host_parser; /* frames the pty's client wrote, counted as they arrive */
   uint32_t host_frames;
+  int host_idle; /* free lockstep: nothing read and the pty refused our bytes last service */
   /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */
   uint8_t tx_pending[SIM_TX_PENDING_BYTES];
   size_t tx_pending_n;
@@ -127,6 +128,9 @@ struct sim {
   int box_placed[SCN_MAX_LATE_BOXES];    /* has appeared */
   int box_new[SCN_MAX_LATE_BOXES];       /* appeared during the last step */
   int box_car_below[SCN_MAX_LATE_BOXES]; /* car it landed on (1-based), 0: none */
+  uint64_t seed;                         /* of the current run (sim_create, sim_reset) */
+  char script_spec[256];                 /* every car's scripted driver, "" for none */
+  int lidar, lidar_on_request, lidar_rays;
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
@@ -458,23 +462,61 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   return 0;
 }
 
-static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err,
-                         size_t err_sz) {
-  c->sim = s;
-  c->servo_us = 1500;
+/* A car at power-on: actuators idle, UARTs empty, the firmware freshly booted, its noise and
+ * biases drawn from (seed, car), its scripted driver at its first frame, its LIDAR head (with
+ * its own noise seed) at the start of a revolution. sim_create and sim_reset share it. */
+static int sim_car_boot(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
+  memset(c->fz_n, 0, sizeof c->fz_n);
+  memset(c->mu, 0, sizeof c->mu);
+  memset(c->normal, 0, sizeof c->normal);
+  memset(c->contact_pos, 0, sizeof c->contact_pos);
+  c->in_collision = 0;
+  c->duty = c->reverse = c->lamps = 0;
   c->brake = 1;
+  c->servo_us = 1500;
+  c->steer_rad = 0.0;
+  c->lamps_shown = 0xFF; /* draw on the first step */
+  c->tx_pending_n = 0;
+  c->host_idle = 0;
+  c->lidar_new = 0;
   uart_init(&c->rx, PROTO_BAUD);
   uart_init(&c->tx, PROTO_BAUD);
   /* every car draws its own biases and noise from (seed, car) */
-  rng_seed(&c->rng, cfg->seed * 1000003ull + (uint64_t)c->index);
+  rng_seed(&c->rng, s->seed * 1000003ull + (uint64_t)c->index);
   for (int k = 0; k < 3; k++) {
     c->accel_bias[k] = (2.0 * rng_uniform(&c->rng) - 1.0) * s->p.accel_bias_m_s2;
     c->gyro_bias[k] = (2.0 * rng_uniform(&c->rng) - 1.0) * s->p.gyro_bias_rad_s;
   }
-  if (cfg->script) {
-    if (script_parse(&c->script, cfg->script, err, err_sz) != 0) return -1;
+  if (s->script_spec[0]) {
+    if (script_parse(&c->script, s->script_spec, err, err_sz) != 0) return -1;
     c->has_script = 1;
   }
+  if (s->lidar) {
+    sim_lidar_config_t lc;
+    sim_lidar_config_default(&lc);
+    mju_copy3(lc.mount_pos_m, s->p.lidar_pos_m);
+    lc.seed = s->seed * 7919ull + (uint64_t)c->index;
+    if (s->lidar_rays > 0) lc.num_rays = s->lidar_rays;
+    char body[32];
+    snprintf(body, sizeof body, "nigel%d/base_link", c->index);
+    sim_lidar_destroy(c->lidar);
+    c->lidar = sim_lidar_create(s->m, body, &lc, err, err_sz);
+    if (!c->lidar) return -1;
+  }
+  nigel_init(&c->nano, &c->hal, 0, 0, SIM_BUILD_ID);
+  return 0;
+}
+
+static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err,
+                         size_t err_sz) {
+  c->sim = s;
+  c->hal.ctx = c;
+  c->hal.motor_set = hal_motor_set;
+  c->hal.servo_set_us = hal_servo_set_us;
+  c->hal.lamps_set = hal_lamps_set;
+  c->hal.imu_read = hal_imu_read;
+  c->hal.battery_read_mv = hal_battery_read_mv;
+  c->hal.serial_write = hal_serial_write;
   if (cfg->open_ptys) {
     char link[512];
     snprintf(link, sizeof link, "%s/nigel%d-nano", cfg->run_dir, c->index);
@@ -483,29 +525,12 @@ static int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *
     c->host_rx_us = -1;
     proto_parser_init(&c->host_parser);
   }
-  if (cfg->lidar) {
-    sim_lidar_config_t lc;
-    sim_lidar_config_default(&lc);
-    mju_copy3(lc.mount_pos_m, s->p.lidar_pos_m);
-    lc.seed = cfg->seed * 7919ull + (uint64_t)c->index;
-    char body[32];
-    snprintf(body, sizeof body, "nigel%d/base_link", c->index);
-    c->lidar = sim_lidar_create(s->m, body, &lc, err, err_sz);
-    if (!c->lidar) return -1;
-    if (cfg->open_ptys) {
-      snprintf(c->lidar_link, sizeof c->lidar_link, "%s/nigel%d-lidar", cfg->run_dir, c->index);
-      c->rplidar = sim_rplidar_create(c->lidar_link, SIM_RPLIDAR_BAUD, err, err_sz);
-      if (!c->rplidar) return -1;
-    }
+  if (sim_car_boot(s, c, err, err_sz) != 0) return -1;
+  if (cfg->lidar && cfg->open_ptys) {
+    snprintf(c->lidar_link, sizeof c->lidar_link, "%s/nigel%d-lidar", cfg->run_dir, c->index);
+    c->rplidar = sim_rplidar_create(c->lidar_link, SIM_RPLIDAR_BAUD, err, err_sz);
+    if (!c->rplidar) return -1;
   }
-  c->hal.ctx = c;
-  c->hal.motor_set = hal_motor_set;
-  c->hal.servo_set_us = hal_servo_set_us;
-  c->hal.lamps_set = hal_lamps_set;
-  c->hal.imu_read = hal_imu_read;
-  c->hal.battery_read_mv = hal_battery_read_mv;
-  c->hal.serial_write = hal_serial_write;
-  nigel_init(&c->nano, &c->hal, 0, 0, SIM_BUILD_ID);
   return 0;
 }
 
@@ -543,6 +568,18 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   }
   s->nbox = cfg->late_boxes;
   for (int k = 0; k < s->nbox; k++) s->box[k] = cfg->late_box[k];
+  s->seed = cfg->seed;
+  s->lidar = cfg->lidar;
+  s->lidar_on_request = cfg->lidar_on_request;
+  s->lidar_rays = cfg->lidar_rays;
+  if (cfg->script) {
+    if (strlen(cfg->script) >= sizeof s->script_spec) {
+      snprintf(err, err_sz, "--script '%s': longer than %zu characters", cfg->script,
+               sizeof s->script_spec - 1);
+      goto fail;
+    }
+    snprintf(s->script_spec, sizeof s->script_spec, "%s", cfg->script);
+  }
   if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
   if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
   s->tyre_paper = s->p.tyre_model_paper;
@@ -634,8 +671,21 @@ static void sim_read_host(sim_t *s, sim_car_t *c) {
   proto_parser_feed(&c->host_parser, buf, n, sim_count_host_frame, c);
 }
 
-static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err_sz) {
+/* Free lockstep (a host I/O period > 1 ms): while nobody is on the pty (nothing read, and the
+ * pty's buffer full so our last bytes were refused) it is served only every
+ * SIM_HOST_IDLE_PERIOD_MS, saving two system calls per period; a client's first bytes are then
+ * seen within that time, and the next service that moves bytes ends the idle state. */
+#define SIM_HOST_IDLE_PERIOD_MS 100
+static int sim_host_io_due_car(const sim_t *s, const sim_car_t *c, int io_due) {
+  if (!io_due || !c->host_idle) return io_due;
+  return (s->time_us / SIM_STEP_US + 1) % SIM_HOST_IDLE_PERIOD_MS == 0;
+}
+
+static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due_all, char *err, size_t err_sz) {
   uint8_t buf[512];
+  const int io_due = c->has_pty && sim_host_io_due_car(s, c, io_due_all);
+  const uint32_t frames_before = c->host_frames;
+  const int64_t rx_before = c->host_rx_us;
   if (c->has_pty && io_due) sim_read_host(s, c);
   if (c->has_script) {
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
@@ -654,7 +704,10 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err
     const size_t room = sizeof c->tx_pending - c->tx_pending_n;
     c->tx_pending_n += uart_pop(&c->tx, SIM_STEP_US, c->tx_pending + c->tx_pending_n, room);
     if (io_due || c->tx_pending_n == sizeof c->tx_pending) {
-      ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n); /* a full pty drops bytes */
+      /* a full pty drops bytes */
+      const size_t sent = ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n);
+      const int read_any = c->host_rx_us != rx_before || c->host_frames != frames_before;
+      if (s->host_io_period_steps > 1) c->host_idle = !read_any && c->tx_pending_n > 0 && sent == 0;
       c->tx_pending_n = 0;
     }
   }
@@ -824,7 +877,7 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
   for (int i = 0; i < s->ncars; i++) {
     sim_car_t *c = &s->car[i];
     c->lidar_new = 0;
-    if (!c->lidar) continue;
+    if (!c->lidar || s->lidar_on_request) continue;
     /* mj_step2 leaves kinematics at the start of the step: fine for 1 ms ray timing */
     if (sim_lidar_update(s->m, s->d, c->lidar, s->time_us)) c->lidar_new = 1;
     if (c->rplidar) { /* stream the rays just measured, as the real device does */
@@ -833,7 +886,11 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
       sim_lidar_last_cast(c->lidar, &from, &to, &num_rays, &ranges_m, &quality);
       sim_rplidar_push_rays(c->rplidar, ranges_m, quality, from, to, num_rays);
     }
-    if (c->rplidar && io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
+    /* free lockstep: an RPLIDAR pty nobody scans on is served at the idle period, too */
+    const int lidar_io_due = c->rplidar && io_due &&
+                             (s->host_io_period_steps == 1 || sim_rplidar_scanning(c->rplidar) ||
+                              (s->time_us / SIM_STEP_US) % SIM_HOST_IDLE_PERIOD_MS == 0);
+    if (c->rplidar && lidar_io_due && sim_rplidar_poll(c->rplidar, s->time_us, err, err_sz) != 0)
       return -1;
   }
   if (s->d->warning[mjWARN_BADQACC].number > 0) {
@@ -935,4 +992,71 @@ double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s) {
   const double wall = sim_clock_s(CLOCK_MONOTONIC) - w0;
   mj_deleteData(d);
   return wall;
+}
+
+/* ---- learning API support ----------------------------------------------------------- */
+int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t err_sz) {
+  if (poses) {
+    mjtNum saved[7 * SIM_MAX_CARS]; /* the old start poses, back in place on a refusal */
+    for (int i = 0; i < s->ncars; i++)
+      mju_copy(saved + 7 * i, s->m->qpos0 + s->car[i].root_qpos, 7);
+    for (int i = 0; i < s->ncars; i++) {
+      const double *p = poses + 3 * i;
+      if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]) || fabs(p[0]) > SCN_COORD_MAX_M ||
+          fabs(p[1]) > SCN_COORD_MAX_M) {
+        snprintf(err, err_sz, "reset pose of car %d (%g, %g, %g): not a finite pose on the map", i,
+                 p[0], p[1], p[2]);
+        return -1;
+      }
+      sim_set_car_pose(s, i, p, p[2], 0, 0); /* and qpos0: the new start pose */
+    }
+    mj_kinematics(s->m, s->d); /* the static geoms' poses, for the clearance check */
+    const int ct = s->m->geom_contype[s->car[0].chassis_geom],
+              ca = s->m->geom_conaffinity[s->car[0].chassis_geom];
+    for (int i = 0; i < s->ncars; i++) {
+      cl_prism_t pr;
+      char why[512];
+      sim_car_prism(s, i, &pr);
+      if (cl_check_on_map(s->m, s->d, &pr, ct, ca, why, sizeof why) != 0) {
+        snprintf(err, err_sz, "reset pose of car %d (x %.3f, y %.3f m, yaw %.3f rad): %s", i,
+                 poses[3 * i], poses[3 * i + 1], poses[3 * i + 2], why);
+        for (int j = 0; j < s->ncars; j++)
+          mju_copy(s->m->qpos0 + s->car[j].root_qpos, saved + 7 * j, 7);
+        return -1;
+      }
+    }
+  }
+  s->seed = seed;
+  s->time_us = 0;
+  mj_resetData(s->m, s->d); /* qpos0 holds the start poses; mocap boxes go back to hiding */
+  for (int k = 0; k < s->nbox; k++) s->box_placed[k] = s->box_new[k] = s->box_car_below[k] = 0;
+  mj_forward(s->m, s->d);
+  for (int i = 0; i < s->ncars; i++)
+    if (sim_car_boot(s, &s->car[i], err, err_sz) != 0) return -1;
+  return 0;
+}
+
+int sim_drive(sim_t *s, int car, double throttle, double steering) {
+  if (car < 1 || car > s->ncars) return -1;
+  sim_car_t *c = &s->car[car - 1];
+  if (!c->has_script || !(fabs(throttle) <= 1.0) || !(fabs(steering) <= 1.0)) return -1;
+  c->script.throttle = throttle;
+  c->script.steering = steering;
+  return 0;
+}
+
+const struct sim_lidar_scan *sim_lidar_scan_at_once(sim_t *s, int car) {
+  sim_car_t *c = &s->car[car - 1];
+  if (!c->lidar) return NULL;
+  sim_lidar_scan_now(s->m, s->d, c->lidar, s->time_us);
+  return sim_lidar_last_scan(c->lidar);
+}
+
+void sim_imu(const sim_t *s, int car, double accel_m_s2[3], double gyro_rad_s[3]) {
+  const sim_car_t *c = &s->car[car - 1];
+  const mjtNum *sd = s->d->sensordata;
+  for (int k = 0; k < 3; k++) {
+    accel_m_s2[k] = sd[c->accel_adr + k] + c->accel_bias[k];
+    gyro_rad_s[k] = sd[c->gyro_adr + k] + c->gyro_bias[k];
+  }
 }

@@ -38,6 +38,10 @@ typedef struct sim_config {
    * the bytes the way a USB-serial adapter's latency timer does; free lockstep uses it so an
    * idle pty costs no system call per step. Wire timing inside the Nano's UART is unchanged. */
   int host_io_period_ms;
+  /* 1: the LIDAR has no rotating head stepped every 1 ms; sim_lidar_scan_at_once casts a
+   * whole scan when asked (the learning API: a scan costs only when an observation wants it) */
+  int lidar_on_request;
+  int lidar_rays; /* rays per revolution; 0: the RPLIDAR A1's (sim_lidar_config_default) */
 } sim_config_t;
 
 typedef struct sim sim_t;
@@ -61,6 +65,27 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz);
  * the option (--start, --late-box) and says what is in the way. The program refuses to run a
  * scenario that fails it (exit 2); without these options it checks nothing. */
 int sim_check_scenario(const sim_t *s, char *err, size_t err_sz);
+/* Puts the world back to its state right after sim_create, with seed for the IMU biases and
+ * noise and the LIDAR noise: sim time 0, every car's firmware freshly booted, its scripted
+ * driver (if any) back at its first frame, late boxes not yet there. poses: NULL for the
+ * start poses of sim_create, else ncars poses (x_m, y_m, yaw_rad of base_link) that become
+ * the new start poses; each must be on the floor and clear of walls and obstacles. Returns 0,
+ * or -1 with a message naming the car and what is in the way. The same seed and poses give
+ * the same run, bit for bit. */
+int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t err_sz);
+/* Sets what car's in-process scripted driver (sim_config_t.script, script.h) sends in its
+ * next COMMAND frames (throttle, steering in [-1, 1]): the learning API's command path, the
+ * same frames and rates the runtime's bridge writes to the pty. -1 when the car has no
+ * scripted driver or a value is out of range. */
+int sim_drive(sim_t *s, int car, double throttle, double steering);
+struct sim_lidar_scan;
+/* Casts car's whole LIDAR scan at the current state (stamped now) and returns it; NULL
+ * without a LIDAR. For sim_config_t.lidar_on_request. */
+const struct sim_lidar_scan *sim_lidar_scan_at_once(sim_t *s, int car);
+/* The IMU the firmware reads less its white noise (drawing none, so observing changes
+ * nothing): MuJoCo's accelerometer [m/s^2] and gyro [rad/s] at the IMU site, car axes, plus
+ * the car's biases. */
+void sim_imu(const sim_t *s, int car, double accel_m_s2[3], double gyro_rad_s[3]);
 /* Closes ptys, removes symlinks and the generated scene. NULL is fine. */
 void sim_destroy(sim_t *s);
 
