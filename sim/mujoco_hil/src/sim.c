@@ -19,7 +19,9 @@
 #include "mjcf_gen.h"
 #include "ptylink.h"
 #include "rng.h"
+#include "route_driver.h"
 #include "script.h"
+#include "traffic_lights.h"
 #include "tyre.h"
 #include "uart.h"
 #include "vparams.h"
@@ -127,6 +129,8 @@ struct sim {
   int box_placed[SCN_MAX_LATE_BOXES];    /* has appeared */
   int box_new[SCN_MAX_LATE_BOXES];       /* appeared during the last step */
   int box_car_below[SCN_MAX_LATE_BOXES]; /* car it landed on (1-based), 0: none */
+  traffic_lights_t tl;                   /* the map's lights (traffic_lights.h) */
+  route_driver_t *route;                 /* --script route:NAME (car 1), else NULL */
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
@@ -524,6 +528,35 @@ int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
   return s->box_new[k];
 }
 
+/* --script route:NAME: the route driver of car 1, which starts at the route's start unless
+ * --start says otherwise. */
+static int sim_bind_route(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
+  if (!cfg->script) return 0;
+  script_t sc;
+  if (script_parse(&sc, cfg->script, err, err_sz) != 0) return -1;
+  if (!sc.route) return 0;
+  if (cfg->cars != 1) {
+    snprintf(err, err_sz, "--script '%s': a route driver drives one car (--cars 1, got %d)",
+             cfg->script, cfg->cars);
+    return -1;
+  }
+  s->route = calloc(1, sizeof *s->route);
+  if (!s->route) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
+  if (route_driver_init(s->route, s->m, sc.route_name, sc.throttle, sc.lookahead_m, err, err_sz) !=
+      0) {
+    free(s->route);
+    s->route = NULL;
+    return -1;
+  }
+  if (!s->has_start) {
+    double yaw;
+    route_driver_start(s->route, &s->start.x_m, &s->start.y_m, &yaw);
+    s->start.yaw_deg = yaw * (180.0 / M_PI);
+    s->has_start = 1;
+  }
+  return 0;
+}
+
 sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   if (cfg->cars < 1 || cfg->cars > SIM_MAX_CARS) {
     snprintf(err, err_sz, "--cars %d: must be 1..%d", cfg->cars, SIM_MAX_CARS);
@@ -577,6 +610,8 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
   }
   if (sim_bind_late_boxes(s, err, err_sz) != 0) goto fail;
+  if (tl_load(&s->tl, s->m, err, err_sz) != 0) goto fail;
+  if (sim_bind_route(s, cfg, err, err_sz) != 0) goto fail;
   if (sim_place_cars(s, err, err_sz) != 0) goto fail;
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
@@ -596,6 +631,8 @@ void sim_destroy(sim_t *s) {
   }
   if (s->d) mj_deleteData(s->d);
   if (s->m) mj_deleteModel(s->m);
+  if (s->route) route_driver_free(s->route);
+  free(s->route);
   if (s->scene_dir[0]) { /* the generated scene and tag textures */
     char path[700];
     snprintf(path, sizeof path, "%s/scene.xml", s->scene_dir);
@@ -637,6 +674,11 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err
   uint8_t buf[512];
   if (c->has_pty && io_due) sim_read_host(s, c);
   if (c->has_script) {
+    if (s->route && s->time_us >= c->script.next_us) { /* pure pursuit before each frame */
+      const mjtNum *q = s->d->qpos + c->root_qpos;
+      const double yaw = atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] * q[5] + q[6] * q[6]));
+      route_driver_update(s->route, q[0], q[1], yaw, &c->script.throttle, &c->script.steering);
+    }
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
     uart_push(&c->rx, buf, n);
   }
@@ -807,6 +849,10 @@ static void sim_record_contacts(sim_t *s) {
 }
 
 int sim_step(sim_t *s, char *err, size_t err_sz) {
+  if (s->tl.n > 0) { /* lights: program or command, lamps lit in the model for the cameras */
+    tl_update(&s->tl, s->time_us);
+    tl_draw(&s->tl, s->m);
+  }
   sim_place_late_boxes(s); /* before mj_step1: its kinematics, contacts and rays see them */
   mj_step1(s->m, s->d);
   const int io_due = sim_host_io_due(s);
@@ -843,6 +889,13 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
 }
 
 /* ---- queries ------------------------------------------------------------------------- */
+traffic_lights_t *sim_traffic_lights(sim_t *s) {
+  return &s->tl;
+}
+const route_driver_t *sim_route(const sim_t *s) {
+  return s->route;
+}
+
 int64_t sim_time_us(const sim_t *s) {
   return s->time_us;
 }

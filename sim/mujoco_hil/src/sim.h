@@ -103,6 +103,14 @@ int sim_late_boxes(const sim_t *s);
 const scn_late_box_t *sim_late_box(const sim_t *s, int k);
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below);
 
+/* The map's traffic lights (traffic_lights.h): each step updates them at sim time and lights
+ * their lamps in the model. Commands (tl_command) take effect at the next step. */
+struct traffic_lights;
+struct traffic_lights *sim_traffic_lights(sim_t *s);
+/* The route driver of --script route:NAME (route_driver.h), or NULL. */
+struct route_driver;
+const struct route_driver *sim_route(const sim_t *s);
+
 /* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
  * (and its CPU time in *cpu_s if non-NULL); the benchmark's measure of MuJoCo alone. */
 double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s);
