@@ -6,8 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from . import mjcf, sidecar
-from .loader import MAPS_DIR, load, names
+from . import mjcf, sidecar, textures
+from .loader import MAPS_DIR, load, load_kit, names
 from .model import MapDescriptionError
 
 
@@ -20,11 +20,29 @@ def outputs(name: str, maps_dir: Path = MAPS_DIR) -> dict[Path, str]:
     }
 
 
+def texture_outputs(maps_dir: Path = MAPS_DIR) -> dict[Path, bytes]:
+    """The textures every map in the folder uses (one per tile type and lane count, one per sign
+    kind) in maps_dir/textures, and their PNG bytes."""
+    tile_keys: set[tuple[str, int]] = set()
+    sign_keys: set[tuple[str, str]] = set()
+    for name in names(maps_dir):
+        m = load(maps_dir / f"{name}.yaml", maps_dir / "kit.yaml")
+        tile_keys |= {(t.type, t.lanes) for t in m.tiles}
+        sign_keys |= {
+            (s.kind, textures.sign_texture_name(s.kind, s.speed_limit_m_s))
+            for s in m.placed_signs()
+        }
+    kit = load_kit(maps_dir / "kit.yaml")
+    out = textures.generate(kit, tile_keys, sign_keys)
+    return {maps_dir / textures.DIR_NAME / f"{n}.png": b for n, b in out.items()}
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="tools/gen-maps",
         description="Regenerate sim/mujoco_hil/maps/<map>.xml (MJCF) and <map>.json (sidecar for "
-        "C/C++ readers) from <map>.yaml and kit.yaml, for every map.",
+        "C/C++ readers) from <map>.yaml and kit.yaml, for every map, and the textures the maps "
+        "use (maps/textures/*.png: one per tile type and lane count, one per sign kind).",
     )
     p.add_argument(
         "--check",
@@ -42,16 +60,20 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not (args.dir / "kit.yaml").is_file():
             raise MapDescriptionError(f"{args.dir}: no kit.yaml in this folder")
+        files: dict[Path, bytes] = {}
         for name in names(args.dir):
-            for path, text in outputs(name, args.dir).items():
-                old = path.read_text() if path.is_file() else None
-                if old == text:
-                    continue
-                if args.check:
-                    stale.append(path)
-                else:
-                    path.write_text(text)
-                    print(f"gen-maps: wrote {path}")
+            files.update({p: t.encode() for p, t in outputs(name, args.dir).items()})
+        files.update(texture_outputs(args.dir))
+        for path, data in files.items():
+            old = path.read_bytes() if path.is_file() else None
+            if old == data:
+                continue
+            if args.check:
+                stale.append(path)
+            else:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_bytes(data)
+                print(f"gen-maps: wrote {path}")
     except MapDescriptionError as err:
         print(f"gen-maps: {err}", file=sys.stderr)
         return 2

@@ -14,10 +14,17 @@ from __future__ import annotations
 import math
 from typing import Iterable, Sequence
 
-from . import geometry
+from . import geometry, textures
 from ..geometry import wrap
 from .description import MapDescription
 from .model import ParkingSlot, Vec2
+
+NUMERIC_MAX_VALUES = 500  # MuJoCo 2.2's limit per <numeric>: longer data goes on in <name>.partK
+CUSTOM_STEP_M = 0.05  # spacing of the lane and route centre lines in <custom> numerics
+LAMPS = ("red", "yellow", "green")  # top to bottom
+# light_level -> the look at light level 1 (MuJoCo's default headlight, the sun) scaled down
+DAY_HEADLIGHT = {"ambient": 0.1, "diffuse": 0.4, "specular": 0.5}
+DAY_SUN_DIFFUSE = 0.8
 
 WORLD = 'contype="1" conaffinity="6"'
 VIS = 'contype="0" conaffinity="0" mass="0"'
@@ -75,18 +82,25 @@ class _Writer:
         m, eye = self.m, self.kit.eye_camera
         floor = self.kit.surfaces[m.floor_surface]
         h = m.floor_half_size_m
+        level = m.options.light_level
         self.lines += [
             f'<mujoco model="{m.name}">',
             f"  <!-- generated from {m.name}.yaml and kit.yaml by tools/gen-maps; edit those -->",
+        ]
+        if level != 1:  # night: MuJoCo's default headlight dimmed (texture paths: see below)
+            hl = " ".join(f'{k}="{nums([v * level] * 3)}"' for k, v in DAY_HEADLIGHT.items())
+            self.lines.append(f"  <visual><headlight {hl}/></visual>")
+        self.lines += [
             "  <asset>",
             '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.6 0.7 0.9" '
             'rgb2="0.2 0.25 0.3" width="64" height="64"/>',
-            "  </asset>",
-            "  <worldbody>",
         ]
+        self.assets()
+        self.lines += ["  </asset>", "  <worldbody>"]
+        sun = nums([DAY_SUN_DIFFUSE * level] * 3)
         self.add(
             '<light name="sun" directional="true" pos="0 0 5" dir="0 0 -1" '
-            'diffuse="0.8 0.8 0.8" castshadow="false"/>'
+            f'diffuse="{sun}" castshadow="false"/>'
         )
         self.add(
             f'<camera name="eye" pos="0 0 {num(eye.height_m)}" xyaxes="1 0 0 0 1 0" '
@@ -101,6 +115,124 @@ class _Writer:
             f'<site name="spawn" pos="{nums((sp.x_m, sp.y_m))} 0" euler="0 0 {num(sp.yaw_rad)}" '
             'size="0.02"/>'
         )
+        for s in m.named_spawns():
+            p = s.pose
+            self.add(
+                f'<site name="spawn_{s.name}" pos="{nums((p.x_m, p.y_m))} 0" '
+                f'euler="0 0 {num(p.yaw_rad)}" size="0.02"/>'
+            )
+
+    def assets(self) -> None:
+        """Textures (files relative to the map's folder; the simulator's scene sets texturedir
+        to that folder), one per tile type and sign kind used, and one material per lamp."""
+        m = self.m
+        for name in sorted({t.texture for t in m.tile_contents()}):
+            self.lines.append(
+                f'    <texture name="{name}" type="2d" file="{textures.DIR_NAME}/{name}.png"/>'
+            )
+            self.lines.append(f'    <material name="{name}_mat" texture="{name}"/>')
+        for name in sorted({textures.sign_texture_name(s.kind, s.speed_limit_m_s)
+                            for s in m.placed_signs()}):  # fmt: skip
+            self.lines.append(
+                f'    <texture name="{name}" type="2d" file="{textures.DIR_NAME}/{name}.png"/>'
+            )
+            self.lines.append(f'    <material name="{name}_mat" texture="{name}"/>')
+        tl = self.kit.traffic_light
+        for light in m.lights():
+            for c in LAMPS:
+                self.lines.append(
+                    f'    <material name="{light.name}_lamp_{c}_mat" '
+                    f'rgba="{nums(tl.lamp_off_rgba[c])}" emission="0"/>'
+                )
+
+    def tiles(self) -> None:
+        """One textured box per tile: its markings are in the texture."""
+        tk = self.kit.tiles
+        for t in self.m.tile_contents():
+            h = t.size_m / 2
+            self.add(
+                f'<geom name="tile_{t.spec.name}" type="box" '
+                f'pos="{nums((*t.spec.centre_m, tk.height_m))}" '
+                f'size="{nums((h, h, tk.thickness_m / 2))}" '
+                f'euler="0 0 {num(wrap(math.radians(t.spec.rotation_deg)))}" {VIS} '
+                f'material="{t.texture}_mat"/>'
+            )
+
+    def lights(self) -> None:
+        """Per light: a pole (collidable: a LIDAR sees it), a housing and three lamps (visual),
+        the lamps on the housing's face towards the approach."""
+        tl = self.kit.traffic_light
+        for light in self.m.lights():
+            x, y = light.position_m
+            c, s = math.cos(light.yaw_rad), math.sin(light.yaw_rad)
+            ph = tl.pole_height_m
+            self.add(
+                f'<geom name="{light.name}_pole" type="cylinder" pos="{nums((x, y, ph / 2))}" '
+                f'size="{nums((tl.pole_radius_m, ph / 2))}" {WORLD} '
+                f'{self.friction(self.kit.obstacle.friction)} rgba="{nums(tl.pole_rgba)}"/>'
+            )
+            dx, dy, dz = tl.housing_size_m
+            zc = ph + dz / 2
+            self.add(
+                f'<geom name="{light.name}_housing" type="box" pos="{nums((x, y, zc))}" '
+                f'size="{nums((dx / 2, dy / 2, dz / 2))}" euler="0 0 {num(light.yaw_rad)}" '
+                f'{VIS} rgba="{nums(tl.housing_rgba)}"/>'
+            )
+            for k, colour in enumerate(LAMPS):
+                lx, ly = x + c * dx / 2, y + s * dx / 2
+                lz = zc + (1 - k) * dz / 3
+                self.add(
+                    f'<geom name="{light.name}_lamp_{colour}" type="sphere" '
+                    f'pos="{nums((lx, ly, lz))}" size="{num(tl.lamp_radius_m)}" {VIS} '
+                    f'material="{light.name}_lamp_{colour}_mat"/>'
+                )
+
+    def signs(self) -> None:
+        """Per sign: a post (collidable) and a face (visual) textured with its kind."""
+        sk = self.kit.sign
+        for sign in self.m.placed_signs():
+            x, y = sign.position_m
+            ph = sk.post_height_m
+            self.add(
+                f'<geom name="{sign.name}_post" type="cylinder" pos="{nums((x, y, ph / 2))}" '
+                f'size="{nums((sk.post_radius_m, ph / 2))}" {WORLD} '
+                f'{self.friction(self.kit.obstacle.friction)} rgba="{nums(sk.post_rgba)}"/>'
+            )
+            c, s = math.cos(sign.yaw_rad), math.sin(sign.yaw_rad)
+            off = sk.post_radius_m + sk.face_thickness_m / 2
+            f = sk.face_size_m / 2
+            # the face box's local z is its normal (the way it points), local x is up: MuJoCo
+            # paints a box's 2d texture on its +-z faces
+            self.add(
+                f'<geom name="{sign.name}_face" type="box" '
+                f'pos="{nums((x + c * off, y + s * off, ph + f * 0.6))}" '
+                f'size="{nums((f, f, sk.face_thickness_m / 2))}" '
+                f'zaxis="{nums((round(c, 12), round(s, 12)))} 0" {VIS} '
+                f'material="{textures.sign_texture_name(sign.kind, sign.speed_limit_m_s)}_mat"/>'
+            )
+
+    def custom(self) -> None:
+        """What C readers need, as MuJoCo custom numerics and texts (mj_name2id(mjOBJ_NUMERIC))."""
+        m = self.m
+        out = []
+        for light in m.lights():
+            p = light.program
+            data = nums((p.cycle_s, p.offset_s, p.green_s, p.yellow_s))
+            out.append(f'    <numeric name="{light.name}_program" data="{data}"/>')
+        pairs = m.light_conflicts()
+        if pairs:
+            flat = [float(v) for pair in pairs for v in pair]
+            out.append(f'    <numeric name="tl_conflicts" data="{nums(flat)}"/>')
+        for lane in m.lanes():
+            pts = [v for x, y, _ in m.centre_line(lane, CUSTOM_STEP_M) for v in (x, y)]
+            out += _numeric_parts(f"lane_{lane.name}", [lane.half_width_m], pts)
+        for r in m.named_routes():
+            pts = [v for p in r.polyline_m for v in p]
+            out += _numeric_parts(f"route_{r.name}", [1.0 if r.loop else 0.0, r.half_width_m], pts)
+        for sign in m.placed_signs():
+            out.append(f'    <text name="{sign.name}_kind" data="{sign.kind}"/>')
+        if out:
+            self.lines += ["  <custom>", *out, "  </custom>"]
 
     def slots(self, slots: Sequence[ParkingSlot]) -> None:
         """Each slot's two side lines and its back line; a line shared with a neighbour is drawn
@@ -191,7 +323,8 @@ class _Writer:
     def write(self) -> str:
         m, kit = self.m, self.kit
         self.header()
-        self.slots(m.parking_slots)
+        self.tiles()
+        self.slots(m.parking_slots)  # the tiles' slots are painted in their textures
         self.roads()
         for s in m.stop_lines:
             self.mark(
@@ -205,6 +338,11 @@ class _Writer:
             self.box(b.name, b.centre_m, b.size_m, b.yaw_rad)
         for c in m.cones:
             self.cone(c.name, c.position_m)
+        for p in m.parked:
+            slot = m.slot(p.slot)
+            self.box(f"parked_{p.slot}", slot.centre_m, kit.parked_car_size_m, slot.yaw_rad)
+        self.lights()
+        self.signs()
         t = kit.terrain_patch_thickness_m
         for patch in m.terrain_patches:
             surface = kit.surfaces[patch.surface]
@@ -224,8 +362,26 @@ class _Writer:
                 f'size="{nums((hx, hy))} 0.05" zaxis="{nums((nx, ny))} 0" {WORLD} '
                 f'{self.friction(kit.obstacle.friction)} rgba="{nums(kit.obstacle.wall_rgba)}"/>'
             )
-        self.lines += ["  </worldbody>", "</mujoco>", ""]
+        self.lines.append("  </worldbody>")
+        self.custom()
+        self.lines += ["</mujoco>", ""]
         return "\n".join(self.lines)
+
+
+def _numeric_parts(name: str, head: list[float], points: list[float]) -> list[str]:
+    """<numeric> lines of head + points: the first named name, the rest name.part1, .part2 ...
+    (at most NUMERIC_MAX_VALUES values each; parts hold whole x y pairs)."""
+    values = head + [round(v, 6) for v in points]
+    first = NUMERIC_MAX_VALUES - (NUMERIC_MAX_VALUES - len(head)) % 2
+    chunks = [values[:first]]
+    rest = values[first:]
+    while rest:
+        chunks.append(rest[:NUMERIC_MAX_VALUES])
+        rest = rest[NUMERIC_MAX_VALUES:]
+    return [
+        f'    <numeric name="{name}{f".part{k}" if k else ""}" data="{nums(c)}"/>'
+        for k, c in enumerate(chunks)
+    ]
 
 
 def generate(m: MapDescription) -> str:

@@ -87,6 +87,64 @@ class EyeCameraKit:
 
 
 @dataclass(frozen=True)
+class TileKit:
+    """The road kit's tiles: sizes, lane widths and how their textures are painted."""
+
+    lane_width_m: float
+    shoulder_m: float
+    cell_m: dict[str, float]  # per lane count ("1", "2", "4", "6"): side of a one-cell tile
+    height_m: float
+    thickness_m: float
+    texture_px_per_m: float
+    asphalt_rgb: Vec3
+    verge_rgb: Vec3
+    line_rgb: Vec3
+    centre_rgb: Vec3
+    line_width_m: float
+    stop_line_width_m: float
+    stop_line_setback_m: float
+    dash_length_m: float
+    dash_gap_m: float
+    dead_end_margin_m: float
+    lot_slot_m: Vec2  # perpendicular lot slot: width across, depth
+    roadside_slot_m: Vec2  # parallel roadside slot: width across, length along
+    roadside_clearance_m: float  # kerb to the pole of a light or the post of a sign
+
+
+@dataclass(frozen=True)
+class TrafficLightKit:
+    pole_radius_m: float
+    pole_height_m: float
+    pole_rgba: Rgba
+    housing_size_m: Vec3  # full depth, width, height
+    housing_rgba: Rgba
+    lamp_radius_m: float
+    lamp_off_rgba: dict[str, Rgba]  # red, yellow, green: the dark (off) look
+    min_all_red_s: float
+
+
+@dataclass(frozen=True)
+class SignKindKit:
+    category: Literal["regulatory", "cautionary", "informatory"]
+    meaning: str
+    shape: Literal["octagon", "triangle_down", "triangle_up", "circle", "square", "diamond"]
+    rgb: Vec3  # the face's main colour
+    symbol: Literal["text", "curve_left", "curve_right", "bar", "p", "walker", "none"]
+    text: str = ""
+
+
+@dataclass(frozen=True)
+class SignKit:
+    post_radius_m: float
+    post_height_m: float
+    post_rgba: Rgba
+    face_size_m: float
+    face_thickness_m: float
+    texture_px: int
+    kinds: dict[str, SignKindKit]
+
+
+@dataclass(frozen=True)
 class Kit:
     """Materials, markings and props shared by every map (maps/kit.yaml)."""
 
@@ -98,6 +156,10 @@ class Kit:
     marking: MarkingKit
     road: RoadKit
     eye_camera: EyeCameraKit
+    tiles: TileKit
+    traffic_light: TrafficLightKit
+    sign: SignKit
+    parked_car_size_m: Vec3  # a parked car stand-in (box) in a slot: length, width, height
     source: Path = Path()
 
 
@@ -205,12 +267,16 @@ class Road:
 
 @dataclass(frozen=True)
 class Lane:
-    """A lane with its road: its centre line runs offset_m left of the road's forward line."""
+    """A lane with its road: its centre line runs offset_m left of the road's forward line.
+    half_width_m: half the lane's width; kerb_right_m: from its centre line to the road's edge on
+    its right (where lights and signs stand)."""
 
     name: str
     road: Road
     offset_m: float
     direction: Literal["forward", "backward"]
+    half_width_m: float = 0.0
+    kerb_right_m: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -222,12 +288,100 @@ class StopLine:
 
 
 @dataclass(frozen=True)
-class Fixture:
-    """A traffic light or sign (filled by a later issue)."""
+class Program:
+    """A light's fixed-time program: u = (t - offset_s) mod cycle_s; green while u < green_s,
+    yellow until green_s + yellow_s, red for the rest."""
 
-    id: str
-    position_m: Vec2
-    yaw_deg: float
+    cycle_s: float
+    offset_s: float
+    green_s: float
+    yellow_s: float
+
+
+@dataclass(frozen=True)
+class TrafficLightSpec:
+    """A light at a stop line; it stands on the kerb right of the stop line's lane, facing the
+    approach, unless position_m and yaw_deg (the way its lamps face) are given."""
+
+    id: int
+    stop_line: str
+    program: Program
+    position_m: Optional[Vec2] = None
+    yaw_deg: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class SignSpec:
+    """A sign beside a lane (lane + along_m: on its right kerb, facing its traffic) or at a
+    pose (position_m + yaw_deg: the way its face points)."""
+
+    id: int
+    kind: str
+    lane: Optional[str] = None
+    along_m: Optional[float] = None
+    position_m: Optional[Vec2] = None
+    yaw_deg: Optional[float] = None
+    speed_limit_m_s: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class TileSpec:
+    """A road-kit tile: its type, lane count, centre and rotation (counter-clockwise, a multiple
+    of 90 deg). Unrotated, a straight runs west-east, a curve joins west and south, a dead end,
+    parking lot and 3-way intersection open to the west (the 3-way also east and south)."""
+
+    name: str
+    type: Literal[
+        "straight", "curve", "dead_end", "tee", "cross", "parking_lot", "roadside_parking", "patch"
+    ]
+    lanes: int
+    centre_m: Vec2
+    rotation_deg: float = 0.0
+
+
+@dataclass(frozen=True)
+class RouteSpec:
+    """A named route: lanes driven one after another (each ends where the next starts)."""
+
+    name: str
+    lanes: list[str]
+    loop: bool = False
+
+
+@dataclass(frozen=True)
+class SpawnSpec:
+    """A named start: along_m along a route, or at position_m / yaw_deg."""
+
+    name: str
+    route: Optional[str] = None
+    along_m: Optional[float] = None
+    position_m: Optional[Vec2] = None
+    yaw_deg: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class Parked:
+    """A stand-in for a parked car (a box of the kit's parked car size) in a slot."""
+
+    slot: str
+
+
+@dataclass(frozen=True)
+class LateObstacle:
+    """A box that appears at appear_s [s] of sim time, or when a car comes within
+    trigger_radius_m of it (whichever is given)."""
+
+    name: str
+    centre_m: Vec2
+    size_m: Vec3
+    yaw_rad: float = 0.0
+    appear_s: Optional[float] = None
+    trigger_radius_m: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class Options:
+    light_level: float = 1.0  # 0 (night) .. 1 (day)
 
 
 @dataclass(frozen=True)
@@ -244,8 +398,14 @@ class MapFile:
     parking_slots: list[ParkingSlot]
     roads: list[Road]
     stop_lines: list[StopLine]
-    traffic_lights: list[Fixture]
-    signs: list[Fixture]
+    traffic_lights: list[TrafficLightSpec]
+    signs: list[SignSpec]
+    options: Options = Options()
+    tiles: list[TileSpec] = field(default_factory=list)
+    routes: list[RouteSpec] = field(default_factory=list)
+    spawns: list[SpawnSpec] = field(default_factory=list)
+    parked: list[Parked] = field(default_factory=list)
+    late_obstacles: list[LateObstacle] = field(default_factory=list)
 
 
 @dataclass(frozen=True)

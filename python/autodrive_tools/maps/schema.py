@@ -42,7 +42,7 @@ def build(cls: type[T], data: Any, source: Path, key: str = "") -> T:
     for f in fields:
         sub = _join(key, f.name)
         if f.name not in data:
-            if f.default is dataclasses.MISSING:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise fail(source, sub, "missing key")
             continue
         values[f.name] = _value(hints[f.name], data[f.name], source, sub)
@@ -61,6 +61,10 @@ def _value(tp: Any, value: Any, source: Path, key: str) -> Any:
         if not math.isfinite(value):
             raise fail(source, key, f"expected a finite number, got {value!r}")
         return float(value)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise fail(source, key, f"expected true or false, got {_describe(value)}")
+        return value
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise fail(source, key, f"expected a whole number, got {_describe(value)}")

@@ -9,7 +9,7 @@ import math
 from typing import Any
 
 from .description import MapDescription
-from .model import Fixture, Piece, Vec2
+from .model import Piece, Vec2
 
 CENTRE_LINE_STEP_M = 0.05  # spacing of the sampled lane centre lines in the sidecar
 
@@ -83,7 +83,7 @@ def document(m: MapDescription) -> dict[str, Any]:
                 "depth_m": s.size_m[1],
                 "corners_m": [[_r(x), _r(y)] for x, y in s.corners_m()],
             }
-            for s in m.parking_slots
+            for s in m.slots()
         ],
         "roads": [
             {
@@ -101,6 +101,7 @@ def document(m: MapDescription) -> dict[str, Any]:
                 "road": lane.road.name,
                 "offset_m": lane.offset_m,
                 "direction": lane.direction,
+                "half_width_m": _r(lane.half_width_m),
                 "centre_line_step_m": CENTRE_LINE_STEP_M,
                 "centre_line": [
                     {"x_m": _r(x), "y_m": _r(y), "heading_rad": _r(h)}
@@ -117,10 +118,94 @@ def document(m: MapDescription) -> dict[str, Any]:
                 "length_m": s.length_m,
                 "yaw_rad": _r(m.stop_line_yaw_rad(s)),
             }
-            for s in m.stop_lines
+            for s in m.all_stop_lines()
         ],
-        "traffic_lights": [_fixture(f) for f in m.traffic_lights],
-        "signs": [_fixture(f) for f in m.signs],
+        "traffic_lights": [
+            {
+                "id": t.id,
+                "name": t.name,
+                "position_m": [_r(t.position_m[0]), _r(t.position_m[1])],
+                "yaw_rad": _r(t.yaw_rad),
+                "lane": t.lane,
+                "stop_line": t.stop_line,
+                "program": {
+                    "cycle_s": t.program.cycle_s,
+                    "offset_s": t.program.offset_s,
+                    "green_s": t.program.green_s,
+                    "yellow_s": t.program.yellow_s,
+                },
+            }
+            for t in m.lights()
+        ],
+        "light_conflicts": [list(p) for p in m.light_conflicts()],
+        "signs": [
+            {
+                "id": s.id,
+                "name": s.name,
+                "kind": s.kind,
+                "category": kit.sign.kinds[s.kind].category,
+                "meaning": kit.sign.kinds[s.kind].meaning,
+                "position_m": [_r(s.position_m[0]), _r(s.position_m[1])],
+                "yaw_rad": _r(s.yaw_rad),
+                "lane": s.lane,
+                "speed_limit_m_s": s.speed_limit_m_s,
+            }
+            for s in m.placed_signs()
+        ],
+        "tiles": [
+            {
+                "name": t.spec.name,
+                "type": t.spec.type,
+                "lanes": t.spec.lanes,
+                "centre_m": _xy(t.spec.centre_m),
+                "rotation_rad": _r(math.radians(t.spec.rotation_deg)),
+                "size_m": t.size_m,
+                "road_width_m": _r(t.road_width_m),
+            }
+            for t in m.tile_contents()
+        ],
+        "routes": [
+            {
+                "name": r.name,
+                "lanes": r.lanes,
+                "loop": r.loop,
+                "start": {
+                    "x_m": _r(r.start.x_m),
+                    "y_m": _r(r.start.y_m),
+                    "yaw_rad": _r(r.start.yaw_rad),
+                },
+                "length_m": _r(r.length_m),
+                "half_width_m": _r(r.half_width_m),
+                "polyline_m": [[_r(x), _r(y)] for x, y in r.polyline_m],
+            }
+            for r in m.named_routes()
+        ],
+        "spawns": [
+            {
+                "name": s.name,
+                "x_m": s.pose.x_m,
+                "y_m": s.pose.y_m,
+                "yaw_rad": s.pose.yaw_rad,
+                "route": s.route,
+            }
+            for s in m.named_spawns()
+        ],
+        "parked": [
+            {"slot": p.slot, "name": f"parked_{p.slot}", "size_m": list(kit.parked_car_size_m)}
+            for p in m.parked
+        ],
+        "late_obstacles": [
+            {
+                "name": o.name,
+                "centre_m": _xy(o.centre_m),
+                "size_m": list(o.size_m),
+                "yaw_rad": o.yaw_rad,
+                "appear_s": o.appear_s,
+                "trigger_radius_m": o.trigger_radius_m,
+            }
+            for o in m.late_obstacles
+        ],
+        "options": {"light_level": m.options.light_level},
     }
 
 
@@ -137,10 +222,6 @@ def _piece(p: Piece) -> dict[str, Any]:
             "sweep_rad": _r(math.radians(p.arc.sweep_deg)),
         },
     }
-
-
-def _fixture(f: Fixture) -> dict[str, Any]:
-    return {"id": f.id, "position_m": _xy(f.position_m), "yaw_rad": _r(math.radians(f.yaw_deg))}
 
 
 def _scalar(v: Any) -> bool:

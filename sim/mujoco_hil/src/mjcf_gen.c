@@ -160,11 +160,17 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
     snprintf(err, err_sz, "cannot write scene '%s': %s", out_path, strerror(errno));
     return -1;
   }
-  char rel[4096];
+  char rel[4096], map_dir[4096], rel_dir[4096];
   mg_rel_from(out_path, o->map_path, rel, sizeof rel);
+  /* MuJoCo 2.2 reads an included file's textures relative to THIS file's folder: point it at
+   * the map's folder (maps write file="textures/<name>.png") */
+  snprintf(map_dir, sizeof map_dir, "%s", o->map_path);
+  char *slash = strrchr(map_dir, '/');
+  if (slash) slash[1] = '\0';
+  mg_rel_from(out_path, map_dir, rel_dir, sizeof rel_dir);
   const int ncon = 64 + 16 * o->cars;
   fprintf(f, "<mujoco model=\"autodrive\">\n");
-  fprintf(f, " <compiler angle=\"radian\" autolimits=\"true\"/>\n");
+  fprintf(f, " <compiler angle=\"radian\" autolimits=\"true\" texturedir=\"%s\"/>\n", rel_dir);
   /* 1 ms Euler steps: with sphere tyres the turn radius matches L/tan(delta) */
   fprintf(f, " <option timestep=\"0.001\" integrator=\"Euler\" magnetic=\"%.6g %.6g %.6g\"/>\n",
           p->mag_field_ut[0], p->mag_field_ut[1], p->mag_field_ut[2]); /* [uT] */
