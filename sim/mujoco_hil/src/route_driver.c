@@ -12,7 +12,7 @@ void route_driver_list(const mjModel *m, char *out, size_t out_sz) {
   out[0] = '\0';
   for (int i = 0; i < m->nnumeric; i++) {
     const char *name = m->names + m->name_numericadr[i];
-    if (strncmp(name, "route_", 6) != 0) continue;
+    if (strncmp(name, "route_", 6) != 0 || strstr(name, ".part")) continue;
     const int w = snprintf(out + len, out_sz - len, "%s%s", len ? ", " : "", name + 6);
     if (w < 0 || (size_t)w >= out_sz - len) break;
     len += (size_t)w;
@@ -43,13 +43,35 @@ int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, dou
   }
   snprintf(r->name, sizeof r->name, "%s", name);
   r->half_width_m = v[1];
-  const int n = (sz - 2) / 2;
-  r->xy_m = malloc(sizeof(double) * (size_t)(2 * n));
+  /* a long route continues in route_<r>.part1, .part2, ... (MuJoCo's 500-value limit) */
+  int values = sz - 2, parts = 0;
+  for (;; parts++) {
+    char part[128];
+    snprintf(part, sizeof part, "%s.part%d", key, parts + 1);
+    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
+    if (pid < 0) break;
+    if (m->numeric_size[pid] % 2 != 0) {
+      snprintf(err, err_sz, "--script route:%s: numeric '%s' holds an odd number of values", name,
+               part);
+      return -1;
+    }
+    values += m->numeric_size[pid];
+  }
+  const int n = values / 2;
+  r->xy_m = malloc(sizeof(double) * (size_t)values);
   if (!r->xy_m) {
     snprintf(err, err_sz, "out of memory");
     return -1;
   }
-  for (int k = 0; k < 2 * n; k++) r->xy_m[k] = v[2 + k];
+  int at = 0;
+  for (int k = 2; k < sz; k++) r->xy_m[at++] = v[k];
+  for (int p = 1; p <= parts; p++) {
+    char part[128];
+    snprintf(part, sizeof part, "%s.part%d", key, p);
+    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
+    for (int k = 0; k < m->numeric_size[pid]; k++)
+      r->xy_m[at++] = m->numeric_data[m->numeric_adr[pid] + k];
+  }
   char perr[256];
   if (pp_path_init(&r->path, r->xy_m, n, v[0] != 0, perr, sizeof perr) != 0) {
     snprintf(err, err_sz, "--script route:%s: %s", name, perr);

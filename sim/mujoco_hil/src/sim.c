@@ -415,7 +415,7 @@ static int sim_check_map(const char *path, char *err, size_t err_sz) {
 /* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
 static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err,
                             size_t err_sz) {
-  const size_t asz = 512;
+  const size_t asz = 1024;
   *asset = calloc((size_t)cars, asz);
   *geoms = calloc((size_t)cars, sizeof(char *));
   if (!*asset || !*geoms) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
@@ -426,8 +426,11 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
     if (sim_tags_write_png(png, mg_tag_id(i), 8, err, err_sz) != 0) return -1;
     snprintf(prefix, sizeof prefix, "nigel%d/", i);
     (*geoms)[i - 1] = malloc(1024);
+    /* absolute: the scene's texturedir points at the map's folder (the maps' textures) */
+    char abs_png[4096];
+    if (!realpath(png, abs_png)) return sim_fail(err, err_sz, "roof tag '%s': %s", png, strerror(errno));
     if (!(*geoms)[i - 1] ||
-        sim_tags_mjcf(prefix, file, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
+        sim_tags_mjcf(prefix, abs_png, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
       return sim_fail(err, err_sz, "%s%s", "roof tag MJCF did not fit its buffer", "");
     strcat(*asset, a);
     strcat(*asset, "\n");

@@ -73,7 +73,7 @@ int tl_load(traffic_lights_t *t, const mjModel *m, char *err, size_t err_sz) {
     l->offset_s = v[1];
     l->green_s = v[2];
     l->yellow_s = v[3];
-    l->state = -1; /* first tl_update reports every light as changed */
+    l->state = l->drawn_state = -1; /* the first tl_update reports every light as changed */
     if (tl_bind_lamps(l, m, err, err_sz) != 0) return -1;
   }
   const int c = mj_name2id(m, mjOBJ_NUMERIC, "tl_conflicts");
@@ -198,7 +198,8 @@ int tl_command(traffic_lights_t *t, int id, int state, double duration_s, int64_
 void tl_draw(traffic_lights_t *t, mjModel *m) {
   for (int i = 0; i < t->n; i++) {
     tl_light_t *l = &t->light[i];
-    if (t->drawn && !l->changed) continue;
+    if (l->drawn_state == l->state) continue;
+    l->drawn_state = l->state;
     for (int k = 0; k < 3; k++) {
       const int lit = l->state == TL_RED + k; /* red 1, yellow 2, green 3 */
       const float *rgba = lit ? tl_lit_rgba[k] : l->off_rgba[k];
@@ -209,5 +210,4 @@ void tl_draw(traffic_lights_t *t, mjModel *m) {
       if (l->lamp_geom[k] >= 0) memcpy(m->geom_rgba + 4 * l->lamp_geom[k], rgba, 4 * sizeof(float));
     }
   }
-  t->drawn = 1;
 }

@@ -39,6 +39,7 @@ typedef struct tl_light {
   int64_t hold_until_us;                     /* TL_HOLD_FOREVER: until the next command */
   double remaining_s;                        /* until the next change [s], < 0 unknown */
   int changed;                               /* state changed in the last tl_update */
+  int drawn_state;                           /* state the lamps show in the model, -1: none */
 } tl_light_t;
 
 typedef struct traffic_lights {
@@ -46,7 +47,6 @@ typedef struct traffic_lights {
   tl_light_t light[TL_MAX_LIGHTS];
   int nconflicts;
   int conflict[TL_MAX_CONFLICTS][2]; /* light ids */
-  int drawn;                         /* lamps drawn at least once */
 } traffic_lights_t;
 
 /* Reads the lights of model m (none is fine: n = 0). Returns 0, or -1 with a message naming
