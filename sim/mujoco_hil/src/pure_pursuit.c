@@ -70,6 +70,7 @@ static void pp_take(pp_state_t *st, const pp_path_t *p, int k, double t, double 
                     double lap_m) {
   const double seg_len = p->s_m[k + 1] - p->s_m[k];
   st->seg = k;
+  st->lap_m = lap_m;
   st->s_m = lap_m + p->s_m[k] + t * seg_len;
   st->cross_track_m = side * sqrt(d2);
 }
@@ -89,7 +90,7 @@ void pp_reset(pp_state_t *st, const pp_path_t *p, double x_m, double y_m) {
 
 void pp_project(pp_state_t *st, const pp_path_t *p, double x_m, double y_m) {
   const int nseg = pp_segments(p);
-  const double lap0 = p->loop ? floor(st->s_m / p->length_m) * p->length_m : 0.0;
+  const double lap0 = st->lap_m;
   double best = INFINITY;
   int best_k = st->seg;
   double best_t = 0, best_side = 1, best_lap = lap0;

@@ -25,6 +25,7 @@ typedef struct pp_path {
 typedef struct pp_state {
   int seg;          /* segment of the last projection (search starts here) */
   double s_m;       /* arc length of the projection; grows past length_m on a loop's laps */
+  double lap_m;     /* loop: arc length at the start of the lap of segment seg */
   double cross_track_m; /* signed distance to the path, + = car left of it */
   int done;         /* a path's end (or one lap of a loop) reached */
 } pp_state_t;
