@@ -25,7 +25,10 @@ static void mg_rel_from(const char *scene_path, const char *abs_path, char *out,
   out[n] = '\0';
   const char *a = abs_path;
   while (*a == '/') a++;
-  strncat(out, a, sz - n - 1);
+  size_t len = strlen(a);
+  if (len > sz - n - 1) len = sz - n - 1; /* truncated: MuJoCo then names the missing file */
+  memcpy(out + n, a, len);
+  out[n + len] = '\0';
 }
 
 static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
