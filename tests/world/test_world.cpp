@@ -148,6 +148,25 @@ TEST(World, RouteDriverKeepsItsLaneTinyTown) {
   drive_route("tiny_town", "lot_to_east");
 }
 
+TEST(World, PhysicsModelLeavesOutVisualGeomsTheCamerasStillSeeThem) {
+  WorldSim k("tiny_town", nullptr);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  const mjModel *m = sim_model(k.s), *mv = sim_render_model(k.s);
+  ASSERT_NE(m, mv);
+  EXPECT_LT(mj_name2id(m, mjOBJ_GEOM, "tl1_lamp_red"), 0);
+  EXPECT_GE(mj_name2id(mv, mjOBJ_GEOM, "tl1_lamp_red"), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, "tl1_pole"), 0) << "a pole collides: the physics keeps it";
+  for (int g = 0; g < m->ngeom; g++)  // the map's geoms in the physics model all collide
+    if (m->geom_bodyid[g] == 0) {
+      EXPECT_TRUE(m->geom_contype[g] || m->geom_conaffinity[g]) << g;
+    }
+  EXPECT_EQ(m->nq, mv->nq);
+  ASSERT_TRUE(k.run_to(0.5));
+  const mjData *d = sim_data(k.s), *dv = sim_render_data(k.s);
+  for (int b = 0; b < m->nbody; b++)
+    for (int i = 0; i < 3; i++) EXPECT_NEAR(d->xpos[3 * b + i], dv->xpos[3 * b + i], 1e-9) << b;
+}
+
 TEST(World, ProgramFollowsTheMapsTiming) {
   tl_light_t l{};
   l.cycle_s = 20;
@@ -226,22 +245,22 @@ struct LightCamera {
   }
   bool open() {
     if (!k.s) return false;
-    rd = sim_render_create(sim_model(k.s), 640, 480, SIM_RENDER_AUTO, err, sizeof err);
+    rd = sim_render_create(sim_render_model(k.s), 640, 480, SIM_RENDER_AUTO, err, sizeof err);
     if (rd)
-      cam = sim_camera_create(rd, sim_model(k.s), "nigel1/cam_front", "camera_front", 640, 480, 85,
+      cam = sim_camera_create(rd, sim_render_model(k.s), "nigel1/cam_front", "camera_front", 640, 480, 85,
                               err, sizeof err);
     return cam != nullptr;
   }
   // Mean colour of lamp colour ("red", "yellow", "green") of light 1 in the frame.
   std::vector<double> lamp(const char *colour) {
-    const mjModel *m = sim_model(k.s);
+    const mjModel *m = sim_render_model(k.s);
+    const mjData *d = sim_render_data(k.s);
     const std::string name = std::string("tl1_lamp_") + colour;
     const int g = mj_name2id(m, mjOBJ_GEOM, name.c_str());
     EXPECT_GE(g, 0) << name;
     double u = 0, v = 0;
     const int cam_id = mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front");
-    EXPECT_TRUE(project(m, sim_data(k.s), cam_id, sim_data(k.s)->geom_xpos + 3 * g, 640, 480, &u,
-                        &v))
+    EXPECT_TRUE(project(m, d, cam_id, d->geom_xpos + 3 * g, 640, 480, &u, &v))
         << name << " is not in the frame";
     return mean_rgb(sim_camera_rgb(cam), 640, 480, u, v, 2);
   }
@@ -255,7 +274,7 @@ TEST(World, ALightCommandedRedIsRenderedRedInTheFrontCamera) {
   ASSERT_TRUE(lc.k.run_to(0.5));
   ASSERT_EQ(tl_command(t, 1, TL_RED, 0.0, sim_time_us(lc.k.s), why, sizeof why), 0) << why;
   ASSERT_TRUE(lc.k.run_to(0.52));
-  ASSERT_EQ(sim_camera_capture(lc.cam, sim_model(lc.k.s), sim_data(lc.k.s), 0), 0);
+  ASSERT_EQ(sim_camera_capture(lc.cam, sim_render_model(lc.k.s), sim_render_data(lc.k.s), 0), 0);
   auto red = lc.lamp("red"), green = lc.lamp("green");
   printf("commanded RED: red lamp rgb %.0f %.0f %.0f, green lamp rgb %.0f %.0f %.0f\n", red[0],
          red[1], red[2], green[0], green[1], green[2]);
@@ -265,7 +284,7 @@ TEST(World, ALightCommandedRedIsRenderedRedInTheFrontCamera) {
   // and GREEN: the lamps swap
   ASSERT_EQ(tl_command(t, 1, TL_GREEN, 0.0, sim_time_us(lc.k.s), why, sizeof why), 0) << why;
   ASSERT_TRUE(lc.k.run_to(0.54));
-  ASSERT_EQ(sim_camera_capture(lc.cam, sim_model(lc.k.s), sim_data(lc.k.s), 0), 0);
+  ASSERT_EQ(sim_camera_capture(lc.cam, sim_render_model(lc.k.s), sim_render_data(lc.k.s), 0), 0);
   red = lc.lamp("red");
   green = lc.lamp("green");
   printf("commanded GREEN: red lamp rgb %.0f %.0f %.0f, green lamp rgb %.0f %.0f %.0f\n", red[0],
@@ -284,7 +303,7 @@ TEST(World, AStopSignIsVisibleFrom1mInTheFrontCamera) {
   const scn_pose_t p = facing(sign["position_m"][0], sign["position_m"][1], sign["yaw_rad"], 1.0);
   WorldSim k("tiny_town", &p);
   ASSERT_NE(k.s, nullptr) << k.err;
-  const mjModel *m = sim_model(k.s);
+  const mjModel *m = sim_render_model(k.s);
   char err[1024] = "";
   sim_render_t *rd = sim_render_create(m, 640, 480, SIM_RENDER_AUTO, err, sizeof err);
   ASSERT_NE(rd, nullptr) << err;
@@ -292,13 +311,14 @@ TEST(World, AStopSignIsVisibleFrom1mInTheFrontCamera) {
       sim_camera_create(rd, m, "nigel1/cam_front", "camera_front", 640, 480, 85, err, sizeof err);
   ASSERT_NE(cam, nullptr) << err;
   ASSERT_TRUE(k.run_to(0.05));
-  ASSERT_EQ(sim_camera_capture(cam, m, sim_data(k.s), 0), 0);
+  mjData *d = sim_render_data(k.s);
+  ASSERT_EQ(sim_camera_capture(cam, m, d, 0), 0);
   const std::string face = std::string(sign["name"]) + "_face";
   const int g = mj_name2id(m, mjOBJ_GEOM, face.c_str());
   ASSERT_GE(g, 0) << face;
   double u = 0, v = 0;
-  ASSERT_TRUE(project(m, sim_data(k.s), mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front"),
-                      sim_data(k.s)->geom_xpos + 3 * g, 640, 480, &u, &v));
+  ASSERT_TRUE(project(m, d, mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front"),
+                      d->geom_xpos + 3 * g, 640, 480, &u, &v));
   // the face (8 cm at 1 m: ~40 px): the stop texture's red, with its white letters
   int red = 0, n = 0;
   const uint8_t *rgb = sim_camera_rgb(cam);

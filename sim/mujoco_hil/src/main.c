@@ -251,7 +251,7 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
                           size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
-  const mjModel *m = sim_model(s);
+  const mjModel *m = sim_render_model(s);
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
@@ -282,17 +282,19 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   return 0;
 }
 
-static int main_cams_publish(main_cams_t *k, const sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
+static int main_cams_publish(main_cams_t *k, sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
                              size_t err_sz) {
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
+  mjData *dv = sim_render_data(s); /* the whole map, in step with the physics */
   for (int i = 0; i < k->n; i++) {
-    if (sim_camera_capture(k->cam[i], sim_model(s), sim_data(s), now_us) != 0) {
+    if (sim_camera_capture(k->cam[i], sim_render_model(s), dv, now_us) != 0) {
       snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
       return -1;
     }
     sim_camera_publish_image(k->cam[i], lcm, k->channel[i]);
-    if (info) sim_camera_publish_info(k->cam[i], sim_model(s), lcm, k->info_channel[i], now_us);
+    if (info)
+      sim_camera_publish_info(k->cam[i], sim_render_model(s), lcm, k->info_channel[i], now_us);
   }
   return 0;
 }
@@ -319,7 +321,7 @@ static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, s
     snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
     return -1;
   }
-  w->v = sim_viewer_create(sim_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
+  w->v = sim_viewer_create(sim_render_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
                            1024, 768, err, err_sz);
   return w->v ? 0 : -1;
 }
@@ -332,7 +334,7 @@ static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
   if (now < w->next_frame_s) return 0;
   do {
     w->next_frame_s = now + 1.0 / 30.0;
-    if (sim_viewer_frame(w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
+    if (sim_viewer_frame(w->v, sim_render_model(s), sim_render_data(s), &in) != 0) return 1;
     if (in.quit || main_stop) return 1;
     if (in.reset_requested) {
       /* back to the start poses (qpos0, sim.c); late boxes that appeared come back on the next
@@ -536,7 +538,7 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 2;
   }
-  if (light_level >= 0 && cfx_set_light_level((mjModel *)sim_model(s), light_level) != 0) {
+  if (light_level >= 0 && cfx_set_light_level(sim_render_model(s), light_level) != 0) {
     fprintf(stderr, "autodrive-sim: --light-level %g: the map '%s' is dark (level 0): nothing "
             "to scale\n", light_level, cfg.map_path);
     sim_destroy(s);

@@ -156,6 +156,37 @@ static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
   fprintf(f, "  </body>\n");
 }
 
+int mg_write_physics_map(const char *map_path, const char *out_path, char *err, size_t err_sz) {
+  FILE *in = fopen(map_path, "r");
+  if (!in) {
+    snprintf(err, err_sz, "map file '%s': %s", map_path, strerror(errno));
+    return -1;
+  }
+  FILE *out = fopen(out_path, "w");
+  if (!out) {
+    snprintf(err, err_sz, "cannot write '%s': %s", out_path, strerror(errno));
+    fclose(in);
+    return -1;
+  }
+  char line[16384];
+  int dropped = 0;
+  while (fgets(line, sizeof line, in)) {
+    const int whole = strchr(line, '\n') != NULL || feof(in);
+    if (whole && strstr(line, "<geom ") && strstr(line, "/>") && strstr(line, "contype=\"0\"") &&
+        strstr(line, "conaffinity=\"0\"")) {
+      dropped++;
+      continue;
+    }
+    fputs(line, out);
+  }
+  fclose(in);
+  if (fclose(out) != 0) {
+    snprintf(err, err_sz, "cannot write '%s'", out_path);
+    return -1;
+  }
+  return dropped;
+}
+
 int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz) {
   FILE *f = fopen(out_path, "w");
@@ -167,9 +198,9 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
   mg_rel_from(out_path, o->map_path, rel, sizeof rel);
   /* MuJoCo 2.2 reads an included file's textures relative to THIS file's folder: point it at
    * the map's folder (maps write file="textures/<name>.png") */
-  snprintf(map_dir, sizeof map_dir, "%s", o->map_path);
+  snprintf(map_dir, sizeof map_dir, "%s", o->texture_dir ? o->texture_dir : o->map_path);
   char *slash = strrchr(map_dir, '/');
-  if (slash) slash[1] = '\0';
+  if (slash && !o->texture_dir) slash[1] = '\0';
   mg_rel_from(out_path, map_dir, rel_dir, sizeof rel_dir);
   const int ncon = 64 + 16 * o->cars;
   fprintf(f, "<mujoco model=\"autodrive\">\n");

@@ -69,8 +69,16 @@ int sim_step(sim_t *s, char *err, size_t err_sz);
 
 int64_t sim_time_us(const sim_t *s);
 int sim_cars(const sim_t *s);
+/* The physics model and data: the map without its visual-only geoms (they cost MuJoCo 2.2
+ * collision time every step although they never collide). */
 const mjModel *sim_model(const sim_t *s);
 mjData *sim_data(const sim_t *s);
+/* What cameras, the Eye and the viewer render: the whole map (road tiles, sign faces, light
+ * lamps lit by the sim, car lamps). sim_render_data brings its data to the physics state
+ * (positions, mocap, cameras) and returns it. Without visual-only geoms in the map these are
+ * the physics model and data. */
+mjModel *sim_render_model(const sim_t *s);
+mjData *sim_render_data(sim_t *s);
 void sim_get_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
 /* The Nano's symlink path (empty without ptys). */
 const char *sim_nano_link(const sim_t *s, int car);
