@@ -30,6 +30,7 @@ typedef struct mg_options {
   int late_boxes;                  /* 0..SCN_MAX_LATE_BOXES --late-box obstacles */
   const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
   const char *texture_dir;         /* NULL: the map's folder; else where its textures are */
+  int physics_only;                /* 1: without the cars' visual-only lamps and wheel discs */
 } mg_options_t;
 
 #define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */

@@ -443,7 +443,7 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
 }
 
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
-  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL};
+  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
@@ -467,6 +467,7 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
     mg_options_t po = o;
     po.map_path = phys_map;
     po.texture_dir = map_dir;
+    po.physics_only = 1;
     rc = mg_write_scene(phys_scene, &s->p, &po, err, err_sz);
   }
   if (geoms)
