@@ -187,19 +187,17 @@ class Api(unittest.TestCase):
                 self.assertEqual(floats(e.get("zaxis"))[:2], list(w.normal))
         self.assertEqual(len(self.maps["parking_school"].walls), 4)
 
-    def test_lanes_run_on_the_drawn_roads(self) -> None:
-        m, g = self.maps["driving_school"], self.xml["driving_school"]
-        roads = [e for k, e in g.items() if k.startswith("road_")]
-        names = [lane.name for lane in m.lanes()]
-        self.assertEqual(names, ["loop_ccw", "loop_cw", "x_east", "x_west", "y_north", "y_south"])
+    def test_tile_lanes_run_on_their_tiles(self) -> None:
+        m = self.maps["driving_school"]
+        tiles = {t["name"]: t for t in self.json["driving_school"]["tiles"]}
+        self.assertEqual(len(m.lanes()), 80)
         for lane in m.lanes():
             pts = m.centre_line(lane, 0.05)
-            self.assertGreater(len(pts), 10)
+            t = tiles[lane.road.name]  # a tile lane's road is its tile
+            half = t["size_m"] / 2
             for (x, y, h), (x2, y2, _) in zip(pts, pts[1:]):
-                # on the tarmac (arcs are drawn as chords: thin wedges between them outside 1 m)
-                self.assertTrue(
-                    any(box_contains(e, (x, y), 0.005) for e in roads), (lane.name, x, y)
-                )
+                self.assertLessEqual(abs(x - t["centre_m"][0]), half + 1e-9, lane.name)
+                self.assertLessEqual(abs(y - t["centre_m"][1]), half + 1e-9, lane.name)
                 self.assertLessEqual(math.dist((x, y), (x2, y2)), 0.05 + 1e-9)
                 # headings point to the next point
                 self.assertLess(
@@ -207,36 +205,45 @@ class Api(unittest.TestCase):
                 )
             j = next(l for l in self.json["driving_school"]["lanes"] if l["name"] == lane.name)
             self.assertEqual(len(j["centre_line"]), len(pts))
-            self.assertAlmostEqual(j["centre_line"][3]["x_m"], pts[3][0], places=8)
-        # right-hand traffic: x_east runs +x on the south side of the x road
-        east = m.centre_line("x_east")
-        self.assertAlmostEqual(east[0][1], -0.12)
+            self.assertAlmostEqual(j["centre_line"][-1]["x_m"], pts[-1][0], places=8)
+            self.assertEqual(j["half_width_m"], m.kit.tiles.lane_width_m / 2)
+        # right-hand traffic: the west arm's eastbound lane runs +x on the road's south side
+        east = m.centre_line("cw_w_e")
+        self.assertAlmostEqual(east[0][1], -m.kit.tiles.lane_width_m / 2)
         self.assertLess(east[0][0], east[-1][0])
-        self.assertAlmostEqual(m.centre_line("x_west")[0][2], math.pi)
-        # the loop lanes are closed
-        ccw = m.centre_line("loop_ccw")
-        self.assertLess(math.dist(ccw[0][:2], ccw[-1][:2]), 1e-9)
-        # the spawn stands in x_east, facing along it
+        self.assertAlmostEqual(abs(m.centre_line("cw_e_w")[0][2]), math.pi)
+        # the loop route is closed
+        ccw = m.route("loop_ccw").polyline_m
+        self.assertLess(math.dist(ccw[0], ccw[-1]), 1e-9)
+        # the spawn stands in the west dead end's eastbound lane, facing along it
         sp = m.spawn_pose()
-        d, heading = geometry.nearest_on_polyline((sp.x_m, sp.y_m), east)
+        d, heading = geometry.nearest_on_polyline((sp.x_m, sp.y_m), m.centre_line("w_end_end_e"))
         self.assertLess(d, 1e-9)
         self.assertAlmostEqual(heading, sp.yaw_rad)
 
+    def test_free_form_road_lanes(self) -> None:
+        m = maps.load(ROOT / "tests" / "maps" / "fixtures" / "good_tiny.yaml")
+        east = m.centre_line("x_east")
+        self.assertAlmostEqual(east[0][1], -0.12)
+        self.assertLess(east[0][0], east[-1][0])
+        self.assertAlmostEqual(m.lane("x_east").kerb_right_m, 0.25 - 0.12)
+        self.assertAlmostEqual(m.lane("x_west").kerb_right_m, 0.25 - 0.12)
+        self.assertAlmostEqual(m.centre_line("x_west")[0][2], -math.pi / 2)
+
     def test_stop_lines_cross_their_lanes(self) -> None:
-        m, g = self.maps["driving_school"], self.xml["driving_school"]
-        self.assertEqual(len(m.stop_lines), 4)
-        for s in m.stop_lines:
-            e = g[s.name]
-            self.assertEqual(floats(e.get("pos"))[:2], list(s.centre_m))
-            self.assertAlmostEqual(floats(e.get("size"))[0], s.length_m / 2)
+        m = self.maps["driving_school"]
+        stops = [s for s in m.all_stop_lines() if s.name.startswith("x_stop_")]
+        self.assertEqual(len(stops), 4)
+        js = {s["name"]: s for s in self.json["driving_school"]["stop_lines"]}
+        for s in stops:
             d, heading = geometry.nearest_on_polyline(s.centre_m, m.centre_line(s.lane, 0.01))
             self.assertLess(d, 1e-9)
-            self.assertTrue(same_axis(floats(e.get("euler"))[2], heading + math.pi / 2))
+            self.assertTrue(same_axis(js[s.name]["yaw_rad"], heading + math.pi / 2))
+            self.assertEqual(js[s.name]["lane"], s.lane)
             # before the intersection (the origin): the lane heads towards it
             to_origin = math.atan2(-s.centre_m[1], -s.centre_m[0])
             self.assertLess(abs(math.remainder(to_origin - heading, 2 * math.pi)), math.pi / 2)
         self.assertEqual(m.traffic_lights, [])
-        self.assertEqual(m.signs, [])
         self.assertEqual(self.json["driving_school"]["traffic_lights"], [])
 
 

@@ -1,6 +1,8 @@
-"""maps.generated_fresh: the committed maps/<map>.xml and .json are what tools/gen-maps writes
-from the descriptions, and --check notices a stale or missing file (in a copy of the folder)."""
+"""maps.generated_fresh: the committed maps/<map>.xml and .json and the textures in
+maps/textures/ are what tools/gen-maps writes from the descriptions (byte for byte), and --check
+notices a stale or missing file (in a copy of the folder)."""
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -25,11 +27,47 @@ class GeneratedFresh(unittest.TestCase):
         from autodrive_tools import maps
 
         names = maps.names()
-        self.assertIn("parking_school", names)
-        self.assertIn("driving_school", names)
+        for want in ("parking_school", "driving_school", "intersection_school", "tiny_town"):
+            self.assertIn(want, names)
         for n in names:  # every description has both generated files
             self.assertTrue((MAPS / f"{n}.xml").is_file(), n)
             self.assertTrue((MAPS / f"{n}.json").is_file(), n)
+        # every texture a map names is committed, and nothing else is in textures/
+        used = set()
+        for n in names:
+            used |= set(re.findall(r'file="textures/([^"]+)"', (MAPS / f"{n}.xml").read_text()))
+        have = {p.name for p in (MAPS / "textures").iterdir()}
+        self.assertEqual(used, have)
+        total = sum((MAPS / "textures" / f).stat().st_size for f in have)
+        self.assertLess(total, 400_000, "textures should stay small")
+
+    def test_textures_are_regenerated_byte_for_byte(self) -> None:
+        with tempfile.TemporaryDirectory() as tmp:
+            d = pathlib.Path(tmp) / "maps"
+            shutil.copytree(MAPS, d)
+            tex = d / "textures" / "tile_cross_2.png"
+            tex.write_bytes(tex.read_bytes()[:-20])
+            (d / "textures" / "sign_stop.png").unlink()
+            r = gen("--check", "--dir", str(d))
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertIn("tile_cross_2.png is stale", r.stderr)
+            self.assertIn("sign_stop.png is stale", r.stderr)
+            self.assertNotIn("tile_straight_2.png", r.stderr)
+            r = gen("--dir", str(d))
+            self.assertEqual(r.returncode, 0, r.stderr)
+            for name in ("tile_cross_2.png", "sign_stop.png"):
+                self.assertEqual(
+                    (d / "textures" / name).read_bytes(), (MAPS / "textures" / name).read_bytes()
+                )
+            # a kit change repaints the textures it touches
+            kit = d / "kit.yaml"
+            kit.write_text(
+                kit.read_text().replace("asphalt_rgb: [62, 62, 66]", "asphalt_rgb: [60, 60, 66]")
+            )
+            r = gen("--check", "--dir", str(d))
+            self.assertEqual(r.returncode, 1)
+            self.assertIn("tile_cross_2.png is stale", r.stderr)
+            self.assertNotIn("sign_stop.png", r.stderr)
 
     def test_check_names_stale_and_missing_files_then_regenerates(self) -> None:
         with tempfile.TemporaryDirectory() as tmp:

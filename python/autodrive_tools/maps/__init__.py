@@ -1,13 +1,16 @@
 """The map descriptions (sim/mujoco_hil/maps/<map>.yaml and kit.yaml): the one place a map is
-written. load() reads and checks one; mjcf.generate and sidecar.generate write the simulator's
-MJCF scene and the JSON sidecar for C/C++ readers (tools/gen-maps runs both).
+written. load() reads and checks one; tiles expands the road kit's tiles into lanes, stop lines
+and slots; mjcf.generate, sidecar.generate and textures.generate write the simulator's MJCF
+scene, the JSON sidecar for C/C++ readers and the PNG textures (tools/gen-maps runs them);
+tools/map shows (show.py) and checks (tool.py) a description.
 
 Usage::
 
     from autodrive_tools import maps, vehicle
-    m = maps.load("parking_school")
-    m.spawn_pose(); m.slot(2); m.slot_goal(2, vehicle.load()); m.obstacles()
-    m.lanes(); m.centre_line("x_east"); m.stop_lines; m.traffic_lights; m.signs
+    m = maps.load("tiny_town")
+    m.spawn_pose(); m.slot("lot_s2"); m.slot_goal(2, vehicle.load()); m.obstacles()
+    m.lanes(); m.centre_line("x_n_e"); m.all_stop_lines(); m.lights(); m.light_conflicts()
+    m.placed_signs(); m.named_routes(); m.route("loop_ccw").polyline_m; m.named_spawns()
 """
 
 from .description import MapDescription

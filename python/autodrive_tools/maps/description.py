@@ -78,6 +78,7 @@ class NamedSpawn:
     pose: Pose
     route: str | None
 
+
 if TYPE_CHECKING:
     from ..vehicle import Vehicle
 
@@ -133,14 +134,18 @@ class MapDescription(MapFile):
         )
 
     def obstacles(self) -> list[Rect]:
-        """Collidable props (boxes, cones as their bounding squares) as footprint rectangles;
-        walls are not included (see walls)."""
+        """Collidable props (boxes, cones, traffic light poles and sign posts as their bounding
+        squares, parked cars) as footprint rectangles; walls are not included (see walls)."""
         out = [
             Rect(b.centre_m[0], b.centre_m[1], b.size_m[0] / 2, b.size_m[1] / 2, b.yaw_rad)
             for b in self.boxes
         ]
         r = self.kit.cone.radius_m
         out += [Rect(c.position_m[0], c.position_m[1], r, r, 0.0) for c in self.cones]
+        r = self.kit.traffic_light.pole_radius_m
+        out += [Rect(t.position_m[0], t.position_m[1], r, r, 0.0) for t in self.lights()]
+        r = self.kit.sign.post_radius_m
+        out += [Rect(s.position_m[0], s.position_m[1], r, r, 0.0) for s in self.placed_signs()]
         length, width, _ = self.kit.parked_car_size_m
         for p in self.parked:
             s = self.slot(p.slot)
@@ -301,4 +306,3 @@ class MapDescription(MapFile):
         """Direction of the painted stop line: across its lane."""
         _, heading = geometry.nearest_on_polyline(stop.centre_m, self.centre_line(stop.lane))
         return heading + math.pi / 2
-

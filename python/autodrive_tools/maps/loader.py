@@ -194,8 +194,8 @@ class _Checker:
         starts = [(c.spec.name, p) for c in contents for p in c.ports if p[1] == "start"]
         ends = [(c.spec.name, p) for c in contents for p in c.ports if p[1] == "end"]
         for i, c in enumerate(contents):
-            for lane in c.lanes:
-                self.unique(lane.name, f"tiles[{i}] lane")
+            for tl in c.lanes:
+                self.unique(tl.name, f"tiles[{i}] lane")
             for s in c.stop_lines:
                 self.unique(s.name, f"tiles[{i}] stop line")
             for lane, end, p, yaw in c.ports:
@@ -228,7 +228,9 @@ class _Checker:
             for j, name in enumerate(r.lanes):
                 if name not in lanes:
                     raise self.err(f"{key}.lanes[{j}]", f"no lane '{name}'")
-            pairs = list(zip(r.lanes, r.lanes[1:])) + ([(r.lanes[-1], r.lanes[0])] if r.loop else [])
+            pairs = list(zip(r.lanes, r.lanes[1:])) + (
+                [(r.lanes[-1], r.lanes[0])] if r.loop else []
+            )
             for j, (a, b) in enumerate(pairs):
                 pa, pb = self.m.centre_line(a)[-1], self.m.centre_line(b)[0]
                 gap = math.dist(pa[:2], pb[:2])
@@ -270,8 +272,11 @@ class _Checker:
             p = spec.program
             self.positive((p.cycle_s, p.green_s, p.yellow_s), f"{key}.program")
             if p.green_s + p.yellow_s >= p.cycle_s:
-                raise self.err(f"{key}.program", f"green_s + yellow_s must be < cycle_s (red for "
-                               f"the rest), got {p.green_s:g} + {p.yellow_s:g} >= {p.cycle_s:g}")
+                raise self.err(
+                    f"{key}.program",
+                    f"green_s + yellow_s must be < cycle_s (red for "
+                    f"the rest), got {p.green_s:g} + {p.yellow_s:g} >= {p.cycle_s:g}",
+                )
         placed = self.m.lights()
         for i, light in enumerate(placed):
             self.on_floor([light.position_m], f"traffic_lights[{i}].position_m")
@@ -310,8 +315,9 @@ class _Checker:
             if s.lane is not None and s.lane not in lanes:
                 raise self.err(f"{key}.lane", f"no lane '{s.lane}'")
             if (s.kind == "speed_limit") != (s.speed_limit_m_s is not None):
-                raise self.err(f"{key}.speed_limit_m_s",
-                               "a speed_limit sign needs one, other kinds have none")
+                raise self.err(
+                    f"{key}.speed_limit_m_s", "a speed_limit sign needs one, other kinds have none"
+                )
             if s.speed_limit_m_s is not None:
                 self.positive(s.speed_limit_m_s, f"{key}.speed_limit_m_s")
         for i, placed in enumerate(self.m.placed_signs()):

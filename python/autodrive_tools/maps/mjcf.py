@@ -199,17 +199,23 @@ class _Writer:
                 f'{self.friction(self.kit.obstacle.friction)} rgba="{nums(sk.post_rgba)}"/>'
             )
             c, s = math.cos(sign.yaw_rad), math.sin(sign.yaw_rad)
-            off = sk.post_radius_m + sk.face_thickness_m / 2
+            t = sk.face_thickness_m
             f = sk.face_size_m / 2
-            # the face box's local z is its normal (the way it points), local x is up: MuJoCo
-            # paints a box's 2d texture on its +-z faces
-            self.add(
-                f'<geom name="{sign.name}_face" type="box" '
-                f'pos="{nums((x + c * off, y + s * off, ph + f * 0.6))}" '
-                f'size="{nums((f, f, sk.face_thickness_m / 2))}" '
-                f'zaxis="{nums((round(c, 12), round(s, 12)))} 0" {VIS} '
-                f'material="{textures.sign_texture_name(sign.kind, sign.speed_limit_m_s)}_mat"/>'
-            )
+            z = ph + f * 0.6
+            axes = f'xyaxes="{nums((round(-s, 12), round(c, 12)))} 0 0 0 1"'
+            # the face box's local z is its normal (the way it points), local y is up: MuJoCo
+            # paints a box's 2d texture on its +-z faces, image up = local +y; a plain plate
+            # behind it hides the mirrored copy on its back
+            for part, off, look in (
+                ("back", sk.post_radius_m + t / 2, f'rgba="{nums(sk.post_rgba)}"'),
+                ("face", sk.post_radius_m + 1.5 * t,
+                 f'material="{textures.sign_texture_name(sign.kind, sign.speed_limit_m_s)}_mat"'),
+            ):  # fmt: skip
+                self.add(
+                    f'<geom name="{sign.name}_{part}" type="box" '
+                    f'pos="{nums((x + c * off, y + s * off, z))}" '
+                    f'size="{nums((f, f, t / 2))}" {axes} {VIS} {look}/>'
+                )
 
     def custom(self) -> None:
         """What C readers need, as MuJoCo custom numerics and texts (mj_name2id(mjOBJ_NUMERIC))."""

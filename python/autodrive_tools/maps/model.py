@@ -100,7 +100,7 @@ class TileKit:
     verge_rgb: Vec3
     line_rgb: Vec3
     centre_rgb: Vec3
-    line_width_m: float
+    paint_width_m: float
     stop_line_width_m: float
     stop_line_setback_m: float
     dash_length_m: float

@@ -14,7 +14,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from . import tiles
-from .model import Kit, SignKindKit, TileKit, TileSpec, Vec2
+from .model import Kit, Lane, SignKindKit, TileKit, TileSpec, Vec2
 
 DIR_NAME = "textures"
 Mask = np.ndarray  # a boolean image
@@ -97,7 +97,7 @@ class _Canvas:
         return png_bytes(Image.fromarray(self.rgb, "RGB"))
 
 
-def _lane_prims(lane: tiles.Lane) -> list[tuple[str, tuple[float, ...]]]:
+def _lane_prims(lane: Lane) -> list[tuple[str, tuple[float, ...]]]:
     out: list[tuple[str, tuple[float, ...]]] = []
     for p in lane.road.pieces:
         if p.line is not None:
@@ -154,7 +154,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
         cv.rgb[:] = tk.asphalt_rgb
         return cv.png()
     w, half_w = tk.lane_width_m, content.road_width_m / 2
-    lw = tk.line_width_m / 2
+    lw = tk.paint_width_m / 2
     edge_off = tk.shoulder_m / 2  # edge lines this far inside the road's edge
     offsets = tiles.lane_offsets_m(tk, lanes)
     k = len(offsets)
@@ -162,7 +162,9 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
     h = content.size_m / 2
     box = tiles.cell_m(tk, lanes) / 2
     arms = [tiles.SIDES.index(a) for a in tiles.ARMS[tile_type]]
-    units = {i: (round(math.cos(i * math.pi / 2)), round(math.sin(i * math.pi / 2))) for i in range(4)}
+    units = {
+        i: (round(math.cos(i * math.pi / 2)), round(math.sin(i * math.pi / 2))) for i in range(4)
+    }
     road = np.zeros(cv.x.shape, bool)
     white = np.zeros(cv.x.shape, bool)
     yellow = np.zeros(cv.x.shape, bool)
@@ -193,7 +195,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
             yellow[(cv.seg(pa, pb) <= lw) & (np.mod(cv.along(pa, pb), tk.dash_length_m + tk.dash_gap_m) < tk.dash_length_m)] = True  # fmt: skip
         elif lanes > 2:
             for s in (-1, 1):
-                yellow[cv.seg(*off(s * 1.5 * tk.line_width_m)) <= lw] = True
+                yellow[cv.seg(*off(s * 1.5 * tk.paint_width_m)) <= lw] = True
 
     if tile_type in ("tee", "cross"):
         for i in arms:
@@ -243,7 +245,7 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
                 if i == 0 and lanes == 2 and first_arm:  # one direction draws the shared line
                     yellow |= _dashes(cv, prims, w / 2) & (_dist(cv, prims, w / 2) <= lw)
                 if i == 0 and lanes > 2:
-                    yellow |= _dist(cv, prims, w / 2 - 1.5 * tk.line_width_m) <= lw
+                    yellow |= _dist(cv, prims, w / 2 - 1.5 * tk.paint_width_m) <= lw
     # stop lines (a dead end's and a lot aisle's end bars too)
     for s in content.stop_lines:
         lane = by_name[s.lane]
@@ -266,7 +268,11 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
         def pt(fwd: float, left: float) -> Vec2:
             return (cx + fwd * c - left * s_, cy + fwd * s_ + left * c)
 
-        for a, b in ((pt(-hd, hw), pt(hd, hw)), (pt(-hd, -hw), pt(hd, -hw)), (pt(hd, -hw), pt(hd, hw))):
+        for a, b in (
+            (pt(-hd, hw), pt(hd, hw)),
+            (pt(-hd, -hw), pt(hd, -hw)),
+            (pt(hd, -hw), pt(hd, hw)),
+        ):
             white |= cv.seg(a, b) <= lw
         road |= (np.abs((cv.x - cx) * c + (cv.y - cy) * s_) <= hd) & (
             np.abs(-(cv.x - cx) * s_ + (cv.y - cy) * c) <= hw
@@ -345,7 +351,9 @@ def _sign_png(kit: Kit, kind: str, spec: SignKindKit, text: str) -> bytes:
     return png_bytes(img)
 
 
-def generate(kit: Kit, tile_keys: set[tuple[str, int]], sign_keys: set[tuple[str, str]]) -> dict[str, bytes]:
+def generate(
+    kit: Kit, tile_keys: set[tuple[str, int]], sign_keys: set[tuple[str, str]]
+) -> dict[str, bytes]:
     """PNG bytes by texture name: the tiles (type, lanes) and the signs (kind, texture name)."""
     out = {tiles.texture_name(t, n): _tile_png(kit, t, n) for t, n in sorted(tile_keys)}
     for kind, name in sorted(sign_keys):

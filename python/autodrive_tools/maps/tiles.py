@@ -161,21 +161,27 @@ class _Builder:
 
     def through_lanes(self, arms: tuple[str, ...]) -> None:
         """Every movement between arms that the lanes allow: straight on every lane, right turns
-        from the outermost lane, left turns from the innermost."""
+        from the outermost lane, left turns from the innermost; at a 3-way's stem the middle lanes
+        turn too (left out of the stem, right into it), so every lane has a way on."""
         k = len(self.offsets)
         for a in arms:
             ua = _unit(SIDES.index(a))
             va = (-ua[1], ua[0])
+            # with no road straight on (a 3-way's stem), the middle lanes turn left too
+            straight_on = SIDES[(SIDES.index(a) + 2) % 4] in arms
             for b in arms:
                 if a == b:
                     continue
                 ub = _unit(SIDES.index(b))
                 kind = "straight" if ub == (-ua[0], -ua[1]) else ("right" if ub == va else "left")
                 for i, d in enumerate(self.offsets):
+                    fed_straight = SIDES[(SIDES.index(b) + 2) % 4] in arms
                     if kind == "right" and i != k - 1 and self.spec.type != "curve":
-                        continue
-                    if kind == "left" and i != 0 and self.spec.type != "curve":
-                        continue
+                        if fed_straight or i == 0:  # into a stem: the middle lanes turn right
+                            continue
+                    if kind == "left" and self.spec.type != "curve":
+                        if i != 0 and (straight_on or i == k - 1):
+                            continue
                     name = self.lane_name(self.world_side(a), self.world_side(b), i)
                     self.add_lane(name, self.movement(a, b, i, d), d)
 
@@ -280,7 +286,10 @@ class _Builder:
         cx, cy = self.spec.centre_m
         for lane in self.out.lanes:
             first, last = lane.road.pieces[0], lane.road.pieces[-1]
-            for end, (p, yaw) in (("start", piece_point(first, 0.0)), ("end", piece_point(last, 1.0))):
+            for end, (p, yaw) in (
+                ("start", piece_point(first, 0.0)),
+                ("end", piece_point(last, 1.0)),
+            ):
                 if max(abs(p[0] - cx), abs(p[1] - cy)) > self.half - 1e-9:
                     self.out.ports.append((lane.name, end, p, yaw))
 

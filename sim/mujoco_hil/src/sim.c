@@ -430,7 +430,8 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
     if (sim_tags_write_png(png, mg_tag_id(i), 8, err, err_sz) != 0) return -1;
     snprintf(prefix, sizeof prefix, "nigel%d/", i);
     (*geoms)[i - 1] = malloc(1024);
-    /* absolute: the scene's texturedir points at the map's folder (the maps' textures) */
+    /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder (its
+     * textures), and the run dir may be given relative */
     char abs_png[4096];
     if (!realpath(png, abs_png)) return sim_fail(err, err_sz, "roof tag '%s': %s", png, strerror(errno));
     if (!(*geoms)[i - 1] ||
