@@ -44,10 +44,25 @@ def command(light_id: int, state: int, duration_s: float = 0.0) -> None:
 
 with tempfile.TemporaryDirectory(prefix="world-lights-") as run_dir:
     sim = subprocess.Popen(
-        [str(build / "bin" / "autodrive-sim"), "--map", "intersection_school", "--rtf", "1",
-         "--no-pty", "--no-lidar", "--quiet", "--duration", "60", "--run-dir", run_dir,
-         "--lcm-url", url],
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        [
+            str(build / "bin" / "autodrive-sim"),
+            "--map",
+            "intersection_school",
+            "--rtf",
+            "1",
+            "--no-pty",
+            "--no-lidar",
+            "--quiet",
+            "--duration",
+            "60",
+            "--run-dir",
+            run_dir,
+            "--lcm-url",
+            url,
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         pump(3.0)

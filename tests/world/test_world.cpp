@@ -247,8 +247,8 @@ struct LightCamera {
     if (!k.s) return false;
     rd = sim_render_create(sim_render_model(k.s), 640, 480, SIM_RENDER_AUTO, err, sizeof err);
     if (rd)
-      cam = sim_camera_create(rd, sim_render_model(k.s), "nigel1/cam_front", "camera_front", 640, 480, 85,
-                              err, sizeof err);
+      cam = sim_camera_create(rd, sim_render_model(k.s), "nigel1/cam_front", "camera_front", 640,
+                              480, 85, err, sizeof err);
     return cam != nullptr;
   }
   // Mean colour of lamp colour ("red", "yellow", "green") of light 1 in the frame.
@@ -317,8 +317,8 @@ TEST(World, AStopSignIsVisibleFrom1mInTheFrontCamera) {
   const int g = mj_name2id(m, mjOBJ_GEOM, face.c_str());
   ASSERT_GE(g, 0) << face;
   double u = 0, v = 0;
-  ASSERT_TRUE(project(m, d, mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front"),
-                      d->geom_xpos + 3 * g, 640, 480, &u, &v));
+  ASSERT_TRUE(project(m, d, mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front"), d->geom_xpos + 3 * g,
+                      640, 480, &u, &v));
   // the face (8 cm at 1 m: ~40 px): the stop texture's red, with its white letters
   int red = 0, n = 0;
   const uint8_t *rgb = sim_camera_rgb(cam);

@@ -86,16 +86,25 @@ class WorldBench:
         for m in ROUTE_MAPS:
             for r in sidecar(m)["routes"]:
                 name = r["name"]
-                length = sum(
-                    math.dist(a, b) for a, b in zip(r["polyline_m"], r["polyline_m"][1:])
-                )
+                length = sum(math.dist(a, b) for a, b in zip(r["polyline_m"], r["polyline_m"][1:]))
                 cap_s = length / (ROUTE_SPEED * TOP_SPEED_M_S) * 2 + 10
                 res = self.run(
-                    ["--map", m, "--lockstep", "--no-pty", "--no-lidar", "--duration",
-                     f"{cap_s:.1f}", "--script", f"route:{name},speed={ROUTE_SPEED}"]
+                    [
+                        "--map",
+                        m,
+                        "--lockstep",
+                        "--no-pty",
+                        "--no-lidar",
+                        "--duration",
+                        f"{cap_s:.1f}",
+                        "--script",
+                        f"route:{name},speed={ROUTE_SPEED}",
+                    ]
                 )
                 n = int(res["route_samples"])
-                rms, mx = float(res["route_cross_track_rms_m"]), float(res["route_cross_track_max_m"])
+                rms, mx = float(res["route_cross_track_rms_m"]), float(
+                    res["route_cross_track_max_m"]
+                )
                 total += 1
                 if res["route_done"]:
                     done += 1
@@ -163,8 +172,17 @@ class WorldBench:
         lat_ms: list[float] = []
         with tempfile.TemporaryDirectory(prefix="bench-world-") as run_dir:
             sim = subprocess.Popen(
-                [str(self.sim), "--map", "intersection_school", "--no-pty", "--quiet",
-                 "--run-dir", run_dir, "--lcm-url", URL],
+                [
+                    str(self.sim),
+                    "--map",
+                    "intersection_school",
+                    "--no-pty",
+                    "--quiet",
+                    "--run-dir",
+                    run_dir,
+                    "--lcm-url",
+                    URL,
+                ],
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.PIPE,
             )
@@ -221,7 +239,9 @@ def main(argv: list[str] | None = None) -> int:
         figures.update(bench.rtf(int(os.environ.get("WORLD_BENCH_REPEATS", "5"))))
     figures.update(bench.light_latency())
     for name, r in per_route.items():
-        print(f"{name}: RMS {r['rms_m'] * 1e3:.2f} mm, max {r['max_m'] * 1e3:.2f} mm"
-              + ("" if r["done"] else " (NOT done)"))
+        print(
+            f"{name}: RMS {r['rms_m'] * 1e3:.2f} mm, max {r['max_m'] * 1e3:.2f} mm"
+            + ("" if r["done"] else " (NOT done)")
+        )
     print_figures(figures, key_value_lines=True)
     return 0

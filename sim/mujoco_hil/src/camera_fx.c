@@ -74,7 +74,8 @@ static void cfx_blur(cfx_t *f, uint8_t *rgb, int w, int h) {
   const int r = (int)ceil(3.0 * f->blur_px);
   float k[2 * CFX_KERNEL_MAX_R_PX + 1];
   double sum = 0.0;
-  for (int t = -r; t <= r; t++) sum += k[t + r] = (float)exp(-0.5 * t * t / (f->blur_px * f->blur_px));
+  for (int t = -r; t <= r; t++)
+    sum += k[t + r] = (float)exp(-0.5 * t * t / (f->blur_px * f->blur_px));
   for (int t = 0; t <= 2 * r; t++) k[t] = (float)(k[t] / sum);
   float *a = f->tmp, *b = f->tmp + n;
   for (size_t i = 0; i < n; i++) a[i] = rgb[i];

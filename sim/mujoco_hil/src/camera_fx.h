@@ -28,7 +28,7 @@ typedef struct cfx {
   double noise_sigma; /* [8-bit levels], 0: none */
   double blur_px;     /* Gaussian sigma [px], 0: none */
   rng_t rng;
-  float *tmp;  /* blur scratch, w*h*3 */
+  float *tmp; /* blur scratch, w*h*3 */
   size_t tmp_n;
 } cfx_t;
 

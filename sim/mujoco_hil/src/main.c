@@ -286,7 +286,7 @@ static int main_cams_publish(main_cams_t *k, sim_t *s, lcm_t *lcm, int64_t now_u
                              size_t err_sz) {
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
-  mjData *dv = sim_render_data(s); /* the whole map, in step with the physics */
+  mjData *dv = sim_render_data(s);              /* the whole map, in step with the physics */
   for (int i = 0; i < k->n; i++) {
     if (sim_camera_capture(k->cam[i], sim_render_model(s), dv, now_us) != 0) {
       snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
@@ -321,8 +321,8 @@ static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, s
     snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
     return -1;
   }
-  w->v = sim_viewer_create(sim_render_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
-                           1024, 768, err, err_sz);
+  w->v = sim_viewer_create(sim_render_model(s), sim_cars(s), "nigel%d/base_link",
+                           "nigel%d/cam_front", 1024, 768, err, err_sz);
   return w->v ? 0 : -1;
 }
 
@@ -539,8 +539,10 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (light_level >= 0 && cfx_set_light_level(sim_render_model(s), light_level) != 0) {
-    fprintf(stderr, "autodrive-sim: --light-level %g: the map '%s' is dark (level 0): nothing "
-            "to scale\n", light_level, cfg.map_path);
+    fprintf(stderr,
+            "autodrive-sim: --light-level %g: the map '%s' is dark (level 0): nothing "
+            "to scale\n",
+            light_level, cfg.map_path);
     sim_destroy(s);
     if (tlog) fclose(tlog);
     lcm_destroy(lcm);
@@ -607,10 +609,11 @@ int main(int argc, char **argv) {
          url);
   const route_driver_t *route = sim_route(s);
   if (route)
-    printf("route %s: %s, %d points, %.2f m, lane half width %.3f m, throttle %.2f, lookahead "
-           "%.2f m\n",
-           route->name, route->path.loop ? "loop" : "open", route->path.n, route->path.length_m,
-           route->half_width_m, route->speed, route->lookahead_m);
+    printf(
+        "route %s: %s, %d points, %.2f m, lane half width %.3f m, throttle %.2f, lookahead "
+        "%.2f m\n",
+        route->name, route->path.loop ? "loop" : "open", route->path.n, route->path.length_m,
+        route->half_width_m, route->speed, route->lookahead_m);
   if (sim_traffic_lights(s)->n)
     printf("traffic lights: %d (%d conflicting pairs) on " AUTODRIVE_CH_TRAFFIC_LIGHT_STATE "\n",
            sim_traffic_lights(s)->n, sim_traffic_lights(s)->nconflicts);
@@ -730,10 +733,11 @@ int main(int argc, char **argv) {
     if (route) {
       double rms, max;
       const long n = route_driver_stats(route, &rms, &max);
-      printf(", \"route\": \"%s\", \"route_done\": %s, \"route_length_m\": %.3f, "
-             "\"route_samples\": %ld, \"route_cross_track_rms_m\": %.5f, "
-             "\"route_cross_track_max_m\": %.5f",
-             route->name, route->st.done ? "true" : "false", route->path.length_m, n, rms, max);
+      printf(
+          ", \"route\": \"%s\", \"route_done\": %s, \"route_length_m\": %.3f, "
+          "\"route_samples\": %ld, \"route_cross_track_rms_m\": %.5f, "
+          "\"route_cross_track_max_m\": %.5f",
+          route->name, route->st.done ? "true" : "false", route->path.length_m, n, rms, max);
     }
     long refused = 0;
     const long commands = tl_lcm_commands(lights, &refused);

@@ -15,19 +15,19 @@ extern "C" {
 #endif
 
 typedef struct pp_path {
-  int n;          /* points */
+  int n;              /* points */
   const double *xy_m; /* x0 y0 x1 y1 ... (borrowed) */
-  double *s_m;    /* arc length at each point (owned) */
-  int loop;       /* 1: the last point joins the first */
-  double length_m; /* total, the closing segment included for a loop */
+  double *s_m;        /* arc length at each point (owned) */
+  int loop;           /* 1: the last point joins the first */
+  double length_m;    /* total, the closing segment included for a loop */
 } pp_path_t;
 
 typedef struct pp_state {
-  int seg;          /* segment of the last projection (search starts here) */
-  double s_m;       /* arc length of the projection; grows past length_m on a loop's laps */
-  double lap_m;     /* loop: arc length at the start of the lap of segment seg */
+  int seg;              /* segment of the last projection (search starts here) */
+  double s_m;           /* arc length of the projection; grows past length_m on a loop's laps */
+  double lap_m;         /* loop: arc length at the start of the lap of segment seg */
   double cross_track_m; /* signed distance to the path, + = car left of it */
-  int done;         /* a path's end (or one lap of a loop) reached */
+  int done;             /* a path's end (or one lap of a loop) reached */
 } pp_state_t;
 
 /* Builds the path over n >= 2 points (xy borrowed, must outlive it). Returns 0, or -1 with a

@@ -23,7 +23,7 @@ typedef struct route_driver {
   double *xy_m;        /* owned copy of the polyline */
   pp_path_t path;
   pp_state_t st;
-  double speed;        /* throttle, fraction of top speed */
+  double speed; /* throttle, fraction of top speed */
   double lookahead_m;
   /* cross-track statistics over every update while driving [m] */
   double sum_sq_m2, max_abs_m;

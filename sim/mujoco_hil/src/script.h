@@ -20,7 +20,7 @@
 extern "C" {
 #endif
 
-#define SCRIPT_PERIOD_US 20000u /* 50 Hz, the runtime's command rate */
+#define SCRIPT_PERIOD_US 20000u               /* 50 Hz, the runtime's command rate */
 #define SCRIPT_ROUTE_SPEED_DEFAULT 0.8        /* route: throttle, fraction of top speed */
 #define SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M 0.20 /* route: pure pursuit lookahead [m] */
 
@@ -28,7 +28,7 @@ typedef struct script {
   double throttle, steering; /* normalised [-1, 1]; a route driver sets them before each poll */
   int route;                 /* 1: "route:" spec */
   char route_name[64];
-  double lookahead_m; /* route: pure pursuit lookahead [m] */
+  double lookahead_m;        /* route: pure pursuit lookahead [m] */
   int64_t start_us, stop_us; /* stop_us < 0: never */
   int64_t next_us;
   uint16_t cmd_seq;

@@ -433,7 +433,8 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
     /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder (its
      * textures), and the run dir may be given relative */
     char abs_png[4096];
-    if (!realpath(png, abs_png)) return sim_fail(err, err_sz, "roof tag '%s': %s", png, strerror(errno));
+    if (!realpath(png, abs_png))
+      return sim_fail(err, err_sz, "roof tag '%s': %s", png, strerror(errno));
     if (!(*geoms)[i - 1] ||
         sim_tags_mjcf(prefix, abs_png, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
       return sim_fail(err, err_sz, "%s%s", "roof tag MJCF did not fit its buffer", "");
@@ -719,7 +720,8 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due, char *err, size_t err
   if (c->has_script) {
     if (s->route && s->time_us >= c->script.next_us) { /* pure pursuit before each frame */
       const mjtNum *q = s->d->qpos + c->root_qpos;
-      const double yaw = atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] * q[5] + q[6] * q[6]));
+      const double yaw =
+          atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] * q[5] + q[6] * q[6]));
       route_driver_update(s->route, q[0], q[1], yaw, &c->script.throttle, &c->script.steering);
     }
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);

@@ -36,7 +36,8 @@ static void tl_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
   if (tl_command(k->t, msg->light_id, msg->state, msg->duration_s, k->now_us, why, sizeof why) !=
       0) {
     k->refused++;
-    fprintf(stderr, "[autodrive-sim] " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND " refused at t = %.3f s: %s\n",
+    fprintf(stderr,
+            "[autodrive-sim] " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND " refused at t = %.3f s: %s\n",
             k->now_us * 1e-6, why);
     return;
   }

@@ -7,16 +7,16 @@
 
 static const char *tl_colour[3] = {"red", "yellow", "green"};
 /* Lit lamp looks [rgba], emission 1: bright and saturated in any light level. */
-static const float tl_lit_rgba[3][4] = {{1.0f, 0.05f, 0.02f, 1}, {1.0f, 0.75f, 0.0f, 1},
-                                        {0.1f, 1.0f, 0.25f, 1}};
+static const float tl_lit_rgba[3][4] = {
+    {1.0f, 0.05f, 0.02f, 1}, {1.0f, 0.75f, 0.0f, 1}, {0.1f, 1.0f, 0.25f, 1}};
 
 const char *tl_state_name(int state) {
   switch (state) {
-  case TL_OFF: return "OFF";
-  case TL_RED: return "RED";
-  case TL_YELLOW: return "YELLOW";
-  case TL_GREEN: return "GREEN";
-  default: return "?";
+    case TL_OFF: return "OFF";
+    case TL_RED: return "RED";
+    case TL_YELLOW: return "YELLOW";
+    case TL_GREEN: return "GREEN";
+    default: return "?";
   }
 }
 
@@ -148,7 +148,8 @@ int tl_update(traffic_lights_t *t, int64_t now_us) {
   for (int i = 0; i < t->n; i++) {
     if (t->light[i].held || !tl_non_red(want[i])) continue;
     for (int j = 0; j < t->n; j++)
-      if (t->light[j].held && tl_non_red(want[j]) && tl_conflict(t, t->light[i].id, t->light[j].id)) {
+      if (t->light[j].held && tl_non_red(want[j]) &&
+          tl_conflict(t, t->light[i].id, t->light[j].id)) {
         want[i] = TL_RED;
         left[i] = -1.0;
         break;
@@ -165,16 +166,18 @@ int tl_update(traffic_lights_t *t, int64_t now_us) {
   return changed;
 }
 
-int tl_command(traffic_lights_t *t, int id, int state, double duration_s, int64_t now_us,
-               char *why, size_t why_sz) {
+int tl_command(traffic_lights_t *t, int id, int state, double duration_s, int64_t now_us, char *why,
+               size_t why_sz) {
   const int i = tl_find(t, id);
   if (i < 0) {
     snprintf(why, why_sz, "no traffic light %d on this map (%d lights)", id, t->n);
     return -1;
   }
   if (state < TL_OFF || state > TL_GREEN || !isfinite(duration_s)) {
-    snprintf(why, why_sz, "light %d: state %d is not OFF/RED/YELLOW/GREEN (0..3) or duration %g s "
-             "is not finite", id, state, duration_s);
+    snprintf(why, why_sz,
+             "light %d: state %d is not OFF/RED/YELLOW/GREEN (0..3) or duration %g s "
+             "is not finite",
+             id, state, duration_s);
     return -1;
   }
   if (tl_non_red(state)) {

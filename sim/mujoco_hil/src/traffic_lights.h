@@ -29,17 +29,17 @@ enum { TL_OFF = 0, TL_RED = 1, TL_YELLOW = 2, TL_GREEN = 3 };
 #define TL_HOLD_FOREVER INT64_MAX
 
 typedef struct tl_light {
-  int id;                                    /* N of tl<N> */
+  int id;                                      /* N of tl<N> */
   double cycle_s, offset_s, green_s, yellow_s; /* fixed-time program [s] */
-  int lamp_mat[3], lamp_geom[3];             /* red, yellow, green; -1 when absent */
-  float off_rgba[3][4], off_emission[3];     /* the lamps' generated (OFF) look */
-  int state;                                 /* shown now */
-  int held;                                  /* 1 while a command holds the state */
+  int lamp_mat[3], lamp_geom[3];               /* red, yellow, green; -1 when absent */
+  float off_rgba[3][4], off_emission[3];       /* the lamps' generated (OFF) look */
+  int state;                                   /* shown now */
+  int held;                                    /* 1 while a command holds the state */
   int held_state;
-  int64_t hold_until_us;                     /* TL_HOLD_FOREVER: until the next command */
-  double remaining_s;                        /* until the next change [s], < 0 unknown */
-  int changed;                               /* state changed in the last tl_update */
-  int drawn_state;                           /* state the lamps show in the model, -1: none */
+  int64_t hold_until_us; /* TL_HOLD_FOREVER: until the next command */
+  double remaining_s;    /* until the next change [s], < 0 unknown */
+  int changed;           /* state changed in the last tl_update */
+  int drawn_state;       /* state the lamps show in the model, -1: none */
 } tl_light_t;
 
 typedef struct traffic_lights {
@@ -67,8 +67,8 @@ int tl_update(traffic_lights_t *t, int64_t now_us);
 /* Commands light id to state for duration_s (<= 0: until the next command) from now_us.
  * Returns 0 when accepted (the light shows it at once: call tl_update / tl_draw), or -1 with
  * the reason in why (unknown id, bad state, or the conflicting light ids and their states). */
-int tl_command(traffic_lights_t *t, int id, int state, double duration_s, int64_t now_us,
-               char *why, size_t why_sz);
+int tl_command(traffic_lights_t *t, int id, int state, double duration_s, int64_t now_us, char *why,
+               size_t why_sz);
 
 /* Lights the lamps in the model's materials (and lamp geoms): the lit lamp bright and
  * saturated with emission, the others in their generated dark look. Cheap when nothing
