@@ -50,12 +50,16 @@ class MapCheck(unittest.TestCase):
         self.assertEqual(r.stdout.count(": ok ("), 5)
 
     def test_each_bad_fixture_names_file_element_and_problem(self) -> None:
+        r = check(*(str(FIX / name) for name in EXPECTED))  # one run checks them all
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertEqual(r.stdout, "")
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), len(EXPECTED), r.stderr)
         for name, (key, words) in EXPECTED.items():
             with self.subTest(name):
-                r = check(str(FIX / name))
-                self.assertEqual(r.returncode, 1, r.stdout)
-                self.assertIn(f"map check: {FIX / name}: {key}: ", r.stderr)
-                self.assertIn(words, r.stderr)
+                line = next(l for l in lines if l.startswith(f"map check: {FIX / name}: "))
+                self.assertIn(f"map check: {FIX / name}: {key}: ", line)
+                self.assertIn(words, line)
 
     def test_one_bad_file_among_good_ones_fails_the_run(self) -> None:
         r = check(str(FIX / "good_town.yaml"), str(FIX / "bad_tile_gap.yaml"))
