@@ -14,6 +14,9 @@ import yaml
 from .paths import CHANNEL_TABLE
 
 VEH = "<VEH>"
+# Conditions of a channel's optional "when": published only on maps with traffic lights, or only
+# when someone acts (a command). "" = every run.
+WHEN = frozenset({"", "traffic_lights", "on_demand"})
 
 
 class ChannelTableError(ValueError):
@@ -30,6 +33,7 @@ class Channel:
     publishers: tuple[str, ...]
     subscribers: tuple[str, ...]
     content: str
+    when: str = ""  # "": every run; else the condition under which it is published
 
     @property
     def per_vehicle(self) -> bool:
@@ -99,6 +103,10 @@ def load(path: Path | str | None = None) -> ChannelTable:
         missing = [f for f in _FIELDS if not isinstance(entry, dict) or f not in entry]
         if missing:
             raise ChannelTableError(f"{source}: channels[{i}] lacks {', '.join(missing)}")
+        if entry.get("when", "") not in WHEN:
+            raise ChannelTableError(
+                f"{source}: channels[{i}] ({entry['name']}): when must be one of {sorted(WHEN)[1:]}"
+            )
         if entry["status"] not in ("live", "planned"):
             raise ChannelTableError(
                 f"{source}: channels[{i}] ({entry['name']}): status must be live or planned"
@@ -113,6 +121,7 @@ def load(path: Path | str | None = None) -> ChannelTable:
                 publishers=tuple(entry["publishers"]),
                 subscribers=tuple(entry["subscribers"]),
                 content=str(entry["content"]),
+                when=str(entry.get("when", "")),
             )
         )
     return ChannelTable(

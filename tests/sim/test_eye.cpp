@@ -20,13 +20,13 @@ TEST(Eye, RoofTagsDecodeAtTheirIdsAndPositions) {
   simtest::Sim s("constant:throttle=0.3,steering=0.2", 2);
   ASSERT_NE(s.s, nullptr) << s.err;
   ASSERT_TRUE(s.run_to(1.0)) << s.err;  // moving and turned a little
-  const mjModel *m = sim_model(s.s);
+  const mjModel *m = sim_render_model(s.s);
   char err[512] = "";
   sim_render_t *r = sim_render_create(m, 1280, 960, SIM_RENDER_AUTO, err, sizeof err);
   ASSERT_NE(r, nullptr) << err;
   sim_camera_t *cam = sim_camera_create(r, m, "eye", "eye", 1280, 960, 90, err, sizeof err);
   ASSERT_NE(cam, nullptr) << err;
-  ASSERT_EQ(sim_camera_capture(cam, m, sim_data(s.s), sim_time_us(s.s)), 0);
+  ASSERT_EQ(sim_camera_capture(cam, m, sim_render_data(s.s), sim_time_us(s.s)), 0);
   const uint8_t *rgb = sim_camera_rgb(cam);
   image_u8_t *gray = image_u8_create(1280, 960);
   for (int y = 0; y < 960; y++)

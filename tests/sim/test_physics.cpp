@@ -221,7 +221,7 @@ namespace {
 TEST(Sensors, LampGeomsFollowTheFirmware) {
   simtest::Sim s("constant:throttle=-0.5,steering=0");
   ASSERT_NE(s.s, nullptr) << s.err;
-  const mjModel *m = sim_model(s.s);
+  const mjModel *m = sim_render_model(s.s);  // lamps are drawn where the cameras look
   const int rev = mj_name2id(m, mjOBJ_GEOM, "nigel1/lamp_reverse");
   const int head = mj_name2id(m, mjOBJ_GEOM, "nigel1/lamp_head_l");
   ASSERT_GE(rev, 0);

@@ -473,7 +473,7 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0});
   ASSERT_NE(k.s, nullptr) << k.err;
   sim_t *s = k.s;
-  const mjModel *m = sim_model(s);
+  const mjModel *m = sim_render_model(s);
   char err[1024] = "";
   sim_render_t *rd = sim_render_create(m, 640, 480, SIM_RENDER_AUTO, err, sizeof err);
   ASSERT_NE(rd, nullptr) << err;
@@ -481,7 +481,7 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
       sim_camera_create(rd, m, "nigel1/cam_front", "camera_front", 640, 480, 85, err, sizeof err);
   ASSERT_NE(cam, nullptr) << err;
   auto centre_blue_excess = [&]() {  // blue minus red at the image centre (the box is blue)
-    EXPECT_EQ(sim_camera_capture(cam, m, sim_data(s), sim_time_us(s)), 0);
+    EXPECT_EQ(sim_camera_capture(cam, m, sim_render_data(s), sim_time_us(s)), 0);
     const uint8_t *px = sim_camera_rgb(cam) + 3 * (240 * 640 + 320);
     return (int)px[2] - (int)px[0];
   };

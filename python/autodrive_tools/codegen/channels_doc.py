@@ -29,6 +29,9 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         "",
         "A *planned* channel is reserved for work in progress: no program publishes it yet. The",
         "HIL parking test records a run and checks both ways that the code and this table agree.",
+        "A live channel with a condition (status `live (traffic_lights)`: only on maps with",
+        "traffic lights; `live (on_demand)`: only when someone acts) is expected in a recorded",
+        "run only when the audit is told the condition holds (`channel_audit --when ...`).",
         "",
         "| channel | type | rate | publishers | subscribers | status | content |",
         "|---|---|---|---|---|---|---|",
@@ -36,7 +39,8 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
     for ch in table.channels:
         out.append(
             f"| `{ch.name}` | `{ch.type}` | {ch.rate} | {_programs(ch.publishers)} | "
-            f"{_programs(ch.subscribers)} | {ch.status} | {ch.content} |"
+            f"{_programs(ch.subscribers)} | {ch.status}{f' ({ch.when})' if ch.when else ''} | "
+            f"{ch.content} |"
         )
     out.append("")
     return "\n".join(out)

@@ -19,8 +19,12 @@ FINGERPRINT_BYTES = 8  # an LCM message starts with its type's 64-bit fingerprin
 LCM_OWN_CHANNELS = frozenset({"LCM_SELF_TEST"})
 
 
-def audit(log_path: Path, build: Path, vehicles: list[str]) -> tuple[list[str], Counter[str]]:
-    """(problems, messages per channel) of the LCM log at log_path."""
+def audit(
+    log_path: Path, build: Path, vehicles: list[str], conditions: frozenset[str] = frozenset()
+) -> tuple[list[str], Counter[str]]:
+    """(problems, messages per channel) of the LCM log at log_path. A live channel with a
+    "when" (e.g. traffic_lights: only maps with lights publish it) is expected only when its
+    condition is in conditions; it is checked like any other when it appears."""
     table = channels.load()
     types: Any = lcmtypes.load(build)
     seen: Counter[str] = Counter()
@@ -43,7 +47,7 @@ def audit(log_path: Path, build: Path, vehicles: list[str]) -> tuple[list[str], 
         if problems and problems[-1].startswith(name + ":"):
             reported.add(name)
     for entry in table.channels:
-        if entry.status != "live":
+        if entry.status != "live" or (entry.when and entry.when not in conditions):
             continue
         names = [entry.resolve(v) for v in vehicles] if entry.per_vehicle else [entry.name]
         for name in names:
@@ -62,11 +66,21 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--vehicle", action="append", default=None, help="vehicle that ran (default NIGEL1)"
     )
+    p.add_argument(
+        "--when",
+        action="append",
+        default=[],
+        choices=sorted(channels.WHEN - {""}),
+        help="a condition of the run (e.g. traffic_lights: its map has lights); live channels "
+        "published only then are expected too",
+    )
     args = p.parse_args(argv)
     if not args.log.is_file():
         print(f"channel_audit: {args.log}: no such log", file=sys.stderr)
         return 2
-    problems, seen = audit(args.log, args.build, args.vehicle or [channels.vehicle_name(1)])
+    problems, seen = audit(
+        args.log, args.build, args.vehicle or [channels.vehicle_name(1)], frozenset(args.when)
+    )
     for name, n in sorted(seen.items()):
         print(f"{name:24s} {n:8d} messages")
     for problem in problems:

@@ -10,8 +10,12 @@
 
 #include <lcm/lcm.h>
 
+#include "camera_fx.h"
 #include "lcmpub.h"
+#include "route_driver.h"
+#include "script.h"
 #include "sim.h"
+#include "tl_lcm.h"
 
 #include "sim_camera.h"
 #include "sim_lidar_lcm.h"
@@ -43,7 +47,8 @@ static void main_usage(FILE *f) {
       "MuJoCo 2.2 HIL simulator of the AutoDRIVE Nigel car. Each car's emulated Nano (the real\n"
       "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
       "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
-      "  --map NAME|FILE     parking_school (default), driving_school, or an MJCF map file\n"
+      "  --map NAME|FILE     parking_school (default), driving_school, intersection_school,\n"
+      "                      tiny_town, or an MJCF map file\n"
       "  --params FILE       vehicle description (default %s/vehicle/nigel.params)\n"
       "  --seed N            seed of IMU biases and noise (default 1)\n"
       "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
@@ -76,6 +81,10 @@ static void main_usage(FILE *f) {
       "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
       "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
       "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
+      "                      or route:NAME[,speed=F][,start=s][,lookahead=M]: pure pursuit on\n"
+      "                      the map's route NAME at F of top speed (default %g), lookahead M\n"
+      "                      [m] (default %g), from the route's start (--cars 1); the run ends\n"
+      "                      when the route does (one lap of a loop)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
@@ -83,6 +92,10 @@ static void main_usage(FILE *f) {
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
       "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
+      "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
+      "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
+      "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
+      "                      (noise and blur are seeded by --seed: a run repeats)\n"
       "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
       "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
@@ -90,12 +103,14 @@ static void main_usage(FILE *f) {
       "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
       "  --quiet             no progress lines\n"
       "  -h, --help          this text\n"
-      "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors) and\n"
-      "SIM_CLOCK (100 Hz, with --lockstep or --rtf).\n"
+      "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors),\n"
+      "SIM_CLOCK (100 Hz, with --lockstep or --rtf) and, on maps with traffic lights,\n"
+      "TRAFFIC_LIGHT_STATE (10 Hz per light and on each change); obeys TRAFFIC_LIGHT_COMMAND.\n"
       "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
       SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-      SCN_MAX_LATE_BOXES, MAIN_FREE_LOCKSTEP_IO_MS, MAIN_DEFAULT_URL);
+      SCN_MAX_LATE_BOXES, MAIN_FREE_LOCKSTEP_IO_MS, MAIN_DEFAULT_URL, SCRIPT_ROUTE_SPEED_DEFAULT,
+      SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
 }
 
 static double main_clock_s(clockid_t id) {
@@ -217,13 +232,26 @@ typedef struct main_cams {
   int cam_id[MAIN_MAX_CAMS];
   char channel[MAIN_MAX_CAMS][48], info_channel[MAIN_MAX_CAMS][48];
   int64_t next_info_us;
+  cfx_t fx[MAIN_MAX_CAMS]; /* --camera-noise / --camera-blur, seeded per camera */
 } main_cams_t;
+
+static void main_cam_fx(uint8_t *rgb, int w, int h, void *ctx) {
+  cfx_apply(ctx, rgb, w, h);
+}
+
+/* Noise and blur on every camera: each its own seeded noise stream. */
+static void main_cams_fx(main_cams_t *k, double noise, double blur_px, uint64_t seed) {
+  for (int i = 0; i < k->n; i++) {
+    cfx_init(&k->fx[i], noise, blur_px, seed * 2654435761ull + (uint64_t)i);
+    if (cfx_active(&k->fx[i])) sim_camera_set_filter(k->cam[i], main_cam_fx, &k->fx[i]);
+  }
+}
 
 static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, char *err,
                           size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
-  const mjModel *m = sim_model(s);
+  const mjModel *m = sim_render_model(s);
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
@@ -254,23 +282,28 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   return 0;
 }
 
-static int main_cams_publish(main_cams_t *k, const sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
+static int main_cams_publish(main_cams_t *k, sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
                              size_t err_sz) {
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
+  mjData *dv = sim_render_data(s);              /* the whole map, in step with the physics */
   for (int i = 0; i < k->n; i++) {
-    if (sim_camera_capture(k->cam[i], sim_model(s), sim_data(s), now_us) != 0) {
+    if (sim_camera_capture(k->cam[i], sim_render_model(s), dv, now_us) != 0) {
       snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
       return -1;
     }
     sim_camera_publish_image(k->cam[i], lcm, k->channel[i]);
-    if (info) sim_camera_publish_info(k->cam[i], sim_model(s), lcm, k->info_channel[i], now_us);
+    if (info)
+      sim_camera_publish_info(k->cam[i], sim_render_model(s), lcm, k->info_channel[i], now_us);
   }
   return 0;
 }
 
 static void main_cams_close(main_cams_t *k) {
-  for (int i = 0; i < k->n; i++) sim_camera_destroy(k->cam[i]);
+  for (int i = 0; i < k->n; i++) {
+    sim_camera_destroy(k->cam[i]);
+    cfx_free(&k->fx[i]);
+  }
   if (k->render) sim_render_destroy(k->render);
   k->n = 0;
 }
@@ -288,8 +321,8 @@ static int main_view_open(main_view_t *w, const sim_t *s, int want, char *err, s
     snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
     return -1;
   }
-  w->v = sim_viewer_create(sim_model(s), sim_cars(s), "nigel%d/base_link", "nigel%d/cam_front",
-                           1024, 768, err, err_sz);
+  w->v = sim_viewer_create(sim_render_model(s), sim_cars(s), "nigel%d/base_link",
+                           "nigel%d/cam_front", 1024, 768, err, err_sz);
   return w->v ? 0 : -1;
 }
 
@@ -301,7 +334,7 @@ static int main_view_frame(main_view_t *w, sim_t *s, double *t0_s) {
   if (now < w->next_frame_s) return 0;
   do {
     w->next_frame_s = now + 1.0 / 30.0;
-    if (sim_viewer_frame(w->v, sim_model(s), sim_data(s), &in) != 0) return 1;
+    if (sim_viewer_frame(w->v, sim_render_model(s), sim_render_data(s), &in) != 0) return 1;
     if (in.quit || main_stop) return 1;
     if (in.reset_requested) {
       /* back to the start poses (qpos0, sim.c); late boxes that appeared come back on the next
@@ -342,7 +375,7 @@ int main(int argc, char **argv) {
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
   int lockstep = 0, client_sync = 0, frame_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0,
       lidar_lcm = 1, view = 0;
-  double camera_fps = 30.0;
+  double camera_fps = 30.0, light_level = -1.0, camera_noise = 0.0, camera_blur = 0.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
   int host_io_ms = 0; /* 0: the mode's default */
@@ -432,6 +465,15 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--camera-fps")) {
       if (main_number(a, v, 0.1, 1000, &camera_fps)) return 2;
       i++;
+    } else if (!strcmp(a, "--light-level")) {
+      if (main_number(a, v, 0, 1, &light_level)) return 2;
+      i++;
+    } else if (!strcmp(a, "--camera-noise")) {
+      if (main_number(a, v, 0, CFX_MAX_NOISE, &camera_noise)) return 2;
+      i++;
+    } else if (!strcmp(a, "--camera-blur")) {
+      if (main_number(a, v, 0, CFX_MAX_BLUR_PX, &camera_blur)) return 2;
+      i++;
     } else if (!strcmp(a, "--tyre-model") && v) {
       if (!strcmp(v, "paper"))
         cfg.tyre_model = 1;
@@ -496,6 +538,16 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 2;
   }
+  if (light_level >= 0 && cfx_set_light_level(sim_render_model(s), light_level) != 0) {
+    fprintf(stderr,
+            "autodrive-sim: --light-level %g: the map '%s' is dark (level 0): nothing "
+            "to scale\n",
+            light_level, cfg.map_path);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 2;
+  }
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = main_on_signal;
@@ -511,7 +563,18 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
+  main_cams_fx(&cams, camera_noise, camera_blur, cfg.seed);
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
+  /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
+  tl_lcm_t *lights = tl_lcm_create(lcm, sim_traffic_lights(s), err, sizeof err);
+  if (!lights && err[0]) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    main_cams_close(&cams);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
   main_view_t viewer;
   if (main_view_open(&viewer, s, view, err, sizeof err) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
@@ -544,6 +607,16 @@ int main(int argc, char **argv) {
          : lockstep    ? "lockstep"
                        : (rtf_given ? "rtf" : "real time"),
          url);
+  const route_driver_t *route = sim_route(s);
+  if (route)
+    printf(
+        "route %s: %s, %d points, %.2f m, lane half width %.3f m, throttle %.2f, lookahead "
+        "%.2f m\n",
+        route->name, route->path.loop ? "loop" : "open", route->path.n, route->path.length_m,
+        route->half_width_m, route->speed, route->lookahead_m);
+  if (sim_traffic_lights(s)->n)
+    printf("traffic lights: %d (%d conflicting pairs) on " AUTODRIVE_CH_TRAFFIC_LIGHT_STATE "\n",
+           sim_traffic_lights(s)->n, sim_traffic_lights(s)->nconflicts);
   if (cfg.start)
     printf(AUTODRIVE_VEHICLE_DEFAULT " start (--start): x %.3f, y %.3f m, yaw %.1f deg\n",
            start.x_m, start.y_m, start.yaw_deg);
@@ -568,6 +641,8 @@ int main(int argc, char **argv) {
       lcmq_flush(pubq); /* the client may be waiting for the SIM_CLOCK we queued */
       main_sync_wait(s, &sync);
     }
+    /* light commands: every step, but every host-I/O period in free lockstep (a system call) */
+    if (lights && step % cfg.host_io_period_ms == 0) tl_lcm_poll(lights, sim_time_us(s));
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
@@ -576,6 +651,11 @@ int main(int argc, char **argv) {
     step++;
     const int64_t now_us = sim_time_us(s);
     main_report_late_boxes(s);
+    tl_lcm_publish(lights, now_us);
+    if (route && route->st.done) {
+      printf("route %s done at t = %.3f s\n", route->name, now_us * 1e-6);
+      break;
+    }
     if (step % MAIN_TRUTH_EVERY == 0)
       for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(pubq, s, c, tlog);
     for (int c = 1; c <= sim_cars(s); c++) {
@@ -645,12 +725,26 @@ int main(int argc, char **argv) {
     printf(
         "{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
         "\"rtf_cpu\": %.3f, \"rtf_step_thread_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, "
-        "\"bare_mj_step_rtf_cpu\": %.3f}\n",
+        "\"bare_mj_step_rtf_cpu\": %.3f",
         sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
         cpu_s > 0 ? sim_s / cpu_s : 0.0, step_cpu_s > 0 ? sim_s / step_cpu_s : 0.0,
         bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
         bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
+    if (route) {
+      double rms, max;
+      const long n = route_driver_stats(route, &rms, &max);
+      printf(
+          ", \"route\": \"%s\", \"route_done\": %s, \"route_length_m\": %.3f, "
+          "\"route_samples\": %ld, \"route_cross_track_rms_m\": %.5f, "
+          "\"route_cross_track_max_m\": %.5f",
+          route->name, route->st.done ? "true" : "false", route->path.length_m, n, rms, max);
+    }
+    long refused = 0;
+    const long commands = tl_lcm_commands(lights, &refused);
+    printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld}\n",
+           sim_traffic_lights(s)->n, commands, refused);
   }
+  tl_lcm_destroy(lights);
   main_view_close(&viewer);
   main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */

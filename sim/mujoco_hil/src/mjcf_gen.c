@@ -25,12 +25,15 @@ static void mg_rel_from(const char *scene_path, const char *abs_path, char *out,
   out[n] = '\0';
   const char *a = abs_path;
   while (*a == '/') a++;
-  /* copied by hand: gcc -O3 warns (an error here) about strncat/snprintf truncating it */
-  while (*a && n + 1 < sz) out[n++] = *a++;
-  out[n] = '\0';
+  size_t len = strlen(a);
+  if (len > sz - n - 1) len = sz - n - 1; /* truncated: MuJoCo then names the missing file */
+  memcpy(out + n, a, len);
+  out[n + len] = '\0';
 }
 
-static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
+/* physics_only: leave out the car's visual-only lamps and wheel discs (drawn in the render
+ * model; in the physics model they would only cost collision tests) */
+static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom, int physics_only) {
   const double L = p->wheelbase_m, hw = 0.5 * p->track_m, r = p->wheel_radius_m;
   const double mw = p->wheel_mass_kg, mk = MG_KNUCKLE_KG, M = p->mass_kg;
   const double mc = M - 4.0 * mw - 2.0 * mk;
@@ -92,7 +95,7 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
   } lamp[] = {{"lamp_head_l", 1, 1, 0},  {"lamp_head_r", 1, -1, 0}, {"lamp_ind_fl", 1, 1, 1},
               {"lamp_ind_fr", 1, -1, 1}, {"lamp_tail_l", 0, 1, 0},  {"lamp_tail_r", 0, -1, 0},
               {"lamp_ind_rl", 0, 1, 1},  {"lamp_ind_rr", 0, -1, 1}, {"lamp_reverse", 0, 0, 0}};
-  for (size_t k = 0; k < sizeof lamp / sizeof lamp[0]; k++)
+  for (size_t k = 0; !physics_only && k < sizeof lamp / sizeof lamp[0]; k++)
     fprintf(
         f,
         "   <geom name=\"nigel%d/%s\" type=\"box\" size=\"0.002 0.008 0.005\" pos=\"%.6g %.6g "
@@ -133,10 +136,11 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom) {
             "    <geom name=\"nigel%d/tyre_%s\" type=\"sphere\" size=\"%.6g\" contype=\"2\" "
             "conaffinity=\"1\" %s mass=\"0\" group=\"3\" rgba=\"0.1 0.1 0.1 1\"/>\n",
             i, names[w], r, tyre_attr);
-    fprintf(f,
-            "    <geom type=\"cylinder\" size=\"%.6g %.6g\" euler=\"1.5708 0 0\" contype=\"0\" "
-            "conaffinity=\"0\" mass=\"0\" rgba=\"0.15 0.15 0.15 1\"/>\n",
-            r, 0.5 * p->wheel_width_m);
+    if (!physics_only)
+      fprintf(f,
+              "    <geom type=\"cylinder\" size=\"%.6g %.6g\" euler=\"1.5708 0 0\" "
+              "contype=\"0\" conaffinity=\"0\" mass=\"0\" rgba=\"0.15 0.15 0.15 1\"/>\n",
+              r, 0.5 * p->wheel_width_m);
     fprintf(f, front ? "    </body>\n   </body>\n" : "   </body>\n");
   }
   fprintf(f, "  </body>\n");
@@ -155,6 +159,37 @@ static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
   fprintf(f, "  </body>\n");
 }
 
+int mg_write_physics_map(const char *map_path, const char *out_path, char *err, size_t err_sz) {
+  FILE *in = fopen(map_path, "r");
+  if (!in) {
+    snprintf(err, err_sz, "map file '%s': %s", map_path, strerror(errno));
+    return -1;
+  }
+  FILE *out = fopen(out_path, "w");
+  if (!out) {
+    snprintf(err, err_sz, "cannot write '%s': %s", out_path, strerror(errno));
+    fclose(in);
+    return -1;
+  }
+  char line[16384];
+  int dropped = 0;
+  while (fgets(line, sizeof line, in)) {
+    const int whole = strchr(line, '\n') != NULL || feof(in);
+    if (whole && strstr(line, "<geom ") && strstr(line, "/>") && strstr(line, "contype=\"0\"") &&
+        strstr(line, "conaffinity=\"0\"")) {
+      dropped++;
+      continue;
+    }
+    fputs(line, out);
+  }
+  fclose(in);
+  if (fclose(out) != 0) {
+    snprintf(err, err_sz, "cannot write '%s'", out_path);
+    return -1;
+  }
+  return dropped;
+}
+
 int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz) {
   FILE *f = fopen(out_path, "w");
@@ -166,9 +201,9 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
   mg_rel_from(out_path, o->map_path, rel, sizeof rel);
   /* MuJoCo 2.2 reads an included file's textures relative to THIS file's folder: point it at
    * the map's folder (maps write file="textures/<name>.png") */
-  snprintf(map_dir, sizeof map_dir, "%s", o->map_path);
+  snprintf(map_dir, sizeof map_dir, "%s", o->texture_dir ? o->texture_dir : o->map_path);
   char *slash = strrchr(map_dir, '/');
-  if (slash) slash[1] = '\0';
+  if (slash && !o->texture_dir) slash[1] = '\0';
   mg_rel_from(out_path, map_dir, rel_dir, sizeof rel_dir);
   const int ncon = 64 + 16 * o->cars;
   fprintf(f, "<mujoco model=\"autodrive\">\n");
@@ -185,7 +220,7 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
   if (o->tag_asset_xml) fprintf(f, " <asset>\n%s\n </asset>\n", o->tag_asset_xml);
   fprintf(f, " <worldbody>\n");
   for (int i = 1; i <= o->cars; i++)
-    mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL);
+    mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL, o->physics_only);
   for (int k = 0; k < o->late_boxes; k++) mg_late_box(f, k + 1, &o->late_box[k]);
   fprintf(f, " </worldbody>\n <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */

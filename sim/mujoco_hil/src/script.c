@@ -26,15 +26,34 @@ static int script_num(const char *spec, const char *key, const char *val, double
 int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
   memset(s, 0, sizeof *s);
   s->stop_us = -1;
-  const char *prefix = "constant:";
-  if (strncmp(spec, prefix, strlen(prefix)) != 0) {
-    snprintf(err, err_sz, "--script '%s': unknown kind (expected 'constant:key=value,...')", spec);
+  const char *prefix = "constant:", *route = "route:";
+  char buf[256];
+  char *save = NULL, *tok;
+  if (strncmp(spec, prefix, strlen(prefix)) == 0) {
+    snprintf(buf, sizeof buf, "%s", spec + strlen(prefix));
+    tok = strtok_r(buf, ",", &save);
+  } else if (strncmp(spec, route, strlen(route)) == 0) {
+    snprintf(buf, sizeof buf, "%s", spec + strlen(route));
+    tok = strtok_r(buf, ",", &save);
+    if (!tok || strchr(tok, '=') || strlen(tok) >= sizeof s->route_name) {
+      snprintf(err, err_sz, "--script '%s': expected route:NAME[,speed=F][,start=s][,lookahead=m]",
+               spec);
+      return -1;
+    }
+    s->route = 1;
+    snprintf(s->route_name, sizeof s->route_name, "%s", tok);
+    s->throttle = SCRIPT_ROUTE_SPEED_DEFAULT;
+    s->lookahead_m = SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M;
+    tok = strtok_r(NULL, ",", &save);
+  } else {
+    snprintf(err, err_sz,
+             "--script '%s': unknown kind (expected 'constant:key=value,...' or "
+             "'route:NAME,key=value,...')",
+             spec);
     return -1;
   }
-  char buf[256];
-  snprintf(buf, sizeof buf, "%s", spec + strlen(prefix));
   double start = 0.0, stop = -1.0;
-  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+  for (; tok; tok = strtok_r(NULL, ",", &save)) {
     char *eq = strchr(tok, '=');
     if (!eq) {
       snprintf(err, err_sz, "--script '%s': '%s' is not key=value", spec, tok);
@@ -43,18 +62,22 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     *eq = '\0';
     const char *val = eq + 1;
     int rc;
-    if (strcmp(tok, "throttle") == 0) {
+    if (s->route && strcmp(tok, "speed") == 0) {
+      rc = script_num(spec, tok, val, 0, 1, &s->throttle, err, err_sz);
+    } else if (s->route && strcmp(tok, "lookahead") == 0) {
+      rc = script_num(spec, tok, val, 0.02, 5, &s->lookahead_m, err, err_sz);
+    } else if (!s->route && strcmp(tok, "throttle") == 0) {
       rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
-    } else if (strcmp(tok, "steering") == 0) {
+    } else if (!s->route && strcmp(tok, "steering") == 0) {
       rc = script_num(spec, tok, val, -1, 1, &s->steering, err, err_sz);
     } else if (strcmp(tok, "start") == 0) {
       rc = script_num(spec, tok, val, 0, 1e6, &start, err, err_sz);
     } else if (strcmp(tok, "stop_after") == 0) {
       rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
     } else {
-      snprintf(err, err_sz,
-               "--script '%s': unknown key '%s' (throttle, steering, start, stop_after)", spec,
-               tok);
+      snprintf(err, err_sz, "--script '%s': unknown key '%s' (%s)", spec, tok,
+               s->route ? "speed, start, stop_after, lookahead"
+                        : "throttle, steering, start, stop_after");
       return -1;
     }
     if (rc) return -1;

@@ -1,9 +1,13 @@
 /* Scripted driver: stands in for the Jetson runtime in tests and benchmarks by sending real
  * protocol frames (COMMAND at 50 Hz, arming with engaged=0 then engaged=1 as the failsafe
  * requires) into the emulated Nano's UART.
- * Spec: "constant:throttle=<-1..1>,steering=<-1..1>[,start=<s>][,stop_after=<s>]"
+ * Specs: "constant:throttle=<-1..1>,steering=<-1..1>[,start=<s>][,stop_after=<s>]"
+ *        "route:<NAME>[,speed=<0..1>][,start=<s>][,stop_after=<s>][,lookahead=<m>]"
  *   start: first command time [s] (default 0); stop_after: the driver goes quiet at this sim
- *   time [s] (default never), which must trip the Nano's failsafe. */
+ *   time [s] (default never), which must trip the Nano's failsafe.
+ *   route: the map's named route, driven by pure pursuit (route_driver.h) at throttle `speed`
+ *   (fraction of top speed, default 0.8) with `lookahead` [m]; the simulator places the car at
+ *   the route's start and sets throttle/steering before each frame. */
 #ifndef SIM_SCRIPT_H
 #define SIM_SCRIPT_H
 
@@ -16,10 +20,15 @@
 extern "C" {
 #endif
 
-#define SCRIPT_PERIOD_US 20000u /* 50 Hz, the runtime's command rate */
+#define SCRIPT_PERIOD_US 20000u               /* 50 Hz, the runtime's command rate */
+#define SCRIPT_ROUTE_SPEED_DEFAULT 0.8        /* route: throttle, fraction of top speed */
+#define SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M 0.20 /* route: pure pursuit lookahead [m] */
 
 typedef struct script {
-  double throttle, steering; /* normalised [-1, 1] */
+  double throttle, steering; /* normalised [-1, 1]; a route driver sets them before each poll */
+  int route;                 /* 1: "route:" spec */
+  char route_name[64];
+  double lookahead_m;        /* route: pure pursuit lookahead [m] */
   int64_t start_us, stop_us; /* stop_us < 0: never */
   int64_t next_us;
   uint16_t cmd_seq;

@@ -19,7 +19,9 @@
 #include "mjcf_gen.h"
 #include "ptylink.h"
 #include "rng.h"
+#include "route_driver.h"
 #include "script.h"
+#include "traffic_lights.h"
 #include "tyre.h"
 #include "uart.h"
 #include "vparams.h"
@@ -108,8 +110,12 @@ typedef struct sim_car {
 
 struct sim {
   vp_params_t p;
-  mjModel *m;
+  mjModel *m; /* physics: the map without its visual-only geoms */
   mjData *d;
+  /* render model: the whole map (road tiles, lamps, sign faces), kept in step with the physics
+   * for the cameras, the Eye and the viewer; NULL when the map has no visual-only geoms */
+  mjModel *mv;
+  mjData *dv;
   int ncars;
   sim_car_t *car;
   int64_t time_us;
@@ -131,6 +137,8 @@ struct sim {
   uint64_t seed;                         /* of the current run (sim_create, sim_reset) */
   char script_spec[256];                 /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
+  traffic_lights_t tl;                   /* the map's lights (traffic_lights.h) */
+  route_driver_t *route;                 /* --script route:NAME (car 1), else NULL */
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
@@ -222,7 +230,7 @@ static int sim_bind_car(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   for (int k = 0; k < SIM_LAMPS; k++) { /* optional: older scenes may lack lamps */
     char name[64];
     snprintf(name, sizeof name, "nigel%d/%s", c->index, sim_lamp[k].name);
-    c->lamp_geom[k] = mj_name2id(m, mjOBJ_GEOM, name);
+    c->lamp_geom[k] = mj_name2id(s->mv ? s->mv : m, mjOBJ_GEOM, name); /* drawn there */
   }
   c->lamps_shown = 0xFF; /* draw on the first step */
   static const char *sn[3] = {"accel", "gyro", "mag"};
@@ -415,20 +423,24 @@ static int sim_check_map(const char *path, char *err, size_t err_sz) {
 /* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
 static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, char *err,
                             size_t err_sz) {
-  const size_t asz = 512;
+  const size_t asz = 1024;
   *asset = calloc((size_t)cars, asz);
   *geoms = calloc((size_t)cars, sizeof(char *));
   if (!*asset || !*geoms) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
   for (int i = 1; i <= cars; i++) {
-    /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder */
     char png[700], file[64], prefix[32], a[asz];
     snprintf(file, sizeof file, "tag36h11_%d.png", mg_tag_id(i));
     snprintf(png, sizeof png, "%s/%s", s->scene_dir, file);
     if (sim_tags_write_png(png, mg_tag_id(i), 8, err, err_sz) != 0) return -1;
     snprintf(prefix, sizeof prefix, "nigel%d/", i);
     (*geoms)[i - 1] = malloc(1024);
+    /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder (its
+     * textures), and the run dir may be given relative */
+    char abs_png[4096];
+    if (!realpath(png, abs_png))
+      return sim_fail(err, err_sz, "roof tag '%s': %s", png, strerror(errno));
     if (!(*geoms)[i - 1] ||
-        sim_tags_mjcf(prefix, png, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
+        sim_tags_mjcf(prefix, abs_png, s->p.tag_size_m, a, sizeof a, (*geoms)[i - 1], 1024) != 0)
       return sim_fail(err, err_sz, "%s%s", "roof tag MJCF did not fit its buffer", "");
     strcat(*asset, a);
     strcat(*asset, "\n");
@@ -437,7 +449,7 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
 }
 
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
-  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box};
+  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
@@ -448,6 +460,22 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   o.tag_asset_xml = asset;
   o.tag_geom_xml = (const char *const *)geoms;
   if (rc == 0) rc = mg_write_scene(s->scene_path, &s->p, &o, err, err_sz);
+  /* the physics scene: the same with a copy of the map without visual-only geoms */
+  char map_dir[4096], phys_map[700], phys_scene[700];
+  snprintf(map_dir, sizeof map_dir, "%s", map_abs);
+  char *slash = strrchr(map_dir, '/');
+  if (slash) slash[1] = '\0';
+  snprintf(phys_map, sizeof phys_map, "%s/map_physics.xml", s->scene_dir);
+  snprintf(phys_scene, sizeof phys_scene, "%s/scene_physics.xml", s->scene_dir);
+  int dropped = 0;
+  if (rc == 0 && (dropped = mg_write_physics_map(map_abs, phys_map, err, err_sz)) < 0) rc = -1;
+  if (rc == 0 && dropped > 0) {
+    mg_options_t po = o;
+    po.map_path = phys_map;
+    po.texture_dir = map_dir;
+    po.physics_only = 1;
+    rc = mg_write_scene(phys_scene, &s->p, &po, err, err_sz);
+  }
   if (geoms)
     for (int i = 0; i < cfg->cars; i++) free(geoms[i]);
   free(geoms);
@@ -457,6 +485,19 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   s->m = mj_loadXML(s->scene_path, NULL, merr, sizeof merr);
   if (!s->m)
     return sim_fail(err, err_sz, "generated scene '%s' does not compile: %s", s->scene_path, merr);
+  if (dropped > 0) {
+    mjModel *pm = mj_loadXML(phys_scene, NULL, merr, sizeof merr);
+    /* the same bodies and joints (only geoms left out), or no split at all */
+    if (pm && pm->nq == s->m->nq && pm->nv == s->m->nv && pm->nbody == s->m->nbody &&
+        pm->nmocap == s->m->nmocap) {
+      s->mv = s->m;
+      s->m = pm;
+      s->dv = mj_makeData(s->mv);
+      if (!s->dv) return sim_fail(err, err_sz, "%s%s", "mj_makeData failed (out of memory)", "");
+    } else if (pm) {
+      mj_deleteModel(pm);
+    }
+  }
   s->d = mj_makeData(s->m);
   if (!s->d) return sim_fail(err, err_sz, "%s%s", "mj_makeData failed (out of memory)", "");
   return 0;
@@ -550,6 +591,35 @@ int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
   return s->box_new[k];
 }
 
+/* --script route:NAME: the route driver of car 1, which starts at the route's start unless
+ * --start says otherwise. */
+static int sim_bind_route(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
+  if (!cfg->script) return 0;
+  script_t sc;
+  if (script_parse(&sc, cfg->script, err, err_sz) != 0) return -1;
+  if (!sc.route) return 0;
+  if (cfg->cars != 1) {
+    snprintf(err, err_sz, "--script '%s': a route driver drives one car (--cars 1, got %d)",
+             cfg->script, cfg->cars);
+    return -1;
+  }
+  s->route = calloc(1, sizeof *s->route);
+  if (!s->route) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
+  if (route_driver_init(s->route, s->m, sc.route_name, sc.throttle, sc.lookahead_m, err, err_sz) !=
+      0) {
+    free(s->route);
+    s->route = NULL;
+    return -1;
+  }
+  if (!s->has_start) {
+    double yaw;
+    route_driver_start(s->route, &s->start.x_m, &s->start.y_m, &yaw);
+    s->start.yaw_deg = yaw * (180.0 / M_PI);
+    s->has_start = 1;
+  }
+  return 0;
+}
+
 sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   if (cfg->cars < 1 || cfg->cars > SIM_MAX_CARS) {
     snprintf(err, err_sz, "--cars %d: must be 1..%d", cfg->cars, SIM_MAX_CARS);
@@ -615,6 +685,8 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     if (sim_bind_car(s, &s->car[i], err, err_sz) != 0) goto fail;
   }
   if (sim_bind_late_boxes(s, err, err_sz) != 0) goto fail;
+  if (tl_load(&s->tl, s->mv ? s->mv : s->m, err, err_sz) != 0) goto fail;
+  if (sim_bind_route(s, cfg, err, err_sz) != 0) goto fail;
   if (sim_place_cars(s, err, err_sz) != 0) goto fail;
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
@@ -634,9 +706,17 @@ void sim_destroy(sim_t *s) {
   }
   if (s->d) mj_deleteData(s->d);
   if (s->m) mj_deleteModel(s->m);
+  if (s->dv) mj_deleteData(s->dv);
+  if (s->mv) mj_deleteModel(s->mv);
+  if (s->route) route_driver_free(s->route);
+  free(s->route);
   if (s->scene_dir[0]) { /* the generated scene and tag textures */
     char path[700];
     snprintf(path, sizeof path, "%s/scene.xml", s->scene_dir);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/scene_physics.xml", s->scene_dir);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/map_physics.xml", s->scene_dir);
     unlink(path);
     for (int i = 1; i <= s->ntag_files; i++) {
       snprintf(path, sizeof path, "%s/tag36h11_%d.png", s->scene_dir, mg_tag_id(i));
@@ -688,6 +768,12 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due_all, char *err, size_t
   const int64_t rx_before = c->host_rx_us;
   if (c->has_pty && io_due) sim_read_host(s, c);
   if (c->has_script) {
+    if (s->route && s->time_us >= c->script.next_us) { /* pure pursuit before each frame */
+      const mjtNum *q = s->d->qpos + c->root_qpos;
+      const double yaw =
+          atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] * q[5] + q[6] * q[6]));
+      route_driver_update(s->route, q[0], q[1], yaw, &c->script.throttle, &c->script.steering);
+    }
     const size_t n = script_poll(&c->script, s->time_us, buf, sizeof buf);
     uart_push(&c->rx, buf, n);
   }
@@ -723,7 +809,7 @@ static void sim_draw_lamps(sim_t *s, sim_car_t *c) {
   for (int k = 0; k < SIM_LAMPS; k++) {
     if (c->lamp_geom[k] < 0) continue;
     const float *rgb = (c->lamps & sim_lamp[k].bits) ? sim_lamp[k].on : sim_lamp[k].off;
-    float *dst = s->m->geom_rgba + 4 * c->lamp_geom[k];
+    float *dst = (s->mv ? s->mv : s->m)->geom_rgba + 4 * c->lamp_geom[k];
     dst[0] = rgb[0];
     dst[1] = rgb[1];
     dst[2] = rgb[2];
@@ -861,6 +947,10 @@ static void sim_record_contacts(sim_t *s) {
 }
 
 int sim_step(sim_t *s, char *err, size_t err_sz) {
+  if (s->tl.n > 0) { /* lights: program or command, lamps lit in the model for the cameras */
+    tl_update(&s->tl, s->time_us);
+    tl_draw(&s->tl, s->mv ? s->mv : s->m);
+  }
   sim_place_late_boxes(s); /* before mj_step1: its kinematics, contacts and rays see them */
   mj_step1(s->m, s->d);
   const int io_due = sim_host_io_due(s);
@@ -901,6 +991,13 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
 }
 
 /* ---- queries ------------------------------------------------------------------------- */
+traffic_lights_t *sim_traffic_lights(sim_t *s) {
+  return &s->tl;
+}
+const route_driver_t *sim_route(const sim_t *s) {
+  return s->route;
+}
+
 int64_t sim_time_us(const sim_t *s) {
   return s->time_us;
 }
@@ -912,6 +1009,22 @@ const mjModel *sim_model(const sim_t *s) {
 }
 mjData *sim_data(const sim_t *s) {
   return s->d;
+}
+mjModel *sim_render_model(const sim_t *s) {
+  return s->mv ? s->mv : s->m;
+}
+mjData *sim_render_data(sim_t *s) {
+  if (!s->mv) return s->d;
+  const mjModel *m = s->m;
+  mjData *dv = s->dv;
+  dv->time = s->d->time;
+  mju_copy(dv->qpos, s->d->qpos, m->nq);
+  mju_copy(dv->qvel, s->d->qvel, m->nv);
+  mju_copy(dv->mocap_pos, s->d->mocap_pos, 3 * m->nmocap);
+  mju_copy(dv->mocap_quat, s->d->mocap_quat, 4 * m->nmocap);
+  mj_kinematics(s->mv, dv);
+  mj_camlight(s->mv, dv);
+  return dv;
 }
 const char *sim_nano_link(const sim_t *s, int car) {
   return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : "";

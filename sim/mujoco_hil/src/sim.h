@@ -94,8 +94,16 @@ int sim_step(sim_t *s, char *err, size_t err_sz);
 
 int64_t sim_time_us(const sim_t *s);
 int sim_cars(const sim_t *s);
+/* The physics model and data: the map without its visual-only geoms (they cost MuJoCo 2.2
+ * collision time every step although they never collide). */
 const mjModel *sim_model(const sim_t *s);
 mjData *sim_data(const sim_t *s);
+/* What cameras, the Eye and the viewer render: the whole map (road tiles, sign faces, light
+ * lamps lit by the sim, car lamps). sim_render_data brings its data to the physics state
+ * (positions, mocap, cameras) and returns it. Without visual-only geoms in the map these are
+ * the physics model and data. */
+mjModel *sim_render_model(const sim_t *s);
+mjData *sim_render_data(sim_t *s);
 void sim_get_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
 /* The Nano's symlink path (empty without ptys). */
 const char *sim_nano_link(const sim_t *s, int car);
@@ -127,6 +135,14 @@ int sim_lidar_pty_scanning(const sim_t *s, int car);
 int sim_late_boxes(const sim_t *s);
 const scn_late_box_t *sim_late_box(const sim_t *s, int k);
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below);
+
+/* The map's traffic lights (traffic_lights.h): each step updates them at sim time and lights
+ * their lamps in the model. Commands (tl_command) take effect at the next step. */
+struct traffic_lights;
+struct traffic_lights *sim_traffic_lights(sim_t *s);
+/* The route driver of --script route:NAME (route_driver.h), or NULL. */
+struct route_driver;
+const struct route_driver *sim_route(const sim_t *s);
 
 /* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
  * (and its CPU time in *cpu_s if non-NULL); the benchmark's measure of MuJoCo alone. */

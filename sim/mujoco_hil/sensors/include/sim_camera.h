@@ -40,6 +40,11 @@ sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *c
                                 char *err, size_t err_len);
 void sim_camera_destroy(sim_camera_t *c);
 
+/* An optional filter run on each rendered frame before JPEG encoding (camera realism: blur,
+ * noise): rgb rows top-down, w*h*3 bytes, changed in place. NULL: none. */
+typedef void (*sim_camera_filter_fn)(uint8_t *rgb, int width_px, int height_px, void *ctx);
+void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx);
+
 /* Renders the current state d and JPEG-encodes it. Returns 0, or -1 on failure. */
 int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime);
 

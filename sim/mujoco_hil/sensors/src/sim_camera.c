@@ -21,7 +21,14 @@ struct sim_camera {
   const uint8_t *jpg;
   size_t jpg_len;
   int64_t utime;
+  sim_camera_filter_fn filter;
+  void *filter_ctx;
 };
+
+void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx) {
+  c->filter = fn;
+  c->filter_ctx = ctx;
+}
 
 sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *cam_name,
                                 const char *frame_id, int width_px, int height_px, int jpeg_quality,
@@ -70,6 +77,7 @@ void sim_camera_destroy(sim_camera_t *c) {
 
 int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime) {
   if (sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb) != 0) return -1;
+  if (c->filter) c->filter(c->rgb, c->w, c->h, c->filter_ctx);
   if (sim_jpeg_encode(c->jpeg, c->rgb, c->w, c->h, &c->jpg, &c->jpg_len) != 0) return -1;
   c->utime = utime;
   return 0;

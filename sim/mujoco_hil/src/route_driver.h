@@ -1,0 +1,56 @@
+/* Route driver: the scripted driver `--script route:NAME[,speed=F][,start=S][,lookahead=M]`
+ * follows the map's named route (MJCF numeric `route_<NAME>` = "loop half_width_m x0 y0 x1 y1
+ * ...", contract with the map side) by pure pursuit (pure_pursuit.h) with the car's wheelbase
+ * and steering limit from <autodrive_vehicle.h>, at throttle F (the fraction of top speed),
+ * and keeps the cross-track error statistics of the rear-axle centre (base_link). Its
+ * throttle and steering reach the emulated Nano as real COMMAND frames (script.h). */
+#ifndef SIM_ROUTE_DRIVER_H
+#define SIM_ROUTE_DRIVER_H
+
+#include <stddef.h>
+
+#include <mujoco/mujoco.h>
+
+#include "pure_pursuit.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct route_driver {
+  char name[64];
+  double half_width_m; /* the lane's half width [m] */
+  double *xy_m;        /* owned copy of the polyline */
+  pp_path_t path;
+  pp_state_t st;
+  double speed; /* throttle, fraction of top speed */
+  double lookahead_m;
+  /* cross-track statistics over every update while driving [m] */
+  double sum_sq_m2, max_abs_m;
+  long samples;
+} route_driver_t;
+
+/* Loads route `name` from model m. Returns 0, or -1 with a message naming the route (and the
+ * routes the map has) in err. */
+int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, double speed,
+                      double lookahead_m, char *err, size_t err_sz);
+void route_driver_free(route_driver_t *r);
+
+/* Start pose: the route's first point, heading along its first segment. */
+void route_driver_start(const route_driver_t *r, double *x_m, double *y_m, double *yaw_rad);
+
+/* One update at the rear-axle pose: projects, records the cross-track error, and gives the
+ * normalised command (throttle 0 once the route is done; steering = angle / limit). */
+void route_driver_update(route_driver_t *r, double x_m, double y_m, double yaw_rad,
+                         double *throttle, double *steering);
+
+/* Cross-track RMS and max [m] so far; returns the number of samples. */
+long route_driver_stats(const route_driver_t *r, double *rms_m, double *max_m);
+
+/* Names of the routes in model m, comma-separated, into out (for messages and --help). */
+void route_driver_list(const mjModel *m, char *out, size_t out_sz);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

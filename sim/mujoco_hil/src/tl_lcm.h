@@ -1,0 +1,40 @@
+/* The traffic lights on LCM (program side): TRAFFIC_LIGHT_COMMAND in, TRAFFIC_LIGHT_STATE out
+ * for every light at 10 Hz of sim time and at once on each change (a command's effect is
+ * published as soon as the command is handled). A refused command is logged on stderr
+ * naming the light ids. Nothing is subscribed or published on a map without lights. */
+#ifndef SIM_TL_LCM_H
+#define SIM_TL_LCM_H
+
+#include <stdint.h>
+
+#include <lcm/lcm.h>
+
+#include "traffic_lights.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TL_LCM_STATE_PERIOD_US 100000 /* 10 Hz of sim time */
+
+typedef struct tl_lcm tl_lcm_t;
+
+/* NULL when the map has no lights (nothing to do) or on an LCM error (message in err). */
+tl_lcm_t *tl_lcm_create(lcm_t *lcm, traffic_lights_t *t, char *err, size_t err_sz);
+void tl_lcm_destroy(tl_lcm_t *k);
+
+/* Handles the commands waiting on the socket (no wait) at sim time now_us: accepted ones
+ * change the light at once and its new state is published. */
+void tl_lcm_poll(tl_lcm_t *k, int64_t now_us);
+
+/* After a sim step at now_us: publishes the lights whose state changed in it, and every light
+ * when the 10 Hz period is due. */
+void tl_lcm_publish(tl_lcm_t *k, int64_t now_us);
+
+/* Commands handled so far, and how many were refused. */
+long tl_lcm_commands(const tl_lcm_t *k, long *refused);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

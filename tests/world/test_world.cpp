@@ -1,0 +1,381 @@
+// The world side of the simulator (ctest prefix "world."): every map loads and steps, the route
+// driver keeps its lane, traffic lights are lit in rendered frames and refuse conflicting
+// commands, signs are visible, camera noise and blur. In-process, real MuJoCo and rendering.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "camera_fx.h"
+#include "pure_pursuit.h"
+#include "route_driver.h"
+#include "sim.h"
+#include "sim_camera.h"
+#include "sim_render.h"
+#include "sim_test_util.h"
+#include "traffic_lights.h"
+
+namespace {
+
+const char *const kMaps[] = {"parking_school", "driving_school", "intersection_school",
+                             "tiny_town"};
+
+nlohmann::json sidecar(const char *map) {
+  std::ifstream f(std::string(SIM_DIR) + "/maps/" + map + ".json");
+  return nlohmann::json::parse(f);
+}
+
+// A sim on map with car 1 at a start pose (or the map's spawn) and an optional script.
+struct WorldSim {
+  sim_t *s = nullptr;
+  std::string run_dir, err, params, map;
+  scn_pose_t start{};
+  WorldSim(const char *map_name, const scn_pose_t *pose, const char *script = nullptr) {
+    run_dir = simtest::temp_dir();
+    params = simtest::params_path();
+    map = simtest::map_path(map_name);
+    sim_config_t cfg = {};
+    cfg.params_path = params.c_str();
+    cfg.map_path = map.c_str();
+    cfg.run_dir = run_dir.c_str();
+    cfg.cars = 1;
+    cfg.seed = 1;
+    cfg.script = script;
+    cfg.tyre_model = -1;
+    if (pose) {
+      start = *pose;
+      cfg.start = &start;
+    }
+    char e[2048] = "";
+    s = sim_create(&cfg, e, sizeof e);
+    err = e;
+  }
+  ~WorldSim() {
+    sim_destroy(s);
+    rmdir(run_dir.c_str());
+  }
+  bool run_to(double t_s) {
+    char e[512];
+    while (sim_time_us(s) < (int64_t)llround(t_s * 1e6))
+      if (sim_step(s, e, sizeof e) != 0) {
+        err = e;
+        return false;
+      }
+    return true;
+  }
+};
+
+// Pixel (column, row) of world point p in camera cam_id (MuJoCo: looks along -z, y up).
+bool project(const mjModel *m, const mjData *d, int cam_id, const double p[3], int w, int h,
+             double *u, double *v) {
+  const mjtNum *c = d->cam_xpos + 3 * cam_id, *R = d->cam_xmat + 9 * cam_id;
+  double rel[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]}, loc[3];
+  for (int i = 0; i < 3; i++) loc[i] = R[i] * rel[0] + R[3 + i] * rel[1] + R[6 + i] * rel[2];
+  const double depth = -loc[2];
+  if (depth <= 0) return false;
+  const double f = 0.5 * h / tan(0.5 * m->cam_fovy[cam_id] * M_PI / 180.0);
+  *u = 0.5 * (w - 1) + f * loc[0] / depth;
+  *v = 0.5 * (h - 1) - f * loc[1] / depth;
+  return *u >= 0 && *u < w && *v >= 0 && *v < h;
+}
+
+// Mean RGB in a (2r+1)^2 window around (u, v).
+std::vector<double> mean_rgb(const uint8_t *rgb, int w, int h, double u, double v, int r) {
+  std::vector<double> acc(3, 0.0);
+  int n = 0;
+  for (int y = (int)v - r; y <= (int)v + r; y++)
+    for (int x = (int)u - r; x <= (int)u + r; x++) {
+      if (x < 0 || y < 0 || x >= w || y >= h) continue;
+      for (int c = 0; c < 3; c++) acc[c] += rgb[3 * (y * w + x) + c];
+      n++;
+    }
+  for (double &a : acc) a /= n > 0 ? n : 1;
+  return acc;
+}
+
+// Car 1's pose facing the thing at (x, y) whose face points along yaw, dist metres from it.
+scn_pose_t facing(double x, double y, double face_yaw, double dist) {
+  scn_pose_t p{};
+  p.x_m = x + dist * cos(face_yaw);
+  p.y_m = y + dist * sin(face_yaw);
+  p.yaw_deg = (face_yaw + M_PI) * 180.0 / M_PI;
+  return p;
+}
+
+class EveryMap : public ::testing::TestWithParam<const char *> {};
+
+TEST_P(EveryMap, LoadsAndSteps10sWithoutAMujocoWarning) {
+  WorldSim k(GetParam(), nullptr);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  ASSERT_TRUE(k.run_to(10.0)) << k.err;
+  const mjData *d = sim_data(k.s);
+  for (int w = 0; w < mjNWARNING; w++)
+    EXPECT_EQ(d->warning[w].number, 0) << GetParam() << ": MuJoCo warning " << w;
+}
+INSTANTIATE_TEST_SUITE_P(World, EveryMap, ::testing::ValuesIn(kMaps));
+
+// Drives a route to its end at 0.8 of top speed; the cross-track error stays within 3 cm.
+void drive_route(const char *map, const char *route) {
+  const std::string script = std::string("route:") + route + ",speed=0.8";
+  WorldSim k(map, nullptr, script.c_str());
+  ASSERT_NE(k.s, nullptr) << k.err;
+  const route_driver_t *r = sim_route(k.s);
+  ASSERT_NE(r, nullptr);
+  const double t_end = r->path.length_m / (0.8 * 0.267) * 1.5 + 2.0;
+  char e[512];
+  while (!r->st.done && sim_time_us(k.s) < (int64_t)(t_end * 1e6))
+    ASSERT_EQ(sim_step(k.s, e, sizeof e), 0) << e;
+  double rms, max;
+  const long n = route_driver_stats(r, &rms, &max);
+  printf("%s %s: %.2f m in %.1f s, %ld samples, cross-track RMS %.2f mm, max %.2f mm\n", map, route,
+         r->path.length_m, sim_time_us(k.s) * 1e-6, n, rms * 1e3, max * 1e3);
+  EXPECT_TRUE(r->st.done) << "the car did not reach the route's end";
+  EXPECT_GT(n, 100);
+  EXPECT_LE(max, 0.03);
+  EXPECT_LT(max, r->half_width_m);
+}
+
+TEST(World, RouteDriverKeepsItsLaneIntersectionSchoolLeftTurn) {
+  drive_route("intersection_school", "west_to_north");
+}
+TEST(World, RouteDriverKeepsItsLaneIntersectionSchoolRightTurn) {
+  drive_route("intersection_school", "north_to_west");
+}
+TEST(World, RouteDriverKeepsItsLaneTinyTown) {
+  drive_route("tiny_town", "lot_to_east");
+}
+
+TEST(World, PhysicsModelLeavesOutVisualGeomsTheCamerasStillSeeThem) {
+  WorldSim k("tiny_town", nullptr);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  const mjModel *m = sim_model(k.s), *mv = sim_render_model(k.s);
+  ASSERT_NE(m, mv);
+  EXPECT_LT(mj_name2id(m, mjOBJ_GEOM, "tl1_lamp_red"), 0);
+  EXPECT_GE(mj_name2id(mv, mjOBJ_GEOM, "tl1_lamp_red"), 0);
+  EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, "tl1_pole"), 0) << "a pole collides: the physics keeps it";
+  for (int g = 0; g < m->ngeom; g++)  // the map's geoms in the physics model all collide
+    if (m->geom_bodyid[g] == 0) {
+      EXPECT_TRUE(m->geom_contype[g] || m->geom_conaffinity[g]) << g;
+    }
+  EXPECT_EQ(m->nq, mv->nq);
+  ASSERT_TRUE(k.run_to(0.5));
+  const mjData *d = sim_data(k.s), *dv = sim_render_data(k.s);
+  for (int b = 0; b < m->nbody; b++)
+    for (int i = 0; i < 3; i++) EXPECT_NEAR(d->xpos[3 * b + i], dv->xpos[3 * b + i], 1e-9) << b;
+}
+
+TEST(World, ProgramFollowsTheMapsTiming) {
+  tl_light_t l{};
+  l.cycle_s = 20;
+  l.offset_s = 10;
+  l.green_s = 6;
+  l.yellow_s = 2;
+  double left;
+  EXPECT_EQ(tl_program_state(&l, 0.0, &left), TL_RED);
+  EXPECT_NEAR(left, 10.0, 1e-9);
+  EXPECT_EQ(tl_program_state(&l, 10.5, &left), TL_GREEN);
+  EXPECT_NEAR(left, 5.5, 1e-9);
+  EXPECT_EQ(tl_program_state(&l, 17.0, nullptr), TL_YELLOW);
+  EXPECT_EQ(tl_program_state(&l, 18.5, nullptr), TL_RED);
+  EXPECT_EQ(tl_program_state(&l, 30.0, nullptr), TL_GREEN);
+}
+
+TEST(World, ACommandThatWouldPutTwoConflictingLightsGreenIsRefused) {
+  WorldSim k("intersection_school", nullptr);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  traffic_lights_t *t = sim_traffic_lights(k.s);
+  ASSERT_EQ(t->n, 4);
+  ASSERT_TRUE(k.run_to(1.0));  // programs: lights 1 and 3 green, 2 and 4 red (offset 10 s)
+  EXPECT_EQ(t->light[tl_find(t, 1)].state, TL_GREEN);
+  char why[256] = "";
+  EXPECT_NE(tl_command(t, 2, TL_GREEN, 0.0, sim_time_us(k.s), why, sizeof why), 0);
+  printf("refused: %s\n", why);
+  EXPECT_NE(std::string(why).find("light 2"), std::string::npos) << why;
+  EXPECT_NE(std::string(why).find("light 1"), std::string::npos) << why;
+  EXPECT_NE(tl_command(t, 4, TL_YELLOW, 0.0, sim_time_us(k.s), why, sizeof why), 0);
+  EXPECT_NE(tl_command(t, 9, TL_RED, 0.0, sim_time_us(k.s), why, sizeof why), 0);  // no light 9
+  ASSERT_TRUE(k.run_to(1.1));
+  EXPECT_EQ(t->light[tl_find(t, 2)].state, TL_RED);
+  // green straight to red is fine; then 2 may go green while 1 and 3 are red
+  EXPECT_EQ(tl_command(t, 1, TL_RED, 0.0, sim_time_us(k.s), why, sizeof why), 0) << why;
+  EXPECT_EQ(tl_command(t, 3, TL_RED, 0.0, sim_time_us(k.s), why, sizeof why), 0) << why;
+  ASSERT_TRUE(k.run_to(1.2));
+  EXPECT_EQ(tl_command(t, 2, TL_GREEN, 3.0, sim_time_us(k.s), why, sizeof why), 0) << why;
+  ASSERT_TRUE(k.run_to(1.3));
+  EXPECT_EQ(t->light[tl_find(t, 2)].state, TL_GREEN);
+  // light 1's command ends (RED until the next command): free it with a short one; its program
+  // says green at t < 6 s but it yields while light 2 is held green
+  EXPECT_EQ(tl_command(t, 1, TL_RED, 0.1, sim_time_us(k.s), why, sizeof why), 0) << why;
+  ASSERT_TRUE(k.run_to(2.0));
+  EXPECT_EQ(t->light[tl_find(t, 1)].state, TL_RED);
+  EXPECT_EQ(t->light[tl_find(t, 2)].state, TL_GREEN);
+  // light 2's hold (3 s from 1.2 s) ends at 4.2 s: back to its program (red), 1 back to green
+  ASSERT_TRUE(k.run_to(4.3));
+  EXPECT_EQ(t->light[tl_find(t, 2)].state, TL_RED);
+  EXPECT_EQ(t->light[tl_find(t, 1)].state, TL_GREEN);
+  for (double ts = 4.3; ts < 40.0; ts += 0.1) {  // and never two conflicting lights non-red
+    ASSERT_TRUE(k.run_to(ts));
+    for (int c = 0; c < t->nconflicts; c++) {
+      const int a = t->light[tl_find(t, t->conflict[c][0])].state,
+                b = t->light[tl_find(t, t->conflict[c][1])].state;
+      ASSERT_FALSE((a == TL_GREEN || a == TL_YELLOW) && (b == TL_GREEN || b == TL_YELLOW))
+          << "t = " << ts;
+    }
+  }
+}
+
+// Front camera of a car 1.2 m in front of light 1, facing it.
+struct LightCamera {
+  scn_pose_t p;
+  WorldSim k;
+  sim_render_t *rd = nullptr;
+  sim_camera_t *cam = nullptr;
+  char err[1024] = "";
+  static scn_pose_t pose() {
+    const auto j = sidecar("intersection_school")["traffic_lights"][0];
+    return facing(j["position_m"][0], j["position_m"][1], j["yaw_rad"], 1.2);
+  }
+  LightCamera() : p(pose()), k("intersection_school", &p) {}
+  ~LightCamera() {
+    sim_camera_destroy(cam);
+    sim_render_destroy(rd);
+  }
+  bool open() {
+    if (!k.s) return false;
+    rd = sim_render_create(sim_render_model(k.s), 640, 480, SIM_RENDER_AUTO, err, sizeof err);
+    if (rd)
+      cam = sim_camera_create(rd, sim_render_model(k.s), "nigel1/cam_front", "camera_front", 640,
+                              480, 85, err, sizeof err);
+    return cam != nullptr;
+  }
+  // Mean colour of lamp colour ("red", "yellow", "green") of light 1 in the frame.
+  std::vector<double> lamp(const char *colour) {
+    const mjModel *m = sim_render_model(k.s);
+    const mjData *d = sim_render_data(k.s);
+    const std::string name = std::string("tl1_lamp_") + colour;
+    const int g = mj_name2id(m, mjOBJ_GEOM, name.c_str());
+    EXPECT_GE(g, 0) << name;
+    double u = 0, v = 0;
+    const int cam_id = mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front");
+    EXPECT_TRUE(project(m, d, cam_id, d->geom_xpos + 3 * g, 640, 480, &u, &v))
+        << name << " is not in the frame";
+    return mean_rgb(sim_camera_rgb(cam), 640, 480, u, v, 2);
+  }
+};
+
+TEST(World, ALightCommandedRedIsRenderedRedInTheFrontCamera) {
+  LightCamera lc;
+  ASSERT_TRUE(lc.open()) << lc.k.err << lc.err;
+  traffic_lights_t *t = sim_traffic_lights(lc.k.s);
+  char why[256] = "";
+  ASSERT_TRUE(lc.k.run_to(0.5));
+  ASSERT_EQ(tl_command(t, 1, TL_RED, 0.0, sim_time_us(lc.k.s), why, sizeof why), 0) << why;
+  ASSERT_TRUE(lc.k.run_to(0.52));
+  ASSERT_EQ(sim_camera_capture(lc.cam, sim_render_model(lc.k.s), sim_render_data(lc.k.s), 0), 0);
+  auto red = lc.lamp("red"), green = lc.lamp("green");
+  printf("commanded RED: red lamp rgb %.0f %.0f %.0f, green lamp rgb %.0f %.0f %.0f\n", red[0],
+         red[1], red[2], green[0], green[1], green[2]);
+  EXPECT_GT(red[0], 180);
+  EXPECT_GT(red[0] - red[1], 100);
+  EXPECT_LT(green[1], 120);
+  // and GREEN: the lamps swap
+  ASSERT_EQ(tl_command(t, 1, TL_GREEN, 0.0, sim_time_us(lc.k.s), why, sizeof why), 0) << why;
+  ASSERT_TRUE(lc.k.run_to(0.54));
+  ASSERT_EQ(sim_camera_capture(lc.cam, sim_render_model(lc.k.s), sim_render_data(lc.k.s), 0), 0);
+  red = lc.lamp("red");
+  green = lc.lamp("green");
+  printf("commanded GREEN: red lamp rgb %.0f %.0f %.0f, green lamp rgb %.0f %.0f %.0f\n", red[0],
+         red[1], red[2], green[0], green[1], green[2]);
+  EXPECT_GT(green[1], 180);
+  EXPECT_GT(green[1] - green[0], 100);
+  EXPECT_LT(red[0], 120);
+}
+
+TEST(World, AStopSignIsVisibleFrom1mInTheFrontCamera) {
+  const auto j = sidecar("tiny_town")["signs"];
+  nlohmann::json sign;
+  for (const auto &s : j)
+    if (s["kind"] == "stop") sign = s;
+  ASSERT_FALSE(sign.is_null());
+  const scn_pose_t p = facing(sign["position_m"][0], sign["position_m"][1], sign["yaw_rad"], 1.0);
+  WorldSim k("tiny_town", &p);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  const mjModel *m = sim_render_model(k.s);
+  char err[1024] = "";
+  sim_render_t *rd = sim_render_create(m, 640, 480, SIM_RENDER_AUTO, err, sizeof err);
+  ASSERT_NE(rd, nullptr) << err;
+  sim_camera_t *cam =
+      sim_camera_create(rd, m, "nigel1/cam_front", "camera_front", 640, 480, 85, err, sizeof err);
+  ASSERT_NE(cam, nullptr) << err;
+  ASSERT_TRUE(k.run_to(0.05));
+  mjData *d = sim_render_data(k.s);
+  ASSERT_EQ(sim_camera_capture(cam, m, d, 0), 0);
+  const std::string face = std::string(sign["name"]) + "_face";
+  const int g = mj_name2id(m, mjOBJ_GEOM, face.c_str());
+  ASSERT_GE(g, 0) << face;
+  double u = 0, v = 0;
+  ASSERT_TRUE(project(m, d, mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front"), d->geom_xpos + 3 * g,
+                      640, 480, &u, &v));
+  // the face (8 cm at 1 m: ~40 px): the stop texture's red, with its white letters
+  int red = 0, n = 0;
+  const uint8_t *rgb = sim_camera_rgb(cam);
+  for (int y = (int)v - 12; y <= (int)v + 12; y++)
+    for (int x = (int)u - 12; x <= (int)u + 12; x++, n++) {
+      const uint8_t *px = rgb + 3 * (y * 640 + x);
+      red += px[0] > 120 && px[0] > 2 * px[1] && px[0] > 2 * px[2];
+    }
+  printf("stop sign at pixel (%.0f, %.0f): %d of %d pixels red\n", u, v, red, n);
+  EXPECT_GT(red, n / 3);
+  sim_camera_destroy(cam);
+  sim_render_destroy(rd);
+}
+
+TEST(World, PurePursuitSteersACircleExactly) {
+  // a circle of radius 0.6 m, CCW, points 0.02 m apart: on it and tangent, the steering angle is
+  // atan(L / R) for any lookahead
+  std::vector<double> xy;
+  const double R = 0.6, L = 0.14154;
+  const int n = (int)(2 * M_PI * R / 0.02);
+  for (int i = 0; i < n; i++) {
+    xy.push_back(R * cos(2 * M_PI * i / n));
+    xy.push_back(R * sin(2 * M_PI * i / n));
+  }
+  pp_path_t p;
+  char err[128];
+  ASSERT_EQ(pp_path_init(&p, xy.data(), n, 1, err, sizeof err), 0) << err;
+  pp_state_t st;
+  pp_reset(&st, &p, R, 0.0);
+  pp_project(&st, &p, R, 0.0);
+  EXPECT_NEAR(st.cross_track_m, 0.0, 1e-9);
+  for (double ld : {0.1, 0.2, 0.4})
+    EXPECT_NEAR(pp_steer(&st, &p, R, 0.0, M_PI / 2, ld, L, 1.0), atan(L / R), 2e-3) << ld;
+  pp_project(&st, &p, R + 0.01, 0.0);  // 1 cm outside the CCW circle: right of it
+  EXPECT_NEAR(st.cross_track_m, -0.01, 1e-4);
+  pp_path_free(&p);
+}
+
+TEST(World, CameraNoiseIsSeededAndBlurSmooths) {
+  std::vector<uint8_t> a(64 * 48 * 3), b, c;
+  for (size_t i = 0; i < a.size(); i++) a[i] = (i / 3) % 2 ? 200 : 40;  // a fine stripe pattern
+  cfx_t f1, f2, blur;
+  cfx_init(&f1, 8.0, 0.0, 7);
+  cfx_init(&f2, 8.0, 0.0, 7);
+  cfx_init(&blur, 0.0, 2.0, 7);
+  b = a;
+  c = a;
+  cfx_apply(&f1, b.data(), 64, 48);
+  cfx_apply(&f2, c.data(), 64, 48);
+  EXPECT_EQ(b, c) << "same seed, same noise";
+  EXPECT_NE(b, a);
+  c = a;
+  cfx_apply(&blur, c.data(), 64, 48);
+  EXPECT_NEAR(c[3 * (24 * 64 + 32)], 120, 8) << "blurred stripes tend to their mean";
+  cfx_free(&f1);
+  cfx_free(&f2);
+  cfx_free(&blur);
+}
+
+}  // namespace
