@@ -61,6 +61,15 @@ MEDIAN_MAX_KEYS = (
 PER_SEED_KEYS = MEDIAN_MAX_KEYS + ("min_clearance_m", "collisions", "path_length_m")
 # Per-seed facts that the seed and slot fix (the scenario), kept as they are.
 PER_SEED_FACTS = ("start_world", "goal_world")
+# Two sweeps of the same seeds agree when the scenario and each run's success are the same
+# and the closed-loop figures are within these. Not exact: in the demo's --lockstep-client the
+# runtime's and the autonomy's commands land at sim steps that depend on wall-clock scheduling
+# (docs/ARCHITECTURE.md, Clocks), so two runs of one seed on one machine differ this much too.
+AGREE_TOLERANCE = {
+    "final_pos_error_m": 0.01,
+    "final_heading_error_deg": 1.5,
+    "localization_rms_m": 0.01,
+}
 EXIT_FILE = "demo_exit_code"  # per seed dir: the demo's exit code, kept for --aggregate-only
 
 Run = dict[str, Any]
@@ -436,6 +445,21 @@ def aggregate(runs: list[Run]) -> dict[str, Any]:
     for k in PER_SEED_FACTS:
         s["per_seed"][k] = [(rep or {}).get(k) for rep in reps]
     return s
+
+
+def disagreements(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
+    """How two sweep summaries of the same seeds differ beyond AGREE_TOLERANCE ([] = they
+    agree): seeds, slots, per-seed success and scenario exactly, figures within tolerance."""
+    pa, pb = a["per_seed"], b["per_seed"]
+    exact = ("seed", "slot", "ok") + PER_SEED_FACTS
+    out = [f"{k}: {pa.get(k)} != {pb.get(k)}" for k in exact if pa.get(k) != pb.get(k)]
+    if out:
+        return out
+    for k, tol in AGREE_TOLERANCE.items():
+        for seed, x, y in zip(pa["seed"], pa[k], pb[k]):
+            if (x is None) != (y is None) or (x is not None and abs(x - y) > tol):
+                out.append(f"seed {seed} {k}: {x} vs {y} (tolerance {tol})")
+    return out
 
 
 def progress_line(i: int, n: int, name: str, run: Run, measured_wall_s: float | None) -> str:

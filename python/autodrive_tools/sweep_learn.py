@@ -313,7 +313,9 @@ def main(kind: str, argv: list[str]) -> int:
     except (ValueError, RuntimeError) as e:
         log(f"[{kind}] ERROR: {e}")
         return 2
-    log(f"[{kind}] {len(specs)} job(s) of {args.env} {pool.describe()}")
+    log(
+        f"[{kind}] {len(specs)} job(s) of {args.env} {pool.describe()}; ready in {pool.init_s:.1f} s"
+    )
     finished = 0
 
     def done(i: int, r: dict[str, Any], host: str, wall_s: float) -> None:

@@ -11,6 +11,7 @@ import logging
 import os
 import shutil
 import socket
+import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -93,11 +94,20 @@ def close_pool(pool: Pool) -> None:
         shutil.rmtree(pool.temp_dir, ignore_errors=True)
 
 
+def where() -> str:
+    """This process's place: the host name, and on Ray "host:node" (8 hex digits of the Ray
+    node id: several nodes may share a host)."""
+    ray = sys.modules.get("ray")  # never imported here for a serial run
+    if ray is not None and ray.is_initialized():
+        return f"{socket.gethostname()}:{ray.get_runtime_context().get_node_id()[:8]}"
+    return socket.gethostname()
+
+
 def _on_node(fn: Callable[[A], R], arg: A) -> tuple[R, str, float]:
-    """Runs one job where Ray put it: (its result, the node's host name, its wall time [s])."""
+    """Runs one job where Ray put it: (its result, where(), its wall time [s])."""
     t0 = time.monotonic()
     result = fn(arg)
-    return result, socket.gethostname(), time.monotonic() - t0
+    return result, where(), time.monotonic() - t0
 
 
 def run_jobs(
