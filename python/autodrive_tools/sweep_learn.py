@@ -17,6 +17,7 @@ import importlib
 import json
 import statistics
 import sys
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -156,13 +157,19 @@ class LearnJob:
     algo: str
     register: tuple[str, ...]
     options: dict[str, Any] = field(default_factory=dict)
+    policy_zip: bytes | None = None  # a .zip policy travels with the job: nodes need no copy
 
 
 def run_learn_job(spec: LearnJob) -> dict[str, Any]:
     fn = resolve(spec.job, "--job")
-    result: dict[str, Any] = fn(
-        spec.env_id, spec.seed, spec.policy, algo=spec.algo, register=spec.register, **spec.options
-    )
+    with tempfile.TemporaryDirectory(prefix="autodrive-sweep-policy-") as tmp:
+        policy = spec.policy
+        if spec.policy_zip is not None:
+            policy = str(Path(tmp) / "policy.zip")
+            Path(policy).write_bytes(spec.policy_zip)
+        result: dict[str, Any] = fn(
+            spec.env_id, spec.seed, policy, algo=spec.algo, register=spec.register, **spec.options
+        )
     return result
 
 
@@ -238,15 +245,15 @@ def parse_args(kind: str, argv: list[str]) -> argparse.Namespace:
 
 
 def _specs(kind: str, args: argparse.Namespace) -> list[LearnJob]:
-    policy = (
-        str(Path(args.policy).resolve())
-        if args.policy and args.policy.endswith(".zip")
-        else args.policy
-    )
+    policy, policy_zip = args.policy, None
+    if policy and policy.endswith(".zip"):
+        policy_zip = Path(policy).read_bytes()
     options = {"steps": args.steps} if kind == "rollouts" else {}
     seeds = range(args.first_seed, args.first_seed + args.seeds)
     return [
-        LearnJob(args.job, args.env, s, policy, args.algo, tuple(args.register), options)
+        LearnJob(
+            args.job, args.env, s, policy, args.algo, tuple(args.register), options, policy_zip
+        )
         for s in seeds
     ]
 
