@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import signal
 import socket
 import sys
 import tempfile
@@ -104,9 +105,15 @@ def where() -> str:
 
 
 def _on_node(fn: Callable[[A], R], arg: A) -> tuple[R, str, float]:
-    """Runs one job where Ray put it: (its result, where(), its wall time [s])."""
+    """Runs one job where Ray put it: (its result, where(), its wall time [s]). A Ray worker
+    blocks SIGINT, and the programs a job starts would inherit that mask and ignore the SIGINT
+    that asks them to stop cleanly: unblocked while the job runs."""
     t0 = time.monotonic()
-    result = fn(arg)
+    mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        result = fn(arg)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
     return result, where(), time.monotonic() - t0
 
 
