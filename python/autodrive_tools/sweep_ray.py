@@ -73,6 +73,7 @@ def open_pool(workers: int, address: str | None, serial: bool = False) -> Pool:
                 log_to_driver=False,
             )
         else:
+            _reachable(address)  # Ray itself would retry for minutes
             ray.init(address=address, logging_level=logging.WARNING, log_to_driver=False)
     except (ConnectionError, RuntimeError, ValueError) as e:
         close_pool(pool)
@@ -81,6 +82,17 @@ def open_pool(workers: int, address: str | None, serial: bool = False) -> Pool:
     pool.cluster_cpus = float(ray.cluster_resources().get("CPU", 0.0))
     pool.init_s = time.monotonic() - t0
     return pool
+
+
+def _reachable(address: str, timeout_s: float = 5.0) -> None:
+    """ConnectionError naming the address unless its HOST:PORT accepts a TCP connection."""
+    host, sep, port = address.rpartition(":")
+    if not sep or not host or not port.isdigit():
+        raise ValueError("want HOST:PORT, the address `ray start --head` printed")
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout_s).close()
+    except OSError as e:
+        raise ConnectionError(f"no Ray head answers there ({e})") from None
 
 
 def close_pool(pool: Pool) -> None:

@@ -86,4 +86,6 @@ with tempfile.TemporaryDirectory(prefix="sweep-learn-") as t:
     assert "missing.zip: no such file" in err, err
     _, err = sweep("eval", *common, "--workers", "0", code=2)
     assert "--workers 0" in err, err
+    _, err = sweep("eval", *common, "--address", "127.0.0.1:1", code=2)
+    assert "--address 127.0.0.1:1" in err and "no Ray head answers" in err, err
 print("eval and rollouts: Ray and serial agree seed by seed")
