@@ -27,10 +27,11 @@ from autodrive_tools import sweep
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 RAY = root / ".venv" / "bin" / "ray"
 SEEDS = 4
-# A short scenario: map standing still, no late box (the default demo is the HIL suite's); in
-# real time: under ASan, two runs at once on a 2-core machine leave the autonomy (not in the
-# sim's lockstep) too far behind a sim that runs as fast as the runtime keeps up.
-SCENARIO = ["--mapping-route", "", "--no-late-box", "--realtime", "--timeout", "200"]
+# A short scenario: map standing still, no late box (the default demo is the HIL suite's);
+# paced at half real time: under ASan, two runs at once on a 2-core machine leave the autonomy
+# (not in the sim's lockstep) too far behind a sim that runs as fast as the runtime keeps up,
+# and in real time still missed the goal on a loaded machine.
+SCENARIO = ["--mapping-route", "", "--no-late-box", "--rtf", "0.5", "--timeout", "300"]
 ENV = dict(os.environ, RAY_USAGE_STATS_ENABLED="0")
 
 
