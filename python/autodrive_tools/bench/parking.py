@@ -1,6 +1,7 @@
 """tools/bench parking: the HIL parking demo (sim + unchanged runtime + autodrive-autonomy)
-over PARKING_SEEDS seeds (default 10), one after the other, aggregated against the goals of
-issue 7 by autodrive_tools.sweep. Writes out/bench/parking/ (seed<N>/ per run, summary.json,
+over PARKING_SEEDS seeds (default 10), as jobs on an embedded local Ray (--workers N jobs at a
+time, default 1; --address joins a cluster), aggregated against the goals of issue 7 by
+autodrive_tools.sweep. Writes out/bench/parking/ (seed<N>/ per run, summary.json,
 parking_sweep.png). Options go to the sweep (--help), e.g. --slot K, --extra --realtime."""
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ DEFAULT_SEEDS = "10"
 def main(argv: list[str]) -> int:
     if any(a in ("-h", "--help") for a in argv):
         print(__doc__.strip() + "\n")
-        return sweep.main(["--help"])
+        return sweep.main(["--help"], "tools/bench parking")
     seeds = os.environ.get("PARKING_SEEDS", DEFAULT_SEEDS)
     if not re.fullmatch(r"[1-9][0-9]*", seeds):
         print(
@@ -29,4 +30,4 @@ def main(argv: list[str]) -> int:
     # --seeds/--out first: options given to the suite come later and win (argparse keeps
     # the last).
     base = ["--build", str(build_dir("parking")), "--seeds", seeds]
-    return sweep.main(base + ["--out", str(out_dir() / "parking")] + argv)
+    return sweep.main(base + ["--out", str(out_dir() / "parking")] + argv, "tools/bench parking")
