@@ -37,6 +37,11 @@ need_venv() {
 AARCH64_TARGETS=(autodrive-runtime autodrive-autonomy autodrive-eye firmware_host_tests
   runtime_unit_tests eye_tests autonomy_test_planner autonomy_test_scan_match
   autonomy_test_icp autonomy_test_amcl autonomy_test_tracker autonomy_test_map_io)
+# What runs under qemu: the unit tests that matter for portability (protocol codec and the
+# portability checks, bridge conversions, EKF, config, RPLIDAR decoder, teleop, clock, the
+# autonomy's planners, scan matching, ICP, AMCL, tracker and map files, the Eye's
+# localisation). Not the pty/LCM/process tests: they test Linux, not the CPU.
+AARCH64_TESTS='^(firmware\.|runtime\.unit\.|autonomy\.(planner|scan_match|icp|amcl|tracker|map_io)\.|eye\.)'
 build_aarch64() {
   local dir="$ROOT/build/aarch64/build"
   if [ ! -f "$dir/build.ninja" ]; then

@@ -3,6 +3,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 extern "C" {
@@ -11,6 +12,7 @@ extern "C" {
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
+#include <simavr/sim_hex.h>
 #include <simavr/sim_io.h>
 #include "nigel_hal.h"
 }
@@ -83,6 +85,35 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   proto_parser_init(&parser_);
 }
 
+void Board::boot_from(const std::string &hex_path) {
+  ihex_chunk_p chunks = nullptr;
+  const int n = read_ihex_chunks(hex_path.c_str(), &chunks);
+  if (n <= 0) throw std::runtime_error("cannot read bootloader HEX '" + hex_path + "'");
+  const uint32_t flash_bytes = avr_->flashend + 1;
+  std::memset(avr_->flash, 0xFF, flash_bytes);
+  uint32_t start = flash_bytes;
+  for (int i = 0; i < n; i++) {
+    const ihex_chunk_t &c = chunks[i];
+    if (c.baseaddr + c.size > flash_bytes || c.baseaddr < flash_bytes / 2) {
+      std::free(chunks);
+      throw std::runtime_error("'" + hex_path + "' is not a bootloader: data outside the boot section");
+    }
+    std::memcpy(avr_->flash + c.baseaddr, c.data, c.size);
+    if (c.baseaddr < start) start = c.baseaddr;
+  }
+  for (int i = 0; i < n; i++) std::free(chunks[i].data);
+  std::free(chunks);
+  avr_->codeend = avr_->flashend;
+  avr_->reset_pc = start;  // BOOTRST programmed: reset jumps into the bootloader
+  avr_reset(avr_);
+  quiet_uart(avr_);
+  constexpr uint16_t kMcusr = 0x54;
+  constexpr uint8_t kExtrf = 0x02;
+  avr_->data[kMcusr] = kExtrf;  // reset pin pulled by DTR: the bootloader stays
+  next_tx_cycle_ = cycle() + 1000 * kCyclesPerUs;
+  wake_at(next_tx_cycle_, &tx_queue_);
+}
+
 Board::~Board() {
   if (avr_ != nullptr) {
     avr_terminate(avr_);
@@ -122,6 +153,7 @@ void Board::on_uart_byte(uint8_t b) {
 
 void Board::send(const uint8_t *data, size_t n) {
   tx_queue_.insert(tx_queue_.end(), data, data + n);
+  wake_at(next_tx_cycle_, &tx_queue_);
 }
 
 void Board::send_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
@@ -245,6 +277,18 @@ void Board::sample_pwm() {
   }
 }
 
+// A no-op cycle timer: while the firmware sleeps, simavr jumps straight to its next cycle
+// timer; these stop it at the harness's own next event (a UART byte, an encoder edge, the end
+// of run_us), which the harness polls by cycle. One timer per tag (re-registering replaces).
+static avr_cycle_count_t wake_for_harness(avr_t *, avr_cycle_count_t, void *) {
+  return 0;
+}
+
+void Board::wake_at(uint64_t at_cycle, void *tag) {
+  const uint64_t c = cycle();
+  if (at_cycle > c) avr_cycle_timer_register(avr_, at_cycle - c, wake_for_harness, tag);
+}
+
 void Board::step_io() {
   const uint64_t c = cycle();
   if (!tx_queue_.empty() && c >= next_tx_cycle_) {
@@ -252,6 +296,7 @@ void Board::step_io() {
     tx_queue_.pop_front();
     next_tx_cycle_ = c + kUartByteCycles;
     if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
+    else wake_at(next_tx_cycle_, &tx_queue_);
   }
   if (enc_rate_ > 0 && c >= enc_next_cycle_) {
     for (int s = 0; s < 2; s++) {
@@ -267,16 +312,21 @@ void Board::step_io() {
     }
     enc_next_cycle_ =
         static_cast<uint64_t>(static_cast<double>(enc_next_cycle_) + enc_phase_cycles_);
+    wake_at(enc_next_cycle_, &enc_next_cycle_);
   }
 }
 
 bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
   const uint64_t end = cycle() + us * kCyclesPerUs;
+  wake_at(end, &run_end_tag_);
   uint32_t n = 0;
   while (cycle() < end) {
     step_io();
     const uint32_t pc_before = avr_->pc;
+    const bool was_sleeping = avr_->state == cpu_Sleeping;
+    const uint64_t cycle_before = avr_->cycle;
     const int state = avr_run(avr_);
+    if (was_sleeping) loop_sleep_cycles_ += avr_->cycle - cycle_before;
     if (state == cpu_Done || state == cpu_Crashed) return false;
     const uint32_t pc = avr_->pc;
     if (pc != pc_before) {
@@ -285,17 +335,19 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         quiet_uart(avr_);
         isr_active_ = -1;
         loop_last_cycle_ = 0;
+        loop_sleep_cycles_ = 0;
       } else if (pc < kVectorTableBytes && (pc & 3u) == 0) {  // entered an interrupt vector
         isr_active_ = static_cast<int>(pc / 4);
         // the 4-cycle interrupt response (datasheet) counts as part of the ISR
         isr_start_ = avr_->cycle - 4;
       } else if (pc == loop_addr_) {
-        if (loop_last_cycle_ != 0) {
-          const uint64_t d = avr_->cycle - loop_last_cycle_;
+        if (loop_last_cycle_ != 0) {  // a pass's busy cycles: ISRs in, sleep out
+          const uint64_t d = avr_->cycle - loop_last_cycle_ - loop_sleep_cycles_;
           if (d > loop_max_) loop_max_ = static_cast<uint32_t>(d);
           if (record_loop_) loop_cycles_.push_back(static_cast<uint32_t>(d));
         }
         loop_last_cycle_ = avr_->cycle;
+        loop_sleep_cycles_ = 0;
         loop_passes_++;
       }
     }

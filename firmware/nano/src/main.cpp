@@ -3,6 +3,7 @@
  * and the CMake build (firmware/nano/avr) build the same file. */
 #include <Arduino.h>
 #include <avr/interrupt.h>
+#include <avr/sleep.h>
 
 #include "enc.h"
 #include "fw_enc.h"
@@ -83,6 +84,26 @@ void setup() {
   nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0), NIGEL_BUILD_ID);
 }
 
+/* Between passes the CPU sleeps (IDLE: timers, UART, TWI and the pin interrupts keep running)
+ * until the next interrupt: Timer0's overflow (every 1.024 ms, millis/micros), a received or
+ * sent byte, a TWI step, an encoder edge. Everything the loop does is started by one of those
+ * or by time, so no pass is lost; the CPU does not spin, which saves power on the car and
+ * lets simavr skip the idle cycles (nano-simavr then keeps up with real time). Telemetry keeps
+ * its 10 ms mean period: nigel_step schedules it drift-free, the wake-up only adds jitter
+ * below 1.024 ms. Unread received bytes mean another pass right away. */
+static void fw_sleep_until_interrupt(void) {
+  set_sleep_mode(SLEEP_MODE_IDLE);
+  cli();
+  if (!fw_uart_rx_pending()) {
+    sleep_enable();
+    sei(); /* the instruction after SEI runs before any interrupt: no wake-up is missed */
+    sleep_cpu();
+    sleep_disable();
+  }
+  sei();
+}
+
 void loop() {
   fw_loop_once();
+  fw_sleep_until_interrupt();
 }
