@@ -153,7 +153,8 @@ TEST(Portability, PayloadAtEveryOffset) {
     EXPECT_EQ(d.enc_counts[1], 654321) << "offset " << off;
     EXPECT_EQ(d.gyro_raw[1], -300) << "offset " << off;
     EXPECT_EQ(d.last_cmd_seq, 0xBEEFu) << "offset " << off;
-    EXPECT_EQ(proto_crc16(0xFFFFu, at, PROTO_LEN_STATE), proto_crc16(0xFFFFu, ref, PROTO_LEN_STATE));
+    EXPECT_EQ(proto_crc16(0xFFFFu, at, PROTO_LEN_STATE),
+              proto_crc16(0xFFFFu, ref, PROTO_LEN_STATE));
   }
 }
 

@@ -52,8 +52,18 @@ def main() -> int:
             assert time.monotonic() < deadline, "no pty symlink"
             time.sleep(0.05)
         up = subprocess.run(
-            [str(root / ".venv/bin/pio"), "run", "-d", str(root), "-e", "nano_offline_new",
-             "-t", "upload", "--upload-port", str(link)],
+            [
+                str(root / ".venv/bin/pio"),
+                "run",
+                "-d",
+                str(root),
+                "-e",
+                "nano_offline_new",
+                "-t",
+                "upload",
+                "--upload-port",
+                str(link),
+            ],
             env=pio_env(work),
             capture_output=True,
             text=True,
@@ -89,11 +99,15 @@ def main() -> int:
         want_id = int(
             subprocess.run(
                 ["git", "-C", str(root), "rev-parse", "--short=8", "HEAD"],
-                capture_output=True, text=True, check=True,
+                capture_output=True,
+                text=True,
+                check=True,
             ).stdout.strip(),
             16,
         )
-        print(f"HELLO fw {fw[0]}.{fw[1]}.{fw[2]} proto {fw[3]} schema 0x{fw[4]:08x} build 0x{fw[5]:08x}")
+        print(
+            f"HELLO fw {fw[0]}.{fw[1]}.{fw[2]} proto {fw[3]} schema 0x{fw[4]:08x} build 0x{fw[5]:08x}"
+        )
         assert fw[3] == 1, f"protocol version {fw[3]}"
         assert fw[5] == want_id, f"build id 0x{fw[5]:08x}, PlatformIO stamped 0x{want_id:08x}"
     finally:

@@ -84,8 +84,19 @@ def check_upload(root: Path, work: Path, pio: Path, env_name: str, baud: int) ->
     master, slave = pty.openpty()
     port = os.ttyname(slave)
     proc = subprocess.Popen(
-        [str(pio), "run", "-d", str(root), "-e", env_name, "-t", "upload",
-         "--upload-port", port, "-v"],
+        [
+            str(pio),
+            "run",
+            "-d",
+            str(root),
+            "-e",
+            env_name,
+            "-t",
+            "upload",
+            "--upload-port",
+            port,
+            "-v",
+        ],
         env=pio_env(work),
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,

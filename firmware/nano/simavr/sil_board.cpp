@@ -96,7 +96,8 @@ void Board::boot_from(const std::string &hex_path) {
     const ihex_chunk_t &c = chunks[i];
     if (c.baseaddr + c.size > flash_bytes || c.baseaddr < flash_bytes / 2) {
       std::free(chunks);
-      throw std::runtime_error("'" + hex_path + "' is not a bootloader: data outside the boot section");
+      throw std::runtime_error("'" + hex_path +
+                               "' is not a bootloader: data outside the boot section");
     }
     std::memcpy(avr_->flash + c.baseaddr, c.data, c.size);
     if (c.baseaddr < start) start = c.baseaddr;
@@ -295,8 +296,10 @@ void Board::step_io() {
     avr_raise_irq(uart_in_, tx_queue_.front());
     tx_queue_.pop_front();
     next_tx_cycle_ = c + kUartByteCycles;
-    if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
-    else wake_at(next_tx_cycle_, &tx_queue_);
+    if (tx_queue_.empty())
+      last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
+    else
+      wake_at(next_tx_cycle_, &tx_queue_);
   }
   if (enc_rate_ > 0 && c >= enc_next_cycle_) {
     for (int s = 0; s < 2; s++) {

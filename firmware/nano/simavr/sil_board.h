@@ -145,7 +145,8 @@ class Board {
   std::deque<uint8_t> tx_queue_;
   uint64_t next_tx_cycle_ = 0, last_tx_cycle_ = 0;
   uint8_t run_end_tag_ = 0;
-  uint64_t loop_sleep_cycles_ = 0;  // cycles asleep since the last loop pass began  // address only: the cycle-timer tag of run_us's end
+  uint64_t loop_sleep_cycles_ = 0;  // cycles asleep since the last loop pass began  // address
+                                    // only: the cycle-timer tag of run_us's end
   void wake_at(uint64_t at_cycle, void *tag);
   proto_parser_t parser_{};
   std::vector<Frame> frames_;

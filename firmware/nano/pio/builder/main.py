@@ -81,9 +81,7 @@ target_elf = env.BuildProgram()
 target_hex = env.Command(
     os.path.join("$BUILD_DIR", "${PROGNAME}.hex"),
     target_elf,
-    env.VerboseAction(
-        "$OBJCOPY -O ihex -R .eeprom $SOURCES $TARGET", "Building $TARGET"
-    ),
+    env.VerboseAction("$OBJCOPY -O ihex -R .eeprom $SOURCES $TARGET", "Building $TARGET"),
 )
 AlwaysBuild(env.Alias("nobuild", target_hex))
 Default([env.Alias("buildprog", target_hex)])
