@@ -54,7 +54,8 @@ TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
   uint8_t payload[PROTO_LEN_STATE];
   proto_state_pack(&s, payload);
   uint8_t frame[PROTO_MAX_FRAME];
-  const size_t n = proto_frame_encode(PROTO_ID_STATE, 0xFFu, payload, PROTO_LEN_STATE, frame);
+  const size_t n =
+      proto_frame_encode(PROTO_ID_STATE, 0xFFu, payload, PROTO_LEN_STATE, frame, sizeof frame);
   ASSERT_EQ(n, PROTO_LEN_STATE + PROTO_OVERHEAD);
 
   std::vector<char> as_chars(n);

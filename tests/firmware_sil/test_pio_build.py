@@ -17,6 +17,7 @@ import pty
 import re
 import select
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -100,6 +101,7 @@ def check_upload(root: Path, work: Path, pio: Path, env_name: str, baud: int) ->
         env=pio_env(work),
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
+        start_new_session=True,  # avrdude runs under a shell: stop the whole group at the end
     )
     assert proc.stdout is not None
     os.set_blocking(proc.stdout.fileno(), False)
@@ -116,7 +118,7 @@ def check_upload(root: Path, work: Path, pio: Path, env_name: str, baud: int) ->
             if proc.poll() is not None and master not in ready:
                 break
     finally:
-        proc.kill()
+        os.killpg(proc.pid, signal.SIGKILL)
         rest = proc.communicate()[0] or b""
         out += rest
         os.close(master)
@@ -126,11 +128,13 @@ def check_upload(root: Path, work: Path, pio: Path, env_name: str, baud: int) ->
     assert m, f"{env_name}: no avrdude command in PlatformIO's output:\n{text[-3000:]}"
     cmd = m.group(0)
     print(f"{env_name}: {cmd}")
-    want = (
-        f'avrdude -p atmega328p -c arduino -P "{port}" -b {baud} -D '
-        f"-U flash:w:{work}/build/{env_name}/firmware.hex:i"
-    )
-    assert cmd == want, f"{env_name}: avrdude command\n  got  {cmd}\n  want {want}"
+    m_hex = re.search(r" -U flash:w:(\S+):i$", cmd)
+    assert m_hex, f"{env_name}: no flash:w:<hex>:i in {cmd}"
+    hex_path = (root / m_hex.group(1)).resolve()  # PlatformIO names it relative to the project
+    want_hex = (work / "build" / env_name / "firmware.hex").resolve()
+    assert hex_path == want_hex, f"{env_name}: uploads {hex_path}, built {want_hex}"
+    want = f'avrdude -p atmega328p -c arduino -P "{port}" -b {baud} -D -U flash:w:'
+    assert cmd.startswith(want), f"{env_name}: avrdude command\n  got  {cmd}\n  want {want}..."
     assert STK_GET_SYNC in seen, f"{env_name}: avrdude sent no STK500 GET_SYNC on {port}: {seen!r}"
     print(f"{env_name}: avrdude sent GET_SYNC on {port} at {baud} baud")
 

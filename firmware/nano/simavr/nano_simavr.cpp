@@ -34,9 +34,9 @@ void usage(FILE *out) {
       "with UART0 (500000 baud) on a pseudo-terminal.\n"
       "  --elf PATH          firmware ELF (default: <bin>/../nano_avr/nigel_nano.elf)\n"
       "  --bootloader HEX    start as a Nano being flashed: application flash erased, this\n"
-      "                      bootloader (e.g. Debian's Optiboot) run from reset once the first\n"
-      "                      byte arrives on the pty (the DTR reset of an upload); the ELF\n"
-      "                      only names symbols. Upload with avrdude -c arduino at 115200\n"
+      "                      bootloader (e.g. the Nano's ATmegaBOOT) run from reset once an\n"
+      "                      uploader configures the pty (the DTR reset of an upload); the\n"
+      "                      ELF only names symbols. Upload: avrdude -c arduino -b 57600\n"
       "  --pty PATH          symlink to the pty (default /tmp/nano-simavr/nano)\n"
       "  --encoder-hz N      encoder A edges per second on both wheels, forward (default 0)\n"
       "  --pwm-log FILE      log servo/motor register changes: t_sim_us t_mono_us servo_us\n"
@@ -187,11 +187,18 @@ int main(int argc, char **argv) {
     std::printf("nano-simavr: %s on %s, linked at %s\n", elf.c_str(), slave.c_str(),
                 pty_link.c_str());
     std::fflush(stdout);
-    if (!bootloader.empty()) {  // hold the board in reset until the uploader talks
+    if (!bootloader.empty()) {
+      // Held in reset until the uploader opens the port: a real Nano resets on the DTR pulse
+      // of the open, before the uploader's first byte. A pty has no DTR; the uploader's
+      // tcsetattr() (baud rate, raw mode) on the slave is the sign, or else its first byte.
       std::printf("nano-simavr: bootloader %s, waiting for the uploader\n", bootloader.c_str());
       std::fflush(stdout);
+      termios idle{}, now{};
+      tcgetattr(slave_fd, &idle);
       pollfd pfd{master, POLLIN, 0};
-      while (!g_stop && poll(&pfd, 1, 100) == 0) {
+      while (!g_stop && poll(&pfd, 1, 10) == 0) {
+        tcgetattr(slave_fd, &now);
+        if (cfgetospeed(&now) != cfgetospeed(&idle) || now.c_lflag != idle.c_lflag) break;
       }
       board.boot_from(bootloader);
     }

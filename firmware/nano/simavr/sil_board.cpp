@@ -1,5 +1,6 @@
 #include "sil_board.h"
 
+#include <cctype>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -12,7 +13,6 @@ extern "C" {
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
-#include <simavr/sim_hex.h>
 #include <simavr/sim_io.h>
 #include "nigel_hal.h"
 }
@@ -63,6 +63,9 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   avr_->frequency = kCpuHz;
   avr_->vcc = avr_->avcc = avr_->aref = 5000;  // [mV]
   avr_load_firmware(avr_, &fw);
+  // simavr's default sleep callback usleep()s the host for the cycles a sleeping AVR skips;
+  // the harness paces simulated time itself (nano-simavr --speed), so a sleep costs nothing.
+  avr_->sleep = [](avr_t *, avr_cycle_count_t) {};
   avr_->log = LOG_NONE;
   for (uint32_t i = 0; i < fw.symbolcount; i++) {
     symbols_.emplace_back(fw.symbol[i]->symbol, fw.symbol[i]->addr);
@@ -85,25 +88,61 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   proto_parser_init(&parser_);
 }
 
+// Intel HEX data records into flash (types 00 data, 01 end, 02/04 extended addresses; 03/05
+// start addresses are ignored: the AVR starts at its reset vector). Returns the lowest address
+// written. simavr's own reader refuses the type-03 record of Debian's Optiboot image.
+static uint32_t load_ihex(const std::string &path, uint8_t *flash, uint32_t flash_bytes) {
+  FILE *f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) throw std::runtime_error("cannot read bootloader HEX '" + path + "'");
+  char line[600];
+  uint32_t base = 0, lowest = flash_bytes, line_no = 0;
+  bool end = false;
+  auto bad = [&](const char *why) {
+    std::fclose(f);
+    throw std::runtime_error("bootloader HEX '" + path + "' line " + std::to_string(line_no) +
+                             ": " + why);
+  };
+  while (!end && std::fgets(line, sizeof line, f) != nullptr) {
+    line_no++;
+    if (line[0] != ':') continue;
+    uint8_t rec[300];
+    size_t n = 0;
+    for (const char *c = line + 1;
+         std::isxdigit(static_cast<unsigned char>(c[0])) &&
+         std::isxdigit(static_cast<unsigned char>(c[1])) && n < sizeof rec;
+         c += 2) {
+      rec[n++] = static_cast<uint8_t>(std::strtoul(std::string(c, 2).c_str(), nullptr, 16));
+    }
+    if (n < 5 || n != static_cast<size_t>(rec[0]) + 5) bad("malformed record");
+    uint8_t sum = 0;
+    for (size_t k = 0; k < n; k++) sum = static_cast<uint8_t>(sum + rec[k]);
+    if (sum != 0) bad("checksum");
+    const uint32_t addr = static_cast<uint32_t>(rec[1] << 8 | rec[2]);
+    switch (rec[3]) {
+      case 0x00:
+        if (base + addr + rec[0] > flash_bytes) bad("data beyond the flash");
+        std::memcpy(flash + base + addr, rec + 4, rec[0]);
+        if (base + addr < lowest) lowest = base + addr;
+        break;
+      case 0x01: end = true; break;
+      case 0x02: base = static_cast<uint32_t>(rec[4] << 8 | rec[5]) << 4; break;
+      case 0x04: base = static_cast<uint32_t>(rec[4] << 8 | rec[5]) << 16; break;
+      default: break;  // 03, 05: start addresses
+    }
+  }
+  std::fclose(f);
+  if (lowest == flash_bytes) throw std::runtime_error("bootloader HEX '" + path + "' has no data");
+  return lowest;
+}
+
 void Board::boot_from(const std::string &hex_path) {
-  ihex_chunk_p chunks = nullptr;
-  const int n = read_ihex_chunks(hex_path.c_str(), &chunks);
-  if (n <= 0) throw std::runtime_error("cannot read bootloader HEX '" + hex_path + "'");
   const uint32_t flash_bytes = avr_->flashend + 1;
   std::memset(avr_->flash, 0xFF, flash_bytes);
-  uint32_t start = flash_bytes;
-  for (int i = 0; i < n; i++) {
-    const ihex_chunk_t &c = chunks[i];
-    if (c.baseaddr + c.size > flash_bytes || c.baseaddr < flash_bytes / 2) {
-      std::free(chunks);
-      throw std::runtime_error("'" + hex_path +
-                               "' is not a bootloader: data outside the boot section");
-    }
-    std::memcpy(avr_->flash + c.baseaddr, c.data, c.size);
-    if (c.baseaddr < start) start = c.baseaddr;
+  const uint32_t start = load_ihex(hex_path, avr_->flash, flash_bytes);
+  if (start < flash_bytes / 2) {
+    throw std::runtime_error("'" + hex_path + "' is not a bootloader: it starts at " +
+                             std::to_string(start) + ", below the boot section");
   }
-  for (int i = 0; i < n; i++) std::free(chunks[i].data);
-  std::free(chunks);
   avr_->codeend = avr_->flashend;
   avr_->reset_pc = start;  // BOOTRST programmed: reset jumps into the bootloader
   avr_reset(avr_);

@@ -84,17 +84,23 @@ void setup() {
   nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0), NIGEL_BUILD_ID);
 }
 
+/* Arduino core (wiring.c): Timer0 overflows so far, one every 1.024 ms (millis/micros). */
+extern "C" volatile unsigned long timer0_overflow_count;
+
 /* Between passes the CPU sleeps (IDLE: timers, UART, TWI and the pin interrupts keep running)
- * until the next interrupt: Timer0's overflow (every 1.024 ms, millis/micros), a received or
- * sent byte, a TWI step, an encoder edge. Everything the loop does is started by one of those
- * or by time, so no pass is lost; the CPU does not spin, which saves power on the car and
- * lets simavr skip the idle cycles (nano-simavr then keeps up with real time). Telemetry keeps
- * its 10 ms mean period: nigel_step schedules it drift-free, the wake-up only adds jitter
- * below 1.024 ms. Unread received bytes mean another pass right away. */
-static void fw_sleep_until_interrupt(void) {
+ * until there is work: received bytes, or the next Timer0 tick (1.024 ms), which is the
+ * resolution of everything the core schedules by time (telemetry, failsafe, IMU, battery). The
+ * other interrupts (a sent byte, an encoder edge, a TWI step) do their work in their ISR and
+ * the CPU goes back to sleep; encoder counts and the TWI state are read at the next pass. The
+ * CPU does not spin, which saves power on the car and lets simavr skip the idle cycles
+ * (nano-simavr keeps up with real time). Telemetry keeps its 10 ms mean period: nigel_step
+ * schedules it drift-free, the tick only adds jitter below 1.024 ms. */
+static void fw_sleep_until_work(void) {
+  const uint8_t tick = (uint8_t)timer0_overflow_count; /* one byte: read atomically */
   set_sleep_mode(SLEEP_MODE_IDLE);
-  cli();
-  if (!fw_uart_rx_pending()) {
+  for (;;) {
+    cli();
+    if (fw_uart_rx_pending() || (uint8_t)timer0_overflow_count != tick) break;
     sleep_enable();
     sei(); /* the instruction after SEI runs before any interrupt: no wake-up is missed */
     sleep_cpu();
@@ -105,5 +111,5 @@ static void fw_sleep_until_interrupt(void) {
 
 void loop() {
   fw_loop_once();
-  fw_sleep_until_interrupt();
+  fw_sleep_until_work();
 }
