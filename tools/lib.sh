@@ -31,3 +31,30 @@ need_venv() {
   "$PY" -c 'import autodrive_tools' 2>/dev/null || "$ROOT/tools/setup" >&2 \
     || die "tools/setup failed"
 }
+# The aarch64 (Jetson) cross build in build/aarch64/build: the runtime, the autonomy, the Eye
+# and the unit tests that run under qemu-user (toolchain cmake/aarch64-linux-gnu.cmake; the
+# sysroot from tools/setup --aarch64). No simulator, no host tools: they do not run on the car.
+AARCH64_TARGETS=(autodrive-runtime autodrive-autonomy autodrive-eye firmware_host_tests
+  runtime_unit_tests eye_tests autonomy_test_planner autonomy_test_scan_match
+  autonomy_test_icp autonomy_test_amcl autonomy_test_tracker autonomy_test_map_io)
+# What runs under qemu: the unit tests that matter for portability (protocol codec and the
+# portability checks, bridge conversions, EKF, config, RPLIDAR decoder, teleop, clock, the
+# autonomy's planners, scan matching, ICP, AMCL, tracker and map files, the Eye's
+# localisation). Not the pty/LCM/process tests: they test Linux, not the CPU.
+AARCH64_TESTS='^(firmware\.|runtime\.unit\.|autonomy\.(planner|scan_match|icp|amcl|tracker|map_io)\.|eye\.)'
+# Not under qemu: tests of targets this build skips, and the Eye's intrinsic calibration
+# (each case exceeds its 120 s limit under emulation; it is numerics OpenCV owns).
+AARCH64_TESTS_EXCLUDE='_NOT_BUILT|^eye\.Intrinsics\.'
+build_aarch64() {
+  local dir="$ROOT/build/aarch64/build"
+  if [ ! -f "$dir/build.ninja" ]; then
+    log "configuring the aarch64 cross build"
+    cmake -G Ninja -S "$ROOT" -B "$dir" --toolchain "$ROOT/cmake/aarch64-linux-gnu.cmake" \
+      -DCMAKE_BUILD_TYPE=Release \
+      "-DAUTODRIVE_PARTS=vehicle;common/cpp;lcm_types;firmware/nano;runtime/jetson;eye;tests" \
+      "-DAUTODRIVE_TEST_SUITES=firmware_host;runtime;autonomy;eye" >/dev/null \
+      || die "aarch64 configure failed"
+  fi
+  log "building for aarch64: ${AARCH64_TARGETS[*]}"
+  cmake --build "$dir" -j2 --target "${AARCH64_TARGETS[@]}" || die "aarch64 build failed"
+}

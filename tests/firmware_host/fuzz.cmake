@@ -3,7 +3,7 @@
 # is ~10 s; longer runs: tools/fuzz-parser <seconds>.
 find_program(AUTODRIVE_CLANG14 clang-14)
 file(GLOB _fuzz_rt_found "/usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a")
-if(AUTODRIVE_CLANG14 AND _fuzz_rt_found)
+if(NOT CMAKE_CROSSCOMPILING AND AUTODRIVE_CLANG14 AND _fuzz_rt_found)
   set(_fuzz_bin "${CMAKE_CURRENT_BINARY_DIR}/fuzz/fuzz_parser")
   add_custom_command(
     OUTPUT ${_fuzz_bin}

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""platformio.ini checked offline through PlatformIO's own parser (it cannot download its AVR
-platform here): no warnings, the two Nano envs, src/lib dirs that exist and hold the firmware.
+"""platformio.ini checked through PlatformIO's own parser: no warnings, the two online Nano envs
+(PlatformIO's atmelavr, which needs its registry) and the two offline ones (the platform in
+firmware/nano/pio), src/lib dirs that exist and hold the firmware.
 usage: test_platformio_ini.py <repo root>"""
 import os
 import sys
@@ -15,8 +16,15 @@ def main() -> int:
     cfg.validate()
     assert cfg.warnings == [], f"platformio.ini warnings: {cfg.warnings}"
     envs = cfg.envs()
-    assert sorted(envs) == ["nanoatmega328", "nanoatmega328new"], f"envs: {envs}"
-    for env in envs:
+    want = ["nano_offline", "nano_offline_new", "nanoatmega328", "nanoatmega328new"]
+    assert sorted(envs) == want, f"envs: {envs}"
+    for env in ("nano_offline", "nano_offline_new"):
+        platform = cfg.get(f"env:{env}", "platform")
+        assert platform == "symlink://firmware/nano/pio", f"{env}: platform {platform}"
+        assert cfg.get(f"env:{env}", "board") == "nigel_nano", f"{env}: board"
+    speed = cfg.get("env:nano_offline_new", "board_upload.speed")
+    assert str(speed) == "115200", f"nano_offline_new: upload speed {speed}"
+    for env in ("nanoatmega328", "nanoatmega328new"):
         assert cfg.get(f"env:{env}", "board") == env, f"{env}: board"
         assert cfg.get(f"env:{env}", "platform") == "atmelavr", f"{env}: platform"
         assert cfg.get(f"env:{env}", "framework") == ["arduino"], f"{env}: framework"

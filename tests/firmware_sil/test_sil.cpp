@@ -272,7 +272,9 @@ TEST(Sil, imu_absent_fault) {
   EXPECT_TRUE(s.faults & PROTO_FAULT_IMU_LOST);
   EXPECT_EQ(s.faults & PROTO_FAULT_LOOP_OVERRUN, 0) << "the loop never stalled";
   EXPECT_GE(b.states().size() - states_before, 45u) << "telemetry continues (100 Hz)";
-  EXPECT_GE(b.loop_passes() - passes_before, 500u) << "the loop runs >= 1 kHz";
+  // The loop sleeps between passes and runs at least on every Timer0 tick (1.024 ms): 488
+  // passes in 500 ms.
+  EXPECT_GE(b.loop_passes() - passes_before, 480u) << "the loop runs on every 1.024 ms tick";
   EXPECT_LT(b.loop_cycles_max(), 48000u) << "no pass took 3 ms";
   // the IMU comes back: the firmware re-probes it and the fault clears
   b.imu().set_present(true);

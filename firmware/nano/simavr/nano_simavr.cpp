@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <termios.h>
 #include <time.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -32,6 +33,10 @@ void usage(FILE *out) {
       "Runs the Nigel Nano firmware ELF in simavr (ATmega328P, 16 MHz) paced to the wall clock,\n"
       "with UART0 (500000 baud) on a pseudo-terminal.\n"
       "  --elf PATH          firmware ELF (default: <bin>/../nano_avr/nigel_nano.elf)\n"
+      "  --bootloader HEX    start as a Nano being flashed: application flash erased, this\n"
+      "                      bootloader (e.g. the Nano's ATmegaBOOT) run from reset once an\n"
+      "                      uploader configures the pty (the DTR reset of an upload); the\n"
+      "                      ELF only names symbols. Upload: avrdude -c arduino -b 57600\n"
       "  --pty PATH          symlink to the pty (default /tmp/nano-simavr/nano)\n"
       "  --encoder-hz N      encoder A edges per second on both wheels, forward (default 0)\n"
       "  --pwm-log FILE      log servo/motor register changes: t_sim_us t_mono_us servo_us\n"
@@ -94,7 +99,7 @@ int open_pty(std::string *slave_name, int *slave_fd) {
 int main(int argc, char **argv) {
   std::string elf = default_elf(argv[0]);
   std::string pty_link = "/tmp/nano-simavr/nano";
-  std::string pwm_log;
+  std::string pwm_log, bootloader;
   double encoder_hz = 0, speed = 1, duration_s = 0;
   bool imu = true;
   for (int i = 1; i < argc; i++) {
@@ -111,6 +116,8 @@ int main(int argc, char **argv) {
       return 0;
     } else if (a == "--elf") {
       elf = value("--elf");
+    } else if (a == "--bootloader") {
+      bootloader = value("--bootloader");
     } else if (a == "--pty") {
       pty_link = value("--pty");
     } else if (a == "--encoder-hz") {
@@ -127,6 +134,11 @@ int main(int argc, char **argv) {
       std::fprintf(stderr, "nano-simavr: unknown option '%s' (see --help)\n", a.c_str());
       return 2;
     }
+  }
+  if (!bootloader.empty() && access(bootloader.c_str(), R_OK) != 0) {
+    std::fprintf(stderr, "nano-simavr: --bootloader '%s': %s\n", bootloader.c_str(),
+                 std::strerror(errno));
+    return 1;
   }
   if (access(elf.c_str(), R_OK) != 0) {
     std::fprintf(stderr, "nano-simavr: firmware ELF '%s': %s\n", elf.c_str(), std::strerror(errno));
@@ -175,6 +187,21 @@ int main(int argc, char **argv) {
     std::printf("nano-simavr: %s on %s, linked at %s\n", elf.c_str(), slave.c_str(),
                 pty_link.c_str());
     std::fflush(stdout);
+    if (!bootloader.empty()) {
+      // Held in reset until the uploader opens the port: a real Nano resets on the DTR pulse
+      // of the open, before the uploader's first byte. A pty has no DTR; the uploader's
+      // tcsetattr() (baud rate, raw mode) on the slave is the sign, or else its first byte.
+      std::printf("nano-simavr: bootloader %s, waiting for the uploader\n", bootloader.c_str());
+      std::fflush(stdout);
+      termios idle{}, now{};
+      tcgetattr(slave_fd, &idle);
+      pollfd pfd{master, POLLIN, 0};
+      while (!g_stop && poll(&pfd, 1, 10) == 0) {
+        tcgetattr(slave_fd, &now);
+        if (cfgetospeed(&now) != cfgetospeed(&idle) || now.c_lflag != idle.c_lflag) break;
+      }
+      board.boot_from(bootloader);
+    }
     const uint64_t wall0 = mono_us();
     const uint64_t slice_us = 250;
     uint64_t dropped = 0;

@@ -1,8 +1,10 @@
 #include "sil_board.h"
 
+#include <cctype>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 extern "C" {
@@ -61,6 +63,9 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   avr_->frequency = kCpuHz;
   avr_->vcc = avr_->avcc = avr_->aref = 5000;  // [mV]
   avr_load_firmware(avr_, &fw);
+  // simavr's default sleep callback usleep()s the host for the cycles a sleeping AVR skips;
+  // the harness paces simulated time itself (nano-simavr --speed), so a sleep costs nothing.
+  avr_->sleep = [](avr_t *, avr_cycle_count_t) {};
   avr_->log = LOG_NONE;
   for (uint32_t i = 0; i < fw.symbolcount; i++) {
     symbols_.emplace_back(fw.symbol[i]->symbol, fw.symbol[i]->addr);
@@ -81,6 +86,72 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   imu_ = std::make_unique<Mpu9250>(avr_, imu_present);
   set_adc7_mv(2850);  // ~12.1 V pack through the 10k:3.3k divider
   proto_parser_init(&parser_);
+}
+
+// Intel HEX data records into flash (types 00 data, 01 end, 02/04 extended addresses; 03/05
+// start addresses are ignored: the AVR starts at its reset vector). Returns the lowest address
+// written. simavr's own reader refuses the type-03 record of Debian's Optiboot image.
+static uint32_t load_ihex(const std::string &path, uint8_t *flash, uint32_t flash_bytes) {
+  FILE *f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) throw std::runtime_error("cannot read bootloader HEX '" + path + "'");
+  char line[600];
+  uint32_t base = 0, lowest = flash_bytes, line_no = 0;
+  bool end = false;
+  auto bad = [&](const char *why) {
+    std::fclose(f);
+    throw std::runtime_error("bootloader HEX '" + path + "' line " + std::to_string(line_no) +
+                             ": " + why);
+  };
+  while (!end && std::fgets(line, sizeof line, f) != nullptr) {
+    line_no++;
+    if (line[0] != ':') continue;
+    uint8_t rec[300];
+    size_t n = 0;
+    for (const char *c = line + 1;
+         std::isxdigit(static_cast<unsigned char>(c[0])) &&
+         std::isxdigit(static_cast<unsigned char>(c[1])) && n < sizeof rec;
+         c += 2) {
+      rec[n++] = static_cast<uint8_t>(std::strtoul(std::string(c, 2).c_str(), nullptr, 16));
+    }
+    if (n < 5 || n != static_cast<size_t>(rec[0]) + 5) bad("malformed record");
+    uint8_t sum = 0;
+    for (size_t k = 0; k < n; k++) sum = static_cast<uint8_t>(sum + rec[k]);
+    if (sum != 0) bad("checksum");
+    const uint32_t addr = static_cast<uint32_t>(rec[1] << 8 | rec[2]);
+    switch (rec[3]) {
+      case 0x00:
+        if (base + addr + rec[0] > flash_bytes) bad("data beyond the flash");
+        std::memcpy(flash + base + addr, rec + 4, rec[0]);
+        if (base + addr < lowest) lowest = base + addr;
+        break;
+      case 0x01: end = true; break;
+      case 0x02: base = static_cast<uint32_t>(rec[4] << 8 | rec[5]) << 4; break;
+      case 0x04: base = static_cast<uint32_t>(rec[4] << 8 | rec[5]) << 16; break;
+      default: break;  // 03, 05: start addresses
+    }
+  }
+  std::fclose(f);
+  if (lowest == flash_bytes) throw std::runtime_error("bootloader HEX '" + path + "' has no data");
+  return lowest;
+}
+
+void Board::boot_from(const std::string &hex_path) {
+  const uint32_t flash_bytes = avr_->flashend + 1;
+  std::memset(avr_->flash, 0xFF, flash_bytes);
+  const uint32_t start = load_ihex(hex_path, avr_->flash, flash_bytes);
+  if (start < flash_bytes / 2) {
+    throw std::runtime_error("'" + hex_path + "' is not a bootloader: it starts at " +
+                             std::to_string(start) + ", below the boot section");
+  }
+  avr_->codeend = avr_->flashend;
+  avr_->reset_pc = start;  // BOOTRST programmed: reset jumps into the bootloader
+  avr_reset(avr_);
+  quiet_uart(avr_);
+  constexpr uint16_t kMcusr = 0x54;
+  constexpr uint8_t kExtrf = 0x02;
+  avr_->data[kMcusr] = kExtrf;  // reset pin pulled by DTR: the bootloader stays
+  next_tx_cycle_ = cycle() + 1000 * kCyclesPerUs;
+  wake_at(next_tx_cycle_, &tx_queue_);
 }
 
 Board::~Board() {
@@ -122,6 +193,7 @@ void Board::on_uart_byte(uint8_t b) {
 
 void Board::send(const uint8_t *data, size_t n) {
   tx_queue_.insert(tx_queue_.end(), data, data + n);
+  wake_at(next_tx_cycle_, &tx_queue_);
 }
 
 void Board::send_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
@@ -245,13 +317,28 @@ void Board::sample_pwm() {
   }
 }
 
+// A no-op cycle timer: while the firmware sleeps, simavr jumps straight to its next cycle
+// timer; these stop it at the harness's own next event (a UART byte, an encoder edge, the end
+// of run_us), which the harness polls by cycle. One timer per tag (re-registering replaces).
+static avr_cycle_count_t wake_for_harness(avr_t *, avr_cycle_count_t, void *) {
+  return 0;
+}
+
+void Board::wake_at(uint64_t at_cycle, void *tag) {
+  const uint64_t c = cycle();
+  if (at_cycle > c) avr_cycle_timer_register(avr_, at_cycle - c, wake_for_harness, tag);
+}
+
 void Board::step_io() {
   const uint64_t c = cycle();
   if (!tx_queue_.empty() && c >= next_tx_cycle_) {
     avr_raise_irq(uart_in_, tx_queue_.front());
     tx_queue_.pop_front();
     next_tx_cycle_ = c + kUartByteCycles;
-    if (tx_queue_.empty()) last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
+    if (tx_queue_.empty())
+      last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
+    else
+      wake_at(next_tx_cycle_, &tx_queue_);
   }
   if (enc_rate_ > 0 && c >= enc_next_cycle_) {
     for (int s = 0; s < 2; s++) {
@@ -267,16 +354,21 @@ void Board::step_io() {
     }
     enc_next_cycle_ =
         static_cast<uint64_t>(static_cast<double>(enc_next_cycle_) + enc_phase_cycles_);
+    wake_at(enc_next_cycle_, &enc_next_cycle_);
   }
 }
 
 bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
   const uint64_t end = cycle() + us * kCyclesPerUs;
+  wake_at(end, &run_end_tag_);
   uint32_t n = 0;
   while (cycle() < end) {
     step_io();
     const uint32_t pc_before = avr_->pc;
+    const bool was_sleeping = avr_->state == cpu_Sleeping;
+    const uint64_t cycle_before = avr_->cycle;
     const int state = avr_run(avr_);
+    if (was_sleeping) loop_sleep_cycles_ += avr_->cycle - cycle_before;
     if (state == cpu_Done || state == cpu_Crashed) return false;
     const uint32_t pc = avr_->pc;
     if (pc != pc_before) {
@@ -285,17 +377,19 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
         quiet_uart(avr_);
         isr_active_ = -1;
         loop_last_cycle_ = 0;
+        loop_sleep_cycles_ = 0;
       } else if (pc < kVectorTableBytes && (pc & 3u) == 0) {  // entered an interrupt vector
         isr_active_ = static_cast<int>(pc / 4);
         // the 4-cycle interrupt response (datasheet) counts as part of the ISR
         isr_start_ = avr_->cycle - 4;
       } else if (pc == loop_addr_) {
-        if (loop_last_cycle_ != 0) {
-          const uint64_t d = avr_->cycle - loop_last_cycle_;
+        if (loop_last_cycle_ != 0) {  // a pass's busy cycles: ISRs in, sleep out
+          const uint64_t d = avr_->cycle - loop_last_cycle_ - loop_sleep_cycles_;
           if (d > loop_max_) loop_max_ = static_cast<uint32_t>(d);
           if (record_loop_) loop_cycles_.push_back(static_cast<uint32_t>(d));
         }
         loop_last_cycle_ = avr_->cycle;
+        loop_sleep_cycles_ = 0;
         loop_passes_++;
       }
     }

@@ -55,6 +55,13 @@ class Board {
   uint64_t cycle() const;
   uint64_t now_us() const { return cycle() / kCyclesPerUs; }
 
+  // The Nano as it leaves the bootloader's reset: the application flash erased (0xFF), the
+  // bootloader of hex_path (Intel HEX, e.g. Debian's Optiboot) at its address, BOOTRST (reset
+  // vector = the bootloader) and MCUSR = EXTRF, as after the DTR pulse of an upload. The host's
+  // bytes reach the UART from 1 ms on (the bootloader has set it up by then). Throws
+  // std::runtime_error naming the file if it cannot be read or is not a bootloader.
+  void boot_from(const std::string &hex_path);
+
   // UART into the AVR: bytes go out on the wire one byte-time apart.
   void send(const uint8_t *data, size_t n);
   void send_frame(uint8_t id, const uint8_t *payload, uint8_t len);
@@ -137,6 +144,10 @@ class Board {
   uint8_t enc_phase_[2]{};
   std::deque<uint8_t> tx_queue_;
   uint64_t next_tx_cycle_ = 0, last_tx_cycle_ = 0;
+  uint8_t run_end_tag_ = 0;
+  uint64_t loop_sleep_cycles_ = 0;  // cycles asleep since the last loop pass began  // address
+                                    // only: the cycle-timer tag of run_us's end
+  void wake_at(uint64_t at_cycle, void *tag);
   proto_parser_t parser_{};
   std::vector<Frame> frames_;
   size_t uart_bytes_out_ = 0;

@@ -62,6 +62,10 @@ void fw_uart_write(const uint8_t *data, uint8_t n) {
   UCSR0B |= _BV(UDRIE0); /* RMW is safe: the ISR clears UDRIE0 only when the ring is empty */
 }
 
+uint8_t fw_uart_rx_pending(void) {
+  return (uint8_t)(s_rx_head != s_rx_tail);
+}
+
 uint16_t fw_uart_rx_lost(void) {
   uint8_t sreg = SREG;
   cli();

@@ -13,6 +13,8 @@ extern "C" {
 void fw_uart_init(void);
 /* Moves up to max received bytes into out; returns the count. */
 uint8_t fw_uart_read(uint8_t *out, uint8_t max);
+/* Received bytes wait in the ring (call with interrupts off to decide on sleeping). */
+uint8_t fw_uart_rx_pending(void);
 /* Queues n bytes; drops what does not fit (counted) rather than blocking the loop. */
 void fw_uart_write(const uint8_t *data, uint8_t n);
 /* Bytes lost to a full RX ring or a hardware overrun, and TX bytes dropped [bytes]. */

@@ -3,6 +3,7 @@
  * and the CMake build (firmware/nano/avr) build the same file. */
 #include <Arduino.h>
 #include <avr/interrupt.h>
+#include <avr/sleep.h>
 
 #include "enc.h"
 #include "fw_enc.h"
@@ -83,6 +84,32 @@ void setup() {
   nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0), NIGEL_BUILD_ID);
 }
 
+/* Arduino core (wiring.c): Timer0 overflows so far, one every 1.024 ms (millis/micros). */
+extern "C" volatile unsigned long timer0_overflow_count;
+
+/* Between passes the CPU sleeps (IDLE: timers, UART, TWI and the pin interrupts keep running)
+ * until there is work: received bytes, or the next Timer0 tick (1.024 ms), which is the
+ * resolution of everything the core schedules by time (telemetry, failsafe, IMU, battery). The
+ * other interrupts (a sent byte, an encoder edge, a TWI step) do their work in their ISR and
+ * the CPU goes back to sleep; encoder counts and the TWI state are read at the next pass. The
+ * CPU does not spin, which saves power on the car and lets simavr skip the idle cycles
+ * (nano-simavr keeps up with real time). Telemetry keeps its 10 ms mean period: nigel_step
+ * schedules it drift-free, the tick only adds jitter below 1.024 ms. */
+static void fw_sleep_until_work(void) {
+  const uint8_t tick = (uint8_t)timer0_overflow_count; /* one byte: read atomically */
+  set_sleep_mode(SLEEP_MODE_IDLE);
+  for (;;) {
+    cli();
+    if (fw_uart_rx_pending() || (uint8_t)timer0_overflow_count != tick) break;
+    sleep_enable();
+    sei(); /* the instruction after SEI runs before any interrupt: no wake-up is missed */
+    sleep_cpu();
+    sleep_disable();
+  }
+  sei();
+}
+
 void loop() {
   fw_loop_once();
+  fw_sleep_until_work();
 }
