@@ -16,7 +16,7 @@ MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
 
 def gen(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, str(GEN), *args], capture_output=True, text=True, timeout=60
+        [str(GEN), *args], capture_output=True, text=True, timeout=60
     )
 
 

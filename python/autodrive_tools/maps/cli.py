@@ -80,3 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     for path in stale:
         print(f"gen-maps: {path} is stale: run tools/gen-maps and commit it", file=sys.stderr)
     return 1 if stale else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
