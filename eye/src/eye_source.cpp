@@ -98,8 +98,8 @@ class LcmSource : public Source {
     if (!lcm_.good()) throw Error("lcm: cannot open " + url);
     // A plain function + context (autodrive_lcm::subscribe: decodes, counts malformed
     // messages): LCM 1.3.1's member-function subscription on a polymorphic class trips UBSan.
-    sub_ = autodrive_lcm::subscribe<autodrive::compressed_image_t, LcmSource,
-                                    &LcmSource::on_image>(lcm_, channel, this);
+    sub_ = autodrive_lcm::subscribe<autodrive::compressed_image_t, LcmSource, &LcmSource::on_image>(
+        lcm_, channel, this);
     sub_->setQueueCapacity(4);  // drop old frames rather than fall behind the camera
   }
   bool next(Frame *f) override {
@@ -124,9 +124,9 @@ class LcmSource : public Source {
     f.utime = m->utime;
     f.label = chan + "@" + std::to_string(m->utime);
     // Believe the header only if it names the calibrated size: nothing else is decoded.
-    const std::string why =
-        width_px_ > 0 ? check_frame(m->data.data(), m->data.size(), m->format, width_px_, height_px_)
-                      : "";
+    const std::string why = width_px_ > 0 ? check_frame(m->data.data(), m->data.size(), m->format,
+                                                        width_px_, height_px_)
+                                          : "";
     if (!why.empty()) {
       skipped_frames_log().event(chan, "frame @" + std::to_string(m->utime) + " skipped: " + why);
       return;
@@ -165,8 +165,8 @@ autodrive::LogLimiter &skipped_frames_log() {
 }
 
 std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
-                                    const std::string &lcm_url, double idle_timeout_s,
-                                    int width_px, int height_px) {
+                                    const std::string &lcm_url, double idle_timeout_s, int width_px,
+                                    int height_px) {
   const auto colon = spec.find(':');
   if (colon == std::string::npos)
     throw Error("source '" + spec +
@@ -175,8 +175,8 @@ std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
   if (!(fps_hint > 0)) throw Error("source '" + spec + "': fps must be positive");
   if (kind == "folder") return std::make_unique<FolderSource>(what, fps_hint);
   if (kind == "lcm")
-    return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s,
-                                       width_px, height_px);
+    return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s, width_px,
+                                       height_px);
   cv::VideoCapture cap;
   if (kind == "device") {
     int idx = -1;

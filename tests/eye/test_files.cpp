@@ -141,9 +141,11 @@ TEST(BadFiles, RunConfig) {
   expect_error([&] { eye::runconfig_load(dec); },
                {dec, "detector.decimate: 100 is out of range: must be 1..8"});
   const auto ham = write_tmp("eye_cfg_ham.yaml", head + "detector: {max_hamming: -1}\n" + veh);
-  expect_error([&] { eye::runconfig_load(ham); }, {ham, "detector.max_hamming: -1 is out of range"});
+  expect_error([&] { eye::runconfig_load(ham); },
+               {ham, "detector.max_hamming: -1 is out of range"});
   const auto big = write_tmp("eye_cfg_big.yaml",
                              "intrinsics: eye_cfg_camera.yaml\nmap: eye_cfg_map.yaml\n"
-                             "tag_size_m: 50\n" + veh);
+                             "tag_size_m: 50\n" +
+                                 veh);
   expect_error([&] { eye::runconfig_load(big); }, {big, "tag_size_m: 50 is out of range"});
 }

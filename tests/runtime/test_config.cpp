@@ -141,7 +141,8 @@ TEST(ConfigRanges, CommandTimeoutAbove500msRefused) {
 
 TEST(ConfigRanges, HeartbeatOutOfRangeRefused) {
   for (const char *bad : {"0.001", "0", "-5", "10000", ".nan", ".inf"}) {
-    const std::string e = error_of(replace(kGood, "heartbeat_hz: 50", std::string("heartbeat_hz: ") + bad));
+    const std::string e =
+        error_of(replace(kGood, "heartbeat_hz: 50", std::string("heartbeat_hz: ") + bad));
     EXPECT_NE(e.find("bridge.heartbeat_hz"), std::string::npos) << bad << ": " << e;
   }
   // 10 Hz is in range but too slow for the default 100 ms failsafe: named with the reason.
@@ -152,8 +153,8 @@ TEST(ConfigRanges, HeartbeatOutOfRangeRefused) {
 }
 
 TEST(ConfigRanges, EveryRuntimeNumberHasABound) {
-  const std::string lidar = std::string(kGood) +
-                            "lidar: {device: /dev/ttyUSB1, baud: 115200, range_max_m: 400}\n";
+  const std::string lidar =
+      std::string(kGood) + "lidar: {device: /dev/ttyUSB1, baud: 115200, range_max_m: 400}\n";
   EXPECT_NE(error_of(lidar).find("lidar.range_max_m: 400 is out of range"), std::string::npos)
       << error_of(lidar);
   const std::string est = std::string(kGood) + "estimator: {rate_hz: 100, history_ms: 1000000}\n";
@@ -163,6 +164,7 @@ TEST(ConfigRanges, EveryRuntimeNumberHasABound) {
   const std::string gate = std::string(kGood) + "estimator: {rate_hz: 100, pose_gate_chi2: 0}\n";
   EXPECT_NE(error_of(gate).find("estimator.pose_gate_chi2: 0 is out of range"), std::string::npos)
       << error_of(gate);
-  EXPECT_NE(error_of(replace(kGood, "baud: 500000", "baud: 0")).find("bridge.baud: 0 is out of range"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(replace(kGood, "baud: 500000", "baud: 0")).find("bridge.baud: 0 is out of range"),
+      std::string::npos);
 }

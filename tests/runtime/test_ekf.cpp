@@ -223,7 +223,8 @@ TEST(EkfGate, ForgedPoseStreamIsRejectedAndCounted) {
   for (double offset_m : {1000.0, 10.0, 1.0, 0.3}) {
     est::EkfStats st;
     // Honest Eye all along; from 5 s on, a forged stream at 100 Hz (10x the Eye's rate).
-    const double err = run_gate(always, [](double s) { return s > 5.0; }, offset_m, 1.0, &st);
+    const double err = run_gate(
+        always, [](double s) { return s > 5.0; }, offset_m, 1.0, &st);
     EXPECT_LT(err, 0.05) << "offset " << offset_m;
     EXPECT_GE(st.gated, 2400u) << "offset " << offset_m;
     EXPECT_EQ(st.reacquired, 0u) << "offset " << offset_m;
@@ -234,8 +235,7 @@ TEST(EkfGate, ReacquiresTheRealEyeAfterALongGap) {
   est::EkfStats st;
   // Eye lost from 3 s to 23 s while the odometry over-reads by 20 %: ~1 m of drift, far
   // outside the gate when the Eye comes back; a steady run of poses re-places the car.
-  const double err =
-      run_gate([](double s) { return s < 3.0 || s > 23.0; }, never, 0.0, 1.2, &st);
+  const double err = run_gate([](double s) { return s < 3.0 || s > 23.0; }, never, 0.0, 1.2, &st);
   EXPECT_LT(err, 0.05);
   EXPECT_EQ(st.reacquired, 1u);
 }

@@ -19,7 +19,7 @@ TEST(MalformedLcm, CountedPerChannelAndNeverHandedToTheHandler) {
   ASSERT_TRUE(lcm.good());
   Sink sink;
   autodrive_lcm::subscribe<autodrive::vehicle_state_t, Sink, &Sink::on_state>(lcm, "T_MAL_STATE",
-                                                                               &sink);
+                                                                              &sink);
   const uint64_t before = autodrive_lcm::malformed_log().total("T_MAL_STATE");
   std::vector<uint8_t> garbage(37, 0xA5);
   for (int i = 0; i < 50; ++i) {

@@ -25,8 +25,8 @@ template <class Msg>
 bool decode(const lcm::ReceiveBuffer *rb, const std::string &channel, Msg *m) {
   const int len = static_cast<int>(rb->data_size);
   if (m->decode(rb->data, 0, len) == len) return true;
-  malformed_log().event(channel, fmt::format("{} bytes do not decode as {}: dropped",
-                                             rb->data_size, Msg::getTypeName()));
+  malformed_log().event(channel, fmt::format("{} bytes do not decode as {}: dropped", rb->data_size,
+                                             Msg::getTypeName()));
   return false;
 }
 

@@ -248,7 +248,13 @@ def bench_estimator(build: Path, tmp: Path, progress: Callable[[str], None]) -> 
     log = tmp / "runtime-ekf.log"
     procs.start(
         "autodrive-runtime",
-        [build / "bin" / "autodrive-runtime", "--config", runtime_config(tmp), "--only", "estimator"],
+        [
+            build / "bin" / "autodrive-runtime",
+            "--config",
+            runtime_config(tmp),
+            "--only",
+            "estimator",
+        ],
         log,
     )
     try:
@@ -291,7 +297,13 @@ def bench_log_flood(build: Path, tmp: Path, progress: Callable[[str], None]) -> 
     log = tmp / "runtime-flood.log"
     procs.start(
         "autodrive-runtime",
-        [build / "bin" / "autodrive-runtime", "--config", runtime_config(tmp), "--only", "estimator"],
+        [
+            build / "bin" / "autodrive-runtime",
+            "--config",
+            runtime_config(tmp),
+            "--only",
+            "estimator",
+        ],
         log,
     )
     sources = [channel(c, VEHICLE) for c in ("STATE", "IMU", "POSE_EYE")]
@@ -358,7 +370,9 @@ def bench_fuzz(build: Path, fuzz_s: int, progress: Callable[[str], None]) -> dic
     return {"fuzz_crashes": crashes, "fuzz_runs": runs, "fuzz_s_each": fuzz_s}
 
 
-def run(progress: Callable[[str], None], build: Path | None = None, fuzz_s: int = 60) -> dict[str, Any]:
+def run(
+    progress: Callable[[str], None], build: Path | None = None, fuzz_s: int = 60
+) -> dict[str, Any]:
     """Every figure of the input checks (see the module's doc)."""
     b = build or Path(os.environ.get("AUTODRIVE_BUILD", ""))
     if not (b / "bin" / "autodrive-runtime").is_file():

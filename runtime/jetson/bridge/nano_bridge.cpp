@@ -173,8 +173,7 @@ struct NanoBridge::Impl {
     last_tick = tick;
     uint8_t buf[512];
     long n;
-    while ((n = port.read_some(buf, sizeof buf)) > 0)
-      feed(buf, static_cast<size_t>(n));
+    while ((n = port.read_some(buf, sizeof buf)) > 0) feed(buf, static_cast<size_t>(n));
     if (n < 0) lose_device(port.error());
     if (!port.is_open()) return;
     if (scheduled_cmd && scheduled_cmd->utime <= clock.now_us()) {
@@ -304,8 +303,9 @@ struct NanoBridge::Impl {
 
   void bad_payload(const char *what, unsigned len) {
     count([](Status &s) { ++s.rx_bad_payload; });
-    rx_log.event(config.bridge.device,
-                 fmt::format("{} frame with a {}-byte payload does not unpack: dropped", what, len));
+    rx_log.event(
+        config.bridge.device,
+        fmt::format("{} frame with a {}-byte payload does not unpack: dropped", what, len));
   }
 
   // Feeds received bytes to the parser; counts and logs (limited) any new garbage.

@@ -48,8 +48,9 @@ Bridge parse_bridge(const Section &s) {
   if (1000.0 / b.heartbeat_hz > b.failsafe_timeout_ms / 2.0)
     s.fail(s.key("heartbeat_hz"),
            std::to_string(b.heartbeat_hz) + " is too slow for failsafe_timeout_ms " +
-               std::to_string(b.failsafe_timeout_ms) + ": must be >= " +
-               std::to_string(2000.0 / b.failsafe_timeout_ms) + " (two frames per failsafe period)");
+               std::to_string(b.failsafe_timeout_ms) +
+               ": must be >= " + std::to_string(2000.0 / b.failsafe_timeout_ms) +
+               " (two frames per failsafe period)");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
   if (b.servo_trim_us < -200 || b.servo_trim_us > 200)

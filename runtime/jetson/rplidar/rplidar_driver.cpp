@@ -108,8 +108,8 @@ struct Driver::Impl {
         return;
       }
       reset_times_us.push_back(now);
-      health_log.event(device,
-                       fmt::format("device reports error code 0x{:04x}; resetting it", h.error_code));
+      health_log.event(
+          device, fmt::format("device reports error code 0x{:04x}; resetting it", h.error_code));
       {
         std::lock_guard<std::mutex> g(mu);
         ++st.resets;

@@ -29,7 +29,9 @@ namespace {
 cfg::Vehicle vehicle;
 cfg::Bridge bridge_cfg;
 
-bool finite_within(double v, double bound) { return std::isfinite(v) && std::abs(v) <= bound; }
+bool finite_within(double v, double bound) {
+  return std::isfinite(v) && std::abs(v) <= bound;
+}
 
 void check_state(const proto_frame_t &f) {
   proto_state_t s{};
@@ -72,8 +74,9 @@ void on_frame(const proto_frame_t *f, void *) {
 
 const uint8_t kIds[] = {PROTO_ID_HELLO, PROTO_ID_STATE, PROTO_ID_NACK};
 uint8_t right_len(uint8_t id) {
-  return id == PROTO_ID_HELLO ? PROTO_LEN_HELLO
-                              : id == PROTO_ID_STATE ? PROTO_LEN_STATE : PROTO_LEN_NACK;
+  return id == PROTO_ID_HELLO   ? PROTO_LEN_HELLO
+         : id == PROTO_ID_STATE ? PROTO_LEN_STATE
+                                : PROTO_LEN_NACK;
 }
 
 }  // namespace

@@ -14,8 +14,8 @@ const char *const kCarFigure =
     "is a figure of the car: it comes from vehicle/nigel.params, not from a config";
 
 // Every number has a range; a value outside (or NaN) is refused naming the key and the bound.
-constexpr double kMaxCoordM = 1000.0;             // |x|, |y| of any pose in the map [m]
-constexpr double kMaxYawRad = 2.0 * M_PI;         // |yaw| of a pose [rad]
+constexpr double kMaxCoordM = 1000.0;                 // |x|, |y| of any pose in the map [m]
+constexpr double kMaxYawRad = 2.0 * M_PI;             // |yaw| of a pose [rad]
 constexpr long long kMaxGridCells = 4096LL * 4096LL;  // the SLAM grid's finest level
 
 void read_pose(const Section &s, Pose2 &p) {
