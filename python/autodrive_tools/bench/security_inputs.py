@@ -350,7 +350,7 @@ def bench_log_flood(build: Path, tmp: Path, progress: Callable[[str], None]) -> 
 def bench_fuzz(build: Path, fuzz_s: int, progress: Callable[[str], None]) -> dict[str, Any]:
     crashes, runs = 0, {}
     for rel in FUZZ_TARGETS:
-        exe = build / rel
+        exe = (build / rel).resolve()
         name = exe.name
         if not exe.is_file():
             raise RuntimeError(f"{exe} is missing (clang-14 and libfuzzer-14-dev build it)")
@@ -374,7 +374,7 @@ def run(
     progress: Callable[[str], None], build: Path | None = None, fuzz_s: int = 60
 ) -> dict[str, Any]:
     """Every figure of the input checks (see the module's doc)."""
-    b = build or Path(os.environ.get("AUTODRIVE_BUILD", ""))
+    b = (build or Path(os.environ.get("AUTODRIVE_BUILD", ""))).resolve()
     if not (b / "bin" / "autodrive-runtime").is_file():
         raise RuntimeError(f"{b}: no bin/autodrive-runtime (set AUTODRIVE_BUILD or pass the build)")
     figures: dict[str, Any] = {}
