@@ -19,6 +19,7 @@
 #include <optional>
 
 #include "eye_detect.hpp"
+#include "eye_intrinsics.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
 #include "eye_source.hpp"
@@ -194,6 +195,34 @@ Accuracy accuracy(const Scene &sc, const RunResult &r) {
   return a;
 }
 
+// A fixed scene for programs that feed the Eye over LCM: its calibration, a run config and
+// one good frame. Returns the exit status.
+int write_scene(const std::string &dir, const std::string &url, double tag_size_m) {
+  const eye::SynthScene s = eye::synth_scene(640, 480, tag_size_m);
+  eye::intrinsics_save(dir + "/camera.yaml", s.in);
+  eye::MapCalib m;
+  m.pose = s.pose;
+  m.width_px = 640;
+  m.height_px = 480;
+  eye::mapcal_save(dir + "/map.yaml", m);
+  std::ofstream cfg(dir + "/eye.yaml");
+  cfg << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
+      << "tag_size_m: " << s.car.tag_size_m << "\ntag_offset_m: [" << s.car.tag_offset_m[0] << ", "
+      << s.car.tag_offset_m[1] << ", " << s.car.tag_offset_m[2] << "]\n"
+      << "base_link_height_m: " << s.car.base_link_height_m << "\n"
+      << "vehicles:\n - {name: NIGEL1, tag_id: 1}\n";
+  std::vector<uchar> jpg;
+  cv::imencode(".jpg", eye::synth_frame(s, {{1, 1.2, 0.9, 0.5}}, {}, 1), jpg,
+               {cv::IMWRITE_JPEG_QUALITY, 95});
+  std::ofstream(dir + "/frame.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char *>(jpg.data()), static_cast<std::streamsize>(jpg.size()));
+  if (!cfg) {
+    std::fprintf(stderr, "eye_bench: cannot write the scene to %s\n", dir.c_str());
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -207,7 +236,13 @@ int main(int argc, char **argv) {
   app.add_option("--tag-size-m", tag_size_m, "roof tag black border [m]")->capture_default_str();
   app.add_option("--csv", csv, "write truth vs estimate per frame (720p) here");
   app.add_option("--lcm-url", url, "where poses are published")->capture_default_str();
+  std::string scene_dir;
+  app.add_option("--write-scene", scene_dir,
+                 "only write a 640x480 scene to this folder (camera.yaml, map.yaml, eye.yaml "
+                 "with --lcm-url, frame.jpg with NIGEL1 at x 1.2 m, y 0.9 m, yaw 0.5 rad) and "
+                 "exit: the frames of tools/bench security");
   CLI11_PARSE(app, argc, argv);
+  if (!scene_dir.empty()) return write_scene(scene_dir, url, tag_size_m);
   cv::setNumThreads(1);  // one thread: aruco and imdecode would otherwise use a pool
 
   lcm::LCM lcm(url);

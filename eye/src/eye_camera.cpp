@@ -16,8 +16,8 @@ cv::Vec3d CameraPose::centre_map() const {
 Intrinsics intrinsics_load(const std::string &path) {
   const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
   Intrinsics in;
-  in.width_px = n.positive_int("width_px", 0, true);
-  in.height_px = n.positive_int("height_px", 0, true);
+  in.width_px = n.in_range("width_px", 16, 16384);
+  in.height_px = n.in_range("height_px", 16, 16384);
   std::vector<double> k = n.numbers("k", 9);
   for (int i = 0; i < 9; ++i) in.k(i / 3, i % 3) = k[static_cast<size_t>(i)];
   if (!(in.k(0, 0) > 0 && in.k(1, 1) > 0) || in.k(2, 2) != 1.0 || in.k(1, 0) != 0 ||

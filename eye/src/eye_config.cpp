@@ -22,32 +22,34 @@ RunConfig runconfig_load(const std::string &path) {
   c.map_path = resolve(path, n.get<std::string>("map"));
   n.read("lcm_url", c.lcm_url);
   // Default: the simulated Nigel's tag (vehicle/nigel.params); a lab gives its printed size.
-  c.locate.tag_size_m = n.positive("tag_size_m", AUTODRIVE_VEHICLE_TAG_SIZE_M);
+  c.locate.tag_size_m = n.positive_up_to("tag_size_m", 2.0, AUTODRIVE_VEHICLE_TAG_SIZE_M);
   // Nigel's roof tag offset comes from vehicle/nigel.params (tag_pos_m); a config gives it only
   // for a car of another kind.
   if (n.has("tag_offset_m")) {
     const auto off = n.numbers("tag_offset_m", 3);
     c.locate.tag_offset_m = cv::Vec3d(off[0], off[1], off[2]);
   }
-  c.locate.base_link_height_m = n.number("base_link_height_m", c.locate.base_link_height_m);
-  c.locate.corner_sigma_px = n.number("corner_sigma_px", c.locate.corner_sigma_px);
-  c.locate.max_fit_rms_m = n.number("max_fit_rms_m", c.locate.max_fit_rms_m);
+  n.read_in_range("base_link_height_m", c.locate.base_link_height_m, 0.0, 2.0);
+  c.locate.corner_sigma_px = n.positive_up_to("corner_sigma_px", 20.0, c.locate.corner_sigma_px);
+  c.locate.max_fit_rms_m = n.positive_up_to("max_fit_rms_m", 1.0, c.locate.max_fit_rms_m);
   if (n.has("detector")) {
     const auto d = n.child("detector");
-    c.detector.decimate = static_cast<float>(d.number("decimate", c.detector.decimate));
-    c.detector.sigma_px = static_cast<float>(d.number("sigma_px", c.detector.sigma_px));
-    c.detector.refine_edges = d.get<int>("refine_edges", c.detector.refine_edges) != 0;
-    c.detector.sharpening = d.number("sharpening", c.detector.sharpening);
-    d.read("max_hamming", c.detector.max_hamming);
-    c.detector.min_margin = static_cast<float>(d.number("min_margin", c.detector.min_margin));
+    c.detector.decimate =
+        static_cast<float>(d.in_range("decimate", 1.0, 8.0, double{c.detector.decimate}));
+    c.detector.sigma_px =
+        static_cast<float>(d.in_range("sigma_px", 0.0, 10.0, double{c.detector.sigma_px}));
+    c.detector.refine_edges = d.in_range("refine_edges", 0, 1, int{c.detector.refine_edges}) != 0;
+    d.read_in_range("sharpening", c.detector.sharpening, 0.0, 1.0);
+    d.read_in_range("max_hamming", c.detector.max_hamming, 0, 3);
+    c.detector.min_margin =
+        static_cast<float>(d.in_range("min_margin", 0.0, 1000.0, double{c.detector.min_margin}));
     d.reject_unknown();
-    if (!(c.detector.decimate >= 1)) d.fail_key("decimate", "must be >= 1");
   }
   if (n.has("tracking")) {
     const auto t = n.child("tracking");
-    c.tracking.roi = t.get<int>("roi", c.tracking.roi) != 0;
-    c.tracking.full_every = t.positive_int("full_every", c.tracking.full_every);
-    c.tracking.margin = t.positive("margin", c.tracking.margin);
+    c.tracking.roi = t.in_range("roi", 0, 1, int{c.tracking.roi}) != 0;
+    t.read_in_range("full_every", c.tracking.full_every, 1, 10000);
+    c.tracking.margin = t.positive_up_to("margin", 20.0, c.tracking.margin);
     t.reject_unknown();
   }
   const YAML::Node vs = n.list("vehicles", "must be a non-empty list");

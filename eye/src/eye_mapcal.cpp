@@ -28,7 +28,7 @@ std::vector<RefTag> reftags_load(const std::string &path) {
     r.y_m = t.number("y_m");
     r.z_m = t.number("z_m", 0.0);
     r.yaw_rad = t.number("yaw_rad", 0.0);
-    r.size_m = t.positive("size_m", 0, true);
+    r.size_m = t.positive_up_to("size_m", 2.0, 0, true);
     t.reject_unknown();
     if (r.id < 0 || r.id > 586) t.fail_key("id", "must be a tag36h11 id 0..586");
     if (!ids.insert(r.id).second) t.fail_key("id", std::to_string(r.id) + " is listed twice");
@@ -138,8 +138,8 @@ void mapcal_save(const std::string &path, const MapCalib &m) {
 MapCalib mapcal_load(const std::string &path) {
   const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
   MapCalib m;
-  m.width_px = n.positive_int("width_px", 0, true);
-  m.height_px = n.positive_int("height_px", 0, true);
+  m.width_px = n.in_range("width_px", 16, 16384);
+  m.height_px = n.in_range("height_px", 16, 16384);
   const auto r = n.numbers("r_cam_map", 9);
   const auto t = n.numbers("t_cam_map_m", 3);
   for (int i = 0; i < 9; ++i) m.pose.r_cam_map(i / 3, i % 3) = r[static_cast<size_t>(i)];

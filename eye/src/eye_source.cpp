@@ -1,6 +1,8 @@
 #include "eye_source.hpp"
 
+#include <autodrive_lcm/subscribe.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include <spdlog/sinks/stdout_sinks.h>
 #include <autodrive/compressed_image_t.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -12,6 +14,7 @@
 #include <filesystem>
 
 #include "eye_error.hpp"
+#include "eye_frame_check.hpp"
 
 namespace eye {
 
@@ -89,12 +92,14 @@ class FolderSource : public Source {
 
 class LcmSource : public Source {
  public:
-  LcmSource(const std::string &url, const std::string &channel, double idle_s)
-      : lcm_(url), channel_(channel), idle_s_(idle_s) {
+  LcmSource(const std::string &url, const std::string &channel, double idle_s, int width_px,
+            int height_px)
+      : lcm_(url), channel_(channel), idle_s_(idle_s), width_px_(width_px), height_px_(height_px) {
     if (!lcm_.good()) throw Error("lcm: cannot open " + url);
-    // A plain function + context: LCM 1.3.1's member-function subscription on a polymorphic
-    // class trips UBSan (member pointer call seen as access at address 0x1).
-    sub_ = lcm_.subscribeFunction(channel, &LcmSource::on_image_cb, this);
+    // A plain function + context (autodrive_lcm::subscribe: decodes, counts malformed
+    // messages): LCM 1.3.1's member-function subscription on a polymorphic class trips UBSan.
+    sub_ = autodrive_lcm::subscribe<autodrive::compressed_image_t, LcmSource, &LcmSource::on_image>(
+        lcm_, channel, this);
     sub_->setQueueCapacity(4);  // drop old frames rather than fall behind the camera
   }
   bool next(Frame *f) override {
@@ -104,6 +109,7 @@ class LcmSource : public Source {
       if (r < 0) throw Error("lcm: handle failed on channel " + channel_);
       const double waited =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      skipped_frames_log().flush();
       if (q_.empty() && idle_s_ > 0 && waited > idle_s_) return false;
     }
     *f = std::move(q_.front());
@@ -112,24 +118,23 @@ class LcmSource : public Source {
   }
 
  private:
-  static void on_image_cb(const lcm::ReceiveBuffer *rb, const std::string &chan,
-                          const autodrive::compressed_image_t *m, LcmSource *self) {
-    self->on_image(rb, chan, m);
-  }
   void on_image(const lcm::ReceiveBuffer *, const std::string &chan,
                 const autodrive::compressed_image_t *m) {
     Frame f;
     f.utime = m->utime;
     f.label = chan + "@" + std::to_string(m->utime);
-    if (m->format != "jpeg" && m->format != "png") {
-      std::fprintf(stderr, "autodrive-eye: %s: skipped, format '%s' is not jpeg or png\n",
-                   f.label.c_str(), m->format.c_str());
+    // Believe the header only if it names the calibrated size: nothing else is decoded.
+    const std::string why = width_px_ > 0 ? check_frame(m->data.data(), m->data.size(), m->format,
+                                                        width_px_, height_px_)
+                                          : "";
+    if (!why.empty()) {
+      skipped_frames_log().event(chan, "frame @" + std::to_string(m->utime) + " skipped: " + why);
       return;
     }
     try {
       f.gray = decode_gray(m->data.data(), m->data.size(), f.label);
     } catch (const Error &e) {
-      std::fprintf(stderr, "autodrive-eye: %s (frame skipped)\n", e.what());
+      skipped_frames_log().event(chan, std::string(e.what()) + " (frame skipped)");
       return;
     }
     if (q_.size() >= 2) q_.pop_front();  // keep the newest
@@ -138,6 +143,7 @@ class LcmSource : public Source {
   lcm::LCM lcm_;
   std::string channel_;
   double idle_s_;
+  int width_px_, height_px_;
   lcm::Subscription *sub_ = nullptr;
   std::deque<Frame> q_;
 };
@@ -152,8 +158,15 @@ std::string lcm_url_for_images(const std::string &url) {
   return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
 }
 
+autodrive::LogLimiter &skipped_frames_log() {
+  static autodrive::LogLimiter log("skipped frames", autodrive::LogLimits(),
+                                   spdlog::stderr_logger_mt("autodrive-eye"));
+  return log;
+}
+
 std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
-                                    const std::string &lcm_url, double idle_timeout_s) {
+                                    const std::string &lcm_url, double idle_timeout_s, int width_px,
+                                    int height_px) {
   const auto colon = spec.find(':');
   if (colon == std::string::npos)
     throw Error("source '" + spec +
@@ -162,7 +175,8 @@ std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
   if (!(fps_hint > 0)) throw Error("source '" + spec + "': fps must be positive");
   if (kind == "folder") return std::make_unique<FolderSource>(what, fps_hint);
   if (kind == "lcm")
-    return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s);
+    return std::make_unique<LcmSource>(lcm_url_for_images(lcm_url), what, idle_timeout_s, width_px,
+                                       height_px);
   cv::VideoCapture cap;
   if (kind == "device") {
     int idx = -1;

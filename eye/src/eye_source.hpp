@@ -1,6 +1,7 @@
 // Frame sources for `run`: camera device, GStreamer pipeline, video file, image folder, or an
 // LCM image channel. Each frame is decoded to grey and stamped with its capture time.
 #pragma once
+#include <autodrive/log_limiter.hpp>
 #include <opencv2/core.hpp>
 
 #include <cstdint>
@@ -26,8 +27,15 @@ class Source {
 // fps_hint: frame period used to stamp video and folder frames (their capture time is not
 // recorded); lcm_url: for lcm sources; idle_timeout_s: a live source with no frame for this
 // long ends the stream (0: wait forever). Throws eye::Error naming the source if it cannot open.
+// width_px x height_px: the calibrated frame size; an lcm source skips (and logs at a limited
+// rate) every frame whose header names another size, before decoding it.
 std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
-                                    const std::string &lcm_url, double idle_timeout_s);
+                                    const std::string &lcm_url, double idle_timeout_s,
+                                    int width_px = 0, int height_px = 0);
+
+// Frames skipped because they cannot be believed, counted and logged at a limited rate per
+// channel or source (on stderr): wrong size, bombs, garbage.
+autodrive::LogLimiter &skipped_frames_log();
 
 // Decodes a JPEG/PNG buffer to grey; throws eye::Error naming `what` if it is not an image.
 cv::Mat decode_gray(const uint8_t *data, size_t n, const std::string &what);

@@ -219,11 +219,21 @@ int main(int argc, char **argv) {
       if (!rn_url.empty()) cfg.lcm_url = rn_url;
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
-      auto src = eye::source_open(rn_source, rn_fps, cfg.lcm_url, rn_idle_s);
+      auto src = eye::source_open(rn_source, rn_fps, cfg.lcm_url, rn_idle_s, cfg.in.width_px,
+                                  cfg.in.height_px);
       eye::Tracker tr(cfg);
       eye::Frame f;
       long frames = 0, published = 0;
       while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && src->next(&f)) {
+        // A frame never ends the run: one of another size is skipped and logged.
+        if (f.gray.cols != cfg.in.width_px || f.gray.rows != cfg.in.height_px) {
+          eye::skipped_frames_log().event(
+              rn_source, f.label + ": size " + std::to_string(f.gray.cols) + "x" +
+                             std::to_string(f.gray.rows) + " differs from the calibrated " +
+                             std::to_string(cfg.in.width_px) + "x" +
+                             std::to_string(cfg.in.height_px) + " (frame skipped)");
+          continue;
+        }
         const auto poses = tr.process(f.gray);
         published += eye::publish_poses(lcm, poses, f.utime);
         if (!rn_debug.empty() && frames % std::max(1, rn_debug_every) == 0 &&

@@ -128,5 +128,9 @@ TEST(MapIo, BadFilesGiveClearErrors) {
 
   write(d / "m.pgm", "P5\n4 4\n65535\n");
   expect_load_error(d / "m.yaml", "m.pgm", "16-bit");
+  // Probe finding: a huge grid aborted with bad_alloc. Refused before allocating, naming the
+  // dimensions.
+  write(d / "m.pgm", "P5\n200000 200000\n255\n");
+  expect_load_error(d / "m.yaml", "m.pgm", "width x height 200000 x 200000");
   fs::remove_all(d);
 }

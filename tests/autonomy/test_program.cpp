@@ -101,6 +101,31 @@ TEST(Program, HelpAndBadConfig) {
   fs::remove(bad);
 }
 
+// Probe findings: a negative steering limit or footprint and a NaN goal were accepted; a huge
+// map grid aborted with an uncaught bad_alloc. Each is refused, naming the key and the bound.
+TEST(Program, OutOfRangeConfigValuesAreRefusedNamingTheKey) {
+  const fs::path bad =
+      fs::temp_directory_path() / ("autonomy_range_" + std::to_string(getpid()) + ".yaml");
+  const std::pair<const char *, const char *> cases[] = {
+      {"goal: {x_m: .nan, y_m: 0, yaw_rad: 0}\n", "goal.x_m: must be a finite number"},
+      {"goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nfootprint: {margin_m: -0.1}\n",
+       "footprint.margin_m: -0.1 is out of range: must be 0..0.5"},
+      {"goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nplanner: {steer_use_fraction: -1}\n",
+       "planner.steer_use_fraction: -1 is out of range"},
+      {"goal: {x_m: 1, y_m: 0, yaw_rad: 0}\ncommand_rate_hz: 0\n", "command_rate_hz: must be"},
+      {"goal: {x_m: 1, y_m: 0, yaw_rad: 0}\nslam: {resolution_m: 0.001, width_m: 900, height_m: "
+       "900}\n",
+       "slam: a grid of 900000 x 900000 cells"},
+  };
+  for (const auto &[yaml, expected] : cases) {
+    std::ofstream(bad) << yaml;
+    std::string out;
+    EXPECT_EQ(run_program({"--config", bad.string()}, &out), 2) << yaml;
+    EXPECT_NE(out.find(expected), std::string::npos) << yaml << " -> " << out;
+  }
+  fs::remove(bad);
+}
+
 TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   const synth::World world = synth::World::parking_lot();
   const fs::path dir = fs::temp_directory_path() / ("autonomy_program_" + std::to_string(getpid()));

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include "eye_render.hpp"
 #include "eye_synth.hpp"
 #include "eye_mapcal.hpp"
+#include "eye_test_util.hpp"
 
 namespace fs = std::filesystem;
 
@@ -307,4 +309,104 @@ TEST(Cli, RunOnVideoFile) {
           &out),
       1);
   EXPECT_NE(out.find("none.avi"), std::string::npos) << out;
+}
+
+// Probe findings: one wrong-size frame made the Eye exit 1; a 335-byte JPEG claiming
+// 20000x20000 px took 459 MB, then the Eye exited. Now every bad frame is skipped before it is
+// decoded (logged at a limited rate), and the Eye still localises the good frame after them.
+// Real UDP multicast on loopback, port 7792.
+TEST(Cli, RunOnLcmSurvivesWrongSizesBombsAndGarbage) {
+  const std::string url = "udpm://239.255.76.67:7792?ttl=0";
+  const std::string d = fresh_dir("eye_cli_bad_frames");
+  eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  {
+    eye::intrinsics_save(d + "/camera.yaml", s.in);
+    eye::MapCalib m;
+    m.pose = s.pose;
+    m.width_px = 640;
+    m.height_px = 480;
+    eye::mapcal_save(d + "/map.yaml", m);
+  }
+  write_config(d + "/eye.yaml", s, url);
+  lcm::LCM lcm(url);
+  ASSERT_TRUE(lcm.good());
+  std::mutex mu;
+  std::vector<int64_t> got;
+  struct Handler {
+    std::mutex *mu;
+    std::vector<int64_t> *got;
+    static void on(const lcm::ReceiveBuffer *, const std::string &, const autodrive::pose2d_t *m,
+                   Handler *h) {
+      std::lock_guard<std::mutex> l(*h->mu);
+      h->got->push_back(m->utime);
+    }
+  } h{&mu, &got};
+  lcm.subscribeFunction("NIGEL1_POSE_EYE", &Handler::on, &h);
+  std::string eye_out;
+  std::atomic<int> eye_status{-2};
+  std::thread child([&] {
+    eye_status = run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source lcm:EYE_IMAGE " +
+                         "--idle-timeout-s 4 -q",
+                     &eye_out);
+  });
+  auto send = [&](int64_t utime, const std::string &format, const std::vector<uchar> &data) {
+    autodrive::compressed_image_t m;
+    m.utime = utime;
+    m.frame_id = "eye";
+    m.format = format;
+    m.width_px = 640;
+    m.height_px = 480;
+    m.size_bytes = static_cast<int32_t>(data.size());
+    m.data.assign(data.begin(), data.end());
+    lcm.publish("EYE_IMAGE", &m);
+  };
+  const eye::SynthCar car{1, 1.2, 0.9, 0.5};
+  auto good = [&](int64_t utime) {
+    std::vector<uchar> jpg;
+    cv::imencode(".jpg", eye::synth_frame(s, {car}, {}, static_cast<uint64_t>(utime)), jpg,
+                 {cv::IMWRITE_JPEG_QUALITY, 95});
+    send(utime, "jpeg", jpg);
+  };
+  auto has = [&](int64_t utime) {
+    std::lock_guard<std::mutex> l(mu);
+    return std::find(got.begin(), got.end(), utime) != got.end();
+  };
+  auto await = [&](int64_t utime, bool republish) {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!has(utime) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+      if (republish) good(utime);
+      for (int i = 0; i < 10; ++i) lcm.handleTimeout(50);
+    }
+    return has(utime);
+  };
+  const int64_t t0 = 1'700'000'000'000'000;
+  ASSERT_TRUE(await(t0, true));  // the Eye is up
+  std::vector<uchar> small;
+  cv::imencode(".jpg", cv::Mat(240, 320, CV_8UC1, cv::Scalar(50)), small);
+  std::vector<uchar> big_png;
+  cv::imencode(".png", cv::Mat(960, 1280, CV_8UC1, cv::Scalar(50)), big_png);
+  const std::vector<uchar> bomb = eye_test::jpeg_claiming(20000, 20000);
+  std::vector<uchar> garbage(335);
+  for (size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<uchar>(i * 91 + 7);
+  int64_t t = t0;
+  for (int k = 0; k < 20; ++k) {
+    send(++t, "jpeg", small);
+    send(++t, "png", big_png);
+    send(++t, "jpeg", bomb);
+    send(++t, "jpeg", garbage);
+    send(++t, "png", garbage);
+    send(++t, "bmp", garbage);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  // Still alive and still localising.
+  EXPECT_TRUE(await(t + 1000, true));
+  child.join();
+  EXPECT_EQ(eye_status.load(), 0) << eye_out;
+  // Skipped frames were logged at a limited rate: at most 5 lines (+ a summary) per 10 s.
+  size_t lines = 0;
+  for (size_t at = eye_out.find("EYE_IMAGE: "); at != std::string::npos;
+       at = eye_out.find("EYE_IMAGE: ", at + 1))
+    ++lines;
+  EXPECT_GE(lines, 1u) << eye_out;
+  EXPECT_LE(lines, 6u) << eye_out;
 }

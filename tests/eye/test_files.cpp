@@ -135,4 +135,17 @@ TEST(BadFiles, RunConfig) {
                 "intrinsics: eye_cfg_camera.yaml\nmap: eye_cfg_map720.yaml\ntag_size_m: 0.1\n"
                 "tag_offset_m: [0.03, 0, 0.1]\nvehicles:\n - {name: A, tag_id: 1}\n");
   expect_error([&] { eye::runconfig_load(mismatch); }, {"eye_cfg_map720.yaml", "differs"});
+  // Every number has a range: refused naming the key and the bound.
+  const auto veh = std::string("vehicles:\n - {name: A, tag_id: 1}\n");
+  const auto dec = write_tmp("eye_cfg_dec.yaml", head + "detector: {decimate: 100}\n" + veh);
+  expect_error([&] { eye::runconfig_load(dec); },
+               {dec, "detector.decimate: 100 is out of range: must be 1..8"});
+  const auto ham = write_tmp("eye_cfg_ham.yaml", head + "detector: {max_hamming: -1}\n" + veh);
+  expect_error([&] { eye::runconfig_load(ham); },
+               {ham, "detector.max_hamming: -1 is out of range"});
+  const auto big = write_tmp("eye_cfg_big.yaml",
+                             "intrinsics: eye_cfg_camera.yaml\nmap: eye_cfg_map.yaml\n"
+                             "tag_size_m: 50\n" +
+                                 veh);
+  expect_error([&] { eye::runconfig_load(big); }, {big, "tag_size_m: 50 is out of range"});
 }

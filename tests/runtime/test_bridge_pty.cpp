@@ -270,3 +270,33 @@ TEST(BridgePty, MissingDeviceRetriedUntilItAppears) {
   ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 2; }));
   EXPECT_EQ(h.status().opens, 1u);
 }
+
+// Probe finding: garbage on the Nano link gave no log line at all. It is counted (and logged
+// at a limited rate, naming the device); telemetry between the garbage still flows, and a
+// STATE whose fields are out of range is dropped, not published.
+TEST(BridgePty, GarbageFromTheNanoIsCountedAndStateStillFlows) {
+  BridgeHarness h(7785);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 3; }));
+  std::vector<uint8_t> garbage(300);
+  for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<uint8_t>(i * 37 + 11);
+  for (int k = 0; k < 20; ++k) {
+    h.nano.pty.write(garbage);
+    const std::size_t before = h.states.size();
+    ASSERT_TRUE(h.wait_for([&] { return h.states.size() > before; }));
+  }
+  const bridge::Status st = h.status();
+  EXPECT_GE(st.rx_skipped_bytes + st.rx_bad_crc + st.rx_bad_length, 20u);
+  EXPECT_EQ(st.state, bridge::LinkState::linked);
+  // A STATE claiming 30x full steering is implausible: dropped and counted.
+  h.send_states = false;
+  proto_state_t bad{};
+  bad.steering_milli = 30000;
+  bad.quat_q14[0] = PROTO_QUAT_ONE;
+  const uint64_t bad_before = h.status().rx_bad_payload;
+  h.nano.send_state(bad);
+  ASSERT_TRUE(h.wait_for([&] { return h.status().rx_bad_payload > bad_before; }));
+  h.wait_for([] { return false; }, 0.2);
+  for (const auto &s : h.states) EXPECT_LE(std::abs(s.steering_applied), 1.0f);
+}

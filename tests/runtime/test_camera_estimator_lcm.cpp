@@ -6,6 +6,7 @@
 
 #include <autodrive/camera_info_t.hpp>
 #include <autodrive/compressed_image_t.hpp>
+#include <autodrive/imu_t.hpp>
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/pose2d_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
@@ -159,4 +160,67 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
   EXPECT_NEAR(m.x_m, 2.0, 0.05);
   EXPECT_NEAR(m.yaw_rad, M_PI / 2, 0.05);
   EXPECT_GT(m.y_m, 1.3);
+}
+
+// Probe findings: a forged POSE_EYE stream moved the map pose 1,000 m; an encoder jump gave
+// an odometry speed of 1,063 m/s. Both are refused by the running estimator and counted.
+TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
+  const cfg::Config c = cfg::parse(base_yaml(7786) + "estimator: {rate_hz: 100}\n", "test config");
+  lcm::LCM lcm(c.lcm_url);
+  Sink sink;
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP",
+                                                                       &sink);
+  est::EstimatorNode node(c);
+  ASSERT_EQ(node.init_error(), "");
+  std::atomic<bool> stop{false};
+  std::thread th([&] { node.run(stop); });
+  int k = 0;
+  auto feed = [&] {
+    autodrive::vehicle_state_t s{};
+    s.utime = 1000000 + k * 10000LL;
+    s.nano_time_us = k * 10000LL;
+    s.encoder_counts[0] = s.encoder_counts[1] = k * 1920 / 100;
+    if (k == 150) s.encoder_counts[0] += 1000000;  // a glitch: ~1,000 m/s for 10 ms
+    lcm.publish("TESTCAR_STATE", &s);
+    autodrive::pose2d_t e{};
+    e.utime = s.utime;
+    e.vehicle = "TESTCAR";
+    e.yaw_rad = M_PI / 2;
+    if (k % 10 == 0) {  // the real Eye at 10 Hz
+      e.x_m = 2.0;
+      e.y_m = 1.0 + 0.204 * k * 0.01;
+      lcm.publish("TESTCAR_POSE_EYE", &e);
+    }
+    if (k > 100) {  // a forger at 100 Hz, 1,000 m away
+      e.x_m = 1002.0;
+      e.y_m = 1.0;
+      lcm.publish("TESTCAR_POSE_EYE", &e);
+    }
+    if (k == 200) {
+      autodrive::imu_t imu{};
+      imu.utime = s.utime;
+      imu.angular_velocity_rad_s[2] = 1e6;
+      lcm.publish("TESTCAR_IMU", &imu);
+    }
+    ++k;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  };
+  const bool got = pump_until(
+      lcm, [&] { return k >= 300 && sink.odom.size() > 200 && sink.map.size() > 50; }, 60, feed);
+  stop = true;
+  th.join();
+  ASSERT_TRUE(got);
+  double max_speed = 0, max_map_x = 0;
+  for (const auto &o : sink.odom) max_speed = std::max(max_speed, std::abs(o.vx_m_s));
+  for (const auto &m : sink.map) max_map_x = std::max(max_map_x, m.x_m);
+  EXPECT_LT(max_speed, 0.5);
+  EXPECT_LT(max_map_x, 2.05);
+  EXPECT_NEAR(sink.map.back().x_m, 2.0, 0.05);
+  const est::InputStats st = node.input_stats();
+  EXPECT_GE(st.wheel_dropped, 1u);
+  EXPECT_LE(st.wheel_dropped, 2u);  // the jump and the step back
+  EXPECT_GE(st.poses_gated, 150u);
+  EXPECT_EQ(st.gyro_dropped, 1u);
+  EXPECT_EQ(st.reacquired, 0u);
 }

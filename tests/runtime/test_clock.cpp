@@ -31,3 +31,43 @@ TEST(Clock, SimModeFollowsSimClock) {
   ASSERT_GT(lcm.handleTimeout(1000), 0);
   EXPECT_EQ(c.now_us(), 123466789);
 }
+
+// Probe finding: a forged SIM_CLOCK of 0 stopped odometry for 4.7 s. Ticks are believed only
+// in sim mode and only when they move forward (by at most Clock::kMaxSimStepUs).
+TEST(Clock, SimClockBackwardsOrFarAheadIsRefusedAndCounted) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  clk::Clock c(cfg::ClockMode::sim);
+  c.attach(lcm);
+  autodrive::sim_clock_t m{};
+  auto tick = [&](int64_t t_us) {
+    m.utime = t_us;
+    lcm.publish("SIM_CLOCK", &m);
+    ASSERT_GT(lcm.handleTimeout(1000), 0);
+  };
+  tick(5000000);
+  EXPECT_EQ(c.now_us(), 5000000);
+  tick(0);  // the forged reset
+  EXPECT_EQ(c.now_us(), 5000000);
+  tick(4999999);  // backwards
+  EXPECT_EQ(c.now_us(), 5000000);
+  tick(5000000 + clk::Clock::kMaxSimStepUs + 1);  // far ahead: would freeze every later tick
+  EXPECT_EQ(c.now_us(), 5000000);
+  EXPECT_EQ(c.sim_ticks_refused(), 3u);
+  tick(5010000);  // the honest next tick still moves it
+  EXPECT_EQ(c.now_us(), 5010000);
+}
+
+TEST(Clock, SimClockIgnoredInWallMode) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  clk::Clock c(cfg::ClockMode::wall);
+  c.attach(lcm);
+  autodrive::sim_clock_t m{};
+  m.utime = 0;
+  lcm.publish("SIM_CLOCK", &m);
+  lcm.handleTimeout(50);
+  const int64_t before = clk::wall_us();
+  EXPECT_GE(c.now_us(), before);  // still the wall clock, not 0
+  EXPECT_EQ(c.sim_ticks_refused(), 0u);
+}

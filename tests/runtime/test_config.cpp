@@ -53,7 +53,7 @@ TEST(Config, BadValueNamesKeyAndValue) {
 
 TEST(Config, NegativeRateRefused) {
   EXPECT_NE(error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: -5"))
-                .find("bridge.heartbeat_hz: must be"),
+                .find("bridge.heartbeat_hz: -5 is out of range: must be 10..500"),
             std::string::npos);
 }
 
@@ -126,4 +126,45 @@ TEST(Config, ShippedConfigsParse) {
     EXPECT_TRUE(c.has_bridge);
     EXPECT_TRUE(c.has_estimator);
   }
+}
+
+// Probe findings: limits that would defeat the failsafe are refused, naming the key and bound.
+TEST(ConfigRanges, CommandTimeoutAbove500msRefused) {
+  const std::string e =
+      error_of(replace(kGood, "command_timeout_ms: 200", "command_timeout_ms: 100000"));
+  EXPECT_NE(e.find("test.yaml: bridge.command_timeout_ms: 100000 is out of range"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("1..500"), std::string::npos) << e;
+  EXPECT_EQ(error_of(replace(kGood, "command_timeout_ms: 200", "command_timeout_ms: 500")), "");
+}
+
+TEST(ConfigRanges, HeartbeatOutOfRangeRefused) {
+  for (const char *bad : {"0.001", "0", "-5", "10000", ".nan", ".inf"}) {
+    const std::string e =
+        error_of(replace(kGood, "heartbeat_hz: 50", std::string("heartbeat_hz: ") + bad));
+    EXPECT_NE(e.find("bridge.heartbeat_hz"), std::string::npos) << bad << ": " << e;
+  }
+  // 10 Hz is in range but too slow for the default 100 ms failsafe: named with the reason.
+  const std::string e = error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 10"));
+  EXPECT_NE(e.find("bridge.heartbeat_hz: 10.000000 is too slow for failsafe_timeout_ms 100"),
+            std::string::npos)
+      << e;
+}
+
+TEST(ConfigRanges, EveryRuntimeNumberHasABound) {
+  const std::string lidar =
+      std::string(kGood) + "lidar: {device: /dev/ttyUSB1, baud: 115200, range_max_m: 400}\n";
+  EXPECT_NE(error_of(lidar).find("lidar.range_max_m: 400 is out of range"), std::string::npos)
+      << error_of(lidar);
+  const std::string est = std::string(kGood) + "estimator: {rate_hz: 100, history_ms: 1000000}\n";
+  EXPECT_NE(error_of(est).find("estimator.history_ms: 1000000 is out of range: must be 1..10000"),
+            std::string::npos)
+      << error_of(est);
+  const std::string gate = std::string(kGood) + "estimator: {rate_hz: 100, pose_gate_chi2: 0}\n";
+  EXPECT_NE(error_of(gate).find("estimator.pose_gate_chi2: 0 is out of range"), std::string::npos)
+      << error_of(gate);
+  EXPECT_NE(
+      error_of(replace(kGood, "baud: 500000", "baud: 0")).find("bridge.baud: 0 is out of range"),
+      std::string::npos);
 }

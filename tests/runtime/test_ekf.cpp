@@ -172,3 +172,97 @@ TEST(Ekf, WheelSpeedFromEncodersAcrossClockWrap) {
   EXPECT_NEAR(v, 2 * M_PI * 0.0325 / 0.1, 1e-9);
   EXPECT_FALSE(est::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
 }
+
+// ---- The pose gate (probe finding: one forged POSE_EYE stream moved the map pose 1,000 m) ----
+namespace {
+// A map filter as the estimator runs it: no reset, odometry from t = 0, the first Eye fix at
+// `first_fix_s`, then honest Eye poses every 100 ms (when `eye_on(s)`), forged poses at 100 Hz
+// at `forged_offset_m` from the truth (when `forged_on(s)`). Straight at 0.25 m/s for 30 s,
+// odometry speed scaled by `speed_scale`. Returns the final position error [m].
+template <class EyeOn, class ForgedOn>
+double run_gate(EyeOn eye_on, ForgedOn forged_on, double forged_offset_m, double speed_scale,
+                est::EkfStats *stats, double duration_s = 30.0) {
+  est::Ekf ekf;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  Truth t;
+  t.x = 2.0;
+  t.y = -1.0;
+  t.yaw = 0.5;
+  const int steps = static_cast<int>(duration_s * 100);
+  for (int k = 1; k <= steps; ++k) {
+    const double s = k * 0.01;
+    const double delta = 0.15 * std::sin(0.3 * s);
+    step(t, 0.25, delta, 0.01);
+    const int64_t t_us = k * 10000;
+    ekf.add_wheel(t_us, 0.25 * speed_scale, delta);
+    ekf.add_gyro(t_us, 0.25 * std::tan(delta) / kL);
+    if (k % 10 == 0 && eye_on(s))
+      ekf.add_pose(t_us, t.x + noise(rng), t.y + noise(rng), t.yaw + 0.5 * noise(rng),
+                   eye_cov(0.01, 0.02));
+    if (forged_on(s))
+      ekf.add_pose(t_us + 1, t.x + forged_offset_m, t.y, t.yaw, eye_cov(0.01, 0.02));
+  }
+  if (stats) *stats = ekf.stats();
+  return std::hypot(ekf.latest().x(0) - t.x, ekf.latest().x(1) - t.y);
+}
+const auto always = [](double) { return true; };
+const auto never = [](double) { return false; };
+}  // namespace
+
+TEST(EkfGate, HonestEyeIsNeverRejectedAndTheFirstFixPlacesTheCar) {
+  est::EkfStats st;
+  // The car starts 2.2 m from the filter's origin: the first fix must pass the gate.
+  EXPECT_LT(run_gate(always, never, 0.0, 1.1, &st), 0.02);
+  EXPECT_EQ(st.gated, 0u);
+  EXPECT_EQ(st.reacquired, 0u);
+  EXPECT_EQ(st.fused, 3000u * 2 + 300u);
+}
+
+TEST(EkfGate, ForgedPoseStreamIsRejectedAndCounted) {
+  for (double offset_m : {1000.0, 10.0, 1.0, 0.3}) {
+    est::EkfStats st;
+    // Honest Eye all along; from 5 s on, a forged stream at 100 Hz (10x the Eye's rate).
+    const double err = run_gate(
+        always, [](double s) { return s > 5.0; }, offset_m, 1.0, &st);
+    EXPECT_LT(err, 0.05) << "offset " << offset_m;
+    EXPECT_GE(st.gated, 2400u) << "offset " << offset_m;
+    EXPECT_EQ(st.reacquired, 0u) << "offset " << offset_m;
+  }
+}
+
+TEST(EkfGate, ReacquiresTheRealEyeAfterALongGap) {
+  est::EkfStats st;
+  // Eye lost from 3 s to 23 s while the odometry over-reads by 20 %: ~1 m of drift, far
+  // outside the gate when the Eye comes back; a steady run of poses re-places the car.
+  const double err = run_gate([](double s) { return s < 3.0 || s > 23.0; }, never, 0.0, 1.2, &st);
+  EXPECT_LT(err, 0.05);
+  EXPECT_EQ(st.reacquired, 1u);
+}
+
+TEST(EkfGate, AForgedPoseHeldStillWhileTheCarDrivesNeverReplacesIt) {
+  est::EkfStats st;
+  // No real Eye after 3 s (the worst case): a forged stream 1 m off, not moving with the car.
+  est::Ekf ekf;
+  Truth t;
+  for (int k = 1; k <= 3000; ++k) {
+    step(t, 0.25, 0.0, 0.01);
+    const int64_t t_us = k * 10000;
+    ekf.add_wheel(t_us, 0.25, 0.0);
+    ekf.add_gyro(t_us, 0.0);
+    if (k % 10 == 0 && k < 300) ekf.add_pose(t_us, t.x, t.y, t.yaw, eye_cov(0.01, 0.02));
+    if (k >= 300) ekf.add_pose(t_us, 5.0, 1.0, 0.0, eye_cov(0.01, 0.02));
+  }
+  st = ekf.stats();
+  EXPECT_EQ(st.reacquired, 0u);
+  EXPECT_GE(st.gated, 2600u);
+  EXPECT_LT(std::hypot(ekf.latest().x(0) - t.x, ekf.latest().x(1) - t.y), 0.1);
+}
+
+TEST(EkfGate, DistanceIsMahalanobis) {
+  est::Ekf ekf;
+  ekf.reset(0, 0, 0, 0, 0.01 * 0.01, 1e-4);
+  const Eigen::Matrix3d r = eye_cov(0.01, 0.01);
+  // S = diag(2e-4, 2e-4, 2e-4): 0.02 m in x is 2 sigma -> d2 = 2.
+  EXPECT_NEAR(ekf.pose_distance2(0, 0.02, 0, 0, r), 2.0, 1e-9);
+}

@@ -11,7 +11,11 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <sstream>
 #include <thread>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include "common/config.hpp"
 #include <autodrive_lcm/subscribe.hpp>
@@ -34,6 +38,8 @@ struct FakeRplidar {
   int resets = 0, scans = 0, healths = 0;
   int angle = 0;
   double corrupt_fraction = 0.0;
+  bool sticky_error = false;  // health error after every reset (a broken or lying device)
+  bool forge_health = false;  // a health-error packet after every 40 nodes (a forger)
   std::mt19937 rng{99};
 
   void pump() {
@@ -44,7 +50,7 @@ struct FakeRplidar {
       if (cmd == rplidar::kCmdGetHealth) {
         ++healths;
         pty.write({0xA5, 0x5A, 0x03, 0x00, 0x00, 0x00, 0x06, health_status, 0x01, 0x00});
-        if (health_status == 2) health_status = 0;  // healthy after the driver's reset
+        if (health_status == 2 && !sticky_error) health_status = 0;  // healthy after a reset
       } else if (cmd == rplidar::kCmdScan) {
         ++scans;
         scanning = true;
@@ -67,6 +73,10 @@ struct FakeRplidar {
       if (u(rng) < corrupt_fraction) b[rng() % 5] ^= static_cast<uint8_t>(1u << (rng() % 8));
       out.insert(out.end(), b, b + 5);
       angle = (angle + 1) % 360;
+    }
+    if (forge_health) {
+      const uint8_t forged[] = {0xA5, 0x5A, 0x03, 0x00, 0x00, 0x00, 0x06, 0x02, 0x34, 0x12};
+      out.insert(out.end(), forged, forged + sizeof forged);
     }
     pty.write(out);
   }
@@ -175,4 +185,41 @@ TEST(RplidarPty, ReopensAfterUnplug) {
   const std::size_t before = h.scans.size();
   ASSERT_TRUE(h.wait_for([&] { return h.scans.size() >= before + 2; }));
   EXPECT_GE(h.driver->status().opens, 2u);
+}
+
+// Probe findings: forged health packets gave one log line each and endless resets.
+TEST(RplidarPty, HealthErrorFloodLimitsResets) {
+  LidarHarness h(7783);
+  h.fake.health_status = 2;
+  h.fake.sticky_error = true;
+  h.fake.pty.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.driver->status().resets_refused >= 1; }, 40.0));
+  EXPECT_EQ(h.driver->status().resets, 3u);
+  EXPECT_EQ(h.fake.resets, 3);
+}
+
+TEST(RplidarPty, ForgedHealthPacketsWhileScanningAreIgnoredAndLoggedAtALimitedRate) {
+  // Capture the log: the driver logs through spdlog's default logger.
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  sink->set_pattern("%v");
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("captured", sink));
+  {
+    LidarHarness h(7784);
+    h.fake.forge_health = true;
+    h.fake.pty.open();
+    h.start();
+    ASSERT_TRUE(h.wait_for([&] { return h.driver->status().unsolicited_health >= 50; }));
+    EXPECT_EQ(h.fake.resets, 0);
+    EXPECT_EQ(h.driver->status().resets, 0u);
+  }
+  spdlog::set_default_logger(previous);
+  std::istringstream in(log.str());
+  int health_lines = 0;
+  for (std::string line; std::getline(in, line);)
+    health_lines += line.find("health") != std::string::npos;
+  EXPECT_LE(health_lines, 6);  // 5 lines per 10 s and device, then one summary
+  EXPECT_GE(health_lines, 1);
 }

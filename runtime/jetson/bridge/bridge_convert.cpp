@@ -74,6 +74,19 @@ std::string command_problem(const autodrive::vehicle_command_t &c) {
   return "";
 }
 
+std::string state_problem(const proto_state_t &s) {
+  if (s.throttle_milli < -PROTO_MILLI || s.throttle_milli > PROTO_MILLI)
+    return "applied throttle " + std::to_string(s.throttle_milli) + " outside +-" +
+           std::to_string(PROTO_MILLI);
+  if (s.steering_milli < -PROTO_MILLI || s.steering_milli > PROTO_MILLI)
+    return "applied steering " + std::to_string(s.steering_milli) + " outside +-" +
+           std::to_string(PROTO_MILLI);
+  if (s.mode > PROTO_MODE_FAILSAFE) return "unknown mode " + std::to_string(s.mode);
+  if ((s.lights & PROTO_LIGHTS_HEAD_MASK) > 2)
+    return "unknown headlight level " + std::to_string(s.lights & PROTO_LIGHTS_HEAD_MASK);
+  return "";
+}
+
 proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh, uint16_t seq) {
   proto_command_t m{};
   m.seq = seq;

@@ -32,6 +32,10 @@ void fill_imu(const proto_state_t &s, const cfg::Bridge &br, int64_t utime_us,
 
 // Returns "" if the command is usable, else what is wrong with it.
 std::string command_problem(const autodrive::vehicle_command_t &c);
+// "" if a STATE from the Nano is plausible (applied throttle and steering within
+// [-PROTO_MILLI, PROTO_MILLI], a known mode and headlight level), else what is wrong; such a STATE
+// is dropped.
+std::string state_problem(const proto_state_t &s);
 
 // The COMMAND frame for the heartbeat. `fresh` is false when the LCM command stream is stale
 // (or absent): then throttle is 0, steering centred and engaged cleared; lights are kept.

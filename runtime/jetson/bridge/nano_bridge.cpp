@@ -7,6 +7,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <autodrive/log_limiter.hpp>
 
 #include <algorithm>
 #include <cinttypes>
@@ -63,6 +64,10 @@ struct NanoBridge::Impl {
   int64_t last_rx_frame_us = 0;  // last good frame from the Nano
   bool open_failure_logged = false;
   bool rejected_logged = false;
+  // Receive side: what a noisy or hostile link produces is counted and logged at a limited
+  // rate per device, never one line per frame.
+  autodrive::LogLimiter rx_log{"receive problems"};
+  proto_stats_t rx_reported{};  // parser counters already logged
 
   explicit Impl(const cfg::Config &c)
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
@@ -168,8 +173,7 @@ struct NanoBridge::Impl {
     last_tick = tick;
     uint8_t buf[512];
     long n;
-    while ((n = port.read_some(buf, sizeof buf)) > 0)
-      proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
+    while ((n = port.read_some(buf, sizeof buf)) > 0) feed(buf, static_cast<size_t>(n));
     if (n < 0) lose_device(port.error());
     if (!port.is_open()) return;
     if (scheduled_cmd && scheduled_cmd->utime <= clock.now_us()) {
@@ -207,6 +211,7 @@ struct NanoBridge::Impl {
     spdlog::info("{}opened {} at {} baud; handshaking", tag, config.bridge.device,
                  config.bridge.baud);
     proto_parser_init(&parser);
+    rx_reported = proto_stats_t{};
     count([](Status &s) {
       ++s.opens;
       s.state = LinkState::handshaking;
@@ -237,7 +242,7 @@ struct NanoBridge::Impl {
 
   void on_hello(const proto_frame_t &f, int64_t now_us) {
     proto_hello_t h{};
-    if (proto_hello_unpack(f.payload, f.len, &h) != 0) return;
+    if (proto_hello_unpack(f.payload, f.len, &h) != 0) return bad_payload("HELLO", f.len);
     const uint32_t ours = proto_schema_hash();
     if (h.schema_hash != ours || h.proto_version != PROTO_VERSION) {
       const std::string msg = "schema mismatch on " + config.bridge.device +
@@ -273,7 +278,13 @@ struct NanoBridge::Impl {
 
   void on_state(const proto_frame_t &f) {
     proto_state_t s{};
-    if (proto_state_unpack(f.payload, f.len, &s) != 0) return;
+    if (proto_state_unpack(f.payload, f.len, &s) != 0) return bad_payload("STATE", f.len);
+    const std::string problem = state_problem(s);
+    if (!problem.empty()) {
+      count([](Status &st2) { ++st2.rx_bad_payload; });
+      rx_log.event(config.bridge.device, "implausible STATE dropped: " + problem);
+      return;
+    }
     const int64_t t = clock.now_us();
     autodrive::vehicle_state_t vs{};
     fill_state(s, config.vehicle, host_stats(), t, &vs);
@@ -290,6 +301,32 @@ struct NanoBridge::Impl {
     });
   }
 
+  void bad_payload(const char *what, unsigned len) {
+    count([](Status &s) { ++s.rx_bad_payload; });
+    rx_log.event(
+        config.bridge.device,
+        fmt::format("{} frame with a {}-byte payload does not unpack: dropped", what, len));
+  }
+
+  // Feeds received bytes to the parser; counts and logs (limited) any new garbage.
+  void feed(const uint8_t *buf, size_t n) {
+    proto_parser_feed(&parser, buf, n, &Impl::on_frame, this);
+    const proto_stats_t &p = parser.stats;
+    const uint32_t skipped = p.skipped_bytes - rx_reported.skipped_bytes;
+    const uint32_t crc = p.bad_crc - rx_reported.bad_crc;
+    const uint32_t len = p.bad_length - rx_reported.bad_length;
+    if (skipped == 0 && crc == 0 && len == 0) return;
+    rx_reported = p;
+    count([&](Status &s) {
+      s.rx_skipped_bytes += skipped;
+      s.rx_bad_crc += crc;
+      s.rx_bad_length += len;
+    });
+    rx_log.event(config.bridge.device,
+                 fmt::format("garbage from the Nano: {} bytes skipped, {} bad CRC, {} bad length",
+                             skipped, crc, len));
+  }
+
   static void on_frame(const proto_frame_t *f, void *ctx) {
     auto *self = static_cast<Impl *>(ctx);
     const int64_t now = clk::monotonic_us();
@@ -304,8 +341,11 @@ struct NanoBridge::Impl {
       proto_nack_t n{};
       if (proto_nack_unpack(f->payload, f->len, &n) == 0) {
         self->count([](Status &st2) { ++st2.nacks; });
-        spdlog::warn("{}Nano refused frame id 0x{:02x} seq {}: reason {}", self->tag, n.rejected_id,
-                     n.seq, n.reason);
+        self->rx_log.event(self->config.bridge.device,
+                           fmt::format("Nano refused frame id 0x{:02x} seq {}: reason {}",
+                                       n.rejected_id, n.seq, n.reason));
+      } else {
+        self->bad_payload("NACK", f->len);
       }
     }
   }
@@ -331,7 +371,7 @@ struct NanoBridge::Impl {
         if (n < 0)
           lose_device(port.error());
         else if (n > 0)
-          proto_parser_feed(&parser, buf, static_cast<size_t>(n), &Impl::on_frame, this);
+          feed(buf, static_cast<size_t>(n));
       } else if (fds[1].revents & (POLLHUP | POLLERR | POLLNVAL)) {
         lose_device(config.bridge.device + ": hang-up (unplugged, or the peer closed it)");
       }
@@ -382,7 +422,11 @@ std::string NanoBridge::init_error() const {
 }
 
 void NanoBridge::run(const std::atomic<bool> &stop) {
-  while (!stop) impl_->poll_once(stop);
+  while (!stop) {
+    impl_->poll_once(stop);
+    impl_->rx_log.flush();
+    autodrive_lcm::malformed_log().flush();
+  }
   impl_->port.close();
 }
 

@@ -2,7 +2,10 @@
 #include "common/clock.hpp"
 
 #include <autodrive/sim_clock_t.hpp>
+#include <autodrive_lcm/subscribe.hpp>
 #include <lcm/lcm-cpp.hpp>
+
+#include <autodrive/log_limiter.hpp>
 
 #include <chrono>
 
@@ -19,15 +22,37 @@ int64_t monotonic_us() {
 }
 
 namespace {
-void on_sim_clock(const lcm::ReceiveBuffer *, const std::string &, const autodrive::sim_clock_t *m,
-                  Clock *clock) {
-  clock->set_sim_us(m->utime);
+autodrive::LogLimiter &refused_log() {
+  static autodrive::LogLimiter log("refused SIM_CLOCK ticks");
+  return log;
 }
 }  // namespace
 
+void Clock::on_sim_clock(const autodrive::sim_clock_t *m) {
+  const int64_t before = sim_us_.load();
+  if (!set_sim_us(m->utime))
+    refused_log().event(AUTODRIVE_CH_SIM_CLOCK,
+                        fmt::format("tick {} us refused (clock at {} us; ticks must move "
+                                    "forward by at most {} us)",
+                                    m->utime, before, kMaxSimStepUs));
+}
+
+bool Clock::set_sim_us(int64_t t_us) {
+  const int64_t now = sim_us_.load();
+  const bool first = !have_sim_.load();
+  if (t_us < 0 || (!first && (t_us < now || t_us - now > kMaxSimStepUs))) {
+    ++refused_;
+    return false;
+  }
+  sim_us_.store(t_us);
+  have_sim_.store(true);
+  return true;
+}
+
 void Clock::attach(lcm::LCM &lcm) {
   if (mode_ != cfg::ClockMode::sim) return;
-  lcm.subscribeFunction(AUTODRIVE_CH_SIM_CLOCK, &on_sim_clock, this);
+  autodrive_lcm::subscribe<autodrive::sim_clock_t, Clock, &Clock::on_sim_clock>(
+      lcm, AUTODRIVE_CH_SIM_CLOCK, this);
 }
 
 int64_t Clock::now_us() const {

@@ -1,7 +1,9 @@
 // Time sources. Wall mode stamps messages with the system clock; sim mode follows the
 // simulator's SIM_CLOCK (lockstep) so that runs are repeatable and faster than real time.
 // Rates, timeouts and the serial heartbeat always run on the monotonic clock: the serial
-// link is real whatever the clock source.
+// link is real whatever the clock source. SIM_CLOCK is believed only in sim mode and only
+// when it moves forward by at most kMaxSimStepUs: a forged tick (0, backwards, far future)
+// is refused, counted and logged at a limited rate.
 #pragma once
 
 #include <atomic>
@@ -12,6 +14,9 @@
 
 namespace lcm {
 class LCM;
+}
+namespace autodrive {
+class sim_clock_t;
 }
 
 namespace clk {
@@ -27,11 +32,17 @@ class Clock {
   // Stamp for outgoing messages [us]: wall time, or the last SIM_CLOCK (0 before the first).
   int64_t now_us() const;
   bool sim() const { return mode_ == cfg::ClockMode::sim; }
-  void set_sim_us(int64_t t_us) { sim_us_.store(t_us); }
+  static constexpr int64_t kMaxSimStepUs = 10000000;  // largest forward step of SIM_CLOCK [us]
+  // Takes a SIM_CLOCK tick; false (and counted) if refused: not forward, or too far forward.
+  bool set_sim_us(int64_t t_us);
+  uint64_t sim_ticks_refused() const { return refused_.load(); }
+  void on_sim_clock(const autodrive::sim_clock_t *m);
 
  private:
   cfg::ClockMode mode_;
   std::atomic<int64_t> sim_us_{0};
+  std::atomic<bool> have_sim_{false};
+  std::atomic<uint64_t> refused_{0};
 };
 
 }  // namespace clk

@@ -9,6 +9,8 @@ namespace {
 
 using autodrive::yaml::Section;
 
+constexpr int kMinBaud = 1200, kMaxBaud = 4000000;  // [bit/s]
+
 Vehicle parse_vehicle(const Section &s) {
   Vehicle v;
   v.name = s.get<std::string>("name");
@@ -27,19 +29,28 @@ Vehicle parse_vehicle(const Section &s) {
 Bridge parse_bridge(const Section &s) {
   Bridge b;
   b.device = s.get<std::string>("device");
-  b.baud = s.positive_int("baud", 0, true);
-  b.heartbeat_hz = s.positive("heartbeat_hz", 0, true);
-  b.command_timeout_ms = s.positive_int("command_timeout_ms", 0, true);
-  b.hello_retry_ms = s.positive_int("hello_retry_ms", b.hello_retry_ms);
-  b.refused_retry_ms = s.positive_int("refused_retry_ms", b.refused_retry_ms);
-  b.reconnect_ms = s.positive_int("reconnect_ms", b.reconnect_ms);
-  b.link_timeout_ms = s.positive_int("link_timeout_ms", b.link_timeout_ms);
+  // Ranges that keep the failsafe meaningful: a command older than 500 ms is never obeyed,
+  // and the heartbeat is fast enough for the Nano's failsafe (20..150 ms) yet bounded.
+  b.baud = s.in_range("baud", kMinBaud, kMaxBaud);
+  b.heartbeat_hz = s.in_range("heartbeat_hz", 10.0, 500.0);
+  b.command_timeout_ms = s.in_range("command_timeout_ms", 1, 500);
+  b.hello_retry_ms = s.in_range("hello_retry_ms", 10, 10000, b.hello_retry_ms);
+  b.refused_retry_ms = s.in_range("refused_retry_ms", 10, 60000, b.refused_retry_ms);
+  b.reconnect_ms = s.in_range("reconnect_ms", 10, 60000, b.reconnect_ms);
+  b.link_timeout_ms = s.in_range("link_timeout_ms", 50, 10000, b.link_timeout_ms);
   b.telemetry_period_ms = s.get<int>("telemetry_period_ms", b.telemetry_period_ms);
   if (b.telemetry_period_ms != 0 && (b.telemetry_period_ms < 5 || b.telemetry_period_ms > 1000))
     s.fail(s.key("telemetry_period_ms"), "must be 0 (do not configure) or 5..1000");
   b.failsafe_timeout_ms = s.get<int>("failsafe_timeout_ms", b.failsafe_timeout_ms);
   if (b.failsafe_timeout_ms < 20 || b.failsafe_timeout_ms > 150)
     s.fail(s.key("failsafe_timeout_ms"), "must be 20..150 (firmware range)");
+  // Two heartbeats per Nano failsafe period at least, or a healthy link trips the failsafe.
+  if (1000.0 / b.heartbeat_hz > b.failsafe_timeout_ms / 2.0)
+    s.fail(s.key("heartbeat_hz"),
+           std::to_string(b.heartbeat_hz) + " is too slow for failsafe_timeout_ms " +
+               std::to_string(b.failsafe_timeout_ms) +
+               ": must be >= " + std::to_string(2000.0 / b.failsafe_timeout_ms) +
+               " (two frames per failsafe period)");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
   if (b.servo_trim_us < -200 || b.servo_trim_us > 200)
@@ -61,11 +72,11 @@ Bridge parse_bridge(const Section &s) {
 Lidar parse_lidar(const Section &s) {
   Lidar l;
   l.device = s.get<std::string>("device");
-  l.baud = s.positive_int("baud", 0, true);
+  l.baud = s.in_range("baud", kMinBaud, kMaxBaud);
   l.frame_id = s.get<std::string>("frame_id", l.frame_id);
-  l.mount_yaw_rad = s.get<double>("mount_yaw_rad", 0.0);
-  l.range_min_m = s.positive("range_min_m", l.range_min_m);
-  l.range_max_m = s.positive("range_max_m", l.range_max_m);
+  l.mount_yaw_rad = s.in_range("mount_yaw_rad", -M_PI, M_PI, 0.0);
+  l.range_min_m = s.positive_up_to("range_min_m", 5.0, l.range_min_m);
+  l.range_max_m = s.positive_up_to("range_max_m", 40.0, l.range_max_m);
   if (l.range_max_m <= l.range_min_m) s.fail(s.key("range_max_m"), "must exceed range_min_m");
   s.reject_unknown();
   return l;
@@ -87,11 +98,10 @@ Camera parse_camera(const Section &s) {
            "must be CAM_FRONT or CAM_REAR (lcm_types/channels.yaml), got '" + channel + "'");
   }
   c.frame_id = s.get<std::string>("frame_id", c.frame_id);
-  c.rate_hz = s.positive("rate_hz", 0, true);
-  c.width_px = s.positive_int("width_px", c.width_px);
-  c.height_px = s.positive_int("height_px", c.height_px);
-  c.jpeg_quality = s.positive_int("jpeg_quality", c.jpeg_quality);
-  if (c.jpeg_quality > 100) s.fail(s.key("jpeg_quality"), "must be 1..100");
+  c.rate_hz = s.positive_up_to("rate_hz", 240.0, 0, true);
+  c.width_px = s.in_range("width_px", 16, 8192, c.width_px);
+  c.height_px = s.in_range("height_px", 16, 8192, c.height_px);
+  c.jpeg_quality = s.in_range("jpeg_quality", 1, 100, c.jpeg_quality);
   c.loop_file = s.get<bool>("loop_file", c.loop_file);
   // Intrinsics: from the pinhole figures of the Nigel camera unless given.
   const double fx = c.width_px / (2.0 * std::tan(0.5 * 62.2 * M_PI / 180.0));
@@ -108,14 +118,18 @@ Camera parse_camera(const Section &s) {
 
 Estimator parse_estimator(const Section &s) {
   Estimator e;
-  e.rate_hz = s.positive("rate_hz", 0, true);
-  e.odom_speed_std_m_s = s.positive("odom_speed_std_m_s", e.odom_speed_std_m_s);
-  e.yaw_rate_std_rad_s = s.positive("yaw_rate_std_rad_s", e.yaw_rate_std_rad_s);
-  e.eye_pos_std_m = s.positive("eye_pos_std_m", e.eye_pos_std_m);
-  e.eye_yaw_std_rad = s.positive("eye_yaw_std_rad", e.eye_yaw_std_rad);
-  e.process_pos_std_m = s.positive("process_pos_std_m", e.process_pos_std_m);
-  e.process_yaw_std_rad = s.positive("process_yaw_std_rad", e.process_yaw_std_rad);
-  e.history_ms = s.positive_int("history_ms", e.history_ms);
+  e.rate_hz = s.positive_up_to("rate_hz", 1000.0, 0, true);
+  e.odom_speed_std_m_s = s.positive_up_to("odom_speed_std_m_s", 10.0, e.odom_speed_std_m_s);
+  e.yaw_rate_std_rad_s = s.positive_up_to("yaw_rate_std_rad_s", 10.0, e.yaw_rate_std_rad_s);
+  e.eye_pos_std_m = s.positive_up_to("eye_pos_std_m", 10.0, e.eye_pos_std_m);
+  e.eye_yaw_std_rad = s.positive_up_to("eye_yaw_std_rad", M_PI, e.eye_yaw_std_rad);
+  e.process_pos_std_m = s.positive_up_to("process_pos_std_m", 10.0, e.process_pos_std_m);
+  e.process_yaw_std_rad = s.positive_up_to("process_yaw_std_rad", M_PI, e.process_yaw_std_rad);
+  e.history_ms = s.in_range("history_ms", 1, 10000, e.history_ms);
+  s.read_in_range("pose_gate_chi2", e.pose_gate_chi2, 1.0, 1000.0);
+  s.read_in_range("pose_reacquire_s", e.pose_reacquire_s, 0.5, 600.0);
+  s.read_in_range("max_speed_m_s", e.max_speed_m_s, 0.1, 50.0);
+  s.read_in_range("max_yaw_rate_rad_s", e.max_yaw_rate_rad_s, 0.1, 100.0);
   e.use_imu = s.get<bool>("use_imu", e.use_imu);
   s.reject_unknown();
   return e;

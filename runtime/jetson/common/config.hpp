@@ -83,6 +83,15 @@ struct Estimator {
   double process_pos_std_m = 0.01;    // per sqrt(s)
   double process_yaw_std_rad = 0.02;  // per sqrt(s)
   int history_ms = 1000;              // how late an Eye pose may arrive and still be fused
+  // Input checks. An Eye pose whose squared Mahalanobis distance to the estimate exceeds
+  // pose_gate_chi2 (3 degrees of freedom; 16.3 = 99.9 %) is rejected and counted. After
+  // pose_reacquire_s without an accepted pose, a run of mutually consistent poses re-places
+  // the car (the Eye's re-acquisition after a long gap; a forged stream cannot do this while
+  // the real Eye keeps being accepted).
+  double pose_gate_chi2 = 16.3;
+  double pose_reacquire_s = 5.0;      // [s]
+  double max_speed_m_s = 10.0;        // encoder speed above this is a glitch: dropped
+  double max_yaw_rate_rad_s = 17.45;  // gyro z above this (1000 deg/s, the IMU's range): dropped
   bool use_imu = true;
 };
 

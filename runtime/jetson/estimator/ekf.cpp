@@ -2,6 +2,7 @@
 
 #include <autodrive/angles.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace est {
@@ -102,17 +103,19 @@ void Ekf::apply(Event &e, const Estimate &before) const {
       H(0, 0) = H(1, 1) = H(2, 2) = 1.0;
       Eigen::Matrix<double, 3, 1> innov;
       innov << e.z(0) - s.x(0), e.z(1) - s.x(1), autodrive::angle_wrap_rad(e.z(2) - s.x(2));
-      update<3>(s, innov, H, e.R);
+      const Eigen::Matrix3d S = s.P.topLeftCorner<3, 3>() + e.R;
+      e.gated = !(innov.dot(S.ldlt().solve(innov)) <= p_.pose_gate_chi2);
+      if (!e.gated) update<3>(s, innov, H, e.R);
       break;
     }
   }
   e.after = s;
 }
 
-void Ekf::add(Event e) {
+Ekf::Outcome Ekf::add(Event e) {
   if (!e.z.allFinite() || !e.R.allFinite()) {
     ++stats_.rejected;
-    return;
+    return Outcome::dropped;
   }
   if (!init_) {
     // Nothing to anchor the pose yet: start at this measurement's time.
@@ -122,12 +125,13 @@ void Ekf::add(Event e) {
   }
   if (e.t_us < base_.t_us) {
     ++stats_.too_old;
-    return;
+    return Outcome::dropped;
   }
-  ++stats_.fused;
+  bool gated = false;
   if (events_.empty() || e.t_us >= events_.back().t_us) {
     apply(e, cur_);
     cur_ = e.after;
+    gated = e.gated;
     events_.push_back(std::move(e));
   } else {
     // Late: insert at its time and replay everything after it.
@@ -137,6 +141,7 @@ void Ekf::add(Event e) {
     it = events_.insert(it, std::move(e));
     for (auto j = it; j != events_.end(); ++j)
       apply(*j, j == events_.begin() ? base_ : (j - 1)->after);
+    gated = it->gated;
     cur_ = events_.back().after;
   }
   // Forget what is older than the history window.
@@ -144,22 +149,82 @@ void Ekf::add(Event e) {
     base_ = events_.front().after;
     events_.pop_front();
   }
+  if (gated) {
+    ++stats_.gated;
+    return Outcome::gated;
+  }
+  ++stats_.fused;
+  return Outcome::fused;
+}
+
+void Ekf::reacquire(int64_t t_us) {
+  // Forget the pose (keep speed and yaw rate): the next pose places the car, as at start.
+  Estimate s = estimate_at(std::max(t_us, cur_.t_us));
+  s.P.row(0).setZero();
+  s.P.row(1).setZero();
+  s.P.row(2).setZero();
+  s.P.col(0).setZero();
+  s.P.col(1).setZero();
+  s.P.col(2).setZero();
+  s.P(0, 0) = s.P(1, 1) = 1e4;
+  s.P(2, 2) = 10.0;
+  events_.clear();
+  base_ = cur_ = s;
+  candidates_.clear();
+  ++stats_.reacquired;
 }
 
 void Ekf::add_wheel(int64_t t_us, double speed_m_s, double steering_rad) {
-  Event e{t_us, Kind::wheel, {speed_m_s, steering_rad, 0.0}, Eigen::Matrix3d::Zero(), {}};
+  Event e{t_us, Kind::wheel, {speed_m_s, steering_rad, 0.0}, Eigen::Matrix3d::Zero(), {}, false};
   add(std::move(e));
 }
 
 void Ekf::add_gyro(int64_t t_us, double yaw_rate_rad_s) {
-  Event e{t_us, Kind::gyro, {yaw_rate_rad_s, 0.0, 0.0}, Eigen::Matrix3d::Zero(), {}};
+  Event e{t_us, Kind::gyro, {yaw_rate_rad_s, 0.0, 0.0}, Eigen::Matrix3d::Zero(), {}, false};
   add(std::move(e));
 }
 
 void Ekf::add_pose(int64_t t_us, double x_m, double y_m, double yaw_rad,
                    const Eigen::Matrix3d &cov) {
-  Event e{t_us, Kind::pose, {x_m, y_m, yaw_rad}, cov, {}};
-  add(std::move(e));
+  const Outcome o = add(Event{t_us, Kind::pose, {x_m, y_m, yaw_rad}, cov, {}, false});
+  if (o == Outcome::fused) {
+    last_pose_us_ = std::max(last_pose_us_, t_us);
+    candidates_.clear();
+    return;
+  }
+  if (o != Outcome::gated || t_us - last_pose_us_ < p_.pose_reacquire_us) return;
+  // Long without an accepted pose: is this one of a run that moves as the odometry says the
+  // car moves (a constant offset: the odometry's drift), for at least reacquire_span_us? Then
+  // re-place the car on it. A forged pose held still while the car drives is not.
+  const Estimate s = estimate_at(t_us);
+  const Eigen::Vector3d innov(x_m - s.x(0), y_m - s.x(1),
+                              autodrive::angle_wrap_rad(yaw_rad - s.x(2)));
+  if (!candidates_.empty()) {
+    const Candidate &first = candidates_.front();
+    Eigen::Vector3d d = innov - first.innov;
+    d(2) = autodrive::angle_wrap_rad(d(2));
+    const double span_s = (t_us - first.t_us) * 1e-6;
+    const double drift = p_.reacquire_drift_per_s * span_s;  // odometry drift allowance
+    Eigen::Matrix3d S = cov + first.cov;
+    S.diagonal() += Eigen::Vector3d(drift * drift, drift * drift, drift * drift);
+    if (!(d.dot(S.ldlt().solve(d)) <= p_.pose_gate_chi2)) candidates_.clear();
+  }
+  candidates_.push_back({t_us, innov, cov});
+  if (static_cast<int>(candidates_.size()) < p_.reacquire_poses ||
+      t_us - candidates_.front().t_us < p_.reacquire_span_us)
+    return;
+  reacquire(t_us);
+  add(Event{t_us, Kind::pose, {x_m, y_m, yaw_rad}, cov, {}, false});
+  last_pose_us_ = t_us;
+}
+
+double Ekf::pose_distance2(int64_t t_us, double x_m, double y_m, double yaw_rad,
+                           const Eigen::Matrix3d &cov) const {
+  const Estimate s = estimate_at(t_us);
+  const Eigen::Vector3d innov(x_m - s.x(0), y_m - s.x(1),
+                              autodrive::angle_wrap_rad(yaw_rad - s.x(2)));
+  const Eigen::Matrix3d S = s.P.topLeftCorner<3, 3>() + cov;
+  return innov.dot(S.ldlt().solve(innov));
 }
 
 Estimate Ekf::estimate_at(int64_t t_us) const {

@@ -7,6 +7,7 @@
 #include <autodrive/vehicle_state_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
+#include <autodrive/log_limiter.hpp>
 
 #include <cmath>
 
@@ -35,6 +36,8 @@ EkfParams params_from_config(const cfg::Config &c) {
   p.r_speed_m_s = c.estimator.odom_speed_std_m_s;
   p.r_gyro_rad_s = c.estimator.yaw_rate_std_rad_s;
   p.history_us = c.estimator.history_ms * 1000LL;
+  p.pose_gate_chi2 = c.estimator.pose_gate_chi2;
+  p.pose_reacquire_us = static_cast<int64_t>(c.estimator.pose_reacquire_s * 1e6);
   return p;
 }
 
@@ -46,6 +49,10 @@ struct EstimatorNode::Impl {
   bool have_prev = false;
   autodrive::vehicle_state_t prev{};
   int64_t next_pub_us = 0;  // next ODOM/POSE_MAP due [us, message time]
+  // Inputs that fail a check are dropped, counted and logged at a limited rate.
+  autodrive::LogLimiter implausible{"implausible inputs"};
+  uint64_t wheel_dropped = 0, gyro_dropped = 0, poses_future = 0, gated_logged = 0;
+  static constexpr int64_t kMaxPoseAheadUs = 1000000;  // a pose may be this far ahead [us]
 
   Impl(const cfg::Config &c, const std::string &output_url)
       : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
@@ -68,8 +75,18 @@ struct EstimatorNode::Impl {
                                     prev.nano_time_us, m->encoder_counts[0], m->encoder_counts[1],
                                     m->nano_time_us, config.vehicle.encoder_counts_per_rev,
                                     config.vehicle.wheel_radius_m, &v)) {
-        odom.add_wheel(m->utime, v, m->steering_angle_rad);
-        map.add_wheel(m->utime, v, m->steering_angle_rad);
+        if (std::abs(v) > config.estimator.max_speed_m_s ||
+            std::abs(m->steering_angle_rad) > 2.0 * config.vehicle.steering_limit_rad) {
+          ++wheel_dropped;
+          implausible.event(config.vehicle.name + AUTODRIVE_CH_STATE_SUFFIX,
+                            fmt::format("encoder speed {:.3g} m/s or steering {:.3g} rad is "
+                                        "implausible (limits {} m/s, {:.3g} rad): dropped",
+                                        v, m->steering_angle_rad, config.estimator.max_speed_m_s,
+                                        2.0 * config.vehicle.steering_limit_rad));
+        } else {
+          odom.add_wheel(m->utime, v, m->steering_angle_rad);
+          map.add_wheel(m->utime, v, m->steering_angle_rad);
+        }
       }
     }
     prev = *m;
@@ -88,6 +105,14 @@ struct EstimatorNode::Impl {
 
   void on_imu(const autodrive::imu_t *m) {
     if (!config.estimator.use_imu) return;
+    const double w = m->angular_velocity_rad_s[2];
+    if (!(std::abs(w) <= config.estimator.max_yaw_rate_rad_s)) {
+      ++gyro_dropped;
+      implausible.event(config.vehicle.name + AUTODRIVE_CH_IMU_SUFFIX,
+                        fmt::format("gyro z {:.3g} rad/s is implausible (limit {} rad/s): dropped",
+                                    w, config.estimator.max_yaw_rate_rad_s));
+      return;
+    }
     odom.add_gyro(m->utime, m->angular_velocity_rad_s[2]);
     map.add_gyro(m->utime, m->angular_velocity_rad_s[2]);
   }
@@ -101,7 +126,29 @@ struct EstimatorNode::Impl {
       cov(0, 0) = cov(1, 1) = std::pow(config.estimator.eye_pos_std_m, 2);
       cov(2, 2) = std::pow(config.estimator.eye_yaw_std_rad, 2);
     }
+    const std::string channel = config.vehicle.name + AUTODRIVE_CH_POSE_EYE_SUFFIX;
+    // A stamp far ahead of the car's own time would drag the filter's clock forward and make
+    // every real measurement "too old": refused against the last STATE's stamp.
+    if (have_prev && m->utime > prev.utime + kMaxPoseAheadUs) {
+      ++poses_future;
+      implausible.event(channel, fmt::format("pose stamped {:.3f} s ahead of the car's STATE: "
+                                             "dropped",
+                                             (m->utime - prev.utime) * 1e-6));
+      return;
+    }
+    const uint64_t reacquired = map.stats().reacquired;
     map.add_pose(m->utime, m->x_m, m->y_m, m->yaw_rad, cov);
+    if (map.stats().gated > gated_logged) {
+      gated_logged = map.stats().gated;
+      implausible.event(channel, fmt::format("pose ({:.3f}, {:.3f}) m far from the estimate "
+                                             "(Mahalanobis gate): rejected, {} so far",
+                                             m->x_m, m->y_m, gated_logged));
+    }
+    if (map.stats().reacquired > reacquired)
+      spdlog::warn(
+          "{}: no pose accepted for {} s; re-placed the car at ({:.3f}, {:.3f}) m on "
+          "a consistent run of poses",
+          channel, config.estimator.pose_reacquire_s, m->x_m, m->y_m);
   }
 
   void publish(const Estimate &e, const char *frame, const char *suffix) {
@@ -137,7 +184,16 @@ std::string EstimatorNode::init_error() const {
 }
 
 void EstimatorNode::run(const std::atomic<bool> &stop) {
-  while (!stop) impl_->lcm.handleTimeout(20);
+  while (!stop) {
+    impl_->lcm.handleTimeout(20);
+    impl_->implausible.flush();
+    autodrive_lcm::malformed_log().flush();
+  }
+}
+
+InputStats EstimatorNode::input_stats() const {
+  return {impl_->map.stats().gated, impl_->map.stats().reacquired, impl_->wheel_dropped,
+          impl_->gyro_dropped, impl_->poses_future};
 }
 
 long EstimatorNode::replay() {

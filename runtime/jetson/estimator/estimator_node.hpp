@@ -22,6 +22,15 @@ bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano
 
 EkfParams params_from_config(const cfg::Config &c);
 
+// Inputs the estimator refused (each also logged at a limited rate, naming the channel).
+struct InputStats {
+  uint64_t poses_gated = 0;    // <VEH>_POSE_EYE poses rejected by the Mahalanobis gate
+  uint64_t reacquired = 0;     // re-placements after a long gap (map filter)
+  uint64_t wheel_dropped = 0;  // <VEH>_STATE encoder speed or steering out of range
+  uint64_t gyro_dropped = 0;   // <VEH>_IMU gyro z out of range
+  uint64_t poses_future = 0;   // <VEH>_POSE_EYE stamped > 1 s ahead of the last STATE
+};
+
 class EstimatorNode {
  public:
   // Inputs from config.lcm_url; outputs there too, or to output_url if given (replay).
@@ -32,6 +41,7 @@ class EstimatorNode {
   // Feeds every message of a file:// input (the config's lcm_url) through the estimator, as
   // fast as it goes; returns the number of messages handled.
   long replay();
+  InputStats input_stats() const;
 
  private:
   struct Impl;

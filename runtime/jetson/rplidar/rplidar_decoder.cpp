@@ -47,6 +47,7 @@ void encode_node(const Node &n, uint8_t out[5]) {
 void Decoder::reset() {
   mode_ = Mode::hunt;
   has_prev_ = false;
+  resume_nodes_ = false;
   // Called from a callback inside process(): let process() drop the buffer when it returns.
   if (processing_)
     reset_requested_ = true;
@@ -86,6 +87,7 @@ void Decoder::process() {
       if (type == kAnsTypeMeasurement && len == 5 && send_mode == 1) {
         mode_ = Mode::nodes;
         has_prev_ = false;
+        resume_nodes_ = false;
       } else if (send_mode == 0 && len <= 256) {
         // A single answer (health, info, ...): read its payload, then hunt again.
         if (type != kAnsTypeHealth && type != kAnsTypeDevInfo) ++stats_.bad_descriptors;
@@ -94,6 +96,7 @@ void Decoder::process() {
         payload_len_ = len;
       } else {
         ++stats_.bad_descriptors;
+        resume_nodes_ = false;
       }
       continue;
     }
@@ -106,7 +109,9 @@ void Decoder::process() {
         on_health(h);
       }
       i += payload_len_;
-      mode_ = Mode::hunt;
+      // A single answer inside a scan stream (noise or forged) does not end the scan.
+      mode_ = resume_nodes_ ? Mode::nodes : Mode::hunt;
+      resume_nodes_ = false;
       continue;
     }
     // Mode::nodes. The standard node has no checksum, only 3 check bits, so a window that
@@ -115,8 +120,10 @@ void Decoder::process() {
     // misaligned window almost never does. Costs one node of latency.
     if (avail < 5) break;
     if (b[0] == kAnsSync1 && b[1] == kAnsSync2) {
-      // A new descriptor inside the stream (the scan was restarted): parse it.
+      // A new descriptor inside the stream (the scan was restarted, or a single answer): parse
+      // it; after a single answer's payload the node stream goes on.
       mode_ = Mode::hunt;
+      resume_nodes_ = true;
       continue;
     }
     if (avail < 10) break;

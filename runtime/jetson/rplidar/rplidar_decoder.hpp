@@ -87,6 +87,7 @@ class Decoder {
   bool processing_ = false;  // inside process(): callbacks may call reset()
   bool reset_requested_ = false;
   bool has_prev_ = false;        // a good node was accepted in this scan stream
+  bool resume_nodes_ = false;    // a descriptor interrupted the node stream: resume after it
   double prev_angle_deg_ = 0.0;  // its angle
 };
 

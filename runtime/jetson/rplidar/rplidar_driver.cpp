@@ -6,6 +6,9 @@
 #include <spdlog/spdlog.h>
 #include <sys/ioctl.h>
 
+#include <autodrive/log_limiter.hpp>
+
+#include <deque>
 #include <mutex>
 
 #include "common/clock.hpp"
@@ -31,6 +34,12 @@ struct Driver::Impl {
   int64_t last_node_us = 0;
   int64_t next_report_us = 0;  // next statistics log line [monotonic us]
   bool open_failure_logged = false;
+  // A device (or a forger on the line) reporting errors must not reset the A1 forever nor
+  // flood the log: at most kMaxResets resets per kResetWindowUs, health lines rate-limited.
+  static constexpr int kMaxResets = 3;
+  static constexpr int64_t kResetWindowUs = 60000000;
+  std::deque<int64_t> reset_times_us;
+  autodrive::LogLimiter health_log{"health reports"};
 
   explicit Impl(const cfg::Config &c)
       : config(c),
@@ -67,20 +76,51 @@ struct Driver::Impl {
   }
 
   void on_health(const Health &h) {
+    const std::string &device = config.lidar.device;
+    if (phase != Phase::health) {
+      // Nobody asked: a health packet in the scan stream is noise or forged.
+      {
+        std::lock_guard<std::mutex> g(mu);
+        ++st.unsolicited_health;
+      }
+      health_log.event(device, fmt::format("unsolicited health packet (status {}, code "
+                                           "0x{:04x}) ignored",
+                                           h.status, h.error_code));
+      return;
+    }
     {
       std::lock_guard<std::mutex> g(mu);
       st.last_health = h.status;
     }
     const int64_t now = clk::monotonic_us();
     if (h.status == 2) {
-      spdlog::error("{}device reports error code 0x{:04x}; resetting it", tag, h.error_code);
+      while (!reset_times_us.empty() && now - reset_times_us.front() > kResetWindowUs)
+        reset_times_us.pop_front();
+      if (static_cast<int>(reset_times_us.size()) >= kMaxResets) {
+        {
+          std::lock_guard<std::mutex> g(mu);
+          ++st.resets_refused;
+        }
+        health_log.event(device, fmt::format("device reports error code 0x{:04x}; already "
+                                             "reset {} times in {} s, asking again in 5 s",
+                                             h.error_code, kMaxResets, kResetWindowUs / 1000000));
+        deadline_us = now + 5000000;
+        return;
+      }
+      reset_times_us.push_back(now);
+      health_log.event(
+          device, fmt::format("device reports error code 0x{:04x}; resetting it", h.error_code));
+      {
+        std::lock_guard<std::mutex> g(mu);
+        ++st.resets;
+      }
       send(kCmdReset);
-      phase = Phase::health;
       deadline_us = now + 2000000;  // the A1 needs time to reboot before it answers again
       return;
     }
-    if (h.status == 1) spdlog::warn("{}device health warning 0x{:04x}", tag, h.error_code);
-    if (phase == Phase::health) start_scan(now);
+    if (h.status == 1)
+      health_log.event(device, fmt::format("device health warning 0x{:04x}", h.error_code));
+    start_scan(now);
   }
 
   void on_node(const Node &n) {
@@ -150,7 +190,7 @@ struct Driver::Impl {
     if (!port.is_open()) return;
     const int64_t t = clk::monotonic_us();
     if (phase == Phase::health && t > deadline_us) {
-      spdlog::warn("{}no health answer; asking again", tag);
+      health_log.event(config.lidar.device, "no health answer; asking again");
       start_health(t);
     } else if (phase == Phase::scan && t - last_node_us > 2000000) {
       spdlog::warn("{}no measurement for 2 s; restarting the scan", tag);
@@ -163,6 +203,7 @@ struct Driver::Impl {
                    d.nodes, d.bad_nodes, d.skipped_bytes, d.descriptors, assembler.scans());
       next_report_us = t + 10000000;
     }
+    health_log.flush();
     std::lock_guard<std::mutex> g(mu);
     st.scanning = decoder.scanning();
     st.nodes = decoder.stats().nodes;

@@ -16,7 +16,10 @@ struct DriverStatus {
   bool scanning = false;
   uint64_t opens = 0, disconnects = 0, scans_published = 0, scan_starts = 0;
   uint64_t nodes = 0, bad_nodes = 0;
-  int last_health = -1;  // 0 good, 1 warning, 2 error, -1 unknown
+  int last_health = -1;             // 0 good, 1 warning, 2 error, -1 unknown
+  uint64_t resets = 0;              // RESET commands sent on a health error
+  uint64_t resets_refused = 0;      // health errors not answered by a reset (limit reached)
+  uint64_t unsolicited_health = 0;  // health packets while scanning: ignored
 };
 
 class Driver {

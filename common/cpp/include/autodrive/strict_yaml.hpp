@@ -1,7 +1,8 @@
 // The one strict YAML config reader of the runtime, the autonomy and the Eye. Every error
 // names the file and the dotted key ("nigel_car.yaml: bridge.baud: missing key"), a key no
 // reader asked for is refused as a typo (reject_unknown), and a value of the wrong kind is
-// refused with its text, never read as a default.
+// refused with its text, never read as a default. Every number has a range (in_range,
+// positive(..., hi)): a value outside is refused naming the key and the bound.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -13,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -102,6 +104,27 @@ class Section {
   double number(const std::string &k, double fallback) const {
     return finite(k, get<double>(k, fallback));
   }
+  // A finite number > 0 and <= hi.
+  double positive_up_to(const std::string &k, double hi, double fallback,
+                        bool required = false) const {
+    const double v = positive(k, fallback, required);
+    if (v > hi) fail_key(k, out_of_range(v, "> 0 and <= " + text(hi)));
+    return v;
+  }
+  // A number (int or double) in [lo, hi]; required, or the fallback when absent.
+  template <typename T>
+  T in_range(const std::string &k, T lo, T hi) const {
+    return check_range(k, get<T>(k), lo, hi);
+  }
+  template <typename T>
+  T in_range(const std::string &k, T lo, T hi, T fallback) const {
+    return check_range(k, get<T>(k, fallback), lo, hi);
+  }
+  // Reads k into out if present (out keeps its default otherwise); refused outside [lo, hi].
+  template <typename T>
+  void read_in_range(const std::string &k, T &out, T lo, T hi) const {
+    out = in_range<T>(k, lo, hi, out);
+  }
   int positive_int(const std::string &k, int fallback, bool required = false) const {
     const int v = required ? get<int>(k) : get<int>(k, fallback);
     if (v <= 0) fail_key(k, "must be an integer > 0");
@@ -152,6 +175,22 @@ class Section {
   const YAML::Node &node() const { return node_; }
 
  private:
+  template <typename T>
+  static std::string text(T v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+  template <typename T>
+  static std::string out_of_range(T v, const std::string &bound) {
+    return text(v) + " is out of range: must be " + bound;
+  }
+  template <typename T>
+  T check_range(const std::string &k, T v, T lo, T hi) const {
+    if constexpr (std::is_floating_point_v<T>) v = finite(k, v);
+    if (!(v >= lo && v <= hi)) fail_key(k, out_of_range(v, text(lo) + ".." + text(hi)));
+    return v;
+  }
   double finite(const std::string &k, double v) const {
     if (!std::isfinite(v)) fail_key(k, "must be a finite number");
     return v;

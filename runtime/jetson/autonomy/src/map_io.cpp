@@ -121,7 +121,12 @@ GridMap map_load(const std::string &yaml_path) {
   const int w = pgm_int(in, pf, "width"), h = pgm_int(in, pf, "height");
   const int maxval = pgm_int(in, pf, "maxval");
   if (maxval > 255) map_fail(pf, "16-bit PGM not supported");
-  if (static_cast<long long>(w) * h > 100000000LL) map_fail(pf, "image too large");
+  // Checked before anything is allocated: a huge map is a clear error, not a bad_alloc.
+  constexpr long long kMaxCells = 4096LL * 4096LL;
+  if (static_cast<long long>(w) * h > kMaxCells)
+    map_fail(pf, "width x height " + std::to_string(w) + " x " + std::to_string(h) + " = " +
+                     std::to_string(static_cast<long long>(w) * h) + " cells exceeds " +
+                     std::to_string(kMaxCells) + " (4096 x 4096)");
 
   GridMap map(w, h, resolution, origin[0], origin[1]);
   map.occupied_thresh = occ_th;
