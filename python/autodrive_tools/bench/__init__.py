@@ -13,7 +13,7 @@ from typing import Any
 
 from ..paths import REPO_ROOT
 
-SUITES = ("eye", "firmware", "link", "parking", "sim")
+SUITES = ("eye", "firmware", "link", "parking", "security", "sim")
 
 
 def build_dir(suite: str) -> Path:

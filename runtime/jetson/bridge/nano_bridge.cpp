@@ -1,6 +1,7 @@
 #include <autodrive_channels.h>
 #include "bridge/nano_bridge.hpp"
 
+#include <autodrive/control_status_t.hpp>
 #include <autodrive/imu_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
@@ -11,9 +12,11 @@
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <map>
 #include <optional>
 
 #include "bridge/bridge_convert.hpp"
+#include "bridge/command_gate.hpp"
 #include "common/clock.hpp"
 #include <autodrive_lcm/subscribe.hpp>
 #include "common/serial_port.hpp"
@@ -63,10 +66,28 @@ struct NanoBridge::Impl {
   int64_t last_rx_frame_us = 0;  // last good frame from the Nano
   bool open_failure_logged = false;
   bool rejected_logged = false;
+  // Command authentication: no key, no gate, and the bridge refuses to run (init_error).
+  std::string key_file, key_error;
+  std::optional<CommandGate> gate;
+  int64_t next_control_us = 0;  // next CONTROL status [monotonic us]
+  // Drop log lines, at most one per second per (source, reason), with the count in between.
+  struct DropLog {
+    int64_t last_us = 0;
+    int64_t suppressed = 0;
+  };
+  std::map<std::string, DropLog> drop_log;
 
   explicit Impl(const cfg::Config &c)
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
     proto_parser_init(&parser);
+    key_file = c.bridge.command_key_file.empty() ? autodrive::auth::default_key_path(c.vehicle.name)
+                                                 : c.bridge.command_key_file;
+    try {
+      gate.emplace(autodrive::auth::load_key(key_file), c.vehicle.name,
+                   c.bridge.replay_window_ms * 1000LL, c.bridge.command_lease_ms * 1000LL);
+    } catch (const autodrive::InputError &e) {
+      key_error = std::string("bridge.command_key_file: ") + e.what();
+    }
     if (lcm.good()) {
       autodrive_lcm::subscribe<autodrive::vehicle_command_t, Impl, &Impl::on_command>(
           lcm, c.vehicle.name + AUTODRIVE_CH_COMMAND_SUFFIX, this);
@@ -92,7 +113,66 @@ struct NanoBridge::Impl {
     return static_cast<int64_t>(1e6 / config.bridge.heartbeat_hz);
   }
 
+  void log_drop(const autodrive::vehicle_command_t &m, Drop d) {
+    if (drop_log.size() > 256) drop_log.clear();  // bounded: sources are chosen by the sender
+    std::string source = m.source.substr(0, autodrive::auth::kMaxSourceChars);
+    for (char &ch : source)
+      if (ch < 0x21 || ch > 0x7e) ch = '?';
+    if (source.empty()) source = "(none)";
+    DropLog &l = drop_log[source + '\n' + drop_name(d)];
+    const int64_t now = clk::monotonic_us();
+    if (l.last_us != 0 && now - l.last_us < 1000000) {
+      ++l.suppressed;
+      return;
+    }
+    spdlog::warn("{}dropped a command from source '{}': {} ({} more since the last line)", tag,
+                 source, drop_name(d), l.suppressed);
+    l.last_us = now;
+    l.suppressed = 0;
+  }
+
+  void publish_control(int64_t now_mono) {
+    const GateCounters &n = gate->counters();
+    autodrive::control_status_t m{};
+    m.utime = clock.now_us();
+    m.holder = gate->holder();
+    m.holder_authority = gate->holder_authority();
+    m.holder_changes = n.holder_changes;
+    m.applied = n.applied;
+    m.dropped_unsigned = n.dropped_unsigned;
+    m.dropped_bad_mac = n.dropped_bad_mac;
+    m.dropped_replay = n.dropped_replay;
+    m.dropped_not_holder = n.dropped_not_holder;
+    m.last_dropped_source = n.last_dropped_source;
+    lcm.publish(config.vehicle.name + AUTODRIVE_CH_CONTROL_SUFFIX, &m);
+    count([&](Status &s) {
+      s.control = n;
+      s.holder = gate->holder();
+    });
+    next_control_us = now_mono + 200000;  // 5 Hz
+  }
+
+  void holder_changed(int64_t now_mono) {
+    if (gate->holder().empty())
+      spdlog::warn("{}control lease lapsed: no source holds control", tag);
+    else
+      spdlog::warn("{}control now held by '{}' ({})", tag, gate->holder(),
+                   gate->holder_authority() == autodrive::vehicle_command_t::AUTHORITY_PERSON
+                       ? "person"
+                       : "machine");
+    publish_control(now_mono);
+  }
+
   void on_command(const autodrive::vehicle_command_t *m) {
+    if (!gate) return;
+    const int64_t now_mono = clk::monotonic_us();
+    if (gate->expire(now_mono)) holder_changed(now_mono);  // a lapse is published on its own
+    const CommandGate::Verdict v = gate->admit(*m, now_mono, clk::wall_us());
+    if (v.holder_changed) holder_changed(now_mono);
+    if (v.drop != Drop::none) {
+      if (v.drop != Drop::idle) log_drop(*m, v.drop);
+      return;
+    }
     const std::string why = command_problem(*m);
     if (!why.empty()) {
       // Rejected commands do not refresh the stream: a sender gone wrong disengages the car.
@@ -111,12 +191,8 @@ struct NanoBridge::Impl {
     }
     latest_cmd = *m;
     latest_cmd_rx_us = clk::monotonic_us();
-    // Forward at once (latency), then keep the heartbeat going from here. In step with
-    // SIM_CLOCK every frame waits for its tick instead.
-    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock) {
-      send_command(latest_cmd_rx_us);
-      next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
-    }
+    // No frame here: the serial link is written at the heartbeat rate only, whatever rate
+    // commands arrive at, so a flood on LCM cannot flood the Nano.
   }
 
   void write_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
@@ -323,7 +399,15 @@ struct NanoBridge::Impl {
       wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
     if (stop) return;
-    if (r > 0 && (fds[0].revents & POLLIN)) lcm.handleTimeout(0);
+    // Drain what LCM has (bounded, so the serial side is served even under a flood).
+    if (r > 0 && (fds[0].revents & POLLIN))
+      for (int i = 0; i < 512 && lcm.handleTimeout(0) > 0; ++i) {
+      }
+    if (gate) {
+      const int64_t tm = clk::monotonic_us();
+      if (gate->expire(tm)) holder_changed(tm);
+      if (tm >= next_control_us) publish_control(tm);
+    }
     if (r > 0 && nfds == 2 && port.is_open()) {
       if (fds[1].revents & POLLIN) {
         uint8_t buf[512];
@@ -374,6 +458,7 @@ NanoBridge::~NanoBridge() = default;
 
 std::string NanoBridge::init_error() const {
   if (!impl_->config.has_bridge) return impl_->config.file + ": bridge: missing section";
+  if (!impl_->key_error.empty()) return impl_->config.file + ": " + impl_->key_error;
   if (!impl_->lcm.good())
     return "LCM URL '" + impl_->config.lcm_url +
            "' unusable (for udpm on a host with no multicast route: ip route add 239.0.0.0/8 dev "

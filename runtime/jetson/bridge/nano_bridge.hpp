@@ -1,7 +1,9 @@
 // Nano bridge: the serial link to the Arduino Nano (or the simulator's / simavr's pty).
 // Handshake (HELLO_REQUEST until a HELLO with our schema hash), telemetry -> <VEH>_STATE and
-// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat, engaged only while the LCM
-// command stream is fresh. Reconnects by itself when the device disappears.
+// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat (the only rate the serial
+// link is written at), engaged only while the LCM command stream is fresh. Only commands the
+// command gate admits (signed, not replayed, from the lease holder) count; the holder and the
+// gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device disappears.
 #pragma once
 
 #include <atomic>
@@ -10,6 +12,7 @@
 #include <mutex>
 #include <string>
 
+#include "bridge/command_gate.hpp"
 #include "common/config.hpp"
 
 namespace bridge {
@@ -32,6 +35,8 @@ struct Status {
   uint64_t imu_published = 0;
   uint64_t nacks = 0;
   std::string last_refusal;  // the refusal message (names both schemas)
+  GateCounters control;      // the command gate's counters (as of the last CONTROL status)
+  std::string holder;        // the source holding the control lease, "" when none
 };
 
 class NanoBridge {
