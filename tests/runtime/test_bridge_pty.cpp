@@ -11,6 +11,9 @@
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 
 #include <atomic>
@@ -66,8 +69,7 @@ class BridgeHarness {
         key(link_ + ".key"),
         config(cfg::parse(config_yaml(port, link_, key.path), "test config")),
         lcm(config.lcm_url),
-        signer(key.key, "TESTCAR", "test-autonomy",
-               autodrive::vehicle_command_t::AUTHORITY_MACHINE) {
+        signer(key.key, "TESTCAR", "test-autonomy", autodrive::auth::kAuthorityMachine) {
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
         lcm, "TESTCAR_STATE", this);
     autodrive_lcm::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(
@@ -331,15 +333,14 @@ TEST(BridgeAuth, UnsignedAndWrongKeyCommandsIgnored) {
   ASSERT_TRUE(h.wait_for([&] {
     auto c = h.command(0.9f, -1.0f, true);
     c.source = "autonomy";  // claims a name, signs nothing
-    c.authority = autodrive::vehicle_command_t::AUTHORITY_PERSON;
+    c.authority = autodrive::auth::kAuthorityPerson;
     h.lcm.publish("TESTCAR_COMMAND", &c);
     return h.status().control.dropped_unsigned >= 5;
   }));
   // ... and signed with a key that is not the car's.
   autodrive::auth::Key wrong = h.key.key;
   wrong[0] ^= 1;
-  autodrive::auth::Signer intruder(wrong, "TESTCAR", "intruder",
-                                   autodrive::vehicle_command_t::AUTHORITY_PERSON);
+  autodrive::auth::Signer intruder(wrong, "TESTCAR", "intruder", autodrive::auth::kAuthorityPerson);
   ASSERT_TRUE(h.wait_for([&] {
     auto c = h.command(0.8f, 1.0f, true);
     intruder.sign(c);
@@ -385,7 +386,7 @@ TEST(BridgeAuth, ReplayedCommandsIgnored) {
   // A validly signed command from a new source, but stamped outside the replay window (5 s old).
   auto old = h.command(0.45f, 0.0f, true);
   autodrive::auth::Signer other(h.key.key, "TESTCAR", "recorded-elsewhere",
-                                autodrive::vehicle_command_t::AUTHORITY_MACHINE);
+                                autodrive::auth::kAuthorityMachine);
   other.sign(old);
   old.counter -= 5000000;
   const auto mac =
@@ -405,7 +406,7 @@ TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
   h.start();
   ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
   autodrive::auth::Signer teleop(h.key.key, "TESTCAR", "test-teleop",
-                                 autodrive::vehicle_command_t::AUTHORITY_PERSON);
+                                 autodrive::auth::kAuthorityPerson);
   auto teleop_cmd = [&](float throttle, bool engaged) {
     auto c = h.command(throttle, 0.0f, engaged);
     teleop.sign(c);
@@ -427,7 +428,7 @@ TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
   }));
   ASSERT_TRUE(h.wait_for([&] {
     return !h.controls.empty() && h.controls.back().holder == "test-teleop" &&
-           h.controls.back().holder_authority == autodrive::vehicle_command_t::AUTHORITY_PERSON;
+           h.controls.back().holder_authority == autodrive::auth::kAuthorityPerson;
   }));
   // Dead-man released (teleop sends disengaged): the autonomy, still sending engaged commands,
   // never gets the car back while the person holds control.
@@ -499,4 +500,41 @@ TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= mark + 40; }));
   EXPECT_LE(count_engaged(h.nano.commands, mark), 200 / 20 + 2);
   EXPECT_FALSE(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+}
+
+TEST(BridgeAuth, UnicastUdpToTheLcmPortDoesNotDrive) {
+  BridgeHarness h(7787);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  // Not a publisher at all: a plain UDP socket writes LCM's "LC02" packet of an engaged
+  // full-throttle command to 127.0.0.1:<port>, which LCM's receive socket accepts.
+  auto c = h.command(1.0f, 1.0f, true);
+  c.source = "unicast";
+  c.authority = autodrive::auth::kAuthorityPerson;
+  std::vector<uint8_t> payload(static_cast<size_t>(c.getEncodedSize()));
+  c.encode(payload.data(), 0, static_cast<int>(payload.size()));
+  uint32_t seqno = 0;
+  ASSERT_TRUE(h.wait_for([&] {
+    // A new socket (source port) each time: the kernel may hand a unicast datagram to any
+    // socket bound to the port, the bridge's or this harness's.
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(7787);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    std::vector<uint8_t> pkt = {0x4c, 0x43, 0x30, 0x32};
+    ++seqno;
+    for (int i = 3; i >= 0; --i) pkt.push_back(static_cast<uint8_t>(seqno >> (8 * i)));
+    const std::string ch = "TESTCAR_COMMAND";
+    pkt.insert(pkt.end(), ch.begin(), ch.end());
+    pkt.push_back(0);
+    pkt.insert(pkt.end(), payload.begin(), payload.end());
+    ::sendto(fd, pkt.data(), pkt.size(), 0, reinterpret_cast<const sockaddr *>(&to), sizeof to);
+    ::close(fd);
+    return h.status().control.dropped_unsigned >= 3;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands), 0);
+  EXPECT_EQ(h.status().control.applied, 0);
+  EXPECT_EQ(h.status().control.last_dropped_source, "unicast");
 }

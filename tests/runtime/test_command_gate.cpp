@@ -93,9 +93,9 @@ TEST(CommandAuth, KeyFilesAreCheckedAndNamed) {
 struct GateTest : ::testing::Test {
   auth::Key key = key_of(std::string(64, '7'));
   bridge::CommandGate gate{key, "NIGEL1", 1000000, 300000};
-  auth::Signer autonomy{key, "NIGEL1", "autonomy", vehicle_command_t::AUTHORITY_MACHINE};
-  auth::Signer policy{key, "NIGEL1", "policy", vehicle_command_t::AUTHORITY_MACHINE};
-  auth::Signer teleop{key, "NIGEL1", "teleop", vehicle_command_t::AUTHORITY_PERSON};
+  auth::Signer autonomy{key, "NIGEL1", "autonomy", auth::kAuthorityMachine};
+  auth::Signer policy{key, "NIGEL1", "policy", auth::kAuthorityMachine};
+  auth::Signer teleop{key, "NIGEL1", "teleop", auth::kAuthorityPerson};
   int64_t wall0 = 0;
   void SetUp() override {
     vehicle_command_t c{};
@@ -162,7 +162,7 @@ TEST_F(GateTest, PersonTakesFromMachineMachineNeverFromPerson) {
   EXPECT_EQ(v.drop, bridge::Drop::none);
   EXPECT_TRUE(v.holder_changed);
   EXPECT_EQ(gate.holder(), "teleop");
-  EXPECT_EQ(gate.holder_authority(), vehicle_command_t::AUTHORITY_PERSON);
+  EXPECT_EQ(gate.holder_authority(), auth::kAuthorityPerson);
   // Dead-man released: the person still holds control; the autonomy cannot take it.
   for (int64_t t = 30000; t < 2000000; t += 100000) {
     EXPECT_EQ(admit(cmd(teleop, false), t), bridge::Drop::none);

@@ -87,7 +87,7 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
         std::filesystem::perms::owner_read | std::filesystem::perms::owner_write,
         std::filesystem::perm_options::replace);
     signer_.emplace(autodrive::auth::load_key(dir_ + "/E2E1.key"), "E2E1", "e2e-test",
-                    autodrive::vehicle_command_t::AUTHORITY_MACHINE);
+                    autodrive::auth::kAuthorityMachine);
     if (b.has_lidar)
       cfg << "lidar: {device: " << lidar_link_
           << ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n";

@@ -68,7 +68,7 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   EXPECT_FALSE(cmds.got.back().engaged);
   const autodrive::auth::Key key = autodrive::auth::load_key(key_file);
   EXPECT_EQ(cmds.got.back().source, "teleop");
-  EXPECT_EQ(cmds.got.back().authority, autodrive::vehicle_command_t::AUTHORITY_PERSON);
+  EXPECT_EQ(cmds.got.back().authority, autodrive::auth::kAuthorityPerson);
   EXPECT_EQ(autodrive::auth::check_mac(key, "JS1", cmds.got.back()), autodrive::auth::MacCheck::ok);
   EXPECT_LT(cmds.got[cmds.got.size() - 2].counter, cmds.got.back().counter);
   // Stick up, steer right, hold the dead-man (button 4), headlights (button 0).

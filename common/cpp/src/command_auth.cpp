@@ -119,8 +119,8 @@ Signer::Signer(const Key &key, std::string vehicle, std::string source, int8_t a
     : key_(key), vehicle_(std::move(vehicle)), source_(std::move(source)), authority_(authority) {
   if (const std::string why = source_problem(source_); !why.empty())
     throw InputError("command signer: source '" + source_ + "': " + why);
-  if (authority_ != autodrive::vehicle_command_t::AUTHORITY_MACHINE &&
-      authority_ != autodrive::vehicle_command_t::AUTHORITY_PERSON)
+  if (authority_ != autodrive::auth::kAuthorityMachine &&
+      authority_ != autodrive::auth::kAuthorityPerson)
     throw InputError("command signer: authority " + std::to_string(authority_) +
                      " is neither AUTHORITY_MACHINE nor AUTHORITY_PERSON");
 }

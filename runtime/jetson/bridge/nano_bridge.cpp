@@ -156,10 +156,9 @@ struct NanoBridge::Impl {
     if (gate->holder().empty())
       spdlog::warn("{}control lease lapsed: no source holds control", tag);
     else
-      spdlog::warn("{}control now held by '{}' ({})", tag, gate->holder(),
-                   gate->holder_authority() == autodrive::vehicle_command_t::AUTHORITY_PERSON
-                       ? "person"
-                       : "machine");
+      spdlog::warn(
+          "{}control now held by '{}' ({})", tag, gate->holder(),
+          gate->holder_authority() == autodrive::auth::kAuthorityPerson ? "person" : "machine");
     publish_control(now_mono);
   }
 

@@ -85,7 +85,7 @@ int main(int argc, char **argv) {
   try {
     signer.emplace(autodrive::auth::load_key(
                        key_file.empty() ? autodrive::auth::default_key_path(vehicle) : key_file),
-                   vehicle, source, autodrive::vehicle_command_t::AUTHORITY_PERSON);
+                   vehicle, source, autodrive::auth::kAuthorityPerson);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "autodrive-teleop: %s\n", e.what());
     return 2;

@@ -550,7 +550,7 @@ int main(int argc, char **argv) {
       g_signer.emplace(
           autodrive::auth::load_key(key_file.empty() ? autodrive::auth::default_key_path(vehicle)
                                                      : key_file),
-          vehicle, "link-bench", autodrive::vehicle_command_t::AUTHORITY_MACHINE);
+          vehicle, "link-bench", autodrive::auth::kAuthorityMachine);
     } catch (const std::exception &e) {
       std::fprintf(stderr, "runtime-link-bench: %s\n", e.what());
       return 2;

@@ -19,6 +19,10 @@ namespace autodrive::auth {
 constexpr size_t kKeyBytes = 32;
 constexpr size_t kMacBytes = 16;
 constexpr size_t kMaxSourceChars = 32;
+// vehicle_command_t's AUTHORITY_* as constants that may be bound to references (LCM's in-class
+// constants have no definition to link against).
+constexpr int8_t kAuthorityMachine = autodrive::vehicle_command_t::AUTHORITY_MACHINE;
+constexpr int8_t kAuthorityPerson = autodrive::vehicle_command_t::AUTHORITY_PERSON;
 using Key = std::array<uint8_t, kKeyBytes>;
 using Mac = std::array<uint8_t, kMacBytes>;
 

@@ -246,7 +246,7 @@ int main(int argc, char **argv) {
       signer.emplace(autodrive::auth::load_key(key_file.empty()
                                                    ? autodrive::auth::default_key_path(cfg.vehicle)
                                                    : key_file),
-                     cfg.vehicle, "autonomy", autodrive::vehicle_command_t::AUTHORITY_MACHINE);
+                     cfg.vehicle, "autonomy", autodrive::auth::kAuthorityMachine);
     } catch (const std::exception &e) {
       std::fprintf(stderr, "autodrive-autonomy: --key-file: %s\n", e.what());
       return 2;
