@@ -190,8 +190,15 @@ struct NanoBridge::Impl {
     }
     latest_cmd = *m;
     latest_cmd_rx_us = clk::monotonic_us();
-    // No frame here: the serial link is written at the heartbeat rate only, whatever rate
-    // commands arrive at, so a flood on LCM cannot flood the Nano.
+    // The serial link carries at most one COMMAND frame per heartbeat period, whatever rate
+    // commands arrive at (a flood on LCM cannot flood the Nano): a fresh command goes out at
+    // once only when a whole period has passed since the last frame (latency), else with the
+    // next heartbeat. In step with SIM_CLOCK every frame waits for its tick instead.
+    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock &&
+        latest_cmd_rx_us >= next_tx_us) {
+      send_command(latest_cmd_rx_us);
+      next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
+    }
   }
 
   void write_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
