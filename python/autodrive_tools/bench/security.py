@@ -100,9 +100,12 @@ class Hostile:
         captured: list[tuple[float, bytes]] = []
         ch_control = channels.channel("CONTROL", VEHICLE)
 
+        replayed: set[bytes] = set()  # each recorded command once (our replays come back too)
+
         def on_command(_ch: str, data: bytes) -> None:
             m = self.types.vehicle_command_t.decode(data)
-            if m.source == "autonomy" and not self._stop.is_set():
+            if m.source == "autonomy" and data not in replayed and not self._stop.is_set():
+                replayed.add(data)
                 captured.append((time.monotonic() + REPLAY_DELAY_S, data))
 
         def on_control(_ch: str, data: bytes) -> None:

@@ -3,6 +3,7 @@
 
 #include <autodrive/control_status_t.hpp>
 #include <autodrive/imu_t.hpp>
+#include <autodrive/log_limiter.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -10,9 +11,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cinttypes>
 #include <cstdio>
-#include <map>
 #include <optional>
 
 #include "bridge/bridge_convert.hpp"
@@ -70,12 +71,10 @@ struct NanoBridge::Impl {
   std::string key_file, key_error;
   std::optional<CommandGate> gate;
   int64_t next_control_us = 0;  // next CONTROL status [monotonic us]
-  // Drop log lines, at most one per second per (source, reason), with the count in between.
-  struct DropLog {
-    int64_t last_us = 0;
-    int64_t suppressed = 0;
-  };
-  std::map<std::string, DropLog> drop_log;
+  // Dropped commands: at most one line per second per source and reason, then a count.
+  autodrive::LogLimiter drop_log{
+      "dropped commands",
+      autodrive::LogLimits{1, std::chrono::milliseconds(1000), spdlog::level::warn}};
 
   explicit Impl(const cfg::Config &c)
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
@@ -114,21 +113,16 @@ struct NanoBridge::Impl {
   }
 
   void log_drop(const autodrive::vehicle_command_t &m, Drop d) {
-    if (drop_log.size() > 256) drop_log.clear();  // bounded: sources are chosen by the sender
+    // The source is what the sender claims: printable, bounded, and only for the log. Sources
+    // a signature vouches for are few; unsigned ones all share one entry.
     std::string source = m.source.substr(0, autodrive::auth::kMaxSourceChars);
     for (char &ch : source)
       if (ch < 0x21 || ch > 0x7e) ch = '?';
     if (source.empty()) source = "(none)";
-    DropLog &l = drop_log[source + '\n' + drop_name(d)];
-    const int64_t now = clk::monotonic_us();
-    if (l.last_us != 0 && now - l.last_us < 1000000) {
-      ++l.suppressed;
-      return;
-    }
-    spdlog::warn("{}dropped a command from source '{}': {} ({} more since the last line)", tag,
-                 source, drop_name(d), l.suppressed);
-    l.last_us = now;
-    l.suppressed = 0;
+    const std::string key = d == Drop::unsigned_cmd || d == Drop::bad_mac
+                                ? tag + "unauthenticated commands (" + drop_name(d) + ")"
+                                : tag + "source '" + source + "' (" + drop_name(d) + ")";
+    drop_log.event(key, "dropped a command from source '" + source + "'");
   }
 
   void publish_control(int64_t now_mono) {
@@ -410,6 +404,7 @@ struct NanoBridge::Impl {
       for (int i = 0; i < 512 && lcm.handleTimeout(0) > 0; ++i) {
       }
     if (gate) {
+      drop_log.flush();
       const int64_t tm = clk::monotonic_us();
       if (gate->expire(tm)) holder_changed(tm);
       if (tm >= next_control_us) publish_control(tm);

@@ -1,9 +1,10 @@
 // Nano bridge: the serial link to the Arduino Nano (or the simulator's / simavr's pty).
 // Handshake (HELLO_REQUEST until a HELLO with our schema hash), telemetry -> <VEH>_STATE and
 // <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat (at most one frame per
-// heartbeat period, whatever rate commands arrive at), engaged only while the LCM command stream is fresh. Only commands the
-// command gate admits (signed, not replayed, from the lease holder) count; the holder and the
-// gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device disappears.
+// heartbeat period, whatever rate commands arrive at), engaged only while the LCM command stream is
+// fresh. Only commands the command gate admits (signed, not replayed, from the lease holder) count;
+// the holder and the gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device
+// disappears.
 #pragma once
 
 #include <atomic>
