@@ -93,6 +93,7 @@ class Hostile:
         c = self.types.vehicle_command_t()
         c.utime = time.time_ns() // 1000
         c.throttle, c.steering, c.engaged = throttle, steering, True
+        c.mac = bytes(command_auth.MAC_BYTES)  # lcm-gen's default ("") does not encode
         return c
 
     def _run(self) -> None:
