@@ -14,8 +14,10 @@ Figures:
   demo_success_under_attack  the mission parked without a collision; the demo's report counts
       the foreign commands (foreign_commands) and so says success: false
   serial_cmd_hz_under_flood  COMMAND frames per second on the serial link (autodrive-runtime
-      --only bridge, fake Nano on a pty) while 40000 commands a second go to <VEH>_COMMAND,
-      against the configured rate (bridge.heartbeat_hz of the car's config)
+      --only bridge, fake Nano on a pty) while 40000 commands a second go to <VEH>_COMMAND
+      (1 in 8 valid, signed by the lease holder, the rest unsigned; lcm_flood_msgs_per_s is the
+      rate the publisher reached), against the configured rate (bridge.heartbeat_hz of the
+      car's config)
 The input-checking figures of security_inputs.py are merged in when that module exists.
 Progress on stderr; the last line is one JSON object. Usage: tools/bench security [--help]"""
 
@@ -275,7 +277,8 @@ def main(argv: list[str]) -> int:
     p.add_argument("--skip-demo", action="store_true", help="only the flood figure")
     a = p.parse_args(argv)
     build = build_dir("security")
-    for prog in ("autodrive-runtime", "runtime-link-bench", *demo.PROGRAMS):
+    needed = ("autodrive-runtime", "runtime-link-bench") + (() if a.skip_demo else demo.PROGRAMS)
+    for prog in needed:
         if not os.access(build / "bin" / prog, os.X_OK):
             log(f"ERROR: {build / 'bin' / prog} missing (build it first)")
             return 1

@@ -9,8 +9,8 @@
 //               ground truth (noise + latency), compares <VEH>_POSE_MAP and <VEH>_ODOM with
 //               ground truth (ekf_*_rms)
 //   flood     : a fake Nano on a pty (--pty) while --flood-hz commands a second go to
-//               <VEH>_COMMAND (half signed by the lease holder, half unsigned); COMMAND frames
-//               per second on the serial link (serial_cmd_hz_under_flood)
+//               <VEH>_COMMAND (1 in 8 signed by the lease holder, the rest unsigned); COMMAND
+//               frames per second on the serial link (serial_cmd_hz_under_flood)
 // Commands are signed with the car's key (--key-file, default as autodrive-teleop's).
 #include <autodrive/angles.hpp>
 #include <autodrive/command_auth.hpp>
@@ -101,10 +101,18 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
     while (!done) {
       // Catch up to the target count at each wake-up (1 ms): bursts, as a flooder sends.
       const auto due = static_cast<long>((clk::monotonic_us() - t0) * 1e-6 * flood_hz);
+      autodrive::vehicle_command_t junk = make_cmd(0, 1.0f, 1.0f, true);
+      std::fill(junk.mac, junk.mac + autodrive::auth::kMacBytes, 0);  // unsigned
       while (sent < due && !done) {
-        autodrive::vehicle_command_t c = make_cmd(seq++, 0.2f, 0.0f, true);
-        if (seq % 2 == 0) std::fill(c.mac, c.mac + autodrive::auth::kMacBytes, 0);  // unsigned
-        lcm.publish(ch, &c);
+        // One valid command of the lease holder in eight (each would once have become a frame),
+        // the rest unsigned junk: the publisher's own signing then does not cap the rate.
+        if (seq % 8 == 0) {
+          const autodrive::vehicle_command_t c = make_cmd(seq, 0.2f, 0.0f, true);
+          lcm.publish(ch, &c);
+        } else {
+          lcm.publish(ch, &junk);
+        }
+        ++seq;
         ++sent;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
