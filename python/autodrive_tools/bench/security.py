@@ -7,9 +7,9 @@ hostile publisher on the same bus, for the whole run, sends <VEH>_COMMAND
     authority);
   - replays of the autonomy's own signed commands, byte for byte, 0.1 s later.
 Figures:
-  unsigned_cmd_applied, replayed_cmd_applied  hostile commands of that kind the bridge's gate did
-      not count as dropped (its <VEH>_CONTROL counters, 0.5 s behind what was sent), plus
-      <VEH>_STATE samples with the hostile throttle applied
+  unsigned_cmd_applied, replayed_cmd_applied  hostile commands of that kind on the recorded bus
+      (classified with the car's key) that the gate's <VEH>_CONTROL counters did not count as
+      dropped 0.5 s later, plus <VEH>_STATE samples with a hostile command applied
   foreign_source_takeover  changes of control to any source but the autonomy
   demo_success_under_attack  the mission parked without a collision; the demo's report counts
       the foreign commands (foreign_commands) and so says success: false
@@ -170,21 +170,64 @@ class Hostile:
         return worst
 
 
+HOSTILE_RUN = 5  # consecutive STATE samples: a legitimate slew passes these values, never stays
+
+
 def hostile_throttle_samples(log_path: Path, types: Any) -> int:
-    """<VEH>_STATE samples with a hostile throttle applied by the Nano."""
+    """<VEH>_STATE samples in runs of HOSTILE_RUN or more with a hostile command applied by the
+    Nano (its throttle and its full lock)."""
     ch = channels.channel("STATE", VEHICLE)
-    n = 0
+    hostile = ((UNSIGNED_THROTTLE, -1.0), (WRONG_KEY_THROTTLE, 1.0))
+    n, run = 0, 0
     for ev in lcmtypes.events(log_path):
         if ev.channel == ch:
             m = types.vehicle_state_t.decode(ev.data)
-            if any(
-                abs(m.throttle_applied - t) < 0.005 for t in (UNSIGNED_THROTTLE, WRONG_KEY_THROTTLE)
-            ):
-                n += 1
+            match = any(
+                abs(m.throttle_applied - t) < 0.005 and abs(m.steering_applied - st) < 0.02
+                for t, st in hostile
+            )
+            run = run + 1 if match else 0
+            n += run if run == HOSTILE_RUN else (1 if run > HOSTILE_RUN else 0)
     return n
 
 
-def demo_under_attack(build: Path, out: Path, timeout_s: float) -> dict[str, Any]:
+def log_unaccounted(log_path: Path, types: Any, key: bytes) -> dict[str, int]:
+    """From the recorded bus (lcm-logger: one process, one order): every <VEH>_COMMAND is
+    classified with the car's key (unsigned, bad signature, or a byte-for-byte repeat of an
+    earlier valid one); for each <VEH>_CONTROL, the commands of a kind logged CONTROL_LAG_S
+    before it that its counters do not count as dropped. The most over the run, per kind."""
+    ch_cmd, ch_control = (channels.channel(c, VEHICLE) for c in ("COMMAND", "CONTROL"))
+    seen: set[bytes] = set()
+    logged: list[tuple[int, str]] = []  # (log time [us], kind)
+    worst = {"unsigned": 0, "bad_mac": 0, "replay": 0}
+    for ev in lcmtypes.events(log_path):
+        if ev.channel == ch_cmd:
+            m = types.vehicle_command_t.decode(ev.data)
+            if not m.source or not m.authority or not any(m.mac):
+                logged.append((ev.timestamp, "unsigned"))
+            elif command_auth.mac_of(key, command_auth.canonical_bytes(m, VEHICLE)) != m.mac:
+                logged.append((ev.timestamp, "bad_mac"))
+            elif ev.data in seen:
+                logged.append((ev.timestamp, "replay"))
+            seen.add(ev.data)
+        elif ev.channel == ch_control:
+            c = types.control_status_t.decode(ev.data)
+            cutoff = ev.timestamp - int(CONTROL_LAG_S * 1e6)
+            n = {k: 0 for k in worst}
+            for t, kind in logged:
+                if t <= cutoff:
+                    n[kind] += 1
+            dropped = {
+                "unsigned": c.dropped_unsigned,
+                "bad_mac": c.dropped_bad_mac,
+                "replay": c.dropped_replay,
+            }
+            for k in worst:
+                worst[k] = max(worst[k], n[k] - dropped[k])
+    return worst
+
+
+def demo_under_attack(build: Path, out: Path, timeout_s: float, key: bytes) -> dict[str, Any]:
     types = lcmtypes.load(build)
     hostile = Hostile(types, url(PORT_DEMO), PORT_DEMO)
     hostile.start()
@@ -198,7 +241,7 @@ def demo_under_attack(build: Path, out: Path, timeout_s: float) -> dict[str, Any
     finally:
         hostile.stop()
     rep = json.loads((out / "report.json").read_text())
-    left = hostile.unaccounted()
+    left = log_unaccounted(out / "run.lcmlog", types, key)
     state_hits = hostile_throttle_samples(out / "run.lcmlog", types)
     takeovers = sorted(h for h in hostile.holders if h != "autonomy")
     return {
@@ -288,7 +331,8 @@ def main(argv: list[str]) -> int:
         os.environ["AUTODRIVE_KEY_DIR"] = str(Path(work) / "keys")
         command_auth.create_key(command_auth.default_key_path(VEHICLE))
         if not a.skip_demo:
-            figures.update(demo_under_attack(build, out_dir() / "security", a.timeout))
+            key = command_auth.load_key(command_auth.default_key_path(VEHICLE))
+            figures.update(demo_under_attack(build, out_dir() / "security", a.timeout, key))
         figures.update(flood(build, Path(work)))
     figures.update(input_figures())
     figures["goals_met"] = (
