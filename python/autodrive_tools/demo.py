@@ -21,7 +21,7 @@ from typing import Any, TextIO
 
 import yaml
 
-from . import channels, report
+from . import channels, command_auth, report
 from .inspect import export_mcap
 from .missions import MissionContext, loop, parking
 from .paths import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
@@ -226,6 +226,11 @@ def run(
         if not (build / "bin" / prog).exists():
             say(f"ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
             return 2
+    try:  # every command is signed: the car's key must exist before anything starts
+        command_auth.load_key(command_auth.default_key_path(VEHICLE))
+    except ValueError as e:
+        say(f"ERROR: {e}")
+        return 2
     # None: lockstep. The sim then steps only while the runtime's bridge keeps writing (its
     # 50 Hz COMMAND stream on SIM_CLOCK), never more than 40 ms of sim time ahead of it.
     rtf = 1.0 if args.realtime else args.rtf
@@ -287,7 +292,17 @@ def run(
     rep.update(result)
     if plan is not None and "goal_world" in result:
         rep.update(parking.score(lcm_log, out, VEHICLE, build, result))
+        # A run with any foreign command on the bus is not a success, even if the car parked.
+        rep["mission_success"] = bool(rep.get("success"))
+        rep["success"] = rep["mission_success"] and rep.get("foreign_commands", 0) == 0
         rep["ok"] = bool(rep.get("success")) and rep.get("collisions", 1) == 0
+    if rep.get("foreign_commands"):
+        say(
+            f"WARNING: the bridge dropped {rep['foreign_commands']} foreign command(s) "
+            f"(unsigned {rep.get('foreign_unsigned')}, bad signature "
+            f"{rep.get('foreign_bad_signature')}, replayed {rep.get('foreign_replayed')}): "
+            "not a success"
+        )
     rep["wall_s"] = round(wall_s, 2)
     rep["rtf_requested"] = rtf if rtf is not None else "lockstep"
     if rep.get("sim_s") and wall_s > 0:

@@ -28,7 +28,11 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
     if not Path(log_path).exists():
         return {"ok": False, "error": f"no LCM log at {log_path}"}
     types = lcmtypes.load(build)
-    ch_truth, ch_pose, ch_state = (channel(c, veh) for c in ("GROUND_TRUTH", "POSE_MAP", "STATE"))
+    ch_truth, ch_pose, ch_state, ch_control = (
+        channel(c, veh) for c in ("GROUND_TRUTH", "POSE_MAP", "STATE", "CONTROL")
+    )
+    control: Any = None  # the bridge's last control_status_t
+    holders: set[str] = set()
     # (sim time [us], x, y, yaw); gt_rx: the log's receive time of each
     gt: list[tuple[int, float, float, float]] = []
     gt_rx: list[int] = []
@@ -51,6 +55,10 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
             m = types.vehicle_state_t.decode(ev.data)
             state_t.append(m.nano_time_us)  # the Nano's clock: sim time in HIL
             faults_seen |= m.fault_flags
+        elif ev.channel == ch_control:
+            control = types.control_status_t.decode(ev.data)
+            if control.holder:
+                holders.add(control.holder)
     rep: Report = {
         "ok": False,
         "gt_samples": len(gt),
@@ -58,6 +66,7 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
         "state_samples": len(state_t),
         "collisions": collisions,
         "fault_flags_seen": faults_seen,
+        **command_figures(control, holders),
     }
     if len(gt) < 10 or len(ekf) < 10 or len(state_t) < 10:
         rep["error"] = "too few ground-truth/EKF/state messages in the log"
@@ -86,7 +95,7 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
     rep["ekf_pos_rms_m"] = round(rms(errs_p), 4)
     rep["ekf_heading_rms_deg"] = round(rms(errs_h), 3)
     rep["ekf_final_pos_error_m"] = round(errs_p[-1], 4)
-    rep["ok"] = rep["path_length_m"] > 1.0 and collisions == 0
+    rep["ok"] = rep["path_length_m"] > 1.0 and collisions == 0 and rep["foreign_commands"] == 0
     plots.trajectory(
         out / "trajectory.png",
         veh,
@@ -97,6 +106,26 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
     )
     plots.ekf_error(out / "ekf_error.png", [(e[0] - ekf[0][0]) / 1e6 for e in ekf], errs_p, errs_h)
     return rep
+
+
+def command_figures(control: Any, holders: set[str]) -> Report:
+    """What the runtime's command gate saw (its last <VEH>_CONTROL): foreign_commands are the
+    commands it dropped as unsigned, wrongly signed or replayed; a run with any is not a success."""
+    if control is None:
+        return {"foreign_commands": 0, "control_status_seen": False, "command_holders": []}
+    return {
+        "foreign_commands": control.dropped_unsigned
+        + control.dropped_bad_mac
+        + control.dropped_replay,
+        "foreign_unsigned": control.dropped_unsigned,
+        "foreign_bad_signature": control.dropped_bad_mac,
+        "foreign_replayed": control.dropped_replay,
+        "commands_not_holder": control.dropped_not_holder,
+        "commands_applied": control.applied,
+        "control_holder_changes": control.holder_changes,
+        "command_holders": sorted(holders),
+        "control_status_seen": True,
+    }
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -18,6 +18,7 @@
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/path2d_t.hpp>
 #include <autodrive/pose2d_t.hpp>
+#include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
 #include "autonomy/map_io.hpp"
@@ -70,7 +71,9 @@ struct Listener {
               const autodrive::vehicle_command_t *m) {
     if (m->engaged && std::abs(m->throttle) > 0.0f && std::abs(m->throttle) <= 1.0f)
       engaged_motion = true;
+    last_cmd = *m;
   }
+  autodrive::vehicle_command_t last_cmd{};
   void on_amcl(const lcm::ReceiveBuffer *, const std::string &, const autodrive::pose2d_t *m) {
     have_amcl = true;
     amcl = *m;
@@ -137,6 +140,11 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
                                   << "map: {load_from: " << (dir / "map.yaml").string() << "}\n"
                                   << "start: {x_m: 1.8, y_m: 1.2, yaw_rad: 0.0}\n"
                                   << "goal: {x_m: 2.45, y_m: 0.18, yaw_rad: 1.5707963}\n";
+  // The car's key (mode 0600): the autonomy signs every command with it.
+  const std::string key_file = (dir / "NIGELT.key").string();
+  std::ofstream(key_file) << std::string(64, 'b') << "\n";
+  fs::permissions(key_file, fs::perms::owner_read | fs::perms::owner_write,
+                  fs::perm_options::replace);
   lcm::LCM lcm(kUrl);
   ASSERT_TRUE(lcm.good());
   Listener l;
@@ -155,8 +163,8 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     const std::string cfg = (dir / "cfg.yaml").string();
-    execl(AUTONOMY_PROGRAM, AUTONOMY_PROGRAM, "--config", cfg.c_str(),
-          static_cast<char *>(nullptr));
+    execl(AUTONOMY_PROGRAM, AUTONOMY_PROGRAM, "--config", cfg.c_str(), "--key-file",
+          key_file.c_str(), static_cast<char *>(nullptr));
     _exit(127);
   }
   const Pose2 lidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0, 0};
@@ -194,6 +202,10 @@ TEST(Program, LocalisesPlansAndCommandsOverLcm) {
   waitpid(pid, &st, 0);
   EXPECT_GE(l.max_state, 4) << "never reached DRIVING";  // mission_status_t.DRIVING
   EXPECT_TRUE(l.engaged_motion) << "no engaged command with a throttle";
+  EXPECT_EQ(l.last_cmd.source, "autonomy");
+  EXPECT_EQ(autodrive::auth::check_mac(autodrive::auth::load_key(key_file), "NIGELT", l.last_cmd),
+            autodrive::auth::MacCheck::ok)
+      << "the autonomy's commands are not signed with the car's key";
   ASSERT_TRUE(l.have_amcl);
   EXPECT_NEAR(l.amcl.x_m, truth.x_m, 0.03);
   EXPECT_NEAR(l.amcl.y_m, truth.y_m, 0.03);

@@ -29,6 +29,9 @@ for i in range(count):
     m.headlights = 2
     m.indicators = 3
     m.engaged = i % 2 == 0
+    # The signature fields round-trip too (a string, an int64 and a fixed byte array).
+    m.source, m.authority, m.counter = "interop", 1, 1764057600000000 + i
+    m.mac = bytes(range(i, i + 16))
     lc.publish("INTEROP_IN", m.encode())
     deadline = time.time() + 5.0
     while len(got) <= i and time.time() < deadline:
@@ -38,6 +41,7 @@ for i in range(count):
     assert len(got) == i + 1, f"no echo for message {i} within 5 s"
     e = got[i]
     assert e.seq == m.seq + 1 and abs(e.throttle - m.throttle) < 1e-6 and e.steering == -0.5
+    assert e.source == "interop" and e.counter == m.counter and e.mac == m.mac
     assert e.headlights == 2 and e.indicators == 3 and e.engaged == m.engaged
 assert proc.wait(timeout=10) == 0
 print(f"interop ok: {count} vehicle_command_t round trips Python(PyPI lcm) <-> C++(Debian LCM)")

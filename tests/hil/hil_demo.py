@@ -1,10 +1,30 @@
 """The demo's command line for the HIL tests (imported from the tests' own folder)."""
 
+import os
 import sys
+import tempfile
+
+from autodrive_tools import channels, command_auth
+
+_KEY_DIR = None
+
+
+def use_test_keys(cars=1):
+    """A temporary key per car in $AUTODRIVE_KEY_DIR (inherited by the demo and its children),
+    so the tests never read or write the user's own keys."""
+    global _KEY_DIR
+    if _KEY_DIR is None:
+        _KEY_DIR = tempfile.TemporaryDirectory(prefix="hil-keys-")
+        os.environ["AUTODRIVE_KEY_DIR"] = _KEY_DIR.name
+    for i in range(1, cars + 1):
+        path = command_auth.default_key_path(channels.vehicle_name(i))
+        if not path.exists():
+            command_auth.create_key(path)
 
 
 def demo_command(build, out, port, *options):
-    """python -m autodrive_tools.demo, headless, into out, on its own LCM port."""
+    """python -m autodrive_tools.demo, headless, into out, on its own LCM port (test keys)."""
+    use_test_keys()
     return [
         sys.executable,
         "-m",

@@ -10,13 +10,14 @@ from __future__ import annotations
 import pathlib
 import subprocess
 import sys
+import os
 import tempfile
 import threading
 import time
 
 import yaml
 
-from autodrive_tools import lcmtypes
+from autodrive_tools import command_auth, lcmtypes
 from autodrive_tools.channels import channel
 from autodrive_tools.paths import RUNTIME_HIL_CONFIG
 
@@ -24,6 +25,10 @@ root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sy
 url = f"udpm://239.255.76.67:{port}?ttl=0"
 SIM_S, SEED, VEHICLE, ENGAGE_AT_US = 4.0, 7, "NIGEL1", 300000
 types = lcmtypes.load(build)
+# A test key for the car, seen by the runtime's bridge and by the driver below.
+key_dir = tempfile.TemporaryDirectory(prefix="hil-repeat-keys-")
+os.environ["AUTODRIVE_KEY_DIR"] = key_dir.name
+command_auth.create_key(command_auth.default_key_path(VEHICLE))
 
 
 def drive(stop: threading.Event) -> None:
@@ -31,6 +36,7 @@ def drive(stop: threading.Event) -> None:
     the bridge (sync_to_sim_clock) sends disengaged frames until that tick, then this one, so
     the firmware arms (disengaged, then engaged) at the same step in every run."""
     bus = lcmtypes.bus(url)
+    signer = command_auth.signer_for(VEHICLE, "hil-repeat")
     seq = 0
     while not stop.is_set():
         c = types.vehicle_command_t()
@@ -41,7 +47,7 @@ def drive(stop: threading.Event) -> None:
             0.4,
             True,
         )
-        bus.publish(channel("COMMAND", VEHICLE), c.encode())
+        bus.publish(channel("COMMAND", VEHICLE), signer.sign(c).encode())
         seq += 1
         time.sleep(0.02)
 

@@ -10,6 +10,10 @@ PIDS=()
 cleanup() { for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$W"; }
 trap cleanup EXIT
 URL="udpm://239.255.76.67:$PORT?ttl=0"
+# A test key for the car, seen by the runtime's bridge and by runtime-link-bench (mode 0600).
+export AUTODRIVE_KEY_DIR="$W/keys"
+mkdir -m 700 "$AUTODRIVE_KEY_DIR"
+(umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$AUTODRIVE_KEY_DIR/NIGEL1.key"; echo >> "$AUTODRIVE_KEY_DIR/NIGEL1.key")
 "$BIN/autodrive-sim" --run-dir "$W/sim" --lcm-url "$URL" --no-lidar --quiet >"$W/sim.log" 2>&1 &
 PIDS+=($!)
 for _ in $(seq 600); do [ -e "$W/sim/nigel1-nano" ] && break; sleep 0.1; done

@@ -5,12 +5,20 @@
 #include <lcm/lcm-cpp.hpp>
 #include <unistd.h>
 
+#include <autodrive/command_auth.hpp>
+#include <autodrive/control_status_t.hpp>
 #include <autodrive/imu_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <thread>
@@ -22,7 +30,22 @@
 
 namespace {
 
-std::string config_yaml(int port, const std::string &device) {
+// A test key file (mode 0600) for one harness; removed with it.
+struct TestKey {
+  explicit TestKey(const std::string &p, uint8_t fill = 0x5a) : path(p) {
+    for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(fill + i);
+    std::ofstream f(path);
+    for (uint8_t b : key) f << "0123456789abcdef"[b >> 4] << "0123456789abcdef"[b & 15];
+    f << "\n";
+    f.close();
+    ::chmod(path.c_str(), 0600);
+  }
+  ~TestKey() { ::unlink(path.c_str()); }
+  std::string path;
+  autodrive::auth::Key key{};
+};
+
+std::string config_yaml(int port, const std::string &device, const std::string &key_file) {
   return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
          "?ttl=0\"\n"
          "clock: wall\n"
@@ -32,6 +55,9 @@ std::string config_yaml(int port, const std::string &device) {
          ", baud: 500000, heartbeat_hz: 50,\n"
          "         command_timeout_ms: 200, hello_retry_ms: 50, refused_retry_ms: 50,\n"
          "         reconnect_ms: 50, link_timeout_ms: 2000, telemetry_period_ms: 10,\n"
+         "         command_key_file: " +
+         key_file +
+         ", command_lease_ms: 300,\n"
          "         imu: {gyro_var_rad2_s2: 0.0004}}\n";
 }
 
@@ -40,12 +66,16 @@ class BridgeHarness {
   BridgeHarness(int port, uint32_t hash = proto_schema_hash())
       : link_("/tmp/adr-rt-test-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         nano(link_, hash),
-        config(cfg::parse(config_yaml(port, link_), "test config")),
-        lcm(config.lcm_url) {
+        key(link_ + ".key"),
+        config(cfg::parse(config_yaml(port, link_, key.path), "test config")),
+        lcm(config.lcm_url),
+        signer(key.key, "TESTCAR", "test-autonomy", autodrive::auth::kAuthorityMachine) {
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
         lcm, "TESTCAR_STATE", this);
     autodrive_lcm::subscribe<autodrive::imu_t, BridgeHarness, &BridgeHarness::on_imu>(
         lcm, "TESTCAR_IMU", this);
+    autodrive_lcm::subscribe<autodrive::control_status_t, BridgeHarness,
+                             &BridgeHarness::on_control>(lcm, "TESTCAR_CONTROL", this);
   }
   ~BridgeHarness() {
     stop_ = true;
@@ -85,8 +115,9 @@ class BridgeHarness {
     return pred();
   }
 
-  void publish_command(float throttle, float steering, bool engaged, int8_t headlights = 1,
-                       int8_t indicators = 2) {
+  // An unsigned command.
+  autodrive::vehicle_command_t command(float throttle, float steering, bool engaged,
+                                       int8_t headlights = 1, int8_t indicators = 2) {
     autodrive::vehicle_command_t c{};
     c.seq = cmd_seq_++;
     c.throttle = throttle;
@@ -94,13 +125,23 @@ class BridgeHarness {
     c.headlights = headlights;
     c.indicators = indicators;
     c.engaged = engaged;
+    return c;
+  }
+  // A command signed by the harness's source (the autonomy's role) with the car's key.
+  void publish_command(float throttle, float steering, bool engaged, int8_t headlights = 1,
+                       int8_t indicators = 2) {
+    autodrive::vehicle_command_t c = command(throttle, steering, engaged, headlights, indicators);
+    signer.sign(c);
     lcm.publish("TESTCAR_COMMAND", &c);
   }
 
   std::string link_;
   rtest::FakeNano nano;
+  TestKey key;
   cfg::Config config;
   lcm::LCM lcm;
+  autodrive::auth::Signer signer;
+  std::vector<autodrive::control_status_t> controls;
   bool send_states = true;
   int32_t enc_left = 100;
   std::vector<autodrive::vehicle_state_t> states;
@@ -109,6 +150,7 @@ class BridgeHarness {
  private:
   void on_state(const autodrive::vehicle_state_t *m) { states.push_back(*m); }
   void on_imu(const autodrive::imu_t *m) { imus.push_back(*m); }
+  void on_control(const autodrive::control_status_t *m) { controls.push_back(*m); }
   std::unique_ptr<bridge::NanoBridge> bridge_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -299,4 +341,230 @@ TEST(BridgePty, GarbageFromTheNanoIsCountedAndStateStillFlows) {
   ASSERT_TRUE(h.wait_for([&] { return h.status().rx_bad_payload > bad_before; }));
   h.wait_for([] { return false; }, 0.2);
   for (const auto &s : h.states) EXPECT_LE(std::abs(s.steering_applied), 1.0f);
+}
+
+// ---- Command authentication (issue: only an authorised source can drive a car) ---------------
+
+namespace {
+bool any_frame_with_throttle(const std::vector<proto_command_t> &cmds, int16_t milli,
+                             std::size_t from = 0) {
+  for (std::size_t i = from; i < cmds.size(); ++i)
+    if (cmds[i].throttle_milli == milli && (cmds[i].flags & PROTO_CMD_ENGAGED)) return true;
+  return false;
+}
+}  // namespace
+
+TEST(BridgeAuth, UnsignedAndWrongKeyCommandsIgnored) {
+  BridgeHarness h(7767);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  // A hostile publisher: full throttle at full lock, unsigned ...
+  ASSERT_TRUE(h.wait_for([&] {
+    auto c = h.command(0.9f, -1.0f, true);
+    c.source = "autonomy";  // claims a name, signs nothing
+    c.authority = autodrive::auth::kAuthorityPerson;
+    h.lcm.publish("TESTCAR_COMMAND", &c);
+    return h.status().control.dropped_unsigned >= 5;
+  }));
+  // ... and signed with a key that is not the car's.
+  autodrive::auth::Key wrong = h.key.key;
+  wrong[0] ^= 1;
+  autodrive::auth::Signer intruder(wrong, "TESTCAR", "intruder", autodrive::auth::kAuthorityPerson);
+  ASSERT_TRUE(h.wait_for([&] {
+    auto c = h.command(0.8f, 1.0f, true);
+    intruder.sign(c);
+    h.lcm.publish("TESTCAR_COMMAND", &c);
+    return h.status().control.dropped_bad_mac >= 5;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands), 0);
+  EXPECT_EQ(h.status().control.applied, 0);
+  EXPECT_EQ(h.status().holder, "");
+  // Counted and named on <VEH>_CONTROL.
+  ASSERT_TRUE(h.wait_for([&] {
+    return !h.controls.empty() && h.controls.back().dropped_bad_mac >= 5 &&
+           h.controls.back().last_dropped_source == "intruder";
+  }));
+  // The same command signed with the car's key drives: the gate is not simply closed.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.7f, 0.0f, true);
+    return any_frame_with_throttle(h.nano.commands, 700);
+  }));
+  EXPECT_EQ(h.status().holder, "test-autonomy");
+}
+
+TEST(BridgeAuth, ReplayedCommandsIgnored) {
+  BridgeHarness h(7768);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  // A recorded command of the real source ...
+  auto recorded = h.command(0.35f, 0.2f, true);
+  h.signer.sign(recorded);
+  h.lcm.publish("TESTCAR_COMMAND", &recorded);
+  ASSERT_TRUE(h.wait_for([&] { return any_frame_with_throttle(h.nano.commands, 350); }));
+  // ... went stale (disengaged frames) ...
+  ASSERT_TRUE(h.wait_for([&] {
+    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+  }));
+  const std::size_t mark = h.nano.commands.size();
+  // ... and is replayed, byte for byte, many times.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.lcm.publish("TESTCAR_COMMAND", &recorded);
+    return h.status().control.dropped_replay >= 20;
+  }));
+  // A validly signed command from a new source, but stamped outside the replay window (5 s old).
+  auto old = h.command(0.45f, 0.0f, true);
+  autodrive::auth::Signer other(h.key.key, "TESTCAR", "recorded-elsewhere",
+                                autodrive::auth::kAuthorityMachine);
+  other.sign(old);
+  old.counter -= 5000000;
+  const auto mac =
+      autodrive::auth::mac_of(h.key.key, autodrive::auth::canonical_bytes(old, "TESTCAR"));
+  std::copy(mac.begin(), mac.end(), old.mac);
+  ASSERT_TRUE(h.wait_for([&] {
+    h.lcm.publish("TESTCAR_COMMAND", &old);
+    return h.status().control.dropped_replay >= 30;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands, mark), 0);
+  EXPECT_EQ(h.status().control.applied, 1);
+}
+
+TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
+  BridgeHarness h(7769);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  autodrive::auth::Signer teleop(h.key.key, "TESTCAR", "test-teleop",
+                                 autodrive::auth::kAuthorityPerson);
+  auto teleop_cmd = [&](float throttle, bool engaged) {
+    auto c = h.command(throttle, 0.0f, engaged);
+    teleop.sign(c);
+    h.lcm.publish("TESTCAR_COMMAND", &c);
+  };
+  // The autonomy drives.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    return any_frame_with_throttle(h.nano.commands, 300);
+  }));
+  ASSERT_TRUE(h.wait_for(
+      [&] { return !h.controls.empty() && h.controls.back().holder == "test-autonomy"; }));
+  // The dead-man is pressed: the person takes control while the autonomy keeps sending.
+  std::size_t mark = h.nano.commands.size();
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    teleop_cmd(0.6f, true);
+    return any_frame_with_throttle(h.nano.commands, 600, mark);
+  }));
+  ASSERT_TRUE(h.wait_for([&] {
+    return !h.controls.empty() && h.controls.back().holder == "test-teleop" &&
+           h.controls.back().holder_authority == autodrive::auth::kAuthorityPerson;
+  }));
+  // Dead-man released (teleop sends disengaged): the autonomy, still sending engaged commands,
+  // never gets the car back while the person holds control.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    teleop_cmd(0.0f, false);
+    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+  }));
+  mark = h.nano.commands.size();
+  const int64_t not_holder0 = h.status().control.dropped_not_holder;
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    teleop_cmd(0.0f, false);
+    return h.nano.commands.size() >= mark + 25;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands, mark), 0);
+  EXPECT_GT(h.status().control.dropped_not_holder, not_holder0);
+  EXPECT_EQ(h.status().holder, "test-teleop");
+  // Teleop quits: its lease lapses (published), then the autonomy may drive again.
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.3f, 0.0f, true);
+    return h.status().holder == "test-autonomy";
+  }));
+  bool lapsed_published = false;
+  for (const auto &c : h.controls) lapsed_published = lapsed_published || c.holder.empty();
+  EXPECT_TRUE(lapsed_published) << "the lapse of the person's lease was not published";
+  EXPECT_GE(h.status().control.holder_changes, 4);  // autonomy, teleop, none, autonomy
+}
+
+TEST(BridgeAuth, FloodDoesNotRaiseTheSerialRate) {
+  BridgeHarness h(7778);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_command(0.2f, 0.0f, true);
+    return count_engaged(h.nano.commands) >= 1;
+  }));
+  // 4000 valid commands as fast as they go (each used to become a serial frame).
+  const std::size_t mark = h.nano.commands.size();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 4000; ++i) {
+    h.publish_command(0.2f, 0.0f, true);
+    if (i % 50 == 0) h.nano.pump(0);
+  }
+  h.wait_for([] { return false; }, 0.2);
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::size_t frames = h.nano.commands.size() - mark;
+  // At most the heartbeat rate (50 Hz) over the time it took, with slack for the edges: a slow
+  // machine makes fewer frames, never more.
+  EXPECT_LE(static_cast<double>(frames), 50.0 * elapsed_s * 1.1 + 3)
+      << frames << " COMMAND frames in " << elapsed_s << " s";
+  EXPECT_GE(h.status().control.applied, 100);
+}
+
+TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
+  BridgeHarness h(7783);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= 3; }));
+  // One burst of a few commands, then silence: the bridge may repeat the command only while it
+  // is younger than command_timeout_ms (200 ms at 50 Hz: about 10 frames), then disengages and
+  // stays so, and the Nano's own failsafe timer runs out as designed.
+  const std::size_t mark = h.nano.commands.size();
+  for (int i = 0; i < 3; ++i) h.publish_command(1.0f, 0.0f, true);
+  ASSERT_TRUE(h.wait_for([&] { return count_engaged(h.nano.commands, mark) >= 1; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= mark + 40; }));
+  EXPECT_LE(count_engaged(h.nano.commands, mark), 200 / 20 + 2);
+  EXPECT_FALSE(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+}
+
+TEST(BridgeAuth, UnicastUdpToTheLcmPortDoesNotDrive) {
+  BridgeHarness h(7787);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  // Not a publisher at all: a plain UDP socket writes LCM's "LC02" packet of an engaged
+  // full-throttle command to 127.0.0.1:<port>, which LCM's receive socket accepts.
+  auto c = h.command(1.0f, 1.0f, true);
+  c.source = "unicast";
+  c.authority = autodrive::auth::kAuthorityPerson;
+  std::vector<uint8_t> payload(static_cast<size_t>(c.getEncodedSize()));
+  c.encode(payload.data(), 0, static_cast<int>(payload.size()));
+  uint32_t seqno = 0;
+  ASSERT_TRUE(h.wait_for([&] {
+    // A new socket (source port) each time: the kernel may hand a unicast datagram to any
+    // socket bound to the port, the bridge's or this harness's.
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(7787);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    std::vector<uint8_t> pkt = {0x4c, 0x43, 0x30, 0x32};
+    ++seqno;
+    for (int i = 3; i >= 0; --i) pkt.push_back(static_cast<uint8_t>(seqno >> (8 * i)));
+    const std::string ch = "TESTCAR_COMMAND";
+    pkt.insert(pkt.end(), ch.begin(), ch.end());
+    pkt.push_back(0);
+    pkt.insert(pkt.end(), payload.begin(), payload.end());
+    ::sendto(fd, pkt.data(), pkt.size(), 0, reinterpret_cast<const sockaddr *>(&to), sizeof to);
+    ::close(fd);
+    return h.status().control.dropped_unsigned >= 3;
+  }));
+  EXPECT_EQ(count_engaged(h.nano.commands), 0);
+  EXPECT_EQ(h.status().control.applied, 0);
+  EXPECT_EQ(h.status().control.last_dropped_source, "unicast");
 }

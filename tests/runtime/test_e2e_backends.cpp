@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <autodrive/lidar_scan_t.hpp>
+#include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 
@@ -74,7 +75,19 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     cfg << "lcm_url: \"" << url_ << "\"\nclock: wall\n"
         << "vehicle: {name: E2E1}\n"
         << "bridge: {device: " << nano_link_ << ", baud: 500000, heartbeat_hz: 50,\n"
-        << "         command_timeout_ms: 200, reconnect_ms: 200}\n";
+        << "         command_timeout_ms: 200, reconnect_ms: 200,\n"
+        << "         command_key_file: " << dir_ << "/E2E1.key}\n";
+    // The car's key (mode 0600): the bridge applies only commands signed with it.
+    {
+      std::ofstream k(dir_ + "/E2E1.key");
+      k << std::string(64, 'e') << "\n";
+    }
+    std::filesystem::permissions(
+        dir_ + "/E2E1.key",
+        std::filesystem::perms::owner_read | std::filesystem::perms::owner_write,
+        std::filesystem::perm_options::replace);
+    signer_.emplace(autodrive::auth::load_key(dir_ + "/E2E1.key"), "E2E1", "e2e-test",
+                    autodrive::auth::kAuthorityMachine);
     if (b.has_lidar)
       cfg << "lidar: {device: " << lidar_link_
           << ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n";
@@ -128,6 +141,7 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     c.throttle = throttle;
     c.steering = steering;
     c.engaged = engaged;
+    signer_->sign(c);
     lcm_->publish("E2E1_COMMAND", &c);
   }
   std::string log(const std::string &name) const {
@@ -153,6 +167,7 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
   std::vector<autodrive::vehicle_state_t> states_;
   std::vector<autodrive::lidar_scan_t> scans_, sim_scans_;
   int32_t seq_ = 0;
+  std::optional<autodrive::auth::Signer> signer_;
   int starts_ = 0;
 };
 

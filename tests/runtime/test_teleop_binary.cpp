@@ -8,9 +8,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
 #include <chrono>
+#include <fstream>
 #include <functional>
 
 #include "child_process.hpp"
@@ -51,12 +53,24 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   Commands cmds;
   autodrive_lcm::subscribe<autodrive::vehicle_command_t, Commands, &Commands::on>(
       lcm, "JS1_COMMAND", &cmds);
+  // The car's key: teleop signs every command with it (a person's authority).
+  const std::string key_file = fifo + ".key";
+  {
+    std::ofstream k(key_file);
+    k << std::string(64, 'c') << "\n";
+  }
+  ::chmod(key_file.c_str(), 0600);
   rtest::Child teleop({AUTODRIVE_TELEOP_EXE, "--vehicle", "JS1", "--lcm-url", url, "--joystick",
-                       fifo, "--no-keyboard", "--max-throttle", "0.5"},
+                       fifo, "--no-keyboard", "--max-throttle", "0.5", "--key-file", key_file},
                       fifo + ".log");
   // Released: commands flow, disengaged.
   ASSERT_TRUE(pump_until(lcm, [&] { return cmds.got.size() >= 5; }));
   EXPECT_FALSE(cmds.got.back().engaged);
+  const autodrive::auth::Key key = autodrive::auth::load_key(key_file);
+  EXPECT_EQ(cmds.got.back().source, "teleop");
+  EXPECT_EQ(cmds.got.back().authority, autodrive::auth::kAuthorityPerson);
+  EXPECT_EQ(autodrive::auth::check_mac(key, "JS1", cmds.got.back()), autodrive::auth::MacCheck::ok);
+  EXPECT_LT(cmds.got[cmds.got.size() - 2].counter, cmds.got.back().counter);
   // Stick up, steer right, hold the dead-man (button 4), headlights (button 0).
   send_js(w, JS_EVENT_AXIS, 1, -32767);
   send_js(w, JS_EVENT_AXIS, 3, 32767);
@@ -79,4 +93,5 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   ::close(w);
   ::unlink(fifo.c_str());
   ::unlink((fifo + ".log").c_str());
+  ::unlink(key_file.c_str());
 }

@@ -10,7 +10,7 @@ import select
 import time
 from typing import Any
 
-from .. import lcmtypes, vehicle
+from .. import command_auth, lcmtypes, vehicle
 from ..channels import channel
 from ..geometry import Point, to_world
 from . import MissionContext
@@ -47,6 +47,10 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
     car = vehicle.load()
     wheelbase_m, steer_limit_rad = car.number("wheelbase_m"), car.number("steer_limit_rad")
     lc = lcmtypes.bus(ctx.lcm_url)
+    try:
+        signer = command_auth.signer_for(ctx.vehicle, "demo-loop")
+    except ValueError as e:
+        raise RuntimeError(str(e)) from None
     pose: dict[str, float] = {}
     state: dict[str, int] = {}
     ch_pose, ch_state, ch_command = (
@@ -125,7 +129,7 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
             if cmd.steering > STEERING_INDICATOR
             else (INDICATOR_RIGHT if cmd.steering < -STEERING_INDICATOR else 0)
         )
-        lc.publish(ch_command, cmd.encode())
+        lc.publish(ch_command, signer.sign(cmd).encode())
         if now - last_print > PRINT_PERIOD_S:
             last_print = now
             ctx.say(
@@ -135,7 +139,7 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
             )
     # Stop: a few disengaged zero commands, then silence (the firmware brakes either way).
     for _ in range(STOP_COMMANDS):
-        lc.publish(ch_command, command(False).encode())
+        lc.publish(ch_command, signer.sign(command(False)).encode())
         time.sleep(COMMAND_PERIOD_S)
     return {
         "driver": "pure pursuit on the runtime EKF (stadium track)",

@@ -1,7 +1,9 @@
 #include <autodrive_channels.h>
 #include "bridge/nano_bridge.hpp"
 
+#include <autodrive/control_status_t.hpp>
 #include <autodrive/imu_t.hpp>
+#include <autodrive/log_limiter.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -10,11 +12,13 @@
 #include <autodrive/log_limiter.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cinttypes>
 #include <cstdio>
 #include <optional>
 
 #include "bridge/bridge_convert.hpp"
+#include "bridge/command_gate.hpp"
 #include "common/clock.hpp"
 #include <autodrive_lcm/subscribe.hpp>
 #include "common/serial_port.hpp"
@@ -68,10 +72,26 @@ struct NanoBridge::Impl {
   // rate per device, never one line per frame.
   autodrive::LogLimiter rx_log{"receive problems"};
   proto_stats_t rx_reported{};  // parser counters already logged
+  // Command authentication: no key, no gate, and the bridge refuses to run (init_error).
+  std::string key_file, key_error;
+  std::optional<CommandGate> gate;
+  int64_t next_control_us = 0;  // next CONTROL status [monotonic us]
+  // Dropped commands: at most one line per second per source and reason, then a count.
+  autodrive::LogLimiter drop_log{
+      "dropped commands",
+      autodrive::LogLimits{1, std::chrono::milliseconds(1000), spdlog::level::warn}};
 
   explicit Impl(const cfg::Config &c)
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
     proto_parser_init(&parser);
+    key_file = c.bridge.command_key_file.empty() ? autodrive::auth::default_key_path(c.vehicle.name)
+                                                 : c.bridge.command_key_file;
+    try {
+      gate.emplace(autodrive::auth::load_key(key_file), c.vehicle.name,
+                   c.bridge.replay_window_ms * 1000LL, c.bridge.command_lease_ms * 1000LL);
+    } catch (const autodrive::InputError &e) {
+      key_error = std::string("bridge.command_key_file: ") + e.what();
+    }
     if (lcm.good()) {
       autodrive_lcm::subscribe<autodrive::vehicle_command_t, Impl, &Impl::on_command>(
           lcm, c.vehicle.name + AUTODRIVE_CH_COMMAND_SUFFIX, this);
@@ -97,7 +117,60 @@ struct NanoBridge::Impl {
     return static_cast<int64_t>(1e6 / config.bridge.heartbeat_hz);
   }
 
+  void log_drop(const autodrive::vehicle_command_t &m, Drop d) {
+    // The source is what the sender claims: printable, bounded, and only for the log. Sources
+    // a signature vouches for are few; unsigned ones all share one entry.
+    std::string source = m.source.substr(0, autodrive::auth::kMaxSourceChars);
+    for (char &ch : source)
+      if (ch < 0x21 || ch > 0x7e) ch = '?';
+    if (source.empty()) source = "(none)";
+    const std::string key = d == Drop::unsigned_cmd || d == Drop::bad_mac
+                                ? tag + "unauthenticated commands (" + drop_name(d) + ")"
+                                : tag + "source '" + source + "' (" + drop_name(d) + ")";
+    drop_log.event(key, "dropped a command from source '" + source + "'");
+  }
+
+  void publish_control(int64_t now_mono) {
+    const GateCounters &n = gate->counters();
+    autodrive::control_status_t m{};
+    m.utime = clock.now_us();
+    m.holder = gate->holder();
+    m.holder_authority = gate->holder_authority();
+    m.holder_changes = n.holder_changes;
+    m.applied = n.applied;
+    m.dropped_unsigned = n.dropped_unsigned;
+    m.dropped_bad_mac = n.dropped_bad_mac;
+    m.dropped_replay = n.dropped_replay;
+    m.dropped_not_holder = n.dropped_not_holder;
+    m.last_dropped_source = n.last_dropped_source;
+    lcm.publish(config.vehicle.name + AUTODRIVE_CH_CONTROL_SUFFIX, &m);
+    count([&](Status &s) {
+      s.control = n;
+      s.holder = gate->holder();
+    });
+    next_control_us = now_mono + 200000;  // 5 Hz
+  }
+
+  void holder_changed(int64_t now_mono) {
+    if (gate->holder().empty())
+      spdlog::warn("{}control lease lapsed: no source holds control", tag);
+    else
+      spdlog::warn(
+          "{}control now held by '{}' ({})", tag, gate->holder(),
+          gate->holder_authority() == autodrive::auth::kAuthorityPerson ? "person" : "machine");
+    publish_control(now_mono);
+  }
+
   void on_command(const autodrive::vehicle_command_t *m) {
+    if (!gate) return;
+    const int64_t now_mono = clk::monotonic_us();
+    if (gate->expire(now_mono)) holder_changed(now_mono);  // a lapse is published on its own
+    const CommandGate::Verdict v = gate->admit(*m, now_mono, clk::wall_us());
+    if (v.holder_changed) holder_changed(now_mono);
+    if (v.drop != Drop::none) {
+      if (v.drop != Drop::idle) log_drop(*m, v.drop);
+      return;
+    }
     const std::string why = command_problem(*m);
     if (!why.empty()) {
       // Rejected commands do not refresh the stream: a sender gone wrong disengages the car.
@@ -116,9 +189,12 @@ struct NanoBridge::Impl {
     }
     latest_cmd = *m;
     latest_cmd_rx_us = clk::monotonic_us();
-    // Forward at once (latency), then keep the heartbeat going from here. In step with
-    // SIM_CLOCK every frame waits for its tick instead.
-    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock) {
+    // The serial link carries at most one COMMAND frame per heartbeat period, whatever rate
+    // commands arrive at (a flood on LCM cannot flood the Nano): a fresh command goes out at
+    // once only when a whole period has passed since the last frame (latency), else with the
+    // next heartbeat. In step with SIM_CLOCK every frame waits for its tick instead.
+    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock &&
+        latest_cmd_rx_us >= next_tx_us) {
       send_command(latest_cmd_rx_us);
       next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
     }
@@ -363,7 +439,16 @@ struct NanoBridge::Impl {
       wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
     if (stop) return;
-    if (r > 0 && (fds[0].revents & POLLIN)) lcm.handleTimeout(0);
+    // Drain what LCM has (bounded, so the serial side is served even under a flood).
+    if (r > 0 && (fds[0].revents & POLLIN))
+      for (int i = 0; i < 512 && lcm.handleTimeout(0) > 0; ++i) {
+      }
+    if (gate) {
+      drop_log.flush();
+      const int64_t tm = clk::monotonic_us();
+      if (gate->expire(tm)) holder_changed(tm);
+      if (tm >= next_control_us) publish_control(tm);
+    }
     if (r > 0 && nfds == 2 && port.is_open()) {
       if (fds[1].revents & POLLIN) {
         uint8_t buf[512];
@@ -414,6 +499,7 @@ NanoBridge::~NanoBridge() = default;
 
 std::string NanoBridge::init_error() const {
   if (!impl_->config.has_bridge) return impl_->config.file + ": bridge: missing section";
+  if (!impl_->key_error.empty()) return impl_->config.file + ": " + impl_->key_error;
   if (!impl_->lcm.good())
     return "LCM URL '" + impl_->config.lcm_url +
            "' unusable (for udpm on a host with no multicast route: ip route add 239.0.0.0/8 dev "

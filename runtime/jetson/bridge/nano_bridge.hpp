@@ -1,7 +1,10 @@
 // Nano bridge: the serial link to the Arduino Nano (or the simulator's / simavr's pty).
 // Handshake (HELLO_REQUEST until a HELLO with our schema hash), telemetry -> <VEH>_STATE and
-// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat, engaged only while the LCM
-// command stream is fresh. Reconnects by itself when the device disappears.
+// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat (at most one frame per
+// heartbeat period, whatever rate commands arrive at), engaged only while the LCM command stream is
+// fresh. Only commands the command gate admits (signed, not replayed, from the lease holder) count;
+// the holder and the gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device
+// disappears.
 #pragma once
 
 #include <atomic>
@@ -10,6 +13,7 @@
 #include <mutex>
 #include <string>
 
+#include "bridge/command_gate.hpp"
 #include "common/config.hpp"
 
 namespace bridge {
@@ -36,7 +40,9 @@ struct Status {
   uint64_t rx_bad_crc = 0;        // frames whose CRC failed
   uint64_t rx_bad_length = 0;     // length byte above PROTO_MAX_PAYLOAD
   uint64_t rx_bad_payload = 0;    // good CRC but a HELLO/STATE/NACK that does not unpack
-  std::string last_refusal;       // the refusal message (names both schemas)
+  std::string last_refusal;  // the refusal message (names both schemas)
+  GateCounters control;      // the command gate's counters (as of the last CONTROL status)
+  std::string holder;        // the source holding the control lease, "" when none
 };
 
 class NanoBridge {

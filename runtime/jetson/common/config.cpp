@@ -53,6 +53,12 @@ Bridge parse_bridge(const Section &s) {
                " (two frames per failsafe period)");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
+  b.command_key_file = s.get<std::string>("command_key_file", "");
+  b.replay_window_ms = s.positive_int("replay_window_ms", b.replay_window_ms);
+  if (b.replay_window_ms > 10000)
+    s.fail(s.key("replay_window_ms"), "must be 1..10000 (a replayed command must go stale fast)");
+  b.command_lease_ms = s.positive_int("command_lease_ms", b.command_lease_ms);
+  if (b.command_lease_ms > 5000) s.fail(s.key("command_lease_ms"), "must be 1..5000");
   if (b.servo_trim_us < -200 || b.servo_trim_us > 200)
     s.fail(s.key("servo_trim_us"), "must be -200..200");
   if (s.has("imu")) {

@@ -45,6 +45,12 @@ struct Bridge {
   // clock sim: one frame per SIM_CLOCK tick, and a command stamped later than the sim clock
   // applies from that sim time (repeatable HIL with autodrive-sim --lockstep-frames)
   bool sync_to_sim_clock = false;
+  // Command authentication (bridge/command_gate.hpp). Optional keys: the key file (default
+  // autodrive::auth::default_key_path(vehicle), created by tools/keys), how far a command's
+  // counter may be from the wall clock, and how long the holder keeps control without commands.
+  std::string command_key_file;
+  int replay_window_ms = 1000;
+  int command_lease_ms = 500;
   std::string imu_frame_id = "imu_link";
   double imu_orientation_var_rad2 = 0.0;  // diagonal of the covariances
   double imu_gyro_var_rad2_s2 = 0.0;

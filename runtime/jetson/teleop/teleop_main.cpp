@@ -1,5 +1,6 @@
 // autodrive-teleop: drive a car from a terminal keyboard and/or a gamepad (Linux joystick
 // API), publishing <VEH>_COMMAND at a steady rate. Dead-man: release stops the car.
+#include <autodrive/command_auth.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
@@ -10,6 +11,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <optional>
 #include <cstdio>
 #include <string>
 
@@ -53,7 +55,8 @@ int main(int argc, char **argv) {
       "level, h headlights, z/c/x left/right/hazard indicators, q quit.\n"
       "Gamepad: hold the dead-man button (LB) and use left stick Y (throttle), right stick X\n"
       "(steering); A headlights, X/B/Y left/right/hazard indicators."};
-  std::string vehicle = AUTODRIVE_VEHICLE_DEFAULT, url = AUTODRIVE_LCM_URL_DEFAULT, js_path;
+  std::string vehicle = AUTODRIVE_VEHICLE_DEFAULT, url = AUTODRIVE_LCM_URL_DEFAULT, js_path,
+              key_file, source = "teleop";
   double rate_hz = 50.0;
   bool no_keyboard = false;
   teleop::Params p;
@@ -69,8 +72,24 @@ int main(int argc, char **argv) {
   app.add_option("--deadman-button", p.deadman_button, "gamepad dead-man button number")
       ->capture_default_str();
   app.add_flag("--no-keyboard", no_keyboard, "do not read the terminal");
+  app.add_option("--key-file", key_file,
+                 "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
+                 "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
+  app.add_option("--source", source,
+                 "source id the commands are signed with (a person's: "
+                 "takes control from the autonomy)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
+  std::optional<autodrive::auth::Signer> signer;
+  try {
+    signer.emplace(autodrive::auth::load_key(
+                       key_file.empty() ? autodrive::auth::default_key_path(vehicle) : key_file),
+                   vehicle, source, autodrive::auth::kAuthorityPerson);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "autodrive-teleop: %s\n", e.what());
+    return 2;
+  }
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-teleop: LCM URL '%s' unusable\n", url.c_str());
@@ -132,6 +151,7 @@ int main(int argc, char **argv) {
     if (now >= next_us) {
       autodrive::vehicle_command_t c = mapper.command(now);
       c.utime = clk::wall_us();
+      signer->sign(c);
       lcm.publish(channel, &c);
       next_us = std::max(next_us + period_us, now);
       if (term.active() && c.seq % 10 == 0) {
@@ -147,6 +167,7 @@ int main(int argc, char **argv) {
   c.utime = clk::wall_us();
   c.engaged = false;
   c.throttle = 0.0f;
+  signer->sign(c);
   lcm.publish(channel, &c);
   if (js >= 0) ::close(js);
   std::printf("\n");

@@ -8,7 +8,12 @@
 //   ekf       : drives a loop through <VEH>_COMMAND, publishes Eye poses made from the sim's
 //               ground truth (noise + latency), compares <VEH>_POSE_MAP and <VEH>_ODOM with
 //               ground truth (ekf_*_rms)
+//   flood     : a fake Nano on a pty (--pty) while --flood-hz commands a second go to
+//               <VEH>_COMMAND (1 in 8 signed by the lease holder, the rest unsigned); COMMAND
+//               frames per second on the serial link (serial_cmd_hz_under_flood)
+// Commands are signed with the car's key (--key-file, default as autodrive-teleop's).
 #include <autodrive/angles.hpp>
+#include <autodrive/command_auth.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -22,7 +27,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <atomic>
 #include <deque>
+#include <optional>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -48,6 +55,8 @@ void progress(const char *fmt, double a, double b = 0) {
   std::fflush(stderr);
 }
 
+std::optional<autodrive::auth::Signer> g_signer;  // set in main
+
 autodrive::vehicle_command_t make_cmd(int32_t seq, float throttle, float steering, bool engaged) {
   autodrive::vehicle_command_t c{};
   c.utime = clk::wall_us();
@@ -55,7 +64,83 @@ autodrive::vehicle_command_t make_cmd(int32_t seq, float throttle, float steerin
   c.throttle = throttle;
   c.steering = steering;
   c.engaged = engaged;
+  if (g_signer) g_signer->sign(c);
   return c;
+}
+
+// ---- flood ---------------------------------------------------------------------------
+int run_flood(const std::string &url, const std::string &vehicle, const std::string &pty,
+              double seconds, double flood_hz) {
+  rtest::FakeNano nano(pty);
+  nano.open();
+  proto_state_t st{};
+  st.quat_q14[0] = PROTO_QUAT_ONE;
+  int64_t next_state = 0;
+  auto service = [&] {
+    nano.pump(1);
+    const int64_t now = clk::monotonic_us();
+    if (nano.hellos_sent > 0 && now >= next_state) {
+      st.nano_time_us += 10000;
+      nano.send_state(st);
+      next_state = now + 10000;
+    }
+  };
+  const int64_t give_up = clk::monotonic_us() + 30000000;
+  while (nano.commands.size() < 5 && clk::monotonic_us() < give_up) service();
+  if (nano.commands.size() < 5) {
+    std::fprintf(stderr, "flood: the bridge never linked on %s\n", pty.c_str());
+    return 1;
+  }
+  std::atomic<bool> done{false};
+  std::atomic<long> sent{0};
+  std::thread flooder([&] {
+    lcm::LCM lcm(url);
+    const std::string ch = vehicle + AUTODRIVE_CH_COMMAND_SUFFIX;
+    const int64_t t0 = clk::monotonic_us();
+    int32_t seq = 0;
+    while (!done) {
+      // Catch up to the target count at each wake-up (1 ms): bursts, as a flooder sends.
+      const auto due = static_cast<long>((clk::monotonic_us() - t0) * 1e-6 * flood_hz);
+      autodrive::vehicle_command_t junk = make_cmd(0, 1.0f, 1.0f, true);
+      std::fill(junk.mac, junk.mac + autodrive::auth::kMacBytes, 0);  // unsigned
+      while (sent < due && !done) {
+        // One valid command of the lease holder in eight (each would once have become a frame),
+        // the rest unsigned junk: the publisher's own signing then does not cap the rate.
+        if (seq % 8 == 0) {
+          const autodrive::vehicle_command_t c = make_cmd(seq, 0.2f, 0.0f, true);
+          lcm.publish(ch, &c);
+        } else {
+          lcm.publish(ch, &junk);
+        }
+        ++seq;
+        ++sent;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  // Measure after a settling second.
+  const int64_t t_settle = clk::monotonic_us() + 1000000;
+  while (clk::monotonic_us() < t_settle) service();
+  const std::size_t n0 = nano.commands.size();
+  const long s0 = sent;
+  const int64_t t0 = clk::monotonic_us();
+  int64_t next_print = t0 + 1000000;
+  while (clk::monotonic_us() < t0 + static_cast<int64_t>(seconds * 1e6)) {
+    service();
+    if (clk::monotonic_us() >= next_print) {
+      progress("flood: %.0f s, %.0f COMMAND frames so far\n", (clk::monotonic_us() - t0) * 1e-6,
+               static_cast<double>(nano.commands.size() - n0));
+      next_print += 1000000;
+    }
+  }
+  const double dt = (clk::monotonic_us() - t0) * 1e-6;
+  const double frames_hz = static_cast<double>(nano.commands.size() - n0) / dt;
+  const double lcm_hz = static_cast<double>(sent - s0) / dt;
+  done = true;
+  flooder.join();
+  std::printf("{\"serial_cmd_hz_under_flood\": %.2f, \"lcm_flood_msgs_per_s\": %.0f}\n", frames_hz,
+              lcm_hz);
+  return 0;
 }
 
 // ---- serial --------------------------------------------------------------------------
@@ -445,10 +530,17 @@ int main(int argc, char **argv) {
   std::string mode, url = "udpm://239.255.76.67:7786?ttl=0", vehicle = AUTODRIVE_VEHICLE_DEFAULT,
                     pty, pwm_log, suffix;
   int samples = 500;
-  double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50;
-  app.add_option("mode", mode, "serial | pwm | telemetry | ekf")
+  double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50, flood_hz = 40000;
+  std::string key_file;
+  app.add_option("mode", mode, "serial | pwm | telemetry | ekf | flood")
       ->required()
-      ->check(CLI::IsMember({"serial", "pwm", "telemetry", "ekf"}));
+      ->check(CLI::IsMember({"serial", "pwm", "telemetry", "ekf", "flood"}));
+  app.add_option("--key-file", key_file,
+                 "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
+                 "~/.config/autodrive/keys/<VEH>.key)");
+  app.add_option("--flood-hz", flood_hz, "flood: commands per second on LCM")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
   app.add_option("--vehicle", vehicle, "vehicle name")->capture_default_str();
   app.add_option("--pty", pty, "serial: symlink for the fake Nano's pty");
@@ -461,6 +553,18 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   app.add_option("--key-suffix", suffix, "telemetry: suffix for the JSON keys");
   CLI11_PARSE(app, argc, argv);
+  if (mode != "telemetry") {
+    try {
+      g_signer.emplace(
+          autodrive::auth::load_key(key_file.empty() ? autodrive::auth::default_key_path(vehicle)
+                                                     : key_file),
+          vehicle, "link-bench", autodrive::auth::kAuthorityMachine);
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "runtime-link-bench: %s\n", e.what());
+      return 2;
+    }
+  }
+  if (mode == "flood") return run_flood(url, vehicle, pty, seconds, flood_hz);
   if (mode == "serial") return run_serial(url, vehicle, pty, samples);
   if (mode == "pwm") return run_pwm(url, vehicle, pwm_log, samples);
   if (mode == "telemetry") return run_telemetry(url, vehicle, seconds, suffix);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -22,6 +23,7 @@
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/path2d_t.hpp>
 #include <autodrive/pose2d_t.hpp>
+#include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
 #include "config.hpp"
@@ -37,7 +39,9 @@ using namespace autonomy;
 
 class App {
  public:
-  App(const ProgramConfig &cfg, lcm::LCM &lcm) : cfg_(cfg), lcm_(lcm), node_(cfg.node) {
+  // signer: signs every command (none in --replay: nothing drives a car there).
+  App(const ProgramConfig &cfg, lcm::LCM &lcm, std::optional<autodrive::auth::Signer> signer)
+      : cfg_(cfg), lcm_(lcm), node_(cfg.node), signer_(std::move(signer)) {
     std::filesystem::create_directories(cfg_.out_dir);
     traj_.open(std::filesystem::path(cfg_.out_dir) / "trajectory.csv");
     traj_ << "t_s,x_m,y_m,yaw_rad,state\n";
@@ -96,6 +100,7 @@ class App {
     c.headlights = 0;
     c.indicators = node_.mission().state() == MissionState::kParked ? 3 : 0;
     c.engaged = !stop && node_.engaged();
+    if (signer_) signer_->sign(c);
     lcm_.publish(cfg_.vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
   }
 
@@ -191,6 +196,7 @@ class App {
   const ProgramConfig &cfg_;
   lcm::LCM &lcm_;
   AutonomyNode node_;
+  std::optional<autodrive::auth::Signer> signer_;
   std::ofstream traj_;
   int32_t seq_ = 0;
   Pose2 last_lo_pose_;
@@ -205,7 +211,7 @@ int main(int argc, char **argv) {
   CLI::App cli{
       "autodrive-autonomy: autonomous parking mission (map, save, localise, plan, drive, park) on "
       "LCM"};
-  std::string config_path, url_override, vehicle_override, replay_in, replay_out;
+  std::string config_path, url_override, vehicle_override, replay_in, replay_out, key_file;
   cli.add_option("--config", config_path,
                  "YAML configuration (see runtime/jetson/autonomy/config/)")
       ->required();
@@ -214,6 +220,9 @@ int main(int argc, char **argv) {
   cli.add_option("--replay", replay_in, "read LIDAR and ODOM from this recorded LCM log")
       ->check(CLI::ExistingFile);
   cli.add_option("--replay-out", replay_out, "with --replay: the LCM log to publish into");
+  cli.add_option("--key-file", key_file,
+                 "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
+                 "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
   CLI11_PARSE(cli, argc, argv);
   if (replay_in.empty() != replay_out.empty()) {
     std::fprintf(stderr, "autodrive-autonomy: --replay and --replay-out go together\n");
@@ -231,6 +240,18 @@ int main(int argc, char **argv) {
   if (!url_override.empty()) cfg.lcm_url = url_override;
   if (!vehicle_override.empty()) cfg.vehicle = vehicle_override;
 
+  std::optional<autodrive::auth::Signer> signer;
+  if (!replay) {
+    try {
+      signer.emplace(autodrive::auth::load_key(key_file.empty()
+                                                   ? autodrive::auth::default_key_path(cfg.vehicle)
+                                                   : key_file),
+                     cfg.vehicle, "autonomy", autodrive::auth::kAuthorityMachine);
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "autodrive-autonomy: --key-file: %s\n", e.what());
+      return 2;
+    }
+  }
   if (replay) {
     cfg.lcm_url = "file://" + std::filesystem::absolute(replay_in).string() + "?speed=0";
     replay_out = "file://" + std::filesystem::absolute(replay_out).string() + "?mode=w";
@@ -245,7 +266,7 @@ int main(int argc, char **argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  App app(cfg, replay_lcm ? *replay_lcm : lcm);
+  App app(cfg, replay_lcm ? *replay_lcm : lcm, std::move(signer));
   auto *s1 = autodrive_lcm::subscribe<autodrive::lidar_scan_t, App, &App::on_scan>(
       lcm, cfg.vehicle + AUTODRIVE_CH_LIDAR_SUFFIX, &app);
   auto *s2 = autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_odom>(
