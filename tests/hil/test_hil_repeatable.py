@@ -59,7 +59,7 @@ def run(tmp: pathlib.Path, name: str) -> bytes:
     cfg["vehicle"] = {"name": VEHICLE}
     cfg["bridge"].update(device=str(run_dir / "nigel1-nano"), sync_to_sim_clock=True)
     # a loaded machine must not let the constant command go stale between two wall ticks
-    cfg["bridge"]["command_timeout_ms"] = 2000
+    cfg["bridge"]["command_timeout_ms"] = 500  # the bound the config reader allows
     for optional in ("lidar", "cameras", "estimator"):
         cfg.pop(optional, None)
     cfg_path = tmp / f"{name}.yaml"
