@@ -50,4 +50,26 @@ std::vector<Detection> Detector::detect(const cv::Mat &gray) {
   return out;
 }
 
+std::vector<Detection> Detector::detect(const cv::Mat &gray, const cv::Rect &roi, float decimate) {
+  const cv::Rect r = roi & cv::Rect(0, 0, gray.cols, gray.rows);
+  if (r.area() == 0) return {};
+  auto *td = static_cast<apriltag_detector_t *>(td_);
+  td->quad_decimate = decimate;
+  std::vector<Detection> out;
+  try {
+    out = detect(gray(r));
+  } catch (...) {
+    td->quad_decimate = params_.decimate;
+    throw;
+  }
+  td->quad_decimate = params_.decimate;
+  // Region pixel (c, r) is frame pixel (c + x, r + y): shifting the corners is exact.
+  const cv::Point2d off(r.x, r.y);
+  for (auto &d : out) {
+    for (auto &p : d.corners_px) p += off;
+    d.centre_px += off;
+  }
+  return out;
+}
+
 }  // namespace eye

@@ -37,8 +37,7 @@ std::vector<RefTag> reftags_load(const std::string &path) {
   return out;
 }
 
-// Map coordinates of a reference tag's corners, libapriltag order.
-static std::array<cv::Point3d, 4> ref_corners(const RefTag &r) {
+std::array<cv::Point3d, 4> reftag_corners_map(const RefTag &r) {
   const auto tf = tag_corners_tagframe(r.size_m);
   const double c = std::cos(r.yaw_rad), s = std::sin(r.yaw_rad);
   std::array<cv::Point3d, 4> out;
@@ -60,7 +59,7 @@ MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
     for (const auto &d : f) {
       auto it = by_id.find(d.id);
       if (it == by_id.end()) continue;
-      const auto c3 = ref_corners(*it->second);
+      const auto c3 = reftag_corners_map(*it->second);
       for (size_t i = 0; i < 4; ++i) {
         obj.push_back(c3[i]);
         img.push_back(d.corners_px[i]);

@@ -1,6 +1,7 @@
 // Map calibration: the camera pose in the map frame from reference tags at known map
 // coordinates, with residuals in millimetres on each tag's own plane.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct MapCalib {
   std::vector<TagResidual> tags;
   std::vector<int> missing_ids;  // reference tags never detected
 };
+
+// Map coordinates of a reference tag's corners, libapriltag order (bottom-left, bottom-right,
+// top-right, top-left of the print).
+std::array<cv::Point3d, 4> reftag_corners_map(const RefTag &r);
 
 // Reads the reference tag list:  tags: [{id, x_m, y_m, z_m, yaw_rad, size_m}, ...]
 std::vector<RefTag> reftags_load(const std::string &path);
