@@ -171,7 +171,17 @@ RunResult run_peer(const Scene &sc, lcm::LCM &lcm, int repeats) {
 
 struct Accuracy {
   double pos_rms_mm = 0, heading_rms_deg = 0, detect_rate = 0, pos_median_mm = 0, pos_max_mm = 0;
+  int misses = 0;
 };
+
+// Pixel of a car's roof tag centre.
+cv::Point2d eye_tag_centre_px(const eye::SynthScene &s, const eye::SynthCar &car) {
+  const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
+  const double ox = s.car.tag_offset_m[0], oy = s.car.tag_offset_m[1];
+  return eye::camera_project(s.in, s.pose,
+                             {car.x_m + c * ox - sn * oy, car.y_m + sn * ox + c * oy,
+                              s.car.base_link_height_m + s.car.tag_offset_m[2]});
+}
 
 Accuracy accuracy(const Scene &sc, const RunResult &r) {
   Accuracy a;
@@ -209,6 +219,9 @@ struct WideScene {
   double tag_px_min = 1e9, tag_px_max = 0;
 };
 
+double g_wide_margin = eye::TrackingParams{}.margin;
+float g_wide_sigma = eye::DetectorParams{}.sigma_px;
+
 WideScene make_wide_scene(int w, int h, int frames) {
   WideScene sc;
   sc.s = eye::synth_scene_wide(w, h);
@@ -223,6 +236,8 @@ WideScene make_wide_scene(int w, int h, int frames) {
   sc.cfg.in = sc.s.in;
   sc.cfg.pose = m.pose;
   sc.cfg.locate = sc.s.car;
+  sc.cfg.tracking.margin = g_wide_margin;
+  sc.cfg.detector.sigma_px = g_wide_sigma;
   for (int k = 1; k <= 10; ++k) sc.cfg.vehicles.push_back({AUTODRIVE_VEHICLE_PREFIX + std::to_string(k), k, 0.0});
   sc.cars = eye::synth_wide_drive(sc.s, frames);
   for (int i = 0; i < frames; ++i) {
@@ -244,6 +259,7 @@ WideScene make_wide_scene(int w, int h, int frames) {
 struct WideResult {
   std::vector<double> pass_fps, pass_fps_cpu, latency_ms;
   std::vector<std::vector<eye::CarPose>> est;  // per frame, first pass
+  int full_scans = 0;                          // first pass
   double fps() const { return median(pass_fps); }
   double fps_cpu() const { return median(pass_fps_cpu); }
 };
@@ -260,7 +276,10 @@ WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::
       const auto poses = tr.process(g);
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
       r.latency_ms.push_back(std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
-      if (rep == 0) r.est.push_back(poses);
+      if (rep == 0) {
+        r.est.push_back(poses);
+        r.full_scans += tr.last_was_full_scan();
+      }
     }
     const double n = static_cast<double>(sc.jpeg.size());
     r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
@@ -276,6 +295,13 @@ Accuracy wide_accuracy(const WideScene &sc, const WideResult &r) {
   for (size_t i = 0; i < sc.cars.size(); ++i)
     for (const auto &t : sc.cars[i]) {
       total += 1;
+      if (std::none_of(r.est[i].begin(), r.est[i].end(),
+                       [&t](const eye::CarPose &p) { return p.tag_id == t.tag_id; }) &&
+          ++a.misses <= 12) {
+        const auto c = eye_tag_centre_px(sc.s, t);
+        std::fprintf(stderr, "[eye_bench]   missed car %d in frame %zu: tag %.1f px at (%.0f, %.0f)\n",
+                     t.tag_id, i, eye::synth_tag_side_px(sc.s, t), c.x, c.y);
+      }
       for (const auto &p : r.est[i]) {
         if (p.tag_id != t.tag_id) continue;
         const double ep = 1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m);
@@ -319,9 +345,9 @@ std::pair<int, bool> bumped_camera(const WideScene &sc, int frames) {
   for (int i = 0; i < frames; ++i) {
     const auto &cars = sc.cars[static_cast<size_t>(i)];
     auto ps = ts.process(eye::synth_frame(sc.s, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
-    still.observe(i * 33333, ts.last_detections(), ts.last_was_full_scan(), &ps);
+    still.observe(i * 33333, ts.last_detections(), &ps);
     auto pb = tb.process(eye::synth_frame(moved, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
-    if (bumped.observe(i * 33333, tb.last_detections(), tb.last_was_full_scan(), &pb) && found < 0)
+    if (bumped.observe(i * 33333, tb.last_detections(), &pb) && found < 0)
       found = i;
   }
   std::fprintf(stderr, "[eye_bench] bumped camera: ref residual %.2f mm (still %.2f mm)\n",
@@ -342,6 +368,10 @@ int main(int argc, char **argv) {
   app.add_option("--tag-size-m", tag_size_m, "roof tag black border [m]")->capture_default_str();
   app.add_option("--csv", csv, "write truth vs estimate per frame (720p) here");
   app.add_option("--lcm-url", url, "where poses are published")->capture_default_str();
+  app.add_option("--wide-margin", g_wide_margin, "wide scene: tracking window margin [tag sizes]")
+      ->capture_default_str();
+  app.add_option("--wide-sigma-px", g_wide_sigma, "wide scene: detector quad_sigma [px]")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   cv::setNumThreads(1);  // one thread: aruco and imdecode would otherwise use a pool
 
@@ -391,7 +421,7 @@ int main(int argc, char **argv) {
   std::fprintf(stderr, "[eye_bench] wide: tags %.1f-%.1f px a side; plan:", wide.tag_px_min,
                wide.tag_px_max);
   const eye::Tracker planned(wide.cfg);
-  for (const auto &r : planned.scan_plan())
+  for (const auto &r : planned.scan_plan().regions)
     std::fprintf(stderr, " [%d,%d %dx%d @%.1f]", r.rect.x, r.rect.y, r.rect.width, r.rect.height,
                  static_cast<double>(r.decimate));
   std::fprintf(stderr, "\n");
@@ -405,6 +435,16 @@ int main(int argc, char **argv) {
   const WideResult w_prev = run_wide(wide, lcm, repeats, cfg_prev);
   std::fprintf(stderr, "[eye_bench] wide: decimate 1 everywhere\n");
   const WideResult w_d1 = run_wide(wide, lcm, repeats, cfg_d1);
+  // The detector alone (every frame scanned whole, no windows to carry a car through): what
+  // the whole-field plan finds that the previous default's decimate-2 scan misses.
+  eye::RunConfig cfg_full = wide.cfg, cfg_prev_full = cfg_prev;
+  cfg_full.tracking.roi = false;
+  cfg_prev_full.tracking.roi = false;
+  std::fprintf(stderr, "[eye_bench] wide: whole-frame scans every frame (Eye, previous)\n");
+  const WideResult wf_eye = run_wide(wide, lcm, 1, cfg_full);
+  const WideResult wf_prev = run_wide(wide, lcm, 1, cfg_prev_full);
+  std::fprintf(stderr, "[eye_bench] wide: full scans %d (Eye), %d (previous), %d (decimate 1)\n",
+               w_eye.full_scans, w_prev.full_scans, w_d1.full_scans);
   const Accuracy aw = wide_accuracy(wide, w_eye), aw_prev = wide_accuracy(wide, w_prev),
                  aw_d1 = wide_accuracy(wide, w_d1);
   std::fprintf(stderr, "[eye_bench] bumped camera (5 mm, 0.3 deg), %d frames\n",
@@ -442,6 +482,11 @@ int main(int argc, char **argv) {
   std::printf("fps_1280x720_1t_wide_angle %.2f\n", w_eye.fps());
   std::printf("fps_1280x720_1t_wide_angle_cpu %.2f\n", w_eye.fps_cpu());
   std::printf("detect_rate_wide_angle_prev_default %.4f\n", aw_prev.detect_rate);
+  std::printf("detect_rate_wide_angle_fullscan %.4f\n", wide_accuracy(wide, wf_eye).detect_rate);
+  std::printf("detect_rate_wide_angle_fullscan_prev_default %.4f\n",
+              wide_accuracy(wide, wf_prev).detect_rate);
+  std::printf("fps_1280x720_1t_wide_angle_fullscan_cpu %.2f\n", wf_eye.fps_cpu());
+  std::printf("fps_1280x720_1t_wide_angle_fullscan_prev_default_cpu %.2f\n", wf_prev.fps_cpu());
   std::printf("fps_1280x720_1t_wide_angle_prev_default %.2f\n", w_prev.fps());
   std::printf("fps_1280x720_1t_wide_angle_prev_default_cpu %.2f\n", w_prev.fps_cpu());
   std::printf("detect_rate_wide_angle_decimate1 %.4f\n", aw_d1.detect_rate);

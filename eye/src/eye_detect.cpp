@@ -3,6 +3,9 @@
 #include <apriltag.h>
 #include <tag36h11.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "eye_error.hpp"
 
 namespace eye {
@@ -52,7 +55,9 @@ std::vector<Detection> Detector::detect(const cv::Mat &gray) {
 
 std::vector<Detection> Detector::detect(const cv::Mat &gray, const cv::Rect &roi, float decimate) {
   const cv::Rect r = roi & cv::Rect(0, 0, gray.cols, gray.rows);
-  if (r.area() == 0) return {};
+  // No tag fits in a sliver, and libapriltag 3.3 crashes (quad_thresh) on a few-pixel image.
+  const int min_px = static_cast<int>(std::ceil(8 * std::max(1.0f, decimate)));
+  if (r.width < min_px || r.height < min_px) return {};
   auto *td = static_cast<apriltag_detector_t *>(td_);
   td->quad_decimate = decimate;
   std::vector<Detection> out;

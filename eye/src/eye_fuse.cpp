@@ -83,8 +83,7 @@ std::vector<CarPose> MultiEye::process(const std::vector<cv::Mat> &frames, int64
     last_[i].clear();
     if (i >= frames.size() || frames[i].empty()) continue;
     last_[i] = trackers_[i]->process(frames[i]);
-    if (health_[i].observe(utime, trackers_[i]->last_detections(),
-                           trackers_[i]->last_was_full_scan(), &last_[i]))
+    if (health_[i].observe(utime, trackers_[i]->last_detections(), &last_[i]))
       moved_now_.push_back(i);
   }
   std::vector<CarPose> fused = fuse_poses(last_);

@@ -12,7 +12,7 @@ CameraHealth::CameraHealth(std::string camera, const Intrinsics &in, const Camer
   if (!refs_.empty()) st_.ref_tags_seen = 0;
 }
 
-bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets, bool full_scan,
+bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets,
                            std::vector<CarPose> *poses) {
   st_.utime = utime;
   ++st_.frames;
@@ -24,7 +24,7 @@ bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets, bo
     st_.fps_hz = 1e6 * static_cast<double>(times_.size() - 1) /
                  static_cast<double>(times_.back() - times_.front());
   bool newly_moved = false;
-  if (full_scan && !refs_.empty()) {
+  if (!refs_.empty()) {
     std::map<int, const RefTag *> by_id;
     for (const auto &r : refs_) by_id[r.id] = &r;
     double ss_mm = 0, ss_px = 0;
@@ -47,8 +47,8 @@ bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets, bo
         ++n;
       }
     }
-    st_.ref_tags_seen = tags;
     if (n > 0) {
+      st_.ref_tags_seen = tags;
       st_.ref_rms_mm = std::sqrt(ss_mm / n);
       st_.ref_rms_px = std::sqrt(ss_px / n);
       over_ = st_.ref_rms_mm > p_.bump_threshold_mm ? over_ + 1 : 0;

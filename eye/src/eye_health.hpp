@@ -18,7 +18,7 @@ namespace eye {
 
 struct HealthParams {
   double bump_threshold_mm = 3.0;  // reference-tag residual RMS that means "the camera moved" [mm]
-  int bump_confirm = 2;            // over the threshold in this many reference observations in a row
+  int bump_confirm = 3;            // over the threshold in this many frames with reference tags in a row
   double bump_cov_scale = 100.0;   // covariance factor of poses from a moved camera (10x sigma)
   double status_period_s = 1.0;    // EYE_CAMERA_STATUS period [s]
 };
@@ -30,7 +30,7 @@ struct CameraStatus {
   long frames = 0;           // frames processed
   int tags_seen = 0;         // tags detected in the last frame
   int cars_seen = 0;         // cars posed in the last frame
-  int ref_tags_seen = -1;    // reference tags in the last full scan (-1: none configured)
+  int ref_tags_seen = -1;    // reference tags in the last frame that had any (-1: none configured)
   double ref_rms_mm = -1;    // their corner residual on their planes [mm] (-1: not measured)
   double ref_rms_px = -1;    // their reprojection residual [px]
   bool moved = false;        // the reference tags drifted: recalibrate
@@ -41,11 +41,10 @@ class CameraHealth {
  public:
   CameraHealth(std::string camera, const Intrinsics &in, const CameraPose &pose,
                std::vector<RefTag> refs, HealthParams p = HealthParams());
-  // One processed frame: its capture time, every tag detected, whether the frame was scanned
-  // whole (reference tags are measured only then), and the car poses, inflated here if moved.
-  // Returns true once, at the frame the camera is found moved.
-  bool observe(int64_t utime, const std::vector<Detection> &dets, bool full_scan,
-               std::vector<CarPose> *poses);
+  // One processed frame: its capture time, every tag detected (the reference tags among them
+  // are measured: the tracker's staggered scan sees each within full_every frames), and the
+  // car poses, inflated here if moved. Returns true once, at the frame the camera is found moved.
+  bool observe(int64_t utime, const std::vector<Detection> &dets, std::vector<CarPose> *poses);
   const CameraStatus &status() const { return st_; }
   // Whether a status message is due at this capture time (then marks it sent).
   bool status_due(int64_t utime);

@@ -32,15 +32,15 @@ float decimate_for_side(double side_px, float coarse, double min_px) {
   return std::min(best, std::max(1.0f, coarse));
 }
 
-std::vector<ScanRegion> plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
-                                       double tag_size_m, float coarse, const ScanPlanParams &p) {
+ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
+                        double tag_size_m, float coarse, const ScanPlanParams &p) {
   const int w = in.width_px, h = in.height_px, cell = std::max(16, p.cell_px);
   const int nc = (w + cell - 1) / cell, nr = (h + cell - 1) / cell;
   // Per cell: the smallest tag (its decimation) and the largest (its padding), over the
   // cell's corners and centre.
   std::vector<float> level(static_cast<size_t>(nc * nr));
+  double max_side = 0;
   std::vector<double> big(level.size());
-  float finest = coarse;
   for (int r = 0; r < nr; ++r)
     for (int c = 0; c < nc; ++c) {
       const double x0 = c * cell - 0.5, y0 = r * cell - 0.5;
@@ -56,20 +56,19 @@ std::vector<ScanRegion> plan_full_scan(const Intrinsics &in, const CameraPose &p
       const size_t k = static_cast<size_t>(r * nc + c);
       level[k] = hi > 0 ? decimate_for_side(lo, coarse, p.min_tag_px_decimated) : coarse;
       big[k] = hi;
-      finest = std::min(finest, level[k]);
+      max_side = std::max(max_side, hi);
     }
   const cv::Rect frame(0, 0, w, h);
-  std::vector<ScanRegion> out;
-  if (finest >= coarse) return {{frame, coarse}};
-  // Every cell finer than coarse needs a scan at its level; one at a finer level also finds
-  // tags a coarser one would, so a cell is covered by the rectangle of its own level.
+  ScanPlan plan;
+  plan.max_tag_px = max_side;
+  std::vector<ScanRegion> &out = plan.regions;
+  // The whole frame at the coarse decimation finds every tag big enough for it, wherever it
+  // is (also one across cell borders); finer rectangles add the cells where tags are small.
+  out.push_back({frame, coarse});
   std::vector<float> levels(level.begin(), level.end());
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
-  bool whole_at_finest = true;
-  for (float l : level) whole_at_finest = whole_at_finest && l == finest;
-  if (whole_at_finest) return {{frame, finest}};
-  out.push_back({frame, coarse});
+  if (levels.front() >= coarse) return plan;
   for (float lv : levels) {
     if (lv >= coarse) continue;
     // Runs of cells at this level per cell row, merged with the same run in the next rows.
@@ -106,6 +105,24 @@ std::vector<ScanRegion> plan_full_scan(const Intrinsics &in, const CameraPose &p
                             frame;
       if (rect.area() > 0) out.push_back({rect, lv});
     }
+  }
+  // Padding and overlap have a price: when the regions cost more detector work (pixels /
+  // decimate^2) than one scan of the frame at the finest level, that scan is the plan.
+  double cost = 0;
+  for (const auto &r : out) cost += r.rect.area() / (static_cast<double>(r.decimate) * r.decimate);
+  const float finest = levels.front();
+  if (cost >= frame.area() / (static_cast<double>(finest) * finest)) out = {{frame, finest}};
+  return plan;
+}
+
+std::vector<ScanRegion> plan_slice(const ScanPlan &plan, int k, int n, int height_px) {
+  if (n <= 1) return plan.regions;
+  const int pad = static_cast<int>(std::ceil(plan.max_tag_px));
+  const int y0 = k * height_px / n - pad, y1 = (k + 1) * height_px / n + pad;
+  std::vector<ScanRegion> out;
+  for (const auto &r : plan.regions) {
+    const cv::Rect band = r.rect & cv::Rect(r.rect.x, y0, r.rect.width, y1 - y0);
+    if (band.area() > 0) out.push_back({band, r.decimate});
   }
   return out;
 }

@@ -32,11 +32,22 @@ cv::Vec2d expected_tag_side_px(const Intrinsics &in, const CameraPose &pose, dou
 // at least min_px a side.
 float decimate_for_side(double side_px, float coarse, double min_px);
 
-// Regions whose union finds every tag of the plane in the frame: the whole frame at `coarse`,
-// plus rectangles at finer decimation where tags become small there; each rectangle is padded
-// by the largest tag in it, so a tag on its border is whole in one region.
-std::vector<ScanRegion> plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
-                                       double tag_size_m, float coarse,
-                                       const ScanPlanParams &p = ScanPlanParams());
+struct ScanPlan {
+  std::vector<ScanRegion> regions;
+  double max_tag_px = 0;  // the largest tag side anywhere in the frame [px]
+};
+
+// Regions whose union finds every tag of the plane in the frame: the whole frame at `coarse`
+// (every tag big enough for it, wherever it is), plus, in cells of cell_px where the smallest
+// tag needs a finer decimation, rectangles at that decimation (cell runs per level, padded by
+// the largest tag in them so that a tag on their border is whole in one region). When those
+// regions together cost more (pixels / decimate^2) than one scan of the frame at the finest
+// level, the plan is that one scan.
+ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
+                        double tag_size_m, float coarse, const ScanPlanParams &p = ScanPlanParams());
+
+// Slice k of n of a plan: its regions cut to band k of n horizontal bands, each band padded by
+// the largest tag, so scanning slices 0..n-1 in n frames finds every tag that stays put.
+std::vector<ScanRegion> plan_slice(const ScanPlan &plan, int k, int n, int height_px);
 
 }  // namespace eye

@@ -34,30 +34,37 @@ std::vector<Detection> merge_detections(const std::vector<Detection> &dets) {
 Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector) {
   for (const auto &v : c.vehicles) by_tag_[v.tag_id] = v;
   const double z_roof_m = c.locate.base_link_height_m + c.locate.tag_offset_m[2];
-  if (c.whole_field.enabled)
+  if (c.whole_field.enabled) {
     plan_ = plan_full_scan(c.in, c.pose, z_roof_m, c.locate.tag_size_m, c.detector.decimate,
                            c.whole_field.plan);
-  else
-    plan_ = {{cv::Rect(0, 0, c.in.width_px, c.in.height_px), c.detector.decimate}};
+  } else {
+    plan_.regions = {{cv::Rect(0, 0, c.in.width_px, c.in.height_px), c.detector.decimate}};
+    // Bands padded by the largest tag (as seen from the frame centre, x1.5 for the edges).
+    plan_.max_tag_px =
+        1.5 * expected_tag_side_px(c.in, c.pose, z_roof_m, c.locate.tag_size_m,
+                                   {c.in.width_px / 2.0, c.in.height_px / 2.0})[1];
+  }
 }
 
 void Tracker::hint(int tag_id, const std::array<cv::Point2d, 4> &corners_px) {
   if (by_tag_.count(tag_id) && !tracks_.count(tag_id)) hints_[tag_id] = corners_px;
 }
 
-std::vector<Detection> Tracker::scan_full(const cv::Mat &gray) {
+std::vector<Detection> Tracker::scan_regions(const cv::Mat &gray,
+                                             const std::vector<ScanRegion> &rs) {
   std::vector<Detection> dets;
-  for (const auto &r : plan_) {
+  for (const auto &r : rs) {
     auto d = r.rect.area() == gray.cols * gray.rows && r.decimate == cfg_.detector.decimate
                  ? det_.detect(gray)
                  : det_.detect(gray, r.rect, r.decimate);
     dets.insert(dets.end(), d.begin(), d.end());
   }
-  return plan_.size() > 1 ? merge_detections(dets) : dets;
+  return rs.size() > 1 ? merge_detections(dets) : dets;
 }
 
 std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
-                                            const std::array<cv::Point2d, 4> &c) {
+                                            const std::array<cv::Point2d, 4> &c,
+                                            double margin) {
   double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
   for (const auto &p : c) {
     x0 = std::min(x0, p.x);
@@ -65,17 +72,14 @@ std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
     y0 = std::min(y0, p.y);
     y1 = std::max(y1, p.y);
   }
-  const double grow = cfg_.tracking.margin * std::max(x1 - x0, y1 - y0);
+  const double grow = margin * std::max(x1 - x0, y1 - y0);
   const cv::Rect win(cv::Point(static_cast<int>(std::floor(x0 - grow)),
                                static_cast<int>(std::floor(y0 - grow))),
                      cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
                                static_cast<int>(std::ceil(y1 + grow)) + 1));
-  // Windows are small: decimate only as far as this tag's size allows (1 without whole_field).
-  const float dec =
-      cfg_.whole_field.enabled
-          ? decimate_for_side(side_px(c), cfg_.detector.decimate,
-                              cfg_.whole_field.plan.min_tag_px_decimated)
-          : 1.0f;
+  // Windows are small: full resolution (measured: at 1.5 a 35 px tag near the image border was
+  // lost from its window for 6 frames).
+  const float dec = 1.0f;
   std::vector<Detection> out;
   for (const auto &d : det_.detect(gray, win, dec))
     if (d.id == id) out.push_back(d);
@@ -89,33 +93,39 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
                 std::to_string(cfg_.in.height_px) + " of " + cfg_.intrinsics_path);
   std::vector<CarPose> out;
   std::map<int, int> count;
-  last_full_ = !cfg_.tracking.roi || (tracks_.empty() && hints_.empty()) ||
-               frame_ % std::max(1, cfg_.tracking.full_every) == 0;
-  ++frame_;
+  const int n_bands = std::max(1, cfg_.tracking.full_every);
+  last_full_ = !cfg_.tracking.roi || (tracks_.empty() && hints_.empty());
+  const long frame = frame_++;
   std::vector<Detection> dets;
   if (!last_full_) {
     for (const auto &[id, t] : tracks_) {
       // Where the tag should be now: last corners moved by the last frame's motion.
       std::array<cv::Point2d, 4> pred = t.corners;
       for (auto &p : pred) p += t.velocity_px;
-      const auto found = scan_window(gray, id, pred);
-      // A tracked car missing from its window (fast motion, occlusion): scan the whole frame
-      // now rather than lose the frame; windows only ever save time, never detections.
+      auto found = scan_window(gray, id, pred, cfg_.tracking.margin);
+      // Missing from its window (a sharp turn, a jolt, occlusion): a window 3x as large, then
+      // the whole frame at once; windows only ever save time, never detections.
+      if (found.empty()) found = scan_window(gray, id, pred, 3.0 * cfg_.tracking.margin + 1.0);
       if (found.empty()) {
         last_full_ = true;
         break;
       }
       dets.insert(dets.end(), found.begin(), found.end());
     }
-    if (!last_full_)
+    if (!last_full_) {
       for (const auto &[id, c] : hints_) {
-        const auto found = scan_window(gray, id, c);
+        const auto found = scan_window(gray, id, c, cfg_.tracking.margin);
         dets.insert(dets.end(), found.begin(), found.end());
       }
+      // The staggered periodic scan: band (frame mod n) of the full-scan plan.
+      const auto band = scan_regions(
+          gray, plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows));
+      dets.insert(dets.end(), band.begin(), band.end());
+    }
   }
   hints_.clear();
   if (last_full_)
-    dets = scan_full(gray);
+    dets = scan_regions(gray, plan_.regions);
   else
     dets = merge_detections(dets);
   last_dets_ = dets;

@@ -5,10 +5,12 @@
 // (eye_scanplan.hpp); tracking windows use the decimation their tag's size allows.
 // Region-of-interest tracking (config `tracking`): a car seen in the previous frame is looked
 // for only in a window around where its tag should be now (last corners moved by the last
-// pixel velocity); the whole frame is scanned every full_every-th frame, whenever no car is
-// being tracked, and at once when a tracked car is missing from its window, so windows save
-// time but never lose a detection; new cars are found within full_every frames, or at once
-// when another camera hints where they are (multi-camera handover).
+// pixel velocity); a car missing there is looked for in a window three times as large, then
+// in the whole frame at once, so windows save time but never lose a detection. New cars: the
+// whole frame is scanned whenever no car is tracked; otherwise the periodic scan is staggered,
+// one of full_every horizontal bands per frame (the cost spread evenly, no slow frames), so a
+// new car is found within full_every frames, or at once when another camera hints where it is
+// (multi-camera handover).
 #pragma once
 #include <opencv2/core.hpp>
 
@@ -33,24 +35,24 @@ class Tracker {
   // The frame with the tags, ids, vehicle names and poses drawn in (BGR).
   cv::Mat annotate(const cv::Mat &gray, const std::vector<CarPose> &poses) const;
   const RunConfig &config() const { return cfg_; }
-  // Whether the last process() scanned the whole frame.
+  // Whether the last process() scanned the whole frame at once.
   bool last_was_full_scan() const { return last_full_; }
   // Every tag the last process() detected (known cars, reference tags, others), merged.
   const std::vector<Detection> &last_detections() const { return last_dets_; }
   // The regions of a full scan (whole frame at the coarse decimation, finer where tags are small).
-  const std::vector<ScanRegion> &scan_plan() const { return plan_; }
+  const ScanPlan &scan_plan() const { return plan_; }
 
  private:
   struct Track {
     std::array<cv::Point2d, 4> corners;  // last frame [px]
     cv::Point2d velocity_px{0, 0};       // centre motion over the last frame [px]
   };
-  std::vector<Detection> scan_full(const cv::Mat &gray);
+  std::vector<Detection> scan_regions(const cv::Mat &gray, const std::vector<ScanRegion> &rs);
   std::vector<Detection> scan_window(const cv::Mat &gray, int id,
-                                     const std::array<cv::Point2d, 4> &corners);
+                                     const std::array<cv::Point2d, 4> &corners, double margin);
   RunConfig cfg_;
   Detector det_;
-  std::vector<ScanRegion> plan_;
+  ScanPlan plan_;
   std::map<int, VehicleTag> by_tag_;
   std::map<int, Track> tracks_;                               // tag id -> last frame
   std::map<int, std::array<cv::Point2d, 4>> hints_;           // tag id -> corners, next frame

@@ -13,6 +13,7 @@
 
 #include "eye_config.hpp"
 #include "eye_error.hpp"
+#include "eye_fuse.hpp"
 #include "eye_intrinsics.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
@@ -219,18 +220,52 @@ int main(int argc, char **argv) {
       if (!rn_url.empty()) cfg.lcm_url = rn_url;
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
-      auto src = eye::source_open(rn_source, rn_fps, cfg.lcm_url, rn_idle_s);
-      eye::Tracker tr(cfg);
-      eye::Frame f;
+      // One source per camera: the config's `source`, else --source (one camera only).
+      std::vector<std::unique_ptr<eye::Source>> srcs;
+      std::vector<eye::RunConfig> cams;
+      std::vector<std::vector<eye::RefTag>> refs;
+      for (size_t i = 0; i < cfg.cameras.size(); ++i) {
+        const std::string spec = cfg.cameras[i].source.empty() ? rn_source : cfg.cameras[i].source;
+        if (cfg.cameras.size() > 1 && cfg.cameras[i].source.empty())
+          throw eye::Error(rn_config + ": cameras[" + std::to_string(i) +
+                           "].source: missing key (each of several cameras needs its source)");
+        srcs.push_back(eye::source_open(spec, rn_fps, cfg.lcm_url, rn_idle_s));
+        cams.push_back(eye::runconfig_camera(cfg, i));
+        refs.push_back(cfg.reference_tags);
+      }
+      eye::MultiEye multi(cams, refs, cfg.health);
+      std::vector<eye::Frame> fs(srcs.size());
       long frames = 0, published = 0;
-      while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && src->next(&f)) {
-        const auto poses = tr.process(f.gray);
-        published += eye::publish_poses(lcm, poses, f.utime);
+      const auto all_next = [&] {
+        for (size_t i = 0; i < srcs.size(); ++i)
+          if (!srcs[i]->next(&fs[i])) return false;
+        return true;
+      };
+      while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && all_next()) {
+        // Cameras of one Eye are triggered together (the simulator renders them at one sim
+        // time): the frame time is the first camera's capture time.
+        std::vector<cv::Mat> grays;
+        for (const auto &f : fs) grays.push_back(f.gray);
+        const int64_t utime = fs[0].utime;
+        const auto poses = multi.process(grays, utime);
+        published += eye::publish_poses(lcm, poses, utime);
+        for (size_t i : multi.newly_moved()) {
+          const auto &st = multi.health(i).status();
+          std::fprintf(stderr,
+                       "autodrive-eye: WARNING: camera %s moved: reference tags %.2f mm (%.2f px) "
+                       "off their calibrated places; its poses now carry %gx covariance: "
+                       "recalibrate (calibrate-map)\n",
+                       st.camera.c_str(), st.ref_rms_mm, st.ref_rms_px, st.cov_scale);
+        }
+        for (size_t i = 0; i < multi.size(); ++i)
+          if (multi.health(i).status_due(utime))
+            eye::publish_status(lcm, multi.health(i).status(), cams[i].in.width_px,
+                                cams[i].in.height_px);
         if (!rn_debug.empty() && frames % std::max(1, rn_debug_every) == 0 &&
-            !cv::imwrite(rn_debug, tr.annotate(f.gray, poses)))
+            !cv::imwrite(rn_debug, multi.tracker(0).annotate(fs[0].gray, multi.last_per_camera()[0])))
           throw eye::Error(rn_debug + ": cannot write the debug image");
         if (!rn_quiet) {
-          std::printf("%s utime=%lld", f.label.c_str(), static_cast<long long>(f.utime));
+          std::printf("%s utime=%lld", fs[0].label.c_str(), static_cast<long long>(utime));
           for (const auto &p : poses)
             std::printf("  %s x=%.4f y=%.4f yaw=%.4f", p.vehicle.c_str(), p.x_m, p.y_m, p.yaw_rad);
           std::printf("\n");

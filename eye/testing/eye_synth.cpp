@@ -149,23 +149,54 @@ std::vector<RefTag> synth_reference_tags_in_view(const SynthScene &s) {
   return out;
 }
 
-std::vector<std::vector<SynthCar>> synth_wide_drive(const SynthScene &s, int frames) {
-  const double w = s.in.width_px, h = s.in.height_px, margin_px = 26;
+// A point at arc length u (0..1 of the perimeter) along a rectangle of half-extents ax, ay with
+// quarter-circle corners of radius rc, centred at (cx, cy), counter-clockwise in the image.
+static cv::Point2d rounded_rect(double u, double cx, double cy, double ax, double ay, double rc) {
+  const double lx = 2 * (ax - rc), ly = 2 * (ay - rc), arc = 0.5 * M_PI * rc;
+  double s = (u - std::floor(u)) * (2 * lx + 2 * ly + 4 * arc);
+  // Segments: bottom edge (+x), corner, right edge (-y), corner, top (-x), corner, left (+y).
+  const double seg[8] = {lx, arc, ly, arc, lx, arc, ly, arc};
+  const cv::Point2d start[4] = {{cx - ax + rc, cy + ay}, {cx + ax, cy + ay - rc},
+                                {cx + ax - rc, cy - ay}, {cx - ax, cy - ay + rc}};
+  const cv::Point2d dir[4] = {{1, 0}, {0, -1}, {-1, 0}, {0, 1}};
+  for (int k = 0; k < 8; ++k) {
+    if (s > seg[k] && k < 7) {
+      s -= seg[k];
+      continue;
+    }
+    const int e = k / 2;
+    if (k % 2 == 0) return start[e] + s * dir[e];
+    // The corner after edge e: centre one radius inwards from the edge's end.
+    const cv::Point2d end = start[e] + seg[k - 1] * dir[e];
+    const cv::Point2d in = dir[(e + 1) % 4] * rc;  // towards the centre of the turn
+    const double a = s / rc;
+    return end + in - in * std::cos(a) + dir[e] * rc * std::sin(a);
+  }
+  return {cx, cy};
+}
+
+std::vector<std::vector<SynthCar>> synth_wide_drive(const SynthScene &s, int frames,
+                                                    double speed_px) {
+  const double w = s.in.width_px, h = s.in.height_px, margin_px = 32;
   const double z_roof = s.car.base_link_height_m + s.car.tag_offset_m[2];
-  const auto sgnpow = [](double v, double e) { return (v < 0 ? -1 : 1) * std::pow(std::abs(v), e); };
-  const auto tag_at = [&](int loop, double t) {
-    const double sc = loop == 0 ? 1.0 : 0.42;
+  const auto loop = [&](int l, double u) {
+    const double sc = l == 0 ? 1.0 : 0.42;
     const double ax = sc * ((w - 1) / 2 - margin_px), ay = sc * ((h - 1) / 2 - margin_px);
-    const cv::Point2d px((w - 1) / 2 + ax * sgnpow(std::cos(t), 1.0 / 3),
-                         (h - 1) / 2 + ay * sgnpow(std::sin(t), 1.0 / 3));
-    return synth_pixel_to_plane(s, px, z_roof);
+    return rounded_rect(u, (w - 1) / 2, (h - 1) / 2, ax, ay, 0.3 * ay);
   };
+  const auto perimeter = [&](int l) {
+    double p = 0;
+    for (int k = 0; k < 400; ++k) p += cv::norm(loop(l, (k + 1) / 400.0) - loop(l, k / 400.0));
+    return p;
+  };
+  const double per[2] = {perimeter(0), perimeter(1)};
   std::vector<std::vector<SynthCar>> out(static_cast<size_t>(frames));
   for (int i = 0; i < frames; ++i)
     for (int k = 0; k < 10; ++k) {
-      const int loop = k / 5;
-      const double t = 2 * M_PI * (static_cast<double>(i) / frames + (k % 5) / 5.0 + 0.1 * loop);
-      const cv::Vec2d a = tag_at(loop, t), b = tag_at(loop, t + 1e-3);
+      const int l = k / 5;
+      const double u = i * speed_px / per[l] + (k % 5) / 5.0 + 0.1 * l;
+      const cv::Vec2d a = synth_pixel_to_plane(s, loop(l, u), z_roof);
+      const cv::Vec2d b = synth_pixel_to_plane(s, loop(l, u + 1e-4), z_roof);
       const double yaw = std::atan2(b[1] - a[1], b[0] - a[0]);
       const double c = std::cos(yaw), sn = std::sin(yaw);
       const double ox = s.car.tag_offset_m[0], oy = s.car.tag_offset_m[1];

@@ -99,17 +99,24 @@ TEST(WholeField, PlanIsFinerWhereTagsAreSmall) {
   EXPECT_GT(mid[0], 30.0);
   EXPECT_LT(corner[0], 26.0);
   const auto plan = eye::plan_full_scan(x.cfg.in, x.cfg.pose, z, 0.08, 2.0f);
-  ASSERT_GE(plan.size(), 2u);
-  EXPECT_EQ(plan[0].rect, cv::Rect(0, 0, x.s.in.width_px, x.s.in.height_px));
-  EXPECT_EQ(plan[0].decimate, 2.0f);
-  bool corner_fine = false, centre_fine = false;
-  for (size_t i = 1; i < plan.size(); ++i) {
-    EXPECT_LT(plan[i].decimate, 2.0f);
-    corner_fine = corner_fine || plan[i].rect.contains({3, 3});
-    centre_fine = centre_fine || plan[i].rect.contains({x.s.in.width_px / 2, x.s.in.height_px / 2});
+  ASSERT_GE(plan.regions.size(), 2u);
+  EXPECT_NEAR(plan.max_tag_px, 40.0, 8.0);
+  bool corner_fine = false, centre_coarse = false;
+  double area = 0;
+  for (const auto &r : plan.regions) {
+    area += r.rect.area();
+    corner_fine = corner_fine || (r.decimate == 1.0f && r.rect.contains({3, 3}));
+    centre_coarse = centre_coarse ||
+                    (r.decimate == 2.0f && r.rect.contains({x.s.in.width_px / 2, x.s.in.height_px / 2}));
   }
   EXPECT_TRUE(corner_fine);
-  EXPECT_FALSE(centre_fine);
+  EXPECT_TRUE(centre_coarse);
+  EXPECT_LT(area, 1.8 * x.s.in.width_px * x.s.in.height_px);
+  // The staggered scan: its bands cover every region.
+  cv::Mat covered(x.s.in.height_px, x.s.in.width_px, CV_8UC1, cv::Scalar(0));
+  for (int k = 0; k < 10; ++k)
+    for (const auto &r : eye::plan_slice(plan, k, 10, x.s.in.height_px)) covered(r.rect).setTo(255);
+  EXPECT_EQ(cv::countNonZero(covered), x.s.in.width_px * x.s.in.height_px);
   // A pinhole looking straight down at big tags needs nothing finer.
   EXPECT_EQ(eye::decimate_for_side(40.0, 2.0f, 16.0), 2.0f);
   EXPECT_EQ(eye::decimate_for_side(25.0, 2.0f, 16.0), 1.5f);
@@ -183,10 +190,10 @@ TEST(Health, BumpedCameraIsFlaggedWithin30FramesAndInflatesCovariance) {
   for (int i = 0; i < 30; ++i) {
     const auto &cars = drive[static_cast<size_t>(i)];
     auto ps = ts.process(eye::synth_frame(x.s, cars, x.refs, static_cast<uint64_t>(100 + i)));
-    EXPECT_FALSE(still.observe(i * 33333, ts.last_detections(), ts.last_was_full_scan(), &ps));
+    EXPECT_FALSE(still.observe(i * 33333, ts.last_detections(), &ps));
     auto pb = tb.process(eye::synth_frame(moved, cars, x.refs, static_cast<uint64_t>(100 + i)));
     std::vector<eye::CarPose> raw = pb;
-    if (bumped.observe(i * 33333, tb.last_detections(), tb.last_was_full_scan(), &pb)) found = i;
+    if (bumped.observe(i * 33333, tb.last_detections(), &pb)) found = i;
     if (bumped.status().moved && !pb.empty())
       EXPECT_NEAR(pb[0].cov[0], 100.0 * raw[0].cov[0], 1e-12);
   }
