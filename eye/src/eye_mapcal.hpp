@@ -42,6 +42,19 @@ std::vector<RefTag> reftags_load(const std::string &path);
 MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
                        const std::vector<std::vector<Detection>> &frames, int min_tags = 3);
 
+// How two calibrated cameras agree where they overlap: for each reference tag both see, the
+// RMS distance [mm] between its corners as camera A and as camera B put them on the tag's own
+// plane (rays of the detected corners through each camera's calibration).
+struct OverlapAgreement {
+  std::vector<TagResidual> tags;  // shared tags, their A-vs-B corner distance RMS [mm]
+  double rms_mm = -1, max_mm = -1;  // over all shared corners (-1: no shared tag)
+};
+OverlapAgreement map_overlap_agreement(const std::vector<RefTag> &refs, const Intrinsics &in_a,
+                                       const CameraPose &pose_a,
+                                       const std::vector<std::vector<Detection>> &frames_a,
+                                       const Intrinsics &in_b, const CameraPose &pose_b,
+                                       const std::vector<std::vector<Detection>> &frames_b);
+
 void mapcal_save(const std::string &path, const MapCalib &m);
 // Throws eye::Error naming the file and the field if it is missing or malformed.
 MapCalib mapcal_load(const std::string &path);

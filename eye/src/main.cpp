@@ -132,6 +132,12 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   cm->add_option("--decimate", cm_decimate, "detector decimation (1: most accurate)")
       ->capture_default_str();
+  std::string cm_ov_map, cm_ov_intr, cm_ov_images;
+  cm->add_option("--overlap-map", cm_ov_map,
+                 "another camera's map.yaml (same map frame): report how the two calibrations "
+                 "agree on the reference tags both cameras see");
+  cm->add_option("--overlap-intrinsics", cm_ov_intr, "that camera's intrinsics YAML");
+  cm->add_option("--overlap-images", cm_ov_images, "that camera's image(s) of the map");
 
   // run
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
@@ -213,6 +219,27 @@ int main(int argc, char **argv) {
       }
       eye::mapcal_save(cm_out, m);
       std::printf("wrote %s\n", cm_out.c_str());
+      if (!cm_ov_map.empty()) {
+        if (cm_ov_intr.empty() || cm_ov_images.empty())
+          throw eye::Error("calibrate-map: --overlap-map needs --overlap-intrinsics and "
+                           "--overlap-images");
+        const eye::Intrinsics in_b = eye::intrinsics_load(cm_ov_intr);
+        const eye::MapCalib m_b = eye::mapcal_load(cm_ov_map);
+        std::vector<std::vector<eye::Detection>> frames_b;
+        for (auto &[name, img] : load_images(cm_ov_images)) {
+          if (img.cols != in_b.width_px || img.rows != in_b.height_px)
+            throw eye::Error(name + ": image size differs from the intrinsics in " + cm_ov_intr);
+          frames_b.push_back(det.detect(img));
+        }
+        const auto o = eye::map_overlap_agreement(refs, in, m.pose, frames, in_b, m_b.pose, frames_b);
+        for (const auto &t : o.tags)
+          std::printf("overlap tag %3d  cameras agree within %.3f mm rms\n", t.id, t.rms_mm);
+        if (o.tags.empty())
+          std::printf("overlap: no reference tag seen by both cameras\n");
+        else
+          std::printf("overlap: %zu shared tags, %.3f mm rms, max %.3f mm\n", o.tags.size(),
+                      o.rms_mm, o.max_mm);
+      }
       return 0;
     }
     if (*rn) {

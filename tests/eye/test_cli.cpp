@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <autodrive/compressed_image_t.hpp>
+#include <autodrive/eye_camera_status_t.hpp>
+#include <autodrive_channels.h>
 #include <autodrive/pose2d_t.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -203,6 +205,18 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
     }
   } h{&mu, &got};
   lcm.subscribeFunction("NIGEL1_POSE_EYE", &Handler::on, &h);
+  // The camera's health, about once a second of capture time (the first frame's at once).
+  std::vector<autodrive::eye_camera_status_t> status;
+  struct StatusHandler {
+    std::mutex *mu;
+    std::vector<autodrive::eye_camera_status_t> *got;
+    static void on(const lcm::ReceiveBuffer *, const std::string &,
+                   const autodrive::eye_camera_status_t *m, StatusHandler *sh) {
+      std::lock_guard<std::mutex> l(*sh->mu);
+      sh->got->push_back(*m);
+    }
+  } sh{&mu, &status};
+  lcm.subscribeFunction(AUTODRIVE_CH_EYE_CAMERA_STATUS, &StatusHandler::on, &sh);
 
   std::string eye_out;
   std::atomic<int> eye_status{-2};
@@ -265,6 +279,14 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
       EXPECT_NEAR(p.yaw_rad, 0.5, 0.01);
     }
   }
+  ASSERT_FALSE(status.empty()) << "no " << AUTODRIVE_CH_EYE_CAMERA_STATUS;
+  EXPECT_EQ(status[0].camera, "eye");
+  EXPECT_EQ(status[0].width_px, s.in.width_px);
+  EXPECT_EQ(status[0].height_px, s.in.height_px);
+  EXPECT_GE(status[0].frames, 1);
+  EXPECT_EQ(status[0].ref_tags_seen, -1);  // no reference_tags in this config
+  EXPECT_FALSE(status[0].moved);
+  EXPECT_EQ(status[0].cov_scale, 1.0f);
 }
 
 // run on a video file (MJPG in AVI via FFMPEG): frames stamped index / --fps, poses found.

@@ -245,18 +245,25 @@ TEST(MultiCam, HandoverWithoutGapAndFusedPoses) {
     refs.push_back({100 + k, 0.3 + 0.55 * k, k % 2 ? 0.45 : 1.55, 0.0, 0.3 * k, 0.10});
   std::vector<eye::RunConfig> cfgs;
   std::vector<std::vector<eye::RefTag>> cam_refs;
+  std::vector<std::vector<std::vector<eye::Detection>>> cal_frames;
   eye::DetectorParams dp;
   dp.decimate = 1;
   eye::Detector det(dp);
   for (size_t c = 0; c < 2; ++c) {
-    const auto m = eye::map_calibrate(cams[c].in, refs,
-                                      {det.detect(eye::synth_frame(cams[c], {}, refs, 5 + c))});
+    cal_frames.push_back({det.detect(eye::synth_frame(cams[c], {}, refs, 5 + c))});
+    const auto m = eye::map_calibrate(cams[c].in, refs, cal_frames.back());
     eye::RunConfig rc = eye_test::config_for(cams[c], m.pose);
     rc.camera_name = c ? "east" : "west";
     rc.tracking.roi = true;
     cfgs.push_back(rc);
     cam_refs.push_back(refs);
   }
+  // calibrate-map's overlap report: the shared tag(s) land within a millimetre in both.
+  const auto agree = eye::map_overlap_agreement(refs, cfgs[0].in, cfgs[0].pose, cal_frames[0],
+                                                cfgs[1].in, cfgs[1].pose, cal_frames[1]);
+  std::printf("overlap: %zu shared tags, %.3f mm rms\n", agree.tags.size(), agree.rms_mm);
+  ASSERT_GE(agree.tags.size(), 1u);
+  EXPECT_LT(agree.rms_mm, 1.0);
   eye::MultiEye multi(cfgs, cam_refs);
   const int frames = 40;
   int gaps = 0, fused = 0;
