@@ -263,6 +263,7 @@ int main(int argc, char **argv) {
       eye::MultiEye multi(cams, refs, cfg.health);
       std::vector<eye::Frame> fs(srcs.size());
       long frames = 0, published = 0;
+      std::vector<double> latency_ms;  // capture (device, gst) to poses on LCM
       const auto all_next = [&] {
         for (size_t i = 0; i < srcs.size(); ++i)
           if (!srcs[i]->next(&fs[i])) return false;
@@ -276,6 +277,7 @@ int main(int argc, char **argv) {
         const int64_t utime = fs[0].utime;
         const auto poses = multi.process(grays, utime);
         published += eye::publish_poses(lcm, poses, utime);
+        if (fs[0].wall_clock) latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
         for (size_t i : multi.newly_moved()) {
           const auto &st = multi.health(i).status();
           std::fprintf(stderr,
@@ -301,6 +303,15 @@ int main(int argc, char **argv) {
         ++frames;
       }
       std::fprintf(stderr, "autodrive-eye: %ld frames, %ld poses published\n", frames, published);
+      if (!latency_ms.empty()) {
+        std::sort(latency_ms.begin(), latency_ms.end());
+        const auto pct = [&](double q) {
+          return latency_ms[std::min(latency_ms.size() - 1,
+                                     static_cast<size_t>(q * static_cast<double>(latency_ms.size())))];
+        };
+        std::fprintf(stderr, "autodrive-eye: capture to pose on LCM: p50 %.2f ms, p99 %.2f ms\n",
+                     pct(0.5), pct(0.99));
+      }
       return 0;
     }
   } catch (const eye::Error &e) {

@@ -330,3 +330,57 @@ TEST(Cli, RunOnVideoFile) {
       1);
   EXPECT_NE(out.find("none.avi"), std::string::npos) << out;
 }
+
+// run on a real GStreamer pipeline (multifilesrc of recorded JPEG frames at 30 fps -> jpegdec ->
+// appsink sync=true): frames stamped with their buffer PTS on the system clock (33.3 ms apart,
+// inside the run's wall-clock span), poses found, capture-to-pose latency printed.
+TEST(Cli, RunOnGstreamerPipelineStampsBufferPts) {
+  const std::string d = fresh_dir("eye_cli_gst");
+  const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  eye::intrinsics_save(d + "/camera.yaml", s.in);
+  eye::MapCalib m;
+  m.pose = s.pose;
+  m.width_px = 640;
+  m.height_px = 480;
+  eye::mapcal_save(d + "/map.yaml", m);
+  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7793?ttl=0");
+  const int n = 6;
+  for (int k = 0; k < n; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/f%03d.jpg", k);
+    ASSERT_TRUE(cv::imwrite(d + name, eye::synth_frame(s, {{1, 1.0 + 0.05 * k, 1.0, 0.2}}, {}, k)));
+  }
+  const std::string pipeline = "multifilesrc location=" + d + "/f%03d.jpg index=0 stop-index=" +
+                               std::to_string(n - 1) +
+                               " caps=image/jpeg,framerate=30/1 ! jpegdec ! videoconvert ! "
+                               "video/x-raw,format=BGR ! appsink sync=true";
+  std::string out;
+  const auto wall_us = [] {
+    return std::chrono::duration_cast<std::chrono::microseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+  };
+  const int64_t t0 = wall_us();
+  ASSERT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --source 'gst:" + pipeline + "'",
+                &out),
+            0)
+      << out;
+  const int64_t t1 = wall_us();
+  std::istringstream lines(out);
+  std::string line;
+  std::vector<long long> utimes;
+  while (std::getline(lines, line)) {
+    const auto at = line.find(" utime=");
+    if (line.rfind("gst:", 0) != 0 || at == std::string::npos) continue;
+    utimes.push_back(std::stoll(line.substr(at + 7)));
+    double x, y, yaw;
+    ASSERT_TRUE(find_pose(line, "NIGEL1", &x, &y, &yaw)) << line;
+    EXPECT_NEAR(x, 1.0 + 0.05 * static_cast<double>(utimes.size() - 1), 0.005) << line;
+  }
+  ASSERT_EQ(utimes.size(), static_cast<size_t>(n)) << out;
+  for (size_t k = 1; k < utimes.size(); ++k)
+    EXPECT_NEAR(utimes[k] - utimes[k - 1], 33333, 2) << "PTS steps of 1/30 s";
+  EXPECT_GE(utimes.front(), t0);
+  EXPECT_LE(utimes.back(), t1);
+  EXPECT_NE(out.find("capture to pose on LCM: p50"), std::string::npos) << out;
+}
