@@ -207,7 +207,6 @@ Accuracy accuracy(const Scene &sc, const RunResult &r) {
   return a;
 }
 
-
 // ---- Wide-angle lens, 10 cars, whole field of view ----------------------------------------
 
 struct WideScene {
@@ -238,7 +237,8 @@ WideScene make_wide_scene(int w, int h, int frames) {
   sc.cfg.locate = sc.s.car;
   sc.cfg.tracking.margin = g_wide_margin;
   sc.cfg.detector.sigma_px = g_wide_sigma;
-  for (int k = 1; k <= 10; ++k) sc.cfg.vehicles.push_back({AUTODRIVE_VEHICLE_PREFIX + std::to_string(k), k, 0.0});
+  for (int k = 1; k <= 10; ++k)
+    sc.cfg.vehicles.push_back({AUTODRIVE_VEHICLE_PREFIX + std::to_string(k), k, 0.0});
   sc.cars = eye::synth_wide_drive(sc.s, frames);
   for (int i = 0; i < frames; ++i) {
     for (const auto &c : sc.cars[static_cast<size_t>(i)]) {
@@ -275,7 +275,8 @@ WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
       const auto poses = tr.process(g);
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
-      r.latency_ms.push_back(std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
+      r.latency_ms.push_back(
+          std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
       if (rep == 0) {
         r.est.push_back(poses);
         r.full_scans += tr.last_was_full_scan();
@@ -299,7 +300,8 @@ Accuracy wide_accuracy(const WideScene &sc, const WideResult &r) {
                        [&t](const eye::CarPose &p) { return p.tag_id == t.tag_id; }) &&
           ++a.misses <= 12) {
         const auto c = eye_tag_centre_px(sc.s, t);
-        std::fprintf(stderr, "[eye_bench]   missed car %d in frame %zu: tag %.1f px at (%.0f, %.0f)\n",
+        std::fprintf(stderr,
+                     "[eye_bench]   missed car %d in frame %zu: tag %.1f px at (%.0f, %.0f)\n",
                      t.tag_id, i, eye::synth_tag_side_px(sc.s, t), c.x, c.y);
       }
       for (const auto &p : r.est[i]) {
@@ -347,8 +349,7 @@ std::pair<int, bool> bumped_camera(const WideScene &sc, int frames) {
     auto ps = ts.process(eye::synth_frame(sc.s, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
     still.observe(i * 33333, ts.last_detections(), &ps);
     auto pb = tb.process(eye::synth_frame(moved, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
-    if (bumped.observe(i * 33333, tb.last_detections(), &pb) && found < 0)
-      found = i;
+    if (bumped.observe(i * 33333, tb.last_detections(), &pb) && found < 0) found = i;
   }
   std::fprintf(stderr, "[eye_bench] bumped camera: ref residual %.2f mm (still %.2f mm)\n",
                bumped.status().ref_rms_mm, still.status().ref_rms_mm);

@@ -48,8 +48,8 @@ struct RunConfig {
   HealthParams health;
   std::vector<RefTag> reference_tags;  // in view of the cameras: health (may be empty)
   std::vector<VehicleTag> vehicles;
-  std::string camera_name = "eye";     // of in / pose
-  std::vector<CameraConfig> cameras;   // every camera; in / pose are cameras[0]'s
+  std::string camera_name = "eye";    // of in / pose
+  std::vector<CameraConfig> cameras;  // every camera; in / pose are cameras[0]'s
 };
 
 // The config of camera i alone (in, pose, names set from cameras[i]).

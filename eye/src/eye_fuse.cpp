@@ -38,7 +38,8 @@ std::vector<CarPose> fuse_poses(const std::vector<std::vector<CarPose>> &per_cam
     f.x_m = x[0];
     f.y_m = x[1];
     f.yaw_rad = autodrive::angle_wrap_rad(x[2]);
-    for (int i = 0; i < 9; ++i) f.cov[static_cast<size_t>(i)] = 0.5 * (cov(i / 3, i % 3) + cov(i % 3, i / 3));
+    for (int i = 0; i < 9; ++i)
+      f.cov[static_cast<size_t>(i)] = 0.5 * (cov(i / 3, i % 3) + cov(i % 3, i / 3));
     f.cameras = static_cast<int>(ps.size());
     out.push_back(f);
   }

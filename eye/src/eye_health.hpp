@@ -18,23 +18,23 @@ namespace eye {
 
 struct HealthParams {
   double bump_threshold_mm = 3.0;  // reference-tag residual RMS that means "the camera moved" [mm]
-  int bump_confirm = 3;            // over the threshold in this many frames with reference tags in a row
-  double bump_cov_scale = 100.0;   // covariance factor of poses from a moved camera (10x sigma)
-  double status_period_s = 1.0;    // EYE_CAMERA_STATUS period [s]
+  int bump_confirm = 3;  // over the threshold in this many frames with reference tags in a row
+  double bump_cov_scale = 100.0;  // covariance factor of poses from a moved camera (10x sigma)
+  double status_period_s = 1.0;   // EYE_CAMERA_STATUS period [s]
 };
 
 struct CameraStatus {
   std::string camera;
-  int64_t utime = 0;         // capture time of the last frame [us]
-  double fps_hz = 0;         // frame rate over the last frames (capture times) [Hz]
-  long frames = 0;           // frames processed
-  int tags_seen = 0;         // tags detected in the last frame
-  int cars_seen = 0;         // cars posed in the last frame
-  int ref_tags_seen = -1;    // reference tags in the last frame that had any (-1: none configured)
-  double ref_rms_mm = -1;    // their corner residual on their planes [mm] (-1: not measured)
-  double ref_rms_px = -1;    // their reprojection residual [px]
-  bool moved = false;        // the reference tags drifted: recalibrate
-  double cov_scale = 1.0;    // factor applied to this camera's pose covariances
+  int64_t utime = 0;       // capture time of the last frame [us]
+  double fps_hz = 0;       // frame rate over the last frames (capture times) [Hz]
+  long frames = 0;         // frames processed
+  int tags_seen = 0;       // tags detected in the last frame
+  int cars_seen = 0;       // cars posed in the last frame
+  int ref_tags_seen = -1;  // reference tags in the last frame that had any (-1: none configured)
+  double ref_rms_mm = -1;  // their corner residual on their planes [mm] (-1: not measured)
+  double ref_rms_px = -1;  // their reprojection residual [px]
+  bool moved = false;      // the reference tags drifted: recalibrate
+  double cov_scale = 1.0;  // factor applied to this camera's pose covariances
 };
 
 class CameraHealth {

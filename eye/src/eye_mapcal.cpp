@@ -114,8 +114,8 @@ static std::map<int, std::array<cv::Vec2d, 4>> corners_on_planes(
     for (const auto &d : f) {
       auto it = by_id.find(d.id);
       if (it == by_id.end() || out.count(d.id)) continue;
-      const auto norm =
-          intrinsics_normalise(in, std::vector<cv::Point2d>(d.corners_px.begin(), d.corners_px.end()));
+      const auto norm = intrinsics_normalise(
+          in, std::vector<cv::Point2d>(d.corners_px.begin(), d.corners_px.end()));
       std::array<cv::Vec2d, 4> c;
       bool ok = true;
       for (size_t i = 0; i < 4; ++i)

@@ -46,7 +46,7 @@ MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
 // RMS distance [mm] between its corners as camera A and as camera B put them on the tag's own
 // plane (rays of the detected corners through each camera's calibration).
 struct OverlapAgreement {
-  std::vector<TagResidual> tags;  // shared tags, their A-vs-B corner distance RMS [mm]
+  std::vector<TagResidual> tags;    // shared tags, their A-vs-B corner distance RMS [mm]
   double rms_mm = -1, max_mm = -1;  // over all shared corners (-1: no shared tag)
 };
 OverlapAgreement map_overlap_agreement(const std::vector<RefTag> &refs, const Intrinsics &in_a,

@@ -32,8 +32,8 @@ float decimate_for_side(double side_px, float coarse, double min_px) {
   return std::min(best, std::max(1.0f, coarse));
 }
 
-ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
-                        double tag_size_m, float coarse, const ScanPlanParams &p) {
+ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m, double tag_size_m,
+                        float coarse, const ScanPlanParams &p) {
   const int w = in.width_px, h = in.height_px, cell = std::max(16, p.cell_px);
   const int nc = (w + cell - 1) / cell, nr = (h + cell - 1) / cell;
   // Per cell: the smallest tag (its decimation) and the largest (its padding), over the
@@ -46,8 +46,9 @@ ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m
       const double x0 = c * cell - 0.5, y0 = r * cell - 0.5;
       const double x1 = std::min(w, (c + 1) * cell) - 0.5, y1 = std::min(h, (r + 1) * cell) - 0.5;
       double lo = 1e9, hi = 0;
-      for (const cv::Point2d &q : {cv::Point2d(x0, y0), cv::Point2d(x1, y0), cv::Point2d(x0, y1),
-                                   cv::Point2d(x1, y1), cv::Point2d((x0 + x1) / 2, (y0 + y1) / 2)}) {
+      for (const cv::Point2d &q :
+           {cv::Point2d(x0, y0), cv::Point2d(x1, y0), cv::Point2d(x0, y1), cv::Point2d(x1, y1),
+            cv::Point2d((x0 + x1) / 2, (y0 + y1) / 2)}) {
         const cv::Vec2d s = expected_tag_side_px(in, pose, z_m, tag_size_m, q);
         if (s[1] <= 0) continue;  // this pixel sees the sky: no tag there
         lo = std::min(lo, s[0]);
@@ -87,9 +88,8 @@ ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m
         double pad = 0;
         while (e < nc && level[static_cast<size_t>(r * nc + e)] == lv)
           pad = std::max(pad, big[static_cast<size_t>(r * nc + e++)]);
-        auto it = std::find_if(runs.begin(), runs.end(), [&](const Run &q) {
-          return q.c0 == c && q.c1 == e && q.r1 == r;
-        });
+        auto it = std::find_if(runs.begin(), runs.end(),
+                               [&](const Run &q) { return q.c0 == c && q.c1 == e && q.r1 == r; });
         if (it != runs.end()) {
           it->r1 = r + 1;
           it->pad = std::max(it->pad, pad);

@@ -43,8 +43,8 @@ struct ScanPlan {
 // the largest tag in them so that a tag on their border is whole in one region). When those
 // regions together cost more (pixels / decimate^2) than one scan of the frame at the finest
 // level, the plan is that one scan.
-ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m,
-                        double tag_size_m, float coarse, const ScanPlanParams &p = ScanPlanParams());
+ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m, double tag_size_m,
+                        float coarse, const ScanPlanParams &p = ScanPlanParams());
 
 // Slice k of n of a plan: its regions cut to band k of n horizontal bands, each band padded by
 // the largest tag, so scanning slices 0..n-1 in n frames finds every tag that stays put.

@@ -60,8 +60,8 @@ class CaptureSource : public Source {
         f->utime = static_cast<int64_t>(1e6 * static_cast<double>(n_) / fps_);
         break;
       case Stamp::kV4l2Buffer:
-        f->utime = t_ms > 0 ? std::llround(1e3 * t_ms) + (now_utime() - monotonic_utime())
-                            : now_utime();
+        f->utime =
+            t_ms > 0 ? std::llround(1e3 * t_ms) + (now_utime() - monotonic_utime()) : now_utime();
         break;
       case Stamp::kGstPts:
         // The pipeline's running time starts at PLAYING, which open() waited for.
@@ -214,8 +214,8 @@ std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
   }
   if (!cap.isOpened()) throw Error("source '" + spec + "': cannot open");
   const Stamp stamp = kind == "device" ? Stamp::kV4l2Buffer
-                     : kind == "gst"  ? Stamp::kGstPts
-                                      : Stamp::kFileIndex;
+                      : kind == "gst"  ? Stamp::kGstPts
+                                       : Stamp::kFileIndex;
   return std::make_unique<CaptureSource>(spec, std::move(cap), stamp, fps_hint);
 }
 

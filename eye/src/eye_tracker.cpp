@@ -40,9 +40,8 @@ Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector) {
   } else {
     plan_.regions = {{cv::Rect(0, 0, c.in.width_px, c.in.height_px), c.detector.decimate}};
     // Bands padded by the largest tag (as seen from the frame centre, x1.5 for the edges).
-    plan_.max_tag_px =
-        1.5 * expected_tag_side_px(c.in, c.pose, z_roof_m, c.locate.tag_size_m,
-                                   {c.in.width_px / 2.0, c.in.height_px / 2.0})[1];
+    plan_.max_tag_px = 1.5 * expected_tag_side_px(c.in, c.pose, z_roof_m, c.locate.tag_size_m,
+                                                  {c.in.width_px / 2.0, c.in.height_px / 2.0})[1];
   }
 }
 
@@ -63,8 +62,7 @@ std::vector<Detection> Tracker::scan_regions(const cv::Mat &gray,
 }
 
 std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
-                                            const std::array<cv::Point2d, 4> &c,
-                                            double margin) {
+                                            const std::array<cv::Point2d, 4> &c, double margin) {
   double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
   for (const auto &p : c) {
     x0 = std::min(x0, p.x);
@@ -73,10 +71,10 @@ std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
     y1 = std::max(y1, p.y);
   }
   const double grow = margin * std::max(x1 - x0, y1 - y0);
-  const cv::Rect win(cv::Point(static_cast<int>(std::floor(x0 - grow)),
-                               static_cast<int>(std::floor(y0 - grow))),
-                     cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
-                               static_cast<int>(std::ceil(y1 + grow)) + 1));
+  const cv::Rect win(
+      cv::Point(static_cast<int>(std::floor(x0 - grow)), static_cast<int>(std::floor(y0 - grow))),
+      cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
+                static_cast<int>(std::ceil(y1 + grow)) + 1));
   // Windows are small: full resolution (measured: at 1.5 a 35 px tag near the image border was
   // lost from its window for 6 frames).
   const float dec = 1.0f;

@@ -54,8 +54,8 @@ class Tracker {
   Detector det_;
   ScanPlan plan_;
   std::map<int, VehicleTag> by_tag_;
-  std::map<int, Track> tracks_;                               // tag id -> last frame
-  std::map<int, std::array<cv::Point2d, 4>> hints_;           // tag id -> corners, next frame
+  std::map<int, Track> tracks_;                      // tag id -> last frame
+  std::map<int, std::array<cv::Point2d, 4>> hints_;  // tag id -> corners, next frame
   std::vector<Detection> last_dets_;
   long frame_ = 0;
   bool last_full_ = true;

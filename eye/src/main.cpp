@@ -221,8 +221,9 @@ int main(int argc, char **argv) {
       std::printf("wrote %s\n", cm_out.c_str());
       if (!cm_ov_map.empty()) {
         if (cm_ov_intr.empty() || cm_ov_images.empty())
-          throw eye::Error("calibrate-map: --overlap-map needs --overlap-intrinsics and "
-                           "--overlap-images");
+          throw eye::Error(
+              "calibrate-map: --overlap-map needs --overlap-intrinsics and "
+              "--overlap-images");
         const eye::Intrinsics in_b = eye::intrinsics_load(cm_ov_intr);
         const eye::MapCalib m_b = eye::mapcal_load(cm_ov_map);
         std::vector<std::vector<eye::Detection>> frames_b;
@@ -231,7 +232,8 @@ int main(int argc, char **argv) {
             throw eye::Error(name + ": image size differs from the intrinsics in " + cm_ov_intr);
           frames_b.push_back(det.detect(img));
         }
-        const auto o = eye::map_overlap_agreement(refs, in, m.pose, frames, in_b, m_b.pose, frames_b);
+        const auto o =
+            eye::map_overlap_agreement(refs, in, m.pose, frames, in_b, m_b.pose, frames_b);
         for (const auto &t : o.tags)
           std::printf("overlap tag %3d  cameras agree within %.3f mm rms\n", t.id, t.rms_mm);
         if (o.tags.empty())
@@ -277,7 +279,8 @@ int main(int argc, char **argv) {
         const int64_t utime = fs[0].utime;
         const auto poses = multi.process(grays, utime);
         published += eye::publish_poses(lcm, poses, utime);
-        if (fs[0].wall_clock) latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
+        if (fs[0].wall_clock)
+          latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
         for (size_t i : multi.newly_moved()) {
           const auto &st = multi.health(i).status();
           std::fprintf(stderr,
@@ -291,7 +294,8 @@ int main(int argc, char **argv) {
             eye::publish_status(lcm, multi.health(i).status(), cams[i].in.width_px,
                                 cams[i].in.height_px);
         if (!rn_debug.empty() && frames % std::max(1, rn_debug_every) == 0 &&
-            !cv::imwrite(rn_debug, multi.tracker(0).annotate(fs[0].gray, multi.last_per_camera()[0])))
+            !cv::imwrite(rn_debug,
+                         multi.tracker(0).annotate(fs[0].gray, multi.last_per_camera()[0])))
           throw eye::Error(rn_debug + ": cannot write the debug image");
         if (!rn_quiet) {
           std::printf("%s utime=%lld", fs[0].label.c_str(), static_cast<long long>(utime));
@@ -306,8 +310,9 @@ int main(int argc, char **argv) {
       if (!latency_ms.empty()) {
         std::sort(latency_ms.begin(), latency_ms.end());
         const auto pct = [&](double q) {
-          return latency_ms[std::min(latency_ms.size() - 1,
-                                     static_cast<size_t>(q * static_cast<double>(latency_ms.size())))];
+          return latency_ms[std::min(
+              latency_ms.size() - 1,
+              static_cast<size_t>(q * static_cast<double>(latency_ms.size())))];
         };
         std::fprintf(stderr, "autodrive-eye: capture to pose on LCM: p50 %.2f ms, p99 %.2f ms\n",
                      pct(0.5), pct(0.99));

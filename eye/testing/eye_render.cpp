@@ -92,7 +92,8 @@ void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int 
   // bend, so 8 points per edge and a pixel of margin.
   const int per_edge = grid.empty() ? 1 : 8;
   std::vector<cv::Point2d> outline;
-  const cv::Vec2d edge[4] = {{-0.5, -0.5}, {tw - 0.5, -0.5}, {tw - 0.5, th - 0.5}, {-0.5, th - 0.5}};
+  const cv::Vec2d edge[4] = {
+      {-0.5, -0.5}, {tw - 0.5, -0.5}, {tw - 0.5, th - 0.5}, {-0.5, th - 0.5}};
   for (int e = 0; e < 4; ++e)
     for (int k = 0; k < per_edge; ++k) {
       const double a = static_cast<double>(k) / per_edge;
@@ -134,7 +135,8 @@ void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int 
           const double fx = (i + 0.5) / ss;
           double x = col - 0.5 + fx, y = row - 0.5 + fy;
           if (!grid.empty()) {
-            const cv::Point2d u = (g00 * (1 - fx) + g01 * fx) * (1 - fy) + (g10 * (1 - fx) + g11 * fx) * fy;
+            const cv::Point2d u =
+                (g00 * (1 - fx) + g01 * fx) * (1 - fy) + (g10 * (1 - fx) + g11 * fx) * fy;
             x = u.x;
             y = u.y;
           }

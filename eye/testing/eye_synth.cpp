@@ -78,13 +78,13 @@ SynthScene synth_scene_wide(int w, int h) {
   s.map_x_m = 4.0;
   s.map_y_m = 3.0;
   const double cx = s.map_x_m / 2, cy = s.map_y_m / 2;
-  s.pose = camera_look_at({cx, cy - height_m * std::tan(tilt_rad), height_m}, {cx, cy, 0.0},
-                          {0, 1, 0});
+  s.pose =
+      camera_look_at({cx, cy - height_m * std::tan(tilt_rad), height_m}, {cx, cy, 0.0}, {0, 1, 0});
   // The map: what the image corners see on the floor (plus nothing: tags reach every edge).
   double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
-  for (const cv::Point2d &c : {cv::Point2d(-0.5, -0.5), cv::Point2d(w - 0.5, -0.5),
-                               cv::Point2d(w - 0.5, h - 0.5), cv::Point2d(-0.5, h - 0.5),
-                               cv::Point2d(w / 2.0, -0.5), cv::Point2d(w / 2.0, h - 0.5)}) {
+  for (const cv::Point2d &c :
+       {cv::Point2d(-0.5, -0.5), cv::Point2d(w - 0.5, -0.5), cv::Point2d(w - 0.5, h - 0.5),
+        cv::Point2d(-0.5, h - 0.5), cv::Point2d(w / 2.0, -0.5), cv::Point2d(w / 2.0, h - 0.5)}) {
     const cv::Vec2d p = synth_pixel_to_plane(s, c, 0.0);
     x0 = std::min(x0, p[0]);
     x1 = std::max(x1, p[0]);
@@ -128,8 +128,8 @@ double synth_tag_side_px(const SynthScene &s, const SynthCar &car) {
   const auto tf = tag_corners_tagframe(s.car.tag_size_m);
   std::array<cv::Point2d, 4> p;
   for (size_t i = 0; i < 4; ++i)
-    p[i] = camera_project(s.in, s.pose,
-                          {tx + c * tf[i][0] - sn * tf[i][1], ty + sn * tf[i][0] + c * tf[i][1], z});
+    p[i] = camera_project(
+        s.in, s.pose, {tx + c * tf[i][0] - sn * tf[i][1], ty + sn * tf[i][0] + c * tf[i][1], z});
   double side = 1e9;
   for (size_t i = 0; i < 4; ++i) side = std::min(side, cv::norm(p[i] - p[(i + 1) % 4]));
   return side;
@@ -156,8 +156,10 @@ static cv::Point2d rounded_rect(double u, double cx, double cy, double ax, doubl
   double s = (u - std::floor(u)) * (2 * lx + 2 * ly + 4 * arc);
   // Segments: bottom edge (+x), corner, right edge (-y), corner, top (-x), corner, left (+y).
   const double seg[8] = {lx, arc, ly, arc, lx, arc, ly, arc};
-  const cv::Point2d start[4] = {{cx - ax + rc, cy + ay}, {cx + ax, cy + ay - rc},
-                                {cx + ax - rc, cy - ay}, {cx - ax, cy - ay + rc}};
+  const cv::Point2d start[4] = {{cx - ax + rc, cy + ay},
+                                {cx + ax, cy + ay - rc},
+                                {cx + ax - rc, cy - ay},
+                                {cx - ax, cy - ay + rc}};
   const cv::Point2d dir[4] = {{1, 0}, {0, -1}, {-1, 0}, {0, 1}};
   for (int k = 0; k < 8; ++k) {
     if (s > seg[k] && k < 7) {

@@ -55,9 +55,9 @@ cv::Mat synth_frame(const SynthScene &s, const std::vector<SynthCar> &cars,
 std::vector<RefTag> synth_reference_tags_in_view(const SynthScene &s);
 // 10 cars (tag ids 1..10) on two loops drawn in the image: an outer one hugging the image
 // border (edges and corners: tag centres 32 px in, so
-// the black border of a 40 px tag stays in the image) and an inner one, 5 per loop, evenly spaced so they
-// never overlap, heading along the motion, each tag moving speed_px per frame (15 px: ~0.5 m/s
-// at 30 fps, twice Nigel's top speed). Per frame, the 10 cars.
+// the black border of a 40 px tag stays in the image) and an inner one, 5 per loop, evenly spaced
+// so they never overlap, heading along the motion, each tag moving speed_px per frame (15 px: ~0.5
+// m/s at 30 fps, twice Nigel's top speed). Per frame, the 10 cars.
 std::vector<std::vector<SynthCar>> synth_wide_drive(const SynthScene &s, int frames,
                                                     double speed_px = 15.0);
 

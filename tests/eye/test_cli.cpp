@@ -350,8 +350,8 @@ TEST(Cli, RunOnGstreamerPipelineStampsBufferPts) {
     std::snprintf(name, sizeof name, "/f%03d.jpg", k);
     ASSERT_TRUE(cv::imwrite(d + name, eye::synth_frame(s, {{1, 1.0 + 0.05 * k, 1.0, 0.2}}, {}, k)));
   }
-  const std::string pipeline = "multifilesrc location=" + d + "/f%03d.jpg index=0 stop-index=" +
-                               std::to_string(n - 1) +
+  const std::string pipeline = "multifilesrc location=" + d +
+                               "/f%03d.jpg index=0 stop-index=" + std::to_string(n - 1) +
                                " caps=image/jpeg,framerate=30/1 ! jpegdec ! videoconvert ! "
                                "video/x-raw,format=BGR ! appsink sync=true";
   std::string out;

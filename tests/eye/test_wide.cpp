@@ -32,7 +32,8 @@ Wide wide_scene(int w = 800, int h = 450) {
   eye::DetectorParams dp;
   dp.decimate = 1;
   eye::Detector det(dp);
-  const auto m = eye::map_calibrate(x.s.in, x.refs, {det.detect(eye::synth_frame(x.s, {}, x.refs, 3))});
+  const auto m =
+      eye::map_calibrate(x.s.in, x.refs, {det.detect(eye::synth_frame(x.s, {}, x.refs, 3))});
   x.cfg.in = x.s.in;
   x.cfg.pose = m.pose;
   x.cfg.locate = x.s.car;
@@ -54,9 +55,9 @@ TEST(Lens, RenderedDistortionMatchesOpenCvProjection) {
   x.s.blur_sigma_px = 0.6;
   std::vector<eye::SynthCar> cars;
   // Cars near the corners and edges, where the lens bends most, and one in the middle.
-  for (const cv::Point2d f : {cv::Point2d(0.08, 0.12), cv::Point2d(0.92, 0.12),
-                              cv::Point2d(0.08, 0.88), cv::Point2d(0.92, 0.88),
-                              cv::Point2d(0.5, 0.5), cv::Point2d(0.5, 0.1)}) {
+  for (const cv::Point2d f :
+       {cv::Point2d(0.08, 0.12), cv::Point2d(0.92, 0.12), cv::Point2d(0.08, 0.88),
+        cv::Point2d(0.92, 0.88), cv::Point2d(0.5, 0.5), cv::Point2d(0.5, 0.1)}) {
     const cv::Vec2d p = eye::synth_pixel_to_plane(
         x.s, {f.x * x.s.in.width_px, f.y * x.s.in.height_px}, x.s.car.tag_offset_m[2]);
     cars.push_back({static_cast<int>(cars.size()) + 1, p[0] - x.s.car.tag_offset_m[0], p[1], 0.7});
@@ -106,8 +107,8 @@ TEST(WholeField, PlanIsFinerWhereTagsAreSmall) {
   for (const auto &r : plan.regions) {
     area += r.rect.area();
     corner_fine = corner_fine || (r.decimate == 1.0f && r.rect.contains({3, 3}));
-    centre_coarse = centre_coarse ||
-                    (r.decimate == 2.0f && r.rect.contains({x.s.in.width_px / 2, x.s.in.height_px / 2}));
+    centre_coarse = centre_coarse || (r.decimate == 2.0f &&
+                                      r.rect.contains({x.s.in.width_px / 2, x.s.in.height_px / 2}));
   }
   EXPECT_TRUE(corner_fine);
   EXPECT_TRUE(centre_coarse);
