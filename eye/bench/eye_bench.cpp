@@ -369,6 +369,9 @@ int main(int argc, char **argv) {
   app.add_option("--tag-size-m", tag_size_m, "roof tag black border [m]")->capture_default_str();
   app.add_option("--csv", csv, "write truth vs estimate per frame (720p) here");
   app.add_option("--lcm-url", url, "where poses are published")->capture_default_str();
+  bool wide_only = false;
+  app.add_flag("--wide-only", wide_only,
+               "only the wide-angle scene (10 cars) and the bumped camera");
   app.add_option("--wide-margin", g_wide_margin, "wide scene: tracking window margin [tag sizes]")
       ->capture_default_str();
   app.add_option("--wide-sigma-px", g_wide_sigma, "wide scene: detector quad_sigma [px]")
@@ -381,40 +384,6 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "eye_bench: cannot open LCM %s\n", url.c_str());
     return 1;
   }
-  // One resolution: its rendered scene, then the Eye with and without window tracking.
-  const auto at_size = [&](int w, int h, Scene *scene, RunResult *tracked, RunResult *full) {
-    std::fprintf(stderr, "[eye_bench] rendering %d frames at %dx%d\n", frames, w, h);
-    *scene = make_scene(w, h, frames, tag_size_m, nullptr);
-    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d, %d passes\n", w, h, repeats);
-    *tracked = run_eye(*scene, lcm, repeats, true);
-    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d without window tracking, %d passes\n", w,
-                 h, repeats);
-    *full = run_eye(*scene, lcm, repeats, false);
-  };
-  Scene hd, fhd;
-  RunResult e720, e720full, e1080, e1080full;
-  at_size(1280, 720, &hd, &e720, &e720full);
-  std::fprintf(stderr, "[eye_bench] peer (OpenCV aruco) 1280x720, %d passes\n", repeats);
-  const RunResult p720 = run_peer(hd, lcm, repeats);
-  const Accuracy a = accuracy(hd, e720), pa = accuracy(hd, p720), afull = accuracy(hd, e720full);
-  if (!csv.empty()) {
-    std::ofstream f(csv);
-    f << "frame,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad,peer_x_m,peer_y_m,peer_"
-         "yaw_rad\n";
-    for (size_t i = 0; i < hd.path.size(); ++i) {
-      f << i << "," << hd.path[i].x_m << "," << hd.path[i].y_m << "," << hd.path[i].yaw_rad;
-      for (const RunResult *r : std::initializer_list<const RunResult *>{&e720, &p720}) {
-        if (r->est[i])
-          f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
-        else
-          f << ",,,";
-      }
-      f << "\n";
-    }
-  }
-  at_size(1920, 1080, &fhd, &e1080, &e1080full);
-  const Accuracy a1080 = accuracy(fhd, e1080);
-
   // Wide-angle lens, 10 cars: the Eye (whole-field detection), the previous default (decimate
   // 2 full scans) and decimate 1 everywhere, same frames, same tracking, same run.
   std::fprintf(stderr, "[eye_bench] wide-angle scene: rendering %d frames, 10 cars\n", frames);
@@ -452,30 +421,6 @@ int main(int argc, char **argv) {
                std::min(frames, 60));
   const auto [bump_frames, still_ok] = bumped_camera(wide, std::min(frames, 60));
 
-  const double jpeg_kb = static_cast<double>(hd.jpeg[0].size()) / 1024.0;
-  std::printf("fps_1280x720_1t %.2f\n", e720.fps());
-  std::printf("fps_1920x1080_1t %.2f\n", e1080.fps());
-  std::printf("peer_fps_1280x720_1t %.2f\n", p720.fps());
-  std::printf("fps_1280x720_1t_cpu %.2f\n", e720.fps_cpu());
-  std::printf("fps_1920x1080_1t_cpu %.2f\n", e1080.fps_cpu());
-  std::printf("peer_fps_1280x720_1t_cpu %.2f\n", p720.fps_cpu());
-  std::printf("fps_1280x720_1t_fullscan %.2f\n", e720full.fps());
-  std::printf("fps_1280x720_1t_fullscan_cpu %.2f\n", e720full.fps_cpu());
-  std::printf("fps_1920x1080_1t_fullscan %.2f\n", e1080full.fps());
-  std::printf("fps_1920x1080_1t_fullscan_cpu %.2f\n", e1080full.fps_cpu());
-  std::printf("detect_rate_fullscan %.4f\n", afull.detect_rate);
-  std::printf("pos_rms_mm_fullscan %.4f\n", afull.pos_rms_mm);
-  std::printf("pos_rms_mm %.4f\n", a.pos_rms_mm);
-  std::printf("heading_rms_deg %.4f\n", a.heading_rms_deg);
-  std::printf("detect_rate %.4f\n", a.detect_rate);
-  std::printf("pos_median_mm %.4f\n", a.pos_median_mm);
-  std::printf("pos_max_mm %.4f\n", a.pos_max_mm);
-  std::printf("pos_rms_mm_1920x1080 %.4f\n", a1080.pos_rms_mm);
-  std::printf("heading_rms_deg_1920x1080 %.4f\n", a1080.heading_rms_deg);
-  std::printf("detect_rate_1920x1080 %.4f\n", a1080.detect_rate);
-  std::printf("peer_pos_rms_mm %.4f\n", pa.pos_rms_mm);
-  std::printf("peer_heading_rms_deg %.4f\n", pa.heading_rms_deg);
-  std::printf("peer_detect_rate %.4f\n", pa.detect_rate);
   std::printf("detect_rate_wide_angle %.4f\n", aw.detect_rate);
   std::printf("pos_rms_mm_wide_angle %.4f\n", aw.pos_rms_mm);
   std::printf("heading_rms_deg_wide_angle %.4f\n", aw.heading_rms_deg);
@@ -503,6 +448,68 @@ int main(int argc, char **argv) {
   std::printf("bumped_camera_detected %d\n", bump_frames >= 0 && bump_frames < 30 ? 1 : 0);
   std::printf("bumped_camera_frames %d\n", bump_frames);
   std::printf("unmoved_camera_no_alarm %d\n", still_ok ? 1 : 0);
+  if (wide_only) {
+    std::printf("frames %d\nrepeats %d\n", frames, repeats);
+    return 0;
+  }
+  // One resolution: its rendered scene, then the Eye with and without window tracking.
+  const auto at_size = [&](int w, int h, Scene *scene, RunResult *tracked, RunResult *full) {
+    std::fprintf(stderr, "[eye_bench] rendering %d frames at %dx%d\n", frames, w, h);
+    *scene = make_scene(w, h, frames, tag_size_m, nullptr);
+    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d, %d passes\n", w, h, repeats);
+    *tracked = run_eye(*scene, lcm, repeats, true);
+    std::fprintf(stderr, "[eye_bench] Eye pipeline %dx%d without window tracking, %d passes\n", w,
+                 h, repeats);
+    *full = run_eye(*scene, lcm, repeats, false);
+  };
+  Scene hd, fhd;
+  RunResult e720, e720full, e1080, e1080full;
+  at_size(1280, 720, &hd, &e720, &e720full);
+  std::fprintf(stderr, "[eye_bench] peer (OpenCV aruco) 1280x720, %d passes\n", repeats);
+  const RunResult p720 = run_peer(hd, lcm, repeats);
+  const Accuracy a = accuracy(hd, e720), pa = accuracy(hd, p720), afull = accuracy(hd, e720full);
+  if (!csv.empty()) {
+    std::ofstream f(csv);
+    f << "frame,true_x_m,true_y_m,true_yaw_rad,eye_x_m,eye_y_m,eye_yaw_rad,peer_x_m,peer_y_m,peer_"
+         "yaw_rad\n";
+    for (size_t i = 0; i < hd.path.size(); ++i) {
+      f << i << "," << hd.path[i].x_m << "," << hd.path[i].y_m << "," << hd.path[i].yaw_rad;
+      for (const RunResult *r : std::initializer_list<const RunResult *>{&e720, &p720}) {
+        if (r->est[i])
+          f << "," << r->est[i]->x_m << "," << r->est[i]->y_m << "," << r->est[i]->yaw_rad;
+        else
+          f << ",,,";
+      }
+      f << "\n";
+    }
+  }
+  at_size(1920, 1080, &fhd, &e1080, &e1080full);
+  const Accuracy a1080 = accuracy(fhd, e1080);
+
+  const double jpeg_kb = static_cast<double>(hd.jpeg[0].size()) / 1024.0;
+  std::printf("fps_1280x720_1t %.2f\n", e720.fps());
+  std::printf("fps_1920x1080_1t %.2f\n", e1080.fps());
+  std::printf("peer_fps_1280x720_1t %.2f\n", p720.fps());
+  std::printf("fps_1280x720_1t_cpu %.2f\n", e720.fps_cpu());
+  std::printf("fps_1920x1080_1t_cpu %.2f\n", e1080.fps_cpu());
+  std::printf("peer_fps_1280x720_1t_cpu %.2f\n", p720.fps_cpu());
+  std::printf("fps_1280x720_1t_fullscan %.2f\n", e720full.fps());
+  std::printf("fps_1280x720_1t_fullscan_cpu %.2f\n", e720full.fps_cpu());
+  std::printf("fps_1920x1080_1t_fullscan %.2f\n", e1080full.fps());
+  std::printf("fps_1920x1080_1t_fullscan_cpu %.2f\n", e1080full.fps_cpu());
+  std::printf("detect_rate_fullscan %.4f\n", afull.detect_rate);
+  std::printf("pos_rms_mm_fullscan %.4f\n", afull.pos_rms_mm);
+  std::printf("pos_rms_mm %.4f\n", a.pos_rms_mm);
+  std::printf("heading_rms_deg %.4f\n", a.heading_rms_deg);
+  std::printf("detect_rate %.4f\n", a.detect_rate);
+  std::printf("pos_median_mm %.4f\n", a.pos_median_mm);
+  std::printf("pos_max_mm %.4f\n", a.pos_max_mm);
+  std::printf("pos_rms_mm_1920x1080 %.4f\n", a1080.pos_rms_mm);
+  std::printf("heading_rms_deg_1920x1080 %.4f\n", a1080.heading_rms_deg);
+  std::printf("detect_rate_1920x1080 %.4f\n", a1080.detect_rate);
+  std::printf("peer_pos_rms_mm %.4f\n", pa.pos_rms_mm);
+  std::printf("peer_heading_rms_deg %.4f\n", pa.heading_rms_deg);
+  std::printf("peer_detect_rate %.4f\n", pa.detect_rate);
   std::printf("frames %d\nrepeats %d\ntag_size_m %.3f\njpeg_kb_1280x720 %.1f\n", frames, repeats,
               tag_size_m, jpeg_kb);
   return 0;
