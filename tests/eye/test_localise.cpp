@@ -206,7 +206,9 @@ TEST(Tracking, WindowsFollowACarAndFullScansFindNewOnes) {
     // The periodic scan is staggered: one band of the frame per frame, the whole frame every
     // 5 frames, so NIGEL2 (in from frame 6) is found within 5 frames and then kept.
     if (seen2 && first2 < 0) first2 = k;
-    if (first2 >= 0) EXPECT_TRUE(seen2) << "frame " << k;
+    if (first2 >= 0) {
+      EXPECT_TRUE(seen2) << "frame " << k;
+    }
   }
   EXPECT_GE(first2, 6);
   EXPECT_LE(first2, 10);

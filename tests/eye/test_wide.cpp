@@ -195,8 +195,9 @@ TEST(Health, BumpedCameraIsFlaggedWithin30FramesAndInflatesCovariance) {
     auto pb = tb.process(eye::synth_frame(moved, cars, x.refs, static_cast<uint64_t>(100 + i)));
     std::vector<eye::CarPose> raw = pb;
     if (bumped.observe(i * 33333, tb.last_detections(), &pb)) found = i;
-    if (bumped.status().moved && !pb.empty())
+    if (bumped.status().moved && !pb.empty()) {
       EXPECT_NEAR(pb[0].cov[0], 100.0 * raw[0].cov[0], 1e-12);
+    }
   }
   std::printf("bumped at frame %d: residual %.2f mm / %.2f px (still camera %.2f mm / %.2f px)\n",
               found, bumped.status().ref_rms_mm, bumped.status().ref_rms_px,
