@@ -36,7 +36,7 @@ namespace {
 enum class Stamp {
   kFileIndex,   // video files: frame index / fps (no capture time recorded)
   kV4l2Buffer,  // the V4L2 buffer time stamp (CLOCK_MONOTONIC) mapped to the system clock
-  kGstPts,      // the GStreamer buffer PTS (running time) + the wall clock at PLAYING
+  kGstPts,      // the GStreamer running time at read + the wall clock at PLAYING
 };
 
 int64_t monotonic_utime() {
@@ -52,8 +52,9 @@ class CaptureSource : public Source {
   bool next(Frame *f) override {
     cv::Mat m;
     if (!cap_.read(m) || m.empty()) return false;
-    // OpenCV 4.6 gives the backend's buffer time as CAP_PROP_POS_MSEC: V4L2 the driver's
-    // buffer time stamp (CLOCK_MONOTONIC, taken at capture), GStreamer the buffer's PTS.
+    // OpenCV 4.6's CAP_PROP_POS_MSEC: V4L2 gives the driver's buffer time stamp
+    // (CLOCK_MONOTONIC, taken at capture); GStreamer the pipeline's position (running time)
+    // when the frame is read, not the buffer's own PTS (a few ms later than it).
     const double t_ms = stamp_ == Stamp::kFileIndex ? 0.0 : cap_.get(cv::CAP_PROP_POS_MSEC);
     switch (stamp_) {
       case Stamp::kFileIndex:
