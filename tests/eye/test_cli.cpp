@@ -334,7 +334,7 @@ TEST(Cli, RunOnVideoFile) {
 // run on a real GStreamer pipeline (multifilesrc of recorded JPEG frames at 30 fps -> jpegdec ->
 // appsink sync=true): frames stamped with their buffer PTS on the system clock (33.3 ms apart,
 // inside the run's wall-clock span), poses found, capture-to-pose latency printed.
-TEST(Cli, RunOnGstreamerPipelineStampsBufferPts) {
+TEST(Cli, RunOnGstreamerPipelineStampsSystemClock) {
   const std::string d = fresh_dir("eye_cli_gst");
   const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
   eye::intrinsics_save(d + "/camera.yaml", s.in);
