@@ -6,6 +6,7 @@
 #include <autodrive/angles.hpp>
 #include <autodrive_channels.h>
 #include <opencv2/aruco.hpp>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -20,6 +21,8 @@
 
 #include "eye_detect.hpp"
 #include "eye_intrinsics.hpp"
+#include "eye_health.hpp"
+#include "eye_render.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
 #include "eye_source.hpp"
@@ -169,7 +172,17 @@ RunResult run_peer(const Scene &sc, lcm::LCM &lcm, int repeats) {
 
 struct Accuracy {
   double pos_rms_mm = 0, heading_rms_deg = 0, detect_rate = 0, pos_median_mm = 0, pos_max_mm = 0;
+  int misses = 0;
 };
+
+// Pixel of a car's roof tag centre.
+cv::Point2d eye_tag_centre_px(const eye::SynthScene &s, const eye::SynthCar &car) {
+  const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
+  const double ox = s.car.tag_offset_m[0], oy = s.car.tag_offset_m[1];
+  return eye::camera_project(s.in, s.pose,
+                             {car.x_m + c * ox - sn * oy, car.y_m + sn * ox + c * oy,
+                              s.car.base_link_height_m + s.car.tag_offset_m[2]});
+}
 
 Accuracy accuracy(const Scene &sc, const RunResult &r) {
   Accuracy a;
@@ -223,6 +236,155 @@ int write_scene(const std::string &dir, const std::string &url, double tag_size_
   return 0;
 }
 
+// ---- Wide-angle lens, 10 cars, whole field of view ----------------------------------------
+
+struct WideScene {
+  eye::SynthScene s;
+  eye::RunConfig cfg;
+  std::vector<eye::RefTag> refs;
+  std::vector<std::vector<eye::SynthCar>> cars;  // per frame
+  std::vector<std::vector<uchar>> jpeg;
+  double tag_px_min = 1e9, tag_px_max = 0;
+};
+
+double g_wide_margin = eye::TrackingParams{}.margin;
+float g_wide_sigma = eye::DetectorParams{}.sigma_px;
+
+WideScene make_wide_scene(int w, int h, int frames) {
+  WideScene sc;
+  sc.s = eye::synth_scene_wide(w, h);
+  sc.refs = eye::synth_reference_tags_in_view(sc.s);
+  eye::DetectorParams dp;
+  dp.decimate = 1;
+  eye::Detector det(dp);
+  const eye::MapCalib m =
+      eye::map_calibrate(sc.s.in, sc.refs, {det.detect(eye::synth_frame(sc.s, {}, sc.refs, 7))});
+  std::fprintf(stderr, "[eye_bench] wide %dx%d: map calibration residual %.3f mm rms, %zu tags\n",
+               w, h, m.rms_mm, m.tags.size());
+  sc.cfg.in = sc.s.in;
+  sc.cfg.pose = m.pose;
+  sc.cfg.locate = sc.s.car;
+  sc.cfg.tracking.margin = g_wide_margin;
+  sc.cfg.detector.sigma_px = g_wide_sigma;
+  for (int k = 1; k <= 10; ++k)
+    sc.cfg.vehicles.push_back({AUTODRIVE_VEHICLE_PREFIX + std::to_string(k), k, 0.0});
+  sc.cars = eye::synth_wide_drive(sc.s, frames);
+  for (int i = 0; i < frames; ++i) {
+    for (const auto &c : sc.cars[static_cast<size_t>(i)]) {
+      const double side = eye::synth_tag_side_px(sc.s, c);
+      sc.tag_px_min = std::min(sc.tag_px_min, side);
+      sc.tag_px_max = std::max(sc.tag_px_max, side);
+    }
+    std::vector<uchar> buf;
+    cv::imencode(".jpg",
+                 eye::synth_frame(sc.s, sc.cars[static_cast<size_t>(i)], sc.refs,
+                                  static_cast<uint64_t>(1000 + i)),
+                 buf, {cv::IMWRITE_JPEG_QUALITY, 90});
+    sc.jpeg.push_back(std::move(buf));
+  }
+  return sc;
+}
+
+struct WideResult {
+  std::vector<double> pass_fps, pass_fps_cpu, latency_ms;
+  std::vector<std::vector<eye::CarPose>> est;  // per frame, first pass
+  int full_scans = 0;                          // first pass
+  double fps() const { return median(pass_fps); }
+  double fps_cpu() const { return median(pass_fps_cpu); }
+};
+
+WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::RunConfig &cfg) {
+  WideResult r;
+  for (int rep = 0; rep < repeats; ++rep) {
+    eye::Tracker tr(cfg);
+    const auto t0 = clock_type::now();
+    const double c0 = thread_cpu_s();
+    for (size_t i = 0; i < sc.jpeg.size(); ++i) {
+      const auto f0 = clock_type::now();
+      const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
+      const auto poses = tr.process(g);
+      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
+      r.latency_ms.push_back(
+          std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
+      if (rep == 0) {
+        r.est.push_back(poses);
+        r.full_scans += tr.last_was_full_scan();
+      }
+    }
+    const double n = static_cast<double>(sc.jpeg.size());
+    r.pass_fps.push_back(n / std::chrono::duration<double>(clock_type::now() - t0).count());
+    r.pass_fps_cpu.push_back(n / (thread_cpu_s() - c0));
+  }
+  return r;
+}
+
+Accuracy wide_accuracy(const WideScene &sc, const WideResult &r) {
+  Accuracy a;
+  std::vector<double> e;
+  double ss_p = 0, ss_h = 0, total = 0;
+  for (size_t i = 0; i < sc.cars.size(); ++i)
+    for (const auto &t : sc.cars[i]) {
+      total += 1;
+      if (std::none_of(r.est[i].begin(), r.est[i].end(),
+                       [&t](const eye::CarPose &p) { return p.tag_id == t.tag_id; }) &&
+          ++a.misses <= 12) {
+        const auto c = eye_tag_centre_px(sc.s, t);
+        std::fprintf(stderr,
+                     "[eye_bench]   missed car %d in frame %zu: tag %.1f px at (%.0f, %.0f)\n",
+                     t.tag_id, i, eye::synth_tag_side_px(sc.s, t), c.x, c.y);
+      }
+      for (const auto &p : r.est[i]) {
+        if (p.tag_id != t.tag_id) continue;
+        const double ep = 1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m);
+        const double eh = autodrive::angle_wrap_rad(p.yaw_rad - t.yaw_rad) * 180 / M_PI;
+        ss_p += ep * ep;
+        ss_h += eh * eh;
+        e.push_back(ep);
+      }
+    }
+  const double n = static_cast<double>(e.size());
+  a.detect_rate = n / total;
+  if (n > 0) {
+    a.pos_rms_mm = std::sqrt(ss_p / n);
+    a.heading_rms_deg = std::sqrt(ss_h / n);
+    a.pos_median_mm = median(e);
+    a.pos_max_mm = *std::max_element(e.begin(), e.end());
+  }
+  return a;
+}
+
+double percentile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  if (v.empty()) return 0;
+  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
+}
+
+// A bumped camera: the wide camera moves by 5 mm and 0.3 deg after its calibration; frames
+// until the Eye marks it moved (0: at once; -1: never in `frames`), and whether the unmoved
+// camera stayed unmarked over the same frames.
+std::pair<int, bool> bumped_camera(const WideScene &sc, int frames) {
+  eye::HealthParams hp;
+  eye::CameraHealth still("wide", sc.cfg.in, sc.cfg.pose, sc.refs, hp);
+  eye::CameraHealth bumped("wide", sc.cfg.in, sc.cfg.pose, sc.refs, hp);
+  eye::SynthScene moved = sc.s;
+  cv::Matx33d rot;
+  cv::Rodrigues(cv::Vec3d(0.6, 0.8, 0.0) * (0.3 * M_PI / 180), rot);
+  moved.pose.r_cam_map = rot * moved.pose.r_cam_map;
+  moved.pose.t_cam_map = rot * moved.pose.t_cam_map + cv::Vec3d(0.003, -0.004, 0.0);
+  eye::Tracker ts(sc.cfg), tb(sc.cfg);
+  int found = -1;
+  for (int i = 0; i < frames; ++i) {
+    const auto &cars = sc.cars[static_cast<size_t>(i)];
+    auto ps = ts.process(eye::synth_frame(sc.s, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
+    still.observe(i * 33333, ts.last_detections(), &ps);
+    auto pb = tb.process(eye::synth_frame(moved, cars, sc.refs, static_cast<uint64_t>(5000 + i)));
+    if (bumped.observe(i * 33333, tb.last_detections(), &pb) && found < 0) found = i;
+  }
+  std::fprintf(stderr, "[eye_bench] bumped camera: ref residual %.2f mm (still %.2f mm)\n",
+               bumped.status().ref_rms_mm, still.status().ref_rms_mm);
+  return {found, !still.status().moved};
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -241,6 +403,15 @@ int main(int argc, char **argv) {
                  "only write a 640x480 scene to this folder (camera.yaml, map.yaml, eye.yaml "
                  "with --lcm-url, frame.jpg with NIGEL1 at x 1.2 m, y 0.9 m, yaw 0.5 rad) and "
                  "exit: the frames of tools/bench security");
+}
+
+  bool wide_only = false;
+  app.add_flag("--wide-only", wide_only,
+               "only the wide-angle scene (10 cars) and the bumped camera");
+  app.add_option("--wide-margin", g_wide_margin, "wide scene: tracking window margin [tag sizes]")
+      ->capture_default_str();
+  app.add_option("--wide-sigma-px", g_wide_sigma, "wide scene: detector quad_sigma [px]")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (!scene_dir.empty()) return write_scene(scene_dir, url, tag_size_m);
   cv::setNumThreads(1);  // one thread: aruco and imdecode would otherwise use a pool
@@ -249,6 +420,74 @@ int main(int argc, char **argv) {
   if (!lcm.good()) {
     std::fprintf(stderr, "eye_bench: cannot open LCM %s\n", url.c_str());
     return 1;
+  }
+  // Wide-angle lens, 10 cars: the Eye (whole-field detection), the previous default (decimate
+  // 2 full scans) and decimate 1 everywhere, same frames, same tracking, same run.
+  std::fprintf(stderr, "[eye_bench] wide-angle scene: rendering %d frames, 10 cars\n", frames);
+  const WideScene wide = make_wide_scene(1280, 720, frames);
+  std::fprintf(stderr, "[eye_bench] wide: tags %.1f-%.1f px a side; plan:", wide.tag_px_min,
+               wide.tag_px_max);
+  const eye::Tracker planned(wide.cfg);
+  for (const auto &r : planned.scan_plan().regions)
+    std::fprintf(stderr, " [%d,%d %dx%d @%.1f]", r.rect.x, r.rect.y, r.rect.width, r.rect.height,
+                 static_cast<double>(r.decimate));
+  std::fprintf(stderr, "\n");
+  eye::RunConfig cfg_prev = wide.cfg, cfg_d1 = wide.cfg;
+  cfg_prev.whole_field.enabled = false;
+  cfg_d1.whole_field.enabled = false;
+  cfg_d1.detector.decimate = 1;
+  std::fprintf(stderr, "[eye_bench] wide: Eye (whole field), %d passes\n", repeats);
+  const WideResult w_eye = run_wide(wide, lcm, repeats, wide.cfg);
+  std::fprintf(stderr, "[eye_bench] wide: previous default (decimate 2 full scans)\n");
+  const WideResult w_prev = run_wide(wide, lcm, repeats, cfg_prev);
+  std::fprintf(stderr, "[eye_bench] wide: decimate 1 everywhere\n");
+  const WideResult w_d1 = run_wide(wide, lcm, repeats, cfg_d1);
+  // The detector alone (every frame scanned whole, no windows to carry a car through): what
+  // the whole-field plan finds that the previous default's decimate-2 scan misses.
+  eye::RunConfig cfg_full = wide.cfg, cfg_prev_full = cfg_prev;
+  cfg_full.tracking.roi = false;
+  cfg_prev_full.tracking.roi = false;
+  std::fprintf(stderr, "[eye_bench] wide: whole-frame scans every frame (Eye, previous)\n");
+  const WideResult wf_eye = run_wide(wide, lcm, 1, cfg_full);
+  const WideResult wf_prev = run_wide(wide, lcm, 1, cfg_prev_full);
+  std::fprintf(stderr, "[eye_bench] wide: full scans %d (Eye), %d (previous), %d (decimate 1)\n",
+               w_eye.full_scans, w_prev.full_scans, w_d1.full_scans);
+  const Accuracy aw = wide_accuracy(wide, w_eye), aw_prev = wide_accuracy(wide, w_prev),
+                 aw_d1 = wide_accuracy(wide, w_d1);
+  std::fprintf(stderr, "[eye_bench] bumped camera (5 mm, 0.3 deg), %d frames\n",
+               std::min(frames, 60));
+  const auto [bump_frames, still_ok] = bumped_camera(wide, std::min(frames, 60));
+
+  std::printf("detect_rate_wide_angle %.4f\n", aw.detect_rate);
+  std::printf("pos_rms_mm_wide_angle %.4f\n", aw.pos_rms_mm);
+  std::printf("heading_rms_deg_wide_angle %.4f\n", aw.heading_rms_deg);
+  std::printf("pos_max_mm_wide_angle %.4f\n", aw.pos_max_mm);
+  std::printf("fps_1280x720_1t_wide_angle %.2f\n", w_eye.fps());
+  std::printf("fps_1280x720_1t_wide_angle_cpu %.2f\n", w_eye.fps_cpu());
+  std::printf("detect_rate_wide_angle_prev_default %.4f\n", aw_prev.detect_rate);
+  std::printf("detect_rate_wide_angle_fullscan %.4f\n", wide_accuracy(wide, wf_eye).detect_rate);
+  std::printf("detect_rate_wide_angle_fullscan_prev_default %.4f\n",
+              wide_accuracy(wide, wf_prev).detect_rate);
+  std::printf("fps_1280x720_1t_wide_angle_fullscan_cpu %.2f\n", wf_eye.fps_cpu());
+  std::printf("fps_1280x720_1t_wide_angle_fullscan_prev_default_cpu %.2f\n", wf_prev.fps_cpu());
+  std::printf("fps_1280x720_1t_wide_angle_prev_default %.2f\n", w_prev.fps());
+  std::printf("fps_1280x720_1t_wide_angle_prev_default_cpu %.2f\n", w_prev.fps_cpu());
+  std::printf("detect_rate_wide_angle_decimate1 %.4f\n", aw_d1.detect_rate);
+  std::printf("fps_1280x720_1t_wide_angle_decimate1 %.2f\n", w_d1.fps());
+  std::printf("fps_1280x720_1t_wide_angle_decimate1_cpu %.2f\n", w_d1.fps_cpu());
+  std::printf("fps_ratio_wide_angle_vs_prev_default %.3f\n", w_eye.fps() / w_prev.fps());
+  std::printf("fps_ratio_wide_angle_vs_decimate1 %.3f\n", w_eye.fps() / w_d1.fps());
+  std::printf("cpu_fps_ratio_wide_angle_vs_decimate1 %.3f\n", w_eye.fps_cpu() / w_d1.fps_cpu());
+  std::printf("frame_to_pose_ms_p50_wide_angle %.3f\n", percentile(w_eye.latency_ms, 0.5));
+  std::printf("frame_to_pose_ms_p99_wide_angle %.3f\n", percentile(w_eye.latency_ms, 0.99));
+  std::printf("tag_px_min_wide_angle %.1f\ntag_px_max_wide_angle %.1f\n", wide.tag_px_min,
+              wide.tag_px_max);
+  std::printf("bumped_camera_detected %d\n", bump_frames >= 0 && bump_frames < 30 ? 1 : 0);
+  std::printf("bumped_camera_frames %d\n", bump_frames);
+  std::printf("unmoved_camera_no_alarm %d\n", still_ok ? 1 : 0);
+  if (wide_only) {
+    std::printf("frames %d\nrepeats %d\n", frames, repeats);
+    return 0;
   }
   // One resolution: its rendered scene, then the Eye with and without window tracking.
   const auto at_size = [&](int w, int h, Scene *scene, RunResult *tracked, RunResult *full) {

@@ -18,8 +18,33 @@ RunConfig runconfig_load(const std::string &path) {
   const autodrive::yaml::Section n(autodrive::yaml::load_file(path), "", path);
   RunConfig c;
   c.path = path;
-  c.intrinsics_path = resolve(path, n.get<std::string>("intrinsics"));
-  c.map_path = resolve(path, n.get<std::string>("map"));
+  // One camera (intrinsics, map) or several (cameras: [{name, intrinsics, map, source}]).
+  if (n.has("cameras")) {
+    const YAML::Node cs = n.list("cameras", "must be a non-empty list");
+    if (cs.size() == 0) n.fail_key("cameras", "must be a non-empty list");
+    std::set<std::string> cam_names;
+    for (size_t i = 0; i < cs.size(); ++i) {
+      const autodrive::yaml::Section cn(cs[i], "cameras[" + std::to_string(i) + "]", path);
+      CameraConfig cc;
+      cc.name = cn.get<std::string>("name");
+      cc.intrinsics_path = resolve(path, cn.get<std::string>("intrinsics"));
+      cc.map_path = resolve(path, cn.get<std::string>("map"));
+      cc.source = cn.get<std::string>("source", "");
+      cn.reject_unknown();
+      if (cc.name.empty() || !cam_names.insert(cc.name).second)
+        cn.fail_key("name", "is empty or used twice");
+      c.cameras.push_back(cc);
+    }
+  } else {
+    CameraConfig cc;
+    cc.name = n.get<std::string>("camera_name", cc.name);
+    cc.intrinsics_path = resolve(path, n.get<std::string>("intrinsics"));
+    cc.map_path = resolve(path, n.get<std::string>("map"));
+    c.cameras.push_back(cc);
+  }
+  c.intrinsics_path = c.cameras[0].intrinsics_path;
+  c.map_path = c.cameras[0].map_path;
+  c.camera_name = c.cameras[0].name;
   n.read("lcm_url", c.lcm_url);
   // Default: the simulated Nigel's tag (vehicle/nigel.params); a lab gives its printed size.
   c.locate.tag_size_m = n.positive_up_to("tag_size_m", 2.0, AUTODRIVE_VEHICLE_TAG_SIZE_M);
@@ -52,6 +77,24 @@ RunConfig runconfig_load(const std::string &path) {
     c.tracking.margin = t.positive_up_to("margin", 20.0, c.tracking.margin);
     t.reject_unknown();
   }
+  if (n.has("whole_field")) {
+    const auto w = n.child("whole_field");
+    c.whole_field.enabled = w.get<int>("enabled", c.whole_field.enabled) != 0;
+    c.whole_field.plan.min_tag_px_decimated =
+        w.positive("min_tag_px_decimated", c.whole_field.plan.min_tag_px_decimated);
+    c.whole_field.plan.cell_px = w.positive_int("cell_px", c.whole_field.plan.cell_px);
+    w.reject_unknown();
+  }
+  if (n.has("reference_tags"))
+    c.reference_tags = reftags_load(resolve(path, n.get<std::string>("reference_tags")));
+  if (n.has("health")) {
+    const auto h = n.child("health");
+    c.health.bump_threshold_mm = h.positive("bump_threshold_mm", c.health.bump_threshold_mm);
+    c.health.bump_confirm = h.positive_int("bump_confirm", c.health.bump_confirm);
+    c.health.bump_cov_scale = h.positive("bump_cov_scale", c.health.bump_cov_scale);
+    c.health.status_period_s = h.positive("status_period_s", c.health.status_period_s);
+    h.reject_unknown();
+  }
   const YAML::Node vs = n.list("vehicles", "must be a non-empty list");
   if (vs.size() == 0) n.fail_key("vehicles", "must be a non-empty list");
   n.reject_unknown();
@@ -70,14 +113,31 @@ RunConfig runconfig_load(const std::string &path) {
     if (!names.insert(tag.name).second) v.fail_key("name", "is used twice");
     c.vehicles.push_back(tag);
   }
-  c.in = intrinsics_load(c.intrinsics_path);
-  const MapCalib m = mapcal_load(c.map_path);
-  if (m.width_px != c.in.width_px || m.height_px != c.in.height_px)
-    throw Error(c.map_path + ": image size " + std::to_string(m.width_px) + "x" +
-                std::to_string(m.height_px) + " differs from the intrinsics in " +
-                c.intrinsics_path);
-  c.pose = m.pose;
+  for (auto &cc : c.cameras) {
+    cc.in = intrinsics_load(cc.intrinsics_path);
+    const MapCalib m = mapcal_load(cc.map_path);
+    if (m.width_px != cc.in.width_px || m.height_px != cc.in.height_px)
+      throw Error(cc.map_path + ": image size " + std::to_string(m.width_px) + "x" +
+                  std::to_string(m.height_px) + " differs from the intrinsics in " +
+                  cc.intrinsics_path);
+    cc.pose = m.pose;
+  }
+  c.in = c.cameras[0].in;
+  c.pose = c.cameras[0].pose;
   return c;
+}
+
+RunConfig runconfig_camera(const RunConfig &c, size_t i) {
+  RunConfig o = c;
+  if (i < c.cameras.size()) {
+    const CameraConfig &cc = c.cameras[i];
+    o.in = cc.in;
+    o.pose = cc.pose;
+    o.camera_name = cc.name;
+    o.intrinsics_path = cc.intrinsics_path;
+    o.map_path = cc.map_path;
+  }
+  return o;
 }
 
 }  // namespace eye

@@ -7,7 +7,10 @@
 
 #include "eye_camera.hpp"
 #include "eye_detect.hpp"
+#include "eye_health.hpp"
 #include "eye_locate.hpp"
+#include "eye_mapcal.hpp"
+#include "eye_scanplan.hpp"
 
 namespace eye {
 
@@ -15,6 +18,20 @@ struct TrackingParams {
   bool roi = true;      // search cars seen last frame only around their last tag
   int full_every = 10;  // scan the whole frame every this many frames
   double margin = 1.0;  // window = last tag box grown by this many tag sizes per side
+};
+
+struct WholeFieldParams {
+  bool enabled = true;  // detector resolution per region from the expected tag size
+  ScanPlanParams plan;
+};
+
+// One camera of the Eye: its calibration and where its frames come from.
+struct CameraConfig {
+  std::string name = "eye";
+  std::string intrinsics_path, map_path;
+  std::string source;  // e.g. "lcm:EYE_IMAGE" (empty: --source)
+  Intrinsics in;
+  CameraPose pose;
 };
 
 struct RunConfig {
@@ -27,8 +44,16 @@ struct RunConfig {
   LocateParams locate;
   DetectorParams detector;
   TrackingParams tracking;
+  WholeFieldParams whole_field;
+  HealthParams health;
+  std::vector<RefTag> reference_tags;  // in view of the cameras: health (may be empty)
   std::vector<VehicleTag> vehicles;
+  std::string camera_name = "eye";    // of in / pose
+  std::vector<CameraConfig> cameras;  // every camera; in / pose are cameras[0]'s
 };
+
+// The config of camera i alone (in, pose, names set from cameras[i]).
+RunConfig runconfig_camera(const RunConfig &c, size_t i);
 
 // Loads the config and the calibration files it names. Throws eye::Error naming the file and
 // the field on anything missing or malformed.

@@ -3,6 +3,9 @@
 #include <apriltag.h>
 #include <tag36h11.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "eye_error.hpp"
 
 namespace eye {
@@ -47,6 +50,30 @@ std::vector<Detection> Detector::detect(const cv::Mat &gray) {
     out.push_back(o);
   }
   apriltag_detections_destroy(dets);
+  return out;
+}
+
+std::vector<Detection> Detector::detect(const cv::Mat &gray, const cv::Rect &roi, float decimate) {
+  const cv::Rect r = roi & cv::Rect(0, 0, gray.cols, gray.rows);
+  // No tag fits in a sliver, and libapriltag 3.3 crashes (quad_thresh) on a few-pixel image.
+  const int min_px = static_cast<int>(std::ceil(8 * std::max(1.0f, decimate)));
+  if (r.width < min_px || r.height < min_px) return {};
+  auto *td = static_cast<apriltag_detector_t *>(td_);
+  td->quad_decimate = decimate;
+  std::vector<Detection> out;
+  try {
+    out = detect(gray(r));
+  } catch (...) {
+    td->quad_decimate = params_.decimate;
+    throw;
+  }
+  td->quad_decimate = params_.decimate;
+  // Region pixel (c, r) is frame pixel (c + x, r + y): shifting the corners is exact.
+  const cv::Point2d off(r.x, r.y);
+  for (auto &d : out) {
+    for (auto &p : d.corners_px) p += off;
+    d.centre_px += off;
+  }
   return out;
 }
 

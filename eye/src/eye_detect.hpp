@@ -40,6 +40,9 @@ class Detector {
   Detector &operator=(const Detector &) = delete;
   // gray: CV_8UC1 image. Throws eye::Error on another type.
   std::vector<Detection> detect(const cv::Mat &gray);
+  // Detects in a region of the frame (corners in frame pixels) at its own decimation.
+  std::vector<Detection> detect(const cv::Mat &gray, const cv::Rect &roi, float decimate);
+  const DetectorParams &params() const { return params_; }
 
  private:
   DetectorParams params_;

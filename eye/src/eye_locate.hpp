@@ -38,6 +38,7 @@ struct CarPose {
   std::array<double, 9> cov{};            // x, y, yaw row-major [m^2, m rad, rad^2]
   double fit_rms_m = 0;                   // corner fit residual [m]
   std::array<cv::Point2d, 4> corners_px;  // for annotation
+  int cameras = 1;                        // cameras whose poses were fused into this one
 };
 
 // Tag-frame corners [m] of a tag with black border size_m, in libapriltag order (bottom-left,

@@ -37,8 +37,7 @@ std::vector<RefTag> reftags_load(const std::string &path) {
   return out;
 }
 
-// Map coordinates of a reference tag's corners, libapriltag order.
-static std::array<cv::Point3d, 4> ref_corners(const RefTag &r) {
+std::array<cv::Point3d, 4> reftag_corners_map(const RefTag &r) {
   const auto tf = tag_corners_tagframe(r.size_m);
   const double c = std::cos(r.yaw_rad), s = std::sin(r.yaw_rad);
   std::array<cv::Point3d, 4> out;
@@ -60,7 +59,7 @@ MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
     for (const auto &d : f) {
       auto it = by_id.find(d.id);
       if (it == by_id.end()) continue;
-      const auto c3 = ref_corners(*it->second);
+      const auto c3 = reftag_corners_map(*it->second);
       for (size_t i = 0; i < 4; ++i) {
         obj.push_back(c3[i]);
         img.push_back(d.corners_px[i]);
@@ -104,6 +103,55 @@ MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
   m.rms_mm = std::sqrt(ss / static_cast<double>(obj.size()));
   for (const auto &[id, a] : acc) m.tags.push_back({id, std::sqrt(a.first / a.second)});
   return m;
+}
+
+// Each reference tag's corners on its own plane as one camera sees them (first detection).
+static std::map<int, std::array<cv::Vec2d, 4>> corners_on_planes(
+    const std::map<int, const RefTag *> &by_id, const Intrinsics &in, const CameraPose &pose,
+    const std::vector<std::vector<Detection>> &frames) {
+  std::map<int, std::array<cv::Vec2d, 4>> out;
+  for (const auto &f : frames)
+    for (const auto &d : f) {
+      auto it = by_id.find(d.id);
+      if (it == by_id.end() || out.count(d.id)) continue;
+      const auto norm = intrinsics_normalise(
+          in, std::vector<cv::Point2d>(d.corners_px.begin(), d.corners_px.end()));
+      std::array<cv::Vec2d, 4> c;
+      bool ok = true;
+      for (size_t i = 0; i < 4; ++i)
+        ok = ok && camera_ray_to_plane(pose, norm[i], it->second->z_m, &c[i]);
+      if (ok) out[d.id] = c;
+    }
+  return out;
+}
+
+OverlapAgreement map_overlap_agreement(const std::vector<RefTag> &refs, const Intrinsics &in_a,
+                                       const CameraPose &pose_a,
+                                       const std::vector<std::vector<Detection>> &frames_a,
+                                       const Intrinsics &in_b, const CameraPose &pose_b,
+                                       const std::vector<std::vector<Detection>> &frames_b) {
+  std::map<int, const RefTag *> by_id;
+  for (const auto &r : refs) by_id[r.id] = &r;
+  const auto a = corners_on_planes(by_id, in_a, pose_a, frames_a);
+  const auto b = corners_on_planes(by_id, in_b, pose_b, frames_b);
+  OverlapAgreement o;
+  double ss = 0;
+  int n = 0;
+  for (const auto &[id, ca] : a) {
+    auto it = b.find(id);
+    if (it == b.end()) continue;
+    double ss_tag = 0;
+    for (size_t i = 0; i < 4; ++i) {
+      const double e_mm = 1000.0 * cv::norm(ca[i] - it->second[i]);
+      ss_tag += e_mm * e_mm;
+      o.max_mm = std::max(o.max_mm, e_mm);
+    }
+    o.tags.push_back({id, std::sqrt(ss_tag / 4)});
+    ss += ss_tag;
+    n += 4;
+  }
+  if (n > 0) o.rms_mm = std::sqrt(ss / n);
+  return o;
 }
 
 void mapcal_save(const std::string &path, const MapCalib &m) {

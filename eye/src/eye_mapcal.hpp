@@ -1,6 +1,7 @@
 // Map calibration: the camera pose in the map frame from reference tags at known map
 // coordinates, with residuals in millimetres on each tag's own plane.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct MapCalib {
   std::vector<int> missing_ids;  // reference tags never detected
 };
 
+// Map coordinates of a reference tag's corners, libapriltag order (bottom-left, bottom-right,
+// top-right, top-left of the print).
+std::array<cv::Point3d, 4> reftag_corners_map(const RefTag &r);
+
 // Reads the reference tag list:  tags: [{id, x_m, y_m, z_m, yaw_rad, size_m}, ...]
 std::vector<RefTag> reftags_load(const std::string &path);
 
@@ -36,6 +41,19 @@ std::vector<RefTag> reftags_load(const std::string &path);
 // eye::Error if fewer than min_tags distinct reference tags are seen.
 MapCalib map_calibrate(const Intrinsics &in, const std::vector<RefTag> &refs,
                        const std::vector<std::vector<Detection>> &frames, int min_tags = 3);
+
+// How two calibrated cameras agree where they overlap: for each reference tag both see, the
+// RMS distance [mm] between its corners as camera A and as camera B put them on the tag's own
+// plane (rays of the detected corners through each camera's calibration).
+struct OverlapAgreement {
+  std::vector<TagResidual> tags;    // shared tags, their A-vs-B corner distance RMS [mm]
+  double rms_mm = -1, max_mm = -1;  // over all shared corners (-1: no shared tag)
+};
+OverlapAgreement map_overlap_agreement(const std::vector<RefTag> &refs, const Intrinsics &in_a,
+                                       const CameraPose &pose_a,
+                                       const std::vector<std::vector<Detection>> &frames_a,
+                                       const Intrinsics &in_b, const CameraPose &pose_b,
+                                       const std::vector<std::vector<Detection>> &frames_b);
 
 void mapcal_save(const std::string &path, const MapCalib &m);
 // Throws eye::Error naming the file and the field if it is missing or malformed.

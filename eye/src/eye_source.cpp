@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <deque>
 #include <filesystem>
@@ -34,14 +35,44 @@ cv::Mat decode_gray(const uint8_t *data, size_t n, const std::string &what) {
 
 namespace {
 
+// How a capture source's frames are stamped.
+enum class Stamp {
+  kFileIndex,   // video files: frame index / fps (no capture time recorded)
+  kV4l2Buffer,  // the V4L2 buffer time stamp (CLOCK_MONOTONIC) mapped to the system clock
+  kGstPts,      // the GStreamer running time at read + the wall clock at PLAYING
+};
+
+int64_t monotonic_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 class CaptureSource : public Source {
  public:
-  CaptureSource(const std::string &spec, cv::VideoCapture cap, bool live, double fps)
-      : spec_(spec), cap_(std::move(cap)), live_(live), fps_(fps) {}
+  CaptureSource(const std::string &spec, cv::VideoCapture cap, Stamp stamp, double fps)
+      : spec_(spec), cap_(std::move(cap)), stamp_(stamp), fps_(fps), base_utime_(now_utime()) {}
   bool next(Frame *f) override {
     cv::Mat m;
     if (!cap_.read(m) || m.empty()) return false;
-    f->utime = live_ ? now_utime() : static_cast<int64_t>(1e6 * n_ / fps_);
+    // OpenCV 4.6's CAP_PROP_POS_MSEC: V4L2 gives the driver's buffer time stamp
+    // (CLOCK_MONOTONIC, taken at capture); GStreamer the pipeline's position (running time)
+    // when the frame is read, not the buffer's own PTS (a few ms later than it).
+    const double t_ms = stamp_ == Stamp::kFileIndex ? 0.0 : cap_.get(cv::CAP_PROP_POS_MSEC);
+    switch (stamp_) {
+      case Stamp::kFileIndex:
+        f->utime = static_cast<int64_t>(1e6 * static_cast<double>(n_) / fps_);
+        break;
+      case Stamp::kV4l2Buffer:
+        f->utime =
+            t_ms > 0 ? std::llround(1e3 * t_ms) + (now_utime() - monotonic_utime()) : now_utime();
+        break;
+      case Stamp::kGstPts:
+        // The pipeline's running time starts at PLAYING, which open() waited for.
+        f->utime = t_ms >= 0 ? base_utime_ + std::llround(1e3 * t_ms) : now_utime();
+        break;
+    }
+    f->wall_clock = stamp_ != Stamp::kFileIndex;
     f->label = spec_ + "#" + std::to_string(n_++);
     if (m.channels() == 3)
       cv::cvtColor(m, f->gray, cv::COLOR_BGR2GRAY);
@@ -55,8 +86,9 @@ class CaptureSource : public Source {
  private:
   std::string spec_;
   cv::VideoCapture cap_;
-  bool live_;
+  Stamp stamp_;
   double fps_;
+  int64_t base_utime_;  // wall clock when the source was open (GStreamer: PLAYING) [us]
   int64_t n_ = 0;
 };
 
@@ -196,7 +228,10 @@ std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
                 "' (device, gst, video, folder, lcm)");
   }
   if (!cap.isOpened()) throw Error("source '" + spec + "': cannot open");
-  return std::make_unique<CaptureSource>(spec, std::move(cap), kind != "video", fps_hint);
+  const Stamp stamp = kind == "device" ? Stamp::kV4l2Buffer
+                      : kind == "gst"  ? Stamp::kGstPts
+                                       : Stamp::kFileIndex;
+  return std::make_unique<CaptureSource>(spec, std::move(cap), stamp, fps_hint);
 }
 
 }  // namespace eye

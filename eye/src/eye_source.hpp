@@ -11,9 +11,10 @@
 namespace eye {
 
 struct Frame {
-  cv::Mat gray;       // CV_8UC1
-  int64_t utime = 0;  // capture time [us]
-  std::string label;  // file name or frame counter, for messages
+  cv::Mat gray;             // CV_8UC1
+  int64_t utime = 0;        // capture time [us]
+  bool wall_clock = false;  // utime is on the system clock (device, gst): latency is measurable
+  std::string label;        // file name or frame counter, for messages
 };
 
 class Source {

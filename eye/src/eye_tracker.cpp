@@ -10,41 +10,77 @@
 
 namespace eye {
 
-static DetectorParams roi_params(DetectorParams p) {
-  p.decimate = 1.0f;
-  return p;
+static double side_px(const std::array<cv::Point2d, 4> &c) {
+  double s = 1e9;
+  for (size_t i = 0; i < 4; ++i) s = std::min(s, cv::norm(c[i] - c[(i + 1) % 4]));
+  return s;
 }
 
-Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector), roi_det_(roi_params(c.detector)) {
-  for (const auto &v : c.vehicles) by_tag_[v.tag_id] = v;
-}
-
-std::vector<Detection> Tracker::detect_windows(const cv::Mat &gray) {
+std::vector<Detection> merge_detections(const std::vector<Detection> &dets) {
   std::vector<Detection> out;
-  const cv::Rect frame(0, 0, gray.cols, gray.rows);
-  for (const auto &[id, c] : last_corners_) {
-    double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
-    for (const auto &p : c) {
-      x0 = std::min(x0, p.x);
-      x1 = std::max(x1, p.x);
-      y0 = std::min(y0, p.y);
-      y1 = std::max(y1, p.y);
-    }
-    const double grow = cfg_.tracking.margin * std::max(x1 - x0, y1 - y0);
-    const cv::Rect win = cv::Rect(cv::Point(static_cast<int>(std::floor(x0 - grow)),
-                                            static_cast<int>(std::floor(y0 - grow))),
-                                  cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
-                                            static_cast<int>(std::ceil(y1 + grow)) + 1)) &
-                         frame;
-    if (win.area() == 0) continue;
-    // Window pixel (c, r) is frame pixel (c + x, r + y): shifting corners is exact.
-    for (auto d : roi_det_.detect(gray(win))) {
-      if (d.id != id) continue;
-      for (auto &p : d.corners_px) p += cv::Point2d(win.x, win.y);
-      d.centre_px += cv::Point2d(win.x, win.y);
+  for (const auto &d : dets) {
+    auto same = std::find_if(out.begin(), out.end(), [&](const Detection &o) {
+      return o.id == d.id &&
+             cv::norm(o.centre_px - d.centre_px) < std::max(side_px(o.corners_px), 1.0);
+    });
+    if (same == out.end())
       out.push_back(d);
-    }
+    else if (d.margin > same->margin)
+      *same = d;
   }
+  return out;
+}
+
+Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector) {
+  for (const auto &v : c.vehicles) by_tag_[v.tag_id] = v;
+  const double z_roof_m = c.locate.base_link_height_m + c.locate.tag_offset_m[2];
+  if (c.whole_field.enabled) {
+    plan_ = plan_full_scan(c.in, c.pose, z_roof_m, c.locate.tag_size_m, c.detector.decimate,
+                           c.whole_field.plan);
+  } else {
+    plan_.regions = {{cv::Rect(0, 0, c.in.width_px, c.in.height_px), c.detector.decimate}};
+    // Bands padded by the largest tag (as seen from the frame centre, x1.5 for the edges).
+    plan_.max_tag_px = 1.5 * expected_tag_side_px(c.in, c.pose, z_roof_m, c.locate.tag_size_m,
+                                                  {c.in.width_px / 2.0, c.in.height_px / 2.0})[1];
+  }
+}
+
+void Tracker::hint(int tag_id, const std::array<cv::Point2d, 4> &corners_px) {
+  if (by_tag_.count(tag_id) && !tracks_.count(tag_id)) hints_[tag_id] = corners_px;
+}
+
+std::vector<Detection> Tracker::scan_regions(const cv::Mat &gray,
+                                             const std::vector<ScanRegion> &rs) {
+  std::vector<Detection> dets;
+  for (const auto &r : rs) {
+    auto d = r.rect.area() == gray.cols * gray.rows && r.decimate == cfg_.detector.decimate
+                 ? det_.detect(gray)
+                 : det_.detect(gray, r.rect, r.decimate);
+    dets.insert(dets.end(), d.begin(), d.end());
+  }
+  return rs.size() > 1 ? merge_detections(dets) : dets;
+}
+
+std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
+                                            const std::array<cv::Point2d, 4> &c, double margin) {
+  double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
+  for (const auto &p : c) {
+    x0 = std::min(x0, p.x);
+    x1 = std::max(x1, p.x);
+    y0 = std::min(y0, p.y);
+    y1 = std::max(y1, p.y);
+  }
+  const double grow = margin * std::max(x1 - x0, y1 - y0);
+  const cv::Rect win(
+      cv::Point(static_cast<int>(std::floor(x0 - grow)), static_cast<int>(std::floor(y0 - grow))),
+      cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
+                static_cast<int>(std::ceil(y1 + grow)) + 1));
+  // Windows are small: full resolution (measured: at 1.5 a 35 px tag near the image border was
+  // lost from its window for 6 frames).
+  const float dec = 1.0f;
+  std::vector<Detection> out;
+  for (const auto &d : det_.detect(gray, win, dec))
+    if (d.id == id) out.push_back(d);
   return out;
 }
 
@@ -55,24 +91,43 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
                 std::to_string(cfg_.in.height_px) + " of " + cfg_.intrinsics_path);
   std::vector<CarPose> out;
   std::map<int, int> count;
-  last_full_ = !cfg_.tracking.roi || last_corners_.empty() ||
-               frame_ % std::max(1, cfg_.tracking.full_every) == 0;
-  ++frame_;
+  const int n_bands = std::max(1, cfg_.tracking.full_every);
+  last_full_ = !cfg_.tracking.roi || (tracks_.empty() && hints_.empty());
+  const long frame = frame_++;
   std::vector<Detection> dets;
   if (!last_full_) {
-    dets = detect_windows(gray);
-    // A tracked car missing from its window (fast motion, occlusion): scan the whole frame
-    // now rather than lose the frame; windows only ever save time, never detections.
-    for (const auto &kv : last_corners_) {
-      const int id = kv.first;
-      if (std::none_of(dets.begin(), dets.end(), [id](const Detection &d) { return d.id == id; })) {
+    for (const auto &[id, t] : tracks_) {
+      // Where the tag should be now: last corners moved by the last frame's motion.
+      std::array<cv::Point2d, 4> pred = t.corners;
+      for (auto &p : pred) p += t.velocity_px;
+      auto found = scan_window(gray, id, pred, cfg_.tracking.margin);
+      // Missing from its window (a sharp turn, a jolt, occlusion): a window 3x as large, then
+      // the whole frame at once; windows only ever save time, never detections.
+      if (found.empty()) found = scan_window(gray, id, pred, 3.0 * cfg_.tracking.margin + 1.0);
+      if (found.empty()) {
         last_full_ = true;
         break;
       }
+      dets.insert(dets.end(), found.begin(), found.end());
+    }
+    if (!last_full_) {
+      for (const auto &[id, c] : hints_) {
+        const auto found = scan_window(gray, id, c, cfg_.tracking.margin);
+        dets.insert(dets.end(), found.begin(), found.end());
+      }
+      // The staggered periodic scan: band (frame mod n) of the full-scan plan.
+      const auto band = scan_regions(
+          gray, plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows));
+      dets.insert(dets.end(), band.begin(), band.end());
     }
   }
-  if (last_full_) dets = det_.detect(gray);
-  last_corners_.clear();
+  hints_.clear();
+  if (last_full_)
+    dets = scan_regions(gray, plan_.regions);
+  else
+    dets = merge_detections(dets);
+  last_dets_ = dets;
+  std::map<int, Track> tracks;
   for (const auto &d : dets) count[d.id]++;
   for (const auto &d : dets) {
     auto it = by_tag_.find(d.id);
@@ -80,9 +135,20 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
     if (it == by_tag_.end() || count[d.id] > 1) continue;
     if (auto p = locate_car(cfg_.in, cfg_.pose, cfg_.locate, it->second, d)) {
       out.push_back(*p);
-      last_corners_[d.id] = d.corners_px;
+      Track t{d.corners_px, {0, 0}};
+      auto old = tracks_.find(d.id);
+      if (old != tracks_.end()) {
+        cv::Point2d c0(0, 0), c1(0, 0);
+        for (size_t i = 0; i < 4; ++i) {
+          c0 += 0.25 * old->second.corners[i];
+          c1 += 0.25 * d.corners_px[i];
+        }
+        t.velocity_px = c1 - c0;
+      }
+      tracks[d.id] = t;
     }
   }
+  tracks_ = std::move(tracks);
   return out;
 }
 

@@ -1,10 +1,16 @@
 // One frame in, the poses of the configured cars out: detect, keep the tags we know, locate.
 // A car whose tag is not in this frame gets no pose (no stale poses).
+// Whole-field detection (config `whole_field`): a full scan runs the detector at its coarse
+// decimation over the frame and at finer decimation where the calibration says tags look small
+// (eye_scanplan.hpp); tracking windows use the decimation their tag's size allows.
 // Region-of-interest tracking (config `tracking`): a car seen in the previous frame is looked
-// for only in a window around its last tag; the whole frame is scanned every full_every-th
-// frame, whenever no car is being tracked, and at once when a tracked car is missing from its
-// window, so windows save time but never lose a detection; new cars are found within
-// full_every frames.
+// for only in a window around where its tag should be now (last corners moved by the last
+// pixel velocity); a car missing there is looked for in a window three times as large, then
+// in the whole frame at once, so windows save time but never lose a detection. New cars: the
+// whole frame is scanned whenever no car is tracked; otherwise the periodic scan is staggered,
+// one of full_every horizontal bands per frame (the cost spread evenly, no slow frames), so a
+// new car is found within full_every frames, or at once when another camera hints where it is
+// (multi-camera handover).
 #pragma once
 #include <opencv2/core.hpp>
 
@@ -14,6 +20,7 @@
 #include "eye_config.hpp"
 #include "eye_detect.hpp"
 #include "eye_locate.hpp"
+#include "eye_scanplan.hpp"
 
 namespace eye {
 
@@ -22,21 +29,40 @@ class Tracker {
   explicit Tracker(const RunConfig &c);
   // gray: CV_8UC1 of the calibrated size; throws eye::Error on another size or type.
   std::vector<CarPose> process(const cv::Mat &gray);
+  // Another camera sees tag_id where this camera would see these corners [px]: look there in
+  // the next frame (a hint that is not found does not force a full scan).
+  void hint(int tag_id, const std::array<cv::Point2d, 4> &corners_px);
   // The frame with the tags, ids, vehicle names and poses drawn in (BGR).
   cv::Mat annotate(const cv::Mat &gray, const std::vector<CarPose> &poses) const;
   const RunConfig &config() const { return cfg_; }
-  // Whether the last process() scanned the whole frame.
+  // Whether the last process() scanned the whole frame at once.
   bool last_was_full_scan() const { return last_full_; }
+  // Every tag the last process() detected (known cars, reference tags, others), merged.
+  const std::vector<Detection> &last_detections() const { return last_dets_; }
+  // The regions of a full scan (whole frame at the coarse decimation, finer where tags are small).
+  const ScanPlan &scan_plan() const { return plan_; }
 
  private:
-  std::vector<Detection> detect_windows(const cv::Mat &gray);
+  struct Track {
+    std::array<cv::Point2d, 4> corners;  // last frame [px]
+    cv::Point2d velocity_px{0, 0};       // centre motion over the last frame [px]
+  };
+  std::vector<Detection> scan_regions(const cv::Mat &gray, const std::vector<ScanRegion> &rs);
+  std::vector<Detection> scan_window(const cv::Mat &gray, int id,
+                                     const std::array<cv::Point2d, 4> &corners, double margin);
   RunConfig cfg_;
   Detector det_;
-  Detector roi_det_;  // decimate 1: windows are small
+  ScanPlan plan_;
   std::map<int, VehicleTag> by_tag_;
-  std::map<int, std::array<cv::Point2d, 4>> last_corners_;  // tag id -> corners last frame
+  std::map<int, Track> tracks_;                      // tag id -> last frame
+  std::map<int, std::array<cv::Point2d, 4>> hints_;  // tag id -> corners, next frame
+  std::vector<Detection> last_dets_;
   long frame_ = 0;
   bool last_full_ = true;
 };
+
+// Same id found twice within one tag size (overlapping regions): one detection, the one with
+// the larger decision margin. Copies farther apart stay (a tag seen twice gives no pose).
+std::vector<Detection> merge_detections(const std::vector<Detection> &dets);
 
 }  // namespace eye

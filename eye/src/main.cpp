@@ -13,6 +13,7 @@
 
 #include "eye_config.hpp"
 #include "eye_error.hpp"
+#include "eye_fuse.hpp"
 #include "eye_intrinsics.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
@@ -131,6 +132,12 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   cm->add_option("--decimate", cm_decimate, "detector decimation (1: most accurate)")
       ->capture_default_str();
+  std::string cm_ov_map, cm_ov_intr, cm_ov_images;
+  cm->add_option("--overlap-map", cm_ov_map,
+                 "another camera's map.yaml (same map frame): report how the two calibrations "
+                 "agree on the reference tags both cameras see");
+  cm->add_option("--overlap-intrinsics", cm_ov_intr, "that camera's intrinsics YAML");
+  cm->add_option("--overlap-images", cm_ov_images, "that camera's image(s) of the map");
 
   // run
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
@@ -212,6 +219,29 @@ int main(int argc, char **argv) {
       }
       eye::mapcal_save(cm_out, m);
       std::printf("wrote %s\n", cm_out.c_str());
+      if (!cm_ov_map.empty()) {
+        if (cm_ov_intr.empty() || cm_ov_images.empty())
+          throw eye::Error(
+              "calibrate-map: --overlap-map needs --overlap-intrinsics and "
+              "--overlap-images");
+        const eye::Intrinsics in_b = eye::intrinsics_load(cm_ov_intr);
+        const eye::MapCalib m_b = eye::mapcal_load(cm_ov_map);
+        std::vector<std::vector<eye::Detection>> frames_b;
+        for (auto &[name, img] : load_images(cm_ov_images)) {
+          if (img.cols != in_b.width_px || img.rows != in_b.height_px)
+            throw eye::Error(name + ": image size differs from the intrinsics in " + cm_ov_intr);
+          frames_b.push_back(det.detect(img));
+        }
+        const auto o =
+            eye::map_overlap_agreement(refs, in, m.pose, frames, in_b, m_b.pose, frames_b);
+        for (const auto &t : o.tags)
+          std::printf("overlap tag %3d  cameras agree within %.3f mm rms\n", t.id, t.rms_mm);
+        if (o.tags.empty())
+          std::printf("overlap: no reference tag seen by both cameras\n");
+        else
+          std::printf("overlap: %zu shared tags, %.3f mm rms, max %.3f mm\n", o.tags.size(),
+                      o.rms_mm, o.max_mm);
+      }
       return 0;
     }
     if (*rn) {
@@ -219,28 +249,71 @@ int main(int argc, char **argv) {
       if (!rn_url.empty()) cfg.lcm_url = rn_url;
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
-      auto src = eye::source_open(rn_source, rn_fps, cfg.lcm_url, rn_idle_s, cfg.in.width_px,
-                                  cfg.in.height_px);
-      eye::Tracker tr(cfg);
-      eye::Frame f;
+      // One source per camera: the config's `source`, else --source (one camera only).
+      std::vector<std::unique_ptr<eye::Source>> srcs;
+      std::vector<eye::RunConfig> cams;
+      std::vector<std::vector<eye::RefTag>> refs;
+      for (size_t i = 0; i < cfg.cameras.size(); ++i) {
+        const std::string spec = cfg.cameras[i].source.empty() ? rn_source : cfg.cameras[i].source;
+        if (cfg.cameras.size() > 1 && cfg.cameras[i].source.empty())
+          throw eye::Error(rn_config + ": cameras[" + std::to_string(i) +
+                           "].source: missing key (each of several cameras needs its source)");
+        cams.push_back(eye::runconfig_camera(cfg, i));
+        srcs.push_back(eye::source_open(spec, rn_fps, cfg.lcm_url, rn_idle_s,
+                                        cams.back().in.width_px, cams.back().in.height_px));
+        refs.push_back(cfg.reference_tags);
+      }
+      eye::MultiEye multi(cams, refs, cfg.health);
+      std::vector<eye::Frame> fs(srcs.size());
       long frames = 0, published = 0;
-      while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && src->next(&f)) {
-        // A frame never ends the run: one of another size is skipped and logged.
-        if (f.gray.cols != cfg.in.width_px || f.gray.rows != cfg.in.height_px) {
+      std::vector<double> latency_ms;  // capture (device, gst) to poses on LCM
+      const auto all_next = [&] {
+        for (size_t i = 0; i < srcs.size(); ++i)
+          if (!srcs[i]->next(&fs[i])) return false;
+        return true;
+      };
+      while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && all_next()) {
+        // A frame never ends the run: one of another size than its camera's calibration is
+        // skipped (with the other cameras' frames of that time) and logged at a limited rate.
+        bool sizes_ok = true;
+        for (size_t i = 0; i < fs.size(); ++i) {
+          const auto &in = cams[i].in;
+          if (fs[i].gray.cols == in.width_px && fs[i].gray.rows == in.height_px) continue;
+          sizes_ok = false;
           eye::skipped_frames_log().event(
-              rn_source, f.label + ": size " + std::to_string(f.gray.cols) + "x" +
-                             std::to_string(f.gray.rows) + " differs from the calibrated " +
-                             std::to_string(cfg.in.width_px) + "x" +
-                             std::to_string(cfg.in.height_px) + " (frame skipped)");
-          continue;
+              fs[i].label, fs[i].label + ": size " + std::to_string(fs[i].gray.cols) + "x" +
+                               std::to_string(fs[i].gray.rows) + " differs from the calibrated " +
+                               std::to_string(in.width_px) + "x" + std::to_string(in.height_px) +
+                               " (frame skipped)");
         }
-        const auto poses = tr.process(f.gray);
-        published += eye::publish_poses(lcm, poses, f.utime);
+        if (!sizes_ok) continue;
+        // Cameras of one Eye are triggered together (the simulator renders them at one sim
+        // time): the frame time is the first camera's capture time.
+        std::vector<cv::Mat> grays;
+        for (const auto &f : fs) grays.push_back(f.gray);
+        const int64_t utime = fs[0].utime;
+        const auto poses = multi.process(grays, utime);
+        published += eye::publish_poses(lcm, poses, utime);
+        if (fs[0].wall_clock)
+          latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
+        for (size_t i : multi.newly_moved()) {
+          const auto &st = multi.health(i).status();
+          std::fprintf(stderr,
+                       "autodrive-eye: WARNING: camera %s moved: reference tags %.2f mm (%.2f px) "
+                       "off their calibrated places; its poses now carry %gx covariance: "
+                       "recalibrate (calibrate-map)\n",
+                       st.camera.c_str(), st.ref_rms_mm, st.ref_rms_px, st.cov_scale);
+        }
+        for (size_t i = 0; i < multi.size(); ++i)
+          if (multi.health(i).status_due(utime))
+            eye::publish_status(lcm, multi.health(i).status(), cams[i].in.width_px,
+                                cams[i].in.height_px);
         if (!rn_debug.empty() && frames % std::max(1, rn_debug_every) == 0 &&
-            !cv::imwrite(rn_debug, tr.annotate(f.gray, poses)))
+            !cv::imwrite(rn_debug,
+                         multi.tracker(0).annotate(fs[0].gray, multi.last_per_camera()[0])))
           throw eye::Error(rn_debug + ": cannot write the debug image");
         if (!rn_quiet) {
-          std::printf("%s utime=%lld", f.label.c_str(), static_cast<long long>(f.utime));
+          std::printf("%s utime=%lld", fs[0].label.c_str(), static_cast<long long>(utime));
           for (const auto &p : poses)
             std::printf("  %s x=%.4f y=%.4f yaw=%.4f", p.vehicle.c_str(), p.x_m, p.y_m, p.yaw_rad);
           std::printf("\n");
@@ -249,6 +322,16 @@ int main(int argc, char **argv) {
         ++frames;
       }
       std::fprintf(stderr, "autodrive-eye: %ld frames, %ld poses published\n", frames, published);
+      if (!latency_ms.empty()) {
+        std::sort(latency_ms.begin(), latency_ms.end());
+        const auto pct = [&](double q) {
+          return latency_ms[std::min(
+              latency_ms.size() - 1,
+              static_cast<size_t>(q * static_cast<double>(latency_ms.size())))];
+        };
+        std::fprintf(stderr, "autodrive-eye: capture to pose on LCM: p50 %.2f ms, p99 %.2f ms\n",
+                     pct(0.5), pct(0.99));
+      }
       return 0;
     }
   } catch (const eye::Error &e) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <opencv2/calib3d.hpp>
 
 #include "eye_error.hpp"
 
@@ -38,21 +40,78 @@ cv::Matx33d render_plane_to_image(const Intrinsics &in, const CameraPose &pose, 
   return in.k * m;
 }
 
-void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int ss) {
+static bool has_distortion(const Intrinsics &in) {
+  return std::any_of(in.dist.begin(), in.dist.end(), [](double d) { return d != 0.0; });
+}
+
+const cv::Mat &render_undistort_grid(const Intrinsics &in) {
+  static const cv::Mat none;
+  if (!has_distortion(in)) return none;
+  struct Entry {
+    cv::Matx33d k;
+    std::vector<double> dist;
+    int w, h;
+    cv::Mat grid;
+  };
+  static std::deque<Entry> cache;  // most recent first; references stay valid on push_front
+  for (const auto &e : cache)
+    if (e.k == in.k && e.dist == in.dist && e.w == in.width_px && e.h == in.height_px)
+      return e.grid;
+  std::vector<cv::Point2d> px;
+  px.reserve(static_cast<size_t>((in.width_px + 1) * (in.height_px + 1)));
+  for (int r = 0; r <= in.height_px; ++r)
+    for (int c = 0; c <= in.width_px; ++c) px.emplace_back(c - 0.5, r - 0.5);
+  std::vector<cv::Point2d> und;
+  cv::undistortPoints(px, und, cv::Mat(in.k), in.dist, cv::noArray(), cv::Mat(in.k),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 1e-12));
+  cv::Mat grid(in.height_px + 1, in.width_px + 1, CV_64FC2);
+  std::copy(und.begin(), und.end(), grid.ptr<cv::Point2d>());
+  cache.push_front({in.k, in.dist, in.width_px, in.height_px, grid});
+  if (cache.size() > 4) cache.pop_back();
+  return cache.front().grid;
+}
+
+// Distorted pixels of undistorted pixels (the lens model of cv::projectPoints).
+static std::vector<cv::Point2d> distort_px(const Intrinsics &in,
+                                           const std::vector<cv::Point2d> &und) {
+  std::vector<cv::Point3d> rays;
+  for (const auto &u : und)
+    rays.emplace_back((u.x - in.k(0, 2)) / in.k(0, 0), (u.y - in.k(1, 2)) / in.k(1, 1), 1.0);
+  std::vector<cv::Point2d> out;
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cv::Mat(in.k), in.dist, out);
+  return out;
+}
+
+void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int ss,
+                    const Intrinsics *in) {
   CV_Assert(img.type() == CV_8UC1 && tex.type() == CV_8UC1 && ss >= 1);
   const double tw = tex.cols, th = tex.rows;
-  // Bounding box of the texture's outer edge in the image.
-  const cv::Vec3d edge[4] = {
-      {-0.5, -0.5, 1}, {tw - 0.5, -0.5, 1}, {tw - 0.5, th - 0.5, 1}, {-0.5, th - 0.5, 1}};
+  const cv::Mat &grid = in ? render_undistort_grid(*in) : cv::Mat();
+  if (!grid.empty()) CV_Assert(grid.rows == img.rows + 1 && grid.cols == img.cols + 1);
+  // Bounding box of the texture's outer edge in the image; through a lens its straight edges
+  // bend, so 8 points per edge and a pixel of margin.
+  const int per_edge = grid.empty() ? 1 : 8;
+  std::vector<cv::Point2d> outline;
+  const cv::Vec2d edge[4] = {
+      {-0.5, -0.5}, {tw - 0.5, -0.5}, {tw - 0.5, th - 0.5}, {-0.5, th - 0.5}};
+  for (int e = 0; e < 4; ++e)
+    for (int k = 0; k < per_edge; ++k) {
+      const double a = static_cast<double>(k) / per_edge;
+      const cv::Vec2d t = edge[e] * (1 - a) + edge[(e + 1) % 4] * a;
+      const cv::Vec3d p = h * cv::Vec3d(t[0], t[1], 1.0);
+      if (p[2] <= 0) return;  // behind the camera
+      outline.emplace_back(p[0] / p[2], p[1] / p[2]);
+    }
+  if (!grid.empty()) outline = distort_px(*in, outline);
+  const double pad = grid.empty() ? 0.0 : 1.0;
   double x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
-  for (const auto &e : edge) {
-    cv::Vec3d p = h * e;
-    if (p[2] <= 0) return;  // behind the camera
-    x0 = std::min(x0, p[0] / p[2]);
-    x1 = std::max(x1, p[0] / p[2]);
-    y0 = std::min(y0, p[1] / p[2]);
-    y1 = std::max(y1, p[1] / p[2]);
+  for (const auto &p : outline) {
+    x0 = std::min(x0, p.x - pad);
+    x1 = std::max(x1, p.x + pad);
+    y0 = std::min(y0, p.y - pad);
+    y1 = std::max(y1, p.y + pad);
   }
+  if (!(x1 >= -1 && y1 >= -1 && x0 <= img.cols && y0 <= img.rows)) return;
   const int c0 = std::max(0, static_cast<int>(std::floor(x0 + 0.5)));
   const int c1 = std::min(img.cols - 1, static_cast<int>(std::ceil(x1 + 0.5)));
   const int r0 = std::max(0, static_cast<int>(std::floor(y0 + 0.5)));
@@ -62,11 +121,25 @@ void render_texture(cv::Mat &img, const cv::Mat &tex, const cv::Matx33d &h, int 
   for (int row = r0; row <= r1; ++row) {
     uint8_t *line = img.ptr<uint8_t>(row);
     for (int col = c0; col <= c1; ++col) {
+      cv::Point2d g00, g01, g10, g11;  // undistorted pixel corners of this pixel
+      if (!grid.empty()) {
+        g00 = grid.at<cv::Point2d>(row, col);
+        g01 = grid.at<cv::Point2d>(row, col + 1);
+        g10 = grid.at<cv::Point2d>(row + 1, col);
+        g11 = grid.at<cv::Point2d>(row + 1, col + 1);
+      }
       double sum = 0, inside = 0;
       for (int j = 0; j < ss; ++j) {
-        const double y = row - 0.5 + (j + 0.5) / ss;
+        const double fy = (j + 0.5) / ss;
         for (int i = 0; i < ss; ++i) {
-          const double x = col - 0.5 + (i + 0.5) / ss;
+          const double fx = (i + 0.5) / ss;
+          double x = col - 0.5 + fx, y = row - 0.5 + fy;
+          if (!grid.empty()) {
+            const cv::Point2d u =
+                (g00 * (1 - fx) + g01 * fx) * (1 - fy) + (g10 * (1 - fx) + g11 * fx) * fy;
+            x = u.x;
+            y = u.y;
+          }
           const cv::Vec3d q = hi * cv::Vec3d(x, y, 1.0);
           const double u = q[0] / q[2], v = q[1] / q[2];
           // Texel (tc, tr) covers [tc-0.5, tc+0.5): nearest texel is floor(u + 0.5).
@@ -107,7 +180,7 @@ void render_tag(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, int 
   render_texture(
       img, bmp,
       texture_homography(in, pose, bmp.cols, bmp.rows, whole_m, whole_m, x_m, y_m, z_m, yaw_rad),
-      ss);
+      ss, &in);
 }
 
 void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uint8_t grey,
@@ -115,7 +188,8 @@ void render_rect(cv::Mat &img, const Intrinsics &in, const CameraPose &pose, uin
                  double yaw_rad, int ss) {
   const cv::Mat tex(1, 1, CV_8UC1, cv::Scalar(grey));
   render_texture(img, tex,
-                 texture_homography(in, pose, 1, 1, length_m, width_m, x_m, y_m, z_m, yaw_rad), ss);
+                 texture_homography(in, pose, 1, 1, length_m, width_m, x_m, y_m, z_m, yaw_rad), ss,
+                 &in);
 }
 
 CameraPose camera_look_at(const cv::Vec3d &eye_m, const cv::Vec3d &target_m,
@@ -140,7 +214,7 @@ cv::Mat render_checkerboard(const Intrinsics &in, const CameraPose &board_pose, 
   // [0, cols sq] x [0, rows sq] and its inner corners sit at (i sq, j sq), i, j >= 1.
   const cv::Matx33d tex_to_board(square_m, 0, -0.5 * square_m, 0, square_m, -0.5 * square_m, 0, 0,
                                  1);
-  render_texture(img, tex, render_plane_to_image(in, board_pose, 0.0) * tex_to_board, ss);
+  render_texture(img, tex, render_plane_to_image(in, board_pose, 0.0) * tex_to_board, ss, &in);
   return img;
 }
 

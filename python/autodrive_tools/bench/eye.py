@@ -2,7 +2,11 @@
 pose, LCM publish) on one thread, and OpenCV's aruco (DICT_APRILTAG_36h11) as the peer on the
 same frames, over a synthesised drive across the whole map (bin/eye_bench); then, when
 autodrive-sim is built, the Eye on the simulator's overhead camera against its ground truth
-(sim_* keys, autodrive_tools.bench.eye_sim). Speeds are medians over passes; *_cpu divide by
+(sim_* keys, autodrive_tools.bench.eye_sim). The *_wide_angle keys: a barrel lens (k1 -0.30,
+k2 0.10), dim light, vignetting, noise sigma 6, 10 cars with 18-40 px tags over the whole image,
+edges included; the Eye (whole-field plan) against the previous default (decimate-2 scans) and
+decimate 1 everywhere in the same run (fps ratios), with and without window tracking; and a
+camera bumped by 5 mm / 0.3 deg (bumped_camera_*). Speeds are medians over passes; *_cpu divide by
 thread CPU time instead of wall time (the machine is shared). Writes out/bench/eye_trajectory
 {.csv,.png} and eye_sim_trajectory{.csv,.png}. Progress on stderr; last line one JSON object.
 Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3), EYE_BENCH_SIM_S (30, 0: skip)."""
