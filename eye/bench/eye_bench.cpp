@@ -403,8 +403,6 @@ int main(int argc, char **argv) {
                  "only write a 640x480 scene to this folder (camera.yaml, map.yaml, eye.yaml "
                  "with --lcm-url, frame.jpg with NIGEL1 at x 1.2 m, y 0.9 m, yaw 0.5 rad) and "
                  "exit: the frames of tools/bench security");
-}
-
   bool wide_only = false;
   app.add_flag("--wide-only", wide_only,
                "only the wide-angle scene (10 cars) and the bumped camera");
