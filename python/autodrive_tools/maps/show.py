@@ -13,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import numpy.typing as npt  # noqa: E402
 from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 from PIL import Image  # noqa: E402
 
@@ -27,7 +28,7 @@ SIGN_COLOUR = "#1f77b4"
 SPAWN_COLOUR = "#9467bd"
 
 
-def _texture(m: MapDescription, tile: TileContent, maps_dir: Path) -> np.ndarray:
+def _texture(m: MapDescription, tile: TileContent, maps_dir: Path) -> npt.NDArray[np.uint8]:
     """A tile's texture: the generated file, or painted now (a map not yet generated)."""
     path = maps_dir / textures.DIR_NAME / f"{tile.texture}.png"
     if path.is_file():

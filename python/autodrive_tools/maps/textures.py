@@ -8,16 +8,18 @@ from __future__ import annotations
 
 import io
 import math
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from . import tiles
 from .model import Kit, Lane, SignKindKit, TileKit, TileSpec, Vec2
 
 DIR_NAME = "textures"
-Mask = np.ndarray  # a boolean image
+Mask = npt.NDArray[np.bool_]  # a boolean image
+Array = npt.NDArray[Any]  # an image or a field of distances [m]
 
 # 3 x 5 pixel glyphs for sign texts (no font files: the same bytes on every machine)
 GLYPHS = {
@@ -69,19 +71,19 @@ class _Canvas:
     def paint(self, mask: Mask, rgb: tuple[float, float, float]) -> None:
         self.rgb[mask] = rgb
 
-    def seg(self, a: Vec2, b: Vec2) -> np.ndarray:
+    def seg(self, a: Vec2, b: Vec2) -> Array:
         """Distance of every pixel from the segment a-b [m]."""
         ax, ay = b[0] - a[0], b[1] - a[1]
         den = ax * ax + ay * ay
         t = np.clip(((self.x - a[0]) * ax + (self.y - a[1]) * ay) / den, 0, 1)
         return np.asarray(np.hypot(a[0] + t * ax - self.x, a[1] + t * ay - self.y))
 
-    def along(self, a: Vec2, b: Vec2) -> np.ndarray:
+    def along(self, a: Vec2, b: Vec2) -> Array:
         """Distance along a-b from a of each pixel's projection [m] (for dashes)."""
         ln = math.dist(a, b)
         return np.asarray(((self.x - a[0]) * (b[0] - a[0]) + (self.y - a[1]) * (b[1] - a[1])) / ln)
 
-    def arc(self, centre: Vec2, r: float, a0: float, sweep: float) -> np.ndarray:
+    def arc(self, centre: Vec2, r: float, a0: float, sweep: float) -> Array:
         """Distance of every pixel from a circular arc (angles in rad, sweep may be < 0)."""
         lo, hi = (a0, a0 + sweep) if sweep > 0 else (a0 + sweep, a0)
         dx, dy = self.x - centre[0], self.y - centre[1]
@@ -110,7 +112,7 @@ def _lane_prims(lane: Lane) -> list[tuple[str, tuple[float, ...]]]:
     return out
 
 
-def _dist(cv: _Canvas, prims: list[tuple[str, tuple[float, ...]]], offset_m: float) -> np.ndarray:
+def _dist(cv: _Canvas, prims: list[tuple[str, tuple[float, ...]]], offset_m: float) -> Array:
     """Distance from a lane's centre line moved offset_m to its left (arcs change radius)."""
     d = np.full(cv.x.shape, np.inf)
     for kind, v in prims:
