@@ -15,9 +15,7 @@ MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
 
 
 def gen(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(GEN), *args], capture_output=True, text=True, timeout=60
-    )
+    return subprocess.run([str(GEN), *args], capture_output=True, text=True, timeout=60)
 
 
 class GeneratedFresh(unittest.TestCase):

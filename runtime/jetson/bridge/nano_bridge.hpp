@@ -40,9 +40,9 @@ struct Status {
   uint64_t rx_bad_crc = 0;        // frames whose CRC failed
   uint64_t rx_bad_length = 0;     // length byte above PROTO_MAX_PAYLOAD
   uint64_t rx_bad_payload = 0;    // good CRC but a HELLO/STATE/NACK that does not unpack
-  std::string last_refusal;  // the refusal message (names both schemas)
-  GateCounters control;      // the command gate's counters (as of the last CONTROL status)
-  std::string holder;        // the source holding the control lease, "" when none
+  std::string last_refusal;       // the refusal message (names both schemas)
+  GateCounters control;           // the command gate's counters (as of the last CONTROL status)
+  std::string holder;             // the source holding the control lease, "" when none
 };
 
 class NanoBridge {

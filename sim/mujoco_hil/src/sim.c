@@ -137,8 +137,8 @@ struct sim {
   uint64_t seed;                         /* of the current run (sim_create, sim_reset) */
   char script_spec[256];                 /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
-  traffic_lights_t tl;                   /* the map's lights (traffic_lights.h) */
-  route_driver_t *route;                 /* --script route:NAME (car 1), else NULL */
+  traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
+  route_driver_t *route; /* --script route:NAME (car 1), else NULL */
 };
 
 /* ---- sim HAL: what the firmware core sees as hardware --------------------------------- */
