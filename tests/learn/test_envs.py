@@ -41,12 +41,12 @@ def test_gym() -> None:
 
 def test_taken_slot_refused() -> None:
     try:
-        ParkingEnv(slot=99)  # Parking School has 6 slots
+        ParkingEnv(slot=5)  # Parking School's slot 5 holds a parked stand-in car
     except ValueError as e:
-        assert "slot" in str(e), str(e)
-        print(f"ParkingEnv refuses a slot the map lacks: {e}")
+        assert "parked car" in str(e) and "free slots" in str(e), str(e)
+        print(f"ParkingEnv refuses a taken slot: {e}")
         return
-    raise AssertionError("a slot the map lacks was accepted")
+    raise AssertionError("a slot with a parked car was accepted")
 
 
 def test_render() -> None:
