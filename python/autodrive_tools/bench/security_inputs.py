@@ -240,23 +240,22 @@ class Drive:
         self.k += 1
 
 
-def bench_estimator(build: Path, tmp: Path, progress: Callable[[str], None]) -> dict[str, Any]:
+def start_estimator(
+    build: Path, tmp: Path, log: Path, progress: Callable[[str], None]
+) -> tuple[Bus, Drive, proc.ProcessGroup]:
+    """The bench's bus and driver, and the runtime's estimator alone writing to log."""
     bus = Bus(build, RUNTIME_URL)
     drive = Drive(bus)
     bus.start()
     procs = proc.ProcessGroup(progress)
+    cmd = [build / "bin" / "autodrive-runtime", "--config", runtime_config(tmp)]
+    procs.start("autodrive-runtime", [*cmd, "--only", "estimator"], log)
+    return bus, drive, procs
+
+
+def bench_estimator(build: Path, tmp: Path, progress: Callable[[str], None]) -> dict[str, Any]:
     log = tmp / "runtime-ekf.log"
-    procs.start(
-        "autodrive-runtime",
-        [
-            build / "bin" / "autodrive-runtime",
-            "--config",
-            runtime_config(tmp),
-            "--only",
-            "estimator",
-        ],
-        log,
-    )
+    bus, drive, procs = start_estimator(build, tmp, log, progress)
     try:
         time.sleep(1.0)
         for phase, offset, n in (
@@ -290,22 +289,8 @@ def bench_estimator(build: Path, tmp: Path, progress: Callable[[str], None]) -> 
 
 
 def bench_log_flood(build: Path, tmp: Path, progress: Callable[[str], None]) -> dict[str, Any]:
-    bus = Bus(build, RUNTIME_URL)
-    drive = Drive(bus)
-    bus.start()
-    procs = proc.ProcessGroup(progress)
     log = tmp / "runtime-flood.log"
-    procs.start(
-        "autodrive-runtime",
-        [
-            build / "bin" / "autodrive-runtime",
-            "--config",
-            runtime_config(tmp),
-            "--only",
-            "estimator",
-        ],
-        log,
-    )
+    bus, drive, procs = start_estimator(build, tmp, log, progress)
     sources = [channel(c, VEHICLE) for c in ("STATE", "IMU", "POSE_EYE")]
     rng = random.Random(2)
     garbage = [bytes(rng.randrange(256) for _ in range(rng.randrange(1, 80))) for _ in range(64)]
