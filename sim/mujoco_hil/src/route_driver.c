@@ -1,6 +1,8 @@
 /* Route driver (see route_driver.h). */
 #include "route_driver.h"
 
+#include "route.h"
+
 #include <autodrive_vehicle.h>
 #include <math.h>
 #include <stdio.h>
@@ -32,48 +34,19 @@ int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, dou
              routes);
     return -1;
   }
-  const int sz = m->numeric_size[id];
-  const mjtNum *v = m->numeric_data + m->numeric_adr[id];
-  if (sz < 6 || sz % 2 != 0 || !(v[1] > 0) || (v[0] != 0 && v[0] != 1)) {
-    snprintf(err, err_sz,
-             "--script route:%s: numeric '%s' must be 'loop half_width_m x0 y0 x1 y1 ...' with "
-             "loop 0/1, half width > 0 and >= 2 points (%d values)",
-             name, key, sz);
+  route_t line; /* the numeric and its .partK continuations, read by route.c */
+  char rerr[256];
+  if (route_from_numeric(&line, m, id, 1, rerr, sizeof rerr) != 0) {
+    snprintf(err, err_sz, "--script route:%s: %s", name, rerr);
     return -1;
   }
   snprintf(r->name, sizeof r->name, "%s", name);
-  r->half_width_m = v[1];
-  /* a long route continues in route_<r>.part1, .part2, ... (MuJoCo's 500-value limit) */
-  int values = sz - 2, parts = 0;
-  for (;; parts++) {
-    char part[128];
-    snprintf(part, sizeof part, "%s.part%d", key, parts + 1);
-    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
-    if (pid < 0) break;
-    if (m->numeric_size[pid] % 2 != 0) {
-      snprintf(err, err_sz, "--script route:%s: numeric '%s' holds an odd number of values", name,
-               part);
-      return -1;
-    }
-    values += m->numeric_size[pid];
-  }
-  const int n = values / 2;
-  r->xy_m = malloc(sizeof(double) * (size_t)values);
-  if (!r->xy_m) {
-    snprintf(err, err_sz, "out of memory");
-    return -1;
-  }
-  int at = 0;
-  for (int k = 2; k < sz; k++) r->xy_m[at++] = v[k];
-  for (int p = 1; p <= parts; p++) {
-    char part[128];
-    snprintf(part, sizeof part, "%s.part%d", key, p);
-    const int pid = mj_name2id(m, mjOBJ_NUMERIC, part);
-    for (int k = 0; k < m->numeric_size[pid]; k++)
-      r->xy_m[at++] = m->numeric_data[m->numeric_adr[pid] + k];
-  }
+  r->half_width_m = line.half_width_m;
+  const int n = line.n, loop = line.loop;
+  r->xy_m = line.xy; /* the driver keeps the points; the arc lengths are pure pursuit's own */
+  free(line.s_m);
   char perr[256];
-  if (pp_path_init(&r->path, r->xy_m, n, v[0] != 0, perr, sizeof perr) != 0) {
+  if (pp_path_init(&r->path, r->xy_m, n, loop, perr, sizeof perr) != 0) {
     snprintf(err, err_sz, "--script route:%s: %s", name, perr);
     route_driver_free(r);
     return -1;
