@@ -15,8 +15,8 @@ from .paths import CHANNEL_TABLE
 
 VEH = "<VEH>"
 # Conditions of a channel's optional "when": published only on maps with traffic lights, or only
-# when someone acts (a command). "" = every run.
-WHEN = frozenset({"", "traffic_lights", "on_demand"})
+# when someone acts (a command), or only while the Smart City Manager runs. "" = every run.
+WHEN = frozenset({"", "traffic_lights", "on_demand", "smart_city"})
 
 
 class ChannelTableError(ValueError):
