@@ -14,8 +14,18 @@ import tempfile
 import time
 from pathlib import Path
 
-from harness import CarFeeder, LightWatch, Server, add_user, check, chromium, start_sim, wait_for
-from selenium.webdriver.common.action_chains import ActionChains
+from harness import (
+    CarFeeder,
+    LightWatch,
+    Server,
+    add_user,
+    check,
+    chromium,
+    click_light,
+    start_sim,
+    wait_for,
+)
+from harness import login_page as login
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
@@ -32,15 +42,6 @@ lc = lcmtypes.bus(url)
 feed_lc = lcmtypes.bus(url)
 
 
-def login(driver, base: str, name: str, password: str) -> None:  # type: ignore[no-untyped-def]
-    driver.get(base + "/")
-    WebDriverWait(driver, 20).until(lambda d: d.find_element(By.ID, "login-name").is_displayed())
-    driver.find_element(By.ID, "login-name").send_keys(name)
-    driver.find_element(By.ID, "login-password").send_keys(password)
-    driver.find_element(By.ID, "login-submit").click()
-    WebDriverWait(driver, 20).until(lambda d: d.find_element(By.ID, "app").is_displayed())
-
-
 def table(driver) -> dict[str, tuple[float, float, str]]:  # type: ignore[no-untyped-def]
     """The vehicle table as the page shows it (read in one script: it is redrawn at 10 Hz)."""
     rows = {}
@@ -52,17 +53,6 @@ def table(driver) -> dict[str, tuple[float, float, str]]:  # type: ignore[no-unt
         if len(cells) >= 6 and cells[1]:
             rows[cells[0]] = (float(cells[1]), float(cells[2]), cells[5])
     return rows
-
-
-def click_light(driver, light_id: int) -> None:  # type: ignore[no-untyped-def]
-    """A real click on the light's lamp on the map (W3C offsets are from the centre of the
-    canvas's visible part: the window is tall enough to show all of it)."""
-    canvas = driver.find_element(By.ID, "map")
-    u, v = driver.execute_script(f"return scm.lightPixel({light_id});")
-    w, h = canvas.size["width"], canvas.size["height"]
-    ActionChains(driver).move_to_element_with_offset(
-        canvas, int(u - w / 2), int(v - h / 2)
-    ).click().perform()
 
 
 with tempfile.TemporaryDirectory(prefix="scm-browser-") as tmp:

@@ -215,13 +215,13 @@ def create_app(scm: Scm) -> FastAPI:
 
     @app.get("/api/vehicles/{name}/history", tags=["vehicles"])
     def history(name: str, _: Viewer, limit: int = 500) -> list[dict[str, Any]]:
-        """The newest poses of a car's history (thinned), newest first."""
+        """The newest poses of a car's history (thinned), newest first; limit <= 100000."""
         with scm.sessions() as s:
             rows = s.scalars(
                 select(Pose)
                 .where(Pose.vehicle == name)
                 .order_by(Pose.id.desc())
-                .limit(max(1, min(limit, 10000)))
+                .limit(max(1, min(limit, 100000)))
             ).all()
             if not rows and name not in scm.cars:
                 raise HTTPException(404, f"no vehicle '{name}'")
@@ -233,6 +233,7 @@ def create_app(scm: Scm) -> FastAPI:
                     "yaw_rad": r.yaw_rad,
                     "speed_m_s": r.speed_m_s,
                     "source": r.source,
+                    "seq": r.seq,
                 }
                 for r in rows
             ]
@@ -248,9 +249,10 @@ def create_app(scm: Scm) -> FastAPI:
 
     @app.post("/api/poses", tags=["vehicles"])
     def ingest(body: PosesIn, user: Operator) -> dict[str, int]:
-        """Poses from a script; the answer comes only after they are committed to the database."""
+        """Poses from a script, all kept in the history; the answer comes only after they are
+        committed to the database (a 503 or no answer: not stored)."""
         for p in body.poses:
-            scm.pose(p.vehicle, p.utime, p.x_m, p.y_m, p.yaw_rad, p.speed_m_s, "rest", p.seq)
+            scm.pose(p.vehicle, p.utime, p.x_m, p.y_m, p.yaw_rad, p.speed_m_s, "rest", p.seq, True)
         done = threading.Event()
         scm.writer.ack(done)
         if not done.wait(timeout=30):

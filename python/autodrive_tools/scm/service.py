@@ -10,6 +10,7 @@ from __future__ import annotations
 import collections
 import json
 import math
+import queue
 import re
 import select
 import threading
@@ -26,6 +27,7 @@ from .db import sessions
 from .lights import STATES, Change, ControlError, Controller, Light, Program
 from .models import Light as LightRow
 from .models import Sign as SignRow
+from .receiver import Receiver
 from .roadnet import Ahead, Place, RoadNet
 from .store import Writer
 
@@ -89,6 +91,7 @@ class Scm:
         self.controller = self._make_controller()
         self.writer = Writer(self.sessions)
         self._stop = threading.Event()
+        self.receiver = Receiver(build, lcm_url, VEHICLE_PATTERN)
         self._threads: list[threading.Thread] = []
         self.lc = lcmtypes.bus(lcm_url)
         self.lc_out = lcmtypes.bus(lcm_url)  # publishing from the control thread
@@ -149,14 +152,13 @@ class Scm:
 
     def start(self) -> None:
         self.writer.start()
-        table = channels.load()
-        for cid, handler in (("POSE_EYE", self._on_eye), ("POSE_MAP", self._on_ekf)):
-            pattern = table.by_id(cid).name.replace(channels.VEH, VEHICLE_PATTERN)
-            self.lc.subscribe(pattern, handler)
+        self.receiver.start()  # before the threads below: a process of its own for the poses
         self.lc.subscribe(channels.channel("TRAFFIC_LIGHT_STATE"), self._on_light_state)
         self.lc.subscribe(channels.channel("V2V"), self._on_v2v)
         self.event("server", "start", "scm", {"map": self.map.name, "vehicles": self.vehicles})
-        for target, name in ((self._lcm_loop, "scm-lcm"), (self._control_loop, "scm-control")):
+        loops = ((self._lcm_loop, "scm-lcm"), (self._ingest_loop, "scm-ingest"),
+                 (self._control_loop, "scm-control"))  # fmt: skip
+        for target, name in loops:
             t = threading.Thread(target=target, name=name, daemon=True)
             t.start()
             self._threads.append(t)
@@ -165,6 +167,7 @@ class Scm:
         self._stop.set()
         for t in self._threads:
             t.join(timeout=5)
+        self.receiver.stop()
         self.event("server", "stop", "scm", {})
         self.writer.stop()
 
@@ -183,17 +186,16 @@ class Scm:
             self.stats["bad_messages"] += 1
             return None
 
-    def _on_eye(self, chan: str, data: bytes) -> None:
-        msg = self._decode(self.types.pose2d_t, data)
-        if msg is not None:
-            self.pose(chan.split("_", 1)[0], msg.utime, msg.x_m, msg.y_m, msg.yaw_rad, None, "eye")
-
-    def _on_ekf(self, chan: str, data: bytes) -> None:
-        msg = self._decode(self.types.odometry_t, data)
-        if msg is not None:
-            self.pose(
-                chan.split("_", 1)[0], msg.utime, msg.x_m, msg.y_m, msg.yaw_rad, msg.vx_m_s, "ekf"
-            )
+    def _ingest_loop(self) -> None:
+        """Poses from the receiver process, a batch at a time."""
+        while not self._stop.is_set():
+            try:
+                batch = self.receiver.queue.get(timeout=0.1)
+            except queue.Empty:
+                continue
+            with self.lock:
+                for source, vehicle, utime, x_m, y_m, yaw_rad, speed in batch:
+                    self.pose(vehicle, utime, x_m, y_m, yaw_rad, speed, source)
 
     def _on_v2v(self, _chan: str, data: bytes) -> None:
         msg = self._decode(self.types.v2v_state_t, data)
@@ -227,8 +229,10 @@ class Scm:
         speed_m_s: float | None,
         source: str,
         seq: int = -1,
+        keep: bool = False,
     ) -> None:
-        """One pose of a car (from LCM, or the REST ingest with source 'rest')."""
+        """One pose of a car (from LCM, or the REST ingest with source 'rest'); keep: into the
+        history whatever the thinning (a script's poses are all kept)."""
         if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
             self.stats["bad_messages"] += 1
             return
@@ -254,7 +258,7 @@ class Scm:
             if car.status != "ok":
                 car.status = "ok"
                 self.event("server", "vehicle_ok", vehicle, {"source": source})
-            keep = utime - car.kept_utime >= self.history_us or utime < car.kept_utime
+            keep = keep or utime - car.kept_utime >= self.history_us or utime < car.kept_utime
             if keep:
                 car.kept_utime = utime
                 self.writer.pose(
@@ -337,11 +341,11 @@ class Scm:
                         "server", "vehicle_stale", car.name, {"age_s": round(t - car.seen_s, 2)}
                     )
                 continue
+            if self.vehicles and car.name not in self.vehicles:
+                continue  # placed and advised: the listed cars only (others are only stored)
             last = car.place.lane if car.place else ""
             car.place = self.roadnet.place(car.x_m, car.y_m, car.yaw_rad, car.route, last)
             car.ahead = self.roadnet.ahead(car.place, car.route) if car.place else Ahead()
-            if self.vehicles and car.name not in self.vehicles:
-                continue
             msg = self.types.v2i_advisory_t()
             msg.utime, msg.seq, msg.vehicle = int(t * 1e6), car.seq, car.name
             car.seq += 1
@@ -479,6 +483,8 @@ class Scm:
                 "events": list(self.recent)[-30:],
                 "stats": {
                     **self.stats,
+                    "lcm_poses_received": int(self.receiver.counters[0]),
+                    "lcm_poses_undecodable": int(self.receiver.counters[1]),
                     "db_rows_written": self.writer.rows_written,
                     "db_errors": self.writer.errors,
                     "db_last_error": self.writer.last_error,

@@ -13,7 +13,10 @@ from typing import Any
 from sqlalchemy import insert, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from .models import Event, Light, Pose, Vehicle
+from .models import Base, Light, Vehicle
+
+POSES = Base.metadata.tables["poses"]
+EVENTS = Base.metadata.tables["events"]
 
 
 @dataclass
@@ -124,11 +127,11 @@ class Writer:
                 )
             if b.vehicles:
                 s.execute(update(Vehicle), [{"name": n, **v} for n, v in b.vehicles.items()])
-            if b.poses:
-                s.execute(insert(Pose), b.poses)
+            if b.poses:  # Core executemany: no ORM objects for the bulk of the rows
+                s.execute(insert(POSES), b.poses)
             if b.lights:
                 s.execute(update(Light), [{"id": i, **v} for i, v in b.lights.items()])
             if b.events:
-                s.execute(insert(Event), b.events)
+                s.execute(insert(EVENTS), b.events)
         self.known.update(new)
         self.rows_written += len(b.poses) + len(b.events)
