@@ -487,6 +487,7 @@ class Scm:
                     "lcm_poses_undecodable": int(self.receiver.counters[1]),
                     "db_rows_written": self.writer.rows_written,
                     "db_errors": self.writer.errors,
+                    "db_pending": self.writer.pending,
                     "db_last_error": self.writer.last_error,
                 },
             }

@@ -31,6 +31,9 @@ class Batch:
         return not (self.poses or self.vehicles or self.lights or self.events or self.acks)
 
 
+MAX_BATCH = 5000  # poses per transaction: commits (and acknowledgements) stay regular
+
+
 class Writer:
     def __init__(self, sessions: sessionmaker[Session], batch_s: float = 0.05) -> None:
         self.sessions = sessions
@@ -41,6 +44,7 @@ class Writer:
             self.known.update(s.scalars(select(Vehicle.name)))
         self.rows_written = 0
         self.errors = 0
+        self.in_flight = 0  # items of the batch being written
         self.last_error = ""
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="scm-writer", daemon=True)
@@ -51,6 +55,11 @@ class Writer:
     def stop(self) -> None:
         self._stop.set()
         self._thread.join(timeout=10)
+
+    @property
+    def pending(self) -> int:
+        """Items queued or being written, not yet committed."""
+        return self.q.qsize() + self.in_flight
 
     def pose(self, row: dict[str, Any]) -> None:
         self.q.put(("pose", row))
@@ -79,6 +88,8 @@ class Writer:
                 return b
             if kind == "pose":
                 b.poses.append(item)
+                if len(b.poses) >= MAX_BATCH:
+                    return b
             elif kind == "vehicle":
                 b.vehicles.setdefault(item[0], {}).update(item[1])
             elif kind == "light":
@@ -93,12 +104,15 @@ class Writer:
             b = self._collect()
             if b.empty():
                 continue
+            self.in_flight = len(b.poses) + len(b.events) + len(b.vehicles) + len(b.lights) + 1
             try:
                 self._write(b)
             except Exception as err:  # keep serving; the error is counted and shown in /api/status
                 self.errors += 1
                 self.last_error = f"{type(err).__name__}: {str(err).splitlines()[0]}"
                 continue
+            finally:
+                self.in_flight = 0
             for done in b.acks:
                 done.set()
 
