@@ -665,7 +665,7 @@ int main(int argc, char **argv) {
       if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
         snprintf(ch, sizeof ch, AUTODRIVE_VEHICLE_PREFIX "%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
-        sim_lidar_publish(lcm, ch, "laser", scan);
+        lcmpub_lidar(pubq, ch, "laser", scan);
       }
     }
     if (cams.n > 0 && now_us % cam_period_us < SIM_STEP_US &&
