@@ -87,6 +87,7 @@ static void main_usage(FILE *f) {
       "                      when the route does (one lap of a loop)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
+      "  --no-late-obstacles leave out the map's late_obstacles (--late-box boxes stay)\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
@@ -454,6 +455,8 @@ int main(int argc, char **argv) {
       cfg.open_ptys = 0;
     } else if (!strcmp(a, "--no-lidar")) {
       cfg.lidar = 0;
+    } else if (!strcmp(a, "--no-late-obstacles")) {
+      cfg.no_map_late_boxes = 1;
     } else if (!strcmp(a, "--no-lidar-lcm")) {
       lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {

@@ -452,13 +452,14 @@ static int sim_read_map_late_boxes(sim_t *s, const mjModel *mm, const char *path
 }
 
 /* The map alone must compile: its errors then name the map file, not the generated scene. */
+/* s: where the map's late obstacles go (NULL: leave them out). */
 static int sim_check_map(sim_t *s, const char *path, char *err, size_t err_sz) {
   if (access(path, R_OK) != 0)
     return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
   char merr[1000] = "";
   mjModel *mm = mj_loadXML(path, NULL, merr, sizeof merr);
   if (!mm) return sim_fail(err, err_sz, "bad map file '%s': %s", path, merr);
-  const int rc = sim_read_map_late_boxes(s, mm, path, err, err_sz);
+  const int rc = s ? sim_read_map_late_boxes(s, mm, path, err, err_sz) : 0;
   mj_deleteModel(mm);
   return rc;
 }
@@ -495,7 +496,7 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
-  if (sim_check_map(s, map_abs, err, err_sz) != 0) return -1;
+  if (sim_check_map(cfg->no_map_late_boxes ? NULL : s, map_abs, err, err_sz) != 0) return -1;
   mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;

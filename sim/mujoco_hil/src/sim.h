@@ -29,6 +29,7 @@ typedef struct sim_config {
   int open_ptys;           /* 1: Nano (and LIDAR) ptys with symlinks */
   const char *script;      /* NULL, or the scripted driver spec for every car (script.h) */
   int lidar;               /* 1: simulate the LIDAR */
+  int no_map_late_boxes;   /* 1: leave out the map's late_obstacles */
   int tyre_model;          /* -1: as the parameter file says, 0: MuJoCo friction, 1: paper */
   const scn_pose_t *start; /* NULL: car 1 at the map's "spawn" site; else at this pose */
   int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run (the
