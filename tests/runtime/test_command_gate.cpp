@@ -89,10 +89,10 @@ TEST(CommandAuth, KeyFilesAreCheckedAndNamed) {
   EXPECT_THROW(auth::load_key(path), autodrive::InputError);
 }
 
-// A gate with a 1 s replay window and a 300 ms lease; times in us.
+// A gate with a 1 s replay window and a 300 ms lease, started long ago; times in us.
 struct GateTest : ::testing::Test {
   auth::Key key = key_of(std::string(64, '7'));
-  bridge::CommandGate gate{key, "NIGEL1", 1000000, 300000};
+  bridge::CommandGate gate{key, "NIGEL1", 1000000, 300000, 0};
   auth::Signer autonomy{key, "NIGEL1", "autonomy", auth::kAuthorityMachine};
   auth::Signer policy{key, "NIGEL1", "policy", auth::kAuthorityMachine};
   auth::Signer teleop{key, "NIGEL1", "teleop", auth::kAuthorityPerson};
@@ -134,6 +134,23 @@ TEST_F(GateTest, ReplaysAndStaleCountersDropped) {
   EXPECT_EQ(gate.admit(later, 2000, later.counter + 2000000).drop, bridge::Drop::replay);  // old
   EXPECT_EQ(gate.admit(later, 2000, later.counter - 2000000).drop, bridge::Drop::replay);  // future
   EXPECT_EQ(gate.counters().dropped_replay, 3);
+}
+
+// A bridge that restarts knows no source's last counter: a replay of a command signed before it
+// started, still inside the window, must not pass as new (nor take the free lease).
+TEST_F(GateTest, ReplayOfACommandSignedBeforeARestartDropped) {
+  const auto before = cmd(autonomy, true);  // recorded by an attacker ...
+  EXPECT_EQ(admit(before, 0), bridge::Drop::none);
+  // the bridge restarts right after it was signed
+  bridge::CommandGate restarted{key, "NIGEL1", 1000000, 300000, before.counter};
+  const int64_t wall = before.counter + 200000;  // ... and the attacker replays it 0.2 s later
+  EXPECT_EQ(restarted.admit(before, 0, wall).drop, bridge::Drop::replay);
+  EXPECT_EQ(restarted.holder(), "");
+  // the source's next command (its counter only grows) passes and takes the lease
+  const auto fresh = cmd(autonomy, true);
+  EXPECT_EQ(restarted.admit(fresh, 1000, fresh.counter).drop, bridge::Drop::none);
+  EXPECT_EQ(restarted.holder(), "autonomy");
+  EXPECT_EQ(restarted.counters().dropped_replay, 1);
 }
 
 TEST_F(GateTest, FirstEngagedSourceTakesAFreeLeaseIdleOnesDoNot) {

@@ -374,11 +374,12 @@ TEST(Scenario, DrivingIntoTheLateBoxSetsTheCollisionFlag) {
 
 // A sim core with car 1 at start and one late box (in-process, no ptys, no LIDAR).
 struct ScenarioSim {
-  std::string dir = simtest::temp_dir(), prm = simtest::params_path(),
-              map = simtest::map_path("parking_school");
+  std::string dir = simtest::temp_dir(), prm = simtest::params_path(), map;
   sim_t *s = nullptr;
   std::string err;
-  ScenarioSim(const scn_pose_t &start, const scn_late_box_t &box) {
+  ScenarioSim(const scn_pose_t &start, const scn_late_box_t &box,
+              const char *map_name = "parking_school", int boxes = 1)
+      : map(simtest::map_path(map_name)) {
     sim_config_t cfg = {};
     cfg.params_path = prm.c_str();
     cfg.map_path = map.c_str();
@@ -387,8 +388,8 @@ struct ScenarioSim {
     cfg.seed = 1;
     cfg.tyre_model = -1;
     cfg.start = &start;
-    cfg.late_boxes = 1;
-    cfg.late_box = &box;
+    cfg.late_boxes = boxes;
+    cfg.late_box = boxes ? &box : nullptr;
     char e[1024] = "";
     s = sim_create(&cfg, e, sizeof e);
     if (s && sim_check_scenario(s, e, sizeof e) != 0) {
@@ -401,7 +402,8 @@ struct ScenarioSim {
     sim_destroy(s);
     rmdir(dir.c_str());
   }
-  int run_to(double t_s) {  // steps to t_s; returns how often box 0 appeared, -1 on error
+  // steps to t_s; returns how often box k appeared, -1 on error
+  int run_to(double t_s, int k = 0) {
     int appeared = 0;
     char e[512];
     while (sim_time_us(s) < (int64_t)llround(t_s * 1e6)) {
@@ -409,7 +411,7 @@ struct ScenarioSim {
         err = e;
         return -1;
       }
-      appeared += sim_late_box_appeared(s, 0, nullptr);
+      appeared += sim_late_box_appeared(s, k, nullptr);
     }
     return appeared;
   }
@@ -417,7 +419,7 @@ struct ScenarioSim {
 
 TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   const scn_pose_t start = {0.4, -2.0, 90.0};
-  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06, 0.0};
+  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, ""};
   ScenarioSim k(start, box);
   ASSERT_NE(k.s, nullptr) << k.err;
   ASSERT_EQ(k.run_to(0.5), 1) << k.err;
@@ -448,7 +450,7 @@ TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
 // With R, a box waits past its time until car 1 comes within R m, like one stepping out.
 TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   const scn_pose_t start = {0.4, -2.0, 90.0};
-  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0};
+  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0, 0.0, 0.0, ""};
   box.near_m = 0.25;  // the car starts 0.35 m away
   ScenarioSim k(start, box);
   ASSERT_NE(k.s, nullptr) << k.err;
@@ -470,7 +472,7 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
 
 TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   // in-process: the sim core with a late box 0.5 m ahead of car 1, appearing at 0.2 s
-  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0});
+  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, ""});
   ASSERT_NE(k.s, nullptr) << k.err;
   sim_t *s = k.s;
   const mjModel *m = sim_render_model(s);
@@ -496,6 +498,52 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   EXPECT_GT(after, 60) << "the camera does not see the box";
   sim_camera_destroy(cam);
   sim_render_destroy(rd);
+}
+
+// The map's late_obstacles (Tiny Town: late_box_1 at x -4.34, y 0.6 m, 0.15 m cube, appearing
+// at 20 s; late_box_0 when a car comes within 0.8 m): the sim adds them after the --late-box
+// ones, in the physics model (a ray at 7 cm height hits it only from its time on) and in the
+// render model. A sensor ray or a collision before that time finds nothing there.
+TEST(Scenario, TheMapsLateObstaclesAppearAtTheirTime) {
+  ScenarioSim k({-1.0, -0.5, 0.0}, scn_late_box_t{}, "tiny_town", 0);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  ASSERT_EQ(sim_late_boxes(k.s), 2);
+  int timed = -1, near = -1;
+  for (int i = 0; i < 2; i++) {
+    const scn_late_box_t *b = sim_late_box(k.s, i);
+    if (std::string(b->name) == "late_box_1") timed = i;
+    if (std::string(b->name) == "late_box_0") near = i;
+  }
+  ASSERT_GE(timed, 0);
+  ASSERT_GE(near, 0);
+  const scn_late_box_t *b = sim_late_box(k.s, timed);
+  EXPECT_NEAR(b->x_m, -4.34, 1e-9);
+  EXPECT_NEAR(b->y_m, 0.6, 1e-9);
+  EXPECT_NEAR(b->t_s, 20.0, 1e-9);
+  EXPECT_NEAR(b->half_z_m, 0.075, 1e-9);
+  EXPECT_NEAR(sim_late_box(k.s, near)->near_m, 0.8, 1e-9);
+  const mjModel *m = sim_model(k.s);
+  mjData *d = sim_data(k.s);
+  const mjtNum from[3] = {b->x_m - 0.5, b->y_m, 0.07}, dir[3] = {1, 0, 0};
+  auto hit_m = [&] {  // what a sensor ray towards the box finds, as the LIDAR casts [m]
+    int geom = -1;
+    const mjtNum r = mj_ray(m, d, from, dir, NULL, 1, -1, &geom);
+    return r < 0 ? 1e9 : r;
+  };
+  ASSERT_EQ(k.run_to(19.9, timed), 0) << k.err;
+  EXPECT_GT(hit_m(), 0.5) << "the box is there before its time";
+  ASSERT_EQ(k.run_to(20.1, timed), 1) << k.err;
+  EXPECT_NEAR(hit_m(), 0.5 - 0.075, 0.002) << "the box did not appear at its place";
+  // the render model shows it too (cameras and the Eye)
+  const mjModel *mv = sim_render_model(k.s);
+  const int body =
+      mj_name2id(mv, mjOBJ_BODY, ("scenario/late_box" + std::to_string(timed + 1)).c_str());
+  ASSERT_GE(body, 0);
+  EXPECT_NEAR(sim_render_data(k.s)->mocap_pos[3 * mv->body_mocapid[body] + 0], -4.34, 1e-9);
+  // the car never came within 0.8 m of late_box_0: it is still out of sight
+  const int nbody =
+      mj_name2id(m, mjOBJ_BODY, ("scenario/late_box" + std::to_string(near + 1)).c_str());
+  EXPECT_LT(d->mocap_pos[3 * m->body_mocapid[nbody] + 2], -1000.0);
 }
 
 }  // namespace

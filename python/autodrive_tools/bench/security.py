@@ -7,9 +7,10 @@ hostile publisher on the same bus, for the whole run, sends <VEH>_COMMAND
     authority);
   - replays of the autonomy's own signed commands, byte for byte, 0.1 s later.
 Figures:
-  unsigned_cmd_applied, replayed_cmd_applied  hostile commands of that kind on the recorded bus
-      (classified with the car's key) that the gate's <VEH>_CONTROL counters did not count as
-      dropped 0.5 s later, plus <VEH>_STATE samples with a hostile command applied
+  replayed_cmd_applied  commands the gate applied beyond those the signed sources had sent
+      (applied_beyond_sent: a replay, or any foreign command, applied shows there)
+  unsigned_cmd_applied, wrong_key_cmd_applied  <VEH>_STATE samples with that hostile
+      command's throttle and lock applied by the Nano
   foreign_source_takeover  changes of control to any source but the autonomy
   demo_success_under_attack  the mission parked without a collision; the demo's report counts
       the foreign commands (foreign_commands) and so says success: false
@@ -52,7 +53,6 @@ VEHICLE = channels.vehicle_name(1)
 HOSTILE_HZ = 50.0
 UNSIGNED_THROTTLE, WRONG_KEY_THROTTLE = 0.93, 0.87
 REPLAY_DELAY_S = 0.1
-CONTROL_LAG_S = 0.5  # what was sent this long before a CONTROL status must be counted in it
 log = Progress("security")
 
 
@@ -74,7 +74,6 @@ class Hostile:
         self.types, self.url, self.port, self.victim = types, lcm_url, port, victim
         self.channel = channels.channel("COMMAND", VEHICLE)
         self.sent = {"unsigned": 0, "unicast": 0, "bad_mac": 0, "replay": 0}
-        self.timeline: list[tuple[float, dict[str, int]]] = []  # (monotonic [s], sent so far)
         self.controls: list[tuple[float, Any]] = []  # (monotonic [s], control_status_t)
         self.holders: set[str] = set()
         self.wrong = command_auth.Signer(
@@ -108,7 +107,12 @@ class Hostile:
 
         def on_command(_ch: str, data: bytes) -> None:
             m = self.types.vehicle_command_t.decode(data)
-            if m.source == self.victim and data not in replayed and not self._stop.is_set():
+            if (
+                m.source == self.victim
+                and any(m.mac)  # its own forged "autonomy" commands are not the victim's
+                and data not in replayed
+                and not self._stop.is_set()
+            ):
                 replayed.add(data)
                 captured.append((time.monotonic() + REPLAY_DELAY_S, data))
 
@@ -145,39 +149,23 @@ class Hostile:
             while captured and captured[0][0] <= now:
                 lc.publish(self.channel, captured.pop(0)[1])
                 self.sent["replay"] += 1
-            self.timeline.append((now, dict(self.sent)))
         udp.close()
-
-    def sent_before(self, t: float) -> dict[str, int]:
-        last = {k: 0 for k in self.sent}
-        for ts, counts in self.timeline:
-            if ts > t:
-                break
-            last = counts
-        return last
-
-    def unaccounted(self) -> dict[str, int]:
-        """Per kind, the most hostile commands sent (CONTROL_LAG_S before a CONTROL status)
-        that the status does not count as dropped: 0 when the gate dropped every one."""
-        worst = {"unsigned": 0, "replay": 0, "bad_mac": 0}
-        for t, m in self.controls:
-            s = self.sent_before(t - CONTROL_LAG_S)
-            # unicast copies reach the bridge's socket or another one on the port: a drop
-            # counted for either kind of unsigned command is an unsigned command dropped
-            worst["unsigned"] = max(worst["unsigned"], s["unsigned"] - m.dropped_unsigned)
-            worst["replay"] = max(worst["replay"], s["replay"] - m.dropped_replay)
-            worst["bad_mac"] = max(worst["bad_mac"], s["bad_mac"] - m.dropped_bad_mac)
-        return worst
 
 
 HOSTILE_RUN = 5  # consecutive STATE samples: a legitimate slew passes these values, never stays
 
 
-def hostile_throttle_samples(log_path: Path, types: Any) -> int:
+def hostile_throttle_samples(
+    log_path: Path,
+    types: Any,
+    hostile: tuple[tuple[float, float], ...] = (
+        (UNSIGNED_THROTTLE, -1.0),
+        (WRONG_KEY_THROTTLE, 1.0),
+    ),
+) -> int:
     """<VEH>_STATE samples in runs of HOSTILE_RUN or more with a hostile command applied by the
-    Nano (its throttle and its full lock)."""
+    Nano (its throttle and its full lock; hostile: the (throttle, steering) pairs looked for)."""
     ch = channels.channel("STATE", VEHICLE)
-    hostile = ((UNSIGNED_THROTTLE, -1.0), (WRONG_KEY_THROTTLE, 1.0))
     n, run = 0, 0
     for ev in lcmtypes.events(log_path):
         if ev.channel == ch:
@@ -191,40 +179,61 @@ def hostile_throttle_samples(log_path: Path, types: Any) -> int:
     return n
 
 
-def log_unaccounted(log_path: Path, types: Any, key: bytes) -> dict[str, int]:
-    """From the recorded bus (lcm-logger: one process, one order): every <VEH>_COMMAND is
-    classified with the car's key (unsigned, bad signature, or a byte-for-byte repeat of an
-    earlier valid one); for each <VEH>_CONTROL, the commands of a kind logged CONTROL_LAG_S
-    before it that its counters do not count as dropped. The most over the run, per kind."""
+Command = tuple[int, str, int]  # (counter: the sender's wall clock [us], source, seq)
+
+
+def applied_beyond_sent(commands: list[Command], statuses: list[tuple[int, int]]) -> int:
+    """Commands the gate applied beyond those its signed sources had sent: the most over the
+    run. commands: every validly signed <VEH>_COMMAND on the recorded bus, originals and
+    byte-for-byte replays alike; statuses: (log time [us, wall clock], applied) of each
+    <VEH>_CONTROL. The sources and the logger share the machine's wall clock.
+
+    Each source numbers its messages (seq, one per message) and stamps them with its wall clock
+    (counter), both covered by the signature, and the gate applies a counter at most once. So
+    at a status logged at t the gate can have applied at most the commands sent before t: for
+    each source, fewer than the seq of its first command sent after t (the logged command with
+    the smallest counter above t, whether the logger kept the original or only a replay). A
+    command applied twice (a replay), or one without a valid signature, makes applied exceed
+    that. Why not compare the gate's drop counters with the commands logged some fixed time
+    before (the old way, which reported 20 unexplained replays): under load the bridge reads
+    the bus 1-4 s behind the logger, and both the logger and the bridge lose packets (a run
+    here: the logger kept 1713 of 2829 bad-signature commands and lost 35 of the autonomy's
+    1276 commands, 25 in a row, original and replay). This bound depends on neither."""
+    first: dict[str, tuple[int, int]] = {}  # source -> (counter, seq) of its first command
+    for counter, src, seq in commands:
+        first[src] = min(first.get(src, (counter, seq)), (counter, seq))
+    by_counter = sorted(commands)
+    worst = 0
+    for t, applied in statuses:
+        sent = 0
+        for src, (c0, s0) in first.items():
+            if c0 > t:
+                continue  # not started yet
+            after = next((seq for c, s, seq in by_counter if c > t and s == src), None)
+            if after is None:
+                sent = -1  # no command of it after the status was logged: no bound
+                break
+            sent += after - s0
+        if sent >= 0:
+            worst = max(worst, applied - sent)
+    return worst
+
+
+def log_applied_beyond_sent(log_path: Path, types: Any, key: bytes) -> int:
+    """applied_beyond_sent over the recorded bus: the validly signed <VEH>_COMMANDs (checked
+    with the car's key) and the applied count of every <VEH>_CONTROL."""
     ch_cmd, ch_control = (channels.channel(c, VEHICLE) for c in ("COMMAND", "CONTROL"))
-    seen: set[bytes] = set()
-    logged: list[tuple[int, str]] = []  # (log time [us], kind)
-    worst = {"unsigned": 0, "bad_mac": 0, "replay": 0}
+    commands: list[Command] = []
+    statuses: list[tuple[int, int]] = []
     for ev in lcmtypes.events(log_path):
         if ev.channel == ch_cmd:
             m = types.vehicle_command_t.decode(ev.data)
-            if not m.source or not m.authority or not any(m.mac):
-                logged.append((ev.timestamp, "unsigned"))
-            elif command_auth.mac_of(key, command_auth.canonical_bytes(m, VEHICLE)) != m.mac:
-                logged.append((ev.timestamp, "bad_mac"))
-            elif ev.data in seen:
-                logged.append((ev.timestamp, "replay"))
-            seen.add(ev.data)
+            if m.source and m.authority and any(m.mac):
+                if command_auth.mac_of(key, command_auth.canonical_bytes(m, VEHICLE)) == m.mac:
+                    commands.append((m.counter, m.source, m.seq))
         elif ev.channel == ch_control:
-            c = types.control_status_t.decode(ev.data)
-            cutoff = ev.timestamp - int(CONTROL_LAG_S * 1e6)
-            n = {k: 0 for k in worst}
-            for t, kind in logged:
-                if t <= cutoff:
-                    n[kind] += 1
-            dropped = {
-                "unsigned": c.dropped_unsigned,
-                "bad_mac": c.dropped_bad_mac,
-                "replay": c.dropped_replay,
-            }
-            for k in worst:
-                worst[k] = max(worst[k], n[k] - dropped[k])
-    return worst
+            statuses.append((ev.timestamp, types.control_status_t.decode(ev.data).applied))
+    return applied_beyond_sent(commands, statuses)
 
 
 def demo_under_attack(build: Path, out: Path, timeout_s: float, key: bytes) -> dict[str, Any]:
@@ -241,13 +250,18 @@ def demo_under_attack(build: Path, out: Path, timeout_s: float, key: bytes) -> d
     finally:
         hostile.stop()
     rep = json.loads((out / "report.json").read_text())
-    left = log_unaccounted(out / "run.lcmlog", types, key)
+    beyond = log_applied_beyond_sent(out / "run.lcmlog", types, key)
     state_hits = hostile_throttle_samples(out / "run.lcmlog", types)
+    # the bad-signature commands are the clock of the accounting: their own figure is what the
+    # Nano applied of them
+    wrong_key_hits = hostile_throttle_samples(
+        out / "run.lcmlog", types, ((WRONG_KEY_THROTTLE, 1.0),)
+    )
     takeovers = sorted(h for h in hostile.holders if h != "autonomy")
     return {
-        "unsigned_cmd_applied": left["unsigned"] + state_hits,
-        "replayed_cmd_applied": left["replay"],
-        "wrong_key_cmd_applied": left["bad_mac"],
+        "unsigned_cmd_applied": state_hits - wrong_key_hits,
+        "replayed_cmd_applied": beyond,
+        "wrong_key_cmd_applied": wrong_key_hits,
         "foreign_source_takeover": len(takeovers),
         "foreign_holders": takeovers,
         "demo_success_under_attack": bool(rep.get("mission_success"))

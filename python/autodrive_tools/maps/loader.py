@@ -24,6 +24,8 @@ TILE_JOIN_TOLERANCE_M = 0.001  # lanes of neighbouring tiles, and a route's lane
 TILE_JOIN_TOLERANCE_RAD = 0.001  # ... with the same heading (a smooth, tangent-continuous path)
 ON_LANE_TOLERANCE_M = 0.01  # a stop line's centre must be this close to its lane's centre line
 
+MAX_LATE_OBSTACLES = 8  # the simulator's SCN_MAX_MAP_LATE_BOXES (scenario.h)
+
 
 def names(maps_dir: Path = MAPS_DIR) -> list[str]:
     """The maps in a folder (default: the shipped ones): every <name>.yaml but kit.yaml."""
@@ -159,6 +161,12 @@ class _Checker:
             self.unique(f"parked_{p.slot}", f"parked[{i}].slot")
             if p.slot not in {s.name for s in m.slots()}:
                 raise self.err(f"parked[{i}].slot", f"no parking slot '{p.slot}'")
+        if len(m.late_obstacles) > MAX_LATE_OBSTACLES:
+            raise self.err(
+                "late_obstacles",
+                f"at most {MAX_LATE_OBSTACLES} (the simulator's SCN_MAX_MAP_LATE_BOXES), "
+                f"got {len(m.late_obstacles)}",
+            )
         for i, o in enumerate(m.late_obstacles):
             key = f"late_obstacles[{i}]"
             self.unique(o.name, f"{key}.name")

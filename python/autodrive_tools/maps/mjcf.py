@@ -237,6 +237,11 @@ class _Writer:
             out += _numeric_parts(f"route_{r.name}", [1.0 if r.loop else 0.0, r.half_width_m], pts)
         for sign in m.placed_signs():
             out.append(f'    <text name="{sign.name}_kind" data="{sign.kind}"/>')
+        for o in m.late_obstacles:  # the simulator adds these (mocap boxes) at their time
+            data = nums(
+                (*o.centre_m, o.yaw_rad, *o.size_m, o.appear_s or 0.0, o.trigger_radius_m or 0.0)
+            )
+            out.append(f'    <numeric name="late_{o.name}" data="{data}"/>')
         if out:
             self.lines += ["  <custom>", *out, "  </custom>"]
 

@@ -22,8 +22,12 @@ const char *drop_name(Drop d) {
 }
 
 CommandGate::CommandGate(const autodrive::auth::Key &key, std::string vehicle,
-                         int64_t replay_window_us, int64_t lease_us)
-    : key_(key), vehicle_(std::move(vehicle)), window_us_(replay_window_us), lease_us_(lease_us) {}
+                         int64_t replay_window_us, int64_t lease_us, int64_t start_wall_us)
+    : key_(key),
+      vehicle_(std::move(vehicle)),
+      window_us_(replay_window_us),
+      lease_us_(lease_us),
+      start_wall_us_(start_wall_us) {}
 
 Drop CommandGate::drop(Drop d, const std::string &source) {
   switch (d) {
@@ -56,9 +60,10 @@ CommandGate::Verdict CommandGate::admit(const autodrive::vehicle_command_t &c, i
     case autodrive::auth::MacCheck::bad_mac: v.drop = drop(Drop::bad_mac, c.source); return v;
     case autodrive::auth::MacCheck::ok: break;
   }
-  // Authentic from here on. Replays: a counter must be new for its source and near our clock.
+  // Authentic from here on. Replays: a counter must be new for its source (or, for a source
+  // not heard since the start, newer than the start) and near our clock.
   auto it = last_counter_.find(c.source);
-  if ((it != last_counter_.end() && c.counter <= it->second) ||
+  if ((it != last_counter_.end() && c.counter <= it->second) || c.counter <= start_wall_us_ ||
       std::llabs(c.counter - wall_us) > window_us_) {
     v.drop = drop(Drop::replay, c.source);
     return v;

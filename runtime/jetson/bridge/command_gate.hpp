@@ -1,7 +1,9 @@
 // The bridge's command gate: which <VEH>_COMMAND may drive the car. A command passes only when
 // it is signed with the car's key (autodrive::auth), its counter is newer than the last one of
-// its source and within the replay window of the wall clock, and its source holds the control
-// lease. Lease rules (after panda's "only the one who holds control may drive"):
+// its source, newer than the gate's start and within the replay window of the wall clock, and
+// its source holds the control lease. (Without the start rule a bridge that restarts, knowing
+// no source's last counter, took a replay of any command of the last window as new.) Lease rules
+// (after panda's "only the one who holds control may drive"):
 //  - the holder renews the lease with every valid command, engaged or not;
 //  - a free (or lapsed) lease goes to the first source that sends an engaged command;
 //  - a person (AUTHORITY_PERSON: the teleop dead-man) takes a live lease from a machine with an
@@ -35,9 +37,10 @@ struct GateCounters {
 class CommandGate {
  public:
   // replay_window_us: how far a counter may be from the wall clock [us]; lease_us: how long the
-  // holder keeps control without a valid command [us].
+  // holder keeps control without a valid command [us]; start_wall_us: the wall clock when the
+  // gate starts [us]: counters at or before it are refused as replays.
   CommandGate(const autodrive::auth::Key &key, std::string vehicle, int64_t replay_window_us,
-              int64_t lease_us);
+              int64_t lease_us, int64_t start_wall_us);
 
   struct Verdict {
     Drop drop = Drop::none;       // none: apply the command
@@ -57,7 +60,7 @@ class CommandGate {
 
   autodrive::auth::Key key_;
   std::string vehicle_;
-  int64_t window_us_, lease_us_;
+  int64_t window_us_, lease_us_, start_wall_us_;
   std::unordered_map<std::string, int64_t> last_counter_;  // per verified source
   std::string holder_;
   int8_t holder_authority_ = 0;

@@ -88,7 +88,8 @@ struct NanoBridge::Impl {
                                                  : c.bridge.command_key_file;
     try {
       gate.emplace(autodrive::auth::load_key(key_file), c.vehicle.name,
-                   c.bridge.replay_window_ms * 1000LL, c.bridge.command_lease_ms * 1000LL);
+                   c.bridge.replay_window_ms * 1000LL, c.bridge.command_lease_ms * 1000LL,
+                   clk::wall_us());
     } catch (const autodrive::InputError &e) {
       key_error = std::string("bridge.command_key_file: ") + e.what();
     }

@@ -50,3 +50,13 @@ int lcmpub_clock(lcmq_t *q, int64_t utime, double rtf, int paused) {
   lcmq_commit(q);
   return 0;
 }
+
+int lcmpub_lidar(lcmq_t *q, const char *channel, const char *frame_id,
+                 const sim_lidar_scan_t *scan) {
+  const int n = sim_lidar_encoded_size(frame_id, scan);
+  if (n <= 0) return -1;
+  uint8_t *out = lcmq_reserve(q, channel, (size_t)n);
+  if (!out || sim_lidar_encode(out, n, frame_id, scan) != n) return -1;
+  lcmq_commit(q);
+  return 0;
+}

@@ -37,13 +37,20 @@ static void *lcmq_run(void *arg) {
       q->worker_waiting = 0;
     }
     if (q->count == 0) break; /* stopped and drained */
-    lcmq_slot_t *sl = &q->slot[q->head];
+    /* Everything committed so far goes in one batch, with the lock released: one lock and
+     * unlock per batch rather than per message, so the stepping thread (which takes the lock
+     * to reserve and commit) seldom finds it held. */
+    const size_t head = q->head, batch = q->count;
     pthread_mutex_unlock(&q->mu); /* the producer never touches a committed slot */
-    const int rc = lcm_publish(q->lcm, sl->channel, sl->data, (unsigned)sl->len);
+    uint64_t failed = 0;
+    for (size_t i = 0; i < batch; i++) {
+      const lcmq_slot_t *sl = &q->slot[(head + i) % LCMQ_SLOTS];
+      if (lcm_publish(q->lcm, sl->channel, sl->data, (unsigned)sl->len) != 0) failed++;
+    }
     pthread_mutex_lock(&q->mu);
-    if (rc != 0) q->failures++;
-    q->head = (q->head + 1) % LCMQ_SLOTS;
-    q->count--;
+    q->failures += failed;
+    q->head = (head + batch) % LCMQ_SLOTS;
+    q->count -= batch;
     if (q->producer_waiting) pthread_cond_signal(&q->has_room);
   }
   pthread_mutex_unlock(&q->mu);

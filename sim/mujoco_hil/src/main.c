@@ -87,6 +87,7 @@ static void main_usage(FILE *f) {
       "                      when the route does (one lap of a loop)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
+      "  --no-late-obstacles leave out the map's late_obstacles (--late-box boxes stay)\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
@@ -454,6 +455,8 @@ int main(int argc, char **argv) {
       cfg.open_ptys = 0;
     } else if (!strcmp(a, "--no-lidar")) {
       cfg.lidar = 0;
+    } else if (!strcmp(a, "--no-late-obstacles")) {
+      cfg.no_map_late_boxes = 1;
     } else if (!strcmp(a, "--no-lidar-lcm")) {
       lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {
@@ -566,7 +569,7 @@ int main(int argc, char **argv) {
   main_cams_fx(&cams, camera_noise, camera_blur, cfg.seed);
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
   /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
-  tl_lcm_t *lights = tl_lcm_create(lcm, sim_traffic_lights(s), err, sizeof err);
+  tl_lcm_t *lights = tl_lcm_create(lcm, url, sim_traffic_lights(s), err, sizeof err);
   if (!lights && err[0]) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     main_cams_close(&cams);
@@ -665,7 +668,7 @@ int main(int argc, char **argv) {
       if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
         snprintf(ch, sizeof ch, AUTODRIVE_VEHICLE_PREFIX "%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
-        sim_lidar_publish(lcm, ch, "laser", scan);
+        lcmpub_lidar(pubq, ch, "laser", scan);
       }
     }
     if (cams.n > 0 && now_us % cam_period_us < SIM_STEP_US &&

@@ -146,16 +146,19 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom, i
   fprintf(f, "  </body>\n");
 }
 
-/* A --late-box obstacle: a mocap body (MuJoCo 2.2 cannot add bodies at run time) carrying a
- * box with the world's collision bits and surface, coloured apart from the map's boxes. */
+/* A late box (--late-box or the map's late_obstacles): a mocap body (MuJoCo 2.2 cannot add
+ * bodies at run time) carrying a box with the world's collision bits and surface, coloured
+ * apart from the map's boxes. */
 static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
-  fprintf(f, "  <body name=\"scenario/late_box%d\" mocap=\"true\" pos=\"0 0 %g\">\n", k,
-          MG_PARKED_Z_M);
+  fprintf(f,
+          "  <body name=\"scenario/late_box%d\" mocap=\"true\" pos=\"0 0 %g\" "
+          "euler=\"0 0 %.9g\">\n",
+          k, MG_PARKED_Z_M, b->yaw_rad);
   fprintf(f,
           "   <geom name=\"scenario/late_box%d\" type=\"box\" size=\"%.6g %.6g %.6g\" "
           "contype=\"1\" conaffinity=\"6\" friction=\"0.5 0.005 0.0001\" "
           "rgba=\"0.15 0.35 0.85 1\"/>\n",
-          k, b->half_x_m, b->half_y_m, 0.5 * SCN_LATE_BOX_HEIGHT_M);
+          k, b->half_x_m, b->half_y_m, scn_late_box_half_z(b));
   fprintf(f, "  </body>\n");
 }
 

@@ -27,7 +27,7 @@ typedef struct mg_options {
   const char *map_path;            /* absolute path of the map MJCF */
   const char *tag_asset_xml;       /* NULL, or <texture>/<material> elements of the roof tags */
   const char *const *tag_geom_xml; /* NULL, or per car the roof tag <geom> (NULL: plain plate) */
-  int late_boxes;                  /* 0..SCN_MAX_LATE_BOXES --late-box obstacles */
+  int late_boxes;                  /* --late-box obstacles and the map's late_obstacles */
   const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
   const char *texture_dir;         /* NULL: the map's folder; else where its textures are */
   int physics_only;                /* 1: without the cars' visual-only lamps and wheel discs */

@@ -129,13 +129,14 @@ struct sim {
   int has_start;
   scn_pose_t start;
   int nbox;
-  scn_late_box_t box[SCN_MAX_LATE_BOXES];
-  int box_mocap[SCN_MAX_LATE_BOXES];     /* index into mocap_pos */
-  int box_placed[SCN_MAX_LATE_BOXES];    /* has appeared */
-  int box_new[SCN_MAX_LATE_BOXES];       /* appeared during the last step */
-  int box_car_below[SCN_MAX_LATE_BOXES]; /* car it landed on (1-based), 0: none */
-  uint64_t seed;                         /* of the current run (sim_create, sim_reset) */
-  char script_spec[256];                 /* every car's scripted driver, "" for none */
+  /* --late-box boxes, then the map's late_obstacles */
+  scn_late_box_t box[SIM_MAX_BOXES];
+  int box_mocap[SIM_MAX_BOXES];     /* index into mocap_pos */
+  int box_placed[SIM_MAX_BOXES];    /* has appeared */
+  int box_new[SIM_MAX_BOXES];       /* appeared during the last step */
+  int box_car_below[SIM_MAX_BOXES]; /* car it landed on (1-based), 0: none */
+  uint64_t seed;                    /* of the current run (sim_create, sim_reset) */
+  char script_spec[256];            /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
   traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
   route_driver_t *route; /* --script route:NAME (car 1), else NULL */
@@ -328,11 +329,11 @@ static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
 static void sim_box_prism(const scn_late_box_t *b, cl_prism_t *out) {
   out->centre_m[0] = b->x_m;
   out->centre_m[1] = b->y_m;
-  out->yaw_rad = 0.0;
+  out->yaw_rad = b->yaw_rad;
   out->half_m[0] = b->half_x_m;
   out->half_m[1] = b->half_y_m;
   out->z_lo_m = SIM_GROUND_CLEARANCE_M;
-  out->z_hi_m = SCN_LATE_BOX_HEIGHT_M;
+  out->z_hi_m = 2.0 * scn_late_box_half_z(b);
 }
 
 int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
@@ -357,8 +358,12 @@ int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
     const scn_late_box_t *b = &s->box[k];
     sim_box_prism(b, &pr);
     if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
-    snprintf(err, err_sz, "--late-box '%g,%g,%g,%g,%g': the box %s", b->x_m, b->y_m, b->t_s,
-             b->half_x_m, b->half_y_m, why);
+    if (b->name[0])
+      snprintf(err, err_sz, "map late obstacle '%s' at x %g, y %g m: the box %s", b->name, b->x_m,
+               b->y_m, why);
+    else
+      snprintf(err, err_sz, "--late-box '%g,%g,%g,%g,%g': the box %s", b->x_m, b->y_m, b->t_s,
+               b->half_x_m, b->half_y_m, why);
     return -1;
   }
   return 0;
@@ -377,7 +382,7 @@ static void sim_place_late_boxes(sim_t *s) {
     mjtNum *pos = s->d->mocap_pos + 3 * s->box_mocap[k];
     pos[0] = b->x_m;
     pos[1] = b->y_m;
-    pos[2] = 0.5 * SCN_LATE_BOX_HEIGHT_M;
+    pos[2] = scn_late_box_half_z(b);
     if (s->box_placed[k]) continue;
     s->box_placed[k] = s->box_new[k] = 1;
     cl_prism_t bp, cp;
@@ -409,15 +414,54 @@ static int sim_fail(char *err, size_t err_sz, const char *fmt, const char *a, co
   return -1;
 }
 
+/* The map's late_obstacles (tools/gen-maps writes each as the custom numeric late_<name>:
+ * x y yaw [m, rad], full sizes x y z [m], appear_s [s] or 0, trigger_radius_m [m] or 0) join
+ * the --late-box boxes, after them. */
+static int sim_read_map_late_boxes(sim_t *s, const mjModel *mm, const char *path, char *err,
+                                   size_t err_sz) {
+  int found = 0;
+  for (int i = 0; i < mm->nnumeric; i++) {
+    const char *name = mm->names + mm->name_numericadr[i];
+    if (strncmp(name, "late_", 5) != 0) continue;
+    if (++found > SCN_MAX_MAP_LATE_BOXES) {
+      snprintf(err, err_sz, "map file '%s': more than %d late obstacles", path,
+               SCN_MAX_MAP_LATE_BOXES);
+      return -1;
+    }
+    const mjtNum *v = mm->numeric_data + mm->numeric_adr[i];
+    if (mm->numeric_size[i] != 8 || !(v[3] > 0 && v[4] > 0 && v[5] > 0) || v[6] < 0 || v[7] < 0) {
+      snprintf(err, err_sz,
+               "map file '%s': numeric '%s' must be x y yaw sx sy sz appear_s trigger_radius_m "
+               "(sizes > 0, times and radius >= 0)",
+               path, name);
+      return -1;
+    }
+    scn_late_box_t *b = &s->box[s->nbox++];
+    memset(b, 0, sizeof *b);
+    snprintf(b->name, sizeof b->name, "%s", name + 5);
+    b->x_m = v[0];
+    b->y_m = v[1];
+    b->yaw_rad = v[2];
+    b->half_x_m = 0.5 * v[3];
+    b->half_y_m = 0.5 * v[4];
+    b->half_z_m = 0.5 * v[5];
+    b->t_s = v[6];
+    b->near_m = v[7];
+  }
+  return 0;
+}
+
 /* The map alone must compile: its errors then name the map file, not the generated scene. */
-static int sim_check_map(const char *path, char *err, size_t err_sz) {
+/* s: where the map's late obstacles go (NULL: leave them out). */
+static int sim_check_map(sim_t *s, const char *path, char *err, size_t err_sz) {
   if (access(path, R_OK) != 0)
     return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
   char merr[1000] = "";
   mjModel *mm = mj_loadXML(path, NULL, merr, sizeof merr);
   if (!mm) return sim_fail(err, err_sz, "bad map file '%s': %s", path, merr);
+  const int rc = s ? sim_read_map_late_boxes(s, mm, path, err, err_sz) : 0;
   mj_deleteModel(mm);
-  return 0;
+  return rc;
 }
 
 /* Writes the roof tag PNGs into the scene dir and collects their MJCF snippets. */
@@ -449,11 +493,11 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
 }
 
 static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) {
-  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
-  if (sim_check_map(map_abs, err, err_sz) != 0) return -1;
+  if (sim_check_map(cfg->no_map_late_boxes ? NULL : s, map_abs, err, err_sz) != 0) return -1;
+  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;
   int rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);

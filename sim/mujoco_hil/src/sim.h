@@ -29,9 +29,11 @@ typedef struct sim_config {
   int open_ptys;           /* 1: Nano (and LIDAR) ptys with symlinks */
   const char *script;      /* NULL, or the scripted driver spec for every car (script.h) */
   int lidar;               /* 1: simulate the LIDAR */
+  int no_map_late_boxes;   /* 1: leave out the map's late_obstacles */
   int tyre_model;          /* -1: as the parameter file says, 0: MuJoCo friction, 1: paper */
   const scn_pose_t *start; /* NULL: car 1 at the map's "spawn" site; else at this pose */
-  int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run */
+  int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run (the
+                            * map's late_obstacles come on top, after them) */
   const scn_late_box_t *late_box;
   /* Host link service period [ms of sim time, = steps]: the ptys are read and written every
    * this many steps. 0 or 1: every step (real time, --rtf, --lockstep-client). Larger batches
@@ -129,9 +131,11 @@ struct sim_lidar_scan;
 const struct sim_lidar_scan *sim_lidar_new_scan(const sim_t *s, int car);
 /* 1 while a client (the runtime's RPLIDAR driver) is scanning on car's emulated RPLIDAR pty. */
 int sim_lidar_pty_scanning(const sim_t *s, int car);
-/* Late boxes (k 0-based): the count, and 1 when box k appeared on the floor during the last
- * sim_step; then *car_below (if non-NULL) is the first car (1-based) whose footprint it
- * landed on, or 0. A box stays on the floor once it has appeared (also after a reset). */
+#define SIM_MAX_BOXES (SCN_MAX_LATE_BOXES + SCN_MAX_MAP_LATE_BOXES)
+/* Late boxes (k 0-based; the --late-box ones, then the map's late_obstacles): the count, and
+ * 1 when box k appeared on the floor during the last sim_step; then *car_below (if non-NULL)
+ * is the first car (1-based) whose footprint it landed on, or 0. A box stays on the floor once
+ * it has appeared (also after a reset). */
 int sim_late_boxes(const sim_t *s);
 const scn_late_box_t *sim_late_box(const sim_t *s, int k);
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below);

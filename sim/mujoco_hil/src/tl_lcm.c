@@ -1,6 +1,8 @@
 /* Traffic lights on LCM (see tl_lcm.h). */
 #include "tl_lcm.h"
 
+#include "lcm_rxfilter.h"
+
 #include <autodrive_channels.h>
 #include <autodrive_traffic_light_command_t.h>
 #include <autodrive_traffic_light_state_t.h>
@@ -46,7 +48,8 @@ static void tl_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
     if (k->t->light[i].changed) tl_lcm_send(k, &k->t->light[i], k->now_us);
 }
 
-tl_lcm_t *tl_lcm_create(lcm_t *lcm, traffic_lights_t *t, char *err, size_t err_sz) {
+tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, char *err,
+                        size_t err_sz) {
   if (t->n == 0) return NULL;
   tl_lcm_t *k = calloc(1, sizeof *k);
   if (!k) {
@@ -62,6 +65,9 @@ tl_lcm_t *tl_lcm_create(lcm_t *lcm, traffic_lights_t *t, char *err, size_t err_s
     free(k);
     return NULL;
   }
+  char why[256];
+  if (lcmrx_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why, sizeof why) < 0)
+    fprintf(stderr, "[autodrive-sim] %s: receiving every message on the bus instead\n", why);
   return k;
 }
 

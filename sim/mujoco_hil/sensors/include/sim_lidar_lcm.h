@@ -2,6 +2,8 @@
 #ifndef SIM_LIDAR_LCM_H
 #define SIM_LIDAR_LCM_H
 
+#include <stdint.h>
+
 #include <lcm/lcm.h>
 
 #include "sim_lidar.h"
@@ -14,6 +16,12 @@ extern "C" {
  * Returns lcm_publish's result (0 on success), -1 on an empty scan. */
 int sim_lidar_publish(lcm_t *lcm, const char *channel, const char *frame_id,
                       const sim_lidar_scan_t *scan);
+
+/* The same message encoded, for a publisher of its own (a queue off the stepping thread):
+ * its size in bytes (-1 on an empty scan), and the encoding into buf of that size (returns
+ * the bytes written, or -1). */
+int sim_lidar_encoded_size(const char *frame_id, const sim_lidar_scan_t *scan);
+int sim_lidar_encode(uint8_t *buf, int size, const char *frame_id, const sim_lidar_scan_t *scan);
 
 #ifdef __cplusplus
 }
