@@ -33,6 +33,7 @@ class ExpertRun:
     camera_fps: float = 15.0  # [Hz] of sim time
     camera_noise: float = 2.0  # sigma [8-bit levels]: the training condition's sensor noise
     light_level: float = 1.0  # day
+    duration_s: float = 0.0  # [s] of sim time: stop early (0: when the laps are done)
 
 
 def meta_path(log: Path) -> Path:
@@ -69,7 +70,7 @@ def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
         "--seed", str(run.seed),
         "--lcm-url", url,
         "--run-dir", str(run_dir),
-    ]  # fmt: skip
+    ] + (["--duration", f"{run.duration_s:g}", "--quiet"] if run.duration_s > 0 else [])  # fmt: skip
 
 
 def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: str = "") -> float:
