@@ -64,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument(
         "--samples-per-epoch", type=int, default=0, help="drawn per epoch (0: training frames)"
     )
+    t.add_argument("--stride", type=int, default=1, help="use every N-th frame")
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -115,7 +116,7 @@ def _run(args: argparse.Namespace) -> int:
         cfg = TrainConfig(
             epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed, name=args.name,
             threads=args.threads, max_frames=args.max_frames,
-            samples_per_epoch=args.samples_per_epoch,
+            samples_per_epoch=args.samples_per_epoch, stride=args.stride,
         )  # fmt: skip
         train(args.dataset, args.out, cfg)
         return 0

@@ -22,6 +22,11 @@ def log(msg: str) -> None:
     print(f"pilot make-model: {msg}", file=sys.stderr, flush=True)
 
 
+# the training recipe of the shipped model: every 2nd frame, 4 epochs of 2560 draws
+STRIDE = 2
+SAMPLES_PER_EPOCH = 2560
+
+
 def make_model(
     out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
     build: Path,
@@ -44,7 +49,13 @@ def make_model(
     report = train(
         run_dir / "dataset",
         run_dir / "model",
-        TrainConfig(epochs=epochs, seed=train_seed, name=name),
+        TrainConfig(
+            epochs=epochs,
+            seed=train_seed,
+            name=name,
+            stride=STRIDE,
+            samples_per_epoch=SAMPLES_PER_EPOCH,
+        ),
     )
     times["train_s"] = time.monotonic() - t2
     t3 = time.monotonic()

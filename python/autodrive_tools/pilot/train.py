@@ -55,6 +55,7 @@ class TrainConfig:
     threads: int = 2
     max_frames: int = 0  # 0: all (tests train on a few)
     samples_per_epoch: int = 0  # 0: as many as training frames
+    stride: int = 1  # every stride-th frame (neighbours at 15-30 Hz are near duplicates)
 
 
 def log(msg: str) -> None:
@@ -80,7 +81,8 @@ def shift_gain_per_px(manifest: dict[str, Any], spec: InputSpec) -> float:
 
 def _split(laps: npt.NDArray[np.int64], cfg: TrainConfig) -> tuple[list[int], list[int]]:
     uniq, counts = np.unique(laps, return_counts=True)
-    full = [int(u) for u, c in zip(uniq, counts) if c >= 0.2 * np.median(counts)]
+    # whole laps only (a recording's first and last laps can be partial): validation sets
+    full = [int(u) for u, c in zip(uniq, counts) if c >= 0.8 * np.median(counts)]
     if len(full) < 2:
         raise ValueError(
             f"the dataset has {len(full)} whole lap(s): validation by lap needs at least 2"
@@ -105,6 +107,7 @@ def train(
     rows = [
         r for r in ds.rows if _f(r["throttle"]) > 0 and not (_f(r["speed_m_s"]) <= MIN_SPEED_M_S)
     ]
+    rows = rows[:: max(1, cfg.stride)]
     if cfg.max_frames:
         rows = rows[: cfg.max_frames]
     if not rows:
@@ -218,6 +221,8 @@ def train(
         "epochs": cfg.epochs,
         "lr": cfg.lr,
         "batch": cfg.batch,
+        "samples_per_epoch": n_batches * cfg.batch,
+        "stride": cfg.stride,
         "optimiser": "Adam",
         "loss": "MSE of normalised steering",
         "train_loss": [round(v, 6) for v in history["train"]],
@@ -274,7 +279,8 @@ def report_md(r: dict[str, Any]) -> str:
         f"({r['train_frames']} training, laps {r['train_laps']}; {r['val_frames']} validation, "
         f"laps {r['val_laps']})",
         f"- recorded in: {json.dumps(r['conditions'])}",
-        f"- seed {r['seed']} (dataset seed {r['dataset_seed']}); {r['epochs']} epochs, "
+        f"- seed {r['seed']} (dataset seed {r['dataset_seed']}); {r['epochs']} epochs of "
+        f"{r['samples_per_epoch']} balanced, augmented draws (every {r['stride']}. frame), "
         f"{r['optimiser']} lr {r['lr']}, batch {r['batch']}, {r['loss']}",
         f"- train loss per epoch: {r['train_loss']}",
         f"- validation loss per epoch: {r['val_loss']} (untrained {r['val_loss_untrained']}); "
