@@ -73,9 +73,9 @@ static double route_driver_perturbation(route_driver_t *r) {
   if (r->perturb <= 0.0) return 0.0;
   const long u = r->updates;
   if (u == r->perturb_next) {
-    const long len = ROUTE_PERTURB_MIN_UPDATES +
-                     (long)(rng_uniform(&r->rng) *
-                            (ROUTE_PERTURB_MAX_UPDATES - ROUTE_PERTURB_MIN_UPDATES + 1));
+    const long len =
+        ROUTE_PERTURB_MIN_UPDATES +
+        (long)(rng_uniform(&r->rng) * (ROUTE_PERTURB_MAX_UPDATES - ROUTE_PERTURB_MIN_UPDATES + 1));
     const long gap = ROUTE_PERTURB_GAP_MIN_UPDATES +
                      (long)(rng_uniform(&r->rng) *
                             (ROUTE_PERTURB_GAP_MAX_UPDATES - ROUTE_PERTURB_GAP_MIN_UPDATES + 1));

@@ -38,14 +38,14 @@ typedef struct route_driver {
   pp_state_t st;
   double speed; /* throttle, fraction of top speed */
   double lookahead_m;
-  int laps;                 /* a loop's laps before done */
-  double perturb;           /* perturbation amplitude, normalised steering (0: none) */
-  rng_t rng;                /* the perturbations' (seeded) */
-  long updates;             /* calls to route_driver_update so far */
-  long perturb_next;        /* update at which the next perturbation starts */
-  long perturb_end;         /* update at which the current one ends */
-  double perturb_offset;    /* current offset, normalised steering */
-  double expert_steering;   /* pure pursuit's last command before any perturbation [-1, 1] */
+  int laps;               /* a loop's laps before done */
+  double perturb;         /* perturbation amplitude, normalised steering (0: none) */
+  rng_t rng;              /* the perturbations' (seeded) */
+  long updates;           /* calls to route_driver_update so far */
+  long perturb_next;      /* update at which the next perturbation starts */
+  long perturb_end;       /* update at which the current one ends */
+  double perturb_offset;  /* current offset, normalised steering */
+  double expert_steering; /* pure pursuit's last command before any perturbation [-1, 1] */
   /* cross-track statistics over every update while driving [m] */
   double sum_sq_m2, max_abs_m;
   long samples;

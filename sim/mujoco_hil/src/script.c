@@ -36,7 +36,8 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     snprintf(buf, sizeof buf, "%s", spec + strlen(route));
     tok = strtok_r(buf, ",", &save);
     if (!tok || strchr(tok, '=') || strlen(tok) >= sizeof s->route_name) {
-      snprintf(err, err_sz, "--script '%s': expected "
+      snprintf(err, err_sz,
+               "--script '%s': expected "
                "route:NAME[,speed=F][,start=s][,lookahead=m][,laps=N][,perturb=A]",
                spec);
       return -1;
