@@ -63,9 +63,14 @@ def main() -> None:
             want = torch_net(torch.from_numpy(x)).numpy()
         diff = float(np.max(np.abs(got - want)))
         assert diff < 1e-4, diff
-        for f in ("loss.png", "steering_hist.png", "report.json", "report.md"):
+        for f in (
+            "loss.png",
+            "steering_hist.png",
+            f"{cfg.name}_report.json",
+            f"{cfg.name}_report.md",
+        ):
             assert (d / "model" / f).stat().st_size > 0, f
-        res = analyse(onnx, d / "ds", d / "analysis", samples=2)
+        res = analyse(onnx, d / "ds", d / "analysis", samples=1)
         assert res["frames"] == 60 and res["lap"] in report["val_laps"]
         for f in res["figures"]:
             assert (d / "analysis" / f).stat().st_size > 1000, f

@@ -78,7 +78,7 @@ def make_model(
     ] = f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
     (out / f"{name}_report.json").write_text(json.dumps(full, indent=2) + "\n")
     md = (
-        (run_dir / "model" / "report.md")
+        (run_dir / "model" / f"{name}_report.md")
         .read_text()
         .replace("](loss.png)", f"]({figs.name}/loss.png)")
     )

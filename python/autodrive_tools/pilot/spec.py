@@ -1,4 +1,4 @@
-"""The model's input contract (/work/wt/CONTRACT-demos.md, "Cloning model"): the JSON sidecar
+"""The model's input contract with the C++ `autodrive-pilot` ("Cloning model"): the JSON sidecar
 `NAME.json` beside `NAME.onnx` is the one place of the preprocessing. Training, analysis and
 the C++ `autodrive-pilot` all apply exactly what it says:
 

@@ -5,7 +5,8 @@ Frames of a moving car only (speed > MIN_SPEED_M_S, throttle > 0). Validation is
 drawn balanced (augment.balance_weights) and augmented per draw; the loss is the MSE of the
 normalised steering; Adam, 4 epochs at 1e-3 by default (the paper's). Everything is seeded
 (numpy, torch, the lap choice). Writes into --out: NAME.onnx, NAME.json (the sidecar),
-NAME.pt (weights, for analysis), loss.png, steering_hist.png, report.json and report.md."""
+NAME.pt (weights, for analysis), loss.png, steering_hist.png and the training report
+(NAME_report.json, NAME_report.md)."""
 
 from __future__ import annotations
 
@@ -244,8 +245,8 @@ def train(
     plots.losses(out / "loss.png", history, n_batches)
     plots.steering_hist(out / "steering_hist.png", steer[idx_train], np.array(drawn_steer))
     report = {"config": asdict(cfg), "input": asdict(spec), **trained}
-    (out / "report.json").write_text(json.dumps(report, indent=2) + "\n")
-    (out / "report.md").write_text(report_md(report))
+    (out / f"{cfg.name}_report.json").write_text(json.dumps(report, indent=2) + "\n")
+    (out / f"{cfg.name}_report.md").write_text(report_md(report))
     log(
         f"done in {wall_s:.0f} s: val loss {history['val'][-1] if history['val'] else v0:.5f}; "
         f"{onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB), OpenCV DNN vs torch "
