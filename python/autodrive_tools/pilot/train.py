@@ -6,7 +6,7 @@ drawn balanced (augment.balance_weights) and augmented per draw; the loss is the
 normalised steering; Adam, 4 epochs at 1e-3 by default (the paper's). Everything is seeded
 (numpy, torch, the lap choice). Writes into --out: NAME.onnx, NAME.json (the sidecar),
 NAME.pt (weights, for analysis), loss.png, steering_hist.png and the training report
-(NAME_report.json, NAME_report.md)."""
+(NAME_report.json and its markdown)."""
 
 from __future__ import annotations
 
