@@ -81,16 +81,20 @@ static void main_usage(FILE *f) {
       "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
       "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
       "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
-      "                      or route:NAME[,speed=F][,start=s][,lookahead=M]: pure pursuit on\n"
-      "                      the map's route NAME at F of top speed (default %g), lookahead M\n"
-      "                      [m] (default %g), from the route's start (--cars 1); the run ends\n"
-      "                      when the route does (one lap of a loop)\n"
+      "                      or route:NAME[,speed=F][,start=s][,lookahead=M][,laps=N]\n"
+      "                      [,perturb=A]: pure pursuit on the map's route NAME at F of top\n"
+      "                      speed (default %g), lookahead M [m] (default %g), from the\n"
+      "                      route's start (--cars 1); the run ends when the route does (N\n"
+      "                      laps of a loop, default 1); A > 0 adds seeded steering\n"
+      "                      perturbations up to A (normalised) now and then (expert\n"
+      "                      recordings with recoveries, tools/pilot)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
       "  --no-late-obstacles leave out the map's late_obstacles (--late-box boxes stay)\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
+      "  --front-camera      render only each car's front camera (half the rendering)\n"
       "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
@@ -225,6 +229,8 @@ static void main_report_late_boxes(const sim_t *s) {
 }
 
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
+#define MAIN_CAMERAS_ALL 1   /* --cameras: front and rear */
+#define MAIN_CAMERAS_FRONT 2 /* --front-camera: front only */
 #define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
 typedef struct main_cams {
   int n;
@@ -256,7 +262,7 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
-    for (int rear = 0; rear < 2; rear++) {
+    for (int rear = 0; rear < (cameras == MAIN_CAMERAS_FRONT ? 1 : 2); rear++) {
       char name[48], frame[48];
       snprintf(name, sizeof name, "nigel%d/cam_%s", c, rear ? "rear" : "front");
       snprintf(frame, sizeof frame, "camera_%s", rear ? "rear" : "front");
@@ -460,7 +466,9 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--no-lidar-lcm")) {
       lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {
-      cameras = 1;
+      cameras = MAIN_CAMERAS_ALL;
+    } else if (!strcmp(a, "--front-camera")) {
+      cameras = MAIN_CAMERAS_FRONT;
     } else if (!strcmp(a, "--eye")) {
       eye = 1;
     } else if (!strcmp(a, "--view")) {
