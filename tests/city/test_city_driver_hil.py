@@ -1,7 +1,7 @@
 """The smart-city behaviour layer in HIL: autodrive-sim (Tiny Town, lockstep with the runtime),
 the unchanged autodrive-runtime on its ptys (its EKF fed by the Eye stand-in,
-autodrive_tools.city.eye_standin), autodrive-city-driver on a loop through light 3
-and the stop sign, and the test's own V2I advisory publisher (autodrive_tools.city.advisory),
+autodrive_tools.city.eye_standin), autodrive-city-driver on Tiny Town's loop city_east (through light
+3 and the stop sign), and the test's own V2I advisory publisher (autodrive_tools.city.advisory),
 all on real LCM. Judged from the simulator's ground truth and light states:
 1. light 3 held RED: the car stops with its front before the stop line (overshoot <= 3 cm);
 2. light 3 GREEN: it goes on across the line;
@@ -21,13 +21,14 @@ root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sy
 sys.path.insert(0, str(root / "python"))
 from autodrive_tools import command_auth, lcmtypes  # noqa: E402
 from autodrive_tools.channels import channel  # noqa: E402
-from autodrive_tools.city import hil, routes, scoring  # noqa: E402
+from autodrive_tools.city import hil, scoring  # noqa: E402
 from autodrive_tools.maps.loader import MAPS_DIR  # noqa: E402
 from autodrive_tools.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
 
 URL = f"udpm://239.255.76.67:{port}?ttl=0"
 MAP = MAPS_DIR / "tiny_town.json"
 LIGHT = 3
+ROUTE = "city_east"  # north through light 3 and the stop sign, round the east half
 SIM_LIMIT_S = 400.0
 types = lcmtypes.load(build)
 
@@ -41,7 +42,6 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
     run_dir.mkdir()
     os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
     command_auth.create_key(command_auth.default_key_path("NIGEL1"))
-    lanes = routes.loop_through(MAP, routes.TINY_TOWN_VIA[0])
     facts = scoring.MapFacts.load(MAP)
     line = facts.stop_for_light(LIGHT)
     sign = facts.stop_sign_points()[0]
@@ -120,7 +120,7 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         procs.start("autodrive-sim", sim, out / "sim.log")
         wait_for_path(run_dir / "nigel1-nano", 60, procs)
         pose0 = hil.start_poses(build, URL, 1)[0]
-        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, routes.route_arg(lanes))
+        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE)
         procs.start(
             "runtime", [build / "bin" / "autodrive-runtime", "--config", cfg], out / "runtime.log"
         )
@@ -158,7 +158,7 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
             "--map",
             MAP,
             "--route",
-            routes.route_arg(lanes),
+            ROUTE,
             "--lcm-url",
             URL,
         ]

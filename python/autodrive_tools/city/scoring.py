@@ -182,8 +182,9 @@ class Scorer:
                 c.still_at.pop(p.name, None)
             c.prev_past[p.name] = past
         self.last[car] = (x, y, yaw)
-        for other, (ox, oy, _) in self.last.items():
-            if other != car:
+        for other, (ox, oy, oyaw) in self.last.items():
+            # cars going the same way (one behind the other), not cars passing in the other lane
+            if other != car and abs(math.remainder(yaw - oyaw, math.tau)) < HEADING_TOL_RAD:
                 self.min_gap_m = min(self.min_gap_m, math.dist((x, y), (ox, oy)))
 
     def report(self) -> dict[str, Any]:
@@ -197,8 +198,11 @@ class Scorer:
             "stop_sign_violations": len(self.sign_violations),
             "max_stop_line_overshoot_m": round(self.overshoot_m, 4),
             "collisions": self.collisions,
-            # base_link to base_link less one car length: the bumper gap of two cars in line
-            "min_gap_m": round(self.min_gap_m - length_m, 3) if self.last else None,
+            # two cars going the same way: base_link to base_link less one car length (the
+            # bumper gap of two cars in line); None when no two cars ever drove the same way
+            "min_gap_m": (
+                round(self.min_gap_m - length_m, 3) if math.isfinite(self.min_gap_m) else None
+            ),
             "laps_completed": min(laps) if laps else 0,
             "laps_per_car": {k: c.laps for k, c in sorted(self.cars.items())},
             "mean_lap_s": round(sum(lap_s) / len(lap_s), 2) if lap_s else None,
