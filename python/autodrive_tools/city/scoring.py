@@ -120,6 +120,8 @@ class CarScore:
     still_since_s: float | None = None
     still_at: dict[str, float] = field(default_factory=dict)  # stop -> longest standstill [s]
     in_collision: bool = False
+    driven_m: float = 0.0
+    at: tuple[float, float] | None = None
 
 
 class Scorer:
@@ -133,6 +135,8 @@ class Scorer:
         self.red_violations: list[dict[str, Any]] = []
         self.sign_violations: list[dict[str, Any]] = []
         self.overshoot_m = 0.0
+        self.front_past_max_m = -math.inf  # signed: how close the fronts came (< 0: before)
+        self.crossings = {"after_red_stop": 0, "after_stop_sign_stop": 0, "on_green_or_yellow": 0}
         self.collisions = 0
         self.min_gap_m = math.inf
         self.lap_radius_m, self.away_m = lap_radius_m, away_m
@@ -154,6 +158,9 @@ class Scorer:
             c.away = False
             c.laps += 1
             c.lap_starts_s.append(t_s)
+        if c.at is not None:
+            c.driven_m += math.dist(c.at, (x, y))
+        c.at = (x, y)
         if hit and not c.in_collision:
             self.collisions += 1
         c.in_collision = hit
@@ -172,13 +179,21 @@ class Scorer:
                 c.still_at[p.name] = max(c.still_at.get(p.name, 0.0), held)
                 if p.light_id < 0 or self.lights.get(p.light_id) == RED or held > 0.5:
                     self.overshoot_m = max(self.overshoot_m, past)
+                    self.front_past_max_m = max(self.front_past_max_m, past)
             prev = c.prev_past.get(p.name)
             if prev is not None and prev < 0.0 <= past:  # the front crosses the line now
                 event = {"car": car, "t_s": round(t_s, 2), "stop": p.name}
                 if p.light_id >= 0 and self.lights.get(p.light_id) == RED:
                     self.red_violations.append({**event, "light": p.light_id})
-                if p.light_id < 0 and c.still_at.get(p.name, 0.0) < STOP_SIGN_HOLD_S:
+                held = c.still_at.get(p.name, 0.0)
+                if p.light_id < 0 and held < STOP_SIGN_HOLD_S:
                     self.sign_violations.append(event)
+                elif p.light_id < 0:
+                    self.crossings["after_stop_sign_stop"] += 1
+                elif held > 0.5:
+                    self.crossings["after_red_stop"] += 1
+                else:
+                    self.crossings["on_green_or_yellow"] += 1
                 c.still_at.pop(p.name, None)
             c.prev_past[p.name] = past
         self.last[car] = (x, y, yaw)
@@ -197,6 +212,13 @@ class Scorer:
             "red_light_violations": len(self.red_violations),
             "stop_sign_violations": len(self.sign_violations),
             "max_stop_line_overshoot_m": round(self.overshoot_m, 4),
+            # the closest any front came to a stop point it stood at (< 0: before the line) [m]
+            "stop_front_past_max_m": (
+                round(self.front_past_max_m, 4) if math.isfinite(self.front_past_max_m) else None
+            ),
+            # stop-line crossings: after standing at a light (> 0.5 s), after a stop-sign stop
+            # (>= 1 s), or without stopping (green or yellow)
+            "stop_line_crossings": dict(self.crossings),
             "collisions": self.collisions,
             # two cars going the same way: base_link to base_link less one car length (the
             # bumper gap of two cars in line); None when no two cars ever drove the same way
@@ -205,6 +227,7 @@ class Scorer:
             ),
             "laps_completed": min(laps) if laps else 0,
             "laps_per_car": {k: c.laps for k, c in sorted(self.cars.items())},
+            "driven_m": {k: round(c.driven_m, 2) for k, c in sorted(self.cars.items())},
             "mean_lap_s": round(sum(lap_s) / len(lap_s), 2) if lap_s else None,
             "violations": self.red_violations + self.sign_violations,
         }
