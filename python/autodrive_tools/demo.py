@@ -23,7 +23,7 @@ import yaml
 
 from . import channels, command_auth, report
 from .inspect import export_mcap
-from .missions import MissionContext, loop, parking
+from .missions import MissionContext, loop, parking, smart_city
 from .paths import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
 from .proc import ProcessGroup, wait_for_path
 
@@ -63,7 +63,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument(
         "--mission",
-        choices=("parking", "loop"),
+        choices=("parking", "loop", "smart-city"),
         default="parking",
         help="parking (default): map, localise, plan and park autonomously; loop: "
         "drive a stadium track with pure pursuit on the EKF",
@@ -125,6 +125,15 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="render every camera (front, rear, the overhead Eye) at FPS [Hz of sim time] and run "
         "autodrive-eye on the overhead one, whose poses the runtime fuses (default 0: off)",
     )
+    p.add_argument("--laps", type=int, default=3, help="smart-city: laps every car drives")
+    p.add_argument(
+        "--advisory",
+        choices=("scm", "standin"),
+        default="scm",
+        help="smart-city: V2I advisories from autodrive-scm (web app; default) or the small "
+        "stand-in publisher (autodrive_tools.city.advisory)",
+    )
+    p.add_argument("--scm-port", type=int, default=8765, help="smart-city: the SCM's web port")
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
     if args.cameras < 0:
@@ -220,6 +229,8 @@ def run(
     def echo(line: str) -> None:
         print(line, file=console, flush=True)
 
+    if args.mission == "smart-city":
+        return smart_city.run(args, console, stop_also)
     build, out = Path(args.build), Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for prog in PROGRAMS:

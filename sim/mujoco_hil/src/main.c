@@ -51,7 +51,8 @@ static void main_usage(FILE *f) {
       "                      tiny_town, or an MJCF map file\n"
       "  --params FILE       vehicle description (default %s/vehicle/nigel.params)\n"
       "  --seed N            seed of IMU biases and noise (default 1)\n"
-      "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site: x, y [m] of\n"
+      "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site (given once per\n"
+      "                      car with --cars N: car k at the k-th): x, y [m] of\n"
       "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
       "                      cars line up to its right as usual. Refused when a car would\n"
       "                      be off the floor or overlap a wall or obstacle (at the spawn\n"
@@ -385,8 +386,9 @@ int main(int argc, char **argv) {
   double camera_fps = 30.0, light_level = -1.0, camera_noise = 0.0, camera_blur = 0.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
-  int host_io_ms = 0; /* 0: the mode's default */
-  scn_pose_t start;
+  int host_io_ms = 0;              /* 0: the mode's default */
+  scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
+  int nstarts = 0;
   scn_late_box_t late_box[SCN_MAX_LATE_BOXES];
   char perr[512];
   for (int i = 1; i < argc; i++) {
@@ -412,11 +414,16 @@ int main(int argc, char **argv) {
       cfg.seed = (uint64_t)x;
       i++;
     } else if (!strcmp(a, "--start")) {
-      if (scn_parse_start(v, &start, perr, sizeof perr) != 0) {
+      if (nstarts == SIM_MAX_CARS) {
+        fprintf(stderr, "autodrive-sim: --start: more than %d given\n", SIM_MAX_CARS);
+        return 2;
+      }
+      if (scn_parse_start(v, &starts[nstarts], perr, sizeof perr) != 0) {
         fprintf(stderr, "autodrive-sim: %s\n", perr);
         return 2;
       }
-      cfg.start = &start;
+      cfg.start = &starts[0];
+      nstarts++;
       i++;
     } else if (!strcmp(a, "--late-box")) {
       if (cfg.late_boxes == SCN_MAX_LATE_BOXES) {
@@ -542,7 +549,26 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
-  if (sim_check_scenario(s, err, sizeof err) != 0) { /* a bad --start / --late-box value */
+  int bad_starts = nstarts > 1 && nstarts != cfg.cars;
+  if (bad_starts)
+    snprintf(err, sizeof err,
+             "--start given %d times for %d cars: give it once (car 1) or once per car", nstarts,
+             cfg.cars);
+  if (!bad_starts && nstarts > 1) { /* one start pose per car: car k at the k-th --start */
+    double poses[3 * SIM_MAX_CARS];
+    for (int k = 0; k < nstarts; k++) {
+      poses[3 * k] = starts[k].x_m;
+      poses[3 * k + 1] = starts[k].y_m;
+      poses[3 * k + 2] = starts[k].yaw_deg * M_PI / 180.0;
+    }
+    char rerr[400];
+    if (sim_reset(s, cfg.seed, poses, rerr, sizeof rerr) != 0) {
+      snprintf(err, sizeof err, "--start: %s", rerr);
+      bad_starts = 1;
+    }
+  }
+  if (bad_starts ||
+      sim_check_scenario(s, err, sizeof err) != 0) { /* a bad --start / --late-box value */
     fprintf(stderr, "autodrive-sim: %s\n", err);
     sim_destroy(s);
     if (tlog) fclose(tlog);
@@ -630,7 +656,7 @@ int main(int argc, char **argv) {
            sim_traffic_lights(s)->n, sim_traffic_lights(s)->nconflicts);
   if (cfg.start)
     printf(AUTODRIVE_VEHICLE_DEFAULT " start (--start): x %.3f, y %.3f m, yaw %.1f deg\n",
-           start.x_m, start.y_m, start.yaw_deg);
+           starts[0].x_m, starts[0].y_m, starts[0].yaw_deg);
   fflush(stdout);
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;

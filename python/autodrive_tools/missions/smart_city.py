@@ -1,0 +1,284 @@
+"""The smart-city mission (tools/demo --mission smart-city): Tiny Town with three cars on looping
+routes through its lights and signs. Starts autodrive-sim (3 cars, lockstep with the runtimes),
+three unchanged autodrive-runtime processes on its ptys (EKF placed at each car's start pose,
+V2V on), the Eye stand-in (poses from ground truth with noise), the Smart City Manager
+(autodrive-scm: web app, database, V2I advisories; --advisory standin uses the small advisory
+publisher instead), three autodrive-city-driver processes and lcm-logger. The run is scored
+from the simulator's ground truth and light states (autodrive_tools.city.scoring) while it
+runs: report.json, trajectories.png (paths and light phases) and run.lcmlog in --out."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import random
+import select
+import shutil
+import signal
+import sys
+import time
+from pathlib import Path
+from types import FrameType
+from typing import Any, TextIO
+
+from .. import command_auth, lcmtypes
+from ..channels import channel, vehicle_name
+from ..city import hil
+from ..city.scoring import MapFacts, Scorer
+from ..maps.loader import MAPS_DIR
+from ..paths import OUT_DIR
+from ..proc import ProcessGroup, wait_for_path
+
+MAP = "tiny_town"
+# One looping route of the map per car: north through light 3 and the stop sign; south through
+# light 1 and a curve sign; round the town past the speed-limit and curve signs.
+ROUTES = ("city_east", "city_west", "loop_ccw")
+START_SPREAD_M = 1.0  # each car starts up to this far along its route from its start [m]
+PROGRESS_S = 10.0
+EXIT_INTERRUPTED = 130
+
+
+def start_poses(seed: int) -> list[tuple[float, float, float]]:
+    """Each car's start on its route (the route's polyline), moved along it by the seed."""
+    routes = {r["name"]: r for r in json.loads((MAPS_DIR / f"{MAP}.json").read_text())["routes"]}
+    rng = random.Random(seed)
+    poses = []
+    for name in ROUTES:
+        pts = routes[name]["polyline_m"]
+        k = int(rng.uniform(0.0, START_SPREAD_M) / 0.05)
+        (x0, y0), (x1, y1) = pts[k], pts[k + 1]
+        poses.append((x0, y0, math.atan2(y1 - y0, x1 - x0)))
+    return poses
+
+
+def ensure_keys(cars: int, say: Any) -> None:
+    for i in range(1, cars + 1):
+        path = command_auth.default_key_path(vehicle_name(i))
+        if not path.exists():
+            command_auth.create_key(path)
+            say(f"created the command key of {vehicle_name(i)} at {path} (tools/keys)")
+
+
+def plot(
+    out: Path,
+    tracks: dict[str, list[tuple[float, float, float]]],
+    phases: dict[int, list[tuple[float, int]]],
+    facts: MapFacts,
+) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(9, 11), gridspec_kw={"height_ratios": [3, 1]})
+    for pts in facts.lanes.values():
+        ax.plot([p["x_m"] for p in pts], [p["y_m"] for p in pts], color="0.85", lw=0.8)
+    for car, tr in sorted(tracks.items()):
+        ax.plot([p[1] for p in tr], [p[2] for p in tr], lw=1.2, label=car)
+    for s in facts.stops:
+        ax.plot(s.x_m, s.y_m, "s", color="red" if s.light_id >= 0 else "darkred", ms=5)
+        ax.annotate(
+            f"light {s.light_id}" if s.light_id >= 0 else "stop", (s.x_m, s.y_m), fontsize=7
+        )
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend()
+    ax.set_title("smart city: ground-truth paths, stop lines of lights and stop signs")
+    colours = {0: "0.3", 1: "red", 2: "gold", 3: "green"}
+    for row, (lid, ph) in enumerate(sorted(phases.items())):
+        for (t0, st), (t1, _) in zip(ph, ph[1:] + [(ph[-1][0] + 0.1, 0)]):
+            bx.barh(row, t1 - t0, left=t0, color=colours.get(st, "0.5"), height=0.8)
+    bx.set_yticks(range(len(phases)), [f"light {k}" for k in sorted(phases)])
+    bx.set_xlabel("sim time [s]")
+    bx.set_title("light phases (ground truth: TRAFFIC_LIGHT_STATE)")
+    fig.tight_layout()
+    fig.savefig(out / "trajectories.png", dpi=110)
+    plt.close(fig)
+
+
+def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any = None) -> int:
+    def say(msg: str) -> None:
+        print(f"[smart-city] {msg}", file=console, flush=True)
+
+    build = Path(args.build)
+    out = Path(args.out)
+    if out == OUT_DIR / "demo":  # the demo's default folder: this mission's own
+        out = OUT_DIR / "demo-smart-city"
+    out.mkdir(parents=True, exist_ok=True)
+    for prog in ("autodrive-sim", "autodrive-runtime", "autodrive-city-driver"):
+        if not (build / "bin" / prog).exists():
+            say(f"ERROR: {build / 'bin' / prog} is missing: build first (tools/demo does)")
+            return 2
+    cars = len(ROUTES)
+    ensure_keys(cars, say)
+    url = args.lcm_url
+    starts = start_poses(args.seed)
+    run_dir = Path(f"/tmp/autodrive-city-{os.getpid()}")
+    run_dir.mkdir(parents=True, exist_ok=True)
+    procs = ProcessGroup(say)
+    interrupted = False
+
+    def on_signal(_s: int, _f: FrameType | None) -> None:
+        nonlocal interrupted
+        interrupted = True
+
+    old = [(s, signal.signal(s, on_signal)) for s in (signal.SIGINT, signal.SIGTERM)]
+    facts = MapFacts.load(MAPS_DIR / f"{MAP}.json")
+    scorer = Scorer(facts)
+    tracks: dict[str, list[tuple[float, float, float]]] = {}
+    phases: dict[int, list[tuple[float, int]]] = {}
+    sim_t = [0.0]
+    result: dict[str, Any] = {}
+    t_wall0 = time.time()
+    scm_url = ""
+    try:
+        types = lcmtypes.load(build)
+        lc = lcmtypes.bus(url)
+
+        def on_truth(_ch: str, data: bytes) -> None:
+            m = types.ground_truth_t.decode(data)
+            t = m.utime * 1e-6
+            sim_t[0] = max(sim_t[0], t)
+            x, y = m.position_m[0], m.position_m[1]
+            scorer.truth(m.vehicle, t, x, y, m.yaw_rad, m.linear_velocity_m_s[0], m.in_collision)
+            tr = tracks.setdefault(m.vehicle, [])
+            if not tr or t - tr[-1][0] >= 0.1:
+                tr.append((t, x, y))
+
+        def on_light(_ch: str, data: bytes) -> None:
+            m = types.traffic_light_state_t.decode(data)
+            scorer.light(m.light_id, m.state)
+            ph = phases.setdefault(m.light_id, [])
+            if not ph or ph[-1][1] != m.state:
+                ph.append((m.utime * 1e-6, m.state))
+
+        for i in range(1, cars + 1):
+            lc.subscribe(channel("GROUND_TRUTH", vehicle_name(i)), on_truth)
+        lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
+        logger = ["lcm-logger", f"--lcm-url={url}", "-f", "--flush-interval=100"]
+        procs.start("lcm-logger", [*logger, out / "run.lcmlog"], out / "lcm-logger.log")
+        sim: list[object] = [build / "bin" / "autodrive-sim", "--map", MAP, "--cars", cars]
+        for x, y, yaw in starts:
+            sim += ["--start", f"{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
+        sim += ["--no-lidar", "--seed", args.seed, "--run-dir", run_dir, "--lcm-url", url]
+        sim += ["--lockstep-client", "--duration", 3600]
+        if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
+            sim += ["--view"]
+        procs.start("autodrive-sim", sim, out / "sim.log")
+        wait_for_path(run_dir / f"{vehicle_name(cars).lower()}-nano", 60, procs)
+        py = sys.executable
+        vehicles = ",".join(vehicle_name(i) for i in range(1, cars + 1))
+        eye = [py, "-m", "autodrive_tools.city.eye_standin", "--vehicles", vehicles]
+        procs.start(
+            "eye-standin",
+            [*eye, "--seed", args.seed, "--lcm-url", url, "--build", build],
+            out / "eye-standin.log",
+        )
+        for i in range(1, cars + 1):
+            cfg = hil.runtime_config(out, run_dir, url, i, starts[i - 1], ROUTES[i - 1])
+            procs.start(
+                f"runtime{i}",
+                [build / "bin" / "autodrive-runtime", "--config", cfg],
+                out / f"runtime{i}.log",
+            )
+        if args.advisory == "scm":
+            port = args.scm_port
+            scm = [
+                py,
+                "-m",
+                "autodrive_tools.scm.cli",
+                "--map",
+                MAP,
+                "--db",
+                f"sqlite:///{(out / 'scm.sqlite').resolve()}",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                port,
+                "--lcm-url",
+                url,
+                "--vehicles",
+                vehicles,
+                "--build",
+                build,
+            ]
+            procs.start("autodrive-scm", scm, out / "scm.log")
+            t0 = time.monotonic()
+            while "SCM ready" not in (out / "scm.log").read_text():
+                procs.check()
+                if time.monotonic() - t0 > 90:
+                    raise RuntimeError(f"autodrive-scm not ready within 90 s ({out / 'scm.log'})")
+                time.sleep(0.2)
+            scm_url = f"http://127.0.0.1:{port}/"
+            say(f"Smart City Manager web app: {scm_url}")
+        else:
+            adv = [py, "-m", "autodrive_tools.city.advisory", "--map", MAP, "--vehicles", vehicles]
+            procs.start(
+                "advisory", [*adv, "--lcm-url", url, "--build", build], out / "advisory.log"
+            )
+        for i in range(1, cars + 1):
+            drv = [build / "bin" / "autodrive-city-driver", "--map", MAPS_DIR / f"{MAP}.json"]
+            drv += ["--route", ROUTES[i - 1], "--vehicle", vehicle_name(i), "--lcm-url", url]
+            procs.start(f"city-driver{i}", drv, out / f"city-driver{i}.log")
+        say(f"driving {args.laps} laps each (timeout {args.timeout:g} s wall) ...")
+        last = time.monotonic()
+        while True:
+            if interrupted or (stop_also is not None and stop_also()):
+                interrupted = True
+                break
+            procs.check(clean_exit_fails=True)
+            if select.select([lc.fileno()], [], [], 0.1)[0]:
+                lc.handle()
+            rep = scorer.report()
+            if scorer.cars and len(scorer.cars) == cars and rep["laps_completed"] >= args.laps:
+                say(f"every car drove {args.laps} laps")
+                break
+            if time.time() - t_wall0 > args.timeout:
+                result["error"] = f"timeout after {args.timeout:g} s wall"
+                say(result["error"])
+                break
+            if time.monotonic() - last > PROGRESS_S:
+                last = time.monotonic()
+                say(
+                    f"t_sim={sim_t[0]:6.1f} s laps {rep['laps_per_car']} red {rep['red_light_violations']} "
+                    f"stop {rep['stop_sign_violations']} collisions {rep['collisions']} "
+                    f"overshoot {rep['max_stop_line_overshoot_m']:.3f} m"
+                )
+    except RuntimeError as e:
+        say(f"ERROR: {e}")
+        result["error"] = str(e)
+    finally:
+        procs.stop_all()
+        shutil.rmtree(run_dir, ignore_errors=True)
+        for s, h in old:
+            signal.signal(s, h)
+    rep = scorer.report()
+    rep.update(result)
+    rep.update(
+        seed=args.seed,
+        routes=list(ROUTES),
+        sim_s=round(sim_t[0], 1),
+        wall_s=round(time.time() - t_wall0, 1),
+        advisory=args.advisory,
+        scm_url=scm_url,
+        eye="stand-in: ground truth + noise (city.eye_standin)",
+    )
+    rep["ok"] = (
+        "error" not in rep
+        and not interrupted
+        and rep["red_light_violations"] == 0
+        and rep["stop_sign_violations"] == 0
+        and rep["collisions"] == 0
+        and rep["laps_completed"] >= args.laps
+    )
+    (out / "report.json").write_text(json.dumps(rep, indent=2))
+    if tracks:
+        plot(out, tracks, phases, facts)
+    say(f"report: {json.dumps({k: v for k, v in rep.items() if k != 'violations'})}")
+    say(f"wrote {out}/report.json, trajectories.png, run.lcmlog")
+    if interrupted:
+        return EXIT_INTERRUPTED
+    return 0 if rep["ok"] else 1

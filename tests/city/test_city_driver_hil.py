@@ -1,0 +1,200 @@
+"""The smart-city behaviour layer in HIL: autodrive-sim (Tiny Town, lockstep with the runtime),
+the unchanged autodrive-runtime on its ptys (its EKF fed by the Eye stand-in,
+autodrive_tools.city.eye_standin), autodrive-city-driver on Tiny Town's loop city_east (through light
+3 and the stop sign), and the test's own V2I advisory publisher (autodrive_tools.city.advisory),
+all on real LCM. Judged from the simulator's ground truth and light states:
+1. light 3 held RED: the car stops with its front before the stop line (overshoot <= 3 cm);
+2. light 3 GREEN: it goes on across the line;
+3. the stop sign: a standstill of at least 1 s before it, then on;
+4. advisory stopped (stale), light 3 held GREEN: the car stops before the line anyway.
+Args: ROOT BUILD PORT."""
+import math
+import os
+import pathlib
+import select
+import subprocess
+import sys
+import tempfile
+import time
+
+root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
+sys.path.insert(0, str(root / "python"))
+from autodrive_tools import command_auth, lcmtypes  # noqa: E402
+from autodrive_tools.channels import channel  # noqa: E402
+from autodrive_tools.city import hil, scoring  # noqa: E402
+from autodrive_tools.maps.loader import MAPS_DIR  # noqa: E402
+from autodrive_tools.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
+
+URL = f"udpm://239.255.76.67:{port}?ttl=0"
+MAP = MAPS_DIR / "tiny_town.json"
+LIGHT = 3
+ROUTE = "city_east"  # north through light 3 and the stop sign, round the east half
+SIM_LIMIT_S = 400.0
+types = lcmtypes.load(build)
+
+
+def log(msg):
+    print(f"[city-hil] {msg}", flush=True)
+
+
+with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
+    out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
+    run_dir.mkdir()
+    os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
+    command_auth.create_key(command_auth.default_key_path("NIGEL1"))
+    facts = scoring.MapFacts.load(MAP)
+    line = facts.stop_for_light(LIGHT)
+    sign = facts.stop_sign_points()[0]
+    # Start 1.5 m before the end of the lane that leads into the T-junction before light 3.
+    start = facts.lane_point("s3_e_w", back_from_end_m=1.2)
+    procs = ProcessGroup(log)
+    lc = lcmtypes.bus(URL)
+    truth = {}
+    lights = {}
+
+    track = open(out / "truth.csv", "w")
+
+    def on_truth(_ch, data):
+        m = types.ground_truth_t.decode(data)
+        track.write(
+            f"{m.utime * 1e-6:.2f},{m.position_m[0]:.4f},{m.position_m[1]:.4f},{m.yaw_rad:.3f}\n"
+        )
+        v = m.linear_velocity_m_s[0]
+        truth.update(t=m.utime * 1e-6, x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=v)
+
+    def on_light(_ch, data):
+        m = types.traffic_light_state_t.decode(data)
+        lights[m.light_id] = m.state
+
+    lc.subscribe(channel("GROUND_TRUTH", "NIGEL1"), on_truth)
+    lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
+
+    def command_light(state):
+        c = types.traffic_light_command_t()
+        c.utime, c.light_id, c.state, c.duration_s = int(time.time() * 1e6), LIGHT, state, 0.0
+        lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), c.encode())
+
+    def spin(seconds):
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < seconds:
+            if select.select([lc.fileno()], [], [], 0.05)[0]:
+                lc.handle()
+
+    def wait_for(what, cond, wall_s=240):
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < wall_s:
+            procs.check()
+            spin(0.1)
+            if truth and cond():
+                return
+            if truth and truth["t"] > SIM_LIMIT_S:
+                break
+        raise AssertionError(f"{what}: not within {wall_s} s wall / {SIM_LIMIT_S} s sim; {truth}")
+
+    def past(stop_point):
+        return scoring.front_past_m(truth["x"], truth["y"], truth["yaw"], stop_point)
+
+    def stopped_at(stop_point, hold_s):
+        """Waits until the car has stood within 0.25 m before stop_point for hold_s of sim time."""
+        since = None
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 240:
+            procs.check()
+            spin(0.1)
+            if not truth:
+                continue
+            near = -0.25 < past(stop_point) < 0.1
+            if near and abs(truth["v"]) < 0.01:
+                since = truth["t"] if since is None else since
+                if truth["t"] - since >= hold_s:
+                    return past(stop_point)
+            else:
+                since = None
+        raise AssertionError(f"never stood {hold_s} s at {stop_point.name}: {truth}")
+
+    try:
+        sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1", "--no-lidar"]
+        sim += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
+        sim += ["--lockstep-client", "--run-dir", run_dir, "--lcm-url", URL]
+        sim += ["--duration", SIM_LIMIT_S + 20]
+        procs.start("autodrive-sim", sim, out / "sim.log")
+        wait_for_path(run_dir / "nigel1-nano", 60, procs)
+        pose0 = hil.start_poses(build, URL, 1)[0]
+        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE)
+        procs.start(
+            "runtime", [build / "bin" / "autodrive-runtime", "--config", cfg], out / "runtime.log"
+        )
+        eye = [
+            sys.executable,
+            "-m",
+            "autodrive_tools.city.eye_standin",
+            "--vehicles",
+            "NIGEL1",
+            "--lcm-url",
+            URL,
+            "--build",
+            build,
+        ]
+        procs.start("eye-standin", eye, out / "eye.log")
+        adv = [
+            sys.executable,
+            "-m",
+            "autodrive_tools.city.advisory",
+            "--map",
+            "tiny_town",
+            "--vehicles",
+            "NIGEL1",
+            "--lcm-url",
+            URL,
+            "--build",
+            build,
+        ]
+        advisory = procs.start("advisory", adv, out / "advisory.log")
+        spin(1.0)
+        command_light(1)  # RED, held
+        wait_for("light 3 RED", lambda: lights.get(LIGHT) == 1, 60)
+        drv = [
+            build / "bin" / "autodrive-city-driver",
+            "--map",
+            MAP,
+            "--route",
+            ROUTE,
+            "--lcm-url",
+            URL,
+        ]
+        procs.start("city-driver", drv, out / "driver.log")
+        # 1. red: stops before the line
+        over = stopped_at(line, 2.0)
+        log(f"1. red light: stood {-over * 100:.1f} cm before the stop line")
+        assert lights[LIGHT] == 1
+        assert over <= 0.03, f"front {over:.3f} m past the stop line on red"
+        # 2. green: goes
+        command_light(3)
+        wait_for("across the line on green", lambda: past(line) > 0.3)
+        log("2. green: crossed the stop line")
+        # 3. stop sign: a full stop of >= 1 s, then on
+        over_sign = stopped_at(sign, 1.0)
+        wait_for("on after the stop sign", lambda: past(sign) > 0.3)
+        log(f"3. stop sign: stood >= 1 s, {-over_sign * 100:.1f} cm before it, then went on")
+        assert over_sign <= 0.03
+        # 4. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway
+        assert stop(advisory, "advisory", log) == 0
+        over_stale = stopped_at(line, 2.0)
+        log(
+            f"4. stale advisory: stood {-over_stale * 100:.1f} cm before the line, light "
+            f"{lights[LIGHT]} (3 = GREEN)"
+        )
+        assert lights[LIGHT] == 3, "the light was not green: the test proves nothing"
+        assert over_stale <= 0.03
+        text = (out / "driver.log").read_text()
+        assert "stale advisory: red light 3" in text, text[-2000:]
+    finally:
+        procs.stop_all()
+        keep = os.environ.get("CITY_TEST_KEEP")  # a folder to keep the logs in
+        if keep:
+            subprocess.run(["cp", "-r", str(out), keep], check=False)
+        for f in ("driver.log", "runtime.log"):
+            p = out / f
+            if p.exists():
+                print(f"---- {f} (tail)\n" + "\n".join(p.read_text().splitlines()[-15:]))
+print("city driver hil ok")

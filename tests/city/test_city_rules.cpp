@@ -1,0 +1,171 @@
+// The behaviour layer's map reading and rules of the road on Tiny Town's real sidecar JSON.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "behaviour/city_map.hpp"
+#include "behaviour/city_rules.hpp"
+
+using namespace behaviour;
+
+namespace {
+
+const std::string kMap = std::string(AUTODRIVE_ROOT) + "/sim/mujoco_hil/maps/tiny_town.json";
+
+const CityMap &city() {
+  static const CityMap m = load_city_map(kMap);
+  return m;
+}
+
+const Stop &stop_of(const Track &t, Stop::Kind kind) {
+  for (const Stop &s : t.stops)
+    if (s.kind == kind) return s;
+  throw std::runtime_error("no such stop");
+}
+
+RulesInput at(double s_m, double v, int64_t t_us, Advisory a = {}) {
+  RulesInput in;
+  in.s_m = s_m;
+  in.speed_m_s = v;
+  in.t_us = t_us;
+  in.advisory = a;
+  return in;
+}
+
+Advisory fresh(int light, LightState st) {
+  Advisory a;
+  a.fresh = true;
+  a.light_id = light;
+  a.light = st;
+  return a;
+}
+
+}  // namespace
+
+TEST(CityMap, RouteCityEastHasLight3AndTheStopSign) {
+  const Track t = track_for(city(), "city_east");
+  EXPECT_TRUE(t.loop);
+  EXPECT_NEAR(t.length_m, 18.49, 0.05);
+  ASSERT_EQ(t.stops.size(), 2u);
+  EXPECT_EQ(stop_of(t, Stop::Kind::light).light_id, 3);
+  EXPECT_EQ(stop_of(t, Stop::Kind::light).name, "x_stop_s");
+  EXPECT_LT(stop_of(t, Stop::Kind::light).s_m, stop_of(t, Stop::Kind::stop_sign).s_m);
+  // The stop line lies on the track: its point there is the map's stop line centre.
+  const TrackPoint p = point_at(t, stop_of(t, Stop::Kind::light).s_m);
+  EXPECT_NEAR(p.x_m, 0.14, 0.01);
+  EXPECT_NEAR(p.y_m, -1.25, 0.01);
+  const Track ccw = track_for(city(), "loop_ccw");
+  EXPECT_TRUE(ccw.stops.empty());   // round the town: no light, no stop sign
+  EXPECT_EQ(ccw.zones.size(), 2u);  // the speed limit and the curve sign
+}
+
+TEST(CityMap, ProjectionFindsProgressAndSide) {
+  const Track t = track_for(city(), "city_east");
+  const TrackPoint p = point_at(t, 5.0);
+  const Projection q = project(t, p.x_m + 0.05 * -std::sin(p.heading_rad),
+                               p.y_m + 0.05 * std::cos(p.heading_rad), 4.9);
+  EXPECT_NEAR(q.s_m, 5.0, 0.01);
+  EXPECT_NEAR(q.lateral_m, 0.05, 0.005);  // left of the track
+}
+
+TEST(CityMap, BadInputNamesWhatIsWrong) {
+  EXPECT_THROW(load_city_map("/nonexistent/map.json"), Error);
+  try {
+    track_for(city(), "no_such_route");
+    FAIL();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("city_east"), std::string::npos) << e.what();
+  }
+  try {
+    track_for(city(), "lanes:x_s_n,e1_s_n");
+    FAIL();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("does not start where"), std::string::npos) << e.what();
+  }
+  const std::string bad = ::testing::TempDir() + "/bad_map.json";
+  std::ofstream(bad) << R"({"name": "x", "lanes": [{"name": "a"}]})";
+  try {
+    load_city_map(bad);
+    FAIL();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("lane a: missing key 'centre_line'"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CityRules, StaleAdvisoryMeansRedEvenWhenTheLightIsGreen) {
+  const Track t = track_for(city(), "city_east");
+  RulesConfig cfg;
+  CityRules r(t, cfg);
+  const double line = stop_of(t, Stop::Kind::light).s_m;
+  const double at_target = line - cfg.stop_margin_m - cfg.front_m;  // base_link where it stops
+  Advisory stale = fresh(3, LightState::green);
+  stale.fresh = false;
+  auto out = r.step(at(at_target, 0.0, 0, stale));
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  EXPECT_NE(out.reason.find("stale advisory: red light 3"), std::string::npos) << out.reason;
+  // Fresh and green: go.
+  out = r.step(at(at_target, 0.0, 0, fresh(3, LightState::green)));
+  EXPECT_DOUBLE_EQ(out.speed_m_s, cfg.cruise_m_s);
+  // Fresh, but about another light: light 3 is red for this car.
+  out = r.step(at(at_target, 0.0, 0, fresh(1, LightState::green)));
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  // Red: the allowed speed falls to 0 at the stop target, and is positive before it.
+  const auto near = r.step(at(at_target - 0.02, 0.15, 0, fresh(3, LightState::red)));
+  EXPECT_GT(near.speed_m_s, 0.1);  // sqrt(2 * 0.3 * 0.02) = 0.155 m/s
+  EXPECT_LT(near.speed_m_s, cfg.cruise_m_s);
+  EXPECT_EQ(near.reason, "red light 3 at x_stop_s");
+  EXPECT_EQ(r.step(at(at_target + 0.01, 0.0, 0, fresh(3, LightState::red))).speed_m_s, 0.0);
+}
+
+TEST(CityRules, YellowStopsWhenItComfortablyCanElseGoesOn) {
+  const Track t = track_for(city(), "city_east");
+  RulesConfig cfg;
+  const double line = stop_of(t, Stop::Kind::light).s_m;
+  const double target = line - cfg.stop_margin_m - cfg.front_m;
+  {
+    CityRules r(t, cfg);  // 4 cm before the target at 0.1 m/s: 1.7 cm needed, so stop
+    const auto out = r.step(at(target - 0.04, 0.1, 0, fresh(3, LightState::yellow)));
+    EXPECT_LT(out.speed_m_s, cfg.cruise_m_s);
+    EXPECT_NE(out.reason.find("yellow"), std::string::npos);
+    EXPECT_EQ(r.step(at(target, 0.0, 1000, fresh(3, LightState::yellow))).speed_m_s, 0.0);
+  }
+  {
+    CityRules r(t, cfg);  // 2 cm before the target at 0.2 m/s: it cannot stop there; go on
+    const auto out = r.step(at(target - 0.02, 0.2, 0, fresh(3, LightState::yellow)));
+    EXPECT_DOUBLE_EQ(out.speed_m_s, cfg.cruise_m_s);
+    // decided once: still going when it has slowed a little
+    EXPECT_DOUBLE_EQ(r.step(at(target, 0.15, 1000, fresh(3, LightState::yellow))).speed_m_s,
+                     cfg.cruise_m_s);
+  }
+}
+
+TEST(CityRules, StopSignNeedsAFullStopOfOneSecond) {
+  const Track t = track_for(city(), "city_east");
+  RulesConfig cfg;
+  CityRules r(t, cfg);
+  const double target = stop_of(t, Stop::Kind::stop_sign).s_m - cfg.stop_margin_m - cfg.front_m;
+  const Advisory g = fresh(-1, LightState::off);
+  EXPECT_EQ(r.step(at(target, 0.0, 0, g)).speed_m_s, 0.0);
+  EXPECT_EQ(r.step(at(target, 0.0, 900000, g)).speed_m_s, 0.0);    // 0.9 s: not yet
+  EXPECT_EQ(r.step(at(target, 0.05, 1000000, g)).speed_m_s, 0.0);  // rolled: starts again
+  EXPECT_EQ(r.step(at(target, 0.0, 1100000, g)).speed_m_s, 0.0);
+  EXPECT_EQ(r.step(at(target, 0.0, 2000000, g)).speed_m_s, 0.0);                    // 0.9 s since
+  EXPECT_DOUBLE_EQ(r.step(at(target, 0.0, 2400000, g)).speed_m_s, cfg.cruise_m_s);  // 1.3 s
+  EXPECT_EQ(r.stop_signs_served(), 1u);
+}
+
+TEST(CityRules, KeepsTheGapBehindACarAhead) {
+  const Track t = track_for(city(), "loop_ccw");
+  RulesConfig cfg;
+  CityRules r(t, cfg);
+  RulesInput in = at(1.0, 0.2, 0);
+  in.peers_ahead_m = {cfg.front_m + cfg.rear_m + cfg.min_gap_m};  // exactly the gap: stand
+  EXPECT_EQ(r.step(in).speed_m_s, 0.0);
+  in.peers_ahead_m = {1.0};
+  EXPECT_DOUBLE_EQ(r.step(in).speed_m_s, cfg.cruise_m_s);
+  in.peers_ahead_m = {0.4};  // 1 cm of room beyond the gap
+  const auto out = r.step(in);
+  EXPECT_LT(out.speed_m_s, cfg.cruise_m_s);
+  EXPECT_EQ(out.reason, "car ahead");
+}

@@ -1,0 +1,63 @@
+"""tools/demo --mission smart-city, short (a smoke test of the whole mission; the laps and the
+goals are measured by full runs, see README): Tiny Town, three cars, three runtimes, three city
+drivers, the advisory stand-in, for --timeout seconds of wall time. The report must have every
+key, no violation, no collision, every car driven; the PNG and the LCM log (with V2V and the
+cars' V2I advisories in it) written. Args: ROOT BUILD PORT."""
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
+sys.path.insert(0, str(root / "python"))
+from autodrive_tools import lcmtypes  # noqa: E402
+
+with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
+    out = pathlib.Path(tmp)
+    env = dict(os.environ, AUTODRIVE_KEY_DIR=str(out / "keys"))
+    cmd = [
+        sys.executable,
+        "-m",
+        "autodrive_tools.demo",
+        "--mission",
+        "smart-city",
+        "--headless",
+        "--build",
+        str(build),
+        "--out",
+        str(out / "run"),
+        "--seed",
+        "2",
+        "--timeout",
+        "60",
+        "--advisory",
+        "standin",
+        "--lcm-url",
+        f"udpm://239.255.76.67:{port}?ttl=0",
+    ]
+    r = subprocess.run(cmd, env=env, timeout=150)
+    rep = json.loads((out / "run" / "report.json").read_text())
+    print(json.dumps(rep, indent=2))
+    assert r.returncode == 1, "a 60 s run cannot finish 3 laps: the mission must say not ok"
+    for key in (
+        "red_light_violations",
+        "stop_sign_violations",
+        "max_stop_line_overshoot_m",
+        "collisions",
+        "min_gap_m",
+        "laps_completed",
+        "mean_lap_s",
+    ):
+        assert key in rep, key
+    assert rep["red_light_violations"] == 0 and rep["stop_sign_violations"] == 0
+    assert rep["collisions"] == 0
+    assert rep["max_stop_line_overshoot_m"] <= 0.03
+    assert set(rep["driven_m"]) == {"NIGEL1", "NIGEL2", "NIGEL3"}
+    assert min(rep["driven_m"].values()) > 0.5, "a car did not drive"
+    assert (out / "run" / "trajectories.png").stat().st_size > 10000
+    seen = {e.channel for e in lcmtypes.events(out / "run" / "run.lcmlog")}
+    for ch in ("V2V", "NIGEL1_V2I", "NIGEL3_COMMAND", "TRAFFIC_LIGHT_STATE"):
+        assert ch in seen, f"{ch} not in the log"
+print("smart-city mission ok")
