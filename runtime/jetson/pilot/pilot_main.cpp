@@ -177,8 +177,11 @@ class PilotNode {
   bool stopped_ = false;
 };
 
-// --predict: the raw network output for each image file, one "path value" line each.
-int predict(pilot::PilotModel &model, const std::vector<std::string> &images) {
+// --predict: the raw network output for each image file, one "path value" line each; with
+// stats_path, the preprocessing + inference time percentiles [ms] as JSON there.
+int predict(pilot::PilotModel &model, const std::vector<std::string> &images,
+            const std::string &stats_path) {
+  std::vector<double> infer_ms;
   for (const auto &path : images) {
     const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
@@ -186,8 +189,19 @@ int predict(pilot::PilotModel &model, const std::vector<std::string> &images) {
                    path.c_str());
       return 2;
     }
-    std::printf("%s %.9g\n", path.c_str(), model.raw(pilot::preprocess(bgr, model.spec())));
+    const auto t0 = std::chrono::steady_clock::now();
+    const float out = model.raw(pilot::preprocess(bgr, model.spec()));
+    infer_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    std::printf("%s %.9g\n", path.c_str(), out);
   }
+  if (!stats_path.empty())
+    std::ofstream(stats_path) << nlohmann::json{{"frames", infer_ms.size()},
+                                                {"inference_ms_p50", percentile(infer_ms, 0.5)},
+                                                {"inference_ms_p99", percentile(infer_ms, 0.99)},
+                                                {"model", model.path()}}
+                                     .dump(2)
+                              << "\n";
   return 0;
 }
 
@@ -210,7 +224,8 @@ int main(int argc, char **argv) {
                  "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
                  "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
   cli.add_option("--stats", stats_path,
-                 "on exit, write frames and inference time percentiles [ms] as JSON here");
+                 "on exit, write frames and inference (preprocessing + network) time percentiles [ms] as "
+                 "JSON here (also with --predict)");
   cli.add_option("--predict", predict_images,
                  "run the model on these image files and print 'path steering' per line (no "
                  "LCM, no config needed), then exit");
@@ -247,7 +262,7 @@ int main(int argc, char **argv) {
   if (check_only) return 0;
   if (!predict_images.empty()) {
     try {
-      return predict(*model, predict_images);
+      return predict(*model, predict_images, stats_path);
     } catch (const std::exception &e) {
       std::fprintf(stderr, "autodrive-pilot: --predict: %s\n", e.what());
       return 2;

@@ -15,6 +15,7 @@
 #include "route_driver.h"
 #include "script.h"
 #include "sim.h"
+#include "teleport_lcm.h"
 #include "tl_lcm.h"
 
 #include "sim_camera.h"
@@ -71,6 +72,9 @@ static void main_usage(FILE *f) {
       "                      of sim time the sim waits for one more frame from the client\n"
       "                      on each Nano pty (a runtime with bridge.sync_to_sim_clock);\n"
       "                      publish SIM_CLOCK\n"
+      "  --allow-teleport    (lockstep modes only) obey SIM_TELEPORT: a pose2d_t naming a\n"
+      "                      car puts it there, standing still (evaluations that put a car\n"
+      "                      back on its lane after an intervention)\n"
       "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
       "                      (default: real time, 1 sim second per wall second)\n"
       "  --host-io-ms N      serve the ptys every N ms of sim time, like a USB-serial\n"
@@ -90,6 +94,7 @@ static void main_usage(FILE *f) {
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
+      "  --front-camera-only with --cameras: only the front cameras (half the rendering)\n"
       "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
@@ -224,6 +229,7 @@ static void main_report_late_boxes(const sim_t *s) {
 }
 
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
+#define MAIN_CAMS_FRONT_ONLY 2 /* main_cams_open's cameras: the front cameras only */
 #define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
 typedef struct main_cams {
   int n;
@@ -255,7 +261,7 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
-    for (int rear = 0; rear < 2; rear++) {
+    for (int rear = 0; rear < (cameras == MAIN_CAMS_FRONT_ONLY ? 1 : 2); rear++) {
       char name[48], frame[48];
       snprintf(name, sizeof name, "nigel%d/cam_%s", c, rear ? "rear" : "front");
       snprintf(frame, sizeof frame, "camera_%s", rear ? "rear" : "front");
@@ -374,7 +380,7 @@ int main(int argc, char **argv) {
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
   int lockstep = 0, client_sync = 0, frame_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0,
-      lidar_lcm = 1, view = 0;
+      lidar_lcm = 1, view = 0, allow_teleport = 0, front_only = 0;
   double camera_fps = 30.0, light_level = -1.0, camera_noise = 0.0, camera_blur = 0.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -428,6 +434,8 @@ int main(int argc, char **argv) {
       lockstep = 1;
     } else if (!strcmp(a, "--lockstep-client")) {
       lockstep = client_sync = 1;
+    } else if (!strcmp(a, "--allow-teleport")) {
+      allow_teleport = 1;
     } else if (!strcmp(a, "--lockstep-frames")) {
       lockstep = client_sync = frame_sync = 1;
     } else if (!strcmp(a, "--rtf")) {
@@ -457,7 +465,9 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--no-lidar-lcm")) {
       lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {
-      cameras = 1;
+      cameras = cameras ? cameras : 1;
+    } else if (!strcmp(a, "--front-camera-only")) {
+      front_only = 1;
     } else if (!strcmp(a, "--eye")) {
       eye = 1;
     } else if (!strcmp(a, "--view")) {
@@ -499,6 +509,12 @@ int main(int argc, char **argv) {
   if (lockstep && rtf_given) {
     fprintf(stderr, "autodrive-sim: --lockstep%s and --rtf exclude each other\n",
             client_sync ? "-client" : "");
+    return 2;
+  }
+  if (front_only && cameras) cameras = MAIN_CAMS_FRONT_ONLY;
+  if (allow_teleport && !lockstep) {
+    fprintf(stderr, "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
+                    "--lockstep-frames (a car never jumps in a real-time run)\n");
     return 2;
   }
   if (client_sync && !cfg.open_ptys) {
@@ -575,6 +591,17 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
+  teleport_lcm_t *teleport = allow_teleport ? teleport_lcm_create(lcm, s, err, sizeof err) : NULL;
+  if (allow_teleport && !teleport) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    tl_lcm_destroy(lights);
+    main_cams_close(&cams);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
+  if (teleport) printf("teleport: obeying " AUTODRIVE_CH_SIM_TELEPORT " (--allow-teleport)\n");
   main_view_t viewer;
   if (main_view_open(&viewer, s, view, err, sizeof err) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
@@ -643,6 +670,7 @@ int main(int argc, char **argv) {
     }
     /* light commands: every step, but every host-I/O period in free lockstep (a system call) */
     if (lights && step % cfg.host_io_period_ms == 0) tl_lcm_poll(lights, sim_time_us(s));
+    if (teleport && step % cfg.host_io_period_ms == 0) teleport_lcm_poll(teleport);
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
@@ -745,6 +773,7 @@ int main(int argc, char **argv) {
            sim_traffic_lights(s)->n, commands, refused);
   }
   tl_lcm_destroy(lights);
+  teleport_lcm_destroy(teleport);
   main_view_close(&viewer);
   main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */
