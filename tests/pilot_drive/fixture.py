@@ -42,7 +42,9 @@ class TinyPilotNet(nn.Module):
             nn.Conv2d(12, 16, 3, stride=2), nn.ELU(),
         )  # fmt: skip
         # 66 x 200 input -> 16 x 6 x 23 features
-        self.head = nn.Sequential(nn.Flatten(), nn.Linear(16 * 6 * 23, 16), nn.ELU(), nn.Linear(16, 1))
+        self.head = nn.Sequential(
+            nn.Flatten(), nn.Linear(16 * 6 * 23, 16), nn.ELU(), nn.Linear(16, 1)
+        )
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return torch.tanh(self.head(self.features(x)))
@@ -78,7 +80,9 @@ def frames(out: pathlib.Path, n: int = 20, seed: int = 0) -> list[pathlib.Path]:
         img[: SOURCE_H // 3] = (200, 170, 140)  # sky / wall
         shift = int(rng.integers(-120, 120))
         for x0 in (180 + shift, 460 + shift):
-            cv2.line(img, (x0, SOURCE_H), (SOURCE_W // 2 + shift // 3, SOURCE_H // 3), (255, 255, 255), 8)
+            cv2.line(
+                img, (x0, SOURCE_H), (SOURCE_W // 2 + shift // 3, SOURCE_H // 3), (255, 255, 255), 8
+            )
         img = np.clip(img + rng.normal(0, 12, img.shape), 0, 255).astype(np.uint8)
         p = out / f"frame_{i:02d}.jpg"
         cv2.imwrite(str(p), img, [cv2.IMWRITE_JPEG_QUALITY, 90])

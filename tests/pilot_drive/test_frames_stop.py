@@ -118,7 +118,9 @@ with tempfile.TemporaryDirectory(prefix="pilot-stop-") as tmp:
         assert abs(truth["v"]) < 0.01, f"the car still moves ({truth['v']:.3f} m/s)"
         log = (out / "pilot.log").read_text()
         assert "STOPPING the car" in log and "CAM_FRONT" in log, log
-        print(f"frames stopped: disengaged after {first_off - t_stop:.2f} s, car at {truth['v']:.4f} m/s")
+        print(
+            f"frames stopped: disengaged after {first_off - t_stop:.2f} s, car at {truth['v']:.4f} m/s"
+        )
         # frames again: it drives again
         pump(3.0, jpegs)
         assert commands[-1][1], "the pilot did not drive again"

@@ -36,7 +36,11 @@ with tempfile.TemporaryDirectory(prefix="pilot-predict-") as tmp:
             ref = float(net(torch.from_numpy(x))[0, 0])
             outs.append(ref)
             worst = max(worst, abs(ref - cpp[str(p)]))
-    print(f"20 frames: torch outputs {min(outs):+.4f}..{max(outs):+.4f}, max |C++ - torch| = {worst:.2e}")
-    assert np.std(outs) > 1e-3, "the frames must give different outputs for the test to mean anything"
+    print(
+        f"20 frames: torch outputs {min(outs):+.4f}..{max(outs):+.4f}, max |C++ - torch| = {worst:.2e}"
+    )
+    assert (
+        np.std(outs) > 1e-3
+    ), "the frames must give different outputs for the test to mean anything"
     assert worst <= 1e-4, f"C++ and PyTorch differ by {worst}"
 print("OK")

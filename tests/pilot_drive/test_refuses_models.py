@@ -13,7 +13,9 @@ pilot = str(build / "bin" / "autodrive-pilot")
 
 
 def refused(model: pathlib.Path, *words: str) -> None:
-    r = subprocess.run([pilot, "--model", str(model), "--check"], capture_output=True, text=True, timeout=60)
+    r = subprocess.run(
+        [pilot, "--model", str(model), "--check"], capture_output=True, text=True, timeout=60
+    )
     print(f"{model.name}: exit {r.returncode}: {r.stderr.strip()}")
     assert r.returncode == 2, r
     for w in words:
@@ -23,7 +25,9 @@ def refused(model: pathlib.Path, *words: str) -> None:
 with tempfile.TemporaryDirectory(prefix="pilot-refuse-") as tmp:
     out = pathlib.Path(tmp)
     good, _ = fixture.export(out, "good")
-    r = subprocess.run([pilot, "--model", str(good), "--check"], capture_output=True, text=True, timeout=60)
+    r = subprocess.run(
+        [pilot, "--model", str(good), "--check"], capture_output=True, text=True, timeout=60
+    )
     assert r.returncode == 0, r.stderr
     # truncated: the same bytes cut in half, the sidecar as exported
     cut = out / "cut.onnx"

@@ -38,11 +38,12 @@ DEFAULT_MODEL = REPO_ROOT / "models" / "pilot" / "driving_school.onnx"
 PILOT_CONFIG = REPO_ROOT / "runtime" / "jetson" / "pilot" / "config" / "pilot_hil.yaml"
 INTERVENTION_COST_S = 6.0  # PilotNet: each intervention costs 6 s of autonomy
 NIGHT_LIGHT_LEVEL = 0.25  # the scene's light level at "night" (1 = day)
-# The camera noise [sigma, 8-bit levels] the model was trained with when its sidecar does not
-# say (its "trained" section's camera_noise); noise2x doubles it.
-DEFAULT_TRAINED_NOISE = 3.0
+# The camera noise [sigma, 8-bit levels] and frame rate [Hz of sim time] the model was trained
+# with when its sidecar's "trained" section does not say (camera_noise, camera_fps: tools/pilot
+# expert's defaults); noise2x doubles the noise.
+DEFAULT_TRAINED_NOISE = 2.0
+DEFAULT_TRAINED_FPS = 15.0
 START_ALONG_M = 0.6  # the car starts this far along the route (the map's loop_east spawn)
-CAMERA_FPS = 30.0
 WATCH_EVERY = 5  # referee every 5th ground truth (20 Hz of sim time)
 START_MOVE_M = 0.01  # elapsed time counts from when the car has moved this far
 TELEPORT_SETTLE_S = 0.3  # sim time after a reset during which no crossing is counted
@@ -75,6 +76,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--model", default=str(DEFAULT_MODEL), help="NAME.onnx (NAME.json beside it)")
     p.add_argument("--timeout", type=float, default=1800.0, help="give up after this many wall s")
     p.add_argument("--headless", action="store_true", help="never open the simulator's window")
+    p.add_argument(
+        "--save-frames",
+        type=int,
+        default=0,
+        metavar="N",
+        help="also keep N front-camera JPEGs (every 3rd frame) in OUT/frames/ (tools/bench "
+        "cloning times the model on them)",
+    )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
     if args.laps < 1:
@@ -82,23 +91,34 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
-def trained_noise(model: Path) -> float:
-    """The camera noise the model was trained with (its sidecar's trained.camera_noise)."""
+def trained(model: Path, key: str, default: float) -> float:
+    """A figure of the model's training (its sidecar's trained.KEY, or of its first recording,
+    trained.conditions[0].KEY), else default; ValueError naming the sidecar when unreadable."""
+    path = model.with_suffix(".json")
     try:
-        side = json.loads(model.with_suffix(".json").read_text())
+        side = json.loads(path.read_text())
     except (OSError, ValueError) as e:
-        raise ValueError(f"{model.with_suffix('.json')}: {e}") from None
-    trained = side.get("trained", {}) if isinstance(side, dict) else {}
-    value = trained.get("camera_noise", DEFAULT_TRAINED_NOISE) if isinstance(trained, dict) else None
-    return float(value) if isinstance(value, (int, float)) else DEFAULT_TRAINED_NOISE
+        raise ValueError(f"{path}: {e}") from None
+    section = side.get("trained", {}) if isinstance(side, dict) else {}
+    if not isinstance(section, dict):
+        return default
+    value = section.get(key)
+    conditions = section.get("conditions")  # tools/pilot train: one entry per recorded log
+    if value is None and isinstance(conditions, list) and conditions:
+        value = conditions[0].get(key) if isinstance(conditions[0], dict) else None
+    return float(value) if isinstance(value, (int, float)) else default
 
 
-def sim_argv(args: argparse.Namespace, build: Path, run_dir: Path, start: maps.Pose) -> list[object]:
+def sim_argv(
+    args: argparse.Namespace, build: Path, run_dir: Path, start: maps.Pose
+) -> list[object]:
     argv: list[object] = [build / "bin" / "autodrive-sim", "--map", MAP, "--run-dir", run_dir]
     argv += ["--seed", args.seed, "--lcm-url", args.lcm_url, "--no-lidar", "--quiet"]
     argv += ["--start", f"{start.x_m:.4f},{start.y_m:.4f},{math.degrees(start.yaw_rad):.3f}"]
-    argv += ["--cameras", "--front-camera-only", "--camera-fps", CAMERA_FPS, "--lockstep-client", "--allow-teleport"]
-    noise = trained_noise(Path(args.model))
+    fps = trained(Path(args.model), "camera_fps", DEFAULT_TRAINED_FPS)
+    argv += ["--cameras", "--front-camera-only", "--camera-fps", fps]
+    argv += ["--lockstep-client", "--allow-teleport"]
+    noise = trained(Path(args.model), "camera_noise", DEFAULT_TRAINED_NOISE)
     if args.condition == "noise2x":
         noise *= 2.0
     if noise > 0:
@@ -142,6 +162,19 @@ class Referee:
         self.interventions: list[tuple[float, float, float]] = []  # t [s], x, y
         self.path: list[tuple[float, float]] = []
         lc.subscribe(channels.channel("GROUND_TRUTH", self.veh), self.on_truth)
+        self.frames_seen = 0
+        if args.save_frames > 0:
+            self.frames_dir = Path(args.out) / "frames"
+            shutil.rmtree(self.frames_dir, ignore_errors=True)
+            self.frames_dir.mkdir(parents=True)
+            lc.subscribe(channels.channel("CAM_FRONT", self.veh), self.on_frame)
+
+    def on_frame(self, _ch: str, data: bytes) -> None:
+        self.frames_seen += 1
+        k = self.frames_seen // 3
+        if self.frames_seen % 3 == 0 and k <= self.args.save_frames:
+            m = self.types.compressed_image_t.decode(data)
+            (self.frames_dir / f"frame_{k:04d}.jpg").write_bytes(bytes(m.data))
 
     def elapsed_s(self) -> float:
         return 0.0 if self.t0_us is None else (self.t_us - self.t0_us) * 1e-6
@@ -233,7 +266,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
     veh = channels.vehicle_name(1)
     try:
         command_auth.load_key(command_auth.default_key_path(veh))
-        trained_noise(model)
+        trained(model, "camera_noise", DEFAULT_TRAINED_NOISE)
     except ValueError as e:
         say(f"ERROR: {e}")
         return 2
@@ -269,7 +302,9 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         next_progress = time.time() + PROGRESS_S
         while referee.watch.laps < args.laps and not interrupted:
             if time.time() - t_wall0 > args.timeout:
-                raise RuntimeError(f"{args.laps} lap(s) not driven within {args.timeout:.0f} s wall")
+                raise RuntimeError(
+                    f"{args.laps} lap(s) not driven within {args.timeout:.0f} s wall"
+                )
             procs.check(clean_exit_fails=True)
             if select.select([lc.fileno()], [], [], 0.1)[0]:
                 lc.handle()

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import vehicle
 from ..maps.description import Route
@@ -25,10 +26,10 @@ class LaneWatch:
     progress_m: float = 0.0  # driven along the route (unwrapped; laps = progress / length)
     last_s_m: float | None = None
     offsets_m: list[float] = field(default_factory=list)  # base_link, + left of the line
-    _a: np.ndarray = field(init=False)
-    _d: np.ndarray = field(init=False)
-    _len2: np.ndarray = field(init=False)
-    _s0: np.ndarray = field(init=False)
+    _a: npt.NDArray[np.float64] = field(init=False)
+    _d: npt.NDArray[np.float64] = field(init=False)
+    _len2: npt.NDArray[np.float64] = field(init=False)
+    _s0: npt.NDArray[np.float64] = field(init=False)
 
     def __post_init__(self) -> None:
         pts = np.asarray(self.route.polyline_m, dtype=float)
@@ -92,5 +93,7 @@ def for_route(route: Route) -> LaneWatch:
     the rear axle (base_link), front wheels a wheelbase ahead, each at half the track plus half a
     wheel width to the side (the outer edge of the tyre)."""
     car = vehicle.load()
-    wb, half = car.number("wheelbase_m"), 0.5 * (car.number("track_m") + car.number("wheel_width_m"))
+    wb, half = car.number("wheelbase_m"), 0.5 * (
+        car.number("track_m") + car.number("wheel_width_m")
+    )
     return LaneWatch(route, [(0.0, half), (0.0, -half), (wb, half), (wb, -half)])

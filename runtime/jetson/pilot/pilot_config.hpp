@@ -11,9 +11,9 @@ namespace pilot {
 struct PilotConfig {
   std::string lcm_url;
   std::string vehicle;
-  std::string model;             // NAME.onnx; relative paths are relative to the config file
-  int frame_timeout_ms = 500;    // no front-camera frame for this long (monotonic) -> stop
-  double command_rate_hz = 50;   // commands at least this often while driving or stopped
+  std::string model;            // NAME.onnx; relative paths are relative to the config file
+  int frame_timeout_ms = 500;   // no front-camera frame for this long (monotonic) -> stop
+  double command_rate_hz = 50;  // commands at least this often while driving or stopped
   SpeedRuleConfig speed;
 };
 

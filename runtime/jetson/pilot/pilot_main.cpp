@@ -1,10 +1,11 @@
 // autodrive-pilot: drives a car from its front camera alone with a behavioural-cloning model.
 // Subscribes <VEH>_CAM_FRONT (the runtime's camera driver on the car, the simulator's camera in
-// HIL) and <VEH>_ODOM (speed, the runtime's estimator), runs the ONNX model with OpenCV's DNN module on one thread, and
-// publishes signed <VEH>_COMMAND (the project's Signer; the bridge's lease) with the network's
-// steering and a throttle that holds a set speed and slows for large steering. When frames stop
-// arriving for frame_timeout_ms (monotonic clock) it stops the car (disengaged commands) and
-// says so; it drives again when frames return. --predict runs the model on image files instead.
+// HIL) and <VEH>_ODOM (speed, the runtime's estimator), runs the ONNX model with OpenCV's DNN
+// module on one thread, and publishes signed <VEH>_COMMAND (the project's Signer; the bridge's
+// lease) with the network's steering and a throttle that holds a set speed and slows for large
+// steering. When frames stop arriving for frame_timeout_ms (monotonic clock) it stops the car
+// (disengaged commands) and says so; it drives again when frames return. --predict runs the model
+// on image files instead.
 #include <autodrive/command_auth.hpp>
 #include <autodrive/compressed_image_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
@@ -41,7 +42,7 @@ void on_signal(int) {
   g_stop = 1;
 }
 
-constexpr int kStopCommands = 10;         // disengaged commands on the way out
+constexpr int kStopCommands = 10;             // disengaged commands on the way out
 constexpr int64_t kReportPeriodUs = 5000000;  // a progress line every 5 s (monotonic)
 
 double percentile(std::vector<double> v, double q) {
@@ -151,11 +152,11 @@ class PilotNode {
   void report(int64_t now) {
     const size_t n = infer_ms_.size();
     if (last_report_us_ > 0)
-      spdlog::info("frames {} (+{})  inference p50 {:.2f} ms p99 {:.2f} ms  steering {:+.3f}  "
-                   "speed {:.3f} m/s{}",
-                   n, n - reported_frames_, percentile(infer_ms_, 0.5),
-                   percentile(infer_ms_, 0.99), steering_, speed_m_s_,
-                   stopped_ ? "  STOPPED (no frames)" : "");
+      spdlog::info(
+          "frames {} (+{})  inference p50 {:.2f} ms p99 {:.2f} ms  steering {:+.3f}  "
+          "speed {:.3f} m/s{}",
+          n, n - reported_frames_, percentile(infer_ms_, 0.5), percentile(infer_ms_, 0.99),
+          steering_, speed_m_s_, stopped_ ? "  STOPPED (no frames)" : "");
     reported_frames_ = n;
     last_report_us_ = now;
   }
@@ -216,16 +217,18 @@ int main(int argc, char **argv) {
   std::vector<std::string> predict_images;
   bool check_only = false;
   cli.add_option("--config", config_path, "YAML configuration (runtime/jetson/pilot/config/)");
-  cli.add_option("--model", model_override, "the model NAME.onnx (its NAME.json beside it); "
-                                            "overrides the config's model");
+  cli.add_option("--model", model_override,
+                 "the model NAME.onnx (its NAME.json beside it); "
+                 "overrides the config's model");
   cli.add_option("--lcm-url", url_override, "override lcm_url of the config");
   cli.add_option("--vehicle", vehicle_override, "override vehicle (e.g. NIGEL1)");
   cli.add_option("--key-file", key_file,
                  "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
                  "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
-  cli.add_option("--stats", stats_path,
-                 "on exit, write frames and inference (preprocessing + network) time percentiles [ms] as "
-                 "JSON here (also with --predict)");
+  cli.add_option(
+      "--stats", stats_path,
+      "on exit, write frames and inference (preprocessing + network) time percentiles [ms] as "
+      "JSON here (also with --predict)");
   cli.add_option("--predict", predict_images,
                  "run the model on these image files and print 'path steering' per line (no "
                  "LCM, no config needed), then exit");
@@ -274,10 +277,10 @@ int main(int argc, char **argv) {
   }
   std::optional<autodrive::auth::Signer> signer;
   try {
-    signer.emplace(autodrive::auth::load_key(key_file.empty()
-                                                 ? autodrive::auth::default_key_path(cfg.vehicle)
-                                                 : key_file),
-                   cfg.vehicle, "pilot", autodrive::auth::kAuthorityMachine);
+    signer.emplace(
+        autodrive::auth::load_key(key_file.empty() ? autodrive::auth::default_key_path(cfg.vehicle)
+                                                   : key_file),
+        cfg.vehicle, "pilot", autodrive::auth::kAuthorityMachine);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "autodrive-pilot: --key-file: %s\n", e.what());
     return 2;
@@ -291,15 +294,15 @@ int main(int argc, char **argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   PilotNode node(cfg, lcm, *model, std::move(*signer));
-  auto *cam = autodrive_lcm::subscribe<autodrive::compressed_image_t, PilotNode,
-                                       &PilotNode::on_frame>(
-      lcm, cfg.vehicle + AUTODRIVE_CH_CAM_FRONT_SUFFIX, &node);
+  auto *cam =
+      autodrive_lcm::subscribe<autodrive::compressed_image_t, PilotNode, &PilotNode::on_frame>(
+          lcm, cfg.vehicle + AUTODRIVE_CH_CAM_FRONT_SUFFIX, &node);
   cam->setQueueCapacity(1);  // the newest frame only: a late frame is worth less than none
   autodrive_lcm::subscribe<autodrive::odometry_t, PilotNode, &PilotNode::on_odom>(
       lcm, cfg.vehicle + AUTODRIVE_CH_ODOM_SUFFIX, &node);
   spdlog::info("{} on {}: listening to {}{}, {}{}; frame timeout {} ms", cfg.vehicle, cfg.lcm_url,
-               cfg.vehicle, AUTODRIVE_CH_CAM_FRONT_SUFFIX, cfg.vehicle,
-               AUTODRIVE_CH_ODOM_SUFFIX, cfg.frame_timeout_ms);
+               cfg.vehicle, AUTODRIVE_CH_CAM_FRONT_SUFFIX, cfg.vehicle, AUTODRIVE_CH_ODOM_SUFFIX,
+               cfg.frame_timeout_ms);
   const int wait_ms = std::max(1, static_cast<int>(500.0 / cfg.command_rate_hz));
   while (!g_stop) {
     if (lcm.handleTimeout(wait_ms) < 0) break;

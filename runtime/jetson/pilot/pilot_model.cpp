@@ -93,7 +93,8 @@ InputSpec read_sidecar(const std::string &json_path, int &opset, std::string &on
     throw InputError(json_path + ": is not valid JSON: " + e.what());
   }
   auto need = [&](const nlohmann::json &o, const char *key, const std::string &dotted) {
-    if (!o.is_object() || !o.contains(key)) throw InputError(json_path + ": " + dotted + ": missing key");
+    if (!o.is_object() || !o.contains(key))
+      throw InputError(json_path + ": " + dotted + ": missing key");
     return o.at(key);
   };
   auto integer = [&](const nlohmann::json &o, const char *key, int lo, int hi) {
@@ -195,8 +196,10 @@ PilotModel::PilotModel(const std::string &onnx_path) : path_(onnx_path) {
   int sidecar_opset = 0;
   spec_ = read_sidecar(sidecar_path(onnx_path), sidecar_opset, sha);
   if (sha256_hex(bytes) != sha)
-    throw InputError(onnx_path + ": its SHA-256 is not the sidecar's onnx_sha256 (a truncated or "
-                     "replaced file; " + std::to_string(bytes.size()) + " bytes)");
+    throw InputError(onnx_path +
+                     ": its SHA-256 is not the sidecar's onnx_sha256 (a truncated or "
+                     "replaced file; " +
+                     std::to_string(bytes.size()) + " bytes)");
   opset_ = onnx_opset(onnx_path, bytes);
   if (opset_ != sidecar_opset)
     throw InputError(onnx_path + ": opset " + std::to_string(opset_) + " but its sidecar says " +

@@ -5,12 +5,12 @@
 namespace pilot {
 
 struct SpeedRuleConfig {
-  double set_speed_m_s = 0.2;          // on a straight
-  double min_speed_m_s = 0.1;          // at full steering
-  double feedforward_per_m_s = 3.5;    // throttle per m/s of target speed
-  double kp_per_m_s = 3.0;             // throttle per m/s of speed error
-  double ki_per_m = 2.0;               // throttle per m of integrated speed error
-  double max_throttle = 1.0;           // never more
+  double set_speed_m_s = 0.2;        // on a straight
+  double min_speed_m_s = 0.1;        // at full steering
+  double feedforward_per_m_s = 3.5;  // throttle per m/s of target speed
+  double kp_per_m_s = 3.0;           // throttle per m/s of speed error
+  double ki_per_m = 2.0;             // throttle per m of integrated speed error
+  double max_throttle = 1.0;         // never more
 };
 
 class SpeedRule {

@@ -513,8 +513,9 @@ int main(int argc, char **argv) {
   }
   if (front_only && cameras) cameras = MAIN_CAMS_FRONT_ONLY;
   if (allow_teleport && !lockstep) {
-    fprintf(stderr, "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
-                    "--lockstep-frames (a car never jumps in a real-time run)\n");
+    fprintf(stderr,
+            "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
+            "--lockstep-frames (a car never jumps in a real-time run)\n");
     return 2;
   }
   if (client_sync && !cfg.open_ptys) {

@@ -28,10 +28,10 @@ static void teleport_on_request(const lcm_recv_buf_t *rbuf, const char *channel,
   char err[640] = "";
   if (car < 1 || !end || *end != '\0') {
     snprintf(err, sizeof err, "vehicle '%s' is not " AUTODRIVE_VEHICLE_PREFIX "<i>", msg->vehicle);
-  } else if (sim_teleport(k->s, (int)car, msg->x_m, msg->y_m, msg->yaw_rad, err, sizeof err) ==
-             0) {
+  } else if (sim_teleport(k->s, (int)car, msg->x_m, msg->y_m, msg->yaw_rad, err, sizeof err) == 0) {
     k->done++;
-    printf("[autodrive-sim] " AUTODRIVE_CH_SIM_TELEPORT ": %s to x %.3f, y %.3f m, yaw %.3f rad "
+    printf("[autodrive-sim] " AUTODRIVE_CH_SIM_TELEPORT
+           ": %s to x %.3f, y %.3f m, yaw %.3f rad "
            "at t = %.3f s\n",
            msg->vehicle, msg->x_m, msg->y_m, msg->yaw_rad, sim_time_us(k->s) * 1e-6);
     fflush(stdout);
