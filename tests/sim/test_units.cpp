@@ -230,4 +230,20 @@ TEST(Script, ArmsThenDrivesAndParsesErrors) {
   EXPECT_NE(std::string(err).find("speed"), std::string::npos);
 }
 
+TEST(Script, RouteTakesLapsAndPerturbation) {
+  script_t s;
+  char err[256];
+  ASSERT_EQ(script_parse(&s, "route:loop_ccw,laps=3,perturb=0.4", err, sizeof err), 0) << err;
+  EXPECT_EQ(s.laps, 3);
+  EXPECT_DOUBLE_EQ(s.perturb, 0.4);
+  ASSERT_EQ(script_parse(&s, "route:loop_ccw", err, sizeof err), 0) << err;
+  EXPECT_EQ(s.laps, 1);  // one lap, no perturbation unless asked
+  EXPECT_DOUBLE_EQ(s.perturb, 0.0);
+  for (const char *bad : {"route:a,laps=0", "route:a,laps=1.5", "route:a,perturb=1.5",
+                          "constant:throttle=0.1,laps=2"}) {
+    EXPECT_EQ(script_parse(&s, bad, err, sizeof err), -1) << bad;
+    EXPECT_NE(std::string(err).find(bad), std::string::npos) << err;  // names the spec
+  }
+}
+
 }  // namespace

@@ -116,7 +116,7 @@ def sim_argv(
     argv += ["--seed", args.seed, "--lcm-url", args.lcm_url, "--no-lidar", "--quiet"]
     argv += ["--start", f"{start.x_m:.4f},{start.y_m:.4f},{math.degrees(start.yaw_rad):.3f}"]
     fps = trained(Path(args.model), "camera_fps", DEFAULT_TRAINED_FPS)
-    argv += ["--cameras", "--front-camera-only", "--camera-fps", fps]
+    argv += ["--front-camera", "--camera-fps", fps]
     argv += ["--lockstep-client", "--allow-teleport"]
     noise = trained(Path(args.model), "camera_noise", DEFAULT_TRAINED_NOISE)
     if args.condition == "noise2x":

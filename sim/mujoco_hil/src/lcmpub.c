@@ -25,6 +25,9 @@ int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
   memcpy(msg.angular_velocity_rad_s, t.gyro_body_rad_s, sizeof msg.angular_velocity_rad_s);
   msg.steering_angle_rad = t.steering_rad;
   msg.in_collision = (int8_t)t.in_collision;
+  msg.command_throttle = (float)t.command_throttle;
+  msg.command_steering = (float)t.command_steering;
+  msg.expert_steering = (float)t.expert_steering;
   uint8_t buf[512];
   const int n = autodrive_ground_truth_t_encode(buf, 0, sizeof buf, &msg);
   if (n <= 0) return -1;

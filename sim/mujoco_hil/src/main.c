@@ -85,16 +85,19 @@ static void main_usage(FILE *f) {
       "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
       "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
       "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
-      "                      or route:NAME[,speed=F][,start=s][,lookahead=M]: pure pursuit on\n"
-      "                      the map's route NAME at F of top speed (default %g), lookahead M\n"
-      "                      [m] (default %g), from the route's start (--cars 1); the run ends\n"
-      "                      when the route does (one lap of a loop)\n"
+      "                      or route:NAME[,speed=F][,start=s][,lookahead=M][,laps=N]\n"
+      "                      [,perturb=A]: pure pursuit on the map's route NAME at F of top\n"
+      "                      speed (default %g), lookahead M [m] (default %g), from the\n"
+      "                      route's start (--cars 1); the run ends when the route does (N\n"
+      "                      laps of a loop, default 1); A > 0 adds seeded steering\n"
+      "                      perturbations up to A (normalised) now and then (expert\n"
+      "                      recordings with recoveries, tools/pilot)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
-      "  --front-camera-only with --cameras: only the front cameras (half the rendering)\n"
+      "  --front-camera      render only each car's front camera (half the rendering)\n"
       "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
@@ -229,7 +232,8 @@ static void main_report_late_boxes(const sim_t *s) {
 }
 
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
-#define MAIN_CAMS_FRONT_ONLY 2 /* main_cams_open's cameras: the front cameras only */
+#define MAIN_CAMERAS_ALL 1   /* --cameras: front and rear */
+#define MAIN_CAMERAS_FRONT 2 /* --front-camera: front only */
 #define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
 typedef struct main_cams {
   int n;
@@ -261,7 +265,7 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
-    for (int rear = 0; rear < (cameras == MAIN_CAMS_FRONT_ONLY ? 1 : 2); rear++) {
+    for (int rear = 0; rear < (cameras == MAIN_CAMERAS_FRONT ? 1 : 2); rear++) {
       char name[48], frame[48];
       snprintf(name, sizeof name, "nigel%d/cam_%s", c, rear ? "rear" : "front");
       snprintf(frame, sizeof frame, "camera_%s", rear ? "rear" : "front");
@@ -380,7 +384,7 @@ int main(int argc, char **argv) {
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
   int lockstep = 0, client_sync = 0, frame_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0,
-      lidar_lcm = 1, view = 0, allow_teleport = 0, front_only = 0;
+      lidar_lcm = 1, view = 0, allow_teleport = 0;
   double camera_fps = 30.0, light_level = -1.0, camera_noise = 0.0, camera_blur = 0.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -465,9 +469,9 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--no-lidar-lcm")) {
       lidar_lcm = 0;
     } else if (!strcmp(a, "--cameras")) {
-      cameras = cameras ? cameras : 1;
-    } else if (!strcmp(a, "--front-camera-only")) {
-      front_only = 1;
+      cameras = MAIN_CAMERAS_ALL;
+    } else if (!strcmp(a, "--front-camera")) {
+      cameras = MAIN_CAMERAS_FRONT;
     } else if (!strcmp(a, "--eye")) {
       eye = 1;
     } else if (!strcmp(a, "--view")) {
@@ -511,7 +515,6 @@ int main(int argc, char **argv) {
             client_sync ? "-client" : "");
     return 2;
   }
-  if (front_only && cameras) cameras = MAIN_CAMS_FRONT_ONLY;
   if (allow_teleport && !lockstep) {
     fprintf(stderr,
             "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "

@@ -53,8 +53,38 @@ int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, dou
   }
   r->speed = speed;
   r->lookahead_m = lookahead_m;
+  r->laps = 1;
   pp_reset(&r->st, &r->path, r->xy_m[0], r->xy_m[1]);
   return 0;
+}
+
+void route_driver_set_laps_perturb(route_driver_t *r, int laps, double amplitude, uint64_t seed) {
+  r->laps = laps < 1 ? 1 : laps;
+  r->perturb = amplitude;
+  rng_seed(&r->rng, seed * 2654435761ull + 16u);
+  r->updates = 0;
+  r->perturb_next = ROUTE_PERTURB_FIRST_UPDATES;
+  r->perturb_end = 0;
+  r->perturb_offset = 0.0;
+}
+
+/* The perturbation to add at this update (starts and ends them on schedule). */
+static double route_driver_perturbation(route_driver_t *r) {
+  if (r->perturb <= 0.0) return 0.0;
+  const long u = r->updates;
+  if (u == r->perturb_next) {
+    const long len =
+        ROUTE_PERTURB_MIN_UPDATES +
+        (long)(rng_uniform(&r->rng) * (ROUTE_PERTURB_MAX_UPDATES - ROUTE_PERTURB_MIN_UPDATES + 1));
+    const long gap = ROUTE_PERTURB_GAP_MIN_UPDATES +
+                     (long)(rng_uniform(&r->rng) *
+                            (ROUTE_PERTURB_GAP_MAX_UPDATES - ROUTE_PERTURB_GAP_MIN_UPDATES + 1));
+    const double mag = r->perturb * (0.5 + 0.5 * rng_uniform(&r->rng));
+    r->perturb_offset = rng_uniform(&r->rng) < 0.5 ? -mag : mag;
+    r->perturb_end = u + len;
+    r->perturb_next = r->perturb_end + gap;
+  }
+  return u < r->perturb_end ? r->perturb_offset : 0.0;
 }
 
 void route_driver_free(route_driver_t *r) {
@@ -72,7 +102,9 @@ void route_driver_start(const route_driver_t *r, double *x_m, double *y_m, doubl
 void route_driver_update(route_driver_t *r, double x_m, double y_m, double yaw_rad,
                          double *throttle, double *steering) {
   pp_project(&r->st, &r->path, x_m, y_m);
+  if (r->path.loop) r->st.done = r->st.s_m >= (double)r->laps * r->path.length_m;
   if (r->st.done) {
+    r->expert_steering = 0.0;
     *throttle = 0.0;
     *steering = 0.0;
     return;
@@ -84,7 +116,10 @@ void route_driver_update(route_driver_t *r, double x_m, double y_m, double yaw_r
   const double delta = pp_steer(&r->st, &r->path, x_m, y_m, yaw_rad, r->lookahead_m,
                                 AUTODRIVE_VEHICLE_WHEELBASE_M, AUTODRIVE_VEHICLE_STEER_LIMIT_RAD);
   *throttle = r->speed;
-  *steering = delta / AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
+  r->expert_steering = delta / AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
+  const double cmd = r->expert_steering + route_driver_perturbation(r);
+  *steering = cmd > 1.0 ? 1.0 : (cmd < -1.0 ? -1.0 : cmd);
+  r->updates++;
 }
 
 long route_driver_stats(const route_driver_t *r, double *rms_m, double *max_m) {

@@ -36,7 +36,9 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     snprintf(buf, sizeof buf, "%s", spec + strlen(route));
     tok = strtok_r(buf, ",", &save);
     if (!tok || strchr(tok, '=') || strlen(tok) >= sizeof s->route_name) {
-      snprintf(err, err_sz, "--script '%s': expected route:NAME[,speed=F][,start=s][,lookahead=m]",
+      snprintf(err, err_sz,
+               "--script '%s': expected "
+               "route:NAME[,speed=F][,start=s][,lookahead=m][,laps=N][,perturb=A]",
                spec);
       return -1;
     }
@@ -44,6 +46,7 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     snprintf(s->route_name, sizeof s->route_name, "%s", tok);
     s->throttle = SCRIPT_ROUTE_SPEED_DEFAULT;
     s->lookahead_m = SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M;
+    s->laps = 1;
     tok = strtok_r(NULL, ",", &save);
   } else {
     snprintf(err, err_sz,
@@ -66,6 +69,16 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
       rc = script_num(spec, tok, val, 0, 1, &s->throttle, err, err_sz);
     } else if (s->route && strcmp(tok, "lookahead") == 0) {
       rc = script_num(spec, tok, val, 0.02, 5, &s->lookahead_m, err, err_sz);
+    } else if (s->route && strcmp(tok, "laps") == 0) {
+      double laps = 1;
+      rc = script_num(spec, tok, val, 1, 1000, &laps, err, err_sz);
+      if (rc == 0 && laps != floor(laps)) {
+        snprintf(err, err_sz, "--script '%s': laps='%s' is not a whole number", spec, val);
+        rc = -1;
+      }
+      s->laps = (int)laps;
+    } else if (s->route && strcmp(tok, "perturb") == 0) {
+      rc = script_num(spec, tok, val, 0, 1, &s->perturb, err, err_sz);
     } else if (!s->route && strcmp(tok, "throttle") == 0) {
       rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
     } else if (!s->route && strcmp(tok, "steering") == 0) {
@@ -76,7 +89,7 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
       rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
     } else {
       snprintf(err, err_sz, "--script '%s': unknown key '%s' (%s)", spec, tok,
-               s->route ? "speed, start, stop_after, lookahead"
+               s->route ? "speed, start, stop_after, lookahead, laps, perturb"
                         : "throttle, steering, start, stop_after");
       return -1;
     }

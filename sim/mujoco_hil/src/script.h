@@ -2,12 +2,16 @@
  * protocol frames (COMMAND at 50 Hz, arming with engaged=0 then engaged=1 as the failsafe
  * requires) into the emulated Nano's UART.
  * Specs: "constant:throttle=<-1..1>,steering=<-1..1>[,start=<s>][,stop_after=<s>]"
- *        "route:<NAME>[,speed=<0..1>][,start=<s>][,stop_after=<s>][,lookahead=<m>]"
+ *        "route:<NAME>[,speed=<0..1>][,start=<s>][,stop_after=<s>][,lookahead=<m>][,laps=<n>]
+ *               [,perturb=<0..1>]"
  *   start: first command time [s] (default 0); stop_after: the driver goes quiet at this sim
  *   time [s] (default never), which must trip the Nano's failsafe.
  *   route: the map's named route, driven by pure pursuit (route_driver.h) at throttle `speed`
  *   (fraction of top speed, default 0.8) with `lookahead` [m]; the simulator places the car at
- *   the route's start and sets throttle/steering before each frame. */
+ *   the route's start and sets throttle/steering before each frame. laps: laps of a loop route
+ *   before the run ends (default 1). perturb: amplitude of seeded steering perturbations
+ *   (normalised, default 0: none) the route driver adds now and then, so a recording holds the
+ *   expert's recoveries (route_driver.h). */
 #ifndef SIM_SCRIPT_H
 #define SIM_SCRIPT_H
 
@@ -29,6 +33,8 @@ typedef struct script {
   int route;                 /* 1: "route:" spec */
   char route_name[64];
   double lookahead_m;        /* route: pure pursuit lookahead [m] */
+  int laps;                  /* route: laps of a loop before the run ends */
+  double perturb;            /* route: steering perturbation amplitude, normalised (0: none) */
   int64_t start_us, stop_us; /* stop_us < 0: never */
   int64_t next_us;
   uint16_t cmd_seq;

@@ -611,6 +611,7 @@ static int sim_bind_route(sim_t *s, const sim_config_t *cfg, char *err, size_t e
     s->route = NULL;
     return -1;
   }
+  route_driver_set_laps_perturb(s->route, sc.laps, sc.perturb, cfg->seed);
   if (!s->has_start) {
     double yaw;
     route_driver_start(s->route, &s->start.x_m, &s->start.y_m, &yaw);
@@ -1087,6 +1088,9 @@ void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {
   o->steering_rad = (fabs(tl + tr) > 1e-12) ? atan(2.0 * tl * tr / (tl + tr)) : 0.0;
   for (int w = 0; w < W_N; w++) o->wheel_speed_rad_s[w] = d->qvel[c->wheel_dof[w]];
   o->in_collision = c->in_collision;
+  o->command_throttle = c->nano.cmd.throttle_milli / (double)PROTO_MILLI;
+  o->command_steering = c->nano.cmd.steering_milli / (double)PROTO_MILLI;
+  o->expert_steering = (car == 1 && s->route) ? s->route->expert_steering : NAN;
 }
 
 static double sim_clock_s(clockid_t id) {

@@ -55,6 +55,10 @@ typedef struct sim_truth {
   double steering_rad;         /* centre angle from the two knuckles (Ackermann inverse) */
   double wheel_speed_rad_s[4]; /* fl fr rl rr, + forward */
   int in_collision;            /* chassis touches anything */
+  double command_throttle;     /* the last valid COMMAND the car's Nano took, [-1, 1] */
+  double command_steering;     /* its steering [-1, 1] (the label of behavioural cloning) */
+  double expert_steering;      /* --script route: pure pursuit's own steering before any
+                                  perturbation [-1, 1]; NaN without a route driver */
 } sim_truth_t;
 
 /* Builds the world. Returns NULL with a message naming the bad input in err. */

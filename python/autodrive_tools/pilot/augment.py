@@ -1,0 +1,79 @@
+"""Balancing and augmentation of the training frames (on the small BGR image between the
+sidecar's two preprocessing halves; all of it seeded through the numpy Generator given).
+
+- Balance: frames are drawn with weights 1/count of their steering bin (capped), so the many
+  straight-ahead frames do not drown the curves and recoveries.
+- Mirror (p 0.5): flipped left-right, steering negated.
+- Brightness (p 0.5): all levels times U(0.3, 1.3); shadow (p 0.3): a random band darkened.
+- Shift (p 0.5): dx px sideways (and up to 2 px up/down), with a steering correction of
+  -gain_per_px * dx: a sideways shift looks like a heading error of dx / fx [rad], which pure
+  pursuit answers with (2 wheelbase / lookahead) / steer_limit per rad (normalised)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from .spec import U8
+
+F64 = npt.NDArray[np.float64]
+
+BIN_WIDTH = 0.05  # steering histogram bin [normalised]
+MAX_WEIGHT_RATIO = 20.0  # a rare frame is drawn at most this many times as often as a common one
+
+
+def bins(steering: F64) -> npt.NDArray[np.int64]:
+    b: npt.NDArray[np.int64] = np.floor((np.clip(steering, -1, 1) + 1.0) / BIN_WIDTH).astype(
+        np.int64
+    )
+    return b
+
+
+def balance_weights(steering: F64) -> F64:
+    """Sampling probabilities that flatten the steering histogram (sum 1)."""
+    b = bins(steering)
+    counts = np.bincount(b)
+    w = 1.0 / counts[b].astype(np.float64)
+    w = np.minimum(w, w.min() * MAX_WEIGHT_RATIO)
+    out: F64 = w / w.sum()
+    return out
+
+
+@dataclass(frozen=True)
+class Augment:
+    gain_per_px: float  # steering correction per px of sideways shift [normalised / px]
+    max_shift_px: float = 8.0
+    p_mirror: float = 0.5
+    p_brightness: float = 0.5
+    p_shadow: float = 0.3
+    p_shift: float = 0.5
+
+    def __call__(self, img: U8, steering: float, rng: np.random.Generator) -> tuple[U8, float]:
+        out = img
+        h, w = img.shape[:2]
+        if rng.random() < self.p_shift:
+            dx = float(rng.uniform(-self.max_shift_px, self.max_shift_px))
+            dy = float(rng.uniform(-2.0, 2.0))
+            m = np.array([[1.0, 0.0, dx], [0.0, 1.0, dy]], np.float32)
+            out = cv2.warpAffine(out, m, (w, h), borderMode=cv2.BORDER_REPLICATE)
+            steering -= self.gain_per_px * dx
+        bright, shadow = rng.random() < self.p_brightness, rng.random() < self.p_shadow
+        if bright or shadow:
+            f = out.astype(np.float32)
+            if bright:
+                f *= np.float32(rng.uniform(0.3, 1.3))
+            if shadow:
+                x0, x1 = sorted(rng.uniform(0, w, 2))
+                slope = float(rng.uniform(-1.0, 1.0)) * w / h
+                xs = np.arange(w, dtype=np.float32)[None, :]
+                ys = np.arange(h, dtype=np.float32)[:, None] - h / 2
+                inside = (xs >= x0 + slope * ys) & (xs <= x1 + slope * ys)
+                f[inside] *= np.float32(rng.uniform(0.4, 0.8))
+            out = np.clip(f, 0, 255).astype(np.uint8)
+        if rng.random() < self.p_mirror:
+            out = np.ascontiguousarray(out[:, ::-1])
+            steering = -steering
+        return out, float(np.clip(steering, -1.0, 1.0))

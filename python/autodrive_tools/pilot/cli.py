@@ -1,0 +1,133 @@
+"""`tools/pilot`: behavioural cloning (issue 16): expert, record, train, analyse, make-model.
+Run `tools/pilot COMMAND --help` for each command's options."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from ..paths import RELEASE_BUILD
+
+DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front camera.
+  expert      drive N laps with the simulator's expert (pure pursuit + perturbations), record an LCM log
+  record      LCM log(s) -> dataset (JPEG frames, frames.csv, manifest.json)
+  train       dataset -> NAME.onnx + NAME.json sidecar, loss curves, report
+  analyse     activation maps, VisualBackProp saliency and a lap of predictions vs the expert
+  make-model  expert 5 laps + record + train + analyse: the shipped models/pilot/driving_school
+A person can drive instead of the expert: autodrive-sim --map driving_school --cameras
+--lockstep-client, the runtime on its pty, autodrive-teleop, and tools/record LOG; then
+`tools/pilot record LOG --map driving_school` (README, Behavioural cloning)."""
+
+
+def _build() -> Path:
+    return Path(os.environ.get("AUTODRIVE_BUILD", str(RELEASE_BUILD)))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="tools/pilot", description=DESCRIPTION, formatter_class=argparse.RawTextHelpFormatter
+    )
+    sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+
+    e = sub.add_parser("expert", help="record the expert driving laps (LCM log + LOG.meta.json)")
+    e.add_argument("--out", type=Path, required=True, help="the LCM log to write")
+    e.add_argument("--map", default="driving_school")
+    e.add_argument("--route", default="loop_ccw", help="a loop route of the map")
+    e.add_argument("--laps", type=int, default=5)
+    e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
+    e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
+    e.add_argument("--perturb", type=float, default=0.35, help="perturbation amplitude (0..1)")
+    e.add_argument("--camera-fps", type=float, default=15.0, help="[Hz] of sim time")
+    e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
+    e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
+    e.add_argument("--lcm-url", default="", help="default: a port of this process's own")
+
+    r = sub.add_parser("record", help="extract a dataset from LCM log(s)")
+    r.add_argument("logs", nargs="+", type=Path, metavar="LOG")
+    r.add_argument("--out", type=Path, required=True, help="the dataset folder")
+    r.add_argument("--map", default=None, help="the map (else from LOG.meta.json)")
+    r.add_argument("--seed", type=int, default=None, help="the recording's seed (else meta)")
+    r.add_argument("--vehicle", default=None, help="default: car 1 (NIGEL1)")
+
+    t = sub.add_parser("train", help="train, export ONNX + sidecar JSON")
+    t.add_argument("dataset", type=Path, metavar="DATASET")
+    t.add_argument("--out", type=Path, required=True)
+    t.add_argument("--name", default="model", help="files NAME.onnx, NAME.json, NAME.pt")
+    t.add_argument("--epochs", type=int, default=4)
+    t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--batch", type=int, default=64)
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--threads", type=int, default=2, help="PyTorch threads")
+    t.add_argument("--max-frames", type=int, default=0, help="use the first N frames (0: all)")
+    t.add_argument(
+        "--samples-per-epoch", type=int, default=0, help="drawn per epoch (0: training frames)"
+    )
+    t.add_argument("--stride", type=int, default=1, help="use every N-th frame")
+
+    a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
+    a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
+    a.add_argument("--dataset", type=Path, required=True)
+    a.add_argument("--out", type=Path, required=True)
+    a.add_argument("--lap", type=int, default=None, help="default: the first validation lap")
+    a.add_argument("--samples", type=int, default=3, help="frames with activation maps")
+
+    m = sub.add_parser("make-model", help="expert + record + train + analyse, one command")
+    m.add_argument("--out", type=Path, default=Path("models/pilot"), help="the shipped files")
+    m.add_argument("--work", type=Path, default=Path("out/pilot"), help="log, dataset, figures")
+    m.add_argument("--name", default="driving_school")
+    m.add_argument("--laps", type=int, default=5)
+    m.add_argument("--seed", type=int, default=1, help="the recording's seed")
+    m.add_argument("--train-seed", type=int, default=0)
+    m.add_argument("--epochs", type=int, default=4)
+
+    args = ap.parse_args(argv)
+    try:
+        return _run(args)
+    except KeyboardInterrupt:
+        print("tools/pilot: interrupted", file=sys.stderr)
+        return 130
+    except (ValueError, FileNotFoundError, FileExistsError, RuntimeError) as err:
+        print(f"tools/pilot {args.cmd}: {err}", file=sys.stderr)
+        return 1
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.cmd == "expert":
+        from .expert import ExpertRun, record_expert
+
+        run = ExpertRun(
+            map=args.map, route=args.route, laps=args.laps, seed=args.seed, speed=args.speed,
+            perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
+            light_level=args.light_level,
+        )  # fmt: skip
+        wall = record_expert(run, args.out, _build(), args.lcm_url)
+        print(f"pilot expert: {args.out} in {wall:.0f} s wall")
+        return 0
+    if args.cmd == "record":
+        from .dataset import record
+
+        record(args.logs, args.out, args.map, args.seed, args.vehicle, _build())
+        return 0
+    if args.cmd == "train":
+        from .train import TrainConfig, train
+
+        cfg = TrainConfig(
+            epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed, name=args.name,
+            threads=args.threads, max_frames=args.max_frames,
+            samples_per_epoch=args.samples_per_epoch, stride=args.stride,
+        )  # fmt: skip
+        train(args.dataset, args.out, cfg)
+        return 0
+    if args.cmd == "analyse":
+        from .analyse import analyse
+
+        analyse(args.model, args.dataset, args.out, args.lap, args.samples)
+        return 0
+    from .make_model import make_model
+
+    make_model(
+        args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs, _build()
+    )
+    return 0

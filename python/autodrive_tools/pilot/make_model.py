@@ -1,0 +1,94 @@
+"""`tools/pilot make-model`: the one command that makes the shipped model. The expert drives
+5 laps of Driving School's loop_ccw (seeded perturbations, day light, the base camera noise),
+the log becomes a dataset, the network trains (seeded) and is exported, the analysis runs on
+the validation lap, and NAME.onnx, NAME.json, the training report and the figures are copied
+into --out (models/pilot). Wall times of each step go into the report."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from .analyse import analyse
+from .dataset import record
+from .expert import ExpertRun, record_expert
+from .train import TrainConfig, train
+
+
+def log(msg: str) -> None:
+    print(f"pilot make-model: {msg}", file=sys.stderr, flush=True)
+
+
+# the training recipe of the shipped model: every 2nd frame, 4 epochs of 2560 draws
+STRIDE = 2
+SAMPLES_PER_EPOCH = 2560
+
+
+def make_model(
+    out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
+    build: Path,
+) -> None:  # fmt: skip
+    stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
+    run_dir = work / f"{name}-{stamp}"
+    run_dir.mkdir(parents=True, exist_ok=False)
+    times: dict[str, float] = {}
+    t0 = time.monotonic()
+    logf = run_dir / "expert.lcmlog"
+    log(f"1/4 expert: {laps} laps, seed {seed} -> {logf}")
+    record_expert(ExpertRun(laps=laps, seed=seed), logf, build)
+    times["expert_s"] = time.monotonic() - t0
+    t1 = time.monotonic()
+    log("2/4 record")
+    record([logf], run_dir / "dataset", build=build)
+    times["record_s"] = time.monotonic() - t1
+    t2 = time.monotonic()
+    log("3/4 train")
+    report = train(
+        run_dir / "dataset",
+        run_dir / "model",
+        TrainConfig(
+            epochs=epochs,
+            seed=train_seed,
+            name=name,
+            stride=STRIDE,
+            samples_per_epoch=SAMPLES_PER_EPOCH,
+        ),
+    )
+    times["train_s"] = time.monotonic() - t2
+    t3 = time.monotonic()
+    log("4/4 analyse")
+    result = analyse(run_dir / "model" / f"{name}.onnx", run_dir / "dataset", run_dir / "analysis")
+    times["analyse_s"] = time.monotonic() - t3
+    times["total_s"] = time.monotonic() - t0
+    out.mkdir(parents=True, exist_ok=True)
+    for f in (f"{name}.onnx", f"{name}.json"):
+        shutil.copy2(run_dir / "model" / f, out / f)
+    figs = out / f"{name}_figures"
+    figs.mkdir(exist_ok=True)
+    for f in ("loss.png", "steering_hist.png"):
+        shutil.copy2(run_dir / "model" / f, figs / f)
+    for f in result["figures"]:
+        shutil.copy2(run_dir / "analysis" / f, figs / f)
+    full = dict(report, analysis=result, wall_times_s={k: round(v, 1) for k, v in times.items()})
+    full[
+        "command"
+    ] = f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
+    (out / f"{name}_report.json").write_text(json.dumps(full, indent=2) + "\n")
+    md = (
+        (run_dir / "model" / f"{name}_report.md")
+        .read_text()
+        .replace("](loss.png)", f"]({figs.name}/loss.png)")
+    )
+    md += (
+        f"\n## Reproduce\n\n`{full['command']}` (wall times on this machine: "
+        + ", ".join(f"{k} {v:.0f}" for k, v in times.items())
+        + f").\n\n## Analysis (validation lap {result['lap']})\n\nRMSE {result['rmse']} "
+        f"(normalised steering) over {result['frames']} frames.\n\n"
+        + "\n".join(f"![{f}]({figs.name}/{f})" for f in result["figures"])
+        + "\n"
+    )
+    (out / f"{name}_report.md").write_text(md)
+    log(f"done in {times['total_s']:.0f} s: {out / (name + '.onnx')}")

@@ -1,0 +1,81 @@
+"""A tiny dataset (a generated two-lap log: drawn lane frames, ground truth) trains one epoch
+and exports: NAME.onnx (input `frames` [N,3,H,W], output `steering` [N,1] in [-1, 1]) and the
+sidecar of the contract (its sha256 the file's), which OpenCV's DNN runs with the sidecar's
+preprocessing to PyTorch's outputs within 1e-4. Validation is a whole lap not trained on.
+`tools/pilot analyse` then writes the lap plot and activation maps."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).parent))
+import gen_log  # noqa: E402
+
+from autodrive_tools.pilot import model  # noqa: E402
+from autodrive_tools.pilot.analyse import analyse  # noqa: E402
+from autodrive_tools.pilot.dataset import record  # noqa: E402
+from autodrive_tools.pilot.spec import preprocess, read_sidecar, sha256_file  # noqa: E402
+from autodrive_tools.pilot.train import TrainConfig, train  # noqa: E402
+
+BUILD = Path(os.environ["AUTODRIVE_BUILD"])
+
+
+def main() -> None:
+    with tempfile.TemporaryDirectory(prefix="pilot-train-") as tmp:
+        d = Path(tmp)
+        n = gen_log.write(d / "tiny.lcmlog", BUILD, laps=2, frames_per_lap=60)
+        m = record([d / "tiny.lcmlog"], d / "ds", map_name="driving_school", seed=0, build=BUILD)
+        assert m["frame_count"] == n and m["laps"] == 2, m
+        assert m["frames_per_lap"] == {"0": 60, "1": 60}, m["frames_per_lap"]
+        cfg = TrainConfig(epochs=1, batch=16, samples_per_epoch=64, seed=0, name="tiny")
+        report = train(d / "ds", d / "model", cfg)
+        assert len(report["train_loss"]) == 1 and len(report["val_loss"]) == 1
+        assert set(report["train_laps"]).isdisjoint(report["val_laps"]), report
+        assert report["val_frames"] == 60, report["val_frames"]
+        onnx = d / "model" / "tiny.onnx"
+        side = read_sidecar(d / "model" / "tiny.json")
+        raw = json.loads((d / "model" / "tiny.json").read_text())
+        for key in ("source_width", "source_height", "crop_top_px", "crop_bottom_px", "width",
+                    "height", "colour", "scale", "mean", "std"):  # fmt: skip
+            assert key in raw["input"], key
+        assert 11 <= raw["opset"] <= 13 and raw["onnx_sha256"] == sha256_file(onnx)
+        assert onnx.stat().st_size < 5e6
+        spec = side.input
+        frames = sorted((d / "ds" / "frames").glob("*.jpg"))[:20]
+        x = np.stack([preprocess(cv2.imread(str(f)), spec) for f in frames])
+        assert x.shape == (20, 3, spec.height, spec.width) and x.dtype == np.float32
+        net = cv2.dnn.readNetFromONNX(str(onnx))
+        net.setInput(x)
+        got = net.forward()
+        assert got.shape == (20, 1) and np.all(np.abs(got) <= 1.0)
+        torch_net = model.PilotNet(spec.height, spec.width)
+        torch_net.load_state_dict(torch.load(d / "model" / "tiny.pt"))
+        torch_net.eval()
+        with torch.no_grad():
+            want = torch_net(torch.from_numpy(x)).numpy()
+        diff = float(np.max(np.abs(got - want)))
+        assert diff < 1e-4, diff
+        for f in (
+            "loss.png",
+            "steering_hist.png",
+            f"{cfg.name}_report.json",
+            f"{cfg.name}_report.md",
+        ):
+            assert (d / "model" / f).stat().st_size > 0, f
+        res = analyse(onnx, d / "ds", d / "analysis", samples=1)
+        assert res["frames"] == 60 and res["lap"] in report["val_laps"]
+        for f in res["figures"]:
+            assert (d / "analysis" / f).stat().st_size > 1000, f
+        print(f"one epoch: val loss {report['val_loss'][0]:.4f}, DNN vs torch {diff:.1e}, ok")
+
+
+if __name__ == "__main__":
+    main()
