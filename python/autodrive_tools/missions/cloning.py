@@ -91,9 +91,15 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
+def _laps_of(recording: dict[str, Any]) -> float:
+    laps = recording.get("laps")
+    return float(laps) if isinstance(laps, (int, float)) else 0.0
+
+
 def trained(model: Path, key: str, default: float) -> float:
-    """A figure of the model's training (its sidecar's trained.KEY, or of its first recording,
-    trained.conditions[0].KEY), else default; ValueError naming the sidecar when unreadable."""
+    """A figure of the model's training (its sidecar's trained.KEY, or that of its recording
+    with the most laps, trained.conditions[i].KEY), else default; ValueError naming the
+    sidecar when unreadable."""
     path = model.with_suffix(".json")
     try:
         side = json.loads(path.read_text())
@@ -104,8 +110,10 @@ def trained(model: Path, key: str, default: float) -> float:
         return default
     value = section.get(key)
     conditions = section.get("conditions")  # tools/pilot train: one entry per recorded log
-    if value is None and isinstance(conditions, list) and conditions:
-        value = conditions[0].get(key) if isinstance(conditions[0], dict) else None
+    if value is None and isinstance(conditions, list):  # the recording with the most laps
+        recs = [c for c in conditions if isinstance(c, dict) and c.get(key) is not None]
+        recs.sort(key=_laps_of)
+        value = recs[-1].get(key) if recs else None
     return float(value) if isinstance(value, (int, float)) else default
 
 
