@@ -63,10 +63,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument(
         "--mission",
-        choices=("parking", "loop", "smart-city"),
+        choices=("parking", "loop", "smart-city", "cloning"),
         default="parking",
         help="parking (default): map, localise, plan and park autonomously; loop: "
-        "drive a stadium track with pure pursuit on the EKF",
+        "drive a stadium track with pure pursuit on the EKF; cloning: Driving School from the "
+        "camera with a behavioural-cloning model (its own options: --mission cloning --help)",
     )
     p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
     p.add_argument(
@@ -332,6 +333,11 @@ def run(
 
 
 def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if any(a in ("--mission=cloning", "cloning") for a in args) and "--mission" in " ".join(args):
+        from .missions import cloning  # its own options (--laps, --condition, --model)
+
+        return cloning.main(args)
     return run(parse_args(argv))
 
 

@@ -274,3 +274,24 @@ def eye_bench(path: Path, truth: XY, eye: XY, peer: XY) -> None:
     a2.legend(fontsize=8)
     fig.tight_layout()
     _save(fig, path, dpi=DPI)
+
+
+def cloning_laps(
+    path: Path, title: str, centre: XY, bounds: Sequence[XY], driven: XY, interventions: XY
+) -> None:
+    """The cloning evaluation: the route's centre line and lane bounds, the driven path of
+    base_link (ground truth), and where the car crossed a lane bound and was put back."""
+    fig, ax = plt.subplots(figsize=(7.5, 7))
+    for b in bounds:
+        ax.plot(b[0], b[1], color="0.6", lw=0.8)
+    ax.plot(centre[0], centre[1], "--", color="0.4", lw=0.8, label="lane centre line")
+    ax.plot(driven[0], driven[1], color="tab:blue", lw=1.0, label="driven (ground truth)")
+    if len(interventions[0]):
+        ax.plot(interventions[0], interventions[1], "x", color="tab:red", ms=9, mew=2,
+                label="intervention (wheel over the lane bound)")  # fmt: skip
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="center", fontsize=8)
+    _save(fig, path, dpi=DPI, bbox_inches="tight")

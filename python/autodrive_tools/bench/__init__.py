@@ -13,7 +13,19 @@ from typing import Any
 
 from ..paths import REPO_ROOT
 
-SUITES = ("eye", "firmware", "learn", "link", "parking", "scm", "security", "sim", "sweep", "world")
+SUITES = (
+    "cloning",
+    "eye",
+    "firmware",
+    "learn",
+    "link",
+    "parking",
+    "scm",
+    "security",
+    "sim",
+    "sweep",
+    "world",
+)
 
 
 def build_dir(suite: str) -> Path:

@@ -15,6 +15,7 @@
 #include "route_driver.h"
 #include "script.h"
 #include "sim.h"
+#include "teleport_lcm.h"
 #include "tl_lcm.h"
 
 #include "sim_camera.h"
@@ -72,6 +73,9 @@ static void main_usage(FILE *f) {
       "                      of sim time the sim waits for one more frame from the client\n"
       "                      on each Nano pty (a runtime with bridge.sync_to_sim_clock);\n"
       "                      publish SIM_CLOCK\n"
+      "  --allow-teleport    (lockstep modes only) obey SIM_TELEPORT: a pose2d_t naming a\n"
+      "                      car puts it there, standing still (evaluations that put a car\n"
+      "                      back on its lane after an intervention)\n"
       "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
       "                      (default: real time, 1 sim second per wall second)\n"
       "  --host-io-ms N      serve the ptys every N ms of sim time, like a USB-serial\n"
@@ -382,7 +386,7 @@ int main(int argc, char **argv) {
   cfg.tyre_model = -1;
   const char *url = MAIN_DEFAULT_URL, *truth_log = NULL;
   int lockstep = 0, client_sync = 0, frame_sync = 0, bench = 0, quiet = 0, cameras = 0, eye = 0,
-      lidar_lcm = 1, view = 0;
+      lidar_lcm = 1, view = 0, allow_teleport = 0;
   double camera_fps = 30.0, light_level = -1.0, camera_noise = 0.0, camera_blur = 0.0;
   double rtf = 1.0, duration = 0.0, x;
   int rtf_given = 0;
@@ -442,6 +446,8 @@ int main(int argc, char **argv) {
       lockstep = 1;
     } else if (!strcmp(a, "--lockstep-client")) {
       lockstep = client_sync = 1;
+    } else if (!strcmp(a, "--allow-teleport")) {
+      allow_teleport = 1;
     } else if (!strcmp(a, "--lockstep-frames")) {
       lockstep = client_sync = frame_sync = 1;
     } else if (!strcmp(a, "--rtf")) {
@@ -517,6 +523,12 @@ int main(int argc, char **argv) {
   if (lockstep && rtf_given) {
     fprintf(stderr, "autodrive-sim: --lockstep%s and --rtf exclude each other\n",
             client_sync ? "-client" : "");
+    return 2;
+  }
+  if (allow_teleport && !lockstep) {
+    fprintf(stderr,
+            "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
+            "--lockstep-frames (a car never jumps in a real-time run)\n");
     return 2;
   }
   if (client_sync && !cfg.open_ptys) {
@@ -603,7 +615,8 @@ int main(int argc, char **argv) {
   main_cams_fx(&cams, camera_noise, camera_blur, cfg.seed);
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
   /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
-  tl_lcm_t *lights = tl_lcm_create(lcm, url, sim_traffic_lights(s), err, sizeof err);
+  tl_lcm_t *lights = tl_lcm_create(lcm, url, sim_traffic_lights(s), !allow_teleport, err,
+                                     sizeof err);
   if (!lights && err[0]) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     main_cams_close(&cams);
@@ -612,6 +625,17 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
+  teleport_lcm_t *teleport = allow_teleport ? teleport_lcm_create(lcm, s, err, sizeof err) : NULL;
+  if (allow_teleport && !teleport) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    tl_lcm_destroy(lights);
+    main_cams_close(&cams);
+    sim_destroy(s);
+    if (tlog) fclose(tlog);
+    lcm_destroy(lcm);
+    return 1;
+  }
+  if (teleport) printf("teleport: obeying " AUTODRIVE_CH_SIM_TELEPORT " (--allow-teleport)\n");
   main_view_t viewer;
   if (main_view_open(&viewer, s, view, err, sizeof err) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
@@ -680,6 +704,7 @@ int main(int argc, char **argv) {
     }
     /* light commands: every step, but every host-I/O period in free lockstep (a system call) */
     if (lights && step % cfg.host_io_period_ms == 0) tl_lcm_poll(lights, sim_time_us(s));
+    if (teleport && step % cfg.host_io_period_ms == 0) teleport_lcm_poll(teleport);
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
@@ -782,6 +807,7 @@ int main(int argc, char **argv) {
            sim_traffic_lights(s)->n, commands, refused);
   }
   tl_lcm_destroy(lights);
+  teleport_lcm_destroy(teleport);
   main_view_close(&viewer);
   main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */

@@ -1197,6 +1197,44 @@ int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t er
   return 0;
 }
 
+int sim_teleport(sim_t *s, int car, double x_m, double y_m, double yaw_rad, char *err,
+                 size_t err_sz) {
+  if (car < 1 || car > s->ncars) {
+    snprintf(err, err_sz, "no car %d (the sim has %d)", car, s->ncars);
+    return -1;
+  }
+  if (!isfinite(x_m) || !isfinite(y_m) || !isfinite(yaw_rad) || fabs(x_m) > SCN_COORD_MAX_M ||
+      fabs(y_m) > SCN_COORD_MAX_M) {
+    snprintf(err, err_sz, "(%g, %g, %g) is not a finite pose on the map", x_m, y_m, yaw_rad);
+    return -1;
+  }
+  sim_car_t *c = &s->car[car - 1];
+  mjtNum *qp = s->d->qpos + c->root_qpos;
+  mjtNum saved[7], saved0[7];
+  mju_copy(saved, qp, 7);
+  mju_copy(saved0, s->m->qpos0 + c->root_qpos, 7);
+  const double base[3] = {x_m, y_m, 0.0};
+  sim_set_car_pose(s, car - 1, base, yaw_rad, 0, 0);
+  mju_copy(s->m->qpos0 + c->root_qpos, saved0, 7); /* the start pose stays the reset's */
+  cl_prism_t pr;
+  char why[512];
+  sim_car_prism(s, car - 1, &pr);
+  if (cl_check_on_map(s->m, s->d, &pr, s->m->geom_contype[c->chassis_geom],
+                      s->m->geom_conaffinity[c->chassis_geom], why, sizeof why) != 0) {
+    mju_copy(qp, saved, 7);
+    snprintf(err, err_sz, "(x %.3f, y %.3f m, yaw %.3f rad): %s", x_m, y_m, yaw_rad, why);
+    return -1;
+  }
+  for (int j = 0; j < s->m->njnt; j++) { /* every joint of the car: free, knuckles, wheels */
+    int b = s->m->jnt_bodyid[j];
+    while (b > 0 && b != c->body) b = s->m->body_parentid[b];
+    if (b == c->body)
+      mju_zero(s->d->qvel + s->m->jnt_dofadr[j], s->m->jnt_type[j] == mjJNT_FREE ? 6 : 1);
+  }
+  mj_forward(s->m, s->d);
+  return 0;
+}
+
 int sim_drive(sim_t *s, int car, double throttle, double steering) {
   if (car < 1 || car > s->ncars) return -1;
   sim_car_t *c = &s->car[car - 1];

@@ -84,6 +84,12 @@ int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t er
  * same frames and rates the runtime's bridge writes to the pty. -1 when the car has no
  * scripted driver or a value is out of range. */
 int sim_drive(sim_t *s, int car, double throttle, double steering);
+/* Puts car (1-based) at (x_m, y_m, yaw_rad) of base_link, standing still (its free joint's
+ * and wheels' velocities zeroed), without touching sim time, the firmware or the other cars:
+ * the evaluation's "put the car back on the centre line" after an intervention. Checked like
+ * a start pose (on the floor, clear of walls and obstacles); -1 with the reason in err. */
+int sim_teleport(sim_t *s, int car, double x_m, double y_m, double yaw_rad, char *err,
+                 size_t err_sz);
 struct sim_lidar_scan;
 /* Casts car's whole LIDAR scan at the current state (stamped now) and returns it; NULL
  * without a LIDAR. For sim_config_t.lidar_on_request. */
