@@ -16,7 +16,7 @@ from autodrive_tools.marl.train import TrainConfig, train
 
 
 def main() -> None:
-    cfg = TrainConfig(stages=[(1, 128), (2, 128)], copies=2, workers=2, seed=3)
+    cfg = TrainConfig(stages=[(1, 128), (2, 128)], copies=2, workers=2, seed=3, buffer=128)
     model, curve, info = train(cfg, print)
     assert info["agent_steps_done"] >= 256
     with tempfile.TemporaryDirectory() as d:

@@ -102,7 +102,9 @@ def main(argv: list[str]) -> int:
     figures["goals_met"] = {
         "success_4cars_shield_ge_0.98_0_collisions": s["success_rate"] >= 0.98
         and s["collisions"] == 0,
-        "policy_at_least_as_fast_as_baseline": s["mean_traverse_s"] <= b["mean_traverse_s"],
+        "policy_as_fast_as_baseline_at_same_safety": s["mean_traverse_s"] <= b["mean_traverse_s"]
+        and s["collisions"] <= b["collisions"]
+        and s["success_rate"] >= b["success_rate"],
         "training_le_45_min": (figures["training_wall_s"] or 1e9) <= 45 * 60
         and s["success_rate"] >= 0.98,
     }

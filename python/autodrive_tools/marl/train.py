@@ -87,6 +87,7 @@ class TrainConfig:
     seed: int = 0
     torch_threads: int = 1
     max_wall_s: float = float("inf")  # stop (and keep the model) after this wall time
+    buffer: int = BUFFER  # rollout buffer (n_steps x slots); smaller only for quick tests
 
 
 def linear(lr0: float) -> Any:
@@ -106,7 +107,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
         env = MarlVecEnv(
             EnvSpec(cars, cfg.action_mode), cfg.copies, cfg.workers, cfg.seed + 7 * cars
         )
-        n_steps = max(BATCH, BUFFER // env.num_envs)
+        n_steps = max(1, cfg.buffer // env.num_envs)
         # the learning rate decays linearly over the whole curriculum
         lr0 = LR * (1.0 - done_all / total_all)
         prev = model
@@ -115,7 +116,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
             env,
             learning_rate=linear(lr0),
             n_steps=n_steps,
-            batch_size=BATCH,
+            batch_size=min(BATCH, n_steps * env.num_envs),
             n_epochs=3,
             gamma=0.99,
             gae_lambda=0.98,
