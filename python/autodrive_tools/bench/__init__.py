@@ -19,6 +19,7 @@ SUITES = (
     "firmware",
     "learn",
     "link",
+    "marl",
     "parking",
     "scm",
     "security",
