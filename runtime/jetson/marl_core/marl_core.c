@@ -1,0 +1,262 @@
+/* The intersection policy's observation builder and time-to-collision shield
+ * (<autodrive/marl_core.h>). Pure arithmetic: no allocation, no I/O, no state. */
+#include "autodrive/marl_core.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+
+static int fail(char *err, size_t err_sz, const char *fmt, ...) {
+  if (err != NULL && err_sz > 0) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, err_sz, fmt, ap);
+    va_end(ap);
+  }
+  return -1;
+}
+
+static int car_ok(const adm_car_t *c) {
+  return isfinite(c->x_m) && isfinite(c->y_m) && isfinite(c->yaw_rad) && isfinite(c->speed_m_s);
+}
+
+/* (wx, wy) in the frame of a car at (x, y, yaw). */
+static void to_car_frame(double x, double y, double yaw, double wx, double wy, double *cx,
+                         double *cy) {
+  const double c = cos(yaw), s = sin(yaw), dx = wx - x, dy = wy - y;
+  *cx = c * dx + s * dy;
+  *cy = -s * dx + c * dy;
+}
+
+int adm_observation(const adm_car_t *self, const double *goal_xy_m, const double *waypoint_xy_m,
+                    double last_steering, const adm_car_t *peers, int n_peers, float *obs,
+                    int obs_len, char *err, size_t err_sz) {
+  if (self == NULL || goal_xy_m == NULL || waypoint_xy_m == NULL || obs == NULL)
+    return fail(err, err_sz, "observation: self, goal, waypoint and obs must not be NULL");
+  if (obs_len != ADM_OBS_DIM)
+    return fail(err, err_sz, "observation: obs_len %d, the layout has %d", obs_len, ADM_OBS_DIM);
+  if (n_peers < 0 || (n_peers > 0 && peers == NULL))
+    return fail(err, err_sz, "observation: %d peers at %p", n_peers, (const void *)peers);
+  if (!car_ok(self) || !isfinite(goal_xy_m[0]) || !isfinite(goal_xy_m[1]) ||
+      !isfinite(waypoint_xy_m[0]) || !isfinite(waypoint_xy_m[1]) || !isfinite(last_steering))
+    return fail(err, err_sz,
+                "observation: car %d: a pose, goal, waypoint or steering is not finite", self->id);
+  for (int i = 0; i < obs_len; i++) obs[i] = 0.0f;
+  double gx, gy, wx, wy;
+  to_car_frame(self->x_m, self->y_m, self->yaw_rad, goal_xy_m[0], goal_xy_m[1], &gx, &gy);
+  to_car_frame(self->x_m, self->y_m, self->yaw_rad, waypoint_xy_m[0], waypoint_xy_m[1], &wx, &wy);
+  obs[0] = (float)(gx / ADM_POSITION_SCALE_M);
+  obs[1] = (float)(gy / ADM_POSITION_SCALE_M);
+  obs[2] = (float)(wx / ADM_WAYPOINT_SCALE_M);
+  obs[3] = (float)(wy / ADM_WAYPOINT_SCALE_M);
+  obs[4] = (float)(self->speed_m_s / ADM_SPEED_SCALE_M_S);
+  obs[5] = (float)(last_steering < -1.0 ? -1.0 : last_steering > 1.0 ? 1.0 : last_steering);
+
+  /* The nearest ADM_PEER_SLOTS peers in range, by insertion into a sorted short list. */
+  int slot_peer[ADM_PEER_SLOTS];
+  double slot_d[ADM_PEER_SLOTS];
+  int used = 0;
+  for (int i = 0; i < n_peers; i++) {
+    const adm_car_t *p = &peers[i];
+    if (p->id == self->id) continue;
+    if (!car_ok(p))
+      return fail(err, err_sz, "observation: peer %d: a pose or speed is not finite", p->id);
+    const double d = hypot(p->x_m - self->x_m, p->y_m - self->y_m);
+    if (d > ADM_PEER_RANGE_M) continue;
+    int k = used < ADM_PEER_SLOTS ? used : ADM_PEER_SLOTS;
+    while (k > 0 &&
+           (d < slot_d[k - 1] || (d == slot_d[k - 1] && p->id < peers[slot_peer[k - 1]].id))) {
+      if (k < ADM_PEER_SLOTS) {
+        slot_d[k] = slot_d[k - 1];
+        slot_peer[k] = slot_peer[k - 1];
+      }
+      k--;
+    }
+    if (k < ADM_PEER_SLOTS) {
+      slot_d[k] = d;
+      slot_peer[k] = i;
+      if (used < ADM_PEER_SLOTS) used++;
+    }
+  }
+  for (int s = 0; s < used; s++) {
+    const adm_car_t *p = &peers[slot_peer[s]];
+    float *o = obs + ADM_OWN_FEATURES + s * ADM_PEER_FEATURES;
+    double rx, ry;
+    to_car_frame(self->x_m, self->y_m, self->yaw_rad, p->x_m, p->y_m, &rx, &ry);
+    const double ryaw = p->yaw_rad - self->yaw_rad;
+    o[0] = 1.0f;
+    o[1] = (float)(rx / ADM_POSITION_SCALE_M);
+    o[2] = (float)(ry / ADM_POSITION_SCALE_M);
+    o[3] = (float)cos(ryaw);
+    o[4] = (float)sin(ryaw);
+    o[5] = (float)(p->speed_m_s / ADM_SPEED_SCALE_M_S);
+  }
+  return 0;
+}
+
+int adm_route_waypoint(const double *route_xy_m, int n_points, double x_m, double y_m,
+                       double lookahead_m, int *hint_index, double *waypoint_xy_m,
+                       double *remaining_m, char *err, size_t err_sz) {
+  if (route_xy_m == NULL || hint_index == NULL || waypoint_xy_m == NULL || remaining_m == NULL)
+    return fail(err, err_sz,
+                "route waypoint: route, hint, waypoint and remaining must not be NULL");
+  if (n_points < 2)
+    return fail(err, err_sz, "route waypoint: a route needs >= 2 points, got %d", n_points);
+  if (!isfinite(x_m) || !isfinite(y_m) || !isfinite(lookahead_m) || lookahead_m < 0.0)
+    return fail(err, err_sz, "route waypoint: position (%g, %g) or lookahead %g m is bad", x_m, y_m,
+                lookahead_m);
+  const int back = 3, ahead = 40; /* search window around the hint [points] */
+  int lo = 0, hi = n_points - 1;
+  if (*hint_index >= 0 && *hint_index < n_points) {
+    lo = *hint_index - back < 0 ? 0 : *hint_index - back;
+    hi = *hint_index + ahead >= n_points ? n_points - 1 : *hint_index + ahead;
+  }
+  int best = lo;
+  double best_d2 = INFINITY;
+  for (int i = lo; i <= hi; i++) {
+    const double dx = route_xy_m[2 * i] - x_m, dy = route_xy_m[2 * i + 1] - y_m;
+    const double d2 = dx * dx + dy * dy;
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = i;
+    }
+  }
+  *hint_index = best;
+  double remaining = 0.0;
+  for (int i = best; i + 1 < n_points; i++)
+    remaining += hypot(route_xy_m[2 * i + 2] - route_xy_m[2 * i],
+                       route_xy_m[2 * i + 3] - route_xy_m[2 * i + 1]);
+  *remaining_m = remaining;
+  /* march lookahead_m along the polyline from the nearest point */
+  double left = lookahead_m;
+  int i = best;
+  waypoint_xy_m[0] = route_xy_m[2 * (n_points - 1)];
+  waypoint_xy_m[1] = route_xy_m[2 * (n_points - 1) + 1];
+  for (; i + 1 < n_points; i++) {
+    const double ax = route_xy_m[2 * i], ay = route_xy_m[2 * i + 1];
+    const double bx = route_xy_m[2 * i + 2], by = route_xy_m[2 * i + 3];
+    const double seg = hypot(bx - ax, by - ay);
+    if (seg >= left && seg > 0.0) {
+      waypoint_xy_m[0] = ax + (bx - ax) * left / seg;
+      waypoint_xy_m[1] = ay + (by - ay) * left / seg;
+      break;
+    }
+    left -= seg;
+  }
+  return 0;
+}
+
+void adm_shield_defaults(adm_shield_config_t *cfg) {
+  if (cfg == NULL) return;
+  *cfg = (adm_shield_config_t){
+      .horizon_s = 2.5,
+      .dt_s = 0.05,
+      .steer_hold_s = 0.3,
+      .margin_m = 0.03,
+      .emergency_s = 0.6,
+      .brake_throttle = 0.0,
+  };
+}
+
+/* The two footprint circles' centres of a car at (x, y, yaw). */
+static void circles(const adm_shield_config_t *cfg, double x, double y, double yaw, double cx[2],
+                    double cy[2]) {
+  const double c = cos(yaw), s = sin(yaw), q = 0.25 * cfg->chassis_length_m;
+  for (int k = 0; k < 2; k++) {
+    const double along = cfg->chassis_offset_m + (k == 0 ? q : -q);
+    cx[k] = x + c * along;
+    cy[k] = y + s * along;
+  }
+}
+
+static double footprint_distance(const adm_shield_config_t *cfg, double ax, double ay, double ayaw,
+                                 double bx, double by, double byaw) {
+  double acx[2], acy[2], bcx[2], bcy[2];
+  circles(cfg, ax, ay, ayaw, acx, acy);
+  circles(cfg, bx, by, byaw, bcx, bcy);
+  double best = INFINITY;
+  for (int i = 0; i < 2; i++)
+    for (int j = 0; j < 2; j++) {
+      const double d = hypot(acx[i] - bcx[j], acy[i] - bcy[j]);
+      best = d < best ? d : best;
+    }
+  return best;
+}
+
+int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
+               const adm_car_t *peers, int n_peers, adm_shield_result_t *out, char *err,
+               size_t err_sz) {
+  if (cfg == NULL || self == NULL || intended == NULL || out == NULL)
+    return fail(err, err_sz, "shield: cfg, self, intended and out must not be NULL");
+  if (n_peers < 0 || (n_peers > 0 && peers == NULL))
+    return fail(err, err_sz, "shield: %d peers at %p", n_peers, (const void *)peers);
+  if (!(cfg->horizon_s > 0.0) || !(cfg->dt_s > 0.0) || cfg->dt_s > cfg->horizon_s ||
+      !(cfg->chassis_length_m > 0.0) || !(cfg->chassis_width_m > 0.0) ||
+      !(cfg->wheelbase_m > 0.0) || !(cfg->top_speed_m_s > 0.0) || !(cfg->steer_limit_rad > 0.0) ||
+      !(cfg->margin_m >= 0.0) || !(cfg->steer_hold_s >= 0.0) || !isfinite(cfg->brake_throttle))
+    return fail(err, err_sz,
+                "shield: config needs horizon_s >= dt_s > 0, chassis, wheelbase, steering limit "
+                "and top speed > 0, margin and steer_hold >= 0");
+  if (!car_ok(self) || !isfinite(intended->throttle) || !isfinite(intended->steering))
+    return fail(err, err_sz, "shield: car %d: its pose, speed or command is not finite", self->id);
+  for (int i = 0; i < n_peers; i++)
+    if (!car_ok(&peers[i]))
+      return fail(err, err_sz, "shield: peer %d: a pose or speed is not finite", peers[i].id);
+
+  out->command = *intended;
+  out->intervened = 0;
+  out->peer_id = -1;
+  out->ttc_s = cfg->horizon_s;
+
+  const double half_len = 0.25 * cfg->chassis_length_m, half_w = 0.5 * cfg->chassis_width_m;
+  const double radius = sqrt(half_len * half_len + half_w * half_w) + cfg->margin_m;
+  const double contact = 2.0 * radius;
+  const double steer = fmax(-1.0, fmin(1.0, intended->steering)) * cfg->steer_limit_rad;
+  const double v_self = intended->throttle > 0.0
+                            ? fmax(self->speed_m_s, intended->throttle * cfg->top_speed_m_s)
+                            : self->speed_m_s;
+  const int steps = (int)ceil(cfg->horizon_s / cfg->dt_s);
+
+  double best_t = INFINITY;
+  int best_peer = -1;
+  double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
+  for (int k = 1; k <= steps; k++) {
+    const double t = k * cfg->dt_s;
+    /* self: kinematic bicycle, the intended steering while t <= steer_hold_s */
+    if (t <= cfg->steer_hold_s + 1e-9) pyaw += v_self * tan(steer) / cfg->wheelbase_m * cfg->dt_s;
+    px += v_self * cos(pyaw) * cfg->dt_s;
+    py += v_self * sin(pyaw) * cfg->dt_s;
+    for (int i = 0; i < n_peers; i++) {
+      const adm_car_t *p = &peers[i];
+      if (p->id == self->id) continue;
+      const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
+      const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
+      if (footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad) >= contact) continue;
+      /* a peer behind self at contact would run into self: its own shield's job */
+      double rx, ry;
+      to_car_frame(px, py, pyaw, qx, qy, &rx, &ry);
+      if (rx < -0.5 * cfg->chassis_length_m) continue;
+      /* right of way: nearer to the contact point (chassis centres) goes first */
+      const double mx = 0.5 * (px + qx), my = 0.5 * (py + qy);
+      double scx[2], scy[2], pcx[2], pcy[2];
+      circles(cfg, self->x_m, self->y_m, self->yaw_rad, scx, scy);
+      circles(cfg, p->x_m, p->y_m, p->yaw_rad, pcx, pcy);
+      const double d_self = hypot(0.5 * (scx[0] + scx[1]) - mx, 0.5 * (scy[0] + scy[1]) - my);
+      const double d_peer = hypot(0.5 * (pcx[0] + pcx[1]) - mx, 0.5 * (pcy[0] + pcy[1]) - my);
+      const int peer_first =
+          d_peer < d_self - 0.05 || (fabs(d_peer - d_self) <= 0.05 && p->id < self->id);
+      if ((t < cfg->emergency_s || peer_first) && t < best_t) {
+        best_t = t;
+        best_peer = p->id;
+      }
+    }
+    if (best_peer >= 0) break; /* the earliest contact that calls for braking */
+  }
+  if (best_peer >= 0) {
+    out->command.throttle = cfg->brake_throttle;
+    out->intervened = 1;
+    out->peer_id = best_peer;
+    out->ttc_s = best_t;
+  }
+  return 0;
+}

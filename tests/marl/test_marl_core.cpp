@@ -1,0 +1,197 @@
+// Unit tests of autodrive_marl_core (<autodrive/marl_core.h>): the observation layout and the
+// time-to-collision shield, with the car's figures from <autodrive_vehicle.h>.
+#include <autodrive/marl_core.h>
+#include <autodrive_vehicle.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+adm_shield_config_t nigel_shield() {
+  adm_shield_config_t cfg;
+  adm_shield_defaults(&cfg);
+  cfg.chassis_length_m = AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X;
+  cfg.chassis_width_m = AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_Y;
+  cfg.chassis_offset_m = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X;
+  cfg.wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
+  cfg.steer_limit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
+  cfg.top_speed_m_s = AUTODRIVE_VEHICLE_MOTOR_NOLOAD_SPEED_RAD_S * AUTODRIVE_VEHICLE_WHEEL_RADIUS_M;
+  return cfg;
+}
+
+adm_car_t car(int id, double x, double y, double yaw, double v) {
+  return {id, x, y, yaw, v};
+}
+
+}  // namespace
+
+TEST(MarlObservation, GoalWaypointAndSpeedInOwnFrame) {
+  const adm_car_t self = car(1, 1.0, 2.0, kPi / 2, 0.25);  // facing +y
+  const double goal[2] = {1.0, 4.0}, wp[2] = {0.5, 2.0};
+  std::vector<float> obs(ADM_OBS_DIM, -9.0f);
+  char err[256] = "";
+  ASSERT_EQ(
+      adm_observation(&self, goal, wp, 0.5, nullptr, 0, obs.data(), ADM_OBS_DIM, err, sizeof err),
+      0)
+      << err;
+  EXPECT_NEAR(obs[0], 2.0 / ADM_POSITION_SCALE_M, 1e-6);  // 2 m straight ahead
+  EXPECT_NEAR(obs[1], 0.0, 1e-6);
+  EXPECT_NEAR(obs[2], 0.0, 1e-6);
+  EXPECT_NEAR(obs[3], 0.5 / ADM_WAYPOINT_SCALE_M, 1e-6);  // 0.5 m to the left
+  EXPECT_NEAR(obs[4], 0.25 / ADM_SPEED_SCALE_M_S, 1e-6);
+  EXPECT_NEAR(obs[5], 0.5, 1e-6);
+  for (int i = ADM_OWN_FEATURES; i < ADM_OBS_DIM; i++)
+    EXPECT_EQ(obs[i], 0.0f) << "empty peer slots are zeros, index " << i;
+}
+
+TEST(MarlObservation, PeersNearestFirstSkipsSelfAndFarOnes) {
+  const adm_car_t self = car(2, 0.0, 0.0, 0.0, 0.0);
+  const adm_car_t peers[] = {car(1, 3.0, 0.0, 0.0, 0.1), car(2, 0.0, 0.0, 0.0, 0.0),
+                             car(3, 0.0, -1.0, kPi, 0.2), car(4, 9.0, 9.0, 0.0, 0.0),
+                             car(5, 1.0, 0.0, kPi / 2, 0.0)};
+  const double goal[2] = {1.0, 0.0};
+  std::vector<float> obs(ADM_OBS_DIM);
+  ASSERT_EQ(adm_observation(&self, goal, goal, 0.0, peers, 5, obs.data(), ADM_OBS_DIM, nullptr, 0),
+            0);
+  const float *s0 = &obs[ADM_OWN_FEATURES], *s1 = s0 + ADM_PEER_FEATURES,
+              *s2 = s1 + ADM_PEER_FEATURES;
+  // slot 0: car 3 at 1 m to the right, facing back, tie with car 5 at 1 m broken by... distance
+  // equal: the lower id (3) first
+  EXPECT_EQ(s0[0], 1.0f);
+  EXPECT_NEAR(s0[2], -1.0 / ADM_POSITION_SCALE_M, 1e-6);
+  EXPECT_NEAR(s0[3], -1.0, 1e-6);
+  EXPECT_NEAR(s0[5], 0.2 / ADM_SPEED_SCALE_M_S, 1e-6);
+  EXPECT_NEAR(s1[1], 1.0 / ADM_POSITION_SCALE_M, 1e-6);  // car 5 ahead
+  EXPECT_NEAR(s1[4], 1.0, 1e-6);
+  EXPECT_NEAR(s2[1], 3.0 / ADM_POSITION_SCALE_M, 1e-6);  // car 1; car 4 is out of range
+}
+
+TEST(MarlObservation, RejectsBadInput) {
+  const adm_car_t self = car(1, NAN, 0.0, 0.0, 0.0);
+  const double goal[2] = {0, 0};
+  std::vector<float> obs(ADM_OBS_DIM);
+  char err[256] = "";
+  EXPECT_EQ(
+      adm_observation(&self, goal, goal, 0.0, nullptr, 0, obs.data(), ADM_OBS_DIM, err, sizeof err),
+      -1);
+  EXPECT_NE(std::string(err).find("not finite"), std::string::npos) << err;
+  const adm_car_t ok = car(1, 0, 0, 0, 0);
+  EXPECT_EQ(adm_observation(&ok, goal, goal, 0.0, nullptr, 0, obs.data(), 5, err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("obs_len 5"), std::string::npos) << err;
+}
+
+TEST(MarlRoute, WaypointAheadAndRemainingLength) {
+  const double route[] = {0, 0, 1, 0, 2, 0, 2, 1};  // 3 m, a left corner at (2, 0)
+  int hint = -1;
+  double wp[2], remaining;
+  ASSERT_EQ(adm_route_waypoint(route, 4, 0.9, 0.1, 0.5, &hint, wp, &remaining, nullptr, 0), 0);
+  EXPECT_EQ(hint, 1);
+  EXPECT_NEAR(wp[0], 1.5, 1e-9);
+  EXPECT_NEAR(remaining, 2.0, 1e-9);
+  ASSERT_EQ(adm_route_waypoint(route, 4, 1.9, 0.0, 0.5, &hint, wp, &remaining, nullptr, 0), 0);
+  EXPECT_EQ(hint, 2);
+  EXPECT_NEAR(wp[1], 0.5, 1e-9);  // around the corner
+  ASSERT_EQ(adm_route_waypoint(route, 4, 2.0, 0.9, 5.0, &hint, wp, &remaining, nullptr, 0), 0);
+  EXPECT_NEAR(wp[1], 1.0, 1e-9);  // clamped at the end
+  char err[128];
+  EXPECT_EQ(adm_route_waypoint(route, 1, 0, 0, 0.5, &hint, wp, &remaining, err, sizeof err), -1);
+}
+
+TEST(MarlShield, BrakesInScriptedHeadOn) {
+  // Two cars 1.2 m apart in one lane, facing each other at the top speed: both shields brake
+  // (contact within the emergency time for neither yet, but the right-of-way rule makes at
+  // least the farther car brake; within emergency_s both do).
+  const adm_shield_config_t cfg = nigel_shield();
+  const double v = cfg.top_speed_m_s;
+  const adm_car_t a = car(1, 0.0, 0.0, 0.0, v);
+  const adm_car_t b = car(2, 1.2, 0.0, kPi, v);
+  const adm_command_t go = {1.0, 0.0};
+  adm_shield_result_t ra, rb;
+  char err[256] = "";
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, err, sizeof err), 0) << err;
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, err, sizeof err), 0) << err;
+  EXPECT_TRUE(ra.intervened || rb.intervened) << "neither car brakes head-on";
+  const adm_shield_result_t &braked = ra.intervened ? ra : rb;
+  EXPECT_EQ(braked.command.throttle, cfg.brake_throttle);
+  EXPECT_EQ(braked.command.steering, 0.0);
+  EXPECT_LT(braked.ttc_s, cfg.horizon_s);
+  // closer in: both brake, whatever the right of way
+  const adm_car_t b_near = car(2, 0.5, 0.0, kPi, v);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b_near, 1, &ra, err, sizeof err), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b_near, &go, &a, 1, &rb, err, sizeof err), 0);
+  EXPECT_TRUE(ra.intervened && rb.intervened);
+  EXPECT_EQ(ra.peer_id, 2);
+  EXPECT_EQ(rb.peer_id, 1);
+  // simulated forward: with the shield, the two cars (kinematic, braking to a stop at once)
+  // never touch; without it they do
+  for (int shielded = 0; shielded < 2; shielded++) {
+    adm_car_t s[2] = {a, b};
+    double closest = 1e9;
+    for (int k = 0; k < 100; k++) {
+      double speed[2];
+      for (int i = 0; i < 2; i++) {
+        adm_shield_result_t r{};
+        ASSERT_EQ(adm_shield(&cfg, &s[i], &go, &s[1 - i], 1, &r, nullptr, 0), 0);
+        speed[i] = shielded && r.intervened ? 0.0 : v;
+      }
+      for (int i = 0; i < 2; i++) {
+        s[i].speed_m_s = speed[i];
+        s[i].x_m += speed[i] * std::cos(s[i].yaw_rad) * 0.05;
+      }
+      closest = std::fmin(closest, std::fabs(s[1].x_m - s[0].x_m));
+    }
+    if (shielded)
+      EXPECT_GT(closest,
+                AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X + 2 * AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X);
+    else
+      EXPECT_LT(closest, AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X);
+  }
+}
+
+TEST(MarlShield, LeavesClearAndParallelTrafficAlone) {
+  const adm_shield_config_t cfg = nigel_shield();
+  const double v = cfg.top_speed_m_s;
+  const adm_command_t go = {1.0, 0.0};
+  adm_shield_result_t r;
+  // opposite lanes 0.28 m apart: passing, not colliding
+  const adm_car_t a = car(1, 0.0, -0.14, 0.0, v), b = car(2, 1.0, 0.14, kPi, v);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &r, nullptr, 0), 0);
+  EXPECT_FALSE(r.intervened);
+  EXPECT_EQ(r.peer_id, -1);
+  EXPECT_EQ(r.command.throttle, 1.0);
+  // a faster follower behind self: its shield's job, not self's
+  const adm_car_t follower = car(3, -0.4, -0.14, 0.0, 2 * v);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &follower, 1, &r, nullptr, 0), 0);
+  EXPECT_FALSE(r.intervened);
+  ASSERT_EQ(adm_shield(&cfg, &follower, &go, &a, 1, &r, nullptr, 0), 0);
+  EXPECT_TRUE(r.intervened);
+}
+
+TEST(MarlShield, CrossingGivesWayToTheNearerCarOnly) {
+  const adm_shield_config_t cfg = nigel_shield();
+  const double v = cfg.top_speed_m_s;
+  const adm_command_t go = {1.0, 0.0};
+  // a from the west to the east, b from the south to the north, b nearer the crossing
+  const adm_car_t a = car(1, -0.9, 0.0, 0.0, v), b = car(2, 0.0, -0.6, kPi / 2, v);
+  adm_shield_result_t ra, rb;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(ra.intervened);
+  EXPECT_FALSE(rb.intervened);
+}
+
+TEST(MarlShield, RejectsBadConfig) {
+  adm_shield_config_t cfg;
+  adm_shield_defaults(&cfg);  // the car's figures are still 0
+  const adm_car_t a = car(1, 0, 0, 0, 0);
+  const adm_command_t go = {1.0, 0.0};
+  adm_shield_result_t r;
+  char err[256] = "";
+  EXPECT_EQ(adm_shield(&cfg, &a, &go, nullptr, 0, &r, err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("config"), std::string::npos) << err;
+}
