@@ -68,6 +68,7 @@ class App {
         route_(std::move(route)),
         baseline_(std::move(baseline)),
         origin_(origin),
+        core_(route_, policy_ ? policy_->spec().waypoint_lookahead_m : 0.3),
         peers_(o.vehicle, static_cast<int64_t>(o.stale_ms * 1000)),
         link_(o.v2v_loss, static_cast<int64_t>(o.v2v_delay_ms * 1000), o.seed) {
     period_us_ = static_cast<int64_t>(
@@ -84,7 +85,7 @@ class App {
   void on_pose(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
     autonomy::Pose2 p{m->x_m, m->y_m, m->yaw_rad};
     if (origin_) p = autonomy::pose_compose(*origin_, p);
-    own_ = marl::CarState{p.x_m, p.y_m, p.yaw_rad, m->vx_m_s};
+    own_ = marl::CarState{marl::vehicle_id(o_.vehicle), p.x_m, p.y_m, p.yaw_rad, m->vx_m_s};
     have_pose_ = true;
   }
 
@@ -102,7 +103,8 @@ class App {
     if (!have_pose_) return;  // nothing to drive on yet: the bridge holds the car still
     const std::vector<autodrive::v2v_state_t> fresh = peers_.fresh(now);
     std::vector<marl::CarState> peers;
-    for (const auto &s : fresh) peers.push_back({s.x_m, s.y_m, s.yaw_rad, s.speed_m_s});
+    for (const auto &s : fresh)
+      peers.push_back({marl::vehicle_id(s.vehicle), s.x_m, s.y_m, s.yaw_rad, s.speed_m_s});
     const auto &end = route_.points.back();
     const bool at_goal = std::hypot(own_.x_m - end.x_m, own_.y_m - end.y_m) < o_.goal_tolerance_m;
     if (at_goal && goal_us_ < 0) {
@@ -117,17 +119,17 @@ class App {
         throttle = c.throttle;
         steering = c.steering;
       } else {
-        const std::vector<float> obs =
-            marl::build_observation(own_, {end.x_m, end.y_m}, peers);
+        const std::vector<float> obs = core_.observation(own_, peers, last_steering_);
         steering = policy_->steering(obs);
         throttle = policy_->spec().throttle;
       }
       if (!o_.no_shield) {
-        const marl::ShieldResult r = marl::shield(own_, throttle, steering, peers);
+        const marl::ShieldResult r = core_.shield(own_, throttle, steering, peers);
         if (r.intervened) {
           ++shield_interventions_;
           if (!last_intervened_)
-            spdlog::info("shield: brake, contact predicted in {:.2f} s", r.ttc_s);
+            spdlog::info("shield: brake for NIGEL{}, contact predicted in {:.2f} s", r.peer_id,
+                         r.ttc_s);
         }
         last_intervened_ = r.intervened;
         throttle = r.throttle;
@@ -135,6 +137,7 @@ class App {
       }
     }
     publish(now, throttle, steering, goal_us_ < 0);
+    last_steering_ = steering;
     ++steps_;
     peers_seen_ = fresh.size();
     if (now - last_status_us_ >= 500000) publish_status(now);
@@ -203,10 +206,12 @@ class App {
   marl::Route route_;
   std::unique_ptr<marl::FcfsBaseline> baseline_;
   std::optional<autonomy::Pose2> origin_;
+  marl::Core core_;
   autodrive::v2v::PeerTable peers_;
   marl::LinkDegrader link_;
   marl::CarState own_;
   bool have_pose_ = false, last_intervened_ = false;
+  double last_steering_ = 0;
   int64_t sim_now_us_ = 0, last_cmd_us_ = -1, last_status_us_ = -1000000000, goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
@@ -322,13 +327,13 @@ int main(int argc, char **argv) {
       return 2;
     }
     if (!o.eval_obs.empty()) return eval_observations(*policy, o.eval_obs);
-    if (policy->spec().obs_layout != marl::obs_layout_name() ||
-        policy->spec().obs_dim != marl::kObsDim) {
+    if (policy->spec().obs_version != marl::obs_version() ||
+        policy->spec().obs_dim != marl::obs_dim()) {
       std::fprintf(stderr,
-                   "autodrive-marl: --policy %s: observation layout '%s' of %d values, this "
-                   "program builds '%s' of %d\n",
-                   o.policy.c_str(), policy->spec().obs_layout.c_str(), policy->spec().obs_dim,
-                   marl::obs_layout_name(), marl::kObsDim);
+                   "autodrive-marl: --policy %s: trained on observation version %d of %d values, "
+                   "the MARL core builds version %d of %d\n",
+                   o.policy.c_str(), policy->spec().obs_version, policy->spec().obs_dim,
+                   marl::obs_version(), marl::obs_dim());
       return 2;
     }
   }

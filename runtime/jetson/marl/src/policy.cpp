@@ -30,9 +30,9 @@ PolicySpec read_policy_spec(const std::string &json_path) {
     if (!j.is_object() || !j.contains(key)) bad(json_path, std::string(key) + ": missing key");
     return j.at(key);
   };
-  const auto &layout = need("obs_layout");
-  if (!layout.is_string()) bad(json_path, "obs_layout: not a string");
-  s.obs_layout = layout.get<std::string>();
+  const auto &version = need("obs_version");
+  if (!version.is_number_integer()) bad(json_path, "obs_version: not an integer");
+  s.obs_version = version.get<int>();
   const auto &dim = need("obs_dim");
   if (!dim.is_number_integer() || dim.get<int>() < 1 || dim.get<int>() > 4096)
     bad(json_path, "obs_dim: not an integer in 1..4096");
@@ -56,6 +56,10 @@ PolicySpec read_policy_spec(const std::string &json_path) {
   if (!thr.is_number() || !(thr.get<double>() > 0.0 && thr.get<double>() <= 1.0))
     bad(json_path, "throttle: not a number in (0, 1]");
   s.throttle = thr.get<double>();
+  const auto &look = need("waypoint_lookahead_m");
+  if (!look.is_number() || !(look.get<double>() > 0.0 && look.get<double>() <= 5.0))
+    bad(json_path, "waypoint_lookahead_m: not a number in (0, 5] m");
+  s.waypoint_lookahead_m = look.get<double>();
   return s;
 }
 

@@ -1,56 +1,54 @@
-// The one place autodrive-marl calls the MARL core: the observation builder and the
-// time-to-collision (TTC) safety shield. The core itself is the C11 library
-// autodrive_marl_core (runtime/jetson/marl_core/, owned by the marl-train branch). Until that
-// branch is merged, src/core_adapter.cpp holds an INTERIM implementation to the contract in
-// /work/wt/CONTRACT-demos.md (observation layout "interim-0"); on the merge it forwards to
-// <autodrive/marl_core.h> and the interim code goes (runtime/jetson/marl/README.md).
+// The one place autodrive-marl calls the MARL core (autodrive_marl_core, <autodrive/marl_core.h>,
+// runtime/jetson/marl_core/): the observation builder and the time-to-collision shield, so the
+// C++ program and Python's training and batch evaluation share them. This wrapper only turns
+// C++ types into the core's and fills the shield's car figures from vehicle/nigel.params.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "marl/route_map.hpp"
+
 namespace marl {
 
 struct CarState {
-  double x_m = 0, y_m = 0, yaw_rad = 0;  // map frame [m, m, rad]
+  int id = 0;                            // vehicle number (NIGEL<id>): the core's tie-break
+  double x_m = 0, y_m = 0, yaw_rad = 0;  // base_link in the map frame [m, m, rad]
   double speed_m_s = 0;                  // [m/s], + forward
 };
 
-struct Goal {
-  double x_m = 0, y_m = 0;  // map frame [m]
-};
+// "NIGEL3" -> 3 (the trailing number; 0 when there is none).
+int vehicle_id(const std::string &vehicle);
 
-// Observation layout interim-0: own goal in the own frame over kGoalScaleM, own speed over the
-// top speed, then kPeerSlots slots, nearest peer first: relative x, y in the own frame over
-// kPeerScaleM, sin and cos of the relative yaw, speed over the top speed, 1 (0 for an empty
-// slot, all zeros).
-constexpr int kPeerSlots = 3;
-constexpr int kObsDim = 3 + 6 * kPeerSlots;
-constexpr double kGoalScaleM = 4.0, kPeerScaleM = 2.0;
-const char *obs_layout_name();
-std::vector<float> build_observation(const CarState &own, const Goal &goal,
-                                     const std::vector<CarState> &peers);
-
-struct ShieldParams {
-  double horizon_s = 2.0;      // prediction horizon [s]
-  double step_s = 0.05;        // prediction step [s]
-  double min_ttc_s = 1.2;      // brake when a predicted contact is nearer than this [s]
-  double contact_m = 0.25;     // chassis-centre distance counted as a contact [m] (~ car length)
-};
+int obs_version();  // ADM_OBS_VERSION
+int obs_dim();      // ADM_OBS_DIM
 
 struct ShieldResult {
   double throttle = 0, steering = 0;  // the command to send
-  bool intervened = false;            // the shield replaced the intended throttle
-  double ttc_s = 1e9;                 // predicted time to the first contact [s] (1e9: none)
+  bool intervened = false;            // the shield braked instead of the intended command
+  int peer_id = -1;                   // the peer it braked for
+  double ttc_s = 0;                   // predicted time to collision with it [s]
 };
 
-// Predicts own car (at the speed the intended throttle asks for, turning with the intended
-// steering) and every peer (constant speed and heading) over the horizon; brakes (throttle 0,
-// steering kept) when a contact is predicted within min_ttc_s.
-ShieldResult shield(const CarState &own, double throttle, double steering,
-                    const std::vector<CarState> &peers, const ShieldParams &p = ShieldParams{});
+class Core {
+ public:
+  // route: the car's route (its end is the goal); lookahead_m [m]: the route waypoint's
+  // distance ahead (from the policy's .json, as in training).
+  Core(const Route &route, double lookahead_m);
+  // The observation of own (heading to the route's end) with these peers; throws
+  // std::runtime_error with the core's message.
+  std::vector<float> observation(const CarState &own, const std::vector<CarState> &peers,
+                                 double last_steering);
+  double remaining_m() const { return remaining_m_; }  // along the route, after observation()
+  ShieldResult shield(const CarState &own, double throttle, double steering,
+                      const std::vector<CarState> &peers) const;
 
-// The car's top speed [m/s] at throttle 1 (motor no-load speed x wheel radius, vehicle/nigel.params).
-double top_speed_m_s();
+ private:
+  std::vector<double> route_xy_m_;
+  double goal_xy_m_[2] = {0, 0};
+  double lookahead_m_;
+  int hint_ = -1;
+  double remaining_m_ = 0;
+};
 
 }  // namespace marl
