@@ -71,8 +71,8 @@ class App {
         core_(route_, policy_ ? policy_->spec().waypoint_lookahead_m : 0.3),
         peers_(o.vehicle, static_cast<int64_t>(o.stale_ms * 1000)),
         link_(o.v2v_loss, static_cast<int64_t>(o.v2v_delay_ms * 1000), o.seed) {
-    period_us_ = static_cast<int64_t>(
-        1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
+    period_us_ =
+        static_cast<int64_t>(1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
   }
 
   void on_clock(const lcm::ReceiveBuffer *, const std::string &, const autodrive::sim_clock_t *m) {
@@ -114,8 +114,8 @@ class App {
     double throttle = 0, steering = 0;
     if (goal_us_ < 0) {
       if (baseline_) {
-        const marl::DriveCommand c = baseline_->step({own_.x_m, own_.y_m, own_.yaw_rad},
-                                                     own_.speed_m_s, fresh, now, dt_s);
+        const marl::DriveCommand c =
+            baseline_->step({own_.x_m, own_.y_m, own_.yaw_rad}, own_.speed_m_s, fresh, now, dt_s);
         throttle = c.throttle;
         steering = c.steering;
       } else {
@@ -159,8 +159,8 @@ class App {
     autodrive::mission_status_t m{};
     m.utime = now;
     m.vehicle = o_.vehicle;
-    m.state = goal_us_ >= 0 ? autodrive::mission_status_t::PARKED
-                            : autodrive::mission_status_t::DRIVING;
+    m.state =
+        goal_us_ >= 0 ? autodrive::mission_status_t::PARKED : autodrive::mission_status_t::DRIVING;
     const auto &end = route_.points.back();
     const double left = std::hypot(own_.x_m - end.x_m, own_.y_m - end.y_m);
     m.progress = static_cast<float>(std::clamp(1.0 - left / route_.s_m.back(), 0.0, 1.0));
@@ -172,8 +172,8 @@ class App {
     std::ostringstream s;
     s << "marl " << o_.mode << (o_.no_shield ? " no-shield" : "") << " route " << route_.name
       << " peers " << peers_seen_ << " v2v_received " << link_.received() << " v2v_lost "
-      << link_.lost() << " v2v_dropped_stale " << peers_.dropped_stale()
-      << " shield_interventions " << shield_interventions_;
+      << link_.lost() << " v2v_dropped_stale " << peers_.dropped_stale() << " shield_interventions "
+      << shield_interventions_;
     if (baseline_) s << " fcfs " << baseline_->phase();
     return s.str();
   }
@@ -272,7 +272,8 @@ int main(int argc, char **argv) {
       "autodrive-marl: one car's intersection traversal (learned policy or first-come-first-"
       "served baseline) on V2V, behind a time-to-collision shield; signed <VEH>_COMMAND out"};
   Options o;
-  cli.add_option("--vehicle", o.vehicle, "this car (channel prefix), e.g. NIGEL2")->capture_default_str();
+  cli.add_option("--vehicle", o.vehicle, "this car (channel prefix), e.g. NIGEL2")
+      ->capture_default_str();
   cli.add_option("--lcm-url", o.lcm_url, "LCM provider")->capture_default_str();
   cli.add_option("--mode", o.mode, "rl (the policy) or baseline (first come, first served)")
       ->check(CLI::IsMember({"rl", "baseline"}))
@@ -309,7 +310,8 @@ int main(int argc, char **argv) {
                  "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
   cli.add_option("--eval-obs", o.eval_obs,
                  "rl: print the policy's raw outputs for each CSV line of observations, then exit");
-  cli.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")->capture_default_str();
+  cli.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")
+      ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
   spdlog::set_level(spdlog::level::from_str(o.log_level));
   spdlog::set_pattern("[marl %n] %^%l%$ %v");
@@ -347,8 +349,8 @@ int main(int argc, char **argv) {
   try {
     route = marl::read_route(o.map_json, o.route);
     if (o.mode == "baseline")
-      baseline = std::make_unique<marl::FcfsBaseline>(
-          o.vehicle, route, marl::read_conflict_zone(o.map_json, 0.1));
+      baseline = std::make_unique<marl::FcfsBaseline>(o.vehicle, route,
+                                                      marl::read_conflict_zone(o.map_json, 0.1));
     origin = parse_origin(o.odom_origin);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "autodrive-marl: %s\n", e.what());
@@ -356,10 +358,10 @@ int main(int argc, char **argv) {
   }
   std::optional<autodrive::auth::Signer> signer;
   try {
-    signer.emplace(autodrive::auth::load_key(o.key_file.empty()
-                                                 ? autodrive::auth::default_key_path(o.vehicle)
-                                                 : o.key_file),
-                   o.vehicle, "marl", autodrive::auth::kAuthorityMachine);
+    signer.emplace(
+        autodrive::auth::load_key(o.key_file.empty() ? autodrive::auth::default_key_path(o.vehicle)
+                                                     : o.key_file),
+        o.vehicle, "marl", autodrive::auth::kAuthorityMachine);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "autodrive-marl: --key-file: %s\n", e.what());
     return 2;
@@ -375,7 +377,7 @@ int main(int argc, char **argv) {
   App app(o, lcm, std::move(*signer), std::move(policy), std::move(route), std::move(baseline),
           origin);
   autodrive_lcm::subscribe<autodrive::sim_clock_t, App, &App::on_clock>(lcm, AUTODRIVE_CH_SIM_CLOCK,
-                                                                       &app);
+                                                                        &app);
   autodrive_lcm::subscribe<autodrive::v2v_state_t, App, &App::on_v2v>(lcm, AUTODRIVE_CH_V2V, &app)
       ->setQueueCapacity(200);
   const std::string pose_ch =

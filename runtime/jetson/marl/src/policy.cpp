@@ -91,8 +91,8 @@ Policy::Policy(const std::string &onnx_path) : net_(std::make_unique<Net>()) {
   }
   const size_t want = spec_.steering_actions.empty() ? 1 : spec_.steering_actions.size();
   if (out.size() != want)
-    bad(onnx_path, "its output has " + std::to_string(out.size()) + " values, its .json's actions " +
-                       "want " + std::to_string(want));
+    bad(onnx_path, "its output has " + std::to_string(out.size()) +
+                       " values, its .json's actions " + "want " + std::to_string(want));
 }
 
 Policy::~Policy() = default;

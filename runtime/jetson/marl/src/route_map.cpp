@@ -66,7 +66,8 @@ Route read_route(const std::string &map_json, const std::string &name) {
       autonomy::Pose2 p{poly[i].at(0).get<double>(), poly[i].at(1).get<double>(), 0.0};
       out.points.push_back(p);
     }
-    if (out.points.size() < 2) throw std::runtime_error(map_json + ": route " + name + ": < 2 points");
+    if (out.points.size() < 2)
+      throw std::runtime_error(map_json + ": route " + name + ": < 2 points");
     out.s_m.assign(out.points.size(), 0.0);
     for (size_t i = 0; i < out.points.size(); ++i) {
       const size_t a = i + 1 < out.points.size() ? i : i - 1;
