@@ -63,10 +63,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument(
         "--mission",
-        choices=("parking", "loop"),
+        choices=("parking", "loop", "intersection"),
         default="parking",
         help="parking (default): map, localise, plan and park autonomously; loop: "
-        "drive a stadium track with pure pursuit on the EKF",
+        "drive a stadium track with pure pursuit on the EKF; intersection: four cars cross "
+        "Intersection School with autodrive-marl (its own options: --mission intersection --help)",
     )
     p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
     p.add_argument(
@@ -321,6 +322,11 @@ def run(
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if "intersection" in argv and ("--mission" in argv or "--mission=intersection" in argv):
+        from .missions import intersection  # its own options (--episodes, --v2v-loss, ...)
+
+        return intersection.main(argv)
     return run(parse_args(argv))
 
 

@@ -51,6 +51,7 @@ struct Options {
   std::string vehicle = "NIGEL1", lcm_url = "udpm://239.255.76.67:7667?ttl=0", mode = "rl";
   std::string policy, map_json, route, clock = "wall", key_file, odom_origin, eval_obs;
   std::string log_level = "info";
+  double start_delay_s = 0;
   double v2v_loss = 0, v2v_delay_ms = 0, stale_ms = 200, rate_hz = 20, goal_tolerance_m = 0.15;
   uint64_t seed = 1;
   bool no_shield = false;
@@ -97,6 +98,8 @@ class App {
     if (!clock_ready()) return;
     const int64_t now = now_us();
     for (const auto &s : link_.due(now)) peers_.on_state(s, now);
+    if (now < static_cast<int64_t>(o_.start_delay_s * 1e6)) return;  // not yet: stays parked
+    if (start_us_ < 0) start_us_ = now;
     if (last_cmd_us_ >= 0 && now - last_cmd_us_ < period_us_) return;
     const double dt_s = last_cmd_us_ < 0 ? period_us_ * 1e-6 : (now - last_cmd_us_) * 1e-6;
     last_cmd_us_ = now;
@@ -184,17 +187,18 @@ class App {
 
   std::string summary_json() const {
     char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "{\"vehicle\": \"%s\", \"mode\": \"%s\", \"shield\": %s, \"route\": \"%s\", "
-                  "\"steps\": %llu, \"goal_s\": %.3f, \"shield_interventions\": %llu, "
-                  "\"v2v_received\": %llu, \"v2v_lost\": %llu, \"v2v_dropped_stale\": %llu}",
-                  o_.vehicle.c_str(), o_.mode.c_str(), o_.no_shield ? "false" : "true",
-                  route_.name.c_str(), static_cast<unsigned long long>(steps_),
-                  goal_us_ >= 0 ? goal_us_ * 1e-6 : -1.0,
-                  static_cast<unsigned long long>(shield_interventions_),
-                  static_cast<unsigned long long>(link_.received()),
-                  static_cast<unsigned long long>(link_.lost()),
-                  static_cast<unsigned long long>(peers_.dropped_stale()));
+    std::snprintf(
+        buf, sizeof buf,
+        "{\"vehicle\": \"%s\", \"mode\": \"%s\", \"shield\": %s, \"route\": \"%s\", "
+        "\"steps\": %llu, \"start_s\": %.3f, \"goal_s\": %.3f, \"shield_interventions\": %llu, "
+        "\"v2v_received\": %llu, \"v2v_lost\": %llu, \"v2v_dropped_stale\": %llu}",
+        o_.vehicle.c_str(), o_.mode.c_str(), o_.no_shield ? "false" : "true", route_.name.c_str(),
+        static_cast<unsigned long long>(steps_), start_us_ >= 0 ? start_us_ * 1e-6 : -1.0,
+        goal_us_ >= 0 ? goal_us_ * 1e-6 : -1.0,
+        static_cast<unsigned long long>(shield_interventions_),
+        static_cast<unsigned long long>(link_.received()),
+        static_cast<unsigned long long>(link_.lost()),
+        static_cast<unsigned long long>(peers_.dropped_stale()));
     return buf;
   }
 
@@ -212,7 +216,8 @@ class App {
   marl::CarState own_;
   bool have_pose_ = false, last_intervened_ = false;
   double last_steering_ = 0;
-  int64_t sim_now_us_ = 0, last_cmd_us_ = -1, last_status_us_ = -1000000000, goal_us_ = -1;
+  int64_t sim_now_us_ = 0, start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000,
+          goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
   uint64_t steps_ = 0, shield_interventions_ = 0;
@@ -296,6 +301,11 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   cli.add_option("--v2v-stale-ms", o.stale_ms, "drop peer states older than this [ms]")
       ->check(CLI::Range(1.0, 10000.0))
+      ->capture_default_str();
+  cli.add_option(
+         "--start-delay-s", o.start_delay_s,
+         "send nothing before this clock time [s] (the bridge holds the car; HIL spawn times)")
+      ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
   cli.add_option("--seed", o.seed, "seed of the V2V loss")->capture_default_str();
   cli.add_flag("--no-shield", o.no_shield, "send the policy's command unshielded (measuring only)");
