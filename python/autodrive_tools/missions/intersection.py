@@ -357,8 +357,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{rec.sim_s:.1f} s sim, {time.time() - t0:.0f} s wall so far)"
             )
     finally:
-        for s, h in old:
-            signal.signal(s, h)
+        for sig, handler in old:
+            signal.signal(sig, handler)
     n = len(done)
     rep: dict[str, Any] = {
         "mission": "intersection",

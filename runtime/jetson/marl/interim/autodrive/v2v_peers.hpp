@@ -1,5 +1,5 @@
 // INTERIM stand-in of the V2V peer table owned by the `city` branch (runtime/jetson/v2v/,
-// library autodrive_v2v), written to the interface of /work/wt/CONTRACT-demos.md so that
+// library autodrive_v2v, owned by the city branch), to its interface, so that
 // autodrive-marl builds and is tested before that branch is merged. Deleted on the merge
 // (then autodrive-marl links autodrive_v2v): see runtime/jetson/marl/README.md.
 #pragma once
