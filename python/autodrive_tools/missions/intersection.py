@@ -4,8 +4,8 @@ or the first-come-first-served baseline, behind the TTC shield), V2V over real L
 
 One episode = one fresh set of processes (the simulator with the four cars placed by
 --car-start, four runtimes, four autodrive-marl), so nothing of an episode leaks into the next:
-that is the reset. Routes (one car per approach, left / straight / right each) and start times
-are drawn from the seed. The simulator runs in lockstep with the runtimes (--lockstep-client),
+that is the reset. Routes (one car per approach, each leaving by a different road: left turns, straight crossings
+and right turns) and start times are drawn from the seed. The simulator runs in lockstep with the runtimes (--lockstep-client),
 so a loaded machine slows the run down and does not change it much.
 
 CLI: tools/demo --mission intersection --help."""
@@ -43,8 +43,9 @@ APPROACHES = ("north", "east", "south", "west")
 # stop line is 0.65 m from the centre).
 START_BEFORE_CENTRE_M = 1.3
 MAX_START_DELAY_S = 3.0  # start times drawn in [0, this] [s of sim time]
-EPISODE_SIM_S = 60.0  # an episode that has not ended by then is a failure [s of sim time]
+EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
 PTY_TIMEOUT_S = 30.0
+PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
 EXIT_INTERRUPTED = 130
 
 
@@ -94,14 +95,21 @@ class CarPlan:
 
 
 def plan_episode(seed: int) -> list[CarPlan]:
-    """One car per approach, each turning left, going straight or right, and a start time,
-    all drawn from seed."""
+    """One car per approach, each leaving by a different road (a car stops at its route's end,
+    so two cars with one exit would queue there), and a start time, all drawn from seed: every
+    exit permutation without a car leaving the way it came, so left turns, straight crossings
+    and right turns mix."""
     rng = np.random.default_rng(seed)
     names = set(tasks.routes(MAP))
+    while True:
+        exits = rng.permutation(len(APPROACHES))
+        if all(int(e) != i for i, e in enumerate(exits)):
+            break
     plans = []
     for i, approach in enumerate(APPROACHES):
-        choices = sorted(n for n in names if n.startswith(f"{approach}_to_"))
-        route_name = choices[int(rng.integers(len(choices)))]
+        route_name = f"{approach}_to_{APPROACHES[int(exits[i])]}"
+        if route_name not in names:
+            raise RuntimeError(f"map {MAP} has no route {route_name} (routes: {sorted(names)})")
         r = tasks.route(MAP, route_name)
         d = np.hypot(r.points_m[:, 0], r.points_m[:, 1])
         k = int(np.argmax(d < START_BEFORE_CENTRE_M))  # first point this close to the centre
@@ -257,6 +265,18 @@ def run_episode(
     return rec, summaries, ended
 
 
+def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
+    """For each car its EKF put at the goal: its true distance from the goal then [m] (the last
+    ground truth: a car at its goal stops there)."""
+    out = []
+    for p in plans:
+        if p.vehicle in rec.at_goal and rec.truth.get(p.vehicle):
+            end = tasks.route(MAP, p.route).points_m[-1]
+            _t, x, y = rec.truth[p.vehicle][-1]
+            out.append(float(math.hypot(x - end[0], y - end[1])))
+    return out
+
+
 def steering_rates(rec: EpisodeRecord) -> list[float]:
     """Every car's steering rate between consecutive commands [1/s of normalised steering]."""
     rates: list[float] = []
@@ -290,8 +310,8 @@ def plot(path: Path, episodes: list[tuple[list[CarPlan], EpisodeRecord, str]]) -
             if p.vehicle in rec.collided:
                 ax.plot(tr[-1, 1], tr[-1, 2], "kx", ms=8)
         ax.set_title(f"episode {k}: {ended}", fontsize=8)
-        ax.set_xlim(-2.0, 2.0)
-        ax.set_ylim(-2.0, 2.0)
+        ax.set_xlim(-PLOT_HALF_M, PLOT_HALF_M)
+        ax.set_ylim(-PLOT_HALF_M, PLOT_HALF_M)
         ax.set_aspect("equal")
         ax.tick_params(labelsize=6)
     for k in range(n, rows * cols):
@@ -332,6 +352,7 @@ def run(args: argparse.Namespace) -> int:
     summaries_all: list[dict[str, Any]] = []
     traverse_s: list[float] = []
     rates: list[float] = []
+    goal_err: list[float] = []
     try:
         for ep in range(args.episodes):
             if interrupted or time.time() - t0 > args.timeout:
@@ -350,6 +371,7 @@ def run(args: argparse.Namespace) -> int:
                 if s.get("goal_s", -1) >= 0 and s.get("start_s", -1) >= 0:
                     traverse_s.append(s["goal_s"] - s["start_s"])
             rates += steering_rates(rec)
+            goal_err += goal_errors_m(plans, rec)
             shield = sum(s.get("shield_interventions", 0) for s in summaries)
             say(
                 f"episode {ep + 1}: {ended} ({len(rec.at_goal)}/{CARS} at goal, "
@@ -377,6 +399,9 @@ def run(args: argparse.Namespace) -> int:
         "shield_interventions": sum(s.get("shield_interventions", 0) for s in summaries_all),
         "mean_traverse_s": round(float(np.mean(traverse_s)), 3) if traverse_s else None,
         "steering_rate_rms": round(float(np.sqrt(np.mean(np.square(rates)))), 4) if rates else None,
+        "goal_error_true_max_m": (
+            round(max(goal_err), 3) if goal_err else None
+        ),  # how far from its goal a car really was when its EKF said it was there
         "v2v_lost": sum(s.get("v2v_lost", 0) for s in summaries_all),
         "v2v_dropped_stale": sum(s.get("v2v_dropped_stale", 0) for s in summaries_all),
         "per_episode": [

@@ -59,9 +59,10 @@ std::vector<float> Core::observation(const CarState &own, const std::vector<CarS
 }
 
 ShieldResult Core::shield(const CarState &own, double throttle, double steering,
-                          const std::vector<CarState> &peers) const {
+                          const std::vector<CarState> &peers, bool emergency_only) const {
   adm_shield_config_t cfg;
   adm_shield_defaults(&cfg);
+  if (emergency_only) cfg.horizon_s = cfg.emergency_s;
   cfg.chassis_length_m = AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X;
   cfg.chassis_width_m = AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_Y;
   cfg.chassis_offset_m = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X;

@@ -127,7 +127,9 @@ class App {
         throttle = policy_->spec().throttle;
       }
       if (!o_.no_shield) {
-        const marl::ShieldResult r = core_.shield(own_, throttle, steering, peers);
+        // The baseline arbitrates the zone by its own rule: its shield is the emergency brake.
+        const marl::ShieldResult r =
+            core_.shield(own_, throttle, steering, peers, baseline_ != nullptr);
         if (r.intervened) {
           ++shield_interventions_;
           if (!last_intervened_)

@@ -40,8 +40,10 @@ class Core {
   std::vector<float> observation(const CarState &own, const std::vector<CarState> &peers,
                                  double last_steering);
   double remaining_m() const { return remaining_m_; }  // along the route, after observation()
+  // emergency_only: predict only the core's emergency horizon, so the shield brakes for an
+  // imminent contact but does not arbitrate right of way (the baseline has its own rule).
   ShieldResult shield(const CarState &own, double throttle, double steering,
-                      const std::vector<CarState> &peers) const;
+                      const std::vector<CarState> &peers, bool emergency_only = false) const;
 
  private:
   std::vector<double> route_xy_m_;

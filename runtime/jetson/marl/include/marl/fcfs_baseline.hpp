@@ -1,11 +1,12 @@
 // The rule-based baseline: first come, first served on the intersection's conflict zone with
-// the peers' V2V states and intents. A car drives its route by pure pursuit; within
-// request_m [m] of the zone it asks for it; it is granted when no peer is inside the zone and
-// no peer that asked earlier (by this car's clock; ties within tie_s [s] go to the lower
-// vehicle name) is still waiting; until then it stops short of the zone. Once inside it is
-// committed. A peer counts as waiting while it is outside the zone, within request_m of it and
-// heading towards it; a peer whose V2V intent is a route it has finished (heading away) never
-// blocks.
+// the peers' V2V states. A car drives its route by pure pursuit. It requests the zone when its
+// base_link comes within request_m [m] of the zone's edge, outside it and heading towards its
+// centre; every car judges itself and its peers by that same rule, with the request time from
+// the sender's V2V stamp (its own clock for itself: SIM_CLOCK in HIL, the same for all). The
+// order is (request time in bins of bin_s [s], vehicle name): a total order that a later-seen
+// peer can only move back, so two cars never both wait for each other. A car is granted the
+// zone when nobody is in it and no peer ahead in that order still requests it; until then it
+// holds short of the zone. Once granted it is committed.
 #pragma once
 
 #include <autodrive/v2v_state_t.hpp>
@@ -21,9 +22,11 @@
 namespace marl {
 
 struct FcfsParams {
-  double request_m = 0.45;  // ask for the zone this far before its edge [m]
-  double stop_m = 0.08;     // stop this far before the edge while not granted [m]
-  double tie_s = 0.2;       // requests closer in time than this are ties [s]
+  double request_m = 0.60;  // base_link this far from the zone's edge requests it [m]
+  // While not granted, stop with base_link this far from the zone's edge [m]: with the
+  // default zone (the 4-way's roads + 0.1 m) the front bumper stays behind the stop line.
+  double hold_m = 0.45;
+  double bin_s = 0.25;  // request times in the same bin are ordered by name [s]
 };
 
 struct DriveCommand {
@@ -40,15 +43,17 @@ class FcfsBaseline {
   const char *phase() const;
 
  private:
-  double distance_to_zone_m(const autonomy::Pose2 &pose) const;  // along the route, 0 inside
-  bool peer_waiting(const autodrive::v2v_state_t &q) const;
+  // Distance of base_link from the zone's edge [m] (<= 0 inside), and whether a car there,
+  // heading yaw_rad, requests the zone.
+  double edge_distance_m(double x_m, double y_m) const;
+  bool requests(double x_m, double y_m, double yaw_rad) const;
 
   std::string self_;
   Route route_;
   ConflictZone zone_;
   FcfsParams p_;
   autonomy::PurePursuit tracker_;
-  double zone_entry_s_m_ = 0, zone_exit_s_m_ = 0;
+  bool crosses_zone_ = false;
   int64_t my_request_us_ = -1;
   bool granted_ = false, left_zone_ = false;
   std::map<std::string, int64_t> peer_request_us_;
