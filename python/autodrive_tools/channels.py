@@ -14,9 +14,10 @@ import yaml
 from .paths import CHANNEL_TABLE
 
 VEH = "<VEH>"
-# Conditions of a channel's optional "when": published only on maps with traffic lights, or only
-# when someone acts (a command). "" = every run.
-WHEN = frozenset({"", "traffic_lights", "on_demand"})
+# Conditions of a channel's optional "when": published only on maps with traffic lights, only
+# when someone acts (a command), or only when a runtime knows its map pose (v2v: an Eye or
+# estimator.initial_pose_map). "" = every run.
+WHEN = frozenset({"", "traffic_lights", "on_demand", "v2v"})
 
 
 class ChannelTableError(ValueError):

@@ -17,6 +17,7 @@
 #include "common/config.hpp"
 #include "estimator/estimator_node.hpp"
 #include "rplidar/rplidar_driver.hpp"
+#include "v2v/v2v_node.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -30,11 +31,15 @@ int main(int argc, char **argv) {
       "autodrive-runtime: the Nigel Jetson runtime (Nano bridge, RPLIDAR, cameras, "
       "EKF estimator) over LCM. The same binary drives the car, the simulator's ptys "
       "and the firmware in simavr: only the device paths in the config change."};
-  std::string config_path, only, level = "info";
+  std::string config_path, only, route, level = "info";
   app.add_option("--config", config_path, "YAML config (runtime/jetson/config/*.yaml)")->required();
   app.add_option("--only", only,
-                 "comma-separated subset of: bridge,lidar,camera,estimator (default: every "
-                 "component with a section in the config)");
+                 "comma-separated subset of: bridge,lidar,camera,estimator,v2v (default: every "
+                 "component with a section in the config; v2v with the estimator unless "
+                 "v2v_hz is 0)");
+  app.add_option("--route", route,
+                 "the map's route this car drives, broadcast on V2V as its intent (overrides "
+                 "the config's route)");
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
@@ -46,18 +51,22 @@ int main(int argc, char **argv) {
     spdlog::error("bad config: {}", e.what());
     return 2;
   }
+  if (!route.empty()) config.route = route;
   std::set<std::string> want;
   if (only.empty()) {
     if (config.has_bridge) want.insert("bridge");
     if (config.has_lidar) want.insert("lidar");
     if (!config.cameras.empty()) want.insert("camera");
     if (config.has_estimator) want.insert("estimator");
+    if (config.has_estimator && config.v2v_hz > 0) want.insert("v2v");
   } else {
     std::stringstream ss(only);
     std::string item;
     while (std::getline(ss, item, ',')) {
-      if (item != "bridge" && item != "lidar" && item != "camera" && item != "estimator") {
-        spdlog::error("--only: unknown component '{}' (bridge, lidar, camera, estimator)", item);
+      if (item != "bridge" && item != "lidar" && item != "camera" && item != "estimator" &&
+          item != "v2v") {
+        spdlog::error("--only: unknown component '{}' (bridge, lidar, camera, estimator, v2v)",
+                      item);
         return 2;
       }
       want.insert(item);
@@ -74,6 +83,7 @@ int main(int argc, char **argv) {
   std::unique_ptr<bridge::NanoBridge> br;
   std::unique_ptr<rplidar::Driver> lidar;
   std::unique_ptr<est::EstimatorNode> estimator;
+  std::unique_ptr<v2v::V2vNode> v2v_node;
   std::vector<std::unique_ptr<cam::CameraDriver>> cameras;
   auto check = [](const std::string &what, const std::string &err) {
     if (err.empty()) return true;
@@ -94,6 +104,11 @@ int main(int argc, char **argv) {
     estimator = std::make_unique<est::EstimatorNode>(config);
     if (!check("estimator", estimator->init_error())) return 2;
     runners.push_back([&] { estimator->run(g_stop); });
+  }
+  if (want.count("v2v")) {
+    v2v_node = std::make_unique<v2v::V2vNode>(config);
+    if (!check("v2v", v2v_node->init_error())) return 2;
+    runners.push_back([&] { v2v_node->run(g_stop); });
   }
   if (want.count("camera")) {
     if (config.cameras.empty()) {

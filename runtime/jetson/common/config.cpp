@@ -137,6 +137,10 @@ Estimator parse_estimator(const Section &s) {
   s.read_in_range("max_speed_m_s", e.max_speed_m_s, 0.1, 50.0);
   s.read_in_range("max_yaw_rate_rad_s", e.max_yaw_rate_rad_s, 0.1, 100.0);
   e.use_imu = s.get<bool>("use_imu", e.use_imu);
+  if ((e.has_initial_pose_map = s.has("initial_pose_map"))) {
+    const auto v = s.numbers("initial_pose_map", 3);
+    for (int i = 0; i < 3; ++i) e.initial_pose_map[i] = v[i];
+  }
   s.reject_unknown();
   return e;
 }
@@ -168,6 +172,10 @@ Config from_node(const YAML::Node &root, const std::string &file) {
       c.cameras.push_back(
           parse_camera(Section(cams[i], "cameras[" + std::to_string(i) + "]", file)));
   }
+  c.v2v_hz = top.number("v2v_hz", c.v2v_hz);
+  if (c.v2v_hz < 0 || c.v2v_hz > 100) top.fail("v2v_hz", "must be in [0, 100] Hz (0: off)");
+  c.v2v_stale_ms = top.in_range("v2v_stale_ms", 10, 10000, c.v2v_stale_ms);
+  c.route = top.get<std::string>("route", c.route);
   top.reject_unknown();
   return c;
 }

@@ -99,6 +99,11 @@ struct Estimator {
   double max_speed_m_s = 10.0;        // encoder speed above this is a glitch: dropped
   double max_yaw_rate_rad_s = 17.45;  // gyro z above this (1000 deg/s, the IMU's range): dropped
   bool use_imu = true;
+  // Optional: the car's map pose (x [m], y [m], yaw [rad]) at start, where it was placed. The
+  // map filter starts there instead of waiting for the Eye, so POSE_MAP (and V2V) exist without
+  // an Eye; Eye poses, when they come, correct it.
+  bool has_initial_pose_map = false;
+  std::array<double, 3> initial_pose_map{};
 };
 
 struct Config {
@@ -111,6 +116,12 @@ struct Config {
   Lidar lidar;
   Estimator estimator;
   std::vector<Camera> cameras;
+  // V2V (optional keys): broadcast rate [Hz] of v2v_state_t (0: off), the age [ms] beyond which
+  // a peer's state is dropped, and the route this car drives (its intent; "" when none, the
+  // runtime's --route overrides it).
+  double v2v_hz = 20.0;
+  int v2v_stale_ms = 200;
+  std::string route;
 };
 
 // Loads and validates the file. Throws cfg::Error("<file>: <key>: <what is wrong>").

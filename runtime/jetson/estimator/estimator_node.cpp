@@ -69,6 +69,12 @@ struct EstimatorNode::Impl {
 
   void on_state(const autodrive::vehicle_state_t *m) {
     if (!odom.initialised()) odom.reset(m->utime, 0, 0, 0, 1e-9, 1e-9);
+    if (!map.initialised() && config.estimator.has_initial_pose_map) {
+      // Placed at a known pose: the map filter starts there, as sure as one Eye pose.
+      const auto &p = config.estimator.initial_pose_map;
+      map.reset(m->utime, p[0], p[1], p[2], std::pow(config.estimator.eye_pos_std_m, 2),
+                std::pow(config.estimator.eye_yaw_std_rad, 2));
+    }
     if (have_prev) {
       double v = 0;
       if (wheel_speed_from_encoders(prev.encoder_counts[0], prev.encoder_counts[1],

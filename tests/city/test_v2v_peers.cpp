@@ -1,0 +1,99 @@
+// V2V peer table: own broadcasts ignored, newest state per peer kept, states older than the
+// stale limit dropped and counted, and the runtime config's V2V keys read strictly.
+#include <autodrive/v2v_peers.hpp>
+#include <gtest/gtest.h>
+
+#include "common/config.hpp"
+
+namespace {
+
+autodrive::v2v_state_t state(const std::string &vehicle, int64_t utime_us, double x_m = 0.0) {
+  autodrive::v2v_state_t s{};
+  s.vehicle = vehicle;
+  s.utime = utime_us;
+  s.x_m = x_m;
+  s.route = "loop_ccw";
+  s.route_s_m = -1.0f;
+  return s;
+}
+
+}  // namespace
+
+TEST(PeerTable, IgnoresItselfAndKeepsTheNewestStatePerPeer) {
+  autodrive::v2v::PeerTable t("NIGEL1");
+  t.on_state(state("NIGEL1", 1000), 1000);
+  t.on_state(state("NIGEL2", 1000, 1.0), 1000);
+  t.on_state(state("NIGEL2", 3000, 2.0), 3000);
+  t.on_state(state("NIGEL2", 2000, 9.0), 3100);  // reordered by the network: ignored
+  t.on_state(state("NIGEL3", 2500, 3.0), 3100);
+  const auto f = t.fresh(3200);
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_EQ(f[0].vehicle, "NIGEL2");
+  EXPECT_DOUBLE_EQ(f[0].x_m, 2.0);
+  EXPECT_EQ(f[1].vehicle, "NIGEL3");
+  EXPECT_EQ(t.received(), 3u);
+  EXPECT_EQ(t.dropped_stale(), 0u);
+}
+
+TEST(PeerTable, DropsAndCountsStatesOlderThan200ms) {
+  autodrive::v2v::PeerTable t("NIGEL1");  // default limit: 200 ms
+  EXPECT_EQ(t.stale_us(), 200000);
+  t.on_state(state("NIGEL2", 1000000), 1000000);
+  t.on_state(state("NIGEL3", 1150000), 1150000);
+  EXPECT_EQ(t.fresh(1200000).size(), 2u);  // 200 ms old exactly: still fresh
+  const auto f = t.fresh(1200001);         // NIGEL2 is 200.001 ms old now
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].vehicle, "NIGEL3");
+  EXPECT_EQ(t.dropped_stale(), 1u);
+  EXPECT_TRUE(t.fresh(2000000).empty());
+  EXPECT_EQ(t.dropped_stale(), 2u);
+  EXPECT_EQ(autodrive::v2v::status_line({}, t.dropped_stale()),
+            "0 fresh peer(s), 2 stale state(s) dropped");
+  // A peer that speaks again is back.
+  t.on_state(state("NIGEL2", 2100000), 2100000);
+  EXPECT_EQ(autodrive::v2v::status_line(t.fresh(2150000), t.dropped_stale()),
+            "1 fresh peer(s) (NIGEL2), 2 stale state(s) dropped");
+}
+
+TEST(PeerTable, OwnLimit) {
+  autodrive::v2v::PeerTable t("NIGEL4", 50000);
+  t.on_state(state("NIGEL1", 0), 0);
+  EXPECT_EQ(t.fresh(50000).size(), 1u);
+  EXPECT_TRUE(t.fresh(50001).empty());
+}
+
+namespace {
+const char *kBase =
+    "lcm_url: \"memq://\"\nclock: sim\nvehicle: {name: NIGEL2}\nestimator: {rate_hz: 100";
+}
+
+TEST(RuntimeConfigV2v, DefaultsAndKeys) {
+  auto c = cfg::parse(std::string(kBase) + "}\n", "t.yaml");
+  EXPECT_DOUBLE_EQ(c.v2v_hz, 20.0);
+  EXPECT_EQ(c.v2v_stale_ms, 200);
+  EXPECT_EQ(c.route, "");
+  EXPECT_FALSE(c.estimator.has_initial_pose_map);
+  c = cfg::parse(
+      std::string(kBase) + ", initial_pose_map: [1.5, -2.0, 0.5]}\nv2v_hz: 10\nroute: loop_cw\n",
+      "t.yaml");
+  EXPECT_DOUBLE_EQ(c.v2v_hz, 10.0);
+  EXPECT_EQ(c.route, "loop_cw");
+  ASSERT_TRUE(c.estimator.has_initial_pose_map);
+  EXPECT_DOUBLE_EQ(c.estimator.initial_pose_map[1], -2.0);
+}
+
+TEST(RuntimeConfigV2v, BadValuesNameTheKey) {
+  try {
+    cfg::parse(std::string(kBase) + "}\nv2v_hz: 500\n", "t.yaml");
+    FAIL() << "accepted v2v_hz 500";
+  } catch (const cfg::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("v2v_hz"), std::string::npos) << e.what();
+  }
+  try {
+    cfg::parse(std::string(kBase) + ", initial_pose_map: [1, 2]}\n", "t.yaml");
+    FAIL() << "accepted a 2-number pose";
+  } catch (const cfg::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("estimator.initial_pose_map"), std::string::npos)
+        << e.what();
+  }
+}
