@@ -124,14 +124,16 @@ def plan_episode(seed: int) -> list[CarPlan]:
     return plans
 
 
-def write_runtime_config(path: Path, run_dir: Path, url: str, car: int) -> Path:
-    """The HIL runtime config of car `car` (1-based): its name and pty, SIM_CLOCK, no LIDAR."""
+def write_runtime_config(path: Path, run_dir: Path, url: str, car: int, plan: CarPlan) -> Path:
+    """The HIL runtime config of car `car` (1-based): its name and pty, SIM_CLOCK, no LIDAR,
+    its EKF's map filter started at the car's start pose (no Eye here: V2V needs a map pose)."""
     cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
     cfg["lcm_url"] = url
     cfg["clock"] = "sim"
     cfg["vehicle"]["name"] = channels.vehicle_name(car)
     cfg["bridge"]["device"] = str(run_dir / f"nigel{car}-nano")
     cfg.pop("lidar", None)  # the sim runs --no-lidar: nothing here needs it
+    cfg["estimator"]["initial_pose_map"] = [float(v) for v in plan.start]
     path.write_text(yaml.safe_dump(cfg, sort_keys=False))
     return path
 
@@ -215,18 +217,17 @@ def run_episode(
             wait_for_path(run_dir / f"nigel{i + 1}-nano", PTY_TIMEOUT_S, procs)
         for i, p in enumerate(plans):
             cfg = write_runtime_config(
-                ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1
+                ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1, p
             )
             procs.start(
                 f"autodrive-runtime {p.vehicle}",
-                [build / "bin" / "autodrive-runtime", "--config", cfg],
+                [build / "bin" / "autodrive-runtime", "--config", cfg, "--route", p.route],
                 ep_dir / f"runtime{i + 1}.log",
             )
         for i, p in enumerate(plans):
             marl = [build / "bin" / "autodrive-marl", "--vehicle", p.vehicle]
             marl += ["--lcm-url", args.lcm_url, "--clock", "sim", "--map-json", MAP_JSON]
             marl += ["--route", p.route, "--mode", args.policy, "--start-delay-s", p.delay_s]
-            marl += ["--odom-origin", f"{p.start[0]},{p.start[1]},{math.degrees(p.start[2])}"]
             marl += ["--v2v-loss", args.v2v_loss, "--v2v-delay-ms", args.v2v_delay_ms]
             marl += ["--seed", args.seed * 1000 + ep * 10 + i]
             if args.policy == "rl":
