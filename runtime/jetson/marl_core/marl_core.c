@@ -219,38 +219,42 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
 
   double best_t = INFINITY;
   int best_peer = -1;
-  double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
-  for (int k = 1; k <= steps; k++) {
-    const double t = k * cfg->dt_s;
-    /* self: kinematic bicycle, the intended steering while t <= steer_hold_s */
-    if (t <= cfg->steer_hold_s + 1e-9) pyaw += v_self * tan(steer) / cfg->wheelbase_m * cfg->dt_s;
-    px += v_self * cos(pyaw) * cfg->dt_s;
-    py += v_self * sin(pyaw) * cfg->dt_s;
-    for (int i = 0; i < n_peers; i++) {
-      const adm_car_t *p = &peers[i];
-      if (p->id == self->id) continue;
+  for (int i = 0; i < n_peers; i++) {
+    const adm_car_t *p = &peers[i];
+    if (p->id == self->id) continue;
+    /* the first predicted contact with this peer decides; later ones follow from it */
+    double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
+    for (int k = 1; k <= steps; k++) {
+      const double t = k * cfg->dt_s;
+      if (t >= best_t) break;
+      /* self: kinematic bicycle, the intended steering while t <= steer_hold_s */
+      if (t <= cfg->steer_hold_s + 1e-9) pyaw += v_self * tan(steer) / cfg->wheelbase_m * cfg->dt_s;
+      px += v_self * cos(pyaw) * cfg->dt_s;
+      py += v_self * sin(pyaw) * cfg->dt_s;
       const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
       const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
       if (footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad) >= contact) continue;
       /* a peer behind self at contact would run into self: its own shield's job */
       double rx, ry;
       to_car_frame(px, py, pyaw, qx, qy, &rx, &ry);
-      if (rx < -0.5 * cfg->chassis_length_m) continue;
-      /* right of way: nearer to the contact point (chassis centres) goes first */
-      const double mx = 0.5 * (px + qx), my = 0.5 * (py + qy);
-      double scx[2], scy[2], pcx[2], pcy[2];
-      circles(cfg, self->x_m, self->y_m, self->yaw_rad, scx, scy);
-      circles(cfg, p->x_m, p->y_m, p->yaw_rad, pcx, pcy);
-      const double d_self = hypot(0.5 * (scx[0] + scx[1]) - mx, 0.5 * (scy[0] + scy[1]) - my);
-      const double d_peer = hypot(0.5 * (pcx[0] + pcx[1]) - mx, 0.5 * (pcy[0] + pcy[1]) - my);
+      if (rx < -0.5 * cfg->chassis_length_m) break;
+      /* right of way: the car whose chassis centre is nearer the contact point goes first */
+      const double off = cfg->chassis_offset_m;
+      const double scx = px + off * cos(pyaw), scy = py + off * sin(pyaw);
+      const double pcx = qx + off * cos(p->yaw_rad), pcy = qy + off * sin(p->yaw_rad);
+      const double mx = 0.5 * (scx + pcx), my = 0.5 * (scy + pcy);
+      const double d_self = hypot(self->x_m + off * cos(self->yaw_rad) - mx,
+                                  self->y_m + off * sin(self->yaw_rad) - my);
+      const double d_peer =
+          hypot(p->x_m + off * cos(p->yaw_rad) - mx, p->y_m + off * sin(p->yaw_rad) - my);
       const int peer_first =
           d_peer < d_self - 0.05 || (fabs(d_peer - d_self) <= 0.05 && p->id < self->id);
-      if ((t < cfg->emergency_s || peer_first) && t < best_t) {
+      if (t < cfg->emergency_s || peer_first) {
         best_t = t;
         best_peer = p->id;
       }
+      break;
     }
-    if (best_peer >= 0) break; /* the earliest contact that calls for braking */
   }
   if (best_peer >= 0) {
     out->command.throttle = cfg->brake_throttle;

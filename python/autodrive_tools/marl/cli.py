@@ -1,0 +1,124 @@
+"""tools/marl {train,eval}: train the shared intersection policy with PPO, and evaluate a policy
+(with and without the shield) and the rule-based baseline on seeded held-out episodes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from ..paths import REPO_ROOT
+
+DEFAULT_MODEL = REPO_ROOT / "models" / "marl" / "intersection.onnx"
+HELD_OUT_SEED = 1_000_000_000  # evaluation seeds start here; training seeds stay far below
+
+
+def log(msg: str) -> None:
+    print(f"[marl] {msg}", file=sys.stderr, flush=True)
+
+
+def parse_stages(text: str) -> list[tuple[int, int]]:
+    """ "1:40000,4:200000" -> [(1, 40000), (4, 200000)]."""
+    out = []
+    for part in text.split(","):
+        try:
+            cars, steps = (int(x) for x in part.split(":"))
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"--stages '{text}': expected cars:steps[,cars:steps...], e.g. 1:40000,4:200000"
+            ) from None
+        if not 1 <= cars <= 4 or steps < 1:
+            raise argparse.ArgumentTypeError(f"--stages '{part}': cars 1..4, steps >= 1")
+        out.append((cars, steps))
+    return out
+
+
+def cmd_train(a: argparse.Namespace) -> int:
+    from .export import export
+    from .train import TrainConfig, plot_curve, save_curve, train
+
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    if a.address:
+        log("--address: rollouts run on worker processes of this machine (pipes), not on Ray")
+        return 2
+    cfg = TrainConfig(
+        a.stages, a.action_mode, a.copies, a.workers, a.seed, max_wall_s=60.0 * a.max_wall_min
+    )
+    model, curve, info = train(cfg, log)
+    info["command"] = " ".join(["tools/marl"] + sys.argv[1:])
+    model.save(out / "ppo_policy.zip")
+    save_curve(curve, out / "learning_curve.json")
+    plot_curve(curve, out / "learning_curve.png", f"PPO, shared policy, {a.action_mode} actions")
+    sidecar = export(model, Path(a.onnx), a.action_mode, info)
+    (out / "train_report.json").write_text(json.dumps(info, indent=2) + "\n")
+    log(f"wrote {a.onnx}, {sidecar}, {out / 'learning_curve.png'}, {out / 'train_report.json'}")
+    print(json.dumps({"wall_s": info["wall_s"], "onnx": str(a.onnx)}))
+    return 0
+
+
+def cmd_eval(a: argparse.Namespace) -> int:
+    from .evaluate import evaluate_all
+
+    report = evaluate_all(
+        Path(a.model), a.episodes, a.cars, a.seed, a.modes.split(","), log, a.workers
+    )
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "eval_report.json").write_text(json.dumps(report, indent=2) + "\n")
+    log(f"wrote {out / 'eval_report.json'}")
+    print(json.dumps(report))
+    return 0
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="tools/marl", description=__doc__)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    t = sub.add_parser("train", help="PPO with a shared policy; writes ONNX + JSON + curves")
+    t.add_argument(
+        "--stages",
+        type=parse_stages,
+        default=parse_stages("1:30000,4:250000"),
+        help="curriculum cars:agent_steps,... (default 1:30000,4:250000)",
+    )
+    t.add_argument(
+        "--action-mode", default="discrete", choices=("discrete", "discrete_throttle", "continuous")
+    )
+    t.add_argument("--copies", type=int, default=2, help="environment copies (each N cars)")
+    t.add_argument("--workers", type=int, default=2, help="rollout processes (1: in process)")
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument(
+        "--max-wall-min",
+        type=float,
+        default=float("inf"),
+        help="stop after this wall time [min] and keep the model",
+    )
+    t.add_argument("--address", default="", help="Ray cluster address (not supported yet)")
+    t.add_argument("--onnx", default=str(DEFAULT_MODEL), help="where the policy goes")
+    t.add_argument("--out", default=str(REPO_ROOT / "out" / "marl-train"))
+    t.set_defaults(func=cmd_train)
+    e = sub.add_parser("eval", help="seeded held-out episodes: policy +-shield and baseline")
+    e.add_argument("--model", default=str(DEFAULT_MODEL))
+    e.add_argument("--episodes", type=int, default=50)
+    e.add_argument("--cars", type=int, default=4)
+    e.add_argument("--seed", type=int, default=HELD_OUT_SEED, help="first held-out seed")
+    e.add_argument(
+        "--modes",
+        default="shield,no_shield,baseline",
+        help="comma list of shield, no_shield, baseline",
+    )
+    e.add_argument("--workers", type=int, default=1, help="processes for the episodes")
+    e.add_argument("--out", default=str(REPO_ROOT / "out" / "marl-eval"))
+    e.set_defaults(func=cmd_eval)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    a = parser().parse_args(argv)
+    t0 = time.monotonic()
+    rc: int = a.func(a)
+    log(f"done in {time.monotonic() - t0:.0f} s")
+    return rc
