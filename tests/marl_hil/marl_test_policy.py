@@ -8,10 +8,12 @@ import torch
 
 OBS_DIM = 24  # ADM_OBS_DIM of <autodrive/marl_core.h>, observation version 1
 OBS_VERSION = 1
-ACTIONS = [-1.0, 0.0, 1.0]
+STEERING = [-1.0, 0.0, 1.0]
+LOOKAHEAD_M = 0.35
 
 
 def make_policy(folder: Path, seed: int = 3, throttle: float = 0.6) -> tuple[Path, torch.nn.Module]:
+    """The network and NAME.json in the sidecar format of autodrive_tools.marl.export."""
     torch.manual_seed(seed)
     net = torch.nn.Sequential(
         torch.nn.Linear(OBS_DIM, 128),
@@ -20,7 +22,7 @@ def make_policy(folder: Path, seed: int = 3, throttle: float = 0.6) -> tuple[Pat
         torch.nn.Tanh(),
         torch.nn.Linear(128, 128),
         torch.nn.Tanh(),
-        torch.nn.Linear(128, len(ACTIONS)),
+        torch.nn.Linear(128, len(STEERING)),
     ).eval()
     onnx_path = folder / "random_policy.onnx"
     torch.onnx.export(
@@ -33,12 +35,9 @@ def make_policy(folder: Path, seed: int = 3, throttle: float = 0.6) -> tuple[Pat
         opset_version=12,
     )
     spec = {
-        "obs_version": OBS_VERSION,
-        "obs_dim": OBS_DIM,
-        "actions": ACTIONS,
-        "control_period_s": 0.05,
-        "throttle": throttle,
-        "waypoint_lookahead_m": 0.3,
+        "obs": {"layout_version": OBS_VERSION, "dim": OBS_DIM, "builder": "autodrive_marl_core"},
+        "action": {"type": "discrete", "throttle_steering": [[throttle, s] for s in STEERING]},
+        "control_period_s": 0.1,
     }
     onnx_path.with_suffix(".json").write_text(json.dumps(spec))
     return onnx_path, net

@@ -44,12 +44,18 @@ with tempfile.TemporaryDirectory(prefix="marl-policy-") as tmp:
     garbage = folder / "garbage.onnx"
     garbage.write_bytes(b"not a network")
     garbage.with_suffix(".json").write_text(json.dumps(good))
-    no_throttle = {k: v for k, v in good.items() if k != "throttle"}
+    no_period = {k: v for k, v in good.items() if k != "control_period_s"}
+    two = {"type": "discrete", "throttle_steering": [[1, -1], [1, 1]]}
     cases = [
-        (onnx_path, no_throttle, "random_policy.json: throttle: missing key"),
-        (onnx_path, {**good, "obs_dim": 7}, "obs_dim 7"),
-        (onnx_path, {**good, "actions": [-1, 0, 2]}, "actions: every steering value"),
-        (onnx_path, {**good, "actions": [-1, 1]}, "its output has 3 values"),
+        (onnx_path, no_period, "random_policy.json: control_period_s: missing key"),
+        (onnx_path, {**good, "obs": {"layout_version": 1, "dim": 7}}, "obs_dim 7"),
+        (
+            onnx_path,
+            {**good, "action": {"type": "discrete", "throttle_steering": [[1, -1], [1, 2]]}},
+            "action.throttle_steering: every entry",
+        ),
+        (onnx_path, {**good, "action": two}, "its output has 3 values"),
+        (onnx_path, {**good, "action": {"type": "beta"}}, "action.type: neither"),
         (garbage, None, "garbage.onnx: OpenCV DNN cannot load it"),
         (folder / "missing.onnx", None, "missing.onnx: no such file"),
     ]

@@ -18,13 +18,13 @@ from autodrive_tools import channels, command_auth, lcmtypes
 from autodrive_tools.paths import REPO_ROOT
 
 sys.path.insert(0, str(Path(__file__).parent))
-from marl_test_policy import make_policy  # noqa: E402
+from marl_test_policy import LOOKAHEAD_M, make_policy  # noqa: E402
 
 exe, build, port = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"
 types = lcmtypes.load(build)
 MAP_JSON = REPO_ROOT / "sim" / "mujoco_hil" / "maps" / "intersection_school.json"
-THROTTLE = 0.6
+THROTTLE = 1.0  # the trained policies' (autodrive_tools.marl.export)
 keys = tempfile.TemporaryDirectory(prefix="marl-keys-")
 os.environ["AUTODRIVE_KEY_DIR"] = keys.name
 command_auth.create_key(command_auth.default_key_path("NIGEL1"))
@@ -34,7 +34,8 @@ def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
     """Runs autodrive-marl for ~2.5 s with the scripted inputs; returns (commands, last status)."""
     proc = subprocess.Popen(
         [exe, "--vehicle", "NIGEL1", "--lcm-url", url, "--policy", str(policy)]
-        + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall", *extra],
+        + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall"]
+        + ["--waypoint-lookahead-m", str(LOOKAHEAD_M), *extra],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,

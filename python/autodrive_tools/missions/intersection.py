@@ -4,8 +4,8 @@ or the first-come-first-served baseline, behind the TTC shield), V2V over real L
 
 One episode = one fresh set of processes (the simulator with the four cars placed by
 --car-start, four runtimes, four autodrive-marl), so nothing of an episode leaks into the next:
-that is the reset. Routes (one car per approach, each leaving by a different road: left turns, straight crossings
-and right turns) and start times are drawn from the seed. The simulator runs in lockstep with the runtimes (--lockstep-client),
+that is the reset. Routes and spawns are drawn from the seed as in training (autodrive_tools.marl.env): one car
+per approach, each turning left, going straight or right, a later spawn further back. The simulator runs in lockstep with the runtimes (--lockstep-client),
 so a loaded machine slows the run down and does not change it much.
 
 CLI: tools/demo --mission intersection --help."""
@@ -31,6 +31,7 @@ import yaml
 
 from .. import channels, command_auth, lcmtypes
 from ..learn import tasks
+from ..marl import env as marl_env
 from ..paths import OUT_DIR, RELEASE_BUILD, REPO_ROOT, RUNTIME_HIL_CONFIG
 from ..proc import ProcessGroup, wait_for_path
 
@@ -38,11 +39,6 @@ MAP = tasks.INTERSECTION_MAP
 MAP_JSON = tasks.MAPS_DIR / f"{MAP}.json"
 DEFAULT_POLICY = REPO_ROOT / "models" / "marl" / "intersection.onnx"
 CARS = 4
-APPROACHES = ("north", "east", "south", "west")
-# Where a car starts: this far before the intersection's centre along its route [m] (the
-# stop line is 0.65 m from the centre).
-START_BEFORE_CENTRE_M = 1.3
-MAX_START_DELAY_S = 3.0  # start times drawn in [0, this] [s of sim time]
 EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
 PTY_TIMEOUT_S = 30.0
 PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
@@ -91,36 +87,21 @@ class CarPlan:
     vehicle: str
     route: str
     start: tasks.Pose
-    delay_s: float
+    goal: tuple[float, float]  # on the route [m]
 
 
 def plan_episode(seed: int) -> list[CarPlan]:
-    """One car per approach, each leaving by a different road (a car stops at its route's end,
-    so two cars with one exit would queue there), and a start time, all drawn from seed: every
-    exit permutation without a car leaving the way it came, so left turns, straight crossings
-    and right turns mix."""
+    """The episode of seed as training draws them (autodrive_tools.marl.env: the one place of
+    the task): each car its own approach, a turn (left, straight or right) and a spawn time,
+    a later spawn starting further back on its approach; the goal on its exit lane."""
     rng = np.random.default_rng(seed)
-    names = set(tasks.routes(MAP))
-    while True:
-        exits = rng.permutation(len(APPROACHES))
-        if all(int(e) != i for i, e in enumerate(exits)):
-            break
+    approaches = rng.permutation(len(marl_env.APPROACHES))[:CARS]
     plans = []
-    for i, approach in enumerate(APPROACHES):
-        route_name = f"{approach}_to_{APPROACHES[int(exits[i])]}"
-        if route_name not in names:
-            raise RuntimeError(f"map {MAP} has no route {route_name} (routes: {sorted(names)})")
-        r = tasks.route(MAP, route_name)
-        d = np.hypot(r.points_m[:, 0], r.points_m[:, 1])
-        k = int(np.argmax(d < START_BEFORE_CENTRE_M))  # first point this close to the centre
-        plans.append(
-            CarPlan(
-                channels.vehicle_name(i + 1),
-                route_name,
-                r.pose_at(k),
-                float(rng.uniform(0.0, MAX_START_DELAY_S)),
-            )
-        )
+    for i, a in enumerate(approaches):
+        turn = list(marl_env.TURNS)[int(rng.integers(len(marl_env.TURNS)))]
+        spawn_s = float(rng.uniform(0.0, marl_env.SPAWN_SPREAD_S))
+        trip = marl_env.plan_route(marl_env.route_name(marl_env.APPROACHES[int(a)], turn), spawn_s)
+        plans.append(CarPlan(channels.vehicle_name(i + 1), trip.name, trip.start, trip.goal_xy_m))
     return plans
 
 
@@ -144,6 +125,7 @@ class EpisodeRecord:
     collided: set[str] = field(default_factory=set)
     steering: dict[str, list[tuple[float, float]]] = field(default_factory=dict)  # t, steer
     at_goal: set[str] = field(default_factory=set)
+    goal_t: dict[str, float] = field(default_factory=dict)  # sim time at the goal [s]
     sim_s: float = 0.0
 
 
@@ -189,8 +171,9 @@ def run_episode(
 
     def on_mission(ch: str, data: bytes) -> None:
         m = types.mission_status_t.decode(data)
-        if m.state == types.mission_status_t.PARKED:
+        if m.state == types.mission_status_t.PARKED and m.vehicle not in rec.at_goal:
             rec.at_goal.add(m.vehicle)
+            rec.goal_t[m.vehicle] = m.utime * 1e-6
 
     subs = []
     for p in plans:
@@ -227,7 +210,16 @@ def run_episode(
         for i, p in enumerate(plans):
             marl = [build / "bin" / "autodrive-marl", "--vehicle", p.vehicle]
             marl += ["--lcm-url", args.lcm_url, "--clock", "sim", "--map-json", MAP_JSON]
-            marl += ["--route", p.route, "--mode", args.policy, "--start-delay-s", p.delay_s]
+            marl += [
+                "--route",
+                p.route,
+                "--mode",
+                args.policy,
+                "--goal",
+                f"{p.goal[0]},{p.goal[1]}",
+            ]
+            marl += ["--goal-tolerance-m", marl_env.GOAL_REACHED_M]
+            marl += ["--waypoint-lookahead-m", marl_env.LOOKAHEAD_M]
             marl += ["--v2v-loss", args.v2v_loss, "--v2v-delay-ms", args.v2v_delay_ms]
             marl += ["--seed", args.seed * 1000 + ep * 10 + i]
             if args.policy == "rl":
@@ -267,14 +259,15 @@ def run_episode(
 
 
 def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
-    """For each car its EKF put at the goal: its true distance from the goal then [m] (the last
-    ground truth: a car at its goal stops there)."""
+    """For each car its EKF put at the goal: its true distance from the goal then [m]."""
     out = []
     for p in plans:
         if p.vehicle in rec.at_goal and rec.truth.get(p.vehicle):
-            end = tasks.route(MAP, p.route).points_m[-1]
-            _t, x, y = rec.truth[p.vehicle][-1]
-            out.append(float(math.hypot(x - end[0], y - end[1])))
+            # the first ground truth after the EKF said "at the goal"
+            t_goal = rec.goal_t.get(p.vehicle, math.inf)
+            after = [(x, y) for t, x, y in rec.truth[p.vehicle] if t >= t_goal]
+            if after:
+                out.append(float(math.hypot(after[0][0] - p.goal[0], after[0][1] - p.goal[1])))
     return out
 
 
@@ -359,7 +352,7 @@ def run(args: argparse.Namespace) -> int:
             if interrupted or time.time() - t0 > args.timeout:
                 break
             plans = plan_episode(args.seed * 1000 + ep)
-            routes = ", ".join(f"{p.vehicle} {p.route} +{p.delay_s:.1f}s" for p in plans)
+            routes = ", ".join(f"{p.vehicle} {p.route}" for p in plans)
             say(f"episode {ep + 1}/{args.episodes}: {routes}")
             rec, summaries, ended = run_episode(
                 args, ep, plans, build, out, say, lambda: interrupted

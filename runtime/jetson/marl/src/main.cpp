@@ -49,7 +49,8 @@ int64_t wall_us() {
 
 struct Options {
   std::string vehicle = "NIGEL1", lcm_url = "udpm://239.255.76.67:7667?ttl=0", mode = "rl";
-  std::string policy, map_json, route, clock = "wall", key_file, odom_origin, eval_obs;
+  std::string policy, map_json, route, clock = "wall", key_file, odom_origin, eval_obs, goal;
+  double waypoint_lookahead_m = 0;
   std::string log_level = "info";
   double start_delay_s = 0;
   double v2v_loss = 0, v2v_delay_ms = 0, stale_ms = 200, rate_hz = 20, goal_tolerance_m = 0.15;
@@ -69,9 +70,14 @@ class App {
         route_(std::move(route)),
         baseline_(std::move(baseline)),
         origin_(origin),
-        core_(route_, policy_ ? policy_->spec().waypoint_lookahead_m : 0.3),
+        core_(route_, o.waypoint_lookahead_m),
         peers_(o.vehicle, static_cast<int64_t>(o.stale_ms * 1000)),
         link_(o.v2v_loss, static_cast<int64_t>(o.v2v_delay_ms * 1000), o.seed) {
+    goal_[0] = route_.points.back().x_m;
+    goal_[1] = route_.points.back().y_m;
+    if (!o.goal.empty()) std::sscanf(o.goal.c_str(), "%lf,%lf", &goal_[0], &goal_[1]);
+    core_.set_goal(goal_[0], goal_[1]);
+    after_goal_.set_path(route_.path());
     period_us_ =
         static_cast<int64_t>(1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
   }
@@ -108,11 +114,11 @@ class App {
     std::vector<marl::CarState> peers;
     for (const auto &s : fresh)
       peers.push_back({marl::vehicle_id(s.vehicle), s.x_m, s.y_m, s.yaw_rad, s.speed_m_s});
-    const auto &end = route_.points.back();
-    const bool at_goal = std::hypot(own_.x_m - end.x_m, own_.y_m - end.y_m) < o_.goal_tolerance_m;
+    const bool at_goal = std::hypot(own_.x_m - goal_[0], own_.y_m - goal_[1]) < o_.goal_tolerance_m;
     if (at_goal && goal_us_ < 0) {
       goal_us_ = now;
       spdlog::info("{} at its goal (route {}) at {:.2f} s", o_.vehicle, route_.name, now * 1e-6);
+      publish_status(now);  // at once: the demo times the arrival by it
     }
     double throttle = 0, steering = 0;
     if (goal_us_ < 0) {
@@ -123,8 +129,9 @@ class App {
         steering = c.steering;
       } else {
         const std::vector<float> obs = core_.observation(own_, peers, last_steering_);
-        steering = policy_->steering(obs);
-        throttle = policy_->spec().throttle;
+        const marl::PolicyCommand c = policy_->act(obs);
+        throttle = c.throttle;
+        steering = c.steering;
       }
       if (!o_.no_shield) {
         // The baseline arbitrates the zone by its own rule: its shield is the emergency brake.
@@ -141,7 +148,16 @@ class App {
         steering = r.steering;
       }
     }
-    publish(now, throttle, steering, goal_us_ < 0);
+    if (goal_us_ >= 0) {
+      // At the goal: drive on along the route to its end (out of the intersection's way, as
+      // in training), braking only for an emergency.
+      const autonomy::TrackerCommand tc =
+          after_goal_.step({own_.x_m, own_.y_m, own_.yaw_rad}, dt_s, own_.speed_m_s);
+      const marl::ShieldResult r = core_.shield(own_, tc.throttle, tc.steering, peers, true);
+      throttle = r.throttle;
+      steering = r.steering;
+    }
+    publish(now, throttle, steering, true);
     last_steering_ = steering;
     ++steps_;
     peers_seen_ = fresh.size();
@@ -166,8 +182,7 @@ class App {
     m.vehicle = o_.vehicle;
     m.state =
         goal_us_ >= 0 ? autodrive::mission_status_t::PARKED : autodrive::mission_status_t::DRIVING;
-    const auto &end = route_.points.back();
-    const double left = std::hypot(own_.x_m - end.x_m, own_.y_m - end.y_m);
+    const double left = std::hypot(own_.x_m - goal_[0], own_.y_m - goal_[1]);
     m.progress = static_cast<float>(std::clamp(1.0 - left / route_.s_m.back(), 0.0, 1.0));
     m.detail = detail();
     lcm_.publish(o_.vehicle + AUTODRIVE_CH_MISSION_SUFFIX, &m);
@@ -213,6 +228,8 @@ class App {
   std::unique_ptr<marl::FcfsBaseline> baseline_;
   std::optional<autonomy::Pose2> origin_;
   marl::Core core_;
+  autonomy::PurePursuit after_goal_;
+  double goal_[2] = {0, 0};
   autodrive::v2v::PeerTable peers_;
   marl::LinkDegrader link_;
   marl::CarState own_;
@@ -288,7 +305,14 @@ int main(int argc, char **argv) {
   cli.add_option("--policy", o.policy, "rl: the policy NAME.onnx (NAME.json beside it)");
   cli.add_option("--map-json", o.map_json, "the map's JSON sidecar (routes, the 4-way tile)")
       ->check(CLI::ExistingFile);
-  cli.add_option("--route", o.route, "the map's route this car drives (its end is the goal)");
+  cli.add_option("--route", o.route, "the map's route this car drives");
+  cli.add_option("--goal", o.goal,
+                 "X,Y: the goal on the route [m] (default: the route's end); at the goal the car "
+                 "drives on to the route's end");
+  cli.add_option("--waypoint-lookahead-m", o.waypoint_lookahead_m,
+                 "rl: the route waypoint's distance ahead in the observation [m], as in training "
+                 "(autodrive_tools.marl.env.LOOKAHEAD_M)")
+      ->check(CLI::Range(0.01, 5.0));
   cli.add_option("--clock", o.clock, "sim (SIM_CLOCK, HIL) or wall")
       ->check(CLI::IsMember({"sim", "wall"}))
       ->capture_default_str();
@@ -350,6 +374,18 @@ int main(int argc, char **argv) {
                    marl::obs_version(), marl::obs_dim());
       return 2;
     }
+  }
+  if (o.mode == "rl" && o.waypoint_lookahead_m <= 0) {
+    std::fprintf(stderr, "autodrive-marl: --waypoint-lookahead-m: required with --mode rl\n");
+    return 2;
+  }
+  double gx, gy;
+  char tail;
+  if (!o.goal.empty() && (std::sscanf(o.goal.c_str(), "%lf,%lf%c", &gx, &gy, &tail) != 2 ||
+                          !std::isfinite(gx) || !std::isfinite(gy))) {
+    std::fprintf(stderr, "autodrive-marl: --goal '%s': want X,Y [m] (finite numbers)\n",
+                 o.goal.c_str());
+    return 2;
   }
   if (o.map_json.empty() || o.route.empty()) {
     std::fprintf(stderr, "autodrive-marl: --map-json and --route are required to drive\n");

@@ -4,6 +4,7 @@
 #include <opencv2/dnn.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -25,41 +26,47 @@ PolicySpec read_policy_spec(const std::string &json_path) {
   } catch (const std::exception &e) {
     bad(json_path, std::string("not JSON: ") + e.what());
   }
-  PolicySpec s;
-  auto need = [&](const char *key) -> const nlohmann::json & {
-    if (!j.is_object() || !j.contains(key)) bad(json_path, std::string(key) + ": missing key");
-    return j.at(key);
+  auto need = [&](const nlohmann::json &o, const std::string &where,
+                  const char *key) -> const nlohmann::json & {
+    if (!o.is_object() || !o.contains(key)) bad(json_path, where + key + ": missing key");
+    return o.at(key);
   };
-  const auto &version = need("obs_version");
-  if (!version.is_number_integer()) bad(json_path, "obs_version: not an integer");
+  PolicySpec s;
+  const auto &obs = need(j, "", "obs");
+  const auto &version = need(obs, "obs.", "layout_version");
+  if (!version.is_number_integer()) bad(json_path, "obs.layout_version: not an integer");
   s.obs_version = version.get<int>();
-  const auto &dim = need("obs_dim");
+  const auto &dim = need(obs, "obs.", "dim");
   if (!dim.is_number_integer() || dim.get<int>() < 1 || dim.get<int>() > 4096)
-    bad(json_path, "obs_dim: not an integer in 1..4096");
+    bad(json_path, "obs.dim: not an integer in 1..4096");
   s.obs_dim = dim.get<int>();
-  const auto &acts = need("actions");
-  if (acts.is_string() && acts.get<std::string>() == "continuous") {
-  } else if (acts.is_array() && acts.size() >= 2) {
-    for (const auto &a : acts) {
-      if (!a.is_number() || !(std::abs(a.get<double>()) <= 1.0))
-        bad(json_path, "actions: every steering value must be a number in [-1, 1]");
-      s.steering_actions.push_back(a.get<double>());
+  const auto &action = need(j, "", "action");
+  const auto &type = need(action, "action.", "type");
+  const auto in_range = [](const nlohmann::json &v) {
+    return v.is_number() && std::abs(v.get<double>()) <= 1.0;
+  };
+  if (type == "discrete") {
+    const auto &table = need(action, "action.", "throttle_steering");
+    if (!table.is_array() || table.size() < 2)
+      bad(json_path, "action.throttle_steering: not a list of >= 2 [throttle, steering] pairs");
+    for (const auto &a : table) {
+      if (!a.is_array() || a.size() != 2 || !in_range(a[0]) || !in_range(a[1]))
+        bad(json_path,
+            "action.throttle_steering: every entry must be [throttle, steering], "
+            "each in [-1, 1]");
+      s.actions.emplace_back(a[0].get<double>(), a[1].get<double>());
     }
+  } else if (type == "continuous") {
+    const auto &thr = need(action, "action.", "throttle");
+    if (!in_range(thr)) bad(json_path, "action.throttle: not a number in [-1, 1]");
+    s.continuous_throttle = thr.get<double>();
   } else {
-    bad(json_path, "actions: neither \"continuous\" nor a list of >= 2 steering values");
+    bad(json_path, "action.type: neither \"discrete\" nor \"continuous\"");
   }
-  const auto &period = need("control_period_s");
+  const auto &period = need(j, "", "control_period_s");
   if (!period.is_number() || !(period.get<double>() >= 0.005 && period.get<double>() <= 1.0))
     bad(json_path, "control_period_s: not a number in [0.005, 1] s");
   s.control_period_s = period.get<double>();
-  const auto &thr = need("throttle");
-  if (!thr.is_number() || !(thr.get<double>() > 0.0 && thr.get<double>() <= 1.0))
-    bad(json_path, "throttle: not a number in (0, 1]");
-  s.throttle = thr.get<double>();
-  const auto &look = need("waypoint_lookahead_m");
-  if (!look.is_number() || !(look.get<double>() > 0.0 && look.get<double>() <= 5.0))
-    bad(json_path, "waypoint_lookahead_m: not a number in (0, 5] m");
-  s.waypoint_lookahead_m = look.get<double>();
   return s;
 }
 
@@ -89,7 +96,7 @@ Policy::Policy(const std::string &onnx_path) : net_(std::make_unique<Net>()) {
     bad(onnx_path, "does not run on an observation of obs_dim " + std::to_string(spec_.obs_dim) +
                        " (from its .json): " + e.what());
   }
-  const size_t want = spec_.steering_actions.empty() ? 1 : spec_.steering_actions.size();
+  const size_t want = spec_.actions.empty() ? 1 : spec_.actions.size();
   if (out.size() != want)
     bad(onnx_path, "its output has " + std::to_string(out.size()) +
                        " values, its .json's actions " + "want " + std::to_string(want));
@@ -108,11 +115,13 @@ std::vector<float> Policy::forward(const std::vector<float> &obs) {
   return std::vector<float>(out.begin<float>(), out.end<float>());
 }
 
-double Policy::steering(const std::vector<float> &obs) {
+PolicyCommand Policy::act(const std::vector<float> &obs) {
   const std::vector<float> out = forward(obs);
-  if (spec_.steering_actions.empty()) return std::clamp(static_cast<double>(out[0]), -1.0, 1.0);
+  if (spec_.actions.empty())
+    return {spec_.continuous_throttle, std::clamp(static_cast<double>(out[0]), -1.0, 1.0)};
   const auto best = std::max_element(out.begin(), out.end()) - out.begin();
-  return spec_.steering_actions[static_cast<size_t>(best)];
+  const auto &a = spec_.actions[static_cast<size_t>(best)];
+  return {a.first, a.second};
 }
 
 }  // namespace marl

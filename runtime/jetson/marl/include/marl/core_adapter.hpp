@@ -32,9 +32,13 @@ struct ShieldResult {
 
 class Core {
  public:
-  // route: the car's route (its end is the goal); lookahead_m [m]: the route waypoint's
-  // distance ahead (from the policy's .json, as in training).
+  // route: the car's route (its end is the goal until set_goal); lookahead_m [m]: the route
+  // waypoint's distance ahead, as in training.
   Core(const Route &route, double lookahead_m);
+  void set_goal(double x_m, double y_m) {
+    goal_xy_m_[0] = x_m;
+    goal_xy_m_[1] = y_m;
+  }
   // The observation of own (heading to the route's end) with these peers; throws
   // std::runtime_error with the core's message.
   std::vector<float> observation(const CarState &own, const std::vector<CarState> &peers,

@@ -1,15 +1,16 @@
 // A trained intersection policy: NAME.onnx (input `obs` float32 [N, D], output `action`:
-// logits over a discrete steering set, or a continuous steering mean) run with OpenCV DNN,
-// and NAME.json beside it, the one place of what the network means:
-//   {"obs_version": V, "obs_dim": D, "actions": [-1, 0, 1] | "continuous",
-//    "control_period_s": 0.05, "throttle": 0.6, "waypoint_lookahead_m": 0.3}
-// (obs_version, obs_dim: the MARL core's observation layout it was trained on;
-// waypoint_lookahead_m: the route waypoint's distance ahead in that observation [m]).
-// (actions: the steering value of each logit, or "continuous" for one output in [-1, 1]).
+// logits over a discrete action set, or a continuous steering mean) run with OpenCV DNN, and
+// NAME.json beside it (written by tools/marl's export, python/autodrive_tools/marl/export.py),
+// the one place of what the network means. The keys read here:
+//   {"obs": {"layout_version": V, "dim": D},
+//    "action": {"type": "discrete", "throttle_steering": [[1.0, -1.0], [1.0, 0.0], ...]}
+//            | {"type": "continuous", "throttle": 1.0},
+//    "control_period_s": 0.1}
 #pragma once
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace marl {
@@ -17,10 +18,14 @@ namespace marl {
 struct PolicySpec {
   int obs_version = 0;
   int obs_dim = 0;
-  std::vector<double> steering_actions;  // empty: continuous
-  double control_period_s = 0.05;        // [s]
-  double throttle = 0.5;                 // [-1, 1], constant
-  double waypoint_lookahead_m = 0.3;     // [m]
+  // Discrete: (throttle, steering) of each logit; empty: continuous.
+  std::vector<std::pair<double, double>> actions;
+  double continuous_throttle = 0;  // continuous: the constant throttle [-1, 1]
+  double control_period_s = 0.1;   // [s]
+};
+
+struct PolicyCommand {
+  double throttle = 0, steering = 0;  // [-1, 1]
 };
 
 // Reads NAME.json; throws std::runtime_error naming the file and the key that is wrong.
@@ -35,8 +40,8 @@ class Policy {
   const PolicySpec &spec() const { return spec_; }
   // The network's raw output for one observation (logits or the mean).
   std::vector<float> forward(const std::vector<float> &obs);
-  // The steering [-1, 1] for one observation (argmax of the logits, or the clipped mean).
-  double steering(const std::vector<float> &obs);
+  // The command for one observation (the argmax logit's, or the clipped mean steering).
+  PolicyCommand act(const std::vector<float> &obs);
 
  private:
   struct Net;
