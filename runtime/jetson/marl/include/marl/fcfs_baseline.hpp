@@ -6,7 +6,8 @@
 // order is (request time in bins of bin_s [s], vehicle name): a total order that a later-seen
 // peer can only move back, so two cars never both wait for each other. A car is granted the
 // zone when nobody is in it and no peer ahead in that order still requests it; until then it
-// holds short of the zone. Once granted it is committed.
+// holds short of the zone. The grant is re-judged until the car is in the zone (a peer that got
+// in first withdraws it); in the zone the car is committed.
 #pragma once
 
 #include <autodrive/v2v_state_t.hpp>
@@ -47,6 +48,8 @@ class FcfsBaseline {
   // heading yaw_rad, requests the zone.
   double edge_distance_m(double x_m, double y_m) const;
   bool requests(double x_m, double y_m, double yaw_rad) const;
+  // base_link or the front bumper of a car there is in the zone
+  bool occupies(double x_m, double y_m, double yaw_rad) const;
 
   std::string self_;
   Route route_;
@@ -55,7 +58,7 @@ class FcfsBaseline {
   autonomy::PurePursuit tracker_;
   bool crosses_zone_ = false;
   int64_t my_request_us_ = -1;
-  bool granted_ = false, left_zone_ = false;
+  bool granted_ = false, committed_ = false, left_zone_ = false;
   std::map<std::string, int64_t> peer_request_us_;
 };
 
