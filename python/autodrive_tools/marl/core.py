@@ -48,7 +48,7 @@ def load() -> tuple[Any, Any]:
     """(ffi, lib) of the core."""
     ffi = cffi.FFI()
     # cffi's ABI mode takes integer #defines only: the float scales stay C-side
-    text = re.sub(r"^#define \w+ [0-9]*\.[0-9]*$", "", declarations(HEADER), flags=re.M)
+    text = re.sub(r"^#define \w+ [0-9]*\.[0-9]+\b.*$", "", declarations(HEADER), flags=re.M)
     ffi.cdef(text)
     return ffi, ffi.dlopen(str(library_path()))
 

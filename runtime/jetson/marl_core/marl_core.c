@@ -217,12 +217,27 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
                             : self->speed_m_s;
   const int steps = (int)ceil(cfg->horizon_s / cfg->dt_s);
 
+  const double touch = 2.0 * (radius - cfg->margin_m); /* footprints without the margin */
   double best_t = INFINITY;
   int best_peer = -1;
   for (int i = 0; i < n_peers; i++) {
     const adm_car_t *p = &peers[i];
     if (p->id == self->id) continue;
-    /* the first predicted contact with this peer decides; later ones follow from it */
+    /* Right of way, the same seen from either car: each projects the other onto its own
+     * heading; the car that has the other farther ahead of it gives way (equal within 5 cm:
+     * the lower id goes first). */
+    const double ahead_of_self =
+        (p->x_m - self->x_m) * cos(self->yaw_rad) + (p->y_m - self->y_m) * sin(self->yaw_rad);
+    const double ahead_of_peer =
+        (self->x_m - p->x_m) * cos(p->yaw_rad) + (self->y_m - p->y_m) * sin(p->yaw_rad);
+    /* Both standing (waiting): the lower id goes, so that no ring of cars, each giving way to
+     * the next, waits for ever. */
+    const int both_stopped =
+        fabs(self->speed_m_s) < ADM_STOPPED_M_S && fabs(p->speed_m_s) < ADM_STOPPED_M_S;
+    const int peer_first =
+        both_stopped ? p->id < self->id
+                     : ahead_of_self > ahead_of_peer + 0.05 ||
+                           (fabs(ahead_of_self - ahead_of_peer) <= 0.05 && p->id < self->id);
     double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
     for (int k = 1; k <= steps; k++) {
       const double t = k * cfg->dt_s;
@@ -233,26 +248,17 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
       py += v_self * sin(pyaw) * cfg->dt_s;
       const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
       const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
-      if (footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad) >= contact) continue;
+      const double d = footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad);
+      /* giving way: any contact with the margin; with the right of way: only a touch of the
+       * bare footprints within emergency_s (so that two cars never both wait for ever) */
+      const int brake = peer_first ? d < contact : (d < touch && t < cfg->emergency_s);
+      if (!brake) continue;
       /* a peer behind self at contact would run into self: its own shield's job */
       double rx, ry;
       to_car_frame(px, py, pyaw, qx, qy, &rx, &ry);
       if (rx < -0.5 * cfg->chassis_length_m) break;
-      /* right of way: the car whose chassis centre is nearer the contact point goes first */
-      const double off = cfg->chassis_offset_m;
-      const double scx = px + off * cos(pyaw), scy = py + off * sin(pyaw);
-      const double pcx = qx + off * cos(p->yaw_rad), pcy = qy + off * sin(p->yaw_rad);
-      const double mx = 0.5 * (scx + pcx), my = 0.5 * (scy + pcy);
-      const double d_self = hypot(self->x_m + off * cos(self->yaw_rad) - mx,
-                                  self->y_m + off * sin(self->yaw_rad) - my);
-      const double d_peer =
-          hypot(p->x_m + off * cos(p->yaw_rad) - mx, p->y_m + off * sin(p->yaw_rad) - my);
-      const int peer_first =
-          d_peer < d_self - 0.05 || (fabs(d_peer - d_self) <= 0.05 && p->id < self->id);
-      if (t < cfg->emergency_s || peer_first) {
-        best_t = t;
-        best_peer = p->id;
-      }
+      best_t = t;
+      best_peer = p->id;
       break;
     }
   }

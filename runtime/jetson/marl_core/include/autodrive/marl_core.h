@@ -35,6 +35,7 @@ extern "C" {
 #define ADM_WAYPOINT_SCALE_M 0.5
 #define ADM_SPEED_SCALE_M_S 0.5
 #define ADM_PEER_RANGE_M 4.0
+#define ADM_STOPPED_M_S 0.02 /* the shield: a car slower than this stands */
 
 typedef struct adm_car {
   int id;           /* vehicle number (tie-breaks: the lower id goes first) */
@@ -67,7 +68,7 @@ typedef struct adm_shield_config {
   double dt_s;             /* prediction step */
   double steer_hold_s;     /* the intended steering is held this long, then the heading */
   double margin_m;         /* clearance added to each car's footprint */
-  double emergency_s;      /* below this time to collision, brake whatever the priority */
+  double emergency_s;      /* with the right of way, brake for a touch within this */
   double chassis_length_m; /* the car's footprint (chassis box) */
   double chassis_width_m;
   double chassis_offset_m; /* box centre ahead of base_link */
@@ -91,10 +92,12 @@ void adm_shield_defaults(adm_shield_config_t *cfg);
 
 /* The time-to-collision shield. Self follows the intended command (kinematic bicycle, steering
  * held steer_hold_s, speed at least throttle * top_speed), each peer keeps its heading and
- * speed. Footprints are two circles per car covering its chassis box plus margin_m. For the
- * earliest predicted contact within the horizon with a peer not behind self, the shield brakes
- * when the contact is closer than emergency_s, or when the peer has the right of way: it is
- * nearer to the contact point (equal within 5 cm: the lower id). */
+ * speed. Footprints are two circles per car covering its chassis box. Right of way between
+ * two cars is the same seen from either: the car that has the other farther ahead along its
+ * own heading gives way (equal within 5 cm, or both standing: the lower id goes first). Giving way,
+ * self brakes for any predicted contact (footprints plus margin_m) within the horizon; with the
+ * right of way, only for a touch of the bare footprints within emergency_s. A peer behind self at
+ * the contact is left to that peer's shield. */
 int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
                const adm_car_t *peers, int n_peers, adm_shield_result_t *out, char *err,
                size_t err_sz);
