@@ -34,9 +34,16 @@ with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
     # Ctrl-C mid-episode: everything stops, exit 130.
     out = Path(tmp) / "interrupted"
     p = demo(out, "--episodes", "2", "--seed", "4")
-    time.sleep(8.0)
+    head = ""
+    assert p.stdout is not None
+    while "episode 1/2" not in head:  # the first episode has started (imports are slow here)
+        line = p.stdout.readline()
+        assert line, head
+        head += line
+    time.sleep(5.0)
     os.killpg(p.pid, signal.SIGINT)
     log, _ = p.communicate(timeout=60)
+    log = head + log
     assert p.returncode == 130, (p.returncode, log)
     rep = json.loads((out / "report.json").read_text())
     assert rep["interrupted"] is True, rep
