@@ -13,7 +13,18 @@ from typing import Any
 
 from ..paths import REPO_ROOT
 
-SUITES = ("eye", "firmware", "learn", "link", "parking", "security", "sim", "sweep", "world")
+SUITES = (
+    "eye",
+    "firmware",
+    "learn",
+    "link",
+    "marl",
+    "parking",
+    "security",
+    "sim",
+    "sweep",
+    "world",
+)
 
 
 def build_dir(suite: str) -> Path:

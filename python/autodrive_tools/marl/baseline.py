@@ -89,7 +89,7 @@ class FcfsBaseline:
             self.granted[i] = not any(
                 self.conflict[i, j]
                 and self.request[j] is not None
-                and (self.request[j], j) < mine  # type: ignore[operator]
+                and (self.request[j], j) < mine
                 and not self.cleared[j]
                 for j in range(env.n_cars)
             )

@@ -111,7 +111,7 @@ class OnnxPolicy:
     """A shipped policy run with OpenCV DNN (as the C++ side can): obs [N, D] -> action."""
 
     def __init__(self, onnx_path: Path) -> None:
-        import cv2
+        import cv2  # type: ignore[import-not-found]
 
         cv2.setNumThreads(1)  # a 24 -> 3 x 128 MLP: threads cost more than they give
         self.meta: dict[str, Any] = json.loads(onnx_path.with_suffix(".json").read_text())
@@ -129,6 +129,7 @@ class OnnxPolicy:
 
     def act(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[Any]:
         out = self.raw(obs)
-        if self.action_mode == "continuous":
-            return np.clip(out, -1.0, 1.0)
-        return np.argmax(out, axis=1)
+        act: npt.NDArray[Any] = (
+            np.clip(out, -1.0, 1.0) if self.action_mode == "continuous" else np.argmax(out, axis=1)
+        )
+        return act

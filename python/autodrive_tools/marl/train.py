@@ -34,7 +34,7 @@ class Curve:
     collision_rate: list[float] = field(default_factory=list)
 
 
-class Progress(BaseCallback):  # type: ignore[misc]
+class Progress(BaseCallback):
     """Progress lines and the learning curve from the environments' episode infos."""
 
     def __init__(

@@ -119,7 +119,7 @@ def _worker(conn: Connection, spec: EnvSpec, copies: list[int], base_seed: int) 
         conn.close()
 
 
-class MarlVecEnv(VecEnv):  # type: ignore[misc]
+class MarlVecEnv(VecEnv):
     """copies x spec.cars slots for stable-baselines3, on `workers` processes."""
 
     def __init__(self, spec: EnvSpec, copies: int, workers: int = 1, seed: int = 0) -> None:
@@ -155,7 +155,8 @@ class MarlVecEnv(VecEnv):  # type: ignore[misc]
             return self.local.reset()
         for c in self.conns:
             c.send(("reset", None))
-        return np.concatenate([c.recv() for c in self.conns])
+        obs: npt.NDArray[np.float32] = np.concatenate([c.recv() for c in self.conns])
+        return obs
 
     def step_async(self, actions: npt.NDArray[Any]) -> None:
         self._actions = np.asarray(actions)
