@@ -21,7 +21,8 @@ const char *FcfsBaseline::phase() const {
 
 bool FcfsBaseline::occupies(double x_m, double y_m, double yaw_rad) const {
   // base_link or the front bumper (the chassis' front, ahead of base_link) inside the zone
-  const double ahead = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X + AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X / 2;
+  const double ahead =
+      AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X + AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X / 2;
   return zone_.contains(x_m, y_m) ||
          zone_.contains(x_m + ahead * std::cos(yaw_rad), y_m + ahead * std::sin(yaw_rad));
 }
