@@ -63,11 +63,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument(
         "--mission",
-        choices=("parking", "loop", "smart-city", "cloning"),
+        choices=("parking", "loop", "smart-city", "cloning", "intersection"),
         default="parking",
         help="parking (default): map, localise, plan and park autonomously; loop: "
-        "drive a stadium track with pure pursuit on the EKF; cloning: Driving School from the "
-        "camera with a behavioural-cloning model (its own options: --mission cloning --help)",
+        "drive a stadium track with pure pursuit on the EKF; smart-city: three cars in Tiny Town "
+        "under the Smart City Manager; cloning: Driving School from the camera with a "
+        "behavioural-cloning model (its own options: --mission cloning --help); intersection: "
+        "four cars cross Intersection School with autodrive-marl (its own options: --mission "
+        "intersection --help)",
     )
     p.add_argument("--slot", type=int, default=2, help="parking: target slot 0..5")
     p.add_argument(
@@ -338,7 +341,11 @@ def main(argv: list[str] | None = None) -> int:
         from .missions import cloning  # its own options (--laps, --condition, --model)
 
         return cloning.main(args)
-    return run(parse_args(argv))
+    if "intersection" in args and ("--mission" in args or "--mission=intersection" in args):
+        from .missions import intersection  # its own options (--episodes, --v2v-loss, ...)
+
+        return intersection.main(args)
+    return run(parse_args(args))
 
 
 if __name__ == "__main__":
