@@ -31,7 +31,8 @@ command_auth.create_key(command_auth.default_key_path("NIGEL1"))
 
 
 def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
-    """Runs autodrive-marl for ~2.5 s with the scripted inputs; returns (commands, last status)."""
+    """Runs autodrive-marl with the scripted inputs for >= 2.5 s and 40 engaged commands; returns
+    (commands, last status)."""
     proc = subprocess.Popen(
         [exe, "--vehicle", "NIGEL1", "--lcm-url", url, "--policy", str(policy)]
         + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall"]
@@ -46,7 +47,13 @@ def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
     lc.subscribe(channels.channel("MISSION", "NIGEL1"), lambda _c, d: status.append(d))
     t0 = time.time()
     seq = 0
-    while time.time() - t0 < 2.5:
+
+    def engaged() -> int:
+        return sum(1 for d in commands if types.vehicle_command_t.decode(d).engaged)
+
+    # At least 2.5 s and 40 engaged commands: the count, not the wall time, is what the asserts
+    # need (a loaded machine starts the program late); 60 s caps a program that never drives.
+    while time.time() - t0 < 60.0 and (time.time() - t0 < 2.5 or engaged() < 40):
         now_us = int(time.time() * 1e6)
         pose = types.odometry_t()
         pose.utime, pose.vehicle, pose.frame_id = now_us, "NIGEL1", "map"
