@@ -111,7 +111,7 @@ class OnnxPolicy:
     """A shipped policy run with OpenCV DNN (as the C++ side can): obs [N, D] -> action."""
 
     def __init__(self, onnx_path: Path) -> None:
-        import cv2  # type: ignore[import-not-found]
+        import cv2
 
         cv2.setNumThreads(1)  # a 24 -> 3 x 128 MLP: threads cost more than they give
         self.meta: dict[str, Any] = json.loads(onnx_path.with_suffix(".json").read_text())
