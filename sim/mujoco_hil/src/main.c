@@ -663,8 +663,8 @@ int main(int argc, char **argv) {
   main_cams_fx(&cams, camera_noise, camera_blur, cfg.seed);
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
   /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
-  tl_lcm_t *lights = tl_lcm_create(lcm, url, sim_traffic_lights(s), !allow_teleport, err,
-                                     sizeof err);
+  tl_lcm_t *lights =
+      tl_lcm_create(lcm, url, sim_traffic_lights(s), !allow_teleport, err, sizeof err);
   if (!lights && err[0]) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     main_cams_close(&cams);

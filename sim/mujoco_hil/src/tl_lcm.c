@@ -48,8 +48,8 @@ static void tl_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
     if (k->t->light[i].changed) tl_lcm_send(k, &k->t->light[i], k->now_us);
 }
 
-tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus,
-                        char *err, size_t err_sz) {
+tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus, char *err,
+                        size_t err_sz) {
   if (t->n == 0) return NULL;
   tl_lcm_t *k = calloc(1, sizeof *k);
   if (!k) {

@@ -22,8 +22,8 @@ typedef struct tl_lcm tl_lcm_t;
 /* NULL when the map has no lights (nothing to do) or on an LCM error (message in err). url:
  * the one lcm was made with. filter_bus: on udpm:// its receive socket then keeps only the
  * commands (lcm_rxfilter.h), so lcm must subscribe to nothing else; 0 when it does. */
-tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus,
-                        char *err, size_t err_sz);
+tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus, char *err,
+                        size_t err_sz);
 void tl_lcm_destroy(tl_lcm_t *k);
 
 /* Handles the commands waiting on the socket (no wait) at sim time now_us: accepted ones
