@@ -15,6 +15,7 @@ from http.cookiejar import CookieJar
 from pathlib import Path
 from typing import Any
 
+from autodrive_tools.scm.light_watch import LightWatch  # noqa: F401  (re-exported)
 from autodrive_tools.scm.testkit import (  # noqa: F401  (re-exported for the tests)
     Client,
     Postgres,
@@ -78,47 +79,6 @@ class CarFeeder:
                 o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = p.x_m, p.y_m, p.yaw_rad, self.speed
                 self.lc.publish(self.channel("POSE_MAP", v), o.encode())
             time.sleep(0.02)
-
-    def stop(self) -> None:
-        self.stop_flag.set()
-        self.thread.join()
-
-
-class LightWatch:
-    """The simulator's TRAFFIC_LIGHT_STATE messages, (wall time received, light id, state)."""
-
-    def __init__(self, lc: Any, types: Any) -> None:
-        import threading
-
-        from autodrive_tools.channels import channel
-
-        self.states: list[tuple[float, int, int]] = []
-        self.T = types
-        lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), self._on)
-        self.lc = lc
-        self.stop_flag = threading.Event()
-        self.thread = threading.Thread(target=self._run, daemon=True)
-        self.thread.start()
-
-    def _on(self, _c: str, data: bytes) -> None:
-        m = self.T.traffic_light_state_t.decode(data)
-        self.states.append((time.time(), m.light_id, m.state))
-
-    def _run(self) -> None:
-        while not self.stop_flag.is_set():
-            self.lc.handle_timeout(20)
-
-    def latest(self, light_id: int) -> int | None:
-        for _, i, s in reversed(self.states):
-            if i == light_id:
-                return s
-        return None
-
-    def first_after(self, light_id: int, state: int, t: float) -> float | None:
-        for tr, i, s in list(self.states):
-            if tr >= t and i == light_id and s == state:
-                return tr
-        return None
 
     def stop(self) -> None:
         self.stop_flag.set()

@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <sstream>
 
@@ -113,6 +115,17 @@ std::string source_problem(const std::string &source) {
   for (char ch : source)
     if (ch < 0x21 || ch > 0x7e) return "source id has a character that is not printable ASCII";
   return "";
+}
+
+std::optional<Signer> load_machine_signer(const char *program, const std::string &vehicle,
+                                          const std::string &key_file, const std::string &source) {
+  try {
+    return Signer(load_key(key_file.empty() ? default_key_path(vehicle) : key_file), vehicle,
+                  source, kAuthorityMachine);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "%s: --key-file: %s\n", program, e.what());
+    return std::nullopt;
+  }
 }
 
 Signer::Signer(const Key &key, std::string vehicle, std::string source, int8_t authority)

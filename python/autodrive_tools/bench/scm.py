@@ -38,48 +38,12 @@ from typing import Any
 from .. import lcmtypes
 from ..channels import channel
 from ..scm import testkit
+from ..scm.light_watch import LightWatch
 from . import Progress, build_dir, out_dir, print_figures
 
 URL = "udpm://239.255.76.67:7796?ttl=0"
 log = Progress("scm")
 OP = ("bench_op", "bench-operator-pass")
-
-
-class LightStates:
-    """TRAFFIC_LIGHT_STATE as received here: (wall time [s], light id, state)."""
-
-    def __init__(self, types: Any) -> None:
-        self.T = types
-        self.lc = lcmtypes.bus(URL)
-        self.states: list[tuple[float, int, int]] = []
-        self.lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), self._on)
-        self.stop_flag = threading.Event()
-        self.thread = threading.Thread(target=self._run, daemon=True)
-        self.thread.start()
-
-    def _on(self, _c: str, data: bytes) -> None:
-        m = self.T.traffic_light_state_t.decode(data)
-        self.states.append((time.time(), int(m.light_id), int(m.state)))
-
-    def _run(self) -> None:
-        while not self.stop_flag.is_set():
-            self.lc.handle_timeout(10)
-
-    def latest(self, light_id: int) -> int | None:
-        for _, i, s in reversed(self.states):
-            if i == light_id:
-                return s
-        return None
-
-    def first_after(self, light_id: int, state: int, t: float) -> float | None:
-        for tr, i, s in list(self.states):
-            if tr >= t and i == light_id and s == state:
-                return tr
-        return None
-
-    def stop(self) -> None:
-        self.stop_flag.set()
-        self.thread.join()
 
 
 def wait(pred: Any, timeout_s: float, what: str) -> None:
@@ -104,7 +68,7 @@ def click_latency(build: Path, clicks: int, shots: Path) -> dict[str, Any]:
             [str(build / "bin" / "autodrive-sim"), "--map", "tiny_town", "--rtf", "1",
              "--no-pty", "--no-lidar", "--quiet", "--run-dir", tmp, "--lcm-url", URL],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
-        watch = LightStates(T)
+        watch = LightWatch(lcmtypes.bus(URL), T, poll_ms=10)
         srv = testkit.Server(db, URL, str(build), "NIGEL1")
         driver = testkit.chromium()
         samples: list[float] = []

@@ -27,17 +27,25 @@ def declarations(header: Path = HEADER) -> str:
     return text[begin + len("/* CFFI-BEGIN */") : end]
 
 
-def library_path() -> Path:
-    """$AUTODRIVE_BUILD/lib, else build/<release|dev|asan>/lib of the tree."""
+def find_library(lib_name: str, target_hint: str) -> Path:
+    """lib_name in $AUTODRIVE_BUILD/lib, else in build/<release|dev|asan>/lib of the tree; the
+    error names every place looked in and what to build (target_hint)."""
     build = os.environ.get("AUTODRIVE_BUILD")
-    candidates = [Path(build) / "lib" / LIB_NAME] if build else []
-    candidates += [REPO_ROOT / "build" / p / "lib" / LIB_NAME for p in PRESETS]
+    candidates = [Path(build) / "lib" / lib_name] if build else []
+    candidates += [REPO_ROOT / "build" / p / "lib" / lib_name for p in PRESETS]
     for c in candidates:
         if c.is_file():
             return c
     raise FileNotFoundError(
-        f"{LIB_NAME} not found (looked in {', '.join(str(c) for c in candidates)}): build the "
-        "target autodrive_sim_core, e.g. cmake --build build/release --target autodrive_sim_core"
+        f"{lib_name} not found (looked in {', '.join(str(c) for c in candidates)}): build the "
+        f"target {target_hint}"
+    )
+
+
+def library_path() -> Path:
+    """The simulator core library (see find_library)."""
+    return find_library(
+        LIB_NAME, "autodrive_sim_core, e.g. cmake --build build/release --target autodrive_sim_core"
     )
 
 

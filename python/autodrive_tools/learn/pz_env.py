@@ -23,6 +23,14 @@ NEIGHBOUR_SCALE_M = 2.0  # other cars' relative positions are observed over this
 ROUTE_END_M = 0.1  # an open route is done this close to its end [m]
 
 ObsArray = npt.NDArray[np.float32]
+# ParallelEnv.step's result: observations, rewards, terminations, truncations, infos per agent
+StepResult = tuple[
+    dict[str, ObsArray],
+    dict[str, float],
+    dict[str, bool],
+    dict[str, bool],
+    dict[str, dict[str, Any]],
+]
 
 
 class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):  # type: ignore[misc]
@@ -125,15 +133,7 @@ class IntersectionEnv(ParallelEnv[str, ObsArray, ObsArray]):  # type: ignore[mis
         obs = {a: self._obs(self._car(a), poses) for a in self.agents}
         return obs, {a: {} for a in self.agents}
 
-    def step(
-        self, actions: dict[str, ObsArray]
-    ) -> tuple[
-        dict[str, ObsArray],
-        dict[str, float],
-        dict[str, bool],
-        dict[str, bool],
-        dict[str, dict[str, Any]],
-    ]:
+    def step(self, actions: dict[str, ObsArray]) -> StepResult:
         for a in self.agents:
             act = np.clip(np.asarray(actions.get(a, (0.0, 0.0)), dtype=np.float64), -1.0, 1.0)
             self.world.command(self._car(a), float(act[0]), float(act[1]))

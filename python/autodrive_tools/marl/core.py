@@ -4,7 +4,6 @@ runtime/jetson/marl_core/include/autodrive/marl_core.h, between its CFFI markers
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -17,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import vehicle
-from ..learn._lib import PRESETS, declarations
+from ..learn._lib import declarations, find_library
 from ..paths import REPO_ROOT
 
 HEADER = REPO_ROOT / "runtime" / "jetson" / "marl_core" / "include" / "autodrive" / "marl_core.h"
@@ -30,17 +29,8 @@ class CoreError(RuntimeError):
 
 
 def library_path() -> Path:
-    """$AUTODRIVE_BUILD/lib, else build/<release|dev|asan>/lib of the tree."""
-    build = os.environ.get("AUTODRIVE_BUILD")
-    candidates = [Path(build) / "lib" / LIB_NAME] if build else []
-    candidates += [REPO_ROOT / "build" / p / "lib" / LIB_NAME for p in PRESETS]
-    for c in candidates:
-        if c.is_file():
-            return c
-    raise FileNotFoundError(
-        f"{LIB_NAME} not found (looked in {', '.join(str(c) for c in candidates)}): build the "
-        "target autodrive_marl_core_shared"
-    )
+    """The MARL core library (see learn._lib.find_library)."""
+    return find_library(LIB_NAME, "autodrive_marl_core_shared")
 
 
 @lru_cache(maxsize=1)

@@ -26,6 +26,7 @@ from pettingzoo import ParallelEnv
 
 from .. import channels
 from ..learn import tasks
+from ..learn.pz_env import ObsArray, StepResult
 from ..learn.world import World
 from .core import OBS_DIM, Car, Core, top_speed_m_s
 
@@ -48,8 +49,6 @@ SHAPING_EPS_M = 0.001
 MAX_STEPS = 300
 STEER_RATE_PENALTY = 0.05  # continuous variant: per unit of |steering change| per step
 FOLLOW_GAIN = 2.5  # the lane follower: steering = gain x waypoint bearing [rad]
-
-ObsArray = npt.NDArray[np.float32]
 
 
 def route_name(approach: str, turn: str) -> str:
@@ -245,15 +244,7 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
         obs = {a: self._obs(i) for i, a in enumerate(self.possible_agents)}
         return obs, {a: {} for a in self.agents}
 
-    def step(
-        self, actions: dict[str, Any]
-    ) -> tuple[
-        dict[str, ObsArray],
-        dict[str, float],
-        dict[str, bool],
-        dict[str, bool],
-        dict[str, dict[str, Any]],
-    ]:
+    def step(self, actions: dict[str, Any]) -> StepResult:
         steer_before = np.array(
             [self.world.observe_raw(i).steering_rad for i in range(self.n_cars)]
         )

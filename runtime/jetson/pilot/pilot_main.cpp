@@ -293,16 +293,9 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "autodrive-pilot: driving needs --config\n");
     return 2;
   }
-  std::optional<autodrive::auth::Signer> signer;
-  try {
-    signer.emplace(
-        autodrive::auth::load_key(key_file.empty() ? autodrive::auth::default_key_path(cfg.vehicle)
-                                                   : key_file),
-        cfg.vehicle, "pilot", autodrive::auth::kAuthorityMachine);
-  } catch (const std::exception &e) {
-    std::fprintf(stderr, "autodrive-pilot: --key-file: %s\n", e.what());
-    return 2;
-  }
+  auto signer =
+      autodrive::auth::load_machine_signer("autodrive-pilot", cfg.vehicle, key_file, "pilot");
+  if (!signer) return 2;
   lcm::LCM lcm(cfg.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-pilot: cannot open LCM at '%s' (multicast route missing?)\n",

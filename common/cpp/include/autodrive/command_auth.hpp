@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,12 @@ class Signer {
   int8_t authority_;
   int64_t last_counter_ = 0;
 };
+
+// For a program's main: the signer with which `source` commands `vehicle` as a machine, its key
+// from key_file or, when that is "", from default_key_path(vehicle). On a bad key or source it
+// prints "<program>: --key-file: <why>" to stderr and returns nullopt (the caller exits 2).
+std::optional<Signer> load_machine_signer(const char *program, const std::string &vehicle,
+                                          const std::string &key_file, const std::string &source);
 
 enum class MacCheck { ok, unsigned_cmd, bad_mac };
 // Whether c carries a signature at all and whether it is valid for key (constant-time compare).

@@ -242,15 +242,9 @@ int main(int argc, char **argv) {
 
   std::optional<autodrive::auth::Signer> signer;
   if (!replay) {
-    try {
-      signer.emplace(autodrive::auth::load_key(key_file.empty()
-                                                   ? autodrive::auth::default_key_path(cfg.vehicle)
-                                                   : key_file),
-                     cfg.vehicle, "autonomy", autodrive::auth::kAuthorityMachine);
-    } catch (const std::exception &e) {
-      std::fprintf(stderr, "autodrive-autonomy: --key-file: %s\n", e.what());
-      return 2;
-    }
+    signer = autodrive::auth::load_machine_signer("autodrive-autonomy", cfg.vehicle, key_file,
+                                                  "autonomy");
+    if (!signer) return 2;
   }
   if (replay) {
     cfg.lcm_url = "file://" + std::filesystem::absolute(replay_in).string() + "?speed=0";

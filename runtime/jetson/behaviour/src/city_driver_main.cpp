@@ -200,16 +200,9 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "autodrive-city-driver: %s\n", e.what());
     return 2;
   }
-  std::optional<autodrive::auth::Signer> signer;
-  try {
-    signer.emplace(
-        autodrive::auth::load_key(o.key_file.empty() ? autodrive::auth::default_key_path(o.vehicle)
-                                                     : o.key_file),
-        o.vehicle, "city-driver", autodrive::auth::kAuthorityMachine);
-  } catch (const std::exception &e) {
-    std::fprintf(stderr, "autodrive-city-driver: --key-file: %s\n", e.what());
-    return 2;
-  }
+  auto signer = autodrive::auth::load_machine_signer("autodrive-city-driver", o.vehicle, o.key_file,
+                                                     "city-driver");
+  if (!signer) return 2;
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-city-driver: --lcm-url '%s' unusable\n", o.lcm_url.c_str());

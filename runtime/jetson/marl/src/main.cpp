@@ -404,16 +404,9 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "autodrive-marl: %s\n", e.what());
     return 2;
   }
-  std::optional<autodrive::auth::Signer> signer;
-  try {
-    signer.emplace(
-        autodrive::auth::load_key(o.key_file.empty() ? autodrive::auth::default_key_path(o.vehicle)
-                                                     : o.key_file),
-        o.vehicle, "marl", autodrive::auth::kAuthorityMachine);
-  } catch (const std::exception &e) {
-    std::fprintf(stderr, "autodrive-marl: --key-file: %s\n", e.what());
-    return 2;
-  }
+  auto signer =
+      autodrive::auth::load_machine_signer("autodrive-marl", o.vehicle, o.key_file, "marl");
+  if (!signer) return 2;
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-marl: cannot open LCM at '%s' (multicast route missing?)\n",
