@@ -23,7 +23,7 @@ import yaml
 
 from . import channels, command_auth, report
 from .inspect import export_mcap
-from .missions import MissionContext, loop, parking, smart_city
+from .missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, MissionContext, loop, parking, smart_city
 from .paths import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNTIME_HIL_CONFIG
 from .proc import ProcessGroup, wait_for_path
 
@@ -42,8 +42,6 @@ LOOP_SIM_MARGIN_S = 8.0
 PARKING_SIM_MARGIN_S = 30.0
 PARKING_LOCKSTEP_RTF_BOUND = 20.0  # the fastest a lockstep run is assumed to go
 LOOP_RTF = 2.0  # the loop driver commands at 50 Hz of wall time: keep the sim paced
-PTY_TIMEOUT_S = 30.0
-EXIT_INTERRUPTED = 130
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:

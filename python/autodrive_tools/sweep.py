@@ -33,6 +33,7 @@ from typing import Any
 from . import demo, plots, sweep_ray
 from .geometry import to_world
 from .mapfacts import parking_school
+from .missions import EXIT_INTERRUPTED
 from .paths import OUT_DIR, RELEASE_BUILD
 from .runfiles import read_columns
 
@@ -302,11 +303,11 @@ def run_job(spec: JobSpec) -> JobResult:
             try:
                 code = demo.run(demo.parse_args(demo_argv(spec, tmp)), console, timed_out)
             except KeyboardInterrupt:  # a cancelled Ray job
-                code = demo.EXIT_INTERRUPTED
+                code = EXIT_INTERRUPTED
             except Exception:  # a crashed run is a failed run; the sweep goes on
                 traceback.print_exc(file=console)
                 code = 1
-            if code == demo.EXIT_INTERRUPTED and timed_out():
+            if code == EXIT_INTERRUPTED and timed_out():
                 print(
                     f"[sweep] still running after {spec.run_timeout_s:.0f} s: stopped", file=console
                 )
@@ -552,7 +553,7 @@ def run_jobs(
         store_job(out, jobs[i], result)
         run = load_run(out, jobs[i])
         log(progress_line(finished, len(jobs), f"{jobs[i].name()} on {host}", run, wall_s))
-        if result["exit_code"] == demo.EXIT_INTERRUPTED:  # Ctrl-C during a serial run
+        if result["exit_code"] == EXIT_INTERRUPTED:  # Ctrl-C during a serial run
             raise KeyboardInterrupt
 
     for job in jobs:  # a failed run must not leave old figures behind

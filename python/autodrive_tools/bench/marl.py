@@ -44,7 +44,7 @@ def inference_p99_us(model: Path, repeats: int) -> float:
 
 
 def main(argv: list[str]) -> int:
-    from ..marl.evaluate import evaluate
+    from ..marl.evaluate import evaluate_logged
 
     if argv:
         print(__doc__)
@@ -66,15 +66,7 @@ def main(argv: list[str]) -> int:
         ("4cars_baseline", 4, "baseline", episodes),
         ("1car_shield", 1, "shield", episodes_1),
     ):
-        t0 = time.monotonic()
-        log(f"{name}: {n} episodes from seed {HELD_OUT_SEED}")
-        r = evaluate(model, n, cars, HELD_OUT_SEED, mode, workers)
-        log(
-            f"{name}: success {r['success_rate']:.3f}, collisions {r['collisions']}, off road "
-            f"{r['off_road']}, timeouts {r['timeouts']}, shield {r['shield_interventions']}, "
-            f"traverse {r['mean_traverse_s']:.2f} s ({time.monotonic() - t0:.0f} s)"
-        )
-        runs[name] = r
+        runs[name] = evaluate_logged(model, n, cars, HELD_OUT_SEED, mode, log, workers, name)
     p99 = inference_p99_us(model, int(os.environ.get("MARL_BENCH_REPEATS", "3")))
     s, b = runs["4cars_shield"], runs["4cars_baseline"]
     figures: dict[str, Any] = {

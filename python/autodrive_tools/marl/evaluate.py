@@ -126,13 +126,28 @@ def evaluate_all(
     """Every mode on the same seeds."""
     report: dict[str, Any] = {"model": str(model), "cars": cars, "episodes": episodes}
     for mode in modes:
-        t0 = time.monotonic()
-        log(f"{mode}: {episodes} episodes, {cars} car(s), seeds {seed}..{seed + episodes - 1}")
-        r = evaluate(model, episodes, cars, seed, mode, workers)
-        log(
-            f"{mode}: success {r['success_rate']:.3f}, collisions {r['collisions']}, shield "
-            f"{r['shield_interventions']}, traverse {r['mean_traverse_s']:.2f} s, steering rate "
-            f"rms {r['steering_rate_rms']:.3f} rad/s ({time.monotonic() - t0:.0f} s)"
-        )
-        report[mode] = r
+        report[mode] = evaluate_logged(model, episodes, cars, seed, mode, log, workers, mode)
     return report
+
+
+def evaluate_logged(
+    model: Path,
+    episodes: int,
+    cars: int,
+    seed: int,
+    mode: str,
+    log: Any,
+    workers: int = 1,
+    label: str = "",
+) -> dict[str, Any]:
+    """evaluate(), with a progress line before and the figures after, under label."""
+    t0 = time.monotonic()
+    log(f"{label}: {episodes} episodes, {cars} car(s), seeds {seed}..{seed + episodes - 1}")
+    r = evaluate(model, episodes, cars, seed, mode, workers)
+    log(
+        f"{label}: success {r['success_rate']:.3f}, collisions {r['collisions']}, off road "
+        f"{r['off_road']}, timeouts {r['timeouts']}, shield {r['shield_interventions']}, "
+        f"traverse {r['mean_traverse_s']:.2f} s, steering rate rms "
+        f"{r['steering_rate_rms']:.3f} rad/s ({time.monotonic() - t0:.0f} s)"
+    )
+    return r

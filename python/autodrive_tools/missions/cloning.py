@@ -27,9 +27,9 @@ from typing import Any, TextIO
 import yaml
 
 from .. import channels, command_auth, lcmtypes, maps, plots
-from ..paths import OUT_DIR, RELEASE_BUILD, REPO_ROOT, RUNTIME_HIL_CONFIG
+from ..paths import REPO_ROOT, RUNTIME_HIL_CONFIG
 from ..proc import ProcessGroup, wait_for_path
-from . import lane_watch
+from . import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
 
 MAP = "driving_school"
 ROUTES = {"normal": "loop_ccw", "night": "loop_ccw", "noise2x": "loop_ccw", "reverse": "loop_cw"}
@@ -48,8 +48,6 @@ WATCH_EVERY = 5  # referee every 5th ground truth (20 Hz of sim time)
 START_MOVE_M = 0.01  # elapsed time counts from when the car has moved this far
 TELEPORT_SETTLE_S = 0.3  # sim time after a reset during which no crossing is counted
 PROGRESS_S = 5.0
-PTY_TIMEOUT_S = 30.0
-EXIT_INTERRUPTED = 130
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -60,10 +58,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "autodrive-pilot (the ONNX model). Counts interventions (a wheel over the lane bound; "
         "the car is put back on the centre line) and writes OUT/report.json and laps.png.",
     )
-    p.add_argument("--mission", choices=("cloning",), default="cloning", help="this mission")
-    p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
-    p.add_argument("--out", default=str(OUT_DIR / "demo-cloning"), help="output folder")
-    p.add_argument("--seed", type=int, default=1, help="sensor and camera-noise seed")
+    add_run_options(p, "cloning", "sensor and camera-noise seed", 1800.0)
     p.add_argument("--laps", type=int, default=1, help="laps of the loop to drive (>= 1)")
     p.add_argument(
         "--condition",
@@ -74,8 +69,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "reverse (the loop the other way, loop_cw)",
     )
     p.add_argument("--model", default=str(DEFAULT_MODEL), help="NAME.onnx (NAME.json beside it)")
-    p.add_argument("--timeout", type=float, default=1800.0, help="give up after this many wall s")
-    p.add_argument("--headless", action="store_true", help="never open the simulator's window")
     p.add_argument(
         "--save-frames",
         type=int,
@@ -84,7 +77,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="also keep N front-camera JPEGs (every 3rd frame) in OUT/frames/ (tools/bench "
         "cloning times the model on them)",
     )
-    p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
     if args.laps < 1:
         p.error(f"--laps {args.laps}: at least 1")

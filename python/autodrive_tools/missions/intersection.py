@@ -32,17 +32,16 @@ import yaml
 from .. import channels, command_auth, lcmtypes
 from ..learn import tasks
 from ..marl import env as marl_env
-from ..paths import OUT_DIR, RELEASE_BUILD, REPO_ROOT, RUNTIME_HIL_CONFIG
+from ..paths import REPO_ROOT, RUNTIME_HIL_CONFIG
 from ..proc import ProcessGroup, wait_for_path
+from . import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options
 
 MAP = tasks.INTERSECTION_MAP
 MAP_JSON = tasks.MAPS_DIR / f"{MAP}.json"
 DEFAULT_POLICY = REPO_ROOT / "models" / "marl" / "intersection.onnx"
 CARS = 4
 EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
-PTY_TIMEOUT_S = 30.0
 PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
-EXIT_INTERRUPTED = 130
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -52,10 +51,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "autodrive-runtime processes on their ptys, four autodrive-marl processes, V2V over "
         "real LCM; N seeded episodes. Writes OUT/report.json and OUT/trajectories.png.",
     )
-    p.add_argument("--mission", choices=("intersection",), default="intersection")
-    p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
-    p.add_argument("--out", default=str(OUT_DIR / "demo-intersection"), help="output folder")
-    p.add_argument("--seed", type=int, default=1, help="seed of routes, start times and noise")
+    add_run_options(p, "intersection", "seed of routes, start times and noise", 3600.0)
     p.add_argument("--episodes", type=int, default=20, help="episodes to run (default 20)")
     p.add_argument(
         "--policy",
@@ -69,9 +65,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--no-shield", action="store_true", help="send commands unshielded")
     p.add_argument("--v2v-loss", type=float, default=0.0, help="V2V loss probability [0, 1]")
     p.add_argument("--v2v-delay-ms", type=float, default=0.0, help="V2V delay [ms]")
-    p.add_argument("--headless", action="store_true", help="never open the simulator's window")
-    p.add_argument("--timeout", type=float, default=3600.0, help="give up after this [s wall]")
-    p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
     if args.episodes < 1:
         p.error(f"--episodes {args.episodes}: at least 1")

@@ -30,6 +30,7 @@ from ..city.scoring import MapFacts, Scorer
 from ..maps.loader import MAPS_DIR
 from ..paths import OUT_DIR
 from ..proc import ProcessGroup, wait_for_path
+from . import EXIT_INTERRUPTED
 
 MAP = "tiny_town"
 # One looping route of the map per car: north through light 3 and the stop sign; south through
@@ -37,7 +38,6 @@ MAP = "tiny_town"
 ROUTES = ("city_east", "city_west", "loop_ccw")
 START_SPREAD_M = 1.0  # each car starts up to this far along its route from its start [m]
 PROGRESS_S = 10.0
-EXIT_INTERRUPTED = 130
 
 
 def start_poses(seed: int) -> list[tuple[float, float, float]]:
