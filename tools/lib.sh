@@ -1,6 +1,8 @@
 # Shared helpers for the tools/ entry points (sourced, not run).
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PY="$ROOT/.venv/bin/python"
+# ccache keys on paths relative to the checkout, so every clone on this machine shares one cache.
+export CCACHE_BASEDIR="$ROOT" CCACHE_NOHASHDIR=1
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*"; }
 die() { printf '[%s] ERROR: %s\n' "$(basename "$0")" "$*" >&2; exit 1; }
 # Configures (once) and builds a preset of the host build: dev, release or asan.
