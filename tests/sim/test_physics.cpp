@@ -172,6 +172,24 @@ TEST(Physics, SnowGivesLessGripThanAsphalt) {
   EXPECT_GT(snow, 1.5 * asphalt) << "asphalt " << asphalt << " m, snow " << snow << " m";
 }
 
+// A terrain patch's friction reaches the paper tyres although its geom is out of the physics
+// model: braking on asphalt under a snow patch is braking on snow.
+TEST(Physics, TerrainPatchGivesItsFrictionToTheTyres) {
+  std::string err;
+  const double snow = braking_distance(simtest::fixture("flat_snow.xml"), &err);
+  ASSERT_TRUE(isfinite(snow)) << err;
+  const double patch = braking_distance(simtest::fixture("asphalt_snow_patch.xml"), &err);
+  ASSERT_TRUE(isfinite(patch)) << err;
+  EXPECT_NEAR(patch, snow, 0.05 * snow) << "snow " << snow << " m, patch " << patch << " m";
+}
+
+TEST(Physics, TerrainListNamingNoGeomIsRefusedWithTheMapAndName) {
+  simtest::Sim s("constant:throttle=0", 1, 0, -1, simtest::fixture("bad_terrain_list.xml").c_str());
+  ASSERT_EQ(s.s, nullptr);
+  EXPECT_NE(s.err.find("bad_terrain_list.xml"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("terrain_ice"), std::string::npos) << s.err;
+}
+
 TEST(Physics, MujocoFrictionModelAlsoDrives) {
   std::string err;
   const double r = turn_radius(0.6, 0, &err);
@@ -199,9 +217,12 @@ namespace {
 TEST(Sensors, RoofTagAndMountsAreInTheModel) {
   simtest::Sim s(nullptr, 2);
   ASSERT_NE(s.s, nullptr) << s.err;
-  const mjModel *m = sim_model(s.s);
-  for (const char *name : {"nigel1/tag", "nigel2/tag"})
-    EXPECT_GE(mj_name2id(m, mjOBJ_GEOM, name), 0) << name;
+  const mjModel *m = sim_model(s.s), *seen = sim_render_model(s.s);
+  ASSERT_NE(seen, nullptr);
+  for (const char *name : {"nigel1/tag", "nigel2/tag"}) {
+    EXPECT_GE(mj_name2id(seen, mjOBJ_GEOM, name), 0) << name;  // the cameras see the tags
+    EXPECT_LT(mj_name2id(m, mjOBJ_GEOM, name), 0) << name;     // they never collide
+  }
   for (const char *name : {"nigel1/cam_front", "nigel1/cam_rear", "eye"})
     EXPECT_GE(mj_name2id(m, mjOBJ_CAMERA, name), 0) << name;
   const int lidar = mj_name2id(m, mjOBJ_SITE, "nigel1/lidar");
@@ -209,8 +230,8 @@ TEST(Sensors, RoofTagAndMountsAreInTheModel) {
   EXPECT_NEAR(m->site_pos[3 * lidar], AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 1e-9);
   EXPECT_NEAR(m->site_pos[3 * lidar + 2], AUTODRIVE_VEHICLE_LIDAR_POS_M_Z, 1e-9);
   // real tag36h11 textures, one per car
-  EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
-  EXPECT_GE(mj_name2id(m, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);
+  EXPECT_GE(mj_name2id(seen, mjOBJ_TEXTURE, "nigel1/tag_tex"), 0);
+  EXPECT_GE(mj_name2id(seen, mjOBJ_TEXTURE, "nigel2/tag_tex"), 0);
 }
 
 }  // namespace

@@ -8,7 +8,12 @@ overhead_ratio = bare / rtf_1 (goal <= 1.11) and rtf_N_over_bare = rtf_N / bare 
 cars >= 0.85; rtf_16 >= 3), each taken within one run, medians over the runs. The *_cpu
 variants divide by CPU time instead of wall time (the stepping thread's for the ratios: the
 LCM sender has a thread of its own); on a shared, loaded machine they show the cost without
-the waits.
+the waits. Since 2026-11-27 each lockstep run pairs every 1 s block of the sim's steps with a
+1 s block of bare mj_step right after it (bench_pairs.h: both halves see the same load), and
+bare_mj_step_rtf_N and the ratios come from those pairs (overhead_ratio_paired_N: the median of
+the per-pair time ratios).
+*_instructions: the same ratios in instructions per step, counted by valgrind's callgrind on a
+short run (2 s with 1 car, 0.5 s with 16; sim_instructions.py): the load-independent figure.
 rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JPEG-published
 at 30 Hz. turn_radius_error_pct: circle fitted to the ground truth at steering 0.6 vs
 L/tan(delta); *_mujoco_friction: the same with plain MuJoCo contact friction instead of the
@@ -32,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from .. import lcmtypes, vehicle
-from . import Progress, build_dir, last_json, print_figures
+from . import Progress, build_dir, last_json, print_figures, sim_instructions
 
 URL = "udpm://239.255.76.67:7731?ttl=0"  # sim's test/bench port range 7730-7759
 CAR_COUNTS_AND_DURATIONS_S = ((1, 20), (4, 10), (16, 4))
@@ -129,6 +134,10 @@ def speed(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
         # ratios within one run (the same load on the machine), then their median
         ratios = [r["bare_mj_step_rtf"] / r["rtf"] for r in runs]
         ratios_cpu = [r["bare_mj_step_rtf_cpu"] / r["rtf_step_thread_cpu"] for r in runs]
+        if "overhead_ratio_paired" in runs[0]:
+            res[f"overhead_ratio_paired_{cars}"] = round(
+                statistics.median([r["overhead_ratio_paired"] for r in runs]), 3
+            )
         if cars == 1:
             res["overhead_ratio"] = round(statistics.median(ratios), 3)
             res["overhead_ratio_cpu"] = round(statistics.median(ratios_cpu), 3)
@@ -144,6 +153,22 @@ def speed(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
         log(f"two cameras at 30 fps: rtf {rtfs}")
     except subprocess.CalledProcessError as e:
         log(f"cameras unavailable: {e.stderr.strip() if e.stderr else e}")
+
+
+def instructions(bench: SimBench, res: dict[str, Any]) -> None:
+    if not sim_instructions.available():
+        log("valgrind not installed: no instruction counts")
+        return
+    for cars, dur in ((1, 2.0), (16, 0.5)):
+        log(f"{cars} car(s): counting instructions per step under callgrind ({dur:g} s sim)")
+        args = ["--cars", str(cars), "--script", DRIVE_SCRIPT]
+        n = sim_instructions.measure(bench.sim, args, dur)
+        res[f"instructions_per_step_{cars}"] = round(n.sim_per_step)
+        res[f"bare_instructions_per_step_{cars}"] = round(n.bare_per_step)
+        if cars == 1:
+            res["overhead_ratio_instructions"] = round(n.overhead_ratio, 4)
+        else:
+            res[f"rtf_{cars}_over_bare_instructions"] = round(1.0 / n.overhead_ratio, 4)
 
 
 def fidelity(bench: SimBench, res: dict[str, Any]) -> None:
@@ -179,7 +204,7 @@ def sensors(build: Path, res: dict[str, Any]) -> None:
 def goals_met(res: dict[str, Any]) -> dict[str, bool]:
     """The issue's speed goals, by wall time and by CPU time (a loaded machine)."""
     out: dict[str, bool] = {}
-    for suffix in ("", "_cpu"):
+    for suffix in ("", "_cpu", "_instructions"):
         if "overhead_ratio" + suffix in res:
             out["overhead_ratio" + suffix] = res["overhead_ratio" + suffix] <= 1.11
         if "rtf_16_over_bare" + suffix in res:
@@ -200,6 +225,7 @@ def main(argv: list[str]) -> int:
     res: dict[str, Any] = {}
     url = bench.pick_url()
     speed(bench, url, repeats, res)
+    instructions(bench, res)
     fidelity(bench, res)
     sensors(build, res)
     res["lcm_url"] = url

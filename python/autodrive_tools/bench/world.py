@@ -17,6 +17,8 @@ the _step_thread_cpu ones by the stepping thread's (without LCM's receive thread
 map with lights reads every message on the bus, the sim's own included, to find the commands).
 Routes that do not reach their end (routes_blocked: stuck against something in their lane) are
 listed and left out of the cross-track figures.
+rtf_1_tiny_town_ratio_instructions: the same ratio in instructions per step (callgrind, 2 s of each
+map, the same script; sim_instructions.py): the load-independent figure.
 light_cmd_to_state_ms_p50: real time on Intersection School over real UDP LCM: wall time from
 publishing a TRAFFIC_LIGHT_COMMAND to receiving the light's TRAFFIC_LIGHT_STATE with the
 commanded state, median (and p90, max) of 40 commands.
@@ -40,7 +42,7 @@ from typing import Any
 from .. import lcmtypes
 from ..channels import channel
 from ..paths import REPO_ROOT
-from . import Progress, build_dir, last_json, print_figures
+from . import Progress, build_dir, last_json, print_figures, sim_instructions
 
 URL = "udpm://239.255.76.67:7758?ttl=0"  # sim's test/bench port range 7730-7759
 MAPS = ("parking_school", "driving_school", "intersection_school", "tiny_town")
@@ -160,6 +162,23 @@ class WorldBench:
             figures[f"rtf_1_tiny_town_ratio{suffix}"] = round(statistics.median(ratios), 3)
         return figures
 
+    def rtf_instructions(self) -> dict[str, Any]:
+        if not sim_instructions.available():
+            log("valgrind not installed: no instruction counts")
+            return {}
+        per_step = {}
+        for m in ("parking_school", "tiny_town"):
+            log(f"{m}: counting instructions per step under callgrind")
+            args = ["--map", m, "--script", RTF_SCRIPT]
+            per_step[m] = sim_instructions.measure(self.sim, args, 2.0).sim_per_step
+        return {
+            "instructions_per_step_parking_school": round(per_step["parking_school"]),
+            "instructions_per_step_tiny_town": round(per_step["tiny_town"]),
+            "rtf_1_tiny_town_ratio_instructions": round(
+                per_step["parking_school"] / per_step["tiny_town"], 4
+            ),
+        }
+
     def light_latency(self) -> dict[str, Any]:
         lc = lcmtypes.bus(URL)
         got: list[tuple[float, int, int]] = []  # wall time, light, state
@@ -245,6 +264,7 @@ def main(argv: list[str] | None = None) -> int:
     figures.update(routes)
     if not args.skip_rtf:
         figures.update(bench.rtf(int(os.environ.get("WORLD_BENCH_REPEATS", "5"))))
+        figures.update(bench.rtf_instructions())
     figures.update(bench.light_latency())
     for name, r in per_route.items():
         print(

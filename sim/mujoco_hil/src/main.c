@@ -18,6 +18,7 @@
 #include "teleport_lcm.h"
 #include "tl_lcm.h"
 
+#include "bench_pairs.h"
 #include "sim_camera.h"
 #include "sim_lidar_lcm.h"
 #include "sim_render.h"
@@ -739,8 +740,15 @@ int main(int argc, char **argv) {
   int rc = 0;
   long step = 0, slips = 0;
   main_sync_t sync = {0};
+  /* --bench in free lockstep: sim blocks paired with bare mj_step blocks (bench_pairs.h) */
+  bench_pairs_t pairs = {0};
+  const int paired = bench && lockstep && !client_sync && !frame_sync && !viewer.v;
+  if (paired && bench_pairs_start(&pairs, s) != 0) {
+    fprintf(stderr, "autodrive-sim: --bench: out of memory for the bare mj_step blocks\n");
+    rc = 1;
+  }
   if (frame_sync) lcmpub_clock(pubq, 0, 0.0, 0); /* the client's first tick */
-  while (!main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
+  while (rc == 0 && !main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
     if (frame_sync) {
       if (sim_time_us(s) % MAIN_FRAME_TICK_US == 0) {
         lcmq_flush(pubq); /* this tick's SIM_CLOCK: the client answers it with a frame */
@@ -789,6 +797,11 @@ int main(int argc, char **argv) {
       lcmpub_clock(pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
     }
     if (viewer.v && main_view_frame(&viewer, s, &t0) != 0) break;
+    if (paired) { /* the bare block is not part of the run: its time moves the start on */
+      const double bare_wall_s = bench_pairs_after_step(&pairs, step);
+      t0 += bare_wall_s;
+      next_progress += bare_wall_s;
+    }
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
     if (wall >= next_flush) { /* queued LCM messages leave at least every millisecond */
@@ -820,26 +833,32 @@ int main(int argc, char **argv) {
     }
   }
   /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
-  const double step_cpu_s = main_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0;
+  const double step_cpu_s =
+      main_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0 - bench_pairs_bare_cpu_s(&pairs);
   const uint64_t lcm_failures = lcmq_failures(pubq);
   lcmq_destroy(pubq); /* sends what is still queued: part of the run's time */
-  const double wall_s = main_wall_s() - t0, cpu_s = main_cpu_s() - cpu0;
+  const double wall_s = main_wall_s() - t0,
+               cpu_s = main_cpu_s() - cpu0 - bench_pairs_bare_cpu_s(&pairs);
   if (lcm_failures)
     fprintf(stderr, "autodrive-sim: LCM refused %llu ground-truth/clock message(s) on '%s'\n",
             (unsigned long long)lcm_failures, url);
   const double sim_s = sim_time_us(s) * 1e-6;
   if (bench) {
-    const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
-    double bare_cpu_s = 0.0;
-    const double bare_s = sim_bare_mj_step_s(s, bare_steps, &bare_cpu_s);
     printf(
         "{\"cars\": %d, \"sim_s\": %.3f, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"rtf\": %.3f, "
-        "\"rtf_cpu\": %.3f, \"rtf_step_thread_cpu\": %.3f, \"bare_mj_step_rtf\": %.3f, "
-        "\"bare_mj_step_rtf_cpu\": %.3f",
+        "\"rtf_cpu\": %.3f, \"rtf_step_thread_cpu\": %.3f, \"steps\": %ld",
         sim_cars(s), sim_s, wall_s, cpu_s, wall_s > 0 ? sim_s / wall_s : 0.0,
-        cpu_s > 0 ? sim_s / cpu_s : 0.0, step_cpu_s > 0 ? sim_s / step_cpu_s : 0.0,
-        bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
-        bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0);
+        cpu_s > 0 ? sim_s / cpu_s : 0.0, step_cpu_s > 0 ? sim_s / step_cpu_s : 0.0, step);
+    if (pairs.n > 0) {
+      bench_pairs_print_json(&pairs, stdout);
+    } else { /* not paired (a short or paced run): one bare loop after the run */
+      const int bare_steps = (int)fmin(sim_s * 1000.0, 20000.0);
+      double bare_cpu_s = 0.0;
+      const double bare_s = sim_bare_mj_step_s(s, bare_steps, &bare_cpu_s);
+      printf(", \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f, \"bare_steps\": %d",
+             bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
+             bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0, bare_steps);
+    }
     if (route) {
       double rms, max;
       const long n = route_driver_stats(route, &rms, &max);
@@ -854,6 +873,7 @@ int main(int argc, char **argv) {
     printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld}\n",
            sim_traffic_lights(s)->n, commands, refused);
   }
+  bench_pairs_free(&pairs);
   tl_lcm_destroy(lights);
   teleport_lcm_destroy(teleport);
   main_view_close(&viewer);

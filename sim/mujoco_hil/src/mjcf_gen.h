@@ -30,16 +30,18 @@ typedef struct mg_options {
   int late_boxes;                  /* --late-box obstacles and the map's late_obstacles */
   const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
   const char *texture_dir;         /* NULL: the map's folder; else where its textures are */
-  int physics_only;                /* 1: without the cars' visual-only lamps and wheel discs */
+  int physics_only; /* 1: without the cars' visual-only lamps, wheel discs and roof tags */
 } mg_options_t;
 
 #define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */
 
 /* Copies the map MJCF at map_path to out_path without its visual-only geoms (one-line <geom>
- * elements with contype="0" and conaffinity="0"): the physics model's map, as such geoms cost
- * MuJoCo 2.2 narrow-phase time every step although they never collide. Returns the number of
- * geoms left out, or -1 with a message. */
-int mg_write_physics_map(const char *map_path, const char *out_path, char *err, size_t err_sz);
+ * elements with contype="0" and conaffinity="0") and without the one-line geoms named in
+ * drop_names (space-separated, or NULL): the physics model's map, as every world geom costs
+ * MuJoCo 2.2 narrow-phase time each step against every car geom. Returns the number of geoms
+ * left out, or -1 with a message. */
+int mg_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
+                         char *err, size_t err_sz);
 
 /* Roof tag id of car i (1-based): tag36h11 id i. */
 int mg_tag_id(int car);

@@ -21,6 +21,7 @@
 #include "rng.h"
 #include "route_driver.h"
 #include "script.h"
+#include "terrain.h"
 #include "traffic_lights.h"
 #include "tyre.h"
 #include "uart.h"
@@ -123,6 +124,7 @@ struct sim {
   tyre_curve_t lon, lat;
   motor_model_t motor;
   int tyre_paper;
+  terrain_t terrain; /* the map's terrain patches; out of the physics model with tyre_paper */
   int host_io_period_steps; /* >= 1: ptys serviced every this many steps */
   int *geom_tyre;           /* per geom: car * W_N + wheel, or -1 */
   int ntag_files;           /* roof tag PNGs that may exist in scene_dir */
@@ -451,15 +453,16 @@ static int sim_read_map_late_boxes(sim_t *s, const mjModel *mm, const char *path
   return 0;
 }
 
-/* The map alone must compile: its errors then name the map file, not the generated scene. */
-/* s: where the map's late obstacles go (NULL: leave them out). */
-static int sim_check_map(sim_t *s, const char *path, char *err, size_t err_sz) {
+/* The map alone must compile: its errors then name the map file, not the generated scene. It
+ * gives the terrain patches and, with late_boxes, the map's late obstacles. */
+static int sim_check_map(sim_t *s, const char *path, int late_boxes, char *err, size_t err_sz) {
   if (access(path, R_OK) != 0)
     return sim_fail(err, err_sz, "map file '%s': %s", path, strerror(errno));
   char merr[1000] = "";
   mjModel *mm = mj_loadXML(path, NULL, merr, sizeof merr);
   if (!mm) return sim_fail(err, err_sz, "bad map file '%s': %s", path, merr);
-  const int rc = s ? sim_read_map_late_boxes(s, mm, path, err, err_sz) : 0;
+  int rc = terrain_load(&s->terrain, mm, path, err, err_sz);
+  if (rc == 0 && late_boxes) rc = sim_read_map_late_boxes(s, mm, path, err, err_sz);
   mj_deleteModel(mm);
   return rc;
 }
@@ -496,7 +499,7 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   char map_abs[4096];
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
-  if (sim_check_map(cfg->no_map_late_boxes ? NULL : s, map_abs, err, err_sz) != 0) return -1;
+  if (sim_check_map(s, map_abs, !cfg->no_map_late_boxes, err, err_sz) != 0) return -1;
   mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;
@@ -512,7 +515,10 @@ static int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   snprintf(phys_map, sizeof phys_map, "%s/map_physics.xml", s->scene_dir);
   snprintf(phys_scene, sizeof phys_scene, "%s/scene_physics.xml", s->scene_dir);
   int dropped = 0;
-  if (rc == 0 && (dropped = mg_write_physics_map(map_abs, phys_map, err, err_sz)) < 0) rc = -1;
+  /* the paper tyres read the terrain's friction from s->terrain: its geoms need not collide */
+  const char *drop = s->tyre_paper ? s->terrain.names : NULL;
+  if (rc == 0 && (dropped = mg_write_physics_map(map_abs, phys_map, drop, err, err_sz)) < 0)
+    rc = -1;
   if (rc == 0 && dropped > 0) {
     mg_options_t po = o;
     po.map_path = phys_map;
@@ -893,16 +899,17 @@ static void sim_actuate(sim_t *s, sim_car_t *c) {
  * fifth of the run. Needs the kinematics of mj_step1. */
 static void sim_apply_point_force(const mjModel *m, mjData *d, int b, const mjtNum p[3],
                                   const mjtNum f[3]) {
-  mjtNum offset[3];
-  mju_sub3(offset, p, d->subtree_com + 3 * m->body_rootid[b]);
+  const mjtNum *com = d->subtree_com + 3 * m->body_rootid[b];
+  const mjtNum r[3] = {p[0] - com[0], p[1] - com[1], p[2] - com[2]};
+  /* f . (v + w x r) = f . v + w . (r x f): one torque for every dof of the chain */
+  const mjtNum tau[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2],
+                         r[0] * f[1] - r[1] * f[0]};
   while (b && !m->body_dofnum[b]) b = m->body_parentid[b];
   if (!b) return;
   for (int i = m->body_dofadr[b] + m->body_dofnum[b] - 1; i >= 0; i = m->dof_parentid[i]) {
     const mjtNum *cdof = d->cdof + 6 * i; /* [angular, linear] motion of dof i */
-    mjtNum cross[3], jacp[3];
-    mju_cross(cross, cdof, offset);
-    mju_add3(jacp, cdof + 3, cross);
-    d->qfrc_applied[i] += mju_dot3(jacp, f);
+    d->qfrc_applied[i] += cdof[0] * tau[0] + cdof[1] * tau[1] + cdof[2] * tau[2] + cdof[3] * f[0] +
+                          cdof[4] * f[1] + cdof[5] * f[2];
   }
 }
 
@@ -977,6 +984,8 @@ static void sim_record_contacts(sim_t *s) {
       if (fn > best[t]) { /* the most loaded contact gives surface, point and normal */
         best[t] = fn;
         c->mu[w] = m->geom_friction[3 * other];
+        if (s->tyre_paper && con->pos[2] < SIM_GROUND_CLEARANCE_M) /* on the floor */
+          c->mu[w] = terrain_mu(&s->terrain, con->pos[0], con->pos[1], c->mu[w]);
         mju_copy3(c->contact_pos[w], con->pos);
         /* frame[0..2] points from geom1 to geom2: make it point from the ground to the tyre */
         for (int q = 0; q < 3; q++) c->normal[w][q] = side ? con->frame[q] : -con->frame[q];
@@ -1143,15 +1152,42 @@ static double sim_clock_s(clockid_t id) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s) {
-  mjData *d = mj_makeData(s->m);
-  if (!d) return -1.0;
-  mju_copy(d->qpos, s->d->qpos, s->m->nq);
+struct sim_bare {
+  const mjModel *m;
+  mjData *d;
+};
+
+sim_bare_t *sim_bare_create(const sim_t *s) {
+  sim_bare_t *b = calloc(1, sizeof *b);
+  if (!b) return NULL;
+  b->m = s->m;
+  b->d = mj_makeData(s->m);
+  if (!b->d) {
+    free(b);
+    return NULL;
+  }
+  mju_copy(b->d->qpos, s->d->qpos, s->m->nq);
+  return b;
+}
+
+double sim_bare_run(sim_bare_t *b, int steps, double *cpu_s) {
   const double w0 = sim_clock_s(CLOCK_MONOTONIC), c0 = sim_clock_s(CLOCK_THREAD_CPUTIME_ID);
-  for (int k = 0; k < steps; k++) mj_step(s->m, d);
+  for (int k = 0; k < steps; k++) mj_step(b->m, b->d);
   if (cpu_s) *cpu_s = sim_clock_s(CLOCK_THREAD_CPUTIME_ID) - c0;
-  const double wall = sim_clock_s(CLOCK_MONOTONIC) - w0;
-  mj_deleteData(d);
+  return sim_clock_s(CLOCK_MONOTONIC) - w0;
+}
+
+void sim_bare_destroy(sim_bare_t *b) {
+  if (!b) return;
+  mj_deleteData(b->d);
+  free(b);
+}
+
+double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s) {
+  sim_bare_t *b = sim_bare_create(s);
+  if (!b) return -1.0;
+  const double wall = sim_bare_run(b, steps, cpu_s);
+  sim_bare_destroy(b);
   return wall;
 }
 

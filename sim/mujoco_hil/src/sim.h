@@ -159,8 +159,17 @@ struct route_driver;
 const struct route_driver *sim_route(const sim_t *s);
 
 /* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
- * (and its CPU time in *cpu_s if non-NULL); the benchmark's measure of MuJoCo alone. */
+ * (*cpu_s, if given: the thread's CPU time [s]). */
 double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s);
+
+/* A bare mj_step loop on its own mjData of the same model (the cars at their start poses),
+ * stepped in blocks between blocks of the sim's own steps: tools/bench sim pairs each sim
+ * block with the bare block after it, so both see the same load on a shared machine. */
+typedef struct sim_bare sim_bare_t;
+sim_bare_t *sim_bare_create(const sim_t *s);
+/* Steps it steps [1 ms] on; returns the wall time [s] and, in *cpu_s, the thread's CPU [s]. */
+double sim_bare_run(sim_bare_t *b, int steps, double *cpu_s);
+void sim_bare_destroy(sim_bare_t *b);
 
 #ifdef __cplusplus
 }
