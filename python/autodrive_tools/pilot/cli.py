@@ -4,6 +4,7 @@ Run `tools/pilot COMMAND --help` for each command's options."""
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import os
 import sys
 from pathlib import Path
@@ -65,6 +66,11 @@ def main(argv: list[str] | None = None) -> int:
         "--samples-per-epoch", type=int, default=0, help="drawn per epoch (0: training frames)"
     )
     t.add_argument("--stride", type=int, default=1, help="use every N-th frame")
+    t.add_argument(
+        "--balance-max-ratio", type=float, default=None,
+        help="balancing: a frame is drawn at most this many times as often as one of the "
+        "commonest steering (default: the shipped recipe's)",
+    )  # fmt: skip
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -118,6 +124,8 @@ def _run(args: argparse.Namespace) -> int:
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
         )  # fmt: skip
+        if args.balance_max_ratio is not None:
+            cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
         train(args.dataset, args.out, cfg)
         return 0
     if args.cmd == "analyse":

@@ -40,9 +40,10 @@ def meta_path(log: Path) -> Path:
     return log.with_name(log.name + META_SUFFIX)
 
 
-def default_url() -> str:
-    """A multicast port of our own, so two recordings on one machine do not mix."""
-    return f"udpm://239.255.76.67:{7800 + os.getpid() % 150}?ttl=0"
+def default_url(k: int = 0) -> str:
+    """A multicast port of our own (k: the k-th of this process's recordings, 0 or 1), so two
+    recordings on one machine do not mix."""
+    return f"udpm://239.255.76.67:{7800 + 2 * (os.getpid() % 150) + k}?ttl=0"
 
 
 def sim_binary(build: Path) -> Path:
