@@ -43,6 +43,10 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("--camera-fps", type=float, default=15.0, help="[Hz] of sim time")
     e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
     e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
+    e.add_argument(
+        "--duration", type=float, default=0.0,
+        help="[s] of sim time: stop there (0: when the laps are done); the run is the same up to it",
+    )  # fmt: skip
     e.add_argument("--lcm-url", default="", help="default: a port of this process's own")
 
     r = sub.add_parser("record", help="extract a dataset from LCM log(s)")
@@ -106,7 +110,7 @@ def _run(args: argparse.Namespace) -> int:
         run = ExpertRun(
             map=args.map, route=args.route, laps=args.laps, seed=args.seed, speed=args.speed,
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
-            light_level=args.light_level,
+            light_level=args.light_level, duration_s=args.duration,
         )  # fmt: skip
         wall = record_expert(run, args.out, _build(), args.lcm_url)
         print(f"pilot expert: {args.out} in {wall:.0f} s wall")

@@ -27,12 +27,11 @@ def log(msg: str) -> None:
 
 # The recipe of the shipped model. The expert's camera renders at 7.5 Hz of sim time (every
 # frame is trained on: neighbours 3 cm apart at the expert's speed are near duplicates, and
-# rendering is most of the recording's cost); 4 epochs of 2560 draws, balanced with a cap of
-# BALANCE_MAX_RATIO (augment.balance_weights).
+# rendering is most of the recording's cost); 4 epochs of 2560 draws, balanced with train's
+# default cap (augment.DEFAULT_MAX_RATIO).
 CAMERA_FPS = 7.5
 STRIDE = 1
 SAMPLES_PER_EPOCH = 2560
-BALANCE_MAX_RATIO = 20.0
 
 
 def expert_runs(laps: int, seed: int) -> list[ExpertRun]:
@@ -87,7 +86,6 @@ def make_model(
             name=name,
             stride=STRIDE,
             samples_per_epoch=SAMPLES_PER_EPOCH,
-            balance_max_ratio=BALANCE_MAX_RATIO,
         ),
     )
     times["train_s"] = time.monotonic() - t2
