@@ -29,6 +29,7 @@ import yaml
 
 from .. import channels, command_auth, lcmtypes, maps, plots
 from ..paths import REPO_ROOT, RUNTIME_HIL_CONFIG
+from ..pilot.expert import ExpertRun
 from ..proc import ProcessGroup, wait_for_path
 from . import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
 
@@ -43,7 +44,7 @@ NIGHT_LIGHT_LEVEL = 0.25  # the scene's light level at "night" (1 = day)
 # with when its sidecar's "trained" section does not say (camera_noise, camera_fps: tools/pilot
 # expert's defaults); noise2x doubles the noise.
 DEFAULT_TRAINED_NOISE = 2.0
-DEFAULT_TRAINED_FPS = 15.0
+DEFAULT_TRAINED_FPS = ExpertRun.camera_fps
 START_ALONG_M = 0.6  # the car starts this far along the route (the map's loop_east spawn)
 WATCH_EVERY = 5  # referee every 5th ground truth (20 Hz of sim time)
 START_MOVE_M = 0.01  # elapsed time counts from when the car has moved this far

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from ..paths import RELEASE_BUILD
+from .expert import ExpertRun
 
 DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front camera.
   expert      drive N laps with the simulator's expert (pure pursuit + perturbations), record an LCM log
@@ -40,7 +41,9 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
     e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
     e.add_argument("--perturb", type=float, default=0.35, help="perturbation amplitude (0..1)")
-    e.add_argument("--camera-fps", type=float, default=15.0, help="[Hz] of sim time")
+    e.add_argument(
+        "--camera-fps", type=float, default=ExpertRun.camera_fps, help="[Hz] of sim time"
+    )
     e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
     e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
     e.add_argument(
@@ -105,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     if args.cmd == "expert":
-        from .expert import ExpertRun, record_expert
+        from .expert import record_expert
 
         run = ExpertRun(
             map=args.map, route=args.route, laps=args.laps, seed=args.seed, speed=args.speed,
