@@ -276,6 +276,39 @@ def eye_bench(path: Path, truth: XY, eye: XY, peer: XY) -> None:
     _save(fig, path, dpi=DPI)
 
 
+def cloning_trace(
+    path: Path,
+    title: str,
+    t_s: Sequence[float],
+    steering: Sequence[float],
+    offset_m: Sequence[float],
+    half_width_m: float,
+    wheel_margin_m: float,
+    interventions_s: Sequence[float],
+) -> None:
+    """The cloning evaluation over time: the network's steering as the Nano took it, base_link's
+    offset from the lane centre line (+ left) and the offsets at which a wheel's outer edge
+    reaches the lane bound; interventions as red lines. Whether the car turns in early (cuts a
+    curve: offset towards the inside) or late (runs wide) reads from it."""
+    fig, (a0, a1) = plt.subplots(2, 1, figsize=(11, 5.5), sharex=True)
+    a0.plot(t_s, steering, lw=0.8, color="tab:orange")
+    a0.set_ylabel("steering (normalised, + left)")
+    a1.plot(t_s, offset_m, lw=0.8, color="tab:blue", label="base_link offset")
+    for sign in (1.0, -1.0):
+        a1.axhline(sign * (half_width_m - wheel_margin_m), color="0.5", ls="--", lw=0.8)
+    a1.set_ylabel("offset from the centre line [m] (+ left)")
+    a1.set_xlabel("elapsed sim time [s]")
+    for ax in (a0, a1):
+        for t in interventions_s:
+            ax.axvline(t, color="tab:red", lw=1.0)
+        ax.grid(alpha=0.3)
+    a1.legend(
+        ["base_link offset", "a wheel's edge on the lane bound"], fontsize=8, loc="lower left"
+    )
+    a0.set_title(title, fontsize=9)
+    _save(fig, path, dpi=DPI, bbox_inches="tight")
+
+
 def cloning_laps(
     path: Path, title: str, centre: XY, bounds: Sequence[XY], driven: XY, interventions: XY
 ) -> None:

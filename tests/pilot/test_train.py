@@ -19,7 +19,7 @@ import torch
 sys.path.insert(0, str(Path(__file__).parent))
 import gen_log  # noqa: E402
 
-from autodrive_tools.pilot import model  # noqa: E402
+from autodrive_tools.pilot import augment, model  # noqa: E402
 from autodrive_tools.pilot.analyse import analyse  # noqa: E402
 from autodrive_tools.pilot.dataset import record  # noqa: E402
 from autodrive_tools.pilot.spec import preprocess, read_sidecar, sha256_file  # noqa: E402
@@ -28,7 +28,22 @@ from autodrive_tools.pilot.train import TrainConfig, train  # noqa: E402
 BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 
 
+def check_balance() -> None:
+    """A rare steering is drawn at most max_ratio times as often as a common one; 1: uniform."""
+    steer = np.array([0.0] * 90 + [0.4] * 10)
+    for ratio, want in ((20.0, 9.0), (3.0, 3.0), (1.0, 1.0)):
+        w = augment.balance_weights(steer, ratio)
+        assert abs(w.sum() - 1.0) < 1e-9 and abs(w[-1] / w[0] - want) < 1e-9, (ratio, w[-1] / w[0])
+    try:
+        augment.balance_weights(steer, 0.5)
+    except ValueError as e:
+        assert "0.5" in str(e)
+    else:
+        raise AssertionError("a ratio below 1 was taken")
+
+
 def main() -> None:
+    check_balance()
     with tempfile.TemporaryDirectory(prefix="pilot-train-") as tmp:
         d = Path(tmp)
         n = gen_log.write(d / "tiny.lcmlog", BUILD, laps=2, frames_per_lap=60)

@@ -4,7 +4,8 @@ obeys SIM_TELEPORT (--allow-teleport), the unchanged autodrive-runtime runs its 
 estimator on the sim's Nano pty, autodrive-pilot runs the model and commands the car. This
 module referees from ground truth and the map's lane data (lane_watch): each time a wheel
 crosses the lane bound it counts an intervention and puts the car back on the centre line.
-autonomy = 1 - interventions x 6 s / elapsed s (PilotNet). Writes OUT/report.json and laps.png.
+autonomy = 1 - interventions x 6 s / elapsed s (PilotNet). Writes OUT/report.json, laps.png (the
+driven path) and trace.png (steering and offset over time, interventions marked).
 
 Unseen conditions (--condition): night (--light-level), noise2x (twice the camera noise the
 model was trained with), reverse (the loop driven the other way, loop_cw)."""
@@ -28,6 +29,7 @@ import yaml
 
 from .. import channels, command_auth, lcmtypes, maps, plots
 from ..paths import REPO_ROOT, RUNTIME_HIL_CONFIG
+from ..pilot.expert import ExpertRun
 from ..proc import ProcessGroup, wait_for_path
 from . import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
 
@@ -42,7 +44,7 @@ NIGHT_LIGHT_LEVEL = 0.25  # the scene's light level at "night" (1 = day)
 # with when its sidecar's "trained" section does not say (camera_noise, camera_fps: tools/pilot
 # expert's defaults); noise2x doubles the noise.
 DEFAULT_TRAINED_NOISE = 2.0
-DEFAULT_TRAINED_FPS = 15.0
+DEFAULT_TRAINED_FPS = ExpertRun.camera_fps
 START_ALONG_M = 0.6  # the car starts this far along the route (the map's loop_east spawn)
 WATCH_EVERY = 5  # referee every 5th ground truth (20 Hz of sim time)
 START_MOVE_M = 0.01  # elapsed time counts from when the car has moved this far
@@ -161,6 +163,7 @@ class Referee:
         self.settle_until_us = 0
         self.interventions: list[tuple[float, float, float]] = []  # t [s], x, y
         self.path: list[tuple[float, float]] = []
+        self.trace: list[tuple[float, float, float]] = []  # elapsed [s], steering, offset [m]
         lc.subscribe(channels.channel("GROUND_TRUTH", self.veh), self.on_truth)
         self.frames_seen = 0
         if args.save_frames > 0:
@@ -192,8 +195,9 @@ class Referee:
             if math.dist((x, y), self.start_xy) < START_MOVE_M:
                 return
             self.t0_us = m.utime
-        self.watch.update((x, y, yaw))
+        offset = self.watch.update((x, y, yaw))
         self.path.append((x, y))
+        self.trace.append((self.elapsed_s(), float(m.command_steering), offset))
         if m.utime < self.settle_until_us or not self.watch.wheels_out((x, y, yaw)):
             return
         _, _, back = self.watch.locate(x, y)
@@ -225,6 +229,12 @@ class Referee:
             "distance_m": round(self.watch.progress_m, 3),
             "intervention_times_s": [round(t, 2) for t, _, _ in self.interventions],
         }
+
+    def plot_trace(self, path: Path, title: str) -> None:
+        t, steering, offset = zip(*self.trace)
+        wheel_margin = max(abs(p[1]) for p in self.watch.wheel_points_m)
+        plots.cloning_trace(path, title, t, steering, offset, self.watch.route.half_width_m,
+                            wheel_margin, [i[0] for i in self.interventions])  # fmt: skip
 
     def plot(self, path: Path, title: str) -> None:
         route = self.watch.route
@@ -345,13 +355,15 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         rep["error"] = error
     rep["ok"] = not error and not interrupted and rep["laps"] >= args.laps
     if referee.path:
-        referee.plot(out / "laps.png", f"cloning, {args.condition}: {rep['laps']:.2f} laps, "
-                     f"{rep['interventions']} interventions, autonomy {rep['autonomy_pct']} %, "
-                     f"cross-track rms {rep['cross_track_rms_m']} m")  # fmt: skip
+        title = (f"cloning, {args.condition}: {rep['laps']:.2f} laps, {rep['interventions']} "
+                 f"interventions, autonomy {rep['autonomy_pct']} %, cross-track rms "
+                 f"{rep['cross_track_rms_m']} m")  # fmt: skip
+        referee.plot(out / "laps.png", title)
+        referee.plot_trace(out / "trace.png", title)
     (out / "report.json.tmp").write_text(json.dumps(rep, indent=2))
     os.replace(out / "report.json.tmp", out / "report.json")
     say(f"report: {json.dumps(rep)}")
-    say(f"wrote {out / 'report.json'} and {out / 'laps.png'}")
+    say(f"wrote {out / 'report.json'}, {out / 'laps.png'} and {out / 'trace.png'}")
     if interrupted:
         say("interrupted: everything stopped")
         return EXIT_INTERRUPTED

@@ -4,11 +4,13 @@ Run `tools/pilot COMMAND --help` for each command's options."""
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import os
 import sys
 from pathlib import Path
 
 from ..paths import RELEASE_BUILD
+from .expert import ExpertRun
 
 DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front camera.
   expert      drive N laps with the simulator's expert (pure pursuit + perturbations), record an LCM log
@@ -39,9 +41,15 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
     e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
     e.add_argument("--perturb", type=float, default=0.35, help="perturbation amplitude (0..1)")
-    e.add_argument("--camera-fps", type=float, default=15.0, help="[Hz] of sim time")
+    e.add_argument(
+        "--camera-fps", type=float, default=ExpertRun.camera_fps, help="[Hz] of sim time"
+    )
     e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
     e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
+    e.add_argument(
+        "--duration", type=float, default=0.0,
+        help="[s] of sim time: stop there (0: when the laps are done); the run is the same up to it",
+    )  # fmt: skip
     e.add_argument("--lcm-url", default="", help="default: a port of this process's own")
 
     r = sub.add_parser("record", help="extract a dataset from LCM log(s)")
@@ -65,6 +73,11 @@ def main(argv: list[str] | None = None) -> int:
         "--samples-per-epoch", type=int, default=0, help="drawn per epoch (0: training frames)"
     )
     t.add_argument("--stride", type=int, default=1, help="use every N-th frame")
+    t.add_argument(
+        "--balance-max-ratio", type=float, default=None,
+        help="balancing: a frame is drawn at most this many times as often as one of the "
+        "commonest steering (default: the shipped recipe's)",
+    )  # fmt: skip
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -95,12 +108,12 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     if args.cmd == "expert":
-        from .expert import ExpertRun, record_expert
+        from .expert import record_expert
 
         run = ExpertRun(
             map=args.map, route=args.route, laps=args.laps, seed=args.seed, speed=args.speed,
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
-            light_level=args.light_level,
+            light_level=args.light_level, duration_s=args.duration,
         )  # fmt: skip
         wall = record_expert(run, args.out, _build(), args.lcm_url)
         print(f"pilot expert: {args.out} in {wall:.0f} s wall")
@@ -118,6 +131,8 @@ def _run(args: argparse.Namespace) -> int:
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
         )  # fmt: skip
+        if args.balance_max_ratio is not None:
+            cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
         train(args.dataset, args.out, cfg)
         return 0
     if args.cmd == "analyse":

@@ -57,6 +57,7 @@ class TrainConfig:
     max_frames: int = 0  # 0: all (tests train on a few)
     samples_per_epoch: int = 0  # 0: as many as training frames
     stride: int = 1  # every stride-th frame (neighbours at 15-30 Hz are near duplicates)
+    balance_max_ratio: float = augment.DEFAULT_MAX_RATIO  # augment.balance_weights
 
 
 def log(msg: str) -> None:
@@ -136,7 +137,7 @@ def train(
     spec = replace(spec, mean=(mean[0], mean[1], mean[2]), std=(std[0], std[1], std[2]))
     gain = shift_gain_per_px(ds.manifest, spec)
     aug = augment.Augment(gain_per_px=gain)
-    weights = augment.balance_weights(steer[idx_train])
+    weights = augment.balance_weights(steer[idx_train], cfg.balance_max_ratio)
     rng = np.random.default_rng(cfg.seed)
     net = model.PilotNet(spec.height, spec.width)
     opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
@@ -224,6 +225,7 @@ def train(
         "batch": cfg.batch,
         "samples_per_epoch": n_batches * cfg.batch,
         "stride": cfg.stride,
+        "balance_max_ratio": cfg.balance_max_ratio,
         "optimiser": "Adam",
         "loss": "MSE of normalised steering",
         "train_loss": [round(v, 6) for v in history["train"]],
