@@ -8,6 +8,9 @@
 // - Stop signs: a full stop (speed below stopped_m_s) for at least stop_sign_hold_s, then on.
 // - Speed limits (signs, and the advisory's when fresh), curve signs (curve_speed_m_s), and a
 //   gap of at least min_gap_m behind any car ahead on the track.
+// - An obstacle on the path (from the LIDAR): stop with the front obstacle_margin_m before it,
+//   and go on once the path has been clear for obstacle_clear_s. No fresh scan (the LIDAR is
+//   gone): the path counts as blocked right ahead.
 #pragma once
 
 #include <autodrive_vehicle.h>
@@ -28,13 +31,15 @@ struct RulesConfig {
   // base_link (rear axle) to the front and to the rear bumper [m], from the car's chassis box
   double front_m = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X + 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X;
   double rear_m = 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X - AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X;
-  double stop_margin_m = 0.04;    // the front stops this far before the stop line [m]
-  double stop_zone_m = 0.12;      // a stop counts within this of its target [m]
-  double stopped_m_s = 0.01;      // below this the car is standing [m/s]
-  double stop_sign_hold_s = 1.2;  // standstill at a stop sign (>= 1 s) [s]
-  double min_gap_m = 0.15;        // bumper to bumper behind a car ahead [m]
-  double peer_corridor_m = 0.17;  // a peer this close to the track's centre line is on it [m]
-  double peer_horizon_m = 1.2;    // how far ahead peers are looked for [m]
+  double stop_margin_m = 0.04;     // the front stops this far before the stop line [m]
+  double stop_zone_m = 0.12;       // a stop counts within this of its target [m]
+  double stopped_m_s = 0.01;       // below this the car is standing [m/s]
+  double stop_sign_hold_s = 1.2;   // standstill at a stop sign (>= 1 s) [s]
+  double min_gap_m = 0.15;         // bumper to bumper behind a car ahead [m]
+  double peer_corridor_m = 0.17;   // a peer this close to the track's centre line is on it [m]
+  double peer_horizon_m = 1.2;     // how far ahead peers are looked for [m]
+  double obstacle_margin_m = 0.1;  // the front stops this far before an obstacle [m]
+  double obstacle_clear_s = 1.0;   // the path clear this long before going on after one [s]
 };
 
 enum class LightState : int8_t { off = 0, red = 1, yellow = 2, green = 3 };
@@ -52,6 +57,10 @@ struct RulesInput {
   int64_t t_us = 0;  // the car's clock [us]
   Advisory advisory;
   std::vector<double> peers_ahead_m;  // along the track from base_link to each peer's base_link
+  // LIDAR: whether a fresh scan was judged (false: the path counts as blocked), and along the
+  // track from base_link to the nearest obstacle on the path (< 0: clear)
+  bool scan_fresh = true;
+  double obstacle_ahead_m = -1;
 };
 
 struct RulesOutput {
@@ -77,6 +86,7 @@ class CityRules {
   std::map<long, int64_t> still_since_us_;
   std::map<long, bool> served_;
   uint64_t stop_signs_served_ = 0;
+  int64_t obstacle_seen_us_ = -1;  // the last step an obstacle held the car [us]
 };
 
 }  // namespace behaviour
