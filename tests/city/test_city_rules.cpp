@@ -260,3 +260,24 @@ TEST(CityRules, StopsBeforeAnObstacleWaitsAndGoesOnWhenItIsGone) {
   EXPECT_EQ(out.speed_m_s, 0.0);
   EXPECT_EQ(out.reason, "no fresh LIDAR scan");
 }
+
+TEST(Obstacle, TheTrackerKeepsAnObstacleAsTheCarMovesAndInTheBlindZone) {
+  const Track t = track_for(city(), "city_east");
+  const ObstacleConfig cfg;
+  const double front_m = RulesConfig{}.front_m;
+  const TrackPoint p = point_at(t, 1.0);
+  const CarPose car{p.x_m, p.y_m, p.heading_rad, 1.0};
+  ObstacleTracker tr;
+  tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
+  EXPECT_NEAR(tr.ahead_m(t, 1.0), 0.6, 0.02);
+  EXPECT_NEAR(tr.ahead_m(t, 1.1), 0.5, 0.02);  // the car moved on 10 cm: 10 cm nearer
+  // a clear scan from where the LIDAR could see the place: gone
+  tr.on_scan(t, car, scan_of(car, {}, cfg), cfg, front_m);
+  EXPECT_LT(tr.ahead_m(t, 1.0), 0.0);
+  // seen, then the car is so near that the LIDAR cannot see it (nearer than range_min): kept
+  tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
+  const TrackPoint q = point_at(t, 1.46);
+  const CarPose near{q.x_m, q.y_m, q.heading_rad, 1.46};
+  tr.on_scan(t, near, scan_of(near, {}, cfg), cfg, front_m);
+  EXPECT_NEAR(tr.ahead_m(t, 1.46), 0.14, 0.02);
+}

@@ -83,7 +83,7 @@ class Driver {
     in.advisory = advisory();
     if (o_.lidar) {
       in.scan_fresh = scan_us_ > 0 && m->utime - scan_us_ <= o_.scan_stale_ms * 1e3;
-      in.obstacle_ahead_m = obstacle_ahead_m_;
+      in.obstacle_ahead_m = obstacle_.ahead_m(track_, s_local_);
     }
     for (const auto &peer : peers_.fresh(m->utime)) {
       const auto q =
@@ -134,8 +134,7 @@ class Driver {
     scan.range_min_m = m->range_min_m;
     scan.range_max_m = m->range_max_m;
     scan.ranges_m = m->ranges_m;
-    obstacle_ahead_m_ =
-        behaviour::obstacle_ahead_m(track_, pose_, scan, o_.obstacles, o_.rules.front_m);
+    obstacle_.on_scan(track_, pose_, scan, o_.obstacles, o_.rules.front_m);
     scan_us_ = m->utime;
   }
 
@@ -177,8 +176,8 @@ class Driver {
   bool have_adv_ = false, have_s_ = false;
   double s_local_ = 0;
   behaviour::CarPose pose_;
-  double obstacle_ahead_m_ = -1;  // from the last scan [m], < 0: clear
-  int64_t scan_us_ = 0;           // the last scan's stamp [us, car time]
+  behaviour::ObstacleTracker obstacle_;
+  int64_t scan_us_ = 0;  // the last scan's stamp [us, car time]
   long lap_ = 0;
   int64_t now_us_ = 0, last_cmd_us_ = 0, last_status_us_ = 0;
   int32_t seq_ = 0;

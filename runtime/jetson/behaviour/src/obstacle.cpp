@@ -29,4 +29,26 @@ double obstacle_ahead_m(const Track &track, const CarPose &car, const Scan &scan
   return ahead[static_cast<size_t>(cfg.min_returns - 1)];
 }
 
+void ObstacleTracker::on_scan(const Track &track, const CarPose &car, const Scan &scan,
+                              const ObstacleConfig &cfg, double front_m) {
+  const double d = obstacle_ahead_m(track, car, scan, cfg, front_m);
+  if (d >= 0) {
+    have_ = true;
+    s_m_ = car.s_m + d;
+    if (track.loop && s_m_ >= track.length_m) s_m_ -= track.length_m;
+    return;
+  }
+  const double kept = ahead_m(track, car.s_m);
+  // out of sight: nearer the LIDAR than its range_min (with 2 cm to spare)
+  if (kept >= 0 && kept - cfg.lidar_x_m < scan.range_min_m + 0.02) return;
+  have_ = false;
+}
+
+double ObstacleTracker::ahead_m(const Track &track, double s_m) const {
+  if (!have_) return -1.0;
+  double d = s_m_ - s_m;
+  if (track.loop) d = std::remainder(d, track.length_m);
+  return d < 0 ? 0.0 : d;  // the car stands at or over it: in the way
+}
+
 }  // namespace behaviour

@@ -31,15 +31,18 @@ struct RulesConfig {
   // base_link (rear axle) to the front and to the rear bumper [m], from the car's chassis box
   double front_m = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X + 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X;
   double rear_m = 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X - AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X;
-  double stop_margin_m = 0.04;     // the front stops this far before the stop line [m]
-  double stop_zone_m = 0.12;       // a stop counts within this of its target [m]
-  double stopped_m_s = 0.01;       // below this the car is standing [m/s]
-  double stop_sign_hold_s = 1.2;   // standstill at a stop sign (>= 1 s) [s]
-  double min_gap_m = 0.15;         // bumper to bumper behind a car ahead [m]
-  double peer_corridor_m = 0.17;   // a peer this close to the track's centre line is on it [m]
-  double peer_horizon_m = 1.2;     // how far ahead peers are looked for [m]
-  double obstacle_margin_m = 0.1;  // the front stops this far before an obstacle [m]
-  double obstacle_clear_s = 1.0;   // the path clear this long before going on after one [s]
+  double stop_margin_m = 0.04;    // the front stops this far before the stop line [m]
+  double stop_zone_m = 0.12;      // a stop counts within this of its target [m]
+  double stopped_m_s = 0.01;      // below this the car is standing [m/s]
+  double stop_sign_hold_s = 1.2;  // standstill at a stop sign (>= 1 s) [s]
+  double min_gap_m = 0.15;        // bumper to bumper behind a car ahead [m]
+  double peer_corridor_m = 0.17;  // a peer this close to the track's centre line is on it [m]
+  double peer_horizon_m = 1.2;    // how far ahead peers are looked for [m]
+  // the front stops this far before an obstacle [m]: more than the LIDAR's blind zone ahead of
+  // the front (range_min_m 0.15 m from the LIDAR, 0.105 m from the front), so that a car
+  // standing before a box still sees it go
+  double obstacle_margin_m = 0.15;
+  double obstacle_clear_s = 1.0;  // the path clear this long before going on after one [s]
 };
 
 enum class LightState : int8_t { off = 0, red = 1, yellow = 2, green = 3 };

@@ -38,4 +38,20 @@ struct CarPose {
 double obstacle_ahead_m(const Track &track, const CarPose &car, const Scan &scan,
                         const ObstacleConfig &cfg, double front_m);
 
+// The nearest obstacle's place along the track, from scan to scan: the car moves on between
+// scans (7 Hz), and the LIDAR sees nothing closer than range_min_m, so an obstacle that has
+// come that close is kept (it has not gone; it is out of sight) until a scan that could see its
+// place shows it clear.
+class ObstacleTracker {
+ public:
+  void on_scan(const Track &track, const CarPose &car, const Scan &scan, const ObstacleConfig &cfg,
+               double front_m);
+  // Along the track from progress s_m to the obstacle [m]; < 0: none.
+  double ahead_m(const Track &track, double s_m) const;
+
+ private:
+  bool have_ = false;
+  double s_m_ = 0;  // the obstacle's progress along the track [m], in [0, length) on a loop
+};
+
 }  // namespace behaviour
