@@ -152,6 +152,7 @@ with tempfile.TemporaryDirectory(prefix="city-gap-") as tmp:
         wait_for("both still standing 2 s later", lambda: truth["NIGEL1"]["t"] > t_both + 2.0)
         assert standing("NIGEL2"), f"the follower crept on: {truth}"
         gap_red = math.dist(*((truth[c]["x"], truth[c]["y"]) for c in CARS)) - LENGTH_M
+        assert past("NIGEL1", line) <= 0.03, "the leader stood past the stop line on red"
         log(
             f"1. red: leader {-past('NIGEL1', line) * 100:.1f} cm before the line, "
             f"follower standing {gap_red * 100:.1f} cm behind it"
