@@ -201,14 +201,19 @@ std::pair<double, double> on_track(const Track &t, double s_m, double left_m) {
   return {p.x_m - left_m * std::sin(p.heading_rad), p.y_m + left_m * std::cos(p.heading_rad)};
 }
 
+// The car on the track's centre line at progress s_m, heading along it.
+CarPose car_at(const Track &t, double s_m) {
+  const TrackPoint p = point_at(t, s_m);
+  return {p.x_m, p.y_m, p.heading_rad, s_m};
+}
+
 }  // namespace
 
 TEST(Obstacle, AReturnOnThePathIsFoundAlongTheTrack) {
   const Track t = track_for(city(), "city_east");
   const ObstacleConfig cfg;
   const double front_m = RulesConfig{}.front_m;
-  const TrackPoint p = point_at(t, 1.0);
-  const CarPose car{p.x_m, p.y_m, p.heading_rad, 1.0};
+  const CarPose car = car_at(t, 1.0);
   // a box 0.6 m ahead of base_link on the centre line
   EXPECT_NEAR(obstacle_ahead_m(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m),
               0.6, 0.02);
@@ -265,8 +270,7 @@ TEST(Obstacle, TheTrackerKeepsAnObstacleAsTheCarMovesAndInTheBlindZone) {
   const Track t = track_for(city(), "city_east");
   const ObstacleConfig cfg;
   const double front_m = RulesConfig{}.front_m;
-  const TrackPoint p = point_at(t, 1.0);
-  const CarPose car{p.x_m, p.y_m, p.heading_rad, 1.0};
+  const CarPose car = car_at(t, 1.0);
   ObstacleTracker tr;
   tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
   EXPECT_NEAR(tr.ahead_m(t, 1.0), 0.6, 0.02);
@@ -276,8 +280,7 @@ TEST(Obstacle, TheTrackerKeepsAnObstacleAsTheCarMovesAndInTheBlindZone) {
   EXPECT_LT(tr.ahead_m(t, 1.0), 0.0);
   // seen, then the car is so near that the LIDAR cannot see it (nearer than range_min): kept
   tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
-  const TrackPoint q = point_at(t, 1.46);
-  const CarPose near{q.x_m, q.y_m, q.heading_rad, 1.46};
+  const CarPose near = car_at(t, 1.46);
   tr.on_scan(t, near, scan_of(near, {}, cfg), cfg, front_m);
   EXPECT_NEAR(tr.ahead_m(t, 1.46), 0.14, 0.02);
 }
