@@ -136,6 +136,20 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "stand-in publisher (autodrive_tools.city.advisory)",
     )
     p.add_argument("--scm-port", type=int, default=8765, help="smart-city: the SCM's web port")
+    p.add_argument(
+        "--late-obstacles",
+        choices=("none", "all"),
+        default="none",
+        help="smart-city: the map's late boxes: none (default), or all: each stands on a route's "
+        "lane for good, the cars stop before them (LIDAR) and the report names the blocked cars",
+    )
+    p.add_argument(
+        "--sim-seconds",
+        type=float,
+        default=0.0,
+        help="smart-city: end after this much sim time [s] (a short run; 0: when every car drove "
+        "--laps)",
+    )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
     if args.cameras < 0:

@@ -3,14 +3,19 @@ the unchanged autodrive-runtime on its ptys (its EKF fed by the Eye stand-in,
 autodrive_tools.city.eye_standin), autodrive-city-driver on Tiny Town's loop city_east (through light
 3 and the stop sign), and the test's own V2I advisory publisher (autodrive_tools.city.advisory),
 all on real LCM. Judged from the simulator's ground truth and light states:
-1. light 3 held RED: the car stops with its front before the stop line (overshoot <= 3 cm);
-2. light 3 GREEN: it goes on across the line;
+1. light 3 held GREEN, the advisory stopped once the car drives (stale): the car stops with its
+   front before the stop line anyway (overshoot <= 3 cm);
+2. the advisory back, light 3 held RED: the car stays; then GREEN: it goes on across the line;
 3. the stop sign: a standstill of at least 1 s before it, then on;
-4. advisory stopped (stale), light 3 held GREEN: the car stops before the line anyway.
+4. a box steps onto the lane ahead (autodrive-sim --late-box, 0.9 m ahead of the car) and leaves
+   again 6 s later: the car, seeing it only with its LIDAR, stands with its front the driver's
+   obstacle margin before it (within 3 cm), never touches it, and goes on once it is gone.
+(Stopping on RED from cruise is city.gap_keeping's leader; this order saves a lap.)
 Args: ROOT BUILD PORT."""
 import math
 import os
 import pathlib
+import re
 import select
 import subprocess
 import sys
@@ -30,6 +35,8 @@ MAP = MAPS_DIR / "tiny_town.json"
 LIGHT = 3
 ROUTE = "city_east"  # north through light 3 and the stop sign, round the east half
 SIM_LIMIT_S = 400.0
+# the box: on lane n2_w_e (y 2.86 m, heading east), after the stop sign; half sizes [m]
+BOX_X, BOX_Y, BOX_HALF_M, BOX_NEAR_M, BOX_STAY_S = 2.2, 2.86, 0.06, 0.9, 6.0
 types = lcmtypes.load(build)
 
 
@@ -61,6 +68,8 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         )
         v = m.linear_velocity_m_s[0]
         truth.update(t=m.utime * 1e-6, x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=v)
+        if m.in_collision:
+            truth["collisions"] = truth.get("collisions", 0) + 1
 
     def on_light(_ch, data):
         m = types.traffic_light_state_t.decode(data)
@@ -113,16 +122,18 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         raise AssertionError(f"never stood {hold_s} s at {stop_point.name}: {truth}")
 
     try:
-        sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1", "--no-lidar"]
+        sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1"]
         sim += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
         sim += ["--lockstep-client", "--run-dir", run_dir, "--lcm-url", URL]
         # the map's late box appears in the crossroads when a car comes near it; the city driver
         # does not avoid obstacles (the smart-city mission leaves them out too)
         sim += ["--duration", SIM_LIMIT_S + 20, "--no-late-obstacles"]
+        sim += ["--late-box", f"{BOX_X},{BOX_Y},0,{BOX_HALF_M},{BOX_HALF_M},{BOX_NEAR_M}"]
+        sim += ["--late-box-stay", BOX_STAY_S]
         procs.start("autodrive-sim", sim, out / "sim.log")
         wait_for_path(run_dir / "nigel1-nano", 60, procs)
         pose0 = hil.start_poses(build, URL, 1)[0]
-        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE)
+        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE, lidar=True)
         procs.start(
             "runtime", [build / "bin" / "autodrive-runtime", "--config", cfg], out / "runtime.log"
         )
@@ -153,8 +164,8 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         ]
         advisory = procs.start("advisory", adv, out / "advisory.log")
         spin(1.0)
-        command_light(1)  # RED, held
-        wait_for("light 3 RED", lambda: lights.get(LIGHT) == 1, 60)
+        command_light(3)  # GREEN, held
+        wait_for("light 3 GREEN", lambda: lights.get(LIGHT) == 3, 60)
         drv = [
             build / "bin" / "autodrive-city-driver",
             "--map",
@@ -165,31 +176,55 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
             URL,
         ]
         procs.start("city-driver", drv, out / "driver.log")
-        # 1. red: stops before the line
-        over = stopped_at(line, 2.0)
-        log(f"1. red light: stood {-over * 100:.1f} cm before the stop line")
-        assert lights[LIGHT] == 1
-        assert over <= 0.03, f"front {over:.3f} m past the stop line on red"
-        # 2. green: goes
-        command_light(3)
-        wait_for("across the line on green", lambda: past(line) > 0.3)
-        log("2. green: crossed the stop line")
-        # 3. stop sign: a full stop of >= 1 s, then on
-        over_sign = stopped_at(sign, 1.0)
-        wait_for("on after the stop sign", lambda: past(sign) > 0.3)
-        log(f"3. stop sign: stood >= 1 s, {-over_sign * 100:.1f} cm before it, then went on")
-        assert over_sign <= 0.03
-        # 4. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway
+        # 1. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway
+        wait_for("driving", lambda: truth["v"] > 0.1)
         assert stop(advisory, "advisory", log) == 0
         over_stale = stopped_at(line, 2.0)
         log(
-            f"4. stale advisory: stood {-over_stale * 100:.1f} cm before the line, light "
+            f"1. stale advisory: stood {-over_stale * 100:.1f} cm before the line, light "
             f"{lights[LIGHT]} (3 = GREEN)"
         )
         assert lights[LIGHT] == 3, "the light was not green: the test proves nothing"
         assert over_stale <= 0.03
         text = (out / "driver.log").read_text()
         assert "stale advisory: red light 3" in text, text[-2000:]
+        # 2. the advisory back, RED: the car stays; GREEN: it goes
+        command_light(1)
+        wait_for("light 3 RED", lambda: lights.get(LIGHT) == 1, 60)
+        procs.start("advisory2", adv, out / "advisory2.log")
+        t_red = truth["t"]
+        wait_for("2 s of red", lambda: truth["t"] > t_red + 2.0 or abs(truth["v"]) > 0.01)
+        assert abs(truth["v"]) < 0.01 and past(line) < 0, f"the car moved on red: {truth}"
+        command_light(3)
+        wait_for("across the line on green", lambda: past(line) > 0.3)
+        log("2. red: stayed; green: crossed the stop line")
+        # 3. stop sign: a full stop of >= 1 s, then on
+        over_sign = stopped_at(sign, 1.0)
+        wait_for("on after the stop sign", lambda: past(sign) > 0.3)
+        log(f"3. stop sign: stood >= 1 s, {-over_sign * 100:.1f} cm before it, then went on")
+        assert over_sign <= 0.03
+        # 4. the box on the lane: stand the obstacle margin before it, go on when it is gone
+        rules = re.search(
+            r"rules: min_gap_m=\S+ obstacle_margin_m=([0-9.]+)", (out / "driver.log").read_text()
+        )
+        assert rules, "the driver's log has no rules line"
+        margin = float(rules.group(1))
+
+        def box_gap():  # the box's west face less the car's front, along the lane (east) [m]
+            front = truth["x"] + scoring.front_offset_m() * math.cos(truth["yaw"])
+            return BOX_X - BOX_HALF_M - front
+
+        wait_for("standing before the box", lambda: abs(truth["v"]) < 0.01 and 0 < box_gap() < 0.5)
+        gap = box_gap()
+        assert "late box 1 appeared" in (out / "sim.log").read_text()
+        log(
+            f"4. box on the lane: stood {gap * 100:.1f} cm before it (margin {margin * 100:.0f} cm)"
+        )
+        assert margin - 0.03 <= gap <= margin + 0.05, f"stood {gap:.3f} m before the box"
+        wait_for("on past the box once it left", lambda: truth["x"] > BOX_X + 0.3)
+        assert "late box 1 left" in (out / "sim.log").read_text()
+        assert truth.get("collisions", 0) == 0, "the car touched something"
+        log("   the box left; the car went on")
     finally:
         procs.stop_all()
         keep = os.environ.get("CITY_TEST_KEEP")  # a folder to keep the logs in

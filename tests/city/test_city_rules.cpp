@@ -5,6 +5,7 @@
 
 #include "behaviour/city_map.hpp"
 #include "behaviour/city_rules.hpp"
+#include "behaviour/obstacle.hpp"
 
 using namespace behaviour;
 
@@ -168,4 +169,118 @@ TEST(CityRules, KeepsTheGapBehindACarAhead) {
   const auto out = r.step(in);
   EXPECT_LT(out.speed_m_s, cfg.cruise_m_s);
   EXPECT_EQ(out.reason, "car ahead");
+}
+
+namespace {
+
+// A 360-ray scan of the car at `car` with returns only from the map points `hits` (each on the
+// ray nearest its bearing and that ray's neighbour, as a small box gives).
+Scan scan_of(const CarPose &car, const std::vector<std::pair<double, double>> &hits,
+             const ObstacleConfig &cfg) {
+  Scan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = 2 * M_PI / 360;
+  s.range_min_m = 0.15;
+  s.range_max_m = 12.0;
+  s.ranges_m.assign(360, std::numeric_limits<float>::infinity());
+  const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
+  const double lx = car.x_m + c * cfg.lidar_x_m - sn * cfg.lidar_y_m;
+  const double ly = car.y_m + sn * cfg.lidar_x_m + c * cfg.lidar_y_m;
+  for (const auto &[x, y] : hits) {
+    const double bearing = std::remainder(std::atan2(y - ly, x - lx) - car.yaw_rad, 2 * M_PI);
+    const auto i =
+        static_cast<size_t>(std::lround((bearing - s.angle_min_rad) / s.angle_increment_rad)) % 360;
+    s.ranges_m[i] = s.ranges_m[(i + 1) % 360] = static_cast<float>(std::hypot(x - lx, y - ly));
+  }
+  return s;
+}
+
+// The map point `along_m` ahead of the car on its track, `left_m` to the left of it.
+std::pair<double, double> on_track(const Track &t, double s_m, double left_m) {
+  const TrackPoint p = point_at(t, s_m);
+  return {p.x_m - left_m * std::sin(p.heading_rad), p.y_m + left_m * std::cos(p.heading_rad)};
+}
+
+// The car on the track's centre line at progress s_m, heading along it.
+CarPose car_at(const Track &t, double s_m) {
+  const TrackPoint p = point_at(t, s_m);
+  return {p.x_m, p.y_m, p.heading_rad, s_m};
+}
+
+}  // namespace
+
+TEST(Obstacle, AReturnOnThePathIsFoundAlongTheTrack) {
+  const Track t = track_for(city(), "city_east");
+  const ObstacleConfig cfg;
+  const double front_m = RulesConfig{}.front_m;
+  const CarPose car = car_at(t, 1.0);
+  // a box 0.6 m ahead of base_link on the centre line
+  EXPECT_NEAR(obstacle_ahead_m(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m),
+              0.6, 0.02);
+  // the same beside the path (the other lane's centre, 0.28 m to the left): clear
+  EXPECT_LT(obstacle_ahead_m(t, car, scan_of(car, {on_track(t, 1.6, 0.28)}, cfg), cfg, front_m),
+            0.0);
+  // just inside the corridor: on the path
+  EXPECT_GT(
+      obstacle_ahead_m(t, car, scan_of(car, {on_track(t, 1.6, cfg.corridor_half_m - 0.01)}, cfg),
+                       cfg, front_m),
+      0.0);
+  // beyond the horizon: later
+  EXPECT_LT(obstacle_ahead_m(t, car, scan_of(car, {on_track(t, 3.0, 0.0)}, cfg), cfg, front_m),
+            0.0);
+  // a single stray return is noise
+  Scan one = scan_of(car, {on_track(t, 1.6, 0.0)}, cfg);
+  int returns = 0;
+  for (auto &r : one.ranges_m)
+    if (std::isfinite(r) && ++returns > 1) r = std::numeric_limits<float>::infinity();
+  EXPECT_LT(obstacle_ahead_m(t, car, one, cfg, front_m), 0.0);
+}
+
+TEST(CityRules, StopsBeforeAnObstacleWaitsAndGoesOnWhenItIsGone) {
+  const Track t = track_for(city(), "city_east");
+  RulesConfig cfg;
+  CityRules r(t, cfg);
+  RulesInput in = at(1.0, 0.2, 0);
+  in.obstacle_ahead_m = cfg.front_m + cfg.obstacle_margin_m;  // the front at the margin: stand
+  auto out = r.step(in);
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  EXPECT_EQ(out.reason, "obstacle ahead (LIDAR)");
+  in.obstacle_ahead_m = cfg.front_m + cfg.obstacle_margin_m + 0.05;  // 5 cm of room: slow
+  EXPECT_GT(r.step(in).speed_m_s, 0.0);
+  EXPECT_LT(r.step(in).speed_m_s, cfg.cruise_m_s);
+  // gone: the car waits obstacle_clear_s after it last held the car, then cruises
+  in.obstacle_ahead_m = cfg.front_m + cfg.obstacle_margin_m;
+  in.t_us = 1000000;
+  r.step(in);
+  in.obstacle_ahead_m = -1;
+  in.t_us += static_cast<int64_t>(0.5 * cfg.obstacle_clear_s * 1e6);
+  out = r.step(in);
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  EXPECT_EQ(out.reason, "obstacle gone, waiting");
+  in.t_us = 1000000 + static_cast<int64_t>(cfg.obstacle_clear_s * 1e6) + 1;
+  EXPECT_DOUBLE_EQ(r.step(in).speed_m_s, cfg.cruise_m_s);
+  // no fresh scan: blocked
+  in.scan_fresh = false;
+  out = r.step(in);
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  EXPECT_EQ(out.reason, "no fresh LIDAR scan");
+}
+
+TEST(Obstacle, TheTrackerKeepsAnObstacleAsTheCarMovesAndInTheBlindZone) {
+  const Track t = track_for(city(), "city_east");
+  const ObstacleConfig cfg;
+  const double front_m = RulesConfig{}.front_m;
+  const CarPose car = car_at(t, 1.0);
+  ObstacleTracker tr;
+  tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
+  EXPECT_NEAR(tr.ahead_m(t, 1.0), 0.6, 0.02);
+  EXPECT_NEAR(tr.ahead_m(t, 1.1), 0.5, 0.02);  // the car moved on 10 cm: 10 cm nearer
+  // a clear scan from where the LIDAR could see the place: gone
+  tr.on_scan(t, car, scan_of(car, {}, cfg), cfg, front_m);
+  EXPECT_LT(tr.ahead_m(t, 1.0), 0.0);
+  // seen, then the car is so near that the LIDAR cannot see it (nearer than range_min): kept
+  tr.on_scan(t, car, scan_of(car, {on_track(t, 1.6, 0.0)}, cfg), cfg, front_m);
+  const CarPose near = car_at(t, 1.46);
+  tr.on_scan(t, near, scan_of(near, {}, cfg), cfg, front_m);
+  EXPECT_NEAR(tr.ahead_m(t, 1.46), 0.14, 0.02);
 }

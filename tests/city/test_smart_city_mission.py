@@ -1,14 +1,18 @@
 """tools/demo --mission smart-city, short (a smoke test of the whole mission; the laps and the
-goals are measured by full runs, see README): Tiny Town, three cars, three runtimes, three city
-drivers, the advisory stand-in, for --timeout seconds of wall time. The report must have every
-key, no violation, no collision, every car driven; the PNG and the LCM log (with V2V and the
-cars' V2I advisories in it) written. Args: ROOT BUILD PORT."""
+goals are measured by full runs, see README): Tiny Town, three cars, three runtimes (LIDAR on),
+three city drivers and the advisory stand-in, for SIM_SECONDS of sim time (--sim-seconds: the machine's load changes only how long that takes).
+The report must have every key, no violation, no collision, every car driven; the PNG and the
+LCM log (with V2V, the cars' V2I advisories and LIDAR scans in it) written. Args: ROOT BUILD
+PORT."""
 import json
 import os
 import pathlib
 import subprocess
 import sys
 import tempfile
+
+SIM_SECONDS = 30  # past a light's cycle (20 s)
+WALL_GUARD_S = 900  # only a hang guard (--timeout)
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 sys.path.insert(0, str(root / "python"))
@@ -31,16 +35,20 @@ with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
         "--seed",
         "2",
         "--timeout",
-        "60",
+        str(WALL_GUARD_S),
+        "--sim-seconds",
+        str(SIM_SECONDS),
         "--advisory",
         "standin",
         "--lcm-url",
         f"udpm://239.255.76.67:{port}?ttl=0",
     ]
-    r = subprocess.run(cmd, env=env, timeout=150)
+    r = subprocess.run(cmd, env=env, timeout=WALL_GUARD_S + 120)
     rep = json.loads((out / "run" / "report.json").read_text())
     print(json.dumps(rep, indent=2))
-    assert r.returncode == 1, "a 60 s run cannot finish 3 laps: the mission must say not ok"
+    assert "error" not in rep, rep.get("error")
+    assert rep["sim_s"] >= SIM_SECONDS
+    assert r.returncode == 1, "a 30 s run cannot finish 3 laps: the mission must say not ok"
     for key in (
         "red_light_violations",
         "stop_sign_violations",
@@ -55,9 +63,10 @@ with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
     assert rep["collisions"] == 0
     assert rep["max_stop_line_overshoot_m"] <= 0.03
     assert set(rep["driven_m"]) == {"NIGEL1", "NIGEL2", "NIGEL3"}
-    assert min(rep["driven_m"].values()) > 0.5, "a car did not drive"
+    assert min(rep["driven_m"].values()) > 1.0, "a car did not drive"
+    assert rep["blocked"] == []
     assert (out / "run" / "trajectories.png").stat().st_size > 10000
     seen = {e.channel for e in lcmtypes.events(out / "run" / "run.lcmlog")}
-    for ch in ("V2V", "NIGEL1_V2I", "NIGEL3_COMMAND", "TRAFFIC_LIGHT_STATE"):
+    for ch in ("V2V", "NIGEL1_V2I", "NIGEL3_COMMAND", "NIGEL2_LIDAR", "TRAFFIC_LIGHT_STATE"):
         assert ch in seen, f"{ch} not in the log"
 print("smart-city mission ok")

@@ -7,6 +7,8 @@ import tempfile
 from pathlib import Path
 
 from autodrive_tools import geometry, mapfacts, scoring, vehicle
+from autodrive_tools.city import scoring as city_scoring
+from autodrive_tools.maps.loader import MAPS_DIR
 from autodrive_tools.missions import parking
 from autodrive_tools.runfiles import read_columns
 
@@ -64,4 +66,14 @@ with tempfile.TemporaryDirectory() as tmp:
     csv.write_text("x_m,y_m\n1,2\n3,x\n")
     raises(lambda: read_columns(csv, ["x_m", "y_m"]), ValueError, str(csv), "non-numeric")
     raises(lambda: read_columns(csv, ["z_m"]), ValueError, "lacks columns")
+# the smart-city scorer: a car standing away from every stop line for blocked_s is blocked; one
+# standing at a stop line, or moving, is not
+town = city_scoring.MapFacts.load(MAPS_DIR / "tiny_town.json")
+sc = city_scoring.Scorer(town, blocked_s=30.0)
+for k in range(400):  # 40 s standing in the middle of the east road
+    sc.truth("NIGEL1", k * 0.1, 4.06, 0.5, -math.pi / 2, 0.0, False)
+    sc.truth("NIGEL2", k * 0.1, 4.34, 0.5 + k * 0.01, math.pi / 2, 0.1, False)
+rep = sc.report()
+assert rep["blocked"] == ["NIGEL1"], rep
+assert rep["longest_standstill_away_s"] == {"NIGEL1": 39.9, "NIGEL2": 0.0}, rep
 print("python tools ok")

@@ -122,12 +122,22 @@ class CarScore:
     in_collision: bool = False
     driven_m: float = 0.0
     at: tuple[float, float] | None = None
+    t_s: float = 0.0
+    # standing away from every stop point (an obstacle, a car ahead) since [s]; the longest [s]
+    held_since_s: float | None = None
+    longest_held_s: float = 0.0
 
 
 class Scorer:
     """Feed it ground truth and light states in time order; read report()."""
 
-    def __init__(self, facts: MapFacts, lap_radius_m: float = 0.25, away_m: float = 1.5) -> None:
+    def __init__(
+        self,
+        facts: MapFacts,
+        lap_radius_m: float = 0.25,
+        away_m: float = 1.5,
+        blocked_s: float = math.inf,
+    ) -> None:
         self.facts = facts
         self.lights: dict[int, int] = {}
         self.cars: dict[str, CarScore] = {}
@@ -140,6 +150,7 @@ class Scorer:
         self.collisions = 0
         self.min_gap_m = math.inf
         self.lap_radius_m, self.away_m = lap_radius_m, away_m
+        self.blocked_s = blocked_s  # standing this long away from every stop point: blocked [s]
 
     def light(self, light_id: int, state: int) -> None:
         self.lights[light_id] = state
@@ -169,11 +180,14 @@ class Scorer:
             c.still_since_s = t_s if c.still_since_s is None else c.still_since_s
         else:
             c.still_since_s = None
+        c.t_s = t_s
+        at_stop = False
         for p in self.facts.stops:
             if not on_approach(x, y, yaw, p):
                 c.prev_past.pop(p.name, None)
                 continue
             past = front_past_m(x, y, yaw, p)
+            at_stop = at_stop or -NEAR_BEFORE_M < past < 0.3
             if standing and -NEAR_BEFORE_M < past < 0.3 and c.still_since_s is not None:
                 held = t_s - c.still_since_s
                 c.still_at[p.name] = max(c.still_at.get(p.name, 0.0), held)
@@ -196,6 +210,11 @@ class Scorer:
                     self.crossings["on_green_or_yellow"] += 1
                 c.still_at.pop(p.name, None)
             c.prev_past[p.name] = past
+        if standing and not at_stop:
+            c.held_since_s = t_s if c.held_since_s is None else c.held_since_s
+            c.longest_held_s = max(c.longest_held_s, t_s - c.held_since_s)
+        else:
+            c.held_since_s = None
         self.last[car] = (x, y, yaw)
         for other, (ox, oy, oyaw) in self.last.items():
             # cars going the same way (one behind the other), not cars passing in the other lane
@@ -229,5 +248,15 @@ class Scorer:
             "laps_per_car": {k: c.laps for k, c in sorted(self.cars.items())},
             "driven_m": {k: round(c.driven_m, 2) for k, c in sorted(self.cars.items())},
             "mean_lap_s": round(sum(lap_s) / len(lap_s), 2) if lap_s else None,
+            # the longest standstill of each car away from every stop line (an obstacle ahead, a
+            # car ahead) [s], and the cars standing so now for blocked_s or more
+            "longest_standstill_away_s": {
+                k: round(c.longest_held_s, 1) for k, c in sorted(self.cars.items())
+            },
+            "blocked": sorted(
+                k
+                for k, c in self.cars.items()
+                if c.held_since_s is not None and c.t_s - c.held_since_s >= self.blocked_s
+            ),
             "violations": self.red_violations + self.sign_violations,
         }

@@ -38,6 +38,12 @@ MAP = "tiny_town"
 ROUTES = ("city_east", "city_west", "loop_ccw")
 START_SPREAD_M = 1.0  # each car starts up to this far along its route from its start [m]
 PROGRESS_S = 10.0
+# The map's late boxes are out by default (--late-obstacles all puts them in): each stands on a
+# route's lane for good once it appeared, so the car behind it stops and waits for ever, and 3
+# laps each cannot be. late_box_0 appears in the middle of the crossroads road c1, 0.065 m from
+# both lane centres (less than half a car's width): it blocks city_east and city_west; late_box_1
+# stands on the centre line of w2_n_s, loop_ccw's lane. The report then names the blocked cars.
+BLOCKED_S = 30.0  # a car standing this long [s sim] away from any stop line is reported blocked
 
 
 def start_poses(seed: int) -> list[tuple[float, float, float]]:
@@ -127,7 +133,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
 
     old = [(s, signal.signal(s, on_signal)) for s in (signal.SIGINT, signal.SIGTERM)]
     facts = MapFacts.load(MAPS_DIR / f"{MAP}.json")
-    scorer = Scorer(facts)
+    scorer = Scorer(facts, blocked_s=BLOCKED_S)
     tracks: dict[str, list[tuple[float, float, float]]] = {}
     phases: dict[int, list[tuple[float, int]]] = {}
     sim_t = [0.0]
@@ -163,10 +169,9 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         sim: list[object] = [build / "bin" / "autodrive-sim", "--map", MAP, "--cars", cars]
         for x, y, yaw in starts:
             sim += ["--start", f"{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
-        # The city driver does not avoid obstacles (it keeps its gap to V2V peers only), so the
-        # map's late-appearing boxes stay out of this mission.
-        sim += ["--no-late-obstacles"]
-        sim += ["--no-lidar", "--seed", args.seed, "--run-dir", run_dir, "--lcm-url", url]
+        if args.late_obstacles == "none":
+            sim += ["--no-late-obstacles"]
+        sim += ["--seed", args.seed, "--run-dir", run_dir, "--lcm-url", url]
         sim += ["--lockstep-client", "--duration", 3600]
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
@@ -181,7 +186,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             out / "eye-standin.log",
         )
         for i in range(1, cars + 1):
-            cfg = hil.runtime_config(out, run_dir, url, i, starts[i - 1], ROUTES[i - 1])
+            cfg = hil.runtime_config(out, run_dir, url, i, starts[i - 1], ROUTES[i - 1], lidar=True)
             procs.start(
                 f"runtime{i}",
                 [build / "bin" / "autodrive-runtime", "--config", cfg],
@@ -239,8 +244,15 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             if scorer.cars and len(scorer.cars) == cars and rep["laps_completed"] >= args.laps:
                 say(f"every car drove {args.laps} laps")
                 break
+            if args.sim_seconds > 0 and sim_t[0] >= args.sim_seconds:
+                say(f"{args.sim_seconds:g} s of sim time driven (--sim-seconds)")
+                break
             if time.time() - t_wall0 > args.timeout:
                 result["error"] = f"timeout after {args.timeout:g} s wall"
+                say(result["error"])
+                break
+            if rep["blocked"]:
+                result["error"] = f"blocked for good: {rep['blocked']} (an obstacle on the lane)"
                 say(result["error"])
                 break
             if time.monotonic() - last > PROGRESS_S:
@@ -268,6 +280,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         advisory=args.advisory,
         scm_url=scm_url,
         eye="stand-in: ground truth + noise (city.eye_standin)",
+        late_obstacles=args.late_obstacles,
     )
     rep["ok"] = (
         "error" not in rep

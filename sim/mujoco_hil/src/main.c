@@ -100,6 +100,8 @@ static void main_usage(FILE *f) {
       "                      recordings with recoveries, tools/pilot)\n"
       "  --no-pty            do not open ptys (with --script)\n"
       "  --no-lidar          do not simulate the LIDAR\n"
+      "  --late-box-stay S   the --late-box before it leaves again S s after it appeared\n"
+      "                      (an obstacle that goes away)\n"
       "  --no-late-obstacles leave out the map's late_obstacles (--late-box boxes stay)\n"
       "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
       "                      unless a client is scanning on the RPLIDAR pty)\n"
@@ -236,6 +238,11 @@ static void main_report_late_boxes(const sim_t *s) {
     printf("\n");
     fflush(stdout);
   }
+  for (int k = 0; k < sim_late_boxes(s); k++)
+    if (sim_late_box_left(s, k)) {
+      printf("late box %d left at t = %.3f s\n", k + 1, (sim_time_us(s) - SIM_STEP_US) * 1e-6);
+      fflush(stdout);
+    }
 }
 
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
@@ -483,6 +490,14 @@ int main(int argc, char **argv) {
       }
       cfg.late_boxes++;
       cfg.late_box = late_box;
+      i++;
+    } else if (!strcmp(a, "--late-box-stay")) {
+      if (cfg.late_boxes == 0) {
+        fprintf(stderr, "autodrive-sim: --late-box-stay: give it after the --late-box it is for\n");
+        return 2;
+      }
+      if (main_number(a, v, 0.01, 1e6, &x)) return 2;
+      late_box[cfg.late_boxes - 1].stay_s = x;
       i++;
     } else if (!strcmp(a, "--lockstep")) {
       lockstep = 1;

@@ -85,7 +85,7 @@ int scn_parse_late_box(const char *text, scn_late_box_t *out, char *err, size_t 
   }
   out->half_x_m = out->half_y_m = SCN_LATE_BOX_HALF_DEFAULT_M;
   out->near_m = 0.0;
-  out->yaw_rad = out->half_z_m = 0.0;
+  out->yaw_rad = out->half_z_m = out->stay_s = 0.0;
   out->name[0] = '\0';
   if (n >= 5) {
     out->half_x_m = v[3];

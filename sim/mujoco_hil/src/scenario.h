@@ -31,6 +31,7 @@ typedef struct scn_late_box {
   double yaw_rad;            /* about z (the map's late obstacles; 0 for --late-box) [rad] */
   double half_z_m;           /* half height [m]; 0: SCN_LATE_BOX_HEIGHT_M / 2 */
   char name[48];             /* the map's obstacle name; "" for a --late-box */
+  double stay_s;             /* > 0: leaves again this long after it appeared [s]; 0: stays */
 } scn_late_box_t;
 
 /* Half height of a late box [m]. */

@@ -137,6 +137,10 @@ struct sim {
   int box_placed[SIM_MAX_BOXES];    /* has appeared */
   int box_new[SIM_MAX_BOXES];       /* appeared during the last step */
   int box_car_below[SIM_MAX_BOXES]; /* car it landed on (1-based), 0: none */
+  int box_body[SIM_MAX_BOXES];      /* its mocap body: where it waits before and after */
+  int64_t box_at_us[SIM_MAX_BOXES]; /* when it appeared [us] */
+  int box_gone[SIM_MAX_BOXES];      /* has left again (stay_s) */
+  int box_left[SIM_MAX_BOXES];      /* left during the last step */
   uint64_t seed;                    /* of the current run (sim_create, sim_reset) */
   char script_spec[256];            /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
@@ -374,19 +378,26 @@ int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
 /* Moves the late boxes that are due onto the floor (again after a reset). */
 static void sim_place_late_boxes(sim_t *s) {
   for (int k = 0; k < s->nbox; k++) {
-    s->box_new[k] = 0;
+    s->box_new[k] = s->box_left[k] = 0;
     const scn_late_box_t *b = &s->box[k];
-    if (s->time_us < (int64_t)llround(b->t_s * 1e6)) continue;
+    if (s->box_gone[k] || s->time_us < (int64_t)llround(b->t_s * 1e6)) continue;
     if (!s->box_placed[k] && b->near_m > 0) { /* a box that steps out as the car comes near */
       const mjtNum *car = s->d->qpos + s->car[0].root_qpos;
       if (hypot(car[0] - b->x_m, car[1] - b->y_m) > b->near_m) continue;
     }
     mjtNum *pos = s->d->mocap_pos + 3 * s->box_mocap[k];
+    if (s->box_placed[k] && b->stay_s > 0 &&
+        s->time_us - s->box_at_us[k] >= (int64_t)llround(b->stay_s * 1e6)) {
+      mju_copy3(pos, s->m->body_pos + 3 * s->box_body[k]); /* back where it waited */
+      s->box_gone[k] = s->box_left[k] = 1;
+      continue;
+    }
     pos[0] = b->x_m;
     pos[1] = b->y_m;
     pos[2] = scn_late_box_half_z(b);
     if (s->box_placed[k]) continue;
     s->box_placed[k] = s->box_new[k] = 1;
+    s->box_at_us[k] = s->time_us;
     cl_prism_t bp, cp;
     sim_box_prism(b, &bp);
     for (int i = 0; i < s->ncars && !s->box_car_below[k]; i++) {
@@ -406,6 +417,7 @@ static int sim_bind_late_boxes(sim_t *s, char *err, size_t err_sz) {
       return -1;
     }
     s->box_mocap[k] = s->m->body_mocapid[b];
+    s->box_body[k] = b;
   }
   return 0;
 }
@@ -639,6 +651,9 @@ const scn_late_box_t *sim_late_box(const sim_t *s, int k) {
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below) {
   if (car_below) *car_below = s->box_car_below[k];
   return s->box_new[k];
+}
+int sim_late_box_left(const sim_t *s, int k) {
+  return s->box_left[k];
 }
 
 /* --script route:NAME: the route driver of car 1, which starts at the route's start unless
@@ -1226,7 +1241,8 @@ int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t er
   s->seed = seed;
   s->time_us = 0;
   mj_resetData(s->m, s->d); /* qpos0 holds the start poses; mocap boxes go back to hiding */
-  for (int k = 0; k < s->nbox; k++) s->box_placed[k] = s->box_new[k] = s->box_car_below[k] = 0;
+  for (int k = 0; k < s->nbox; k++)
+    s->box_placed[k] = s->box_new[k] = s->box_car_below[k] = s->box_gone[k] = s->box_left[k] = 0;
   mj_forward(s->m, s->d);
   for (int i = 0; i < s->ncars; i++)
     if (sim_car_boot(s, &s->car[i], err, err_sz) != 0) return -1;

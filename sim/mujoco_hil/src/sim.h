@@ -145,10 +145,12 @@ int sim_lidar_pty_scanning(const sim_t *s, int car);
 /* Late boxes (k 0-based; the --late-box ones, then the map's late_obstacles): the count, and
  * 1 when box k appeared on the floor during the last sim_step; then *car_below (if non-NULL)
  * is the first car (1-based) whose footprint it landed on, or 0. A box stays on the floor once
- * it has appeared (also after a reset). */
+ * it has appeared, unless its stay_s sends it away again (after a reset it comes back). */
 int sim_late_boxes(const sim_t *s);
 const scn_late_box_t *sim_late_box(const sim_t *s, int k);
 int sim_late_box_appeared(const sim_t *s, int k, int *car_below);
+/* 1 when box k (its stay_s > 0) left the floor again during the last sim_step. */
+int sim_late_box_left(const sim_t *s, int k);
 
 /* The map's traffic lights (traffic_lights.h): each step updates them at sim time and lights
  * their lamps in the model. Commands (tl_command) take effect at the next step. */

@@ -1,10 +1,12 @@
 // autodrive-city-driver: the smart-city behaviour layer of one car. Follows a route along the
 // map's lanes with the runtime's EKF pose (<VEH>_POSE_MAP), obeys lights (from the V2I advisory
 // on <VEH>_V2I; stale -> every light red), stop signs, speed limits and curve signs (from the
-// map's sidecar JSON), keeps a gap behind cars ahead (V2V peers), and drives through the
+// map's sidecar JSON), keeps a gap behind cars ahead (V2V peers), stops for obstacles on its
+// path (the runtime's <VEH>_LIDAR scan; no fresh scan = blocked), and drives through the
 // runtime's guarded path: signed <VEH>_COMMAND (autodrive::auth::Signer), 50 Hz of car time.
 #include <CLI/CLI.hpp>
 #include <autodrive/command_auth.hpp>
+#include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/v2i_advisory_t.hpp>
 #include <autodrive/v2v_peers.hpp>
@@ -27,6 +29,7 @@
 #include "autonomy/pure_pursuit.hpp"
 #include "behaviour/city_map.hpp"
 #include "behaviour/city_rules.hpp"
+#include "behaviour/obstacle.hpp"
 
 namespace {
 
@@ -41,7 +44,10 @@ struct Options {
   std::string map, route, vehicle = "NIGEL1", lcm_url, key_file;
   double lookahead_m = 0.2, speed_kp = 1.5, advisory_stale_ms = 500;
   double status_period_s = 2.0;
+  double scan_stale_ms = 500;  // a scan older than this [ms, car time]: no fresh scan
+  bool lidar = true;
   behaviour::RulesConfig rules;
+  behaviour::ObstacleConfig obstacles;
 };
 
 class Driver {
@@ -66,6 +72,7 @@ class Driver {
     }
     s_local_ = p.s_m;
     have_s_ = true;
+    pose_ = {m->x_m, m->y_m, m->yaw_rad, s_local_};
     if (last_cmd_us_ != 0 && m->utime - last_cmd_us_ < 19000) return;  // 50 Hz
     last_cmd_us_ = m->utime;
     const double s = s_local_ + lap_ * track_.length_m;
@@ -74,6 +81,10 @@ class Driver {
     in.speed_m_s = m->vx_m_s;
     in.t_us = m->utime;
     in.advisory = advisory();
+    if (o_.lidar) {
+      in.scan_fresh = scan_us_ > 0 && m->utime - scan_us_ <= o_.scan_stale_ms * 1e3;
+      in.obstacle_ahead_m = obstacle_.ahead_m(track_, s_local_);
+    }
     for (const auto &peer : peers_.fresh(m->utime)) {
       const auto q =
           behaviour::project(track_, peer.x_m, peer.y_m, s_local_, 0.0, o_.rules.peer_horizon_m);
@@ -114,6 +125,19 @@ class Driver {
 
   void on_peer(const autodrive::v2v_state_t *m) { peers_.on_state(*m, now_us_); }
 
+  // Judged at once with the latest pose (the scan is ~1/7 s long; the margin covers that).
+  void on_scan(const autodrive::lidar_scan_t *m) {
+    if (!have_s_) return;
+    behaviour::Scan scan;
+    scan.angle_min_rad = m->angle_min_rad;
+    scan.angle_increment_rad = m->angle_increment_rad;
+    scan.range_min_m = m->range_min_m;
+    scan.range_max_m = m->range_max_m;
+    scan.ranges_m = m->ranges_m;
+    obstacle_.on_scan(track_, pose_, scan, o_.obstacles, o_.rules.front_m);
+    scan_us_ = m->utime;
+  }
+
   void send(bool engaged, double throttle, double steering) {
     autodrive::vehicle_command_t c{};
     c.utime = now_us_;
@@ -151,6 +175,9 @@ class Driver {
   Clock::time_point adv_wall_{};
   bool have_adv_ = false, have_s_ = false;
   double s_local_ = 0;
+  behaviour::CarPose pose_;
+  behaviour::ObstacleTracker obstacle_;
+  int64_t scan_us_ = 0;  // the last scan's stamp [us, car time]
   long lap_ = 0;
   int64_t now_us_ = 0, last_cmd_us_ = 0, last_status_us_ = 0;
   int32_t seq_ = 0;
@@ -190,6 +217,13 @@ int main(int argc, char **argv) {
                  "an advisory older than this [ms, wall] is stale: every light is red")
       ->check(CLI::Range(50.0, 10000.0))
       ->capture_default_str();
+  cli.add_option("--obstacle-margin", o.rules.obstacle_margin_m,
+                 "the front stops this far before an obstacle on the path (LIDAR) [m]")
+      ->check(CLI::Range(0.03, 1.0))
+      ->capture_default_str();
+  cli.add_flag("!--no-lidar", o.lidar,
+               "do not stop for obstacles: no <VEH>_LIDAR (the car then drives into what is "
+               "not on the map)");
   CLI11_PARSE(cli, argc, argv);
 
   behaviour::Track track;
@@ -215,11 +249,20 @@ int main(int argc, char **argv) {
       lcm, o.vehicle + AUTODRIVE_CH_V2I_SUFFIX, &d);
   autodrive_lcm::subscribe<autodrive::v2v_state_t, Driver, &Driver::on_peer>(lcm, AUTODRIVE_CH_V2V,
                                                                              &d);
+  if (o.lidar)
+    autodrive_lcm::subscribe<autodrive::lidar_scan_t, Driver, &Driver::on_scan>(
+        lcm, o.vehicle + AUTODRIVE_CH_LIDAR_SUFFIX, &d);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::printf("[city-driver] %s on route %s (%.2f m, %s, %zu stops, %zu speed zones)\n",
               o.vehicle.c_str(), track.name.c_str(), track.length_m,
               track.loop ? "loop" : "one way", track.stops.size(), track.zones.size());
+  // the rules' figures, one line (tests read their thresholds from it)
+  std::printf(
+      "[city-driver] rules: min_gap_m=%.3f obstacle_margin_m=%.3f stop_margin_m=%.3f "
+      "cruise_m_s=%.3f lidar=%s\n",
+      o.rules.min_gap_m, o.rules.obstacle_margin_m, o.rules.stop_margin_m, o.rules.cruise_m_s,
+      o.lidar ? "on" : "OFF (obstacles are not seen)");
   for (const auto &st : track.stops)
     std::printf("[city-driver]   stop at s=%.3f m: %s %s\n", st.s_m,
                 st.kind == behaviour::Stop::Kind::light

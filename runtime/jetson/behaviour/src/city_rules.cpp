@@ -91,6 +91,19 @@ RulesOutput CityRules::step(const RulesInput &in) {
     const double room_m = gap_m - cfg_.min_gap_m;
     limit(room_m <= 0.003 ? 0.0 : std::sqrt(2.0 * cfg_.comfort_decel_m_s2 * room_m), "car ahead");
   }
+  // An obstacle on the path (LIDAR): brake to stand obstacle_margin_m before it; once it held
+  // the car, the path must stay clear for obstacle_clear_s before the car goes on.
+  if (!in.scan_fresh) {
+    limit(0.0, "no fresh LIDAR scan");
+  } else if (in.obstacle_ahead_m >= 0) {
+    const double room_m = in.obstacle_ahead_m - cfg_.front_m - cfg_.obstacle_margin_m;
+    const double v = room_m <= 0.003 ? 0.0 : std::sqrt(2.0 * cfg_.comfort_decel_m_s2 * room_m);
+    if (v == 0.0) obstacle_seen_us_ = in.t_us;
+    limit(v, "obstacle ahead (LIDAR)");
+  } else if (obstacle_seen_us_ >= 0 &&
+             (in.t_us - obstacle_seen_us_) * 1e-6 < cfg_.obstacle_clear_s) {
+    limit(0.0, "obstacle gone, waiting");
+  }
   return out;
 }
 

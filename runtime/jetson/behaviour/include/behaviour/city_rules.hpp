@@ -8,6 +8,9 @@
 // - Stop signs: a full stop (speed below stopped_m_s) for at least stop_sign_hold_s, then on.
 // - Speed limits (signs, and the advisory's when fresh), curve signs (curve_speed_m_s), and a
 //   gap of at least min_gap_m behind any car ahead on the track.
+// - An obstacle on the path (from the LIDAR): stop with the front obstacle_margin_m before it,
+//   and go on once the path has been clear for obstacle_clear_s. No fresh scan (the LIDAR is
+//   gone): the path counts as blocked right ahead.
 #pragma once
 
 #include <autodrive_vehicle.h>
@@ -35,6 +38,11 @@ struct RulesConfig {
   double min_gap_m = 0.15;        // bumper to bumper behind a car ahead [m]
   double peer_corridor_m = 0.17;  // a peer this close to the track's centre line is on it [m]
   double peer_horizon_m = 1.2;    // how far ahead peers are looked for [m]
+  // the front stops this far before an obstacle [m]: more than the LIDAR's blind zone ahead of
+  // the front (range_min_m 0.15 m from the LIDAR, 0.105 m from the front), so that a car
+  // standing before a box still sees it go
+  double obstacle_margin_m = 0.15;
+  double obstacle_clear_s = 1.0;  // the path clear this long before going on after one [s]
 };
 
 enum class LightState : int8_t { off = 0, red = 1, yellow = 2, green = 3 };
@@ -52,6 +60,10 @@ struct RulesInput {
   int64_t t_us = 0;  // the car's clock [us]
   Advisory advisory;
   std::vector<double> peers_ahead_m;  // along the track from base_link to each peer's base_link
+  // LIDAR: whether a fresh scan was judged (false: the path counts as blocked), and along the
+  // track from base_link to the nearest obstacle on the path (< 0: clear)
+  bool scan_fresh = true;
+  double obstacle_ahead_m = -1;
 };
 
 struct RulesOutput {
@@ -77,6 +89,7 @@ class CityRules {
   std::map<long, int64_t> still_since_us_;
   std::map<long, bool> served_;
   uint64_t stop_signs_served_ = 0;
+  int64_t obstacle_seen_us_ = -1;  // the last step an obstacle held the car [us]
 };
 
 }  // namespace behaviour
