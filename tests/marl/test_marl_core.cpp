@@ -153,6 +153,28 @@ TEST(MarlShield, BrakesInScriptedHeadOn) {
   }
 }
 
+TEST(MarlShield, BacksOutOfAStandingDeadlock) {
+  // Two standing cars nose to nose (the deadlock a wide turn into the oncoming lane left in the
+  // batch): the one that goes first (id 1) still brakes; the other backs up, straight, unless a
+  // car stands right behind it.
+  const adm_shield_config_t cfg = nigel_shield();
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, 0.0, 0.0, 0.0);
+  const adm_car_t b = car(2, 0.42, 0.0, kPi, 0.0);
+  adm_shield_result_t ra, rb;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(ra.intervened);
+  EXPECT_EQ(ra.command.throttle, cfg.brake_throttle);
+  EXPECT_TRUE(rb.intervened);
+  EXPECT_EQ(rb.command.throttle, cfg.back_throttle);
+  EXPECT_EQ(rb.command.steering, 0.0);
+  const adm_car_t peers[2] = {a, car(3, 0.80, 0.0, kPi, 0.0)};  // right behind b
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, peers, 2, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(rb.intervened);
+  EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
+}
+
 TEST(MarlShield, LeavesClearAndParallelTrafficAlone) {
   const adm_shield_config_t cfg = nigel_shield();
   const double v = cfg.top_speed_m_s;

@@ -11,18 +11,17 @@ Usage: test_ray_cluster_parking.py ROOT BUILD PORT (LCM port of the first job; 4
 from __future__ import annotations
 
 import json
-import os
 import pathlib
-import signal
-import socket
 import subprocess
 import sys
 import shutil
 import tempfile
-import time
 from typing import Any
 
 from autodrive_tools import sweep
+
+sys.path.insert(0, str(pathlib.Path(__file__).parent))
+from ray_cluster import ENV, start_cluster, stop_cluster  # noqa: E402
 
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 RAY = root / ".venv" / "bin" / "ray"
@@ -32,53 +31,6 @@ SEEDS = 4
 # (not in the sim's lockstep) too far behind a sim that runs as fast as the runtime keeps up,
 # and in real time still missed the goal on a loaded machine.
 SCENARIO = ["--mapping-route", "", "--no-late-box", "--rtf", "0.5", "--timeout", "300"]
-ENV = dict(os.environ, RAY_USAGE_STATS_ENABLED="0")
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port: int = s.getsockname()[1]
-        return port
-
-
-def ours(tmp: str) -> list[int]:
-    """Pids of the processes of this cluster: their command line names its temp dir."""
-    pids = []
-    for d in pathlib.Path("/proc").iterdir():
-        if d.name.isdigit() and int(d.name) != os.getpid():
-            try:
-                if tmp.encode() in (d / "cmdline").read_bytes():
-                    pids.append(int(d.name))
-            except OSError:
-                pass
-    return pids
-
-
-def stop_cluster(nodes: list[subprocess.Popen[bytes]], tmp: str) -> None:
-    """SIGTERM to each `ray start --block` (it stops its node), then SIGKILL what is left of
-    this cluster; at most ~30 s."""
-    for n in nodes:
-        if n.poll() is None:
-            n.send_signal(signal.SIGTERM)
-    deadline = time.monotonic() + 20
-    for n in nodes:
-        try:
-            n.wait(timeout=max(0.1, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
-            n.kill()
-            n.wait(timeout=5)
-    for _ in range(10):
-        left = ours(tmp)
-        if not left:
-            return
-        for pid in left:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-        time.sleep(0.5)
-    raise AssertionError(f"cluster processes still alive after the stop: {ours(tmp)}")
 
 
 def sweep_run(out: pathlib.Path, how: list[str]) -> dict[str, Any]:
@@ -120,28 +72,7 @@ def check(on_ray: dict[str, Any], serial: dict[str, Any]) -> None:
 tmp = tempfile.mkdtemp(prefix="adray-t", dir="/tmp")  # short: Ray's sockets live under it
 nodes: list[subprocess.Popen[bytes]] = []
 try:
-    gcs = free_port()
-    address = f"127.0.0.1:{gcs}"
-    common = ["--num-cpus", "1", "--node-ip-address", "127.0.0.1", "--block"]
-    common += ["--disable-usage-stats", "--object-store-memory", str(200 * 1024 * 1024)]
-    head = [str(RAY), "start", "--head", "--port", str(gcs), "--temp-dir", tmp]
-    head += ["--include-dashboard=false", "--ray-client-server-port", str(free_port())]
-    for argv in (head, [str(RAY), "start", "--address", address]):
-        argv += ["--dashboard-agent-listen-port", str(free_port())]
-        argv += ["--dashboard-agent-grpc-port", str(free_port())]
-        argv += ["--metrics-export-port", str(free_port())]
-        log = open(pathlib.Path(tmp) / f"node{len(nodes)}.log", "wb")
-        nodes.append(subprocess.Popen(argv + common, stdout=log, stderr=log, env=ENV))
-        # the head first: the second node joins it
-        probe = [str(RAY), "status", "--address", address]
-        deadline = time.monotonic() + 120
-        while True:
-            assert nodes[-1].poll() is None, f"ray start exited: see {log.name}"
-            st = subprocess.run(probe, capture_output=True, text=True, env=ENV, timeout=60)
-            if st.returncode == 0 and f"0.0/{len(nodes)}.0 CPU" in st.stdout:
-                break
-            assert time.monotonic() < deadline, f"node {len(nodes)} not up: {st.stdout}{st.stderr}"
-            time.sleep(1.0)
+    address = start_cluster(RAY, tmp, [1, 1], nodes)
     print(f"Ray cluster at {address}: 2 nodes, 1 CPU each", flush=True)
 
     on_ray = sweep_run(pathlib.Path(tmp) / "ray", ["--address", address])

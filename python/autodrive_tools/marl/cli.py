@@ -42,13 +42,31 @@ def cmd_train(a: argparse.Namespace) -> int:
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    pool = None
     if a.address:
-        log("--address: rollouts run on worker processes of this machine (pipes), not on Ray")
-        return 2
+        from ..sweep_ray import close_pool, open_pool
+
+        try:
+            pool = open_pool(a.workers, a.address)
+        except (ValueError, RuntimeError) as e:
+            log(str(e))
+            return 2
+        log(f"rollouts on {pool.describe()}, {a.workers} actor(s)")
     cfg = TrainConfig(
-        a.stages, a.action_mode, a.copies, a.workers, a.seed, max_wall_s=60.0 * a.max_wall_min
+        a.stages,
+        a.action_mode,
+        a.copies,
+        a.workers,
+        a.seed,
+        max_wall_s=60.0 * a.max_wall_min,
+        shield=a.shield,
+        ray_address=a.address,
     )
-    model, curve, info = train(cfg, log)
+    try:
+        model, curve, info = train(cfg, log)
+    finally:
+        if pool is not None:
+            close_pool(pool)
     info["command"] = " ".join(["tools/marl"] + sys.argv[1:])
     model.save(out / "ppo_policy.zip")
     save_curve(curve, out / "learning_curve.json")
@@ -87,6 +105,11 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument(
         "--action-mode", default="discrete", choices=("discrete", "discrete_throttle", "continuous")
     )
+    t.add_argument(
+        "--shield",
+        action="store_true",
+        help="train with the time-to-collision shield in the loop (as deployed)",
+    )
     t.add_argument("--copies", type=int, default=2, help="environment copies (each N cars)")
     t.add_argument("--workers", type=int, default=2, help="rollout processes (1: in process)")
     t.add_argument("--seed", type=int, default=0)
@@ -96,7 +119,11 @@ def parser() -> argparse.ArgumentParser:
         default=float("inf"),
         help="stop after this wall time [min] and keep the model",
     )
-    t.add_argument("--address", default="", help="Ray cluster address (not supported yet)")
+    t.add_argument(
+        "--address",
+        default="",
+        help="HOST:PORT of a Ray cluster (`ray start --head`): rollouts on its actors, one per worker",
+    )
     t.add_argument("--onnx", default=str(DEFAULT_MODEL), help="where the policy goes")
     t.add_argument("--out", default=str(REPO_ROOT / "out" / "marl-train"))
     t.set_defaults(func=cmd_train)

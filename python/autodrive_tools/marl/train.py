@@ -88,6 +88,8 @@ class TrainConfig:
     torch_threads: int = 1
     max_wall_s: float = float("inf")  # stop (and keep the model) after this wall time
     buffer: int = BUFFER  # rollout buffer (n_steps x slots); smaller only for quick tests
+    ray_address: str = ""  # rollouts on Ray actors of this cluster ("": local processes)
+    shield: bool = False  # train with the shield in the loop (it brakes; the policy steers)
 
 
 def linear(lr0: float) -> Any:
@@ -105,7 +107,11 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
     done_all = 0
     for cars, steps in cfg.stages:
         env = MarlVecEnv(
-            EnvSpec(cars, cfg.action_mode), cfg.copies, cfg.workers, cfg.seed + 7 * cars
+            EnvSpec(cars, cfg.action_mode, cfg.shield),
+            cfg.copies,
+            cfg.workers,
+            cfg.seed + 7 * cars,
+            cfg.ray_address,
         )
         n_steps = max(1, cfg.buffer // env.num_envs)
         # the learning rate decays linearly over the whole curriculum

@@ -2,7 +2,8 @@
 stable-baselines3 VecEnv of K x N single-agent slots, so one policy acts for every car. A car
 whose episode ended waits for the others as a "dead" slot: zero observation, reward 0, done
 every step (1-step episodes that bootstrap nothing), as SuperSuit's black_death does. The
-copies run in this process (workers=1) or spread over worker processes (workers > 1, pipes).
+copies run in this process (workers=1), spread over worker processes (workers > 1, pipes), or
+over Ray actors (ray_address: a cluster that `ray start --head` started; one actor per worker).
 Episode seeds come from the base seed, so a run is repeatable for a given K and workers."""
 
 from __future__ import annotations
@@ -119,10 +120,29 @@ def _worker(conn: Connection, spec: EnvSpec, copies: list[int], base_seed: int) 
         conn.close()
 
 
-class MarlVecEnv(VecEnv):
-    """copies x spec.cars slots for stable-baselines3, on `workers` processes."""
+class GroupActor:
+    """An EnvGroup in a Ray actor (the same calls as the pipe workers' commands)."""
 
-    def __init__(self, spec: EnvSpec, copies: int, workers: int = 1, seed: int = 0) -> None:
+    def __init__(self, spec: EnvSpec, copies: list[int], base_seed: int) -> None:
+        self.group = EnvGroup(spec, copies, base_seed)
+
+    def reset(self) -> npt.NDArray[np.float32]:
+        return self.group.reset()
+
+    def step(self, actions: npt.NDArray[Any]) -> tuple[Any, Any, Any, list[dict[str, Any]]]:
+        return self.group.step(actions)
+
+    def close(self) -> None:
+        self.group.close()
+
+
+class MarlVecEnv(VecEnv):
+    """copies x spec.cars slots for stable-baselines3, on `workers` processes (or Ray actors on
+    the cluster at ray_address)."""
+
+    def __init__(
+        self, spec: EnvSpec, copies: int, workers: int = 1, seed: int = 0, ray_address: str = ""
+    ) -> None:
         if copies < 1 or not 1 <= workers <= copies:
             raise ValueError(f"copies {copies}, workers {workers}: need 1 <= workers <= copies")
         probe = spec.make()
@@ -135,7 +155,17 @@ class MarlVecEnv(VecEnv):
         self.local: EnvGroup | None = None
         self.conns: list[Connection] = []
         self.procs: list[Any] = []
-        if workers == 1:
+        self.actors: list[Any] = []
+        self.pending: list[Any] = []
+        if ray_address:
+            import ray
+
+            remote = ray.remote(num_cpus=1)(GroupActor)
+            self.actors = [
+                remote.remote(spec, [int(c) for c in part], seed)  # type: ignore[attr-defined]
+                for part in split
+            ]
+        elif workers == 1:
             self.local = EnvGroup(spec, list(range(copies)), seed)
         else:
             ctx = mp.get_context("spawn")  # no fork of a process with torch threads
@@ -153,6 +183,11 @@ class MarlVecEnv(VecEnv):
     def reset(self) -> VecEnvObs:
         if self.local is not None:
             return self.local.reset()
+        if self.actors:
+            import ray
+
+            parts = ray.get([a.reset.remote() for a in self.actors])
+            return np.concatenate(parts)
         for c in self.conns:
             c.send(("reset", None))
         obs: npt.NDArray[np.float32] = np.concatenate([c.recv() for c in self.conns])
@@ -160,16 +195,24 @@ class MarlVecEnv(VecEnv):
 
     def step_async(self, actions: npt.NDArray[Any]) -> None:
         self._actions = np.asarray(actions)
-        if self.local is None:
-            start = 0
-            for c, n in zip(self.conns, self.slot_split):
-                c.send(("step", self._actions[start : start + n]))
-                start += n
+        start = 0
+        for k, n in enumerate(self.slot_split):
+            part = self._actions[start : start + n]
+            start += n
+            if self.actors:
+                self.pending.append(self.actors[k].step.remote(part))
+            elif self.conns:
+                self.conns[k].send(("step", part))
 
     def step_wait(self) -> VecEnvStepReturn:
         assert self._actions is not None
         if self.local is not None:
             parts = [self.local.step(self._actions)]
+        elif self.actors:
+            import ray
+
+            parts = ray.get(self.pending)
+            self.pending = []
         else:
             parts = [c.recv() for c in self.conns]
         obs = np.concatenate([p[0] for p in parts])
@@ -181,6 +224,13 @@ class MarlVecEnv(VecEnv):
     def close(self) -> None:
         if self.local is not None:
             self.local.close()
+        if self.actors:
+            import ray
+
+            ray.get([a.close.remote() for a in self.actors])
+            for a in self.actors:
+                ray.kill(a)
+            self.actors = []
         for c in self.conns:
             try:
                 c.send(("close", None))

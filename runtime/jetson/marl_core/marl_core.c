@@ -155,6 +155,8 @@ void adm_shield_defaults(adm_shield_config_t *cfg) {
       .margin_m = 0.03,
       .emergency_s = 0.6,
       .brake_throttle = 0.0,
+      .back_throttle = -0.5,
+      .back_check_s = 1.0,
   };
 }
 
@@ -181,6 +183,52 @@ static double footprint_distance(const adm_shield_config_t *cfg, double ax, doub
       best = d < best ? d : best;
     }
   return best;
+}
+
+static int standing(const adm_car_t *c) {
+  return fabs(c->speed_m_s) < ADM_STOPPED_M_S;
+}
+
+/* Self stands in the way of a standing peer that goes first (the lower id): the peer's bare
+ * footprint, driven straight on at top speed, touches self's within emergency_s. */
+static int blocks_a_first_peer(const adm_shield_config_t *cfg, const adm_car_t *self,
+                               const adm_car_t *peers, int n_peers) {
+  if (!standing(self)) return 0;
+  const double half_len = 0.25 * cfg->chassis_length_m, half_w = 0.5 * cfg->chassis_width_m;
+  const double touch = 2.0 * sqrt(half_len * half_len + half_w * half_w);
+  for (int i = 0; i < n_peers; i++) {
+    const adm_car_t *p = &peers[i];
+    if (p->id == self->id || p->id > self->id || !standing(p)) continue;
+    for (double t = cfg->dt_s; t < cfg->emergency_s + 1e-9; t += cfg->dt_s) {
+      const double s = cfg->top_speed_m_s * t;
+      const double qx = p->x_m + s * cos(p->yaw_rad), qy = p->y_m + s * sin(p->yaw_rad);
+      if (footprint_distance(cfg, qx, qy, p->yaw_rad, self->x_m, self->y_m, self->yaw_rad) < touch)
+        return 1;
+    }
+  }
+  return 0;
+}
+
+/* Self's way straight back at back_throttle keeps contact (footprints plus margin) with no car
+ * for back_check_s, each peer keeping its heading and speed. */
+static int way_back_clear(const adm_shield_config_t *cfg, const adm_car_t *self,
+                          const adm_car_t *peers, int n_peers, double contact) {
+  const double v = cfg->back_throttle * cfg->top_speed_m_s; /* < 0 */
+  for (double t = cfg->dt_s; t < cfg->back_check_s + 1e-9; t += cfg->dt_s) {
+    const double px = self->x_m + v * t * cos(self->yaw_rad);
+    const double py = self->y_m + v * t * sin(self->yaw_rad);
+    for (int i = 0; i < n_peers; i++) {
+      const adm_car_t *p = &peers[i];
+      if (p->id == self->id) continue;
+      const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
+      const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
+      const double now =
+          footprint_distance(cfg, self->x_m, self->y_m, self->yaw_rad, qx, qy, p->yaw_rad);
+      const double d = footprint_distance(cfg, px, py, self->yaw_rad, qx, qy, p->yaw_rad);
+      if (d < contact && d < now) return 0; /* closer than the margin, and closing */
+    }
+  }
+  return 1;
 }
 
 int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
@@ -238,31 +286,49 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
         both_stopped ? p->id < self->id
                      : ahead_of_self > ahead_of_peer + 0.05 ||
                            (fabs(ahead_of_self - ahead_of_peer) <= 0.05 && p->id < self->id);
-    double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
-    for (int k = 1; k <= steps; k++) {
-      const double t = k * cfg->dt_s;
-      if (t >= best_t) break;
-      /* self: kinematic bicycle, the intended steering while t <= steer_hold_s */
-      if (t <= cfg->steer_hold_s + 1e-9) pyaw += v_self * tan(steer) / cfg->wheelbase_m * cfg->dt_s;
-      px += v_self * cos(pyaw) * cfg->dt_s;
-      py += v_self * sin(pyaw) * cfg->dt_s;
-      const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
-      const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
-      const double d = footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad);
-      /* giving way: any contact with the margin; with the right of way: only a touch of the
-       * bare footprints within emergency_s (so that two cars never both wait for ever) */
-      const int brake = peer_first ? d < contact : (d < touch && t < cfg->emergency_s);
-      if (!brake) continue;
-      /* a peer behind self at contact would run into self: its own shield's job */
-      double rx, ry;
-      to_car_frame(px, py, pyaw, qx, qy, &rx, &ry);
-      if (rx < -0.5 * cfg->chassis_length_m) break;
-      best_t = t;
-      best_peer = p->id;
-      break;
+    /* Self's path under two steerings: the intended one, and straight on. The steering servo
+     * slews (~1 rad/s): a car still turning the other way follows neither exactly, but between
+     * them it stays near the straight path for the first few tenths of a second (batch seed
+     * 1000000001: a right-of-way car commanded full right kept its heading for 0.5 s and met a
+     * waiting car that the turning prediction missed). */
+    for (int hyp = 0; hyp < 2; hyp++) {
+      const double steer_h = hyp == 0 ? steer : 0.0;
+      if (hyp == 1 && steer == 0.0) break;
+      double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
+      for (int k = 1; k <= steps; k++) {
+        const double t = k * cfg->dt_s;
+        if (t >= best_t) break;
+        /* self: kinematic bicycle, the steering while t <= steer_hold_s */
+        if (t <= cfg->steer_hold_s + 1e-9)
+          pyaw += v_self * tan(steer_h) / cfg->wheelbase_m * cfg->dt_s;
+        px += v_self * cos(pyaw) * cfg->dt_s;
+        py += v_self * sin(pyaw) * cfg->dt_s;
+        const double qx = p->x_m + p->speed_m_s * cos(p->yaw_rad) * t;
+        const double qy = p->y_m + p->speed_m_s * sin(p->yaw_rad) * t;
+        const double d = footprint_distance(cfg, px, py, pyaw, qx, qy, p->yaw_rad);
+        /* giving way: any contact with the margin; with the right of way: only a touch of the
+         * bare footprints within emergency_s (so that two cars never both wait for ever) */
+        const int brake = peer_first ? d < contact : (d < touch && t < cfg->emergency_s);
+        if (!brake) continue;
+        /* a peer behind self at contact would run into self: its own shield's job */
+        double rx, ry;
+        to_car_frame(px, py, pyaw, qx, qy, &rx, &ry);
+        if (rx < -0.5 * cfg->chassis_length_m) break;
+        best_t = t;
+        best_peer = p->id;
+        break;
+      }
     }
   }
-  if (best_peer >= 0) {
+  if (best_peer >= 0 && cfg->back_throttle < 0.0 &&
+      blocks_a_first_peer(cfg, self, peers, n_peers) &&
+      way_back_clear(cfg, self, peers, n_peers, contact)) {
+    out->command.throttle = cfg->back_throttle;
+    out->command.steering = 0.0;
+    out->intervened = 1;
+    out->peer_id = best_peer;
+    out->ttc_s = best_t;
+  } else if (best_peer >= 0) {
     out->command.throttle = cfg->brake_throttle;
     out->intervened = 1;
     out->peer_id = best_peer;

@@ -76,11 +76,14 @@ typedef struct adm_shield_config {
   double steer_limit_rad; /* full lock (steering 1) */
   double top_speed_m_s;   /* speed at throttle 1 */
   double brake_throttle;  /* the throttle sent while the shield brakes (0: stop) */
+  double back_throttle;   /* a standing car blocking a standing car that goes first backs at
+                             this (< 0; 0: never backs) */
+  double back_check_s;    /* ... if its path back stays clear (margin) for this long */
 } adm_shield_config_t;
 
 typedef struct adm_shield_result {
   adm_command_t command; /* what to send */
-  int intervened;        /* 1: braked instead of the intended command */
+  int intervened;        /* 1: braked (or backed) instead of the intended command */
   int peer_id;           /* the peer it braked for, else -1 */
   double ttc_s;          /* predicted time to collision with it, else the horizon */
 } adm_shield_result_t;
@@ -91,13 +94,14 @@ typedef struct adm_shield_result {
 void adm_shield_defaults(adm_shield_config_t *cfg);
 
 /* The time-to-collision shield. Self follows the intended command (kinematic bicycle, steering
- * held steer_hold_s, speed at least throttle * top_speed), each peer keeps its heading and
- * speed. Footprints are two circles per car covering its chassis box. Right of way between
- * two cars is the same seen from either: the car that has the other farther ahead along its
- * own heading gives way (equal within 5 cm, or both standing: the lower id goes first). Giving way,
- * self brakes for any predicted contact (footprints plus margin_m) within the horizon; with the
- * right of way, only for a touch of the bare footprints within emergency_s. A peer behind self at
- * the contact is left to that peer's shield. */
+ * held steer_hold_s, speed at least throttle * top_speed), and also goes straight on (the
+ * steering servo lags the command); each peer keeps its heading and speed. Footprints are two
+ * circles per car covering its chassis box. Right of way between two cars is the same seen from
+ * either: the car that has the other farther ahead along its own heading gives way (equal within 5
+ * cm, or both standing: the lower id goes first). Giving way, self brakes for any predicted contact
+ * (footprints plus margin_m) within the horizon; with the right of way, only for a touch of the
+ * bare footprints within emergency_s. A peer behind self at the contact is left to that peer's
+ * shield. */
 int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
                const adm_car_t *peers, int n_peers, adm_shield_result_t *out, char *err,
                size_t err_sz);
