@@ -68,6 +68,8 @@ RunConfig runconfig_load(const std::string &path) {
     d.read_in_range("max_hamming", c.detector.max_hamming, 0, 3);
     c.detector.min_margin =
         static_cast<float>(d.in_range("min_margin", 0.0, 1000.0, double{c.detector.min_margin}));
+    d.read_in_range("min_contrast", c.detector.min_contrast, 0, 255);
+    d.read_in_range("noise_k", c.detector.noise_k, 0.0, 50.0);
     d.reject_unknown();
   }
   if (n.has("tracking")) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 
 #include "eye_error.hpp"
 
@@ -19,6 +21,7 @@ Detector::Detector(const DetectorParams &p) : params_(p) {
   td->quad_sigma = p.sigma_px;
   td->refine_edges = p.refine_edges;
   td->decode_sharpening = p.sharpening;
+  td->qtp.min_white_black_diff = p.min_contrast;
   td_ = td;
   fam_ = fam;
 }
@@ -26,6 +29,35 @@ Detector::Detector(const DetectorParams &p) : params_(p) {
 Detector::~Detector() {
   apriltag_detector_destroy(static_cast<apriltag_detector_t *>(td_));
   tag36h11_destroy(static_cast<apriltag_family_t *>(fam_));
+}
+
+void Detector::set_min_contrast(int grey) {
+  static_cast<apriltag_detector_t *>(td_)->qtp.min_white_black_diff = std::clamp(grey, 0, 255);
+}
+
+int Detector::min_contrast() const {
+  return static_cast<const apriltag_detector_t *>(td_)->qtp.min_white_black_diff;
+}
+
+double estimate_noise_sigma(const cv::Mat &gray, int row_step) {
+  if (gray.type() != CV_8UC1 || gray.rows < 3 || gray.cols < 3) return 0;
+  // |response| <= 16 * 255: a histogram gives the median in one pass, no sort.
+  std::vector<uint32_t> hist(16 * 255 + 1, 0);
+  uint64_t n = 0;
+  for (int r = 1; r + 1 < gray.rows; r += std::max(1, row_step)) {
+    const uint8_t *a = gray.ptr<uint8_t>(r - 1), *b = gray.ptr<uint8_t>(r),
+                  *c = gray.ptr<uint8_t>(r + 1);
+    for (int x = 1; x + 1 < gray.cols; ++x) {
+      const int v = a[x - 1] - 2 * a[x] + a[x + 1] - 2 * (b[x - 1] - 2 * b[x] + b[x + 1]) +
+                    c[x - 1] - 2 * c[x] + c[x + 1];
+      ++hist[static_cast<size_t>(std::abs(v))];
+      ++n;
+    }
+  }
+  uint64_t seen = 0;
+  size_t med = 0;
+  while (med < hist.size() && 2 * (seen + hist[med]) < n) seen += hist[med++];
+  return static_cast<double>(med) / (6.0 * 0.6745);
 }
 
 std::vector<Detection> Detector::detect(const cv::Mat &gray) {

@@ -19,6 +19,15 @@ struct DetectorParams {
   double sharpening = 0.25;  // decode_sharpening
   int max_hamming = 1;       // reject detections with more corrected bits than this
   float min_margin = 20.0f;  // reject detections with a lower decision margin
+  // libapriltag thresholds only where the local grey range (max - min over ~12x12 px) reaches
+  // min_contrast (its qtp.min_white_black_diff); elsewhere it sees no edges. Image noise of
+  // sigma s spans ~5-7 s over such a patch: below that every pixel of a flat region becomes an
+  // edge and the quad search drowns in noise clusters (measured: sigma 6, decimate 1, 720p:
+  // 187 ms per frame at 5 grey levels, 17 ms at 45, the same 400 of 400 tags found, still all at
+  // 70). The tracker sets it to max(min_contrast, noise_k * the frame's estimated noise sigma):
+  // 8 sigma sat on the cliff (sigma 5.2 estimated: 42; 35 still drowned), 10 is past it.
+  int min_contrast = 5;   // [grey levels]
+  double noise_k = 10.0;  // 0: min_contrast alone
 };
 
 struct Detection {
@@ -43,11 +52,20 @@ class Detector {
   // Detects in a region of the frame (corners in frame pixels) at its own decimation.
   std::vector<Detection> detect(const cv::Mat &gray, const cv::Rect &roi, float decimate);
   const DetectorParams &params() const { return params_; }
+  // The contrast libapriltag needs to see an edge [grey levels], from now on.
+  void set_min_contrast(int grey);
+  int min_contrast() const;
 
  private:
   DetectorParams params_;
   void *td_ = nullptr;   // apriltag_detector_t*
   void *fam_ = nullptr;  // apriltag_family_t*
 };
+
+// The standard deviation of the image noise [grey levels], robust to edges and texture: the
+// median absolute response of the Laplacian-difference kernel [1 -2 1; -2 4 -2; 1 -2 1]
+// (Immerkaer's noise operator, which cancels any locally linear shading; pure noise of sigma s
+// gives N(0, 36 s^2)), over every row_step-th row, divided by 6 * 0.6745.
+double estimate_noise_sigma(const cv::Mat &gray, int row_step = 4);
 
 }  // namespace eye

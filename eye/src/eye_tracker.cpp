@@ -94,6 +94,13 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
   const int n_bands = std::max(1, cfg_.tracking.full_every);
   last_full_ = !cfg_.tracking.roi || (tracks_.empty() && hints_.empty());
   const long frame = frame_++;
+  // The camera's noise changes slowly (gain, light): measured once per staggered cycle.
+  if (frame % n_bands == 0 && cfg_.detector.noise_k > 0) {
+    noise_sigma_ = estimate_noise_sigma(gray);
+    det_.set_min_contrast(
+        std::max(cfg_.detector.min_contrast,
+                 static_cast<int>(std::ceil(cfg_.detector.noise_k * noise_sigma_))));
+  }
   std::vector<Detection> dets;
   if (!last_full_) {
     for (const auto &[id, t] : tracks_) {

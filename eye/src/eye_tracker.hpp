@@ -41,6 +41,9 @@ class Tracker {
   const std::vector<Detection> &last_detections() const { return last_dets_; }
   // The regions of a full scan (whole frame at the coarse decimation, finer where tags are small).
   const ScanPlan &scan_plan() const { return plan_; }
+  // The image noise [grey levels] last estimated, and the contrast the detector needs from it.
+  double noise_sigma() const { return noise_sigma_; }
+  int min_contrast() const { return det_.min_contrast(); }
 
  private:
   struct Track {
@@ -57,6 +60,7 @@ class Tracker {
   std::map<int, Track> tracks_;                      // tag id -> last frame
   std::map<int, std::array<cv::Point2d, 4>> hints_;  // tag id -> corners, next frame
   std::vector<Detection> last_dets_;
+  double noise_sigma_ = 0;
   long frame_ = 0;
   bool last_full_ = true;
 };

@@ -173,9 +173,28 @@ TEST(WholeField, EveryCarAtTheEdgesOfAWideLensIsFound) {
   std::printf("wide lens: %d/%d car frames posed, smallest tag %.1f px, RMS %.2f mm, max %.2f mm\n",
               seen, total, tag_min, rms, worst);
   EXPECT_LT(tag_min, 26.0);
+  // The detector's contrast followed the rendered noise (sigma 6): noise-only patches are
+  // skipped, and still every car is found.
+  std::printf("noise sigma %.2f, min contrast %d grey levels\n", tr.noise_sigma(),
+              tr.min_contrast());
+  EXPECT_GT(tr.noise_sigma(), 4.0);
+  EXPECT_LT(tr.noise_sigma(), 7.0);
+  EXPECT_GE(tr.min_contrast(), 40);
   EXPECT_EQ(seen, total);
   EXPECT_LT(rms, 1.5);
   EXPECT_LT(worst, 5.0);
+}
+
+// The noise estimate follows the noise added, not the tags' edges or the vignetting.
+TEST(WholeField, NoiseEstimateFollowsTheNoiseNotTheEdges) {
+  Wide x = wide_scene();
+  const auto cars = eye::synth_wide_drive(x.s, 1)[0];
+  for (double sigma : {2.0, 6.0}) {
+    x.s.noise_sigma = sigma;
+    const double est = eye::estimate_noise_sigma(eye::synth_frame(x.s, cars, x.refs, 3));
+    std::printf("noise sigma %.1f: estimated %.2f\n", sigma, est);
+    EXPECT_NEAR(est, sigma, 0.2 * sigma);
+  }
 }
 
 // Same id found by two overlapping regions: one detection; far apart: both (ambiguous).
