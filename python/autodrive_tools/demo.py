@@ -135,6 +135,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="smart-city: V2I advisories from autodrive-scm (web app; default) or the small "
         "stand-in publisher (autodrive_tools.city.advisory)",
     )
+    p.add_argument(
+        "--city-eye",
+        choices=("cameras", "standin"),
+        default="cameras",
+        help="smart-city: car poses from autodrive-eye on the simulator's rendered overhead "
+        "cameras (default; --cameras FPS sets their rate, 0: the mission's default) or from the "
+        "ground-truth stand-in (truth + noise: cheaper, not the real Eye)",
+    )
     p.add_argument("--scm-port", type=int, default=8765, help="smart-city: the SCM's web port")
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
