@@ -38,10 +38,10 @@ class OverheadCamera:
         return [f, 0, 0.5 * (self.width_px - 1), 0, f, 0.5 * (self.height_px - 1), 0, 0, 1]
 
     def image_channel(self) -> str:
-        return channel("CAM_IMAGE", self.name)
+        return channel("IMAGE", self.name)
 
     def info_channel(self) -> str:
-        return channel("CAM_CAMERA_INFO", self.name)
+        return channel("CAMERA_INFO", self.name)
 
     def pixel(self, x_m: float, y_m: float, z_m: float) -> tuple[float, float]:
         """Where a map point lands in the image [px]."""

@@ -2,7 +2,7 @@
 
 A per-vehicle channel "<VEH>_ODOM" becomes AUTODRIVE_CH_ODOM_SUFFIX "_ODOM" (appended to the
 vehicle name: `vehicle + AUTODRIVE_CH_ODOM_SUFFIX`, or "%s" AUTODRIVE_CH_ODOM_SUFFIX in C), and a
-per-camera one "<CAM>_IMAGE" likewise AUTODRIVE_CH_CAM_IMAGE_SUFFIX "_IMAGE"; a
+per-camera one "<CAM>_IMAGE" likewise AUTODRIVE_CH_IMAGE_SUFFIX "_IMAGE"; a
 global one becomes AUTODRIVE_CH_<ID> with its whole name. Planned channels are generated too,
 marked as such, so that work in progress spells them from the table as well."""
 

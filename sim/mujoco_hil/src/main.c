@@ -299,9 +299,9 @@ static int main_eye_cams_open(main_cams_t *k, const mjModel *m, char *err, size_
     k->cam[k->n] = sim_camera_create(k->render, m, name, name, w, h, 90, err, err_sz);
     if (!k->cam[k->n]) return -1;
     k->cam_id[k->n] = id;
-    snprintf(k->channel[k->n], sizeof k->channel[0], "%s" AUTODRIVE_CH_CAM_IMAGE_SUFFIX, cam);
-    snprintf(k->info_channel[k->n], sizeof k->info_channel[0],
-             "%s" AUTODRIVE_CH_CAM_CAMERA_INFO_SUFFIX, cam);
+    snprintf(k->channel[k->n], sizeof k->channel[0], "%s" AUTODRIVE_CH_IMAGE_SUFFIX, cam);
+    snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "%s" AUTODRIVE_CH_CAMERA_INFO_SUFFIX,
+             cam);
     k->n++;
   }
   return 0;
