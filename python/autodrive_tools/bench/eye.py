@@ -68,22 +68,24 @@ def main(argv: list[str]) -> int:
         text=True,
     ).stdout
     figures = key_values(text)
-    sim_s = float(os.environ.get("EYE_BENCH_SIM_S", "30"))
-    if sim_s != 0 and os.access(build / "bin" / "autodrive-sim", os.X_OK):
-        log(f"simulator overhead camera, {sim_s:g} s")
+    # (option, default sim seconds, what, measure, output prefix) of each simulator run
+    sim_runs = (
+        ("EYE_BENCH_SIM_S", "30", "simulator overhead camera", eye_sim.measure, "eye_sim_trajectory"),
+        ("EYE_BENCH_MULTI_S", "140", "Tiny Town's cameras as one Eye, a lap", eye_multi.measure,
+         "eye_multi_cam"),
+    )  # fmt: skip
+    for option, default, what, measure, prefix in sim_runs:
+        sim_s = float(os.environ.get(option, default))
+        if sim_s == 0:
+            continue
+        if not os.access(build / "bin" / "autodrive-sim", os.X_OK):
+            log(f"autodrive-sim not built: no {what} figures")
+            continue
+        log(f"{what}, {sim_s:g} s")
         try:
-            figures.update(eye_sim.measure(build, sim_s, str(out / "eye_sim_trajectory")))
+            figures.update(measure(build, sim_s, str(out / prefix)))
         except RuntimeError as e:
-            log(f"simulator check failed: {e}")
-    elif sim_s != 0:
-        log("autodrive-sim not built: no simulator figures")
-    multi_s = float(os.environ.get("EYE_BENCH_MULTI_S", "140"))
-    if multi_s != 0 and os.access(build / "bin" / "autodrive-sim", os.X_OK):
-        log(f"Tiny Town's overhead cameras as one Eye, a lap of {multi_s:g} s")
-        try:
-            figures.update(eye_multi.measure(build, multi_s, str(out / "eye_multi_cam")))
-        except RuntimeError as e:
-            log(f"multi-camera check failed: {e}")
+            log(f"{what} failed: {e}")
     for k, v in figures.items():
         print(f"{k} {v}")
     try:
