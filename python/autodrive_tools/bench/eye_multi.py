@@ -45,8 +45,8 @@ TAG_X_M, _, TAG_Z_M = NIGEL.vector("tag_pos_m")  # the roof tag: ahead of, above
 CAMERA_FPS = 10.0
 EYE_START_S = 1.5
 EYE_IDLE_TIMEOUT_S = 8
-# How the car drives: "lap" once round the town's loop (route loop_ccw, ~135 s: eye1, eye2,
-# eye4, eye3 and back, four handovers); "crossing" straight east along the loop's south lane
+# How the car drives: "lap" once round the town's loop (route loop_ccw from its start on the
+# east road, ~135 s: eye2, eye4, eye3, eye1 and back; 60 s reach eye3); "crossing" straight east along the loop's south lane
 # through the overlap of eye1 and eye2 (~8 s: one handover, for the test).
 DRIVES = {
     "lap": ["--script", "route:loop_ccw,laps=1"],
