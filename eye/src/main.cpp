@@ -267,9 +267,26 @@ int main(int argc, char **argv) {
       std::vector<eye::Frame> fs(srcs.size());
       long frames = 0, published = 0;
       std::vector<double> latency_ms;  // capture (device, gst) to poses on LCM
+      // Cameras on the bus (the simulator's) stamp the frames they take together with one
+      // capture time. A frame lost on one channel (UDP, or a full queue) would pair the other
+      // cameras' frames with a later one of it, so lcm: sources are brought to the newest
+      // capture time among them before their frames are used together.
+      bool align = srcs.size() > 1;
+      for (size_t i = 0; i < cfg.cameras.size(); ++i)
+        align = align && cfg.cameras[i].source.rfind("lcm:", 0) == 0;
+      long unpaired = 0;  // frames dropped because another camera lacked theirs
       const auto all_next = [&] {
         for (size_t i = 0; i < srcs.size(); ++i)
           if (!srcs[i]->next(&fs[i])) return false;
+        for (bool same = !align; !same;) {
+          int64_t newest = fs[0].utime;
+          for (const auto &f : fs) newest = std::max(newest, f.utime);
+          same = true;
+          for (size_t i = 0; i < srcs.size(); ++i)
+            for (; fs[i].utime < newest; ++unpaired)
+              if (!srcs[i]->next(&fs[i])) return false;
+          for (const auto &f : fs) same = same && f.utime == fs[0].utime;
+        }
         return true;
       };
       while (!g_stop && (rn_max_frames <= 0 || frames < rn_max_frames) && all_next()) {
@@ -322,6 +339,11 @@ int main(int argc, char **argv) {
         ++frames;
       }
       std::fprintf(stderr, "autodrive-eye: %ld frames, %ld poses published\n", frames, published);
+      if (unpaired > 0)
+        std::fprintf(stderr,
+                     "autodrive-eye: %ld camera frames dropped: another camera had no frame of "
+                     "their capture time\n",
+                     unpaired);
       if (!latency_ms.empty()) {
         std::sort(latency_ms.begin(), latency_ms.end());
         const auto pct = [&](double q) {

@@ -14,10 +14,12 @@ import yaml
 from .paths import CHANNEL_TABLE
 
 VEH = "<VEH>"
+CAM = "<CAM>"  # an overhead camera of the map (EYE1, EYE2, ...: the map's eye_cameras)
 # Conditions of a channel's optional "when": published only on maps with traffic lights, only
 # when someone acts (a command), only when a runtime knows its map pose (v2v: an Eye or
 # estimator.initial_pose_map), or only while the Smart City Manager runs. "" = every run.
-WHEN = frozenset({"", "traffic_lights", "on_demand", "v2v", "smart_city"})
+# eye_cameras: only when the simulator renders a map's several overhead cameras.
+WHEN = frozenset({"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras"})
 
 
 class ChannelTableError(ValueError):
@@ -26,7 +28,7 @@ class ChannelTableError(ValueError):
 
 @dataclass(frozen=True)
 class Channel:
-    name: str  # pattern, "<VEH>_..." for per-vehicle channels
+    name: str  # pattern, "<VEH>_..." per vehicle, "<CAM>_..." per overhead camera
     id: str
     type: str
     rate: str
@@ -40,12 +42,22 @@ class Channel:
     def per_vehicle(self) -> bool:
         return self.name.startswith(VEH + "_")
 
+    @property
+    def per_camera(self) -> bool:
+        return self.name.startswith(CAM + "_")
+
+    @property
+    def placeholder(self) -> str:
+        """<VEH> or <CAM> for a channel per vehicle or per camera, else ""."""
+        return VEH if self.per_vehicle else CAM if self.per_camera else ""
+
     def resolve(self, vehicle: str | None = None) -> str:
-        """The concrete channel name; per-vehicle channels need the vehicle name."""
-        if self.per_vehicle:
+        """The concrete channel name; per-vehicle (per-camera) channels need the vehicle
+        (camera) name."""
+        if self.placeholder:
             if not vehicle:
-                raise ChannelTableError(f"channel {self.name} needs a vehicle name")
-            return vehicle.upper() + self.name[len(VEH) :]
+                raise ChannelTableError(f"channel {self.name} needs a {self.placeholder} name")
+            return vehicle.upper() + self.name[len(self.placeholder) :]
         return self.name
 
 
@@ -65,11 +77,11 @@ class ChannelTable:
     def match(self, concrete: str) -> Channel | None:
         """The table entry a concrete name (e.g. NIGEL2_ODOM) belongs to, or None."""
         for ch in self.channels:
-            if ch.per_vehicle:
-                suffix = ch.name[len(VEH) :]
+            if ch.placeholder:
+                suffix = ch.name[len(ch.placeholder) :]
                 prefix = concrete[: -len(suffix)] if concrete.endswith(suffix) else ""
-                # a vehicle name is capitals and digits, no underscore (NIGEL1_LASER_ODOM is
-                # LASER_ODOM of NIGEL1, not ODOM of NIGEL1_LASER)
+                # a vehicle (camera) name is capitals and digits, no underscore
+                # (NIGEL1_LASER_ODOM is LASER_ODOM of NIGEL1, not ODOM of NIGEL1_LASER)
                 if prefix and prefix.isalnum() and prefix.isupper():
                     return ch
             elif ch.name == concrete:

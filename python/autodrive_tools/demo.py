@@ -135,6 +135,15 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="smart-city: V2I advisories from autodrive-scm (web app; default) or the small "
         "stand-in publisher (autodrive_tools.city.advisory)",
     )
+    p.add_argument(
+        "--city-eye",
+        choices=("cameras", "standin"),
+        default="standin",
+        help="smart-city: car poses from the ground-truth stand-in (truth + noise; default: the "
+        "real Eye's rendering does not leave 2 shared cores enough for 3 laps, README) or from "
+        "autodrive-eye on the simulator's rendered overhead cameras (--cameras FPS sets their "
+        "rate, 0: the mission's default)",
+    )
     p.add_argument("--scm-port", type=int, default=8765, help="smart-city: the SCM's web port")
     p.add_argument(
         "--late-obstacles",

@@ -34,13 +34,13 @@ rows = 0
 for ch in table.channels:
     rows += 1
     name, typ = ch.name, ch.type
-    if not re.fullmatch(r"(<VEH>_)?[A-Z0-9_]+", name):
-        errors.append(f"channel {name}: not UPPER_CASE (with optional <VEH>_ prefix)")
+    if not re.fullmatch(r"(<VEH>_|<CAM>_)?[A-Z0-9_]+", name):
+        errors.append(f"channel {name}: not UPPER_CASE (with optional <VEH>_ or <CAM>_ prefix)")
     if name in channels:
         errors.append(f"channel {name}: listed twice")
     if ch.id in ids:
         errors.append(f"channel {name}: id {ch.id} used twice")
-    if name.replace("<VEH>_", "") != ch.id:
+    if name.replace("<VEH>_", "").replace("<CAM>_", "") != ch.id:
         errors.append(f"channel {name}: id {ch.id} does not match the name")
     ids.add(ch.id)
     channels[name] = typ

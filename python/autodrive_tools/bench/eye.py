@@ -6,10 +6,13 @@ autodrive-sim is built, the Eye on the simulator's overhead camera against its g
 k2 0.10), dim light, vignetting, noise sigma 6, 10 cars with 18-40 px tags over the whole image,
 edges included; the Eye (whole-field plan) against the previous default (decimate-2 scans) and
 decimate 1 everywhere in the same run (fps ratios), with and without window tracking; and a
-camera bumped by 5 mm / 0.3 deg (bumped_camera_*). Speeds are medians over passes; *_cpu divide by
-thread CPU time instead of wall time (the machine is shared). Writes out/bench/eye_trajectory
-{.csv,.png} and eye_sim_trajectory{.csv,.png}. Progress on stderr; last line one JSON object.
-Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3), EYE_BENCH_SIM_S (30, 0: skip)."""
+camera bumped by 5 mm / 0.3 deg (bumped_camera_*). sim_handover_gap_frames and
+sim_multi_cam_*: Tiny Town's four overhead cameras rendered by the simulator as one Eye, a car
+driving a lap through their overlaps (autodrive_tools.bench.eye_multi). Speeds are medians
+over passes; *_cpu divide by thread CPU time instead of wall time (the machine is shared). Writes out/bench/eye_trajectory
+{.csv,.png}, eye_sim_trajectory{.csv,.png} and eye_multi_cam{.csv,.png}. Progress on stderr;
+last line one JSON object. Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3),
+EYE_BENCH_SIM_S (30, 0: skip), EYE_BENCH_MULTI_S (140, 0: skip)."""
 
 from __future__ import annotations
 
@@ -20,7 +23,7 @@ from pathlib import Path
 
 from .. import plots
 from ..runfiles import read_columns
-from . import Progress, build_dir, eye_sim, out_dir, print_figures
+from . import Progress, build_dir, eye_multi, eye_sim, out_dir, print_figures
 
 INT_KEYS = ("frames", "repeats")
 log = Progress("eye")
@@ -65,15 +68,24 @@ def main(argv: list[str]) -> int:
         text=True,
     ).stdout
     figures = key_values(text)
-    sim_s = float(os.environ.get("EYE_BENCH_SIM_S", "30"))
-    if sim_s != 0 and os.access(build / "bin" / "autodrive-sim", os.X_OK):
-        log(f"simulator overhead camera, {sim_s:g} s")
+    # (option, default sim seconds, what, measure, output prefix) of each simulator run
+    sim_runs = (
+        ("EYE_BENCH_SIM_S", "30", "simulator overhead camera", eye_sim.measure, "eye_sim_trajectory"),
+        ("EYE_BENCH_MULTI_S", "140", "Tiny Town's cameras as one Eye, a lap", eye_multi.measure,
+         "eye_multi_cam"),
+    )  # fmt: skip
+    for option, default, what, measure, prefix in sim_runs:
+        sim_s = float(os.environ.get(option, default))
+        if sim_s == 0:
+            continue
+        if not os.access(build / "bin" / "autodrive-sim", os.X_OK):
+            log(f"autodrive-sim not built: no {what} figures")
+            continue
+        log(f"{what}, {sim_s:g} s")
         try:
-            figures.update(eye_sim.measure(build, sim_s, str(out / "eye_sim_trajectory")))
+            figures.update(measure(build, sim_s, str(out / prefix)))
         except RuntimeError as e:
-            log(f"simulator check failed: {e}")
-    elif sim_s != 0:
-        log("autodrive-sim not built: no simulator figures")
+            log(f"{what} failed: {e}")
     for k, v in figures.items():
         print(f"{k} {v}")
     try:

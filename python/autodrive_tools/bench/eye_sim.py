@@ -66,17 +66,21 @@ def write_eye_config(tmp: Path, url: str) -> Path:
 class Recorder:
     """Ground truth, Eye poses and camera infos from the bus, on a thread."""
 
-    def __init__(self, build: Path, url: str) -> None:
+    def __init__(
+        self, build: Path, url: str, vehicle: str = VEHICLE, info_channels: list[str] | None = None
+    ) -> None:
         types = lcmtypes.load(build)
         self.truth: list[Any] = []
         self.poses: list[Any] = []
         self.info: list[Any] = []
         self.lc = lcmtypes.bus(f"{url}&recv_buf_size={RECV_BUF_BYTES}")
-        for ch, typ, into in (
-            (channel("GROUND_TRUTH", VEHICLE), types.ground_truth_t, self.truth),
-            (channel("POSE_EYE", VEHICLE), types.pose2d_t, self.poses),
-            (channel("EYE_CAMERA_INFO"), types.camera_info_t, self.info),
-        ):
+        subs = [
+            (channel("GROUND_TRUTH", vehicle), types.ground_truth_t, self.truth),
+            (channel("POSE_EYE", vehicle), types.pose2d_t, self.poses),
+        ]
+        for ch in info_channels or [channel("EYE_CAMERA_INFO")]:
+            subs.append((ch, types.camera_info_t, self.info))
+        for ch, typ, into in subs:
             self.lc.subscribe(ch, lambda _c, d, t=typ, to=into: to.append(t.decode(d)))
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._pump, daemon=True)

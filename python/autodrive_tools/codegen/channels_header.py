@@ -1,7 +1,8 @@
 """lcm_types/channels.yaml -> <autodrive_channels.h>: the channel names for C and C++.
 
 A per-vehicle channel "<VEH>_ODOM" becomes AUTODRIVE_CH_ODOM_SUFFIX "_ODOM" (appended to the
-vehicle name: `vehicle + AUTODRIVE_CH_ODOM_SUFFIX`, or "%s" AUTODRIVE_CH_ODOM_SUFFIX in C); a
+vehicle name: `vehicle + AUTODRIVE_CH_ODOM_SUFFIX`, or "%s" AUTODRIVE_CH_ODOM_SUFFIX in C), and a
+per-camera one "<CAM>_IMAGE" likewise AUTODRIVE_CH_IMAGE_SUFFIX "_IMAGE"; a
 global one becomes AUTODRIVE_CH_<ID> with its whole name. Planned channels are generated too,
 marked as such, so that work in progress spells them from the table as well."""
 
@@ -23,8 +24,8 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
     ]
     for ch in table.channels:
         note = f"/* {ch.type}, {ch.rate}" + (", planned */" if ch.status == "planned" else " */")
-        if ch.per_vehicle:
-            suffix = ch.name[len(channels.VEH) :]
+        if ch.placeholder:
+            suffix = ch.name[len(ch.placeholder) :]
             lines.append(f'#define AUTODRIVE_CH_{ch.id}_SUFFIX "{suffix}" {note}')
         else:
             lines.append(f'#define AUTODRIVE_CH_{ch.id} "{ch.name}" {note}')

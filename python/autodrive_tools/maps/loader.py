@@ -25,6 +25,7 @@ TILE_JOIN_TOLERANCE_RAD = 0.001  # ... with the same heading (a smooth, tangent-
 ON_LANE_TOLERANCE_M = 0.01  # a stop line's centre must be this close to its lane's centre line
 
 MAX_LATE_OBSTACLES = 8  # the simulator's SCN_MAX_MAP_LATE_BOXES (scenario.h)
+MAX_EYE_CAMERAS = 8  # the simulator's MAIN_MAX_EYE_CAMS (main.c)
 
 
 def names(maps_dir: Path = MAPS_DIR) -> list[str]:
@@ -161,6 +162,7 @@ class _Checker:
             self.unique(f"parked_{p.slot}", f"parked[{i}].slot")
             if p.slot not in {s.name for s in m.slots()}:
                 raise self.err(f"parked[{i}].slot", f"no parking slot '{p.slot}'")
+        self.eye_cameras()
         if len(m.late_obstacles) > MAX_LATE_OBSTACLES:
             raise self.err(
                 "late_obstacles",
@@ -263,6 +265,21 @@ class _Checker:
                 raise self.err(key, "give a route (and along_m) or position_m and yaw_deg")
         for i, sp in enumerate(self.m.named_spawns()):
             self.on_floor([(sp.pose.x_m, sp.pose.y_m)], f"spawns[{i}]")
+
+    def eye_cameras(self) -> None:
+        cams = self.m.eye_cameras
+        if len(cams) > MAX_EYE_CAMERAS:
+            raise self.err("eye_cameras", f"at most {MAX_EYE_CAMERAS}, got {len(cams)}")
+        for i, c in enumerate(cams):
+            key = f"eye_cameras[{i}]"
+            # the name in capitals is a channel's <CAM>: letters and digits, no underscore
+            if not (c.name.isalnum() and c.name.islower() and c.name.startswith("eye")):
+                raise self.err(
+                    f"{key}.name", f"'{c.name}': must be eye<letters or digits>, lower case"
+                )
+            self.unique(c.name, f"{key}.name")
+            self.on_floor([c.centre_m], f"{key}.centre_m")
+            self.positive(c.height_m, f"{key}.height_m")
 
     def lights(self) -> None:
         stops = {s.name for s in self.m.all_stop_lines()}

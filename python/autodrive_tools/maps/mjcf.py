@@ -106,6 +106,12 @@ class _Writer:
             f'<camera name="eye" pos="0 0 {num(eye.height_m)}" xyaxes="1 0 0 0 1 0" '
             f'fovy="{num(eye.fovy_deg)}"/>'
         )
+        for c in m.eye_cameras:  # user: the image size, which marks it for autodrive-sim --eye
+            self.add(
+                f'<camera name="{c.name}" pos="{nums((*c.centre_m, c.height_m))}" '
+                f'xyaxes="1 0 0 0 1 0" fovy="{num(eye.fovy_deg)}" '
+                f'user="{eye.width_px} {eye.height_px}"/>'
+            )
         self.add(
             f'<geom name="floor" type="plane" size="{nums((h, h))} 0.1" {WORLD} '
             f'{self.friction(floor.friction)} rgba="{nums(floor.rgba)}"/>'

@@ -84,6 +84,8 @@ class RoadKit:
 class EyeCameraKit:
     height_m: float
     fovy_deg: float
+    width_px: int  # every overhead camera's image (the map's 'eye' and its eye_cameras)
+    height_px: int
 
 
 @dataclass(frozen=True)
@@ -380,6 +382,17 @@ class LateObstacle:
 
 
 @dataclass(frozen=True)
+class EyeCameraSpec:
+    """One of a map's several overhead cameras: straight down from height_m above centre_m,
+    image up = map +y, the kit's fovy and image size. Its channels are <CAM>_IMAGE and
+    <CAM>_CAMERA_INFO with <CAM> = the name in capitals."""
+
+    name: str
+    centre_m: Vec2
+    height_m: float
+
+
+@dataclass(frozen=True)
 class Options:
     light_level: float = 1.0  # 0 (night) .. 1 (day)
 
@@ -406,6 +419,7 @@ class MapFile:
     spawns: list[SpawnSpec] = field(default_factory=list)
     parked: list[Parked] = field(default_factory=list)
     late_obstacles: list[LateObstacle] = field(default_factory=list)
+    eye_cameras: list[EyeCameraSpec] = field(default_factory=list)
 
 
 @dataclass(frozen=True)

@@ -194,6 +194,17 @@ def document(m: MapDescription) -> dict[str, Any]:
             {"slot": p.slot, "name": f"parked_{p.slot}", "size_m": list(kit.parked_car_size_m)}
             for p in m.parked
         ],
+        "eye_cameras": [
+            {
+                "name": c.name,
+                "centre_m": _xy(c.centre_m),
+                "height_m": c.height_m,
+                "fovy_deg": kit.eye_camera.fovy_deg,
+                "width_px": kit.eye_camera.width_px,
+                "height_px": kit.eye_camera.height_px,
+            }
+            for c in m.eye_cameras
+        ],
         "late_obstacles": [
             {
                 "name": o.name,

@@ -1,7 +1,9 @@
 /* autodrive-sim: the MuJoCo 2.2 HIL simulator of Nigel. See --help and README.md. */
 #include <autodrive_channels.h>
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -107,7 +109,9 @@ static void main_usage(FILE *f) {
       "                      unless a client is scanning on the RPLIDAR pty)\n"
       "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
       "  --front-camera      render only each car's front camera (half the rendering)\n"
-      "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE\n"
+      "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE,\n"
+      "                      or, on a map with eye_cameras (Tiny Town), each of those on\n"
+      "                      <CAM>_IMAGE (EYE1_IMAGE, ...) and <CAM>_CAMERA_INFO\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
       "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
@@ -248,7 +252,8 @@ static void main_report_late_boxes(const sim_t *s) {
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
 #define MAIN_CAMERAS_ALL 1   /* --cameras: front and rear */
 #define MAIN_CAMERAS_FRONT 2 /* --front-camera: front only */
-#define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + 1)
+#define MAIN_MAX_EYE_CAMS 8  /* a map's eye_cameras (autodrive_tools.maps MAX_EYE_CAMERAS) */
+#define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + MAIN_MAX_EYE_CAMS)
 typedef struct main_cams {
   int n;
   sim_render_t *render;
@@ -271,12 +276,57 @@ static void main_cams_fx(main_cams_t *k, double noise, double blur_px, uint64_t 
   }
 }
 
+/* A map's several overhead cameras (its eye_cameras): the MJCF cameras whose user data holds
+ * their image size (width, height px), as tools/gen-maps writes them. */
+static int main_eye_cam_size(const mjModel *m, int id, int *w, int *h) {
+  if (m->nuser_cam < 2 || m->cam_user[id * m->nuser_cam] <= 0) return 0;
+  *w = (int)m->cam_user[id * m->nuser_cam];
+  *h = (int)m->cam_user[id * m->nuser_cam + 1];
+  return 1;
+}
+
+static int main_eye_cams_n(const mjModel *m) {
+  int n = 0, w, h;
+  for (int id = 0; id < m->ncam; id++) n += main_eye_cam_size(m, id, &w, &h);
+  return n;
+}
+
+/* Each on <CAM>_IMAGE and <CAM>_CAMERA_INFO, <CAM> its name in capitals. */
+static int main_eye_cams_open(main_cams_t *k, const mjModel *m, char *err, size_t err_sz) {
+  for (int id = 0, w, h; id < m->ncam; id++) {
+    if (!main_eye_cam_size(m, id, &w, &h)) continue;
+    if (k->n >= MAIN_MAX_CAMS) {
+      snprintf(err, err_sz, "--eye: more than %d overhead cameras", MAIN_MAX_EYE_CAMS);
+      return -1;
+    }
+    const char *name = mj_id2name(m, mjOBJ_CAMERA, id);
+    char cam[24];
+    size_t i = 0;
+    for (; name[i] && i + 1 < sizeof cam; i++) cam[i] = (char)toupper((unsigned char)name[i]);
+    cam[i] = '\0';
+    k->cam[k->n] = sim_camera_create(k->render, m, name, name, w, h, 90, err, err_sz);
+    if (!k->cam[k->n]) return -1;
+    k->cam_id[k->n] = id;
+    snprintf(k->channel[k->n], sizeof k->channel[0], "%s" AUTODRIVE_CH_IMAGE_SUFFIX, cam);
+    snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "%s" AUTODRIVE_CH_CAMERA_INFO_SUFFIX,
+             cam);
+    k->n++;
+  }
+  return 0;
+}
+
 static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, char *err,
                           size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
   const mjModel *m = sim_render_model(s);
-  k->render = sim_render_create(m, eye ? 1280 : 640, eye ? 960 : 480, SIM_RENDER_AUTO, err, err_sz);
+  int rw = eye ? 1280 : 640, rh = eye ? 960 : 480; /* the render buffer: the largest image */
+  for (int id = 0, w, h; eye && id < m->ncam; id++)
+    if (main_eye_cam_size(m, id, &w, &h)) {
+      rw = w > rw ? w : rw;
+      rh = h > rh ? h : rh;
+    }
+  k->render = sim_render_create(m, rw, rh, SIM_RENDER_AUTO, err, err_sz);
   if (!k->render) return -1;
   for (int c = 1; cameras && c <= sim_cars(s); c++)
     for (int rear = 0; rear < (cameras == MAIN_CAMERAS_FRONT ? 1 : 2); rear++) {
@@ -292,7 +342,8 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
                rear ? AUTODRIVE_CH_CAM_REAR_INFO_SUFFIX : AUTODRIVE_CH_CAM_FRONT_INFO_SUFFIX);
       k->n++;
     }
-  if (eye) {
+  if (eye && main_eye_cams_open(k, m, err, err_sz) != 0) return -1;
+  if (eye && !main_eye_cams_n(m)) {
     if (mj_name2id(m, mjOBJ_CAMERA, "eye") < 0) {
       snprintf(err, err_sz, "--eye: the map has no camera named 'eye'");
       return -1;
@@ -306,19 +357,18 @@ static int main_cams_open(main_cams_t *k, const sim_t *s, int cameras, int eye, 
   return 0;
 }
 
-static int main_cams_publish(main_cams_t *k, sim_t *s, lcm_t *lcm, int64_t now_us, char *err,
-                             size_t err_sz) {
+/* Renders and publishes every camera from dv (the whole map at sim time now_us). */
+static int main_cams_publish(main_cams_t *k, const mjModel *mv, mjData *dv, lcm_t *lcm,
+                             int64_t now_us, char *err, size_t err_sz) {
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
-  mjData *dv = sim_render_data(s);              /* the whole map, in step with the physics */
   for (int i = 0; i < k->n; i++) {
-    if (sim_camera_capture(k->cam[i], sim_render_model(s), dv, now_us) != 0) {
+    if (sim_camera_capture(k->cam[i], mv, dv, now_us) != 0) {
       snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
       return -1;
     }
     sim_camera_publish_image(k->cam[i], lcm, k->channel[i]);
-    if (info)
-      sim_camera_publish_info(k->cam[i], sim_render_model(s), lcm, k->info_channel[i], now_us);
+    if (info) sim_camera_publish_info(k->cam[i], mv, lcm, k->info_channel[i], now_us);
   }
   return 0;
 }
@@ -330,6 +380,131 @@ static void main_cams_close(main_cams_t *k) {
   }
   if (k->render) sim_render_destroy(k->render);
   k->n = 0;
+}
+
+/* The cameras on their own thread (real time, --rtf, --lockstep-client). Software OpenGL
+ * takes ~40 ms of CPU per 1280x960 frame, so rendering Tiny Town's four overhead cameras on
+ * the stepping thread stalled it for over 500 ms under load, and the runtimes, which want a
+ * Nano frame every 500 ms of wall time, dropped their links. The stepping thread queues a
+ * snapshot of the state at each frame time and steps on; the render thread renders them in
+ * order. While snapshots wait, the stepping thread sleeps MAIN_RENDER_YIELD_US per step and
+ * waiting frame, so the sim slows to what the renderer follows (frames stay in sim time, the
+ * ptys never go quiet for long); a frame time that finds the queue full is skipped and
+ * counted. Free --lockstep and --lockstep-frames render on the stepping thread, every frame
+ * time (repeatable runs). The GL context lives on the render thread. */
+#define MAIN_RENDER_QUEUE 4
+#define MAIN_RENDER_YIELD_US 3000
+typedef struct main_render_thread {
+  pthread_t th;
+  pthread_mutex_t mu;
+  pthread_cond_t cv;
+  main_cams_t cams;
+  sim_t *s;
+  lcm_t *lcm;
+  mjData *snap[MAIN_RENDER_QUEUE]; /* a ring of states at frame times */
+  int64_t frame_us[MAIN_RENDER_QUEUE];
+  int head, queued;         /* next to render; queued (the one in hand included) */
+  int stop, opened, failed; /* opened: 1 ok, -1 failed */
+  int cameras, eye;         /* main_cams_open's arguments */
+  double noise, blur_px;
+  uint64_t seed;
+  long rendered, skipped;
+  char err[256];
+} main_render_thread_t;
+
+static void *main_render_run(void *arg) {
+  main_render_thread_t *t = arg;
+  char err[256] = "";
+  int rc = main_cams_open(&t->cams, t->s, t->cameras, t->eye, err, sizeof err);
+  if (rc == 0) main_cams_fx(&t->cams, t->noise, t->blur_px, t->seed);
+  pthread_mutex_lock(&t->mu);
+  t->opened = rc == 0 ? 1 : -1;
+  snprintf(t->err, sizeof t->err, "%s", err);
+  pthread_cond_broadcast(&t->cv);
+  while (rc == 0) {
+    while (!t->queued && !t->stop) pthread_cond_wait(&t->cv, &t->mu);
+    if (t->stop) break;
+    mjData *snap = t->snap[t->head];
+    const int64_t frame_us = t->frame_us[t->head];
+    pthread_mutex_unlock(&t->mu);
+    const int r = main_cams_publish(&t->cams, sim_render_model(t->s), snap, t->lcm, frame_us, err,
+                                    sizeof err);
+    pthread_mutex_lock(&t->mu);
+    if (r != 0) {
+      t->failed = 1;
+      snprintf(t->err, sizeof t->err, "%s", err);
+    }
+    t->rendered++;
+    t->head = (t->head + 1) % MAIN_RENDER_QUEUE;
+    t->queued--;
+  }
+  pthread_mutex_unlock(&t->mu);
+  main_cams_close(&t->cams);
+  return NULL;
+}
+
+static int main_render_start(main_render_thread_t *t, sim_t *s, lcm_t *lcm, char *err,
+                             size_t err_sz) {
+  t->s = s;
+  t->lcm = lcm;
+  for (int i = 0; i < MAIN_RENDER_QUEUE; i++)
+    if (!(t->snap[i] = mj_makeData(sim_render_model(s)))) {
+      snprintf(err, err_sz, "cannot allocate the render thread's snapshots");
+      return -1;
+    }
+  if (pthread_mutex_init(&t->mu, NULL) != 0 || pthread_cond_init(&t->cv, NULL) != 0 ||
+      pthread_create(&t->th, NULL, main_render_run, t) != 0) {
+    snprintf(err, err_sz, "cannot start the render thread");
+    return -1;
+  }
+  pthread_mutex_lock(&t->mu);
+  while (!t->opened) pthread_cond_wait(&t->cv, &t->mu);
+  pthread_mutex_unlock(&t->mu);
+  if (t->opened > 0) return 0;
+  pthread_join(t->th, NULL);
+  snprintf(err, err_sz, "%s", t->err);
+  return -1;
+}
+
+/* The state at frame time now_us to the render thread's queue, unless it is full. */
+static int main_render_submit(main_render_thread_t *t, const sim_t *s, int64_t now_us, char *err,
+                              size_t err_sz) {
+  pthread_mutex_lock(&t->mu);
+  const int failed = t->failed;
+  if (failed) {
+    snprintf(err, err_sz, "%s", t->err);
+  } else if (t->queued == MAIN_RENDER_QUEUE) {
+    t->skipped++;
+  } else {
+    const int tail = (t->head + t->queued) % MAIN_RENDER_QUEUE;
+    sim_render_snapshot(s, t->snap[tail]);
+    t->frame_us[tail] = now_us;
+    t->queued++;
+    pthread_cond_signal(&t->cv);
+  }
+  pthread_mutex_unlock(&t->mu);
+  return failed ? -1 : 0;
+}
+
+/* Frames waiting behind the one being rendered: the stepping thread's pause this step [us]. */
+static long main_render_backlog_us(main_render_thread_t *t) {
+  pthread_mutex_lock(&t->mu);
+  const int waiting = t->queued > 1 ? t->queued - 1 : 0;
+  pthread_mutex_unlock(&t->mu);
+  return (long)waiting * MAIN_RENDER_YIELD_US;
+}
+
+static void main_render_stop(main_render_thread_t *t) {
+  pthread_mutex_lock(&t->mu);
+  t->stop = 1;
+  pthread_cond_signal(&t->cv);
+  pthread_mutex_unlock(&t->mu);
+  pthread_join(t->th, NULL);
+  for (int i = 0; i < MAIN_RENDER_QUEUE; i++) mj_deleteData(t->snap[i]);
+  fprintf(stderr,
+          "autodrive-sim: cameras (render thread): %ld frame times rendered, %ld skipped (its "
+          "queue was full)\n",
+          t->rendered, t->skipped);
 }
 
 /* The optional window (sensors library, EGL context): drawn at ~30 Hz of wall time. */
@@ -668,8 +843,17 @@ int main(int argc, char **argv) {
   sigaction(SIGTERM, &sa, NULL);
   signal(SIGPIPE, SIG_IGN);
 
-  main_cams_t cams;
-  if (main_cams_open(&cams, s, cameras, eye, err, sizeof err) != 0) {
+  main_cams_t cams; /* rendered on this thread; empty when the render thread has them */
+  memset(&cams, 0, sizeof cams);
+  static main_render_thread_t rthread; /* static: zeroed, and large (its cameras) */
+  const int threaded = (cameras || eye) && !(lockstep && (frame_sync || !client_sync));
+  rthread.cameras = cameras;
+  rthread.eye = eye;
+  rthread.noise = camera_noise;
+  rthread.blur_px = camera_blur;
+  rthread.seed = cfg.seed;
+  if (threaded ? main_render_start(&rthread, s, lcm, err, sizeof err) != 0
+               : main_cams_open(&cams, s, cameras, eye, err, sizeof err) != 0) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     sim_destroy(s);
     if (tlog) fclose(tlog);
@@ -801,11 +985,20 @@ int main(int argc, char **argv) {
         lcmpub_lidar(pubq, ch, "laser", scan);
       }
     }
-    if (cams.n > 0 && now_us % cam_period_us < SIM_STEP_US &&
-        main_cams_publish(&cams, s, lcm, now_us, err, sizeof err) != 0) {
+    if (now_us % cam_period_us < SIM_STEP_US &&
+        ((cams.n > 0 && main_cams_publish(&cams, sim_render_model(s), sim_render_data(s), lcm,
+                                          now_us, err, sizeof err) != 0) ||
+         (threaded && main_render_submit(&rthread, s, now_us, err, sizeof err) != 0))) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       rc = 1;
       break;
+    }
+    if (threaded) { /* slow down while frames wait to be rendered */
+      const long backlog_us = main_render_backlog_us(&rthread);
+      if (backlog_us > 0) {
+        const struct timespec ts = {0, backlog_us * 1000L};
+        nanosleep(&ts, NULL);
+      }
     }
     if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) {
       const double since = main_wall_s() - t0; /* average rtf of the run so far */
@@ -892,6 +1085,7 @@ int main(int argc, char **argv) {
   tl_lcm_destroy(lights);
   teleport_lcm_destroy(teleport);
   main_view_close(&viewer);
+  if (threaded) main_render_stop(&rthread);
   main_cams_close(&cams);
   sim_destroy(s); /* removes the ptys' symlinks */
   if (tlog) fclose(tlog);

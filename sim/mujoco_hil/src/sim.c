@@ -1082,18 +1082,20 @@ mjData *sim_data(const sim_t *s) {
 mjModel *sim_render_model(const sim_t *s) {
   return s->mv ? s->mv : s->m;
 }
+void sim_render_snapshot(const sim_t *s, mjData *dst) {
+  const mjModel *m = s->m;
+  dst->time = s->d->time;
+  mju_copy(dst->qpos, s->d->qpos, m->nq);
+  mju_copy(dst->qvel, s->d->qvel, m->nv);
+  mju_copy(dst->mocap_pos, s->d->mocap_pos, 3 * m->nmocap);
+  mju_copy(dst->mocap_quat, s->d->mocap_quat, 4 * m->nmocap);
+  mj_kinematics(sim_render_model(s), dst);
+  mj_camlight(sim_render_model(s), dst);
+}
 mjData *sim_render_data(sim_t *s) {
   if (!s->mv) return s->d;
-  const mjModel *m = s->m;
-  mjData *dv = s->dv;
-  dv->time = s->d->time;
-  mju_copy(dv->qpos, s->d->qpos, m->nq);
-  mju_copy(dv->qvel, s->d->qvel, m->nv);
-  mju_copy(dv->mocap_pos, s->d->mocap_pos, 3 * m->nmocap);
-  mju_copy(dv->mocap_quat, s->d->mocap_quat, 4 * m->nmocap);
-  mj_kinematics(s->mv, dv);
-  mj_camlight(s->mv, dv);
-  return dv;
+  sim_render_snapshot(s, s->dv);
+  return s->dv;
 }
 const char *sim_nano_link(const sim_t *s, int car) {
   return s->car[car - 1].has_pty ? s->car[car - 1].pty.link_path : "";

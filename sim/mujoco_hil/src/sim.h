@@ -116,6 +116,9 @@ mjData *sim_data(const sim_t *s);
  * the physics model and data. */
 mjModel *sim_render_model(const sim_t *s);
 mjData *sim_render_data(sim_t *s);
+/* The same into dst (made with mj_makeData(sim_render_model(s))): a snapshot that another
+ * thread may render while the physics steps on. */
+void sim_render_snapshot(const sim_t *s, mjData *dst);
 void sim_get_truth(const sim_t *s, int car, sim_truth_t *out); /* car 1-based */
 /* The Nano's symlink path (empty without ptys). */
 const char *sim_nano_link(const sim_t *s, int car);

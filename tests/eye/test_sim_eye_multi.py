@@ -1,0 +1,32 @@
+#!/usr/bin/env python3
+"""eye.Sim.SeveralCamerasHandOverWithoutGap: autodrive-sim --map tiny_town --eye renders the
+map's overhead cameras, a scripted car drives through the overlap of two of them, and one
+autodrive-eye serves them all; its poses vs the sim's ground truth (autodrive_tools.bench.
+eye_multi, --drive crossing). Usage: test_sim_eye_multi.py <build dir> <duration_s>"""
+import sys
+from pathlib import Path
+
+from autodrive_tools.bench import eye_multi
+
+build, dur = sys.argv[1], sys.argv[2]
+try:
+    fig = eye_multi.measure(Path(build), float(dur), None, "crossing")
+except RuntimeError as e:
+    sys.exit(f"FAIL: {e}")
+print("\n".join(f"{k} {v:g}" for k, v in fig.items()))
+fails = []
+if fig["sim_multi_cam_frames"] < 20:
+    fails.append(f"only {fig['sim_multi_cam_frames']:g} frames processed")
+if fig["sim_multi_cam_cameras_crossed"] < 2 or fig["sim_multi_cam_handovers"] < 1:
+    fails.append("the car was not handed from one camera to another")
+if fig["sim_multi_cam_frames_in_overlap"] < 1:
+    fails.append("no frame with the car's tag in two cameras (no fused pose)")
+if fig["sim_handover_gap_frames"] != 0:
+    fails.append(f"{fig['sim_handover_gap_frames']:g} frames without a pose while in view")
+if fig["sim_multi_cam_pos_rms_mm"] > 2.0:
+    fails.append(f"position rms {fig['sim_multi_cam_pos_rms_mm']} mm > 2")
+if fig["sim_multi_cam_heading_rms_deg"] > 0.5:
+    fails.append(f"heading rms {fig['sim_multi_cam_heading_rms_deg']} deg > 0.5")
+if fails:
+    sys.exit("FAIL: " + "; ".join(fails))
+print("PASS")
