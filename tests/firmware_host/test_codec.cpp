@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "collected_frames.h"
 #include "proto.h"
 
 namespace {
@@ -22,14 +23,6 @@ std::vector<uint8_t> Encode(uint8_t id, uint8_t seq, const std::vector<uint8_t> 
                                 out.data(), out.size());
   out.resize(n);
   return out;
-}
-
-struct Collected {
-  std::vector<proto_frame_t> frames;
-};
-
-void Collect(const proto_frame_t *f, void *ctx) {
-  static_cast<Collected *>(ctx)->frames.push_back(*f);
 }
 
 TEST(Crc, KnownVectors) {
@@ -264,13 +257,13 @@ TEST(Schema, HashIsFnv1aOfTheString) {
 TEST(Parser, ByteByByteAndCounters) {
   proto_parser_t p;
   proto_parser_init(&p);
-  Collected got;
+  CollectedFrames got;
   std::vector<uint8_t> stream;
   for (uint8_t s = 0; s < 5; ++s) {
     auto f = Encode(PROTO_ID_COMMAND, static_cast<uint8_t>(s * 2), std::vector<uint8_t>(9, s));
     stream.insert(stream.end(), f.begin(), f.end());
   }
-  for (uint8_t b : stream) proto_parser_feed(&p, &b, 1, Collect, &got);
+  for (uint8_t b : stream) proto_parser_feed(&p, &b, 1, collect_frame, &got);
   ASSERT_EQ(got.frames.size(), 5u);
   EXPECT_EQ(got.frames[3].seq, 6);
   EXPECT_EQ(got.frames[3].payload[0], 3);
@@ -282,14 +275,14 @@ TEST(Parser, ByteByByteAndCounters) {
 TEST(Parser, BadCrcAndOversizeLengthCounted) {
   proto_parser_t p;
   proto_parser_init(&p);
-  Collected got;
+  CollectedFrames got;
   auto good = Encode(PROTO_ID_CONFIG, 1, std::vector<uint8_t>(6, 7));
   auto bad = good;
   bad[7] ^= 0x10;
   const uint8_t oversize[] = {0xA5, 0x5A, 200};
-  proto_parser_feed(&p, bad.data(), bad.size(), Collect, &got);
-  proto_parser_feed(&p, oversize, sizeof oversize, Collect, &got);
-  proto_parser_feed(&p, good.data(), good.size(), Collect, &got);
+  proto_parser_feed(&p, bad.data(), bad.size(), collect_frame, &got);
+  proto_parser_feed(&p, oversize, sizeof oversize, collect_frame, &got);
+  proto_parser_feed(&p, good.data(), good.size(), collect_frame, &got);
   ASSERT_EQ(got.frames.size(), 1u);
   EXPECT_EQ(p.stats.bad_crc, 1u);
   EXPECT_EQ(p.stats.bad_length, 1u);
@@ -344,11 +337,11 @@ TEST(Parser, RandomizedStreamResync) {
     }
     proto_parser_t p;
     proto_parser_init(&p);
-    Collected got;
+    CollectedFrames got;
     // Feed in random chunk sizes like a UART driver would.
     for (size_t pos = 0; pos < stream.size();) {
       size_t n = std::min<size_t>(1 + rng() % 32, stream.size() - pos);
-      proto_parser_feed(&p, stream.data() + pos, n, Collect, &got);
+      proto_parser_feed(&p, stream.data() + pos, n, collect_frame, &got);
       pos += n;
     }
     stat_bad_crc += p.stats.bad_crc;

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include "collected_frames.h"
 #include "proto.h"
 
 namespace {
@@ -28,13 +29,6 @@ TEST(Portability, PlatformFacts) {
 // char signedness: bytes >= 0x80 must mean the same on every machine. Frames made of such bytes
 // (sync 0xA5, CRC bytes, negative fields) arrive through a `char` buffer, as a read() into
 // char storage would hand them, and must parse to the same values everywhere.
-struct Collected {
-  std::vector<proto_frame_t> frames;
-};
-void collect(const proto_frame_t *f, void *ctx) {
-  static_cast<Collected *>(ctx)->frames.push_back(*f);
-}
-
 TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
   proto_state_t s{};
   s.nano_time_us = 0xFEDCBA98u;
@@ -65,8 +59,8 @@ TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
 
   proto_parser_t p;
   proto_parser_init(&p);
-  Collected got;
-  ASSERT_EQ(proto_parser_feed(&p, back.data(), back.size(), collect, &got), 1u);
+  CollectedFrames got;
+  ASSERT_EQ(proto_parser_feed(&p, back.data(), back.size(), collect_frame, &got), 1u);
   ASSERT_EQ(got.frames.size(), 1u);
   proto_state_t d{};
   ASSERT_EQ(proto_state_unpack(got.frames[0].payload, got.frames[0].len, &d), 0);
