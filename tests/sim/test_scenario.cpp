@@ -419,7 +419,7 @@ struct ScenarioSim {
 
 TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   const scn_pose_t start = {0.4, -2.0, 90.0};
-  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, ""};
+  const scn_late_box_t box = {0.4, -1.65, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, "", 0.0};
   ScenarioSim k(start, box);
   ASSERT_NE(k.s, nullptr) << k.err;
   ASSERT_EQ(k.run_to(0.5), 1) << k.err;
@@ -450,7 +450,7 @@ TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
 // With R, a box waits past its time until car 1 comes within R m, like one stepping out.
 TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   const scn_pose_t start = {0.4, -2.0, 90.0};
-  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0, 0.0, 0.0, ""};
+  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0, 0.0, 0.0, "", 0.0};
   box.near_m = 0.25;  // the car starts 0.35 m away
   ScenarioSim k(start, box);
   ASSERT_NE(k.s, nullptr) << k.err;
@@ -472,7 +472,7 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
 
 TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   // in-process: the sim core with a late box 0.5 m ahead of car 1, appearing at 0.2 s
-  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, ""});
+  ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, "", 0.0});
   ASSERT_NE(k.s, nullptr) << k.err;
   sim_t *s = k.s;
   const mjModel *m = sim_render_model(s);
