@@ -162,7 +162,7 @@ class MarlVecEnv(VecEnv):
 
             remote = ray.remote(num_cpus=1)(GroupActor)
             self.actors = [
-                remote.remote(spec, [int(c) for c in part], seed)  # type: ignore[attr-defined]
+                remote.remote(spec, [int(c) for c in part], seed)
                 for part in split
             ]
         elif workers == 1:
@@ -187,7 +187,8 @@ class MarlVecEnv(VecEnv):
             import ray
 
             parts = ray.get([a.reset.remote() for a in self.actors])
-            return np.concatenate(parts)
+            joined: npt.NDArray[np.float32] = np.concatenate(parts)
+            return joined
         for c in self.conns:
             c.send(("reset", None))
         obs: npt.NDArray[np.float32] = np.concatenate([c.recv() for c in self.conns])
