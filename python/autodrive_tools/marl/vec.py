@@ -161,10 +161,7 @@ class MarlVecEnv(VecEnv):
             import ray
 
             remote = ray.remote(num_cpus=1)(GroupActor)
-            self.actors = [
-                remote.remote(spec, [int(c) for c in part], seed)
-                for part in split
-            ]
+            self.actors = [remote.remote(spec, [int(c) for c in part], seed) for part in split]
         elif workers == 1:
             self.local = EnvGroup(spec, list(range(copies)), seed)
         else:
