@@ -500,7 +500,7 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   sim_render_destroy(rd);
 }
 
-// The map's late_obstacles (Tiny Town: late_box_1 at x -4.34, y 0.6 m, 0.15 m cube, appearing
+// The map's late_obstacles (Tiny Town: late_box_1 at x -4.34, y 0.6 m, 0.15 x 0.15 x 0.2 m, appearing
 // at 20 s; late_box_0 when a car comes within 0.8 m): the sim adds them after the --late-box
 // ones, in the physics model (a ray at 7 cm height hits it only from its time on) and in the
 // render model. A sensor ray or a collision before that time finds nothing there.
@@ -520,7 +520,7 @@ TEST(Scenario, TheMapsLateObstaclesAppearAtTheirTime) {
   EXPECT_NEAR(b->x_m, -4.34, 1e-9);
   EXPECT_NEAR(b->y_m, 0.6, 1e-9);
   EXPECT_NEAR(b->t_s, 20.0, 1e-9);
-  EXPECT_NEAR(b->half_z_m, 0.075, 1e-9);
+  EXPECT_NEAR(b->half_z_m, 0.1, 1e-9);  // 0.2 m tall: the LIDAR sees it
   EXPECT_NEAR(sim_late_box(k.s, near)->near_m, 0.8, 1e-9);
   const mjModel *m = sim_model(k.s);
   mjData *d = sim_data(k.s);
