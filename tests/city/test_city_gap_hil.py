@@ -157,8 +157,18 @@ with tempfile.TemporaryDirectory(prefix="city-gap-") as tmp:
             f"1. red: leader {-past('NIGEL1', line) * 100:.1f} cm before the line, "
             f"follower standing {gap_red * 100:.1f} cm behind it"
         )
-        # 2. green: both on, through the stop sign (the leader stops there again)
-        command_light(3)
+        # 2. green: both on, through the stop sign (the leader stops there again). The simulator
+        # refuses a GREEN while a conflicting light is green on its program, so the command is
+        # repeated (every 0.5 s wall) until light 3 shows it
+        sent = [0.0]
+
+        def green_shown():
+            if lights.get(LIGHT) != 3 and time.monotonic() - sent[0] > 0.5:
+                command_light(3)
+                sent[0] = time.monotonic()
+            return lights.get(LIGHT) == 3
+
+        wait_for("light 3 GREEN", green_shown)
         wait_for("the follower past the stop sign", lambda: past("NIGEL2", sign) > 0.3)
         log("2. green, then the stop sign: both through")
         text = (out / "driver2.log").read_text()
