@@ -500,10 +500,10 @@ TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   sim_render_destroy(rd);
 }
 
-// The map's late_obstacles (Tiny Town: late_box_1 at x -4.34, y 0.6 m, 0.15 x 0.15 x 0.2 m, appearing
-// at 20 s; late_box_0 when a car comes within 0.8 m): the sim adds them after the --late-box
-// ones, in the physics model (a ray at 7 cm height hits it only from its time on) and in the
-// render model. A sensor ray or a collision before that time finds nothing there.
+// The map's late_obstacles (Tiny Town: late_box_1 at x -4.34, y 0.6 m, 0.15 x 0.15 x 0.2 m,
+// appearing at 20 s; late_box_0 when a car comes within 0.8 m): the sim adds them after the
+// --late-box ones, in the physics model (a ray at 7 cm height hits it only from its time on) and in
+// the render model. A sensor ray or a collision before that time finds nothing there.
 TEST(Scenario, TheMapsLateObstaclesAppearAtTheirTime) {
   ScenarioSim k({-1.0, -0.5, 0.0}, scn_late_box_t{}, "tiny_town", 0);
   ASSERT_NE(k.s, nullptr) << k.err;
