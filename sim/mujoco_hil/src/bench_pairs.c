@@ -2,13 +2,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-static double bp_clock_s(clockid_t id) {
-  struct timespec t;
-  clock_gettime(id, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static int bp_cmp(const void *a, const void *b) {
   const double x = *(const double *)a, y = *(const double *)b;
@@ -30,15 +23,15 @@ int bench_pairs_start(bench_pairs_t *bp, const sim_t *s) {
   memset(bp, 0, sizeof *bp);
   bp->bare = sim_bare_create(s);
   if (!bp->bare) return -1;
-  bp->block_wall0_s = bp_clock_s(CLOCK_MONOTONIC);
-  bp->block_cpu0_s = bp_clock_s(CLOCK_THREAD_CPUTIME_ID);
+  bp->block_wall0_s = sim_clock_s(CLOCK_MONOTONIC);
+  bp->block_cpu0_s = sim_clock_s(CLOCK_THREAD_CPUTIME_ID);
   return 0;
 }
 
 double bench_pairs_after_step(bench_pairs_t *bp, long step) {
   if (!bp->bare || step % BENCH_PAIRS_BLOCK_STEPS != 0) return 0.0;
-  const double sim_wall = bp_clock_s(CLOCK_MONOTONIC) - bp->block_wall0_s;
-  const double sim_cpu = bp_clock_s(CLOCK_THREAD_CPUTIME_ID) - bp->block_cpu0_s;
+  const double sim_wall = sim_clock_s(CLOCK_MONOTONIC) - bp->block_wall0_s;
+  const double sim_cpu = sim_clock_s(CLOCK_THREAD_CPUTIME_ID) - bp->block_cpu0_s;
   double bare_cpu = 0.0;
   const double bare_wall = sim_bare_run(bp->bare, BENCH_PAIRS_BLOCK_STEPS, &bare_cpu);
   if (bp->n == bp->cap) {
@@ -57,8 +50,8 @@ double bench_pairs_after_step(bench_pairs_t *bp, long step) {
   bp->bare_wall_s += bare_wall;
   bp->bare_cpu_s += bare_cpu;
   bp->bare_steps += BENCH_PAIRS_BLOCK_STEPS;
-  bp->block_wall0_s = bp_clock_s(CLOCK_MONOTONIC);
-  bp->block_cpu0_s = bp_clock_s(CLOCK_THREAD_CPUTIME_ID);
+  bp->block_wall0_s = sim_clock_s(CLOCK_MONOTONIC);
+  bp->block_cpu0_s = sim_clock_s(CLOCK_THREAD_CPUTIME_ID);
   return bare_wall;
 }
 

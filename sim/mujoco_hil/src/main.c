@@ -134,18 +134,13 @@ static void main_usage(FILE *f) {
       SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
 }
 
-static double main_clock_s(clockid_t id) {
-  struct timespec t;
-  clock_gettime(id, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 static double main_wall_s(void) {
-  return main_clock_s(CLOCK_MONOTONIC);
+  return sim_clock_s(CLOCK_MONOTONIC);
 }
 /* CPU time of this process [s]: on a shared, loaded machine it shows the cost without the
  * time spent waiting for a core */
 static double main_cpu_s(void) {
-  return main_clock_s(CLOCK_PROCESS_CPUTIME_ID);
+  return sim_clock_s(CLOCK_PROCESS_CPUTIME_ID);
 }
 
 /* --lockstep-client: the sim never runs more than MAIN_SYNC_HORIZON_US of sim time past the
@@ -933,7 +928,7 @@ int main(int argc, char **argv) {
 
   const int64_t end_us = duration > 0 ? (int64_t)llround(duration * 1e6) : -1;
   double t0 = main_wall_s(); /* moved forward by the time spent paused in the viewer */
-  const double cpu0 = main_cpu_s(), step_cpu0 = main_clock_s(CLOCK_THREAD_CPUTIME_ID);
+  const double cpu0 = main_cpu_s(), step_cpu0 = sim_clock_s(CLOCK_THREAD_CPUTIME_ID);
   double next_progress = t0 + MAIN_PROGRESS_S, rtf_now = 0.0, next_flush = t0;
   int64_t last_progress_us = 0;
   int rc = 0;
@@ -1042,7 +1037,7 @@ int main(int argc, char **argv) {
   }
   /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
   const double step_cpu_s =
-      main_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0 - bench_pairs_bare_cpu_s(&pairs);
+      sim_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0 - bench_pairs_bare_cpu_s(&pairs);
   const uint64_t lcm_failures = lcmq_failures(pubq);
   lcmq_destroy(pubq); /* sends what is still queued: part of the run's time */
   const double wall_s = main_wall_s() - t0,

@@ -1163,7 +1163,7 @@ void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {
   o->expert_steering = (car == 1 && s->route) ? s->route->expert_steering : NAN;
 }
 
-static double sim_clock_s(clockid_t id) {
+double sim_clock_s(clockid_t id) {
   struct timespec t;
   clock_gettime(id, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;

@@ -7,6 +7,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <time.h>
 
 #include <mujoco/mujoco.h>
 
@@ -162,6 +163,9 @@ struct traffic_lights *sim_traffic_lights(sim_t *s);
 /* The route driver of --script route:NAME (route_driver.h), or NULL. */
 struct route_driver;
 const struct route_driver *sim_route(const sim_t *s);
+
+/* The clock id's time now [s] (CLOCK_MONOTONIC, CLOCK_THREAD_CPUTIME_ID, ...). */
+double sim_clock_s(clockid_t id);
 
 /* Runs a bare mj_step loop on the same model for steps [1 ms] and returns its wall time [s]
  * (*cpu_s, if given: the thread's CPU time [s]). */
