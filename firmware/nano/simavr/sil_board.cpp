@@ -9,6 +9,7 @@
 
 extern "C" {
 #include <simavr/avr_adc.h>
+#include <simavr/avr_extint.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
@@ -79,6 +80,10 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   uart_in_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
   avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
                           &Board::uart_out_hook, this);
+  // simavr 1.6 starts a per-cycle poll of INT0/INT1 when their pin goes low in level mode (the
+  // reset default) and keeps it while the pin stays low, even after the firmware selects "any
+  // change" (EICRA): 4x the host CPU per simulated second. The firmware uses no level mode.
+  for (uint8_t i = 0; i < 2; i++) avr_extint_set_strict_lvl_trig(avr_, i, 0);
   for (int s = 0; s < 2; s++) {
     drive_pin(2 + s, 0);
     drive_pin(4 + s, 0);
