@@ -6,8 +6,12 @@ with the same sizes (only where LTO places a few functions may differ; see firmw
 Then the upload command line: `pio run -e nano_offline[_new] -t upload --upload-port <pty>`
 must run avrdude with the Nano bootloader's settings and talk STK500 on that port (the test
 holds the pty's other end and sees avrdude's GET_SYNC), without a board.
+Last, the whole flashing path without a board: `pio run -e nano_offline -t upload` into
+nano-simavr started as a Nano being flashed (its application flash erased, Debian's ATmegaBOOT
+bootloader running on a pty); avrdude writes and verifies the image, the bootloader starts it,
+and the flashed firmware must then announce itself with a HELLO frame and stream STATE frames.
 PlatformIO's core and build dirs are private to the test (nothing in ~/.platformio or .pio).
-usage: test_pio_build.py <repo root> <CMake nigel_nano.elf> <work dir>
+usage: test_pio_build.py <repo root> <CMake nigel_nano.elf> <work dir> <nano-simavr> <bootloader hex>
 """
 
 from __future__ import annotations
@@ -24,6 +28,9 @@ import time
 from pathlib import Path
 
 STK_GET_SYNC = b"\x30\x20"  # STK500v1 Cmnd_STK_GET_SYNC, Sync_CRC_EOP
+# Frame start of the Nano link and the HELLO / STATE ids (firmware/nano/lib/proto/PROTOCOL.md).
+FRAME_SYNC = b"\xa5\x5a"
+PROTO_ID_HELLO, PROTO_ID_STATE = 0x81, 0x82
 
 
 def sections(elf: Path) -> dict[str, int]:
@@ -139,8 +146,88 @@ def check_upload(root: Path, work: Path, pio: Path, env_name: str, baud: int) ->
     print(f"{env_name}: avrdude sent GET_SYNC on {port} at {baud} baud")
 
 
+def frame_ids(data: bytes) -> list[int]:
+    """The id byte of every frame start in a byte stream (sync, length, id, ...)."""
+    ids = []
+    at = data.find(FRAME_SYNC)
+    while at >= 0 and at + 3 < len(data):
+        ids.append(data[at + 3])
+        at = data.find(FRAME_SYNC, at + 2)
+    return ids
+
+
+def upload_once(root: Path, work: Path, pio: Path, simavr: Path, bootloader: Path) -> str:
+    """One upload into a freshly started nano-simavr; returns what went wrong, or ''."""
+    port = work / "simavr-nano"
+    sim = subprocess.Popen(
+        [str(simavr), "--bootloader", str(bootloader), "--pty", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while not port.exists() and time.monotonic() < deadline and sim.poll() is None:
+            time.sleep(0.05)
+        if not port.exists():
+            return f"nano-simavr made no pty at {port}"
+        up = subprocess.run(
+            [str(pio), "run", "-d", str(root), "-e", "nano_offline", "-t", "upload"]
+            + ["--upload-port", str(port)],
+            env=pio_env(work),
+            capture_output=True,
+            text=True,
+            timeout=240,
+        )
+        out = up.stdout + up.stderr
+        m = re.search(r"(\d+) bytes of flash verified", out)
+        if up.returncode != 0 or not m:
+            return f"the upload failed (rc {up.returncode}):\n{out[-2000:]}"
+        print(f"nano_offline into simavr: {m.group(0)}")
+        fd = os.open(str(port), os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        try:
+            got = b""
+            deadline = time.monotonic() + 20
+            while time.monotonic() < deadline:
+                ids = frame_ids(got)
+                if PROTO_ID_HELLO in ids and ids.count(PROTO_ID_STATE) >= 10:
+                    print(
+                        f"the flashed firmware runs: HELLO and {ids.count(PROTO_ID_STATE)} STATE frames"
+                    )
+                    return ""
+                ready, _, _ = select.select([fd], [], [], 0.2)
+                if ready:
+                    got += os.read(fd, 4096)
+        finally:
+            os.close(fd)
+        return f"no HELLO and STATE frames after the upload: ids {frame_ids(got)[:20]}"
+    finally:
+        sim.terminate()
+        try:
+            sim.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+
+
+def check_upload_into_simavr(
+    root: Path, work: Path, pio: Path, simavr: Path, bootloader: Path
+) -> None:
+    # avrdude's timeouts are wall time and the simulated bootloader keeps pace with the wall
+    # clock only while it gets a core: a starved machine may lose one sync, so up to 3 tries.
+    errors = []
+    for attempt in range(3):
+        why = upload_once(root, work, pio, simavr, bootloader)
+        if not why:
+            return
+        print(f"upload attempt {attempt + 1}: {why}")
+        errors.append(why)
+    raise AssertionError("upload through the bootloader in simavr failed 3 times:\n" + errors[-1])
+
+
 def main() -> int:
-    root, cmake_elf, work = (Path(a).resolve() for a in sys.argv[1:4])
+    if len(sys.argv) != 6:
+        print(__doc__, file=sys.stderr)
+        return 2
+    root, cmake_elf, work, simavr, bootloader = (Path(a).resolve() for a in sys.argv[1:6])
     pio = root / ".venv" / "bin" / "pio"
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
@@ -151,6 +238,7 @@ def main() -> int:
     check_build(root, cmake_elf, work, pio)
     check_upload(root, work, pio, "nano_offline", 57600)
     check_upload(root, work, pio, "nano_offline_new", 115200)
+    check_upload_into_simavr(root, work, pio, simavr, bootloader)
     print("PlatformIO offline build and upload command ok")
     return 0
 

@@ -25,6 +25,8 @@ namespace {
 constexpr uint16_t kTccr0a = 0x44, kOcr0a = 0x47, kOcr1aL = 0x88, kOcr1aH = 0x89;
 constexpr uint16_t kPortb = 0x25, kPortc = 0x28, kPortd = 0x2B;
 constexpr uint8_t kCom0a1 = 0x80;
+constexpr uint16_t kUcsr0a = 0xC0, kUbrr0l = 0xC4, kUbrr0h = 0xC5;
+constexpr uint8_t kU2x0 = 0x02;
 // 26 vectors of 2 words: the table ends at byte 0x68.
 constexpr uint32_t kVectorTableBytes = 26 * 4;
 // Quadrature phases (A, B) in forward order; A changes on 0->1 and 2->3.
@@ -334,14 +336,24 @@ void Board::wake_at(uint64_t at_cycle, void *tag) {
   if (at_cycle > c) avr_cycle_timer_register(avr_, at_cycle - c, wake_for_harness, tag);
 }
 
+// One 8N1 byte on the wire at the baud rate the AVR has set (UBRR0, U2X0) [cycles]: 320 at the
+// firmware's 500000 baud, 2780 at a bootloader's 57600, which must not get bytes faster than
+// its wire rate while it writes a flash page.
+uint64_t Board::uart_byte_cycles() const {
+  const uint32_t ubrr = avr_->data[kUbrr0l] | (avr_->data[kUbrr0h] & 0x0Fu) << 8;
+  const uint32_t cycles_per_bit = ((avr_->data[kUcsr0a] & kU2x0) ? 8u : 16u) * (ubrr + 1u);
+  return 10u * cycles_per_bit;
+}
+
 void Board::step_io() {
   const uint64_t c = cycle();
   if (!tx_queue_.empty() && c >= next_tx_cycle_) {
     avr_raise_irq(uart_in_, tx_queue_.front());
     tx_queue_.pop_front();
-    next_tx_cycle_ = c + kUartByteCycles;
+    const uint64_t byte_cycles = uart_byte_cycles();
+    next_tx_cycle_ = c + byte_cycles;
     if (tx_queue_.empty())
-      last_tx_cycle_ = c + kUartByteCycles;  // stop bit done
+      last_tx_cycle_ = c + byte_cycles;  // stop bit done
     else
       wake_at(next_tx_cycle_, &tx_queue_);
   }

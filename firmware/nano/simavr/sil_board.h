@@ -24,7 +24,6 @@ namespace sil {
 
 constexpr uint32_t kCpuHz = 16000000;
 constexpr uint64_t kCyclesPerUs = kCpuHz / 1000000;
-constexpr uint64_t kUartByteCycles = 320;  // 10 bits at 500000 baud = 20 us
 
 struct Frame {
   uint64_t cycle;  // when its last byte left the AVR
@@ -129,6 +128,7 @@ class Board {
 
  private:
   void step_io();
+  uint64_t uart_byte_cycles() const;
   void drive_pin(int bit, uint8_t level);  // PORTD input pin driven from outside
   void on_uart_byte(uint8_t b);
   void sample_pwm();
