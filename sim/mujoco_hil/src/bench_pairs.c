@@ -21,6 +21,7 @@ static double bp_median(const double *v, int n) {
 
 int bench_pairs_start(bench_pairs_t *bp, const sim_t *s) {
   memset(bp, 0, sizeof *bp);
+  bp->sim = s;
   bp->bare = sim_bare_create(s);
   if (!bp->bare) return -1;
   bp->block_wall0_s = sim_clock_s(CLOCK_MONOTONIC);
@@ -33,6 +34,7 @@ double bench_pairs_after_step(bench_pairs_t *bp, long step) {
   const double sim_wall = sim_clock_s(CLOCK_MONOTONIC) - bp->block_wall0_s;
   const double sim_cpu = sim_clock_s(CLOCK_THREAD_CPUTIME_ID) - bp->block_cpu0_s;
   double bare_cpu = 0.0;
+  sim_bare_sync(bp->bare, bp->sim);
   const double bare_wall = sim_bare_run(bp->bare, BENCH_PAIRS_BLOCK_STEPS, &bare_cpu);
   if (bp->n == bp->cap) {
     const int cap = bp->cap ? 2 * bp->cap : 64;

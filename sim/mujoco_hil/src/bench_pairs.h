@@ -16,6 +16,7 @@ extern "C" {
 #define BENCH_PAIRS_BLOCK_STEPS 1000 /* 1 s of sim time per block [1 ms steps] */
 
 typedef struct bench_pairs {
+  const sim_t *sim; /* whose state each bare block starts from */
   sim_bare_t *bare;
   double block_wall0_s, block_cpu0_s; /* start of the sim block in progress */
   double bare_wall_s, bare_cpu_s;     /* all bare blocks so far */

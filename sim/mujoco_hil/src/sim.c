@@ -1183,8 +1183,23 @@ sim_bare_t *sim_bare_create(const sim_t *s) {
     free(b);
     return NULL;
   }
-  mju_copy(b->d->qpos, s->d->qpos, s->m->nq);
+  sim_bare_sync(b, s);
   return b;
+}
+
+void sim_bare_sync(sim_bare_t *b, const sim_t *s) {
+  const mjModel *m = s->m;
+  const mjData *d = s->d;
+  b->d->time = d->time;
+  mju_copy(b->d->qpos, d->qpos, m->nq);
+  mju_copy(b->d->qvel, d->qvel, m->nv);
+  mju_copy(b->d->qacc_warmstart, d->qacc_warmstart, m->nv);
+  mju_copy(b->d->act, d->act, m->na);
+  mju_copy(b->d->ctrl, d->ctrl, m->nu);
+  mju_copy(b->d->qfrc_applied, d->qfrc_applied, m->nv);
+  mju_copy(b->d->xfrc_applied, d->xfrc_applied, 6 * m->nbody);
+  mju_copy(b->d->mocap_pos, d->mocap_pos, 3 * m->nmocap);
+  mju_copy(b->d->mocap_quat, d->mocap_quat, 4 * m->nmocap);
 }
 
 double sim_bare_run(sim_bare_t *b, int steps, double *cpu_s) {

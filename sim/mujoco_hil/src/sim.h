@@ -171,11 +171,16 @@ double sim_clock_s(clockid_t id);
  * (*cpu_s, if given: the thread's CPU time [s]). */
 double sim_bare_mj_step_s(const sim_t *s, int steps, double *cpu_s);
 
-/* A bare mj_step loop on its own mjData of the same model (the cars at their start poses),
- * stepped in blocks between blocks of the sim's own steps: tools/bench sim pairs each sim
- * block with the bare block after it, so both see the same load on a shared machine. */
+/* A bare mj_step loop on its own mjData of the same model, stepped in blocks between blocks of
+ * the sim's own steps: tools/bench sim pairs each sim block with the bare block after it, so
+ * both see the same load on a shared machine. Each block starts from the sim's state (see
+ * sim_bare_sync), so both halves solve the same moving cars' contacts. */
 typedef struct sim_bare sim_bare_t;
 sim_bare_t *sim_bare_create(const sim_t *s);
+/* Copies the sim's state into the bare loop: time, poses, velocities, mocap bodies, controls and
+ * the applied forces, which the bare loop then holds (the tyres' last forces keep the cars
+ * driving, and the constraint solver's warm start carries over). */
+void sim_bare_sync(sim_bare_t *b, const sim_t *s);
 /* Steps it steps [1 ms] on; returns the wall time [s] and, in *cpu_s, the thread's CPU [s]. */
 double sim_bare_run(sim_bare_t *b, int steps, double *cpu_s);
 void sim_bare_destroy(sim_bare_t *b);
