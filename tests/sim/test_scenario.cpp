@@ -425,15 +425,14 @@ TEST(Scenario, ResetReturnsToTheStartPoseAndKeepsAppearedBoxes) {
   ASSERT_EQ(k.run_to(0.5), 1) << k.err;
   mjData *d = sim_data(k.s);
   const mjModel *m = sim_model(k.s);
-  const int body = mj_name2id(m, mjOBJ_BODY, "scenario/late_box1");
-  ASSERT_GE(body, 0);
-  const mjtNum *box_pos = d->mocap_pos + 3 * m->body_mocapid[body];
+  const int geom = mj_name2id(m, mjOBJ_GEOM, "scenario/late_box1");
+  ASSERT_GE(geom, 0);
+  const mjtNum *box_pos = d->geom_xpos + 3 * geom;
   EXPECT_NEAR(box_pos[0], 0.4, 1e-12);
   EXPECT_NEAR(box_pos[1], -1.65, 1e-12);
   EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
   d->qpos[0] += 0.3;  // pick the car up and put it elsewhere, then reset (the viewer's R)
   mj_resetData(m, d);
-  EXPECT_LT(box_pos[2], -1000.0) << "mj_resetData parks mocap bodies";
   mj_forward(m, d);
   const sim_truth_t t = [&] {
     sim_truth_t x;
@@ -457,8 +456,7 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   ASSERT_EQ(k.run_to(0.5), 0) << "appeared with the car 0.35 m away; " << k.err;
   mjData *d = sim_data(k.s);
   const mjModel *m = sim_model(k.s);
-  const mjtNum *box_pos =
-      d->mocap_pos + 3 * m->body_mocapid[mj_name2id(m, mjOBJ_BODY, "scenario/late_box1")];
+  const mjtNum *box_pos = d->geom_xpos + 3 * mj_name2id(m, mjOBJ_GEOM, "scenario/late_box1");
   EXPECT_LT(box_pos[2], -1000.0) << "still parked out of sight";
   d->qpos[1] += 0.15;  // move the car 0.15 m towards it: 0.2 m away
   mj_forward(m, d);
@@ -536,14 +534,15 @@ TEST(Scenario, TheMapsLateObstaclesAppearAtTheirTime) {
   EXPECT_NEAR(hit_m(), 0.5 - 0.075, 0.002) << "the box did not appear at its place";
   // the render model shows it too (cameras and the Eye)
   const mjModel *mv = sim_render_model(k.s);
-  const int body =
-      mj_name2id(mv, mjOBJ_BODY, ("scenario/late_box" + std::to_string(timed + 1)).c_str());
-  ASSERT_GE(body, 0);
-  EXPECT_NEAR(sim_render_data(k.s)->mocap_pos[3 * mv->body_mocapid[body] + 0], -4.34, 1e-9);
+  const int geom =
+      mj_name2id(mv, mjOBJ_GEOM, ("scenario/late_box" + std::to_string(timed + 1)).c_str());
+  ASSERT_GE(geom, 0);
+  EXPECT_NEAR(sim_render_data(k.s)->geom_xpos[3 * geom + 0], -4.34, 1e-9);
   // the car never came within 0.8 m of late_box_0: it is still out of sight
-  const int nbody =
-      mj_name2id(m, mjOBJ_BODY, ("scenario/late_box" + std::to_string(near + 1)).c_str());
-  EXPECT_LT(d->mocap_pos[3 * m->body_mocapid[nbody] + 2], -1000.0);
+  const int ngeom =
+      mj_name2id(m, mjOBJ_GEOM, ("scenario/late_box" + std::to_string(near + 1)).c_str());
+  ASSERT_GE(ngeom, 0);
+  EXPECT_LT(d->geom_xpos[3 * ngeom + 2], -1000.0);
 }
 
 }  // namespace

@@ -147,20 +147,16 @@ static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom, i
   fprintf(f, "  </body>\n");
 }
 
-/* A late box (--late-box or the map's late_obstacles): a mocap body (MuJoCo 2.2 cannot add
- * bodies at run time) carrying a box with the world's collision bits and surface, coloured
- * apart from the map's boxes. */
+/* A late box (--late-box or the map's late_obstacles): a world geom with the world's collision
+ * bits and surface, coloured apart from the map's boxes, parked out of sight until the sim moves
+ * it in (MuJoCo 2.2 cannot add geoms at run time). A world geom, not a mocap body: world geoms
+ * never collide with each other, and a parked body cost Tiny Town 2 % of a step. */
 static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
   fprintf(f,
-          "  <body name=\"scenario/late_box%d\" mocap=\"true\" pos=\"0 0 %g\" "
-          "euler=\"0 0 %.9g\">\n",
-          k, MG_PARKED_Z_M, b->yaw_rad);
-  fprintf(f,
-          "   <geom name=\"scenario/late_box%d\" type=\"box\" size=\"%.6g %.6g %.6g\" "
-          "contype=\"1\" conaffinity=\"6\" friction=\"0.5 0.005 0.0001\" "
-          "rgba=\"0.15 0.35 0.85 1\"/>\n",
-          k, b->half_x_m, b->half_y_m, scn_late_box_half_z(b));
-  fprintf(f, "  </body>\n");
+          "  <geom name=\"scenario/late_box%d\" type=\"box\" pos=\"0 0 %g\" euler=\"0 0 %.9g\" "
+          "size=\"%.6g %.6g %.6g\" contype=\"1\" conaffinity=\"6\" "
+          "friction=\"0.5 0.005 0.0001\" rgba=\"0.15 0.35 0.85 1\"/>\n",
+          k, MG_PARKED_Z_M, b->yaw_rad, b->half_x_m, b->half_y_m, scn_late_box_half_z(b));
 }
 
 /* Whether line is a one-line <geom> named one of the names (a space-separated list). */
@@ -246,17 +242,6 @@ int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_
     mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL, o->physics_only);
   for (int k = 0; k < o->late_boxes; k++) mg_late_box(f, k + 1, &o->late_box[k]);
   fprintf(f, " </worldbody>\n");
-  /* A late box is moved, never pushed: it needs contacts with the cars only. Against the world
-   * and the other boxes (all parked at one spot) MuJoCo 2.2 would test and solve pairs that
-   * can do nothing, each step: 2 parked boxes cost Tiny Town 8 % of a step. */
-  if (o->late_boxes > 0) fprintf(f, " <contact>\n");
-  for (int k = 1; k <= o->late_boxes; k++) {
-    fprintf(f, "  <exclude body1=\"world\" body2=\"scenario/late_box%d\"/>\n", k);
-    for (int j = k + 1; j <= o->late_boxes; j++)
-      fprintf(f, "  <exclude body1=\"scenario/late_box%d\" body2=\"scenario/late_box%d\"/>\n", k,
-              j);
-  }
-  if (o->late_boxes > 0) fprintf(f, " </contact>\n");
   fprintf(f, " <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */
     fprintf(f,

@@ -5,9 +5,9 @@
  *   joints nigel<i>/steer_{fl,fr} (hinge z), nigel<i>/wheel_{fl,fr,rl,rr} (hinge y, + forward)
  *   sites nigel<i>/imu, nigel<i>/lidar, nigel<i>/tag_site; geom nigel<i>/tag (roof plate)
  *   cameras nigel<i>/cam_front, nigel<i>/cam_rear (fovy 48.67 deg = 62.2 deg HFOV at 4:3)
- * Late boxes k = 1..: mocap body and geom scenario/late_box<k>, parked at MG_PARKED_Z_M
- * (below the floor, beyond every camera's far plane, out of every LIDAR's scan plane) until
- * the sim moves them onto the floor; the body's origin is the box's centre.
+ * Late boxes k = 1..: world geom scenario/late_box<k>, parked at MG_PARKED_Z_M (below the
+ * floor, beyond every camera's far plane, out of every LIDAR's scan plane) until the sim moves
+ * it onto the floor through its model geom_pos (the box's centre).
  * Collision bits: world contype 1 / conaffinity 6, tyres 2 / 1, chassis 4 / 5; late boxes as
  * the world. */
 #ifndef SIM_MJCF_GEN_H

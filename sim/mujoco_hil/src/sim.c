@@ -133,11 +133,12 @@ struct sim {
   int nbox;
   /* --late-box boxes, then the map's late_obstacles */
   scn_late_box_t box[SIM_MAX_BOXES];
-  int box_mocap[SIM_MAX_BOXES];     /* index into mocap_pos */
+  int box_geom[SIM_MAX_BOXES];      /* its world geom in m, moved through geom_pos */
+  int box_geom_v[SIM_MAX_BOXES];    /* the same geom in the render model mv (when split) */
+  mjtNum box_parked[SIM_MAX_BOXES][3]; /* where it waits before and after [m] */
   int box_placed[SIM_MAX_BOXES];    /* has appeared */
   int box_new[SIM_MAX_BOXES];       /* appeared during the last step */
   int box_car_below[SIM_MAX_BOXES]; /* car it landed on (1-based), 0: none */
-  int box_body[SIM_MAX_BOXES];      /* its mocap body: where it waits before and after */
   int64_t box_at_us[SIM_MAX_BOXES]; /* when it appeared [us] */
   int box_gone[SIM_MAX_BOXES];      /* has left again (stay_s) */
   int box_left[SIM_MAX_BOXES];      /* left during the last step */
@@ -375,6 +376,17 @@ int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
   return 0;
 }
 
+/* A late box is a world geom, moved by its model position: MuJoCo's kinematics recompute world
+ * geoms each step, and a world geom costs the step far less than a (mocap) body would. */
+static void sim_move_late_box(sim_t *s, int k, const mjtNum pos_m[3]) {
+  mju_copy3(s->m->geom_pos + 3 * s->box_geom[k], pos_m);
+  if (s->mv) mju_copy3(s->mv->geom_pos + 3 * s->box_geom_v[k], pos_m);
+}
+
+static void sim_park_late_boxes(sim_t *s) {
+  for (int k = 0; k < s->nbox; k++) sim_move_late_box(s, k, s->box_parked[k]);
+}
+
 /* Moves the late boxes that are due onto the floor (again after a reset). */
 static void sim_place_late_boxes(sim_t *s) {
   for (int k = 0; k < s->nbox; k++) {
@@ -385,17 +397,15 @@ static void sim_place_late_boxes(sim_t *s) {
       const mjtNum *car = s->d->qpos + s->car[0].root_qpos;
       if (hypot(car[0] - b->x_m, car[1] - b->y_m) > b->near_m) continue;
     }
-    mjtNum *pos = s->d->mocap_pos + 3 * s->box_mocap[k];
     if (s->box_placed[k] && b->stay_s > 0 &&
         s->time_us - s->box_at_us[k] >= (int64_t)llround(b->stay_s * 1e6)) {
-      mju_copy3(pos, s->m->body_pos + 3 * s->box_body[k]); /* back where it waited */
+      sim_move_late_box(s, k, s->box_parked[k]); /* back where it waited */
       s->box_gone[k] = s->box_left[k] = 1;
       continue;
     }
-    pos[0] = b->x_m;
-    pos[1] = b->y_m;
-    pos[2] = scn_late_box_half_z(b);
     if (s->box_placed[k]) continue;
+    const mjtNum pos[3] = {b->x_m, b->y_m, scn_late_box_half_z(b)};
+    sim_move_late_box(s, k, pos);
     s->box_placed[k] = s->box_new[k] = 1;
     s->box_at_us[k] = s->time_us;
     cl_prism_t bp, cp;
@@ -411,13 +421,15 @@ static int sim_bind_late_boxes(sim_t *s, char *err, size_t err_sz) {
   for (int k = 0; k < s->nbox; k++) {
     char name[48];
     snprintf(name, sizeof name, "scenario/late_box%d", k + 1);
-    const int b = mj_name2id(s->m, mjOBJ_BODY, name);
-    if (b < 0 || s->m->body_mocapid[b] < 0) {
-      snprintf(err, err_sz, "generated model lacks mocap body '%s'", name);
+    const int g = mj_name2id(s->m, mjOBJ_GEOM, name);
+    const int gv = s->mv ? mj_name2id(s->mv, mjOBJ_GEOM, name) : -1;
+    if (g < 0 || s->m->geom_bodyid[g] != 0 || (s->mv && gv < 0)) {
+      snprintf(err, err_sz, "generated model lacks world geom '%s'", name);
       return -1;
     }
-    s->box_mocap[k] = s->m->body_mocapid[b];
-    s->box_body[k] = b;
+    s->box_geom[k] = g;
+    s->box_geom_v[k] = gv;
+    mju_copy3(s->box_parked[k], s->m->geom_pos + 3 * g);
   }
   return 0;
 }
@@ -1257,7 +1269,8 @@ int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t er
   }
   s->seed = seed;
   s->time_us = 0;
-  mj_resetData(s->m, s->d); /* qpos0 holds the start poses; mocap boxes go back to hiding */
+  mj_resetData(s->m, s->d); /* qpos0 holds the start poses */
+  sim_park_late_boxes(s);
   for (int k = 0; k < s->nbox; k++)
     s->box_placed[k] = s->box_new[k] = s->box_car_below[k] = s->box_gone[k] = s->box_left[k] = 0;
   mj_forward(s->m, s->d);
