@@ -468,6 +468,33 @@ TEST(Scenario, ALateBoxWithADistanceWaitsForTheCarToComeNear) {
   EXPECT_NEAR(box_pos[2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
 }
 
+// A box with a stay leaves again: back where it waited (in the physics and the render model),
+// reported once, and no longer in the way of a ray along the floor.
+TEST(Scenario, ALateBoxWithAStayLeavesAgain) {
+  scn_late_box_t box = {0.4, -1.65, 0.1, 0.06, 0.06, 0.0, 0.0, 0.0, "", 0.0};
+  box.stay_s = 0.2;  // appears at 0.1 s, leaves at 0.3 s
+  ScenarioSim k({0.4, -2.0, 90.0}, box);
+  ASSERT_NE(k.s, nullptr) << k.err;
+  mjData *d = sim_data(k.s);
+  const mjModel *m = sim_model(k.s);
+  const int geom = mj_name2id(m, mjOBJ_GEOM, "scenario/late_box1");
+  ASSERT_GE(geom, 0);
+  ASSERT_EQ(k.run_to(0.2), 1) << k.err;
+  EXPECT_NEAR(d->geom_xpos[3 * geom + 2], 0.5 * SCN_LATE_BOX_HEIGHT_M, 1e-12);
+  int left = 0;
+  char e[512];
+  while (sim_time_us(k.s) < 400000) {
+    ASSERT_EQ(sim_step(k.s, e, sizeof e), 0) << e;
+    left += sim_late_box_left(k.s, 0);
+  }
+  EXPECT_EQ(left, 1) << "the box left once";
+  EXPECT_LT(d->geom_xpos[3 * geom + 2], -1000.0) << "back out of sight";
+  const mjModel *mv = sim_render_model(k.s);
+  const int gv = mj_name2id(mv, mjOBJ_GEOM, "scenario/late_box1");
+  ASSERT_GE(gv, 0);
+  EXPECT_LT(sim_render_data(k.s)->geom_xpos[3 * gv + 2], -1000.0) << "the cameras lost it too";
+}
+
 TEST(Scenario, FrontCameraSeesTheLateBoxOnlyAfterItsTime) {
   // in-process: the sim core with a late box 0.5 m ahead of car 1, appearing at 0.2 s
   ScenarioSim k({-1.0, -0.5, 0.0}, {-0.33, -0.5, 0.2, 0.06, 0.06, 0.0, 0.0, 0.0, "", 0.0});
