@@ -246,7 +246,9 @@ class _Writer:
         if m.terrain_patches:  # the sim's tyres read their friction (sim/.../src/terrain.c)
             names = " ".join(p.name for p in m.terrain_patches)
             out.append(f'    <text name="terrain_patches" data="{names}"/>')
-        for o in m.late_obstacles:  # the simulator adds these (mocap boxes) at their time
+        for (
+            o
+        ) in m.late_obstacles:  # the simulator adds these (world geoms it moves in) at their time
             data = nums(
                 (*o.centre_m, o.yaw_rad, *o.size_m, o.appear_s or 0.0, o.trigger_radius_m or 0.0)
             )

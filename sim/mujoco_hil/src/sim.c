@@ -133,17 +133,17 @@ struct sim {
   int nbox;
   /* --late-box boxes, then the map's late_obstacles */
   scn_late_box_t box[SIM_MAX_BOXES];
-  int box_geom[SIM_MAX_BOXES];      /* its world geom in m, moved through geom_pos */
-  int box_geom_v[SIM_MAX_BOXES];    /* the same geom in the render model mv (when split) */
+  int box_geom[SIM_MAX_BOXES];         /* its world geom in m, moved through geom_pos */
+  int box_geom_v[SIM_MAX_BOXES];       /* the same geom in the render model mv (when split) */
   mjtNum box_parked[SIM_MAX_BOXES][3]; /* where it waits before and after [m] */
-  int box_placed[SIM_MAX_BOXES];    /* has appeared */
-  int box_new[SIM_MAX_BOXES];       /* appeared during the last step */
-  int box_car_below[SIM_MAX_BOXES]; /* car it landed on (1-based), 0: none */
-  int64_t box_at_us[SIM_MAX_BOXES]; /* when it appeared [us] */
-  int box_gone[SIM_MAX_BOXES];      /* has left again (stay_s) */
-  int box_left[SIM_MAX_BOXES];      /* left during the last step */
-  uint64_t seed;                    /* of the current run (sim_create, sim_reset) */
-  char script_spec[256];            /* every car's scripted driver, "" for none */
+  int box_placed[SIM_MAX_BOXES];       /* has appeared */
+  int box_new[SIM_MAX_BOXES];          /* appeared during the last step */
+  int box_car_below[SIM_MAX_BOXES];    /* car it landed on (1-based), 0: none */
+  int64_t box_at_us[SIM_MAX_BOXES];    /* when it appeared [us] */
+  int box_gone[SIM_MAX_BOXES];         /* has left again (stay_s) */
+  int box_left[SIM_MAX_BOXES];         /* left during the last step */
+  uint64_t seed;                       /* of the current run (sim_create, sim_reset) */
+  char script_spec[256];               /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
   traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
   route_driver_t *route; /* --script route:NAME (car 1), else NULL */
