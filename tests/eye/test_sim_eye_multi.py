@@ -21,10 +21,10 @@ if fig["sim_multi_cam_cameras_crossed"] < 2 or fig["sim_multi_cam_handovers"] < 
     fails.append("the car was not handed from one camera to another")
 if fig["sim_multi_cam_frames_in_overlap"] < 1:
     fails.append("no frame with the car's tag in two cameras (no fused pose)")
-if fig["sim_handover_gap_frames"] != 0:
-    fails.append(f"{fig['sim_handover_gap_frames']:g} frames without a pose while in view")
-if fig["sim_multi_cam_pos_rms_mm"] > 2.0:
-    fails.append(f"position rms {fig['sim_multi_cam_pos_rms_mm']} mm > 2")
+if fig["handover_gap_frames"] != 0:
+    fails.append(f"{fig['handover_gap_frames']:g} frames without a pose while in view")
+if fig["multi_cam_pos_rms_mm"] > 2.0:
+    fails.append(f"position rms {fig['multi_cam_pos_rms_mm']} mm > 2")
 if fig["sim_multi_cam_heading_rms_deg"] > 0.5:
     fails.append(f"heading rms {fig['sim_multi_cam_heading_rms_deg']} deg > 0.5")
 if fails:

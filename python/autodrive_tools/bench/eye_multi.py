@@ -13,7 +13,7 @@ two or more: fused poses; handovers: changes of the set of cameras that see it).
 
 CLI: python -m autodrive_tools.bench.eye_multi <build dir> [duration_s] [out prefix for
 .csv/.png] [--drive lap|crossing]. Progress on stderr; "key value" lines on stdout (sim_multi_cam_*,
-sim_handover_gap_frames). Run by `tools/bench eye` and the test
+handover_gap_frames). Run by `tools/bench eye` and the test
 eye.Sim.SeveralCamerasHandOverWithoutGap (EYE_MULTI_PORT picks the LCM port)."""
 
 from __future__ import annotations
@@ -156,8 +156,8 @@ def measure(
         "sim_multi_cam_cameras_crossed": len(cams_seen),
         "sim_multi_cam_handovers": handovers,
         "sim_multi_cam_frames_in_overlap": sum(1 for s in seen_by if "+" in s),
-        "sim_handover_gap_frames": len(gaps),
-        "sim_multi_cam_pos_rms_mm": round(rms(errs_mm), 3),
+        "handover_gap_frames": len(gaps),
+        "multi_cam_pos_rms_mm": round(rms(errs_mm), 3),
         "sim_multi_cam_pos_max_mm": round(max(errs_mm), 3),
         "sim_multi_cam_heading_rms_deg": round(rms(errs_deg), 4),
     }
