@@ -6,7 +6,10 @@ autodrive-sim is built, the Eye on the simulator's overhead camera against its g
 k2 0.10), dim light, vignetting, noise sigma 6, 10 cars with 18-40 px tags over the whole image,
 edges included; the Eye (whole-field plan) against the previous default (decimate-2 scans) and
 decimate 1 everywhere in the same run (fps ratios), with and without window tracking; and a
-camera bumped by 5 mm / 0.3 deg (bumped_camera_*). handover_gap_frames and
+camera bumped by 5 mm / 0.3 deg (bumped_camera_*; sim_bumped_camera_*: the same on the
+simulator's frames of Tiny Town, autodrive_tools.bench.eye_multi --bump). The cameras of Tiny
+Town are calibrated from its reference tags by calibrate-map first (refcal_*: residuals, how
+neighbours agree on shared tags; autodrive_tools.bench.eye_refcal). handover_gap_frames and
 sim_multi_cam_*: Tiny Town's four overhead cameras rendered by the simulator as one Eye, a car
 driving a lap through their overlaps (autodrive_tools.bench.eye_multi). capture_to_pose_ms_*:
 a running autodrive-eye fed the wide-angle scene's 720p frames (10 cars) at 30 Hz over LCM,
@@ -17,7 +20,7 @@ time instead (the machine is shared). Writes out/bench/eye_trajectory
 {.csv,.png}, eye_sim_trajectory{.csv,.png} and eye_multi_cam{.csv,.png}. Progress on stderr;
 last line one JSON object. Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3),
 EYE_BENCH_SIM_S (30, 0: skip), EYE_BENCH_MULTI_S (140, 0: skip), EYE_BENCH_LATENCY_FRAMES
-(300, 0: skip)."""
+(300, 0: skip), EYE_BENCH_BUMP (1, 0: skip)."""
 
 from __future__ import annotations
 
@@ -31,7 +34,12 @@ from ..runfiles import read_columns
 from . import Progress, build_dir, eye_latency, eye_multi, eye_sim, out_dir, print_figures
 
 INT_KEYS = ("frames", "repeats")
-BOOL_KEYS = ("bumped_camera_detected", "unmoved_camera_no_alarm")  # printed 0 / 1 by eye_bench
+BOOL_KEYS = (  # measured as 0 / 1
+    "bumped_camera_detected",
+    "unmoved_camera_no_alarm",
+    "sim_bumped_camera_detected",
+    "sim_unmoved_cameras_no_alarm",
+)
 log = Progress("eye")
 
 
@@ -99,6 +107,14 @@ def main(argv: list[str]) -> int:
             figures.update(measure(build, sim_s, str(out / prefix)))
         except RuntimeError as e:
             log(f"{what} failed: {e}")
+    if os.environ.get("EYE_BENCH_BUMP", "1") != "0" and os.access(
+        build / "bin" / "autodrive-sim", os.X_OK
+    ):
+        log("a bumped camera on the simulator's frames (eye1 moved 5 mm / 0.3 deg)")
+        try:
+            figures.update(eye_multi.bumped_camera(build))
+        except RuntimeError as e:
+            log(f"bumped camera run failed: {e}")
     for k, v in figures.items():
         print(f"{k} {v}")
     try:
