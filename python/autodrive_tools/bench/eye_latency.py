@@ -28,7 +28,7 @@ from typing import Any
 
 from .. import lcmtypes, proc
 from ..channels import channel, vehicle_name
-from . import Progress
+from . import Progress, key_value_main
 
 # eye's port range 7790-7809: 7800 for the benchmark, EYE_LATENCY_PORT=7794 for the test
 DEFAULT_PORT = "7800"
@@ -200,14 +200,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("frames", type=int, nargs="?", default=300, help="frames counted")
     p.add_argument("fps", type=float, nargs="?", default=30.0, help="feed rate [Hz]")
     a = p.parse_args(argv)
-    try:
-        fig = measure(a.build, a.frames, a.fps)
-    except RuntimeError as e:
-        print(f"eye_latency: {e}", file=sys.stderr)
-        return 1
-    for k, v in fig.items():
-        print(f"{k} {v:g}")
-    return 0
+    return key_value_main("eye_latency", lambda: measure(a.build, a.frames, a.fps))
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ from .. import eye_cameras, proc, vehicle
 from ..channels import channel, vehicle_name
 from ..geometry import wrap
 from ..scoring import rms
-from . import Progress, eye_refcal
+from . import Progress, eye_refcal, key_value_main
 from .eye_sim import Recorder, match
 
 # eye's port range 7790-7809: 7796 for the benchmark, EYE_MULTI_PORT=7795 for the test
@@ -333,16 +333,12 @@ def main(argv: list[str] | None = None) -> int:
         "--bump", action="store_true", help="only the bumped camera run (sim_bumped_camera_*)"
     )
     a = p.parse_args(argv)
-    try:
-        fig = (
+    return key_value_main(
+        "eye_multi",
+        lambda: (
             bumped_camera(a.build) if a.bump else measure(a.build, a.duration_s, a.prefix, a.drive)
-        )
-    except RuntimeError as e:
-        print(f"eye_multi: {e}", file=sys.stderr)
-        return 1
-    for k, v in fig.items():
-        print(f"{k} {v:g}")
-    return 0
+        ),
+    )
 
 
 if __name__ == "__main__":

@@ -28,7 +28,7 @@ from typing import Any
 
 from .. import eye_cameras, lcmtypes
 from ..maps.loader import MAPS_DIR
-from . import Progress
+from . import Progress, key_value_main
 
 MAP = "tiny_town"
 # eye's port range 7790-7809: 7801 for the benchmark, EYE_REFCAL_PORT for the test
@@ -190,14 +190,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("build", type=Path, help="host build dir")
     p.add_argument("out", type=Path, nargs="?", help="keep frames and calibrations here")
     a = p.parse_args(argv)
-    try:
-        fig = measure(a.build, a.out)
-    except RuntimeError as e:
-        print(f"eye_refcal: {e}", file=sys.stderr)
-        return 1
-    for k, v in fig.items():
-        print(f"{k} {v:g}")
-    return 0
+    return key_value_main("eye_refcal", lambda: measure(a.build, a.out))
 
 
 if __name__ == "__main__":
