@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <mutex>
 
@@ -112,7 +113,7 @@ class GstSource : public Source {
   // The buffer's PTS as a time on the system clock [us]. A PTS is in its segment's time; its
   // running time + the pipeline's base time is the pipeline clock's time of the PTS (for a live
   // camera: when the frame was taken). The pipeline clock (GStreamer's system clock, monotonic)
-  // is mapped to the system clock by reading both now.
+  // is mapped to the system clock by their offset (clock_offset).
   int64_t capture_utime(GstSample *s, int64_t grabbed_utime) {
     GstBuffer *b = gst_sample_get_buffer(s);
     const GstSegment *seg = gst_sample_get_segment(s);
@@ -123,10 +124,9 @@ class GstSource : public Source {
                                      : GST_CLOCK_TIME_NONE;
     int64_t utime = grabbed_utime;
     if (clock && GST_CLOCK_TIME_IS_VALID(running)) {
-      const auto clock_now = static_cast<int64_t>(gst_clock_get_time(clock));
-      const int64_t sys_now = now_utime();
+      if (clock != offset_clock_) clock_offset(clock);
       const auto pts_clock = static_cast<int64_t>(gst_element_get_base_time(pipe_) + running);
-      utime = sys_now - (clock_now - pts_clock) / 1000;
+      utime = pts_clock / 1000 + offset_us_;
     } else if (!warned_no_pts_) {
       warned_no_pts_ = true;
       std::fprintf(stderr,
@@ -136,6 +136,22 @@ class GstSource : public Source {
     }
     if (clock) gst_object_unref(clock);
     return utime;
+  }
+
+  // System clock minus pipeline clock [us], read once per clock: the tightest of a few
+  // (clock, system, clock) reads, so a preemption between two reads cannot shift every stamp.
+  void clock_offset(GstClock *clock) {
+    int64_t best_span = INT64_MAX;
+    for (int k = 0; k < 5; ++k) {
+      const auto c0 = static_cast<int64_t>(gst_clock_get_time(clock));
+      const int64_t sys = now_utime();
+      const auto c1 = static_cast<int64_t>(gst_clock_get_time(clock));
+      if (c1 - c0 < best_span) {
+        best_span = c1 - c0;
+        offset_us_ = sys - (c0 + c1) / 2000;
+      }
+    }
+    offset_clock_ = clock;  // compared only, never dereferenced: the pipeline keeps its clock
   }
 
   // Grey copy of the sample's frame (the buffer is unmapped after).
@@ -182,6 +198,8 @@ class GstSource : public Source {
   GstElement *pipe_ = nullptr, *sink_ = nullptr;
   long n_ = 0;
   bool warned_no_pts_ = false;
+  const GstClock *offset_clock_ = nullptr;  // the clock offset_us_ was read for
+  int64_t offset_us_ = 0;
 };
 
 }  // namespace
