@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -208,6 +209,25 @@ Accuracy accuracy(const Scene &sc, const RunResult &r) {
   return a;
 }
 
+// The run config of a synthetic scene (camera.yaml and map.yaml beside it), its cars' tags.
+bool write_run_config(const std::string &path, const eye::LocateParams &car, const std::string &url,
+                      const std::vector<eye::VehicleTag> &vehicles, bool reference_tags) {
+  std::ofstream cfg(path);
+  cfg << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
+      << "tag_size_m: " << car.tag_size_m << "\ntag_offset_m: [" << car.tag_offset_m[0] << ", "
+      << car.tag_offset_m[1] << ", " << car.tag_offset_m[2] << "]\n"
+      << "base_link_height_m: " << car.base_link_height_m << "\n"
+      << (reference_tags ? "reference_tags: reference_tags.yaml\n" : "") << "vehicles:\n";
+  for (const auto &v : vehicles) cfg << " - {name: " << v.name << ", tag_id: " << v.tag_id << "}\n";
+  return static_cast<bool>(cfg);
+}
+
+bool write_jpeg(const std::string &path, const std::vector<uchar> &jpg) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(reinterpret_cast<const char *>(jpg.data()), static_cast<std::streamsize>(jpg.size()));
+  return static_cast<bool>(f);
+}
+
 // A fixed scene for programs that feed the Eye over LCM: its calibration, a run config and
 // one good frame. Returns the exit status.
 int write_scene(const std::string &dir, const std::string &url, double tag_size_m) {
@@ -218,18 +238,11 @@ int write_scene(const std::string &dir, const std::string &url, double tag_size_
   m.width_px = 640;
   m.height_px = 480;
   eye::mapcal_save(dir + "/map.yaml", m);
-  std::ofstream cfg(dir + "/eye.yaml");
-  cfg << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
-      << "tag_size_m: " << s.car.tag_size_m << "\ntag_offset_m: [" << s.car.tag_offset_m[0] << ", "
-      << s.car.tag_offset_m[1] << ", " << s.car.tag_offset_m[2] << "]\n"
-      << "base_link_height_m: " << s.car.base_link_height_m << "\n"
-      << "vehicles:\n - {name: NIGEL1, tag_id: 1}\n";
   std::vector<uchar> jpg;
   cv::imencode(".jpg", eye::synth_frame(s, {{1, 1.2, 0.9, 0.5}}, {}, 1), jpg,
                {cv::IMWRITE_JPEG_QUALITY, 95});
-  std::ofstream(dir + "/frame.jpg", std::ios::binary)
-      .write(reinterpret_cast<const char *>(jpg.data()), static_cast<std::streamsize>(jpg.size()));
-  if (!cfg) {
+  if (!write_run_config(dir + "/eye.yaml", s.car, url, {{"NIGEL1", 1, 0.0}}, false) ||
+      !write_jpeg(dir + "/frame.jpg", jpg)) {
     std::fprintf(stderr, "eye_bench: cannot write the scene to %s\n", dir.c_str());
     return 1;
   }
@@ -285,6 +298,36 @@ WideScene make_wide_scene(int w, int h, int frames) {
     sc.jpeg.push_back(std::move(buf));
   }
   return sc;
+}
+
+// The wide-angle scene for programs that feed the Eye frames at a fixed rate: camera.yaml,
+// map.yaml (calibrated from the reference tags), reference_tags.yaml, eye.yaml (10 cars, url)
+// and the frames as frames/NNNN.jpg. Returns the exit status.
+int write_wide_scene(const WideScene &sc, const std::string &dir, const std::string &url) {
+  std::filesystem::create_directories(dir + "/frames");
+  eye::intrinsics_save(dir + "/camera.yaml", sc.s.in);
+  eye::MapCalib m;
+  m.pose = sc.cfg.pose;
+  m.width_px = sc.s.in.width_px;
+  m.height_px = sc.s.in.height_px;
+  eye::mapcal_save(dir + "/map.yaml", m);
+  std::ofstream refs(dir + "/reference_tags.yaml");
+  refs << "tags:\n";
+  for (const auto &r : sc.refs)
+    refs << " - {id: " << r.id << ", x_m: " << r.x_m << ", y_m: " << r.y_m << ", z_m: " << r.z_m
+         << ", yaw_rad: " << r.yaw_rad << ", size_m: " << r.size_m << "}\n";
+  bool ok = static_cast<bool>(refs) &&
+            write_run_config(dir + "/eye.yaml", sc.cfg.locate, url, sc.cfg.vehicles, true);
+  for (size_t i = 0; ok && i < sc.jpeg.size(); ++i) {
+    char name[48];
+    std::snprintf(name, sizeof name, "/frames/%04zu.jpg", i);
+    ok = write_jpeg(dir + name, sc.jpeg[i]);
+  }
+  if (!ok) {
+    std::fprintf(stderr, "eye_bench: cannot write the wide scene to %s\n", dir.c_str());
+    return 1;
+  }
+  return 0;
 }
 
 struct WideResult {
@@ -405,6 +448,11 @@ int main(int argc, char **argv) {
                  "only write a 640x480 scene to this folder (camera.yaml, map.yaml, eye.yaml "
                  "with --lcm-url, frame.jpg with NIGEL1 at x 1.2 m, y 0.9 m, yaw 0.5 rad) and "
                  "exit: the frames of tools/bench security");
+  std::string wide_scene_dir;
+  app.add_option("--write-wide-scene", wide_scene_dir,
+                 "only render the wide-angle scene (1280x720, 10 cars, --frames frames) and write "
+                 "it to this folder (camera.yaml, map.yaml, reference_tags.yaml, eye.yaml with "
+                 "--lcm-url, frames/NNNN.jpg) and exit: the frames of the latency benchmark");
   bool wide_only = false;
   app.add_flag("--wide-only", wide_only,
                "only the wide-angle scene (10 cars) and the bumped camera");
@@ -431,6 +479,7 @@ int main(int argc, char **argv) {
   // 2 full scans) and decimate 1 everywhere, same frames, same tracking, same run.
   std::fprintf(stderr, "[eye_bench] wide-angle scene: rendering %d frames, 10 cars\n", frames);
   const WideScene wide = make_wide_scene(1280, 720, frames);
+  if (!wide_scene_dir.empty()) return write_wide_scene(wide, wide_scene_dir, url);
   std::fprintf(stderr, "[eye_bench] wide: tags %.1f-%.1f px a side; plan:", wide.tag_px_min,
                wide.tag_px_max);
   const eye::Tracker planned(wide.cfg);

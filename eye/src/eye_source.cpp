@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <chrono>
 #include <deque>
@@ -16,6 +17,9 @@
 
 #include "eye_error.hpp"
 #include "eye_frame_check.hpp"
+#ifdef AUTODRIVE_EYE_GST_APPSINK
+#include "eye_gst.hpp"
+#endif
 
 namespace eye {
 
@@ -39,7 +43,8 @@ namespace {
 enum class Stamp {
   kFileIndex,   // video files: frame index / fps (no capture time recorded)
   kV4l2Buffer,  // the V4L2 buffer time stamp (CLOCK_MONOTONIC) mapped to the system clock
-  kGstPts,      // the GStreamer running time at read + the wall clock at PLAYING
+  kGstPts,      // the GStreamer running time at read + the wall clock at PLAYING (used only
+                // without the native appsink of eye_gst.cpp)
 };
 
 int64_t monotonic_utime() {
@@ -138,6 +143,7 @@ class LcmSource : public Source {
     auto start = std::chrono::steady_clock::now();
     while (q_.empty()) {
       const int r = lcm_.handleTimeout(100);
+      if (r < 0 && errno == EINTR) return false;  // a signal (SIGINT, SIGTERM): the run ends
       if (r < 0) throw Error("lcm: handle failed on channel " + channel_);
       const double waited =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -219,7 +225,11 @@ std::unique_ptr<Source> source_open(const std::string &spec, double fps_hint,
     }
     cap.open(idx, cv::CAP_V4L2);
   } else if (kind == "gst") {
+#ifdef AUTODRIVE_EYE_GST_APPSINK
+    return gst_source_open(spec, what, idle_timeout_s);  // stamps: the buffers' PTS
+#else
     cap.open(what, cv::CAP_GSTREAMER);
+#endif
   } else if (kind == "video") {
     if (!std::filesystem::exists(what)) throw Error("source '" + spec + "': no such file");
     cap.open(what, cv::CAP_FFMPEG);

@@ -298,10 +298,11 @@ int main(int argc, char **argv) {
           if (fs[i].gray.cols == in.width_px && fs[i].gray.rows == in.height_px) continue;
           sizes_ok = false;
           eye::skipped_frames_log().event(
-              fs[i].label, fs[i].label + ": size " + std::to_string(fs[i].gray.cols) + "x" +
-                               std::to_string(fs[i].gray.rows) + " differs from the calibrated " +
-                               std::to_string(in.width_px) + "x" + std::to_string(in.height_px) +
-                               " (frame skipped)");
+              cams[i].camera_name, fs[i].label + ": size " + std::to_string(fs[i].gray.cols) + "x" +
+                                       std::to_string(fs[i].gray.rows) +
+                                       " differs from the calibrated " +
+                                       std::to_string(in.width_px) + "x" +
+                                       std::to_string(in.height_px) + " (frame skipped)");
         }
         if (!sizes_ok) continue;
         // Cameras of one Eye are triggered together (the simulator renders them at one sim

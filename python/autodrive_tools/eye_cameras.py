@@ -3,8 +3,9 @@ from the map's sidecar JSON (its `eye_cameras`, written by tools/gen-maps from t
 description, the one place of each camera), and an `autodrive-eye run` config that serves them
 all as one Eye (`cameras:`, one `lcm:<CAM>_IMAGE` source each).
 
-The poses come from the map, not from `calibrate-map`: the sim maps carry no floor reference
-tags. Every camera looks straight down, image up = map +y (as the MJCF camera's xyaxes say)."""
+The poses come from the map (the simulator's truth), or from `calibrate-map` on the map's
+reference tags (autodrive_tools.bench.eye_refcal). Every camera looks straight down, image up =
+map +y (as the MJCF camera's xyaxes say)."""
 
 from __future__ import annotations
 
@@ -97,13 +98,26 @@ def load(map_name: str, maps_dir: Path = MAPS_DIR) -> list[OverheadCamera]:
 
 
 def write_eye_config(
-    cams: list[OverheadCamera], folder: Path, url: str, vehicles: list[tuple[str, int]]
+    cams: list[OverheadCamera],
+    folder: Path,
+    url: str,
+    vehicles: list[tuple[str, int]],
+    maps: dict[str, Path] | None = None,
+    reference_tags: Path | None = None,
+    extra: list[str] | None = None,
 ) -> Path:
     """eye.yaml for `autodrive-eye run`: every camera with its lcm: source, the cars (name,
-    tag id). base_link_height_m 0: the simulator's base_link is on the floor."""
-    lines = [f'lcm_url: "{url}"', "base_link_height_m: 0.0", "cameras:"]
+    tag id). base_link_height_m 0: the simulator's base_link is on the floor. maps: a camera's
+    map calibration (calibrate-map's output, in folder) in place of the map's own pose;
+    reference_tags (in folder): the tags the Eye watches for a moved camera; extra: more
+    config lines."""
+    lines = [f'lcm_url: "{url}"', "base_link_height_m: 0.0", *(extra or [])]
+    if reference_tags is not None:
+        lines.append(f"reference_tags: {reference_tags.name}")
+    lines.append("cameras:")
     for c in cams:
         intr, pose = c.write_calibration(folder)
+        pose = (maps or {}).get(c.name, pose)
         lines.append(
             f"  - {{name: {c.name}, intrinsics: {intr.name}, map: {pose.name}, "
             f"source: 'lcm:{c.image_channel()}'}}"

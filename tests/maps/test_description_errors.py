@@ -25,6 +25,7 @@ EXPECTED = {
     "bad_duplicate_name.yaml": ("cones[0].name", "'box_a' is already used by boxes[0].name"),
     "bad_off_floor.yaml": ("cones[0].position_m", "off the floor"),
     "bad_syntax.yaml": ("", "not valid YAML"),
+    "bad_reference_tag_id.yaml": ("reference_tags[0].id", "lower ids are the cars' roof tags"),
 }
 
 

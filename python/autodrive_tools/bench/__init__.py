@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import os
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -73,3 +73,16 @@ def print_figures(figures: Mapping[str, Any], key_value_lines: bool = False) -> 
         for k, v in figures.items():
             print(f"{k}: {v}")
     print(json.dumps(figures), flush=True)
+
+
+def key_value_main(prog: str, measure: Callable[[], Mapping[str, float]]) -> int:
+    """A measurement's CLI end: its figures as "key value" lines on stdout (exit 0), or its
+    RuntimeError on stderr as "prog: why" (exit 1)."""
+    try:
+        fig = measure()
+    except RuntimeError as e:
+        print(f"{prog}: {e}", file=sys.stderr)
+        return 1
+    for k, v in fig.items():
+        print(f"{k} {v:g}")
+    return 0

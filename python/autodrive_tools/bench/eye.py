@@ -6,13 +6,21 @@ autodrive-sim is built, the Eye on the simulator's overhead camera against its g
 k2 0.10), dim light, vignetting, noise sigma 6, 10 cars with 18-40 px tags over the whole image,
 edges included; the Eye (whole-field plan) against the previous default (decimate-2 scans) and
 decimate 1 everywhere in the same run (fps ratios), with and without window tracking; and a
-camera bumped by 5 mm / 0.3 deg (bumped_camera_*). sim_handover_gap_frames and
+camera bumped by 5 mm / 0.3 deg (bumped_camera_*; sim_bumped_camera_*: the same on the
+simulator's frames of Tiny Town, autodrive_tools.bench.eye_multi --bump). The cameras of Tiny
+Town are calibrated from its reference tags by calibrate-map first (refcal_*: residuals, how
+neighbours agree on shared tags; autodrive_tools.bench.eye_refcal). handover_gap_frames and
 sim_multi_cam_*: Tiny Town's four overhead cameras rendered by the simulator as one Eye, a car
-driving a lap through their overlaps (autodrive_tools.bench.eye_multi). Speeds are medians
-over passes; *_cpu divide by thread CPU time instead of wall time (the machine is shared). Writes out/bench/eye_trajectory
+driving a lap through their overlaps (autodrive_tools.bench.eye_multi). capture_to_pose_ms_*:
+a running autodrive-eye fed the wide-angle scene's 720p frames (10 cars) at 30 Hz over LCM,
+from each frame's capture stamp to the last of its poses on LCM
+(autodrive_tools.bench.eye_latency; wall clock, so the machine's load is printed with it).
+Speeds are medians over passes; fps_* are wall-clock, fps_*_cpu divide by the thread's CPU
+time instead (the machine is shared). Writes out/bench/eye_trajectory
 {.csv,.png}, eye_sim_trajectory{.csv,.png} and eye_multi_cam{.csv,.png}. Progress on stderr;
 last line one JSON object. Options: EYE_BENCH_FRAMES (240), EYE_BENCH_REPEATS (3),
-EYE_BENCH_SIM_S (30, 0: skip), EYE_BENCH_MULTI_S (140, 0: skip)."""
+EYE_BENCH_SIM_S (30, 0: skip), EYE_BENCH_MULTI_S (140, 0: skip), EYE_BENCH_LATENCY_FRAMES
+(300, 0: skip), EYE_BENCH_BUMP (1, 0: skip)."""
 
 from __future__ import annotations
 
@@ -23,9 +31,15 @@ from pathlib import Path
 
 from .. import plots
 from ..runfiles import read_columns
-from . import Progress, build_dir, eye_multi, eye_sim, out_dir, print_figures
+from . import Progress, build_dir, eye_latency, eye_multi, eye_sim, out_dir, print_figures
 
 INT_KEYS = ("frames", "repeats")
+BOOL_KEYS = (  # measured as 0 / 1
+    "bumped_camera_detected",
+    "unmoved_camera_no_alarm",
+    "sim_bumped_camera_detected",
+    "sim_unmoved_cameras_no_alarm",
+)
 log = Progress("eye")
 
 
@@ -68,6 +82,13 @@ def main(argv: list[str]) -> int:
         text=True,
     ).stdout
     figures = key_values(text)
+    latency_frames = int(os.environ.get("EYE_BENCH_LATENCY_FRAMES", "300"))
+    if latency_frames > 0:
+        log(f"capture to pose on LCM: {latency_frames} frames at 30 Hz into autodrive-eye")
+        try:
+            figures.update(eye_latency.measure(build, latency_frames, 30.0))
+        except RuntimeError as e:
+            log(f"capture to pose failed: {e}")
     # (option, default sim seconds, what, measure, output prefix) of each simulator run
     sim_runs = (
         ("EYE_BENCH_SIM_S", "30", "simulator overhead camera", eye_sim.measure, "eye_sim_trajectory"),
@@ -86,6 +107,14 @@ def main(argv: list[str]) -> int:
             figures.update(measure(build, sim_s, str(out / prefix)))
         except RuntimeError as e:
             log(f"{what} failed: {e}")
+    if os.environ.get("EYE_BENCH_BUMP", "1") != "0" and os.access(
+        build / "bin" / "autodrive-sim", os.X_OK
+    ):
+        log("a bumped camera on the simulator's frames (eye1 moved 5 mm / 0.3 deg)")
+        try:
+            figures.update(eye_multi.bumped_camera(build))
+        except RuntimeError as e:
+            log(f"bumped camera run failed: {e}")
     for k, v in figures.items():
         print(f"{k} {v}")
     try:
@@ -93,5 +122,10 @@ def main(argv: list[str]) -> int:
         log(f"plot {png}")
     except ValueError as e:
         log(f"plot failed: {e}")
-    print_figures({k: int(v) if k in INT_KEYS else v for k, v in figures.items()})
+    print_figures(
+        {
+            k: int(v) if k in INT_KEYS else bool(v) if k in BOOL_KEYS else v
+            for k, v in figures.items()
+        }
+    )
     return 0

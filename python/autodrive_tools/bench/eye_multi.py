@@ -1,9 +1,11 @@
 """Several overhead cameras, one Eye, over Tiny Town: `autodrive-sim --map tiny_town --eye`
 renders each of the map's eye_cameras on its <CAM>_IMAGE (2 x 2 of them, overlapping), a
 scripted car drives the town's loop (route loop_ccw) through the overlaps, and one
-`autodrive-eye run` serves every camera (config from autodrive_tools.eye_cameras: intrinsics
-and poses from the map). Every <VEH>_POSE_EYE is compared with <VEH>_GROUND_TRUTH interpolated
-at its utime (the frames' capture time).
+`autodrive-eye run` serves every camera (config from autodrive_tools.eye_cameras: the
+intrinsics from the map, the camera poses from `calibrate-map` on the map's reference tags,
+autodrive_tools.bench.eye_refcal, whose refcal_* figures are included; the Eye watches those
+tags). Every <VEH>_POSE_EYE is compared with <VEH>_GROUND_TRUTH interpolated at its utime (the
+frames' capture time); every camera's EYE_CAMERA_STATUS is recorded.
 
 handover_gap_frames: frames the Eye processed in which the car's roof tag lay whole inside at
 least one camera's image (from the ground truth, a tag's half-diagonal from the border) and the
@@ -12,8 +14,10 @@ handed over without a gap. The cameras seeing the tag are counted per frame too 
 two or more: fused poses; handovers: changes of the set of cameras that see it).
 
 CLI: python -m autodrive_tools.bench.eye_multi <build dir> [duration_s] [out prefix for
-.csv/.png] [--drive lap|crossing]. Progress on stderr; "key value" lines on stdout (sim_multi_cam_*,
-sim_handover_gap_frames). Run by `tools/bench eye` and the test
+.csv/.png] [--drive lap|crossing] [--bump]. --bump: only a 4 s crossing with eye1's calibration
+moved by 5 mm / 0.3 deg (a bumped camera), its status every frame: sim_bumped_camera_*.
+Progress on stderr; "key value" lines on stdout (sim_multi_cam_*, handover_gap_frames,
+multi_cam_pos_rms_mm). Run by `tools/bench eye` and the test
 eye.Sim.SeveralCamerasHandOverWithoutGap (EYE_MULTI_PORT picks the LCM port)."""
 
 from __future__ import annotations
@@ -27,11 +31,14 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+import yaml
+
 from .. import eye_cameras, proc, vehicle
 from ..channels import channel, vehicle_name
 from ..geometry import wrap
 from ..scoring import rms
-from . import Progress
+from . import Progress, eye_refcal, key_value_main
 from .eye_sim import Recorder, match
 
 # eye's port range 7790-7809: 7796 for the benchmark, EYE_MULTI_PORT=7795 for the test
@@ -52,6 +59,9 @@ DRIVES = {
     "lap": ["--script", "route:loop_ccw,laps=1"],
     "crossing": ["--start", "-0.8,-3.14,0", "--script", "constant:throttle=0.8,steering=0"],
 }
+# The bumped camera: its calibration moved by 5 mm and 0.3 deg; marked within 30 frames (goal)
+BUMP_CAMERA, BUMP_MM, BUMP_DEG, BUMP_WITHIN_FRAMES = "eye1", 5.0, 0.3, 30
+BUMP_S = 4.0  # sim time of its run, at CAMERA_FPS: 40 frames
 log = Progress("eye multi")
 
 
@@ -71,12 +81,12 @@ def run(
     duration_s: float,
     tmp: Path,
     url: str,
-    cams: list[eye_cameras.OverheadCamera],
+    cfg: Path,
+    n_cams: int,
     drive: str,
 ) -> tuple[list[int], str]:
-    """Runs the Eye on the simulator's cameras: the capture times of the frames it processed
-    and its stderr."""
-    cfg = eye_cameras.write_eye_config(cams, tmp, url, [(VEHICLE, TAG_ID)])
+    """Runs the Eye (config cfg) on the simulator's cameras: the capture times of the frames
+    it processed and its stderr."""
     eye = subprocess.Popen(
         [str(build / "bin" / "autodrive-eye"), "run", "-c", str(cfg)]
         + ["--idle-timeout-s", str(EYE_IDLE_TIMEOUT_S)],
@@ -86,7 +96,7 @@ def run(
     )
     time.sleep(EYE_START_S)
     log(
-        f"autodrive-sim --map {MAP} --eye: {len(cams)} cameras at {CAMERA_FPS:g} fps, "
+        f"autodrive-sim --map {MAP} --eye: {n_cams} cameras at {CAMERA_FPS:g} fps, "
         f"{duration_s:g} s of sim time, drive {drive}"
     )
     t0 = time.monotonic()
@@ -113,10 +123,85 @@ def run(
     return frames, err
 
 
+def calibrated_config(
+    build: Path,
+    tmp: Path,
+    url: str,
+    cams: list[eye_cameras.OverheadCamera],
+    extra: list[str] | None = None,
+    bump: str | None = None,
+) -> tuple[Path, dict[str, float]]:
+    """The Eye's config with every camera calibrated by calibrate-map from the map's reference
+    tags (eye_refcal), which it also watches; with bump, that camera's calibration is moved by
+    BUMP_MM / BUMP_DEG (as if the camera had moved after it was calibrated). Also the refcal_*
+    figures."""
+    figures = eye_refcal.measure(build, tmp)
+    maps = {c.name: tmp / f"{c.name}_calibrated.yaml" for c in cams}
+    if bump is not None:
+        maps[bump] = bumped_calibration(maps[bump], tmp / f"{bump}_bumped.yaml")
+    cfg = eye_cameras.write_eye_config(
+        cams, tmp, url, [(VEHICLE, TAG_ID)], maps, tmp / "reference_tags.yaml", extra
+    )
+    return cfg, figures
+
+
+def bumped_calibration(src: Path, dst: Path) -> Path:
+    """A copy of a map calibration (X_cam = R X_map + t) turned by BUMP_DEG about an axis in
+    the image plane and shifted by BUMP_MM: the 5 mm / 0.3 deg of the issue's bumped camera."""
+    doc = yaml.safe_load(src.read_text())
+    r = np.array(doc["r_cam_map"], dtype=float).reshape(3, 3)
+    t = np.array(doc["t_cam_map_m"], dtype=float)
+    axis = np.array([0.6, 0.8, 0.0])
+    a = math.radians(BUMP_DEG)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    d = np.eye(3) + math.sin(a) * k + (1 - math.cos(a)) * k @ k  # Rodrigues
+    shift = np.array([0.6, -0.8, 0.0]) * BUMP_MM / 1000
+    doc["r_cam_map"] = [float(v) for v in (d @ r).ravel()]
+    doc["t_cam_map_m"] = [float(v) for v in d @ t + shift]
+    dst.write_text(yaml.safe_dump(doc))
+    return dst
+
+
+def bumped_camera(build: Path) -> dict[str, float]:
+    """The Eye on rendered frames with one camera moved after its calibration (BUMP_CAMERA):
+    the frames until it is marked moved (its EYE_CAMERA_STATUS, published every frame here),
+    whether the other cameras stayed unmarked, and its poses' covariance factor."""
+    cams = eye_cameras.load(MAP)
+    url = f"udpm://239.255.76.67:{os.environ.get('EYE_MULTI_PORT', DEFAULT_PORT)}?ttl=0"
+    rec = Recorder(build, url, VEHICLE, [c.info_channel() for c in cams])
+    with tempfile.TemporaryDirectory(prefix="eye-bump-") as tmp:
+        try:
+            cfg, _ = calibrated_config(
+                build, Path(tmp), url, cams, ["health: {status_period_s: 0.001}"], BUMP_CAMERA
+            )
+            run(build, BUMP_S, Path(tmp), url, cfg, len(cams), "crossing")
+            time.sleep(0.5)
+        finally:
+            rec.close()
+    mine = sorted((m for m in rec.status if m.camera == BUMP_CAMERA), key=lambda m: m.utime)
+    if not mine:
+        raise RuntimeError(f"no EYE_CAMERA_STATUS of {BUMP_CAMERA}")
+    first = next((i for i, m in enumerate(mine) if m.moved), -1)
+    others = {m.camera for m in rec.status if m.camera != BUMP_CAMERA and m.moved}
+    log(
+        f"{BUMP_CAMERA} moved {BUMP_MM:g} mm / {BUMP_DEG:g} deg: marked after {first} frames "
+        f"(reference residual {mine[-1].ref_residual_rms_mm:.2f} mm, covariance x"
+        f"{mine[-1].cov_scale:g}); other cameras marked: {sorted(others) or 'none'}"
+    )
+    return {
+        "sim_bumped_camera_detected": float(0 <= first < BUMP_WITHIN_FRAMES),
+        "sim_bumped_camera_frames": float(first),
+        "sim_bumped_camera_cov_scale": float(mine[-1].cov_scale),
+        "sim_bumped_camera_ref_residual_mm": round(float(mine[-1].ref_residual_rms_mm), 3),
+        "sim_unmoved_cameras_no_alarm": float(not others),
+    }
+
+
 def measure(
     build: Path, duration_s: float, prefix: str | None, drive: str = "lap"
 ) -> dict[str, float]:
-    """The sim_multi_cam_* figures; RuntimeError when the run cannot be measured."""
+    """The sim_multi_cam_* figures (the cameras calibrated from the reference tags: refcal_*,
+    and their status messages); RuntimeError when the run cannot be measured."""
     for prog in ("autodrive-sim", "autodrive-eye"):
         if not os.access(build / "bin" / prog, os.X_OK):
             raise RuntimeError(f"{build / 'bin' / prog} not built")
@@ -127,7 +212,8 @@ def measure(
     rec = Recorder(build, url, VEHICLE, [c.info_channel() for c in cams])
     with tempfile.TemporaryDirectory(prefix="eye-multi-") as tmp:
         try:
-            frames, _ = run(build, duration_s, Path(tmp), url, cams, drive)
+            cfg, refcal = calibrated_config(build, Path(tmp), url, cams)
+            frames, _ = run(build, duration_s, Path(tmp), url, cfg, len(cams), drive)
             time.sleep(0.5)
         finally:
             rec.close()
@@ -156,10 +242,17 @@ def measure(
         "sim_multi_cam_cameras_crossed": len(cams_seen),
         "sim_multi_cam_handovers": handovers,
         "sim_multi_cam_frames_in_overlap": sum(1 for s in seen_by if "+" in s),
-        "sim_handover_gap_frames": len(gaps),
-        "sim_multi_cam_pos_rms_mm": round(rms(errs_mm), 3),
+        "handover_gap_frames": len(gaps),
+        "multi_cam_pos_rms_mm": round(rms(errs_mm), 3),
         "sim_multi_cam_pos_max_mm": round(max(errs_mm), 3),
         "sim_multi_cam_heading_rms_deg": round(rms(errs_deg), 4),
+        # EYE_CAMERA_STATUS: every camera's, the largest reference residual, cameras marked moved
+        "sim_multi_cam_status_cameras": len({m.camera for m in rec.status}),
+        "sim_multi_cam_status_ref_residual_mm_max": round(
+            max((m.ref_residual_rms_mm for m in rec.status), default=-1.0), 3
+        ),
+        "sim_multi_cam_status_cameras_moved": len({m.camera for m in rec.status if m.moved}),
+        **refcal,
     }
     if gaps:
         log(f"frames without a pose while the tag was in view: utime {gaps[:10]}")
@@ -236,15 +329,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("duration_s", type=float, nargs="?", default=140.0, help="sim time [s]")
     p.add_argument("prefix", nargs="?", help="write PREFIX.csv and PREFIX.png")
     p.add_argument("--drive", choices=sorted(DRIVES), default="lap", help="the car's path")
+    p.add_argument(
+        "--bump", action="store_true", help="only the bumped camera run (sim_bumped_camera_*)"
+    )
     a = p.parse_args(argv)
-    try:
-        fig = measure(a.build, a.duration_s, a.prefix, a.drive)
-    except RuntimeError as e:
-        print(f"eye_multi: {e}", file=sys.stderr)
-        return 1
-    for k, v in fig.items():
-        print(f"{k} {v:g}")
-    return 0
+    return key_value_main(
+        "eye_multi",
+        lambda: (
+            bumped_camera(a.build) if a.bump else measure(a.build, a.duration_s, a.prefix, a.drive)
+        ),
+    )
 
 
 if __name__ == "__main__":

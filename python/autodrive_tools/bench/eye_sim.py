@@ -73,10 +73,12 @@ class Recorder:
         self.truth: list[Any] = []
         self.poses: list[Any] = []
         self.info: list[Any] = []
+        self.status: list[Any] = []  # the Eye's EYE_CAMERA_STATUS messages
         self.lc = lcmtypes.bus(f"{url}&recv_buf_size={RECV_BUF_BYTES}")
         subs = [
             (channel("GROUND_TRUTH", vehicle), types.ground_truth_t, self.truth),
             (channel("POSE_EYE", vehicle), types.pose2d_t, self.poses),
+            (channel("EYE_CAMERA_STATUS"), types.eye_camera_status_t, self.status),
         ]
         for ch in info_channels or [channel("EYE_CAMERA_INFO")]:
             subs.append((ch, types.camera_info_t, self.info))

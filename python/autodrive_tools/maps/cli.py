@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from . import mjcf, sidecar, textures
+from . import mjcf, reftags, sidecar, textures
 from .loader import MAPS_DIR, load, load_kit, names
 from .model import MapDescriptionError
 
@@ -22,9 +22,10 @@ def outputs(name: str, maps_dir: Path = MAPS_DIR) -> dict[Path, str]:
 
 def texture_outputs(maps_dir: Path = MAPS_DIR) -> dict[Path, bytes]:
     """The textures every map in the folder uses (one per tile type and lane count, one per sign
-    kind) in maps_dir/textures, and their PNG bytes."""
+    kind, one per reference tag) in maps_dir/textures, and their PNG bytes."""
     tile_keys: set[tuple[str, int]] = set()
     sign_keys: set[tuple[str, str]] = set()
+    tag_ids: set[int] = set()
     for name in names(maps_dir):
         m = load(maps_dir / f"{name}.yaml", maps_dir / "kit.yaml")
         tile_keys |= {(t.type, t.lanes) for t in m.tiles}
@@ -32,8 +33,10 @@ def texture_outputs(maps_dir: Path = MAPS_DIR) -> dict[Path, bytes]:
             (s.kind, textures.sign_texture_name(s.kind, s.speed_limit_m_s))
             for s in m.placed_signs()
         }
+        tag_ids |= {t.id for t in m.reference_tags}
     kit = load_kit(maps_dir / "kit.yaml")
     out = textures.generate(kit, tile_keys, sign_keys)
+    out.update({reftags.texture_name(i): reftags.png(i) for i in sorted(tag_ids)})
     return {maps_dir / textures.DIR_NAME / f"{n}.png": b for n, b in out.items()}
 
 

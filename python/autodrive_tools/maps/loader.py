@@ -26,6 +26,8 @@ ON_LANE_TOLERANCE_M = 0.01  # a stop line's centre must be this close to its lan
 
 MAX_LATE_OBSTACLES = 8  # the simulator's SCN_MAX_MAP_LATE_BOXES (scenario.h)
 MAX_EYE_CAMERAS = 8  # the simulator's MAIN_MAX_EYE_CAMS (main.c)
+TAG36H11_CODES = 587  # ids 0..586
+MIN_REFERENCE_TAG_ID = 100  # below: the cars' roof tags (mjcf_gen.c mg_tag_id: car i has id i)
 
 
 def names(maps_dir: Path = MAPS_DIR) -> list[str]:
@@ -163,6 +165,7 @@ class _Checker:
             if p.slot not in {s.name for s in m.slots()}:
                 raise self.err(f"parked[{i}].slot", f"no parking slot '{p.slot}'")
         self.eye_cameras()
+        self.reference_tags()
         if len(m.late_obstacles) > MAX_LATE_OBSTACLES:
             raise self.err(
                 "late_obstacles",
@@ -280,6 +283,19 @@ class _Checker:
             self.unique(c.name, f"{key}.name")
             self.on_floor([c.centre_m], f"{key}.centre_m")
             self.positive(c.height_m, f"{key}.height_m")
+
+    def reference_tags(self) -> None:
+        for i, t in enumerate(self.m.reference_tags):
+            key = f"reference_tags[{i}]"
+            if not MIN_REFERENCE_TAG_ID <= t.id < TAG36H11_CODES:
+                raise self.err(
+                    f"{key}.id",
+                    f"must be in {MIN_REFERENCE_TAG_ID}..{TAG36H11_CODES - 1} (tag36h11; lower "
+                    f"ids are the cars' roof tags), got {t.id}",
+                )
+            self.unique(f"reftag{t.id}", f"{key}.id")
+            self.on_floor([t.centre_m], f"{key}.centre_m")
+            self.positive(t.size_m, f"{key}.size_m")
 
     def lights(self) -> None:
         stops = {s.name for s in self.m.all_stop_lines()}

@@ -14,10 +14,10 @@ from __future__ import annotations
 import math
 from typing import Iterable, Sequence
 
-from . import geometry, textures
+from . import geometry, reftags, textures
 from ..geometry import wrap
 from .description import MapDescription
-from .model import ParkingSlot, Vec2
+from .model import REFERENCE_TAG_THICKNESS_M, REFERENCE_TAG_TOP_M, ParkingSlot, Vec2
 
 NUMERIC_MAX_VALUES = 500  # MuJoCo 2.2's limit per <numeric>: longer data goes on in <name>.partK
 CUSTOM_STEP_M = 0.05  # spacing of the lane and route centre lines in <custom> numerics
@@ -143,6 +143,15 @@ class _Writer:
                 f'    <texture name="{name}" type="2d" file="{textures.DIR_NAME}/{name}.png"/>'
             )
             self.lines.append(f'    <material name="{name}_mat" texture="{name}"/>')
+        for t in m.reference_tags:
+            n = reftags.texture_name(t.id)
+            self.lines.append(
+                f'    <texture name="{n}" type="2d" file="{textures.DIR_NAME}/{n}.png"/>'
+            )
+            self.lines.append(
+                f'    <material name="{n}_mat" texture="{n}" specular="0" shininess="0" '
+                'reflectance="0"/>'
+            )
         tl = self.kit.traffic_light
         for light in m.lights():
             for c in LAMPS:
@@ -162,6 +171,22 @@ class _Writer:
                 f'size="{nums((h, h, tk.thickness_m / 2))}" '
                 f'euler="0 0 {num(wrap(math.radians(t.spec.rotation_deg)))}" {VIS} '
                 f'material="{t.texture}_mat"/>'
+            )
+
+    def reference_tags(self) -> None:
+        """One plate per reference tag, its top face carrying the whole 10-cell image. MuJoCo
+        lays a 2D texture on a box's top face with the image's up along the box's +y: the box
+        is yawed yaw - 90 deg so that the print's top points along yaw (as the roof tags,
+        sim_tags.h)."""
+        t_m = REFERENCE_TAG_THICKNESS_M
+        for t in self.m.reference_tags:
+            half = 0.5 * t.size_m * reftags.CELLS / reftags.BLACK_CELLS
+            self.add(
+                f'<geom name="reftag_{t.id}" type="box" '
+                f'pos="{nums((*t.centre_m, REFERENCE_TAG_TOP_M - t_m / 2))}" '
+                f'size="{nums((half, half, t_m / 2))}" '
+                f'euler="0 0 {num(wrap(math.radians(t.yaw_deg) - math.pi / 2))}" {VIS} '
+                f'material="{reftags.texture_name(t.id)}_mat"/>'
             )
 
     def lights(self) -> None:
@@ -365,6 +390,7 @@ class _Writer:
             self.box(f"parked_{p.slot}", slot.centre_m, kit.parked_car_size_m, slot.yaw_rad)
         self.lights()
         self.signs()
+        self.reference_tags()
         t = kit.terrain_patch_thickness_m
         for patch in m.terrain_patches:
             surface = kit.surfaces[patch.surface]

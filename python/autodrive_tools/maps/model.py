@@ -393,6 +393,25 @@ class EyeCameraSpec:
 
 
 @dataclass(frozen=True)
+class ReferenceTagSpec:
+    """A tag36h11 print lying on the map at a known place, for `autodrive-eye calibrate-map` of
+    the overhead cameras (shared by neighbours where they overlap): its black square's edge
+    size_m, its centre, the top of the print towards yaw_deg (from map +x). Visual only, on a
+    plate just above the tiles (REFERENCE_TAG_TOP_M)."""
+
+    id: int
+    centre_m: Vec2
+    yaw_deg: float
+    size_m: float
+
+
+# A reference tag's plate: top face above the floor (over the tiles' 0.5 mm and the terrain
+# patches' 1 mm) and thickness [m]; the top face is the tag's plane (z_m in the sidecar).
+REFERENCE_TAG_TOP_M = 0.002
+REFERENCE_TAG_THICKNESS_M = 0.001
+
+
+@dataclass(frozen=True)
 class Options:
     light_level: float = 1.0  # 0 (night) .. 1 (day)
 
@@ -420,6 +439,7 @@ class MapFile:
     parked: list[Parked] = field(default_factory=list)
     late_obstacles: list[LateObstacle] = field(default_factory=list)
     eye_cameras: list[EyeCameraSpec] = field(default_factory=list)
+    reference_tags: list[ReferenceTagSpec] = field(default_factory=list)
 
 
 @dataclass(frozen=True)

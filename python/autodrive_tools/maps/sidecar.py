@@ -8,6 +8,7 @@ import json
 import math
 from typing import Any
 
+from . import reftags
 from .description import MapDescription
 from .model import Piece, Vec2
 
@@ -26,7 +27,7 @@ def document(m: MapDescription) -> dict[str, Any]:
     """The sidecar's content as plain JSON types."""
     kit = m.kit
     sp = m.spawn_pose()
-    return {
+    doc: dict[str, Any] = {
         "name": m.name,
         "generated_from": [f"{m.name}.yaml", "kit.yaml"],
         "floor": {
@@ -218,6 +219,9 @@ def document(m: MapDescription) -> dict[str, Any]:
         ],
         "options": {"light_level": m.options.light_level},
     }
+    if m.reference_tags:  # only on maps that have them: the others' sidecars stay as they were
+        doc["reference_tags"] = reftags.sidecar(m.reference_tags)
+    return doc
 
 
 def _piece(p: Piece) -> dict[str, Any]:

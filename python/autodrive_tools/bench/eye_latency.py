@@ -1,0 +1,207 @@
+"""Capture to pose on LCM: a real `autodrive-eye run --source lcm:EYE_IMAGE` process fed the
+wide-angle bench scene (1280x720 JPEG, barrel lens, noise sigma 6, 10 cars, 8 reference tags;
+rendered by `eye_bench --write-wide-scene`) at a fixed frame rate over real LCM (UDP
+multicast). Each frame is stamped with the system clock when it is published (its capture
+time: a camera driver stamps a frame when it has it whole); the time of a frame's pose is when
+the LAST of its cars' `<VEH>_POSE_EYE` messages (utime = that capture time) arrives here. So the
+figure holds the JPEG's trip over UDP, its decode, detection, pose and the poses' trip back.
+
+The first frames (until the Eye has published a pose, plus WARMUP_FRAMES) are not counted: the
+Eye's first frame is a whole-frame scan with no car tracked yet.
+
+CLI: python -m autodrive_tools.bench.eye_latency <build dir> [frames] [fps]. Run by
+`tools/bench eye` (EYE_BENCH_LATENCY_FRAMES, 0: skip) and the test
+eye.Latency.CaptureToPoseOnLcm (EYE_LATENCY_PORT picks the LCM port). Progress on stderr;
+"key value" lines on stdout. Wall-clock figures: they depend on the machine's load (printed)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from .. import lcmtypes, proc
+from ..channels import channel, vehicle_name
+from . import Progress, key_value_main
+
+# eye's port range 7790-7809: 7800 for the benchmark, EYE_LATENCY_PORT=7794 for the test
+DEFAULT_PORT = "7800"
+CARS = 10  # the wide scene's cars: tag ids 1..10 are NIGEL1..NIGEL10
+RECV_BUF_BYTES = 4194304  # the socket also gets the JPEG frames
+WARMUP_FRAMES = 10  # one staggered scan cycle (tracking.full_every) after the first pose
+EYE_IDLE_TIMEOUT_S = 3
+FIRST_POSE_TIMEOUT_S = 30.0
+DRAIN_S = 1.0  # after the last frame, for its poses to arrive
+log = Progress("eye latency")
+
+
+def percentile(values: list[float], q: float) -> float:
+    """The q-quantile (nearest rank, as the Eye's own latency line)."""
+    v = sorted(values)
+    return v[min(len(v) - 1, int(q * len(v)))]
+
+
+class PoseTimes:
+    """Arrival time [us, system clock] of the last pose of each capture time, on a thread."""
+
+    def __init__(self, url: str, types: Any) -> None:
+        self.last: dict[int, int] = {}
+        self.count: dict[int, int] = {}
+        self.lock = threading.Lock()
+        self.lc = lcmtypes.bus(f"{url}&recv_buf_size={RECV_BUF_BYTES}")
+        for k in range(1, CARS + 1):
+            self.lc.subscribe(channel("POSE_EYE", vehicle_name(k)), self._on_pose)
+        self.types = types
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._pump, daemon=True)
+        self.thread.start()
+
+    def _on_pose(self, _channel: str, data: bytes) -> None:
+        now_us = time.time_ns() // 1000
+        utime = self.types.pose2d_t.decode(data).utime
+        with self.lock:
+            self.last[utime] = now_us
+            self.count[utime] = self.count.get(utime, 0) + 1
+
+    def _pump(self) -> None:
+        while not self.stop.is_set():
+            self.lc.handle_timeout(20)
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join()
+
+
+def cpu_s(pid: int) -> float:
+    """User + system CPU time [s] of a running process (/proc/<pid>/stat)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def image(types: Any, jpeg: bytes, utime: int, w: int, h: int) -> bytes:
+    m = types.compressed_image_t()
+    m.utime = utime
+    m.frame_id = "eye"
+    m.format = "jpeg"
+    m.width_px, m.height_px = w, h
+    m.size_bytes = len(jpeg)
+    m.data = jpeg
+    return bytes(m.encode())
+
+
+def feed(
+    pub: Any, types: Any, frames: list[bytes], n: int, fps: float, poses: PoseTimes
+) -> tuple[list[int], int]:
+    """Publishes n frames (cycling through `frames`) at fps on a fixed schedule, after the Eye's
+    first pose and WARMUP_FRAMES more; returns the capture times of the counted frames and the
+    number of frames published."""
+    ch = channel("EYE_IMAGE")
+    period_s = 1.0 / fps
+    i, counted, t_next = 0, [], time.monotonic()
+    first_pose_deadline = time.monotonic() + FIRST_POSE_TIMEOUT_S
+    warm_left = None  # frames still to skip once the Eye has published
+    while len(counted) < n:
+        t_next += period_s
+        utime = time.time_ns() // 1000
+        pub.publish(ch, image(types, frames[i % len(frames)], utime, 1280, 720))
+        i += 1
+        if warm_left is None:
+            with poses.lock:
+                if poses.last:
+                    warm_left = WARMUP_FRAMES
+            if warm_left is None and time.monotonic() > first_pose_deadline:
+                raise RuntimeError(f"no pose from the Eye within {FIRST_POSE_TIMEOUT_S:g} s")
+        elif warm_left > 0:
+            warm_left -= 1
+        else:
+            counted.append(utime)
+        time.sleep(max(0.0, t_next - time.monotonic()))
+    return counted, i
+
+
+def measure(build: Path, n_frames: int = 300, fps: float = 30.0) -> dict[str, float]:
+    """The capture_to_pose_* figures; RuntimeError when the run cannot be measured."""
+    for prog in ("eye_bench", "autodrive-eye"):
+        if not os.access(build / "bin" / prog, os.X_OK):
+            raise RuntimeError(f"{build / 'bin' / prog} not built")
+    url = f"udpm://239.255.76.67:{os.environ.get('EYE_LATENCY_PORT', DEFAULT_PORT)}?ttl=0"
+    types = lcmtypes.load(build)
+    with tempfile.TemporaryDirectory(prefix="eye-latency-") as tmp_s:
+        tmp = Path(tmp_s)
+        scene_frames = min(n_frames, 120)  # cycled: the cars jump back to the start, a test too
+        log(f"rendering the wide-angle scene ({scene_frames} frames, 1280x720, 10 cars)")
+        subprocess.run(
+            [build / "bin" / "eye_bench", "--write-wide-scene", tmp, "--frames", str(scene_frames)]
+            + ["--lcm-url", url],
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
+        frames = [p.read_bytes() for p in sorted((tmp / "frames").glob("*.jpg"))]
+        poses = PoseTimes(url, types)
+        eye = subprocess.Popen(
+            [str(build / "bin" / "autodrive-eye"), "run", "-c", str(tmp / "eye.yaml")]
+            + ["--source", f"lcm:{channel('EYE_IMAGE')}", "-q"]
+            + ["--idle-timeout-s", str(EYE_IDLE_TIMEOUT_S)],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        load0 = os.getloadavg()[0]
+        cpu0 = time.process_time()
+        try:
+            pub = lcmtypes.bus(url)
+            log(f"feeding {n_frames} frames at {fps:g} Hz (load average {load0:.1f})")
+            eye_cpu0 = cpu_s(eye.pid)
+            counted, published = feed(pub, types, frames, n_frames, fps, poses)
+            time.sleep(DRAIN_S)
+            # the Eye's CPU per frame it was sent, its start-up included [ms]
+            eye_cpu_ms = 1000 * (cpu_s(eye.pid) - eye_cpu0) / published
+        finally:
+            poses.close()
+            proc.stop(eye, "autodrive-eye", log)
+        eye_err = eye.stderr.read() if eye.stderr else ""
+        feeder_cpu_s = time.process_time() - cpu0
+    lat_ms, missing, short = [], 0, 0
+    for u in counted:
+        if u not in poses.last:
+            missing += 1
+            continue
+        short += poses.count[u] < CARS
+        lat_ms.append((poses.last[u] - u) / 1000.0)
+    if not lat_ms:
+        raise RuntimeError(f"no counted frame got a pose; autodrive-eye said: {eye_err[-1500:]}")
+    log(eye_err.strip().splitlines()[-1] if eye_err.strip() else "eye printed nothing")
+    return {
+        "capture_to_pose_ms_p50": round(percentile(lat_ms, 0.5), 3),
+        "capture_to_pose_ms_p99": round(percentile(lat_ms, 0.99), 3),
+        "capture_to_pose_ms_max": round(max(lat_ms), 3),
+        "capture_to_pose_frames": float(len(counted)),
+        "capture_to_pose_frames_without_pose": float(missing),
+        "capture_to_pose_frames_short_of_10_cars": float(short),
+        "capture_to_pose_feed_hz": fps,
+        "capture_to_pose_load_avg": round(max(load0, os.getloadavg()[0]), 2),
+        "capture_to_pose_feeder_cpu_s": round(feeder_cpu_s, 2),
+        "capture_to_pose_eye_cpu_ms_per_frame_sent": round(eye_cpu_ms, 2),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(
+        prog="python -m autodrive_tools.bench.eye_latency",
+        description="Capture to pose on LCM of a running autodrive-eye fed 720p frames with 10 "
+        "cars at a fixed rate; prints 'key value' lines (capture_to_pose_*).",
+    )
+    p.add_argument("build", type=Path, help="host build dir")
+    p.add_argument("frames", type=int, nargs="?", default=300, help="frames counted")
+    p.add_argument("fps", type=float, nargs="?", default=30.0, help="feed rate [Hz]")
+    a = p.parse_args(argv)
+    return key_value_main("eye_latency", lambda: measure(a.build, a.frames, a.fps))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
