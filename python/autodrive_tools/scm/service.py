@@ -36,6 +36,9 @@ EYE_PREFERRED_S = 0.5  # an Eye pose this recent [s] wins over the EKF's
 QUEUE_M = 1.2  # a car this close to a red light's stop line [m] is queued on its approach
 COMMAND_HOLD_S = 2.0  # each light command holds this long [s]; refreshed every REFRESH_S
 REFRESH_S = 0.5
+# The simulator publishes every light at 10 Hz of sim time and each change at once; a light
+# not heard of for this long [s, wall] (the simulator gone, not merely slowed) is unknown.
+LIGHT_UNKNOWN_S = 5.0
 VEHICLE_PATTERN = "[A-Z][A-Z0-9]*"  # a vehicle name: capitals and digits
 
 
@@ -324,12 +327,22 @@ class Scm:
             self.lc_out.publish(chan, data)
 
     def light_view(self, light_id: int, t: float) -> tuple[str, float]:
-        """The state a car should obey (the simulator's, when fresh) and its time left [s]."""
-        own = self.controller.lights[light_id].state
+        """The state a car should obey and its time left [s] (< 0: not known). The light is the
+        authority on what it shows: the advisory is the state the simulator (the light) last
+        published on TRAFFIC_LIGHT_STATE, never the SCM's own command, which may not have
+        reached it yet (a loaded machine pauses the simulator in lockstep, so its states come
+        late; a GREEN announced from the command let a car drive off at a red light). The time
+        left is the SCM's (it decides the next change) while the light shows the SCM's state,
+        else unknown (the light is about to follow a command). No state yet, or none for
+        LIGHT_UNKNOWN_S: unknown, advised as RED."""
         sim = self.sim_states.get(light_id)
-        if sim is not None and t - sim[2] < STALE_S and sim[0] != own:
-            return sim[0], -1.0
-        return own, self.controller.time_left_s(light_id, t)
+        if sim is None or t - sim[2] > LIGHT_UNKNOWN_S:
+            return "RED", -1.0
+        shown = sim[0]
+        light = self.controller.lights[light_id]
+        if shown == light.state:
+            return shown, self.controller.time_left_s(light_id, t)
+        return shown, -1.0
 
     def _advise(self, t: float) -> None:
         for car in self.cars.values():
