@@ -166,6 +166,17 @@ class Scm:
             t.start()
             self._threads.append(t)
 
+    def ready(self) -> bool:
+        """Started and every part of it alive: the LCM, ingest and control threads, the pose
+        receiver process and the database writer."""
+        return (
+            bool(self._threads)
+            and all(t.is_alive() for t in self._threads)
+            and self.receiver.proc.is_alive()
+            and self.writer.alive()
+            and not self._stop.is_set()
+        )
+
     def stop(self) -> None:
         self._stop.set()
         for t in self._threads:
