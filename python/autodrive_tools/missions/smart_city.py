@@ -273,6 +273,8 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
                 url,
                 "--vehicles",
                 vehicles,
+                "--clock",  # yellow and all-red last their time in the simulated town
+                "sim",
                 "--build",
                 build,
             ]
