@@ -55,10 +55,11 @@ BLOCKED_S = 30.0  # a car standing this long [s sim] away from any stop line is 
 # give beside three runtimes (README, smart-city section: the figures were measured at 5 Hz).
 EYE_FPS_DEFAULT = 5.0
 # Starting up is bounded by each program's own CPU time, not by wall time (on a loaded machine
-# the wall time of a start is anyone's guess: at load 48 the SCM was not up in 90 s). Here on a
-# quiet core the SCM is ready after ~2-3 s of CPU (Python, FastAPI, SQLAlchemy, Alembic, its
-# pose receiver process) and the simulator has its ptys after well under 10 s (Tiny Town's
-# MJCF); these budgets are ~10x that. --timeout [s wall] bounds the whole run, the start too.
+# the wall time of a start is anyone's guess: at load 48 the SCM was not up in 90 s). Measured
+# here (2026-11-27, load ~10): the SCM is ready after 1.2-1.3 s of its CPU (Python, FastAPI,
+# SQLAlchemy, Alembic; its pose receiver is a process of its own, not counted) and the simulator
+# has its ptys after 0.1 s of its CPU; the budgets are far above that, so that only a start
+# that really is stuck fails. --timeout [s wall] bounds the whole run, the start too.
 SCM_START_CPU_S = 30.0
 SIM_START_CPU_S = 60.0
 TIMEOUT_S = 3600.0  # the default --timeout [s wall]: a hang guard, the run ends at its laps
@@ -217,7 +218,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             sim += ["--view"]
         sim_proc = procs.start("autodrive-sim", sim, out / "sim.log")
         nano = run_dir / f"{vehicle_name(cars).lower()}-nano"
-        wait_ready(
+        sim_cpu_s = wait_ready(
             "autodrive-sim",
             sim_proc,
             lambda: None if nano.exists() else f"no {nano} yet",
@@ -227,6 +228,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             say,
             out / "sim.log",
         )
+        say(f"autodrive-sim has its ptys (after {sim_cpu_s:.1f} s of its CPU)")
         py = sys.executable
         vehicles = ",".join(vehicle_name(i) for i in range(1, cars + 1))
         if args.city_eye == "cameras":
