@@ -113,8 +113,19 @@ def wait_ready(
     t0 = time.monotonic()
     next_note = t0 + 15.0
     why = "no answer yet"
+
+    def log_end() -> str:
+        try:
+            tail = logfile.read_text(errors="replace").splitlines()[-5:]
+        except OSError:
+            tail = []
+        return f"the end of {logfile}: {' | '.join(tail) or '(empty)'}"
+
     while True:
-        procs.check()
+        try:
+            procs.check()
+        except RuntimeError as err:  # a child died: say what its log says
+            raise RuntimeError(f"waiting for {name} to be ready: {err}; {log_end()}") from err
         answer = probe()
         if answer is None:
             return cpu_time_s(proc.pid)
@@ -123,10 +134,6 @@ def wait_ready(
         wall = time.monotonic() - t0
         load = os.getloadavg()[0]
         if cpu > cpu_budget_s or wall > wall_limit_s:
-            try:
-                tail = logfile.read_text(errors="replace").splitlines()[-5:]
-            except OSError:
-                tail = []
             limit = (
                 f"{cpu_budget_s:g} s of its CPU time" if cpu > cpu_budget_s
                 else f"the {wall_limit_s:g} s wall-time guard"
@@ -134,7 +141,7 @@ def wait_ready(
             raise RuntimeError(
                 f"{name} not ready within {limit} (it used {cpu:.1f} s of CPU in {wall:.0f} s "
                 f"wall, load average {load:.1f} on {os.cpu_count()} cores); last probe: {why}; "
-                f"the end of {logfile}: {' | '.join(tail) or '(empty)'}"
+                f"{log_end()}"
             )
         if time.monotonic() >= next_note:
             next_note += 15.0
