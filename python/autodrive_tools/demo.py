@@ -41,6 +41,7 @@ DEFAULT_MAPPING_ROUTE = "-0.35,0,0"
 LOOP_SIM_MARGIN_S = 8.0
 PARKING_SIM_MARGIN_S = 30.0
 PARKING_LOCKSTEP_RTF_BOUND = 20.0  # the fastest a lockstep run is assumed to go
+PARKING_TIMEOUT_S = 240.0  # the default --timeout of parking and loop [s wall]
 LOOP_RTF = 2.0  # the loop driver commands at 50 Hz of wall time: keep the sim paced
 
 
@@ -103,7 +104,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "--no-late-box", action="store_true", help="parking: no box appears (the lot is as mapped)"
     )
     p.add_argument(
-        "--timeout", type=float, default=240.0, help="parking: give up after this many wall seconds"
+        "--timeout",
+        type=float,
+        default=None,
+        help="give up after this many wall seconds (default: parking and loop "
+        f"{PARKING_TIMEOUT_S:g}; smart-city {smart_city.TIMEOUT_S:g}, a hang guard: it ends "
+        "when every car drove its laps)",
     )
     p.add_argument("--duration", type=float, default=40.0, help="loop: driven time [s, sim time]")
     p.add_argument(
@@ -161,6 +167,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
+    if args.timeout is None:
+        args.timeout = smart_city.TIMEOUT_S if args.mission == "smart-city" else PARKING_TIMEOUT_S
+    if args.timeout <= 0:
+        p.error(f"--timeout {args.timeout:g}: expected > 0 s")
     if args.cameras < 0:
         p.error(f"--cameras {args.cameras}: the frame rate must be >= 0 Hz")
     return args

@@ -82,3 +82,68 @@ def wait_for_path(path: Path, timeout_s: float, procs: ProcessGroup) -> None:
         if time.monotonic() - t0 > timeout_s:
             raise RuntimeError(f"{path} did not appear within {timeout_s} s")
         time.sleep(0.05)
+
+
+def cpu_time_s(pid: int) -> float:
+    """CPU time [s] a process has used (user + system, with its children it waited for), from
+    /proc; 0 when it is gone."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return 0.0
+    fields = stat.rsplit(")", 1)[1].split()  # after the command name: field 3 (state) first
+    ticks = sum(int(f) for f in fields[11:15])  # utime, stime, cutime, cstime (fields 14-17)
+    return ticks / os.sysconf("SC_CLK_TCK")
+
+
+def wait_ready(
+    name: str,
+    proc: subprocess.Popen[bytes],
+    probe: Callable[[], str | None],
+    procs: ProcessGroup,
+    cpu_budget_s: float,
+    wall_limit_s: float,
+    log: Log,
+    logfile: Path,
+) -> float:
+    """Waits until probe() answers None (ready; else it says what it saw). A start on a loaded
+    machine takes what the CPU gives it, so the limit is the child's own CPU time: it fails
+    when the child used cpu_budget_s of CPU without becoming ready, or exited, or (a hang
+    guard) after wall_limit_s. Returns the CPU time the start took [s]."""
+    t0 = time.monotonic()
+    next_note = t0 + 15.0
+    why = "no answer yet"
+
+    def log_end() -> str:
+        try:
+            tail = logfile.read_text(errors="replace").splitlines()[-5:]
+        except OSError:
+            tail = []
+        return f"the end of {logfile}: {' | '.join(tail) or '(empty)'}"
+
+    while True:
+        try:
+            procs.check()
+        except RuntimeError as err:  # a child died: say what its log says
+            raise RuntimeError(f"waiting for {name} to be ready: {err}; {log_end()}") from err
+        answer = probe()
+        if answer is None:
+            return cpu_time_s(proc.pid)
+        why = answer
+        cpu = cpu_time_s(proc.pid)
+        wall = time.monotonic() - t0
+        load = os.getloadavg()[0]
+        if cpu > cpu_budget_s or wall > wall_limit_s:
+            limit = (
+                f"{cpu_budget_s:g} s of its CPU time" if cpu > cpu_budget_s
+                else f"the {wall_limit_s:g} s wall-time guard"
+            )  # fmt: skip
+            raise RuntimeError(
+                f"{name} not ready within {limit} (it used {cpu:.1f} s of CPU in {wall:.0f} s "
+                f"wall, load average {load:.1f} on {os.cpu_count()} cores); last probe: {why}; "
+                f"{log_end()}"
+            )
+        if time.monotonic() >= next_note:
+            next_note += 15.0
+            log(f"waiting for {name}: {cpu:.1f} s CPU, {wall:.0f} s wall, load {load:.1f} ({why})")
+        time.sleep(0.2)

@@ -141,6 +141,54 @@ TEST(CityRules, YellowStopsWhenItComfortablyCanElseGoesOn) {
   }
 }
 
+// A red (or a stale advisory) that comes when the car can no longer stop before the line: it
+// goes on instead of standing over the line (seed 1's 4.45 cm overshoot); one that comes in time
+// stops it, however hard.
+TEST(CityRules, ARedTooLateToStopBeforeTheLineIsDrivenThrough) {
+  const Track t = track_for(city(), "city_east");
+  RulesConfig cfg;
+  const double line = stop_of(t, Stop::Kind::light).s_m;
+  const double front_at_line = line - cfg.front_m;  // base_link when the front is at the line
+  Advisory stale = fresh(3, LightState::green);
+  stale.fresh = false;
+  for (const Advisory &red : {fresh(3, LightState::red), stale}) {
+    {
+      // The front 1 cm before the line at cruise: a hard stop needs 0.2 * 0.1 + 0.02 = 4 cm.
+      CityRules r(t, cfg);
+      const auto out = r.step(at(front_at_line - 0.01, cfg.cruise_m_s, 0, red));
+      EXPECT_DOUBLE_EQ(out.speed_m_s, cfg.cruise_m_s) << out.reason;
+      // decided once: still going when the front is over the line
+      EXPECT_DOUBLE_EQ(r.step(at(front_at_line + 0.01, 0.19, 20000, red)).speed_m_s,
+                       cfg.cruise_m_s);
+    }
+    {
+      // The front 2 cm past the line (a green it went on): the light is behind it.
+      CityRules r(t, cfg);
+      EXPECT_DOUBLE_EQ(r.step(at(front_at_line + 0.02, cfg.cruise_m_s, 0, red)).speed_m_s,
+                       cfg.cruise_m_s);
+    }
+    {
+      // 6 cm before the line: it can stop before it, so it brakes (2 cm to its target)...
+      CityRules r(t, cfg);
+      const auto out = r.step(at(front_at_line - 0.06, cfg.cruise_m_s, 0, red));
+      EXPECT_LT(out.speed_m_s, 0.12) << out.reason;  // sqrt(2 * 0.3 * 0.02) = 0.11 m/s
+      EXPECT_NE(out.reason.find("red light 3"), std::string::npos) << out.reason;
+      // ... and stays stopped on this pass, also standing a little over its target
+      EXPECT_EQ(r.step(at(front_at_line - 0.02, 0.0, 500000, red)).speed_m_s, 0.0);
+    }
+  }
+  {
+    // A yellow it went on turns red 5 cm before the line at cruise: a hard stop still fits.
+    CityRules r(t, cfg);
+    EXPECT_DOUBLE_EQ(
+        r.step(at(front_at_line - 0.06, cfg.cruise_m_s, 0, fresh(3, LightState::yellow))).speed_m_s,
+        cfg.cruise_m_s);
+    EXPECT_LT(r.step(at(front_at_line - 0.05, cfg.cruise_m_s, 20000, fresh(3, LightState::red)))
+                  .speed_m_s,
+              0.08);  // sqrt(2 * 0.3 * 0.01) = 0.077 m/s
+  }
+}
+
 TEST(CityRules, StopSignNeedsAFullStopOfOneSecond) {
   const Track t = track_for(city(), "city_east");
   RulesConfig cfg;

@@ -85,9 +85,12 @@ class CarFeeder:
         self.thread.join()
 
 
-def start_sim(build: str, lcm_url: str, run_dir: str, cars: int = 3) -> subprocess.Popen[str]:
-    """autodrive-sim on Tiny Town at real time, no window, no ptys: its lights on LCM."""
+def start_sim(
+    build: str, lcm_url: str, run_dir: str, cars: int = 3, rtf: float = 1.0
+) -> subprocess.Popen[str]:
+    """autodrive-sim on Tiny Town at rtf times real time, no window, no ptys: its lights and
+    SIM_CLOCK on LCM."""
     return subprocess.Popen(
-        [f"{build}/bin/autodrive-sim", "--map", "tiny_town", "--cars", str(cars), "--rtf", "1",
+        [f"{build}/bin/autodrive-sim", "--map", "tiny_town", "--cars", str(cars), "--rtf", str(rtf),
          "--no-pty", "--no-lidar", "--quiet", "--run-dir", run_dir, "--lcm-url", lcm_url],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)  # fmt: skip

@@ -145,6 +145,7 @@ class Scorer:
         self.red_violations: list[dict[str, Any]] = []
         self.sign_violations: list[dict[str, Any]] = []
         self.overshoot_m = 0.0
+        self.overshoot_at: dict[str, Any] | None = None  # where the largest overshoot stood
         self.front_past_max_m = -math.inf  # signed: how close the fronts came (< 0: before)
         self.crossings = {"after_red_stop": 0, "after_stop_sign_stop": 0, "on_green_or_yellow": 0}
         self.collisions = 0
@@ -192,6 +193,9 @@ class Scorer:
                 held = t_s - c.still_since_s
                 c.still_at[p.name] = max(c.still_at.get(p.name, 0.0), held)
                 if p.light_id < 0 or self.lights.get(p.light_id) == RED or held > 0.5:
+                    if past > self.overshoot_m:
+                        self.overshoot_at = {"car": car, "t_s": round(t_s, 2), "stop": p.name,
+                                             "light_state": self.lights.get(p.light_id, -1)}  # fmt: skip
                     self.overshoot_m = max(self.overshoot_m, past)
                     self.front_past_max_m = max(self.front_past_max_m, past)
             prev = c.prev_past.get(p.name)
@@ -231,6 +235,8 @@ class Scorer:
             "red_light_violations": len(self.red_violations),
             "stop_sign_violations": len(self.sign_violations),
             "max_stop_line_overshoot_m": round(self.overshoot_m, 4),
+            # which car stood so, at which stop and sim time [s], the light's state (-1: a sign)
+            "max_stop_line_overshoot_at": self.overshoot_at,
             # the closest any front came to a stop point it stood at (< 0: before the line) [m]
             "stop_front_past_max_m": (
                 round(self.front_past_max_m, 4) if math.isfinite(self.front_past_max_m) else None

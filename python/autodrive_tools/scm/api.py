@@ -195,9 +195,11 @@ def create_app(scm: Scm) -> FastAPI:
 
     @app.get("/api/status", tags=["state"])
     def status() -> dict[str, Any]:
-        """Health, no login needed: counters of the LCM and database sides."""
+        """Health, no login needed: ready (the LCM threads, the pose receiver process and
+        the database writer all run: what tools/demo waits for), counters of the LCM and
+        database sides."""
         snap = scm.snapshot()
-        return {"ok": True, "map": scm.map.name, "stats": snap["stats"]}
+        return {"ok": True, "ready": scm.ready(), "map": scm.map.name, "stats": snap["stats"]}
 
     @app.get("/api/map", tags=["state"])
     def get_map(_: Viewer) -> dict[str, Any]:

@@ -1,7 +1,8 @@
 """autodrive-scm: the Smart City Manager server, and its user administration.
 
     autodrive-scm --map tiny_town [--db URL] [--host H] [--port N] [--lcm-url URL]
-                  [--vehicles NIGEL1,NIGEL2,NIGEL3] [--history-hz HZ] [--build DIR]
+                  [--vehicles NIGEL1,NIGEL2,NIGEL3] [--history-hz HZ] [--clock wall|sim]
+                  [--build DIR]
     autodrive-scm user add NAME --role operator|viewer [--db URL] [--password-stdin]
 
 Prints "SCM ready http://HOST:PORT/" on stdout once it serves."""
@@ -73,6 +74,13 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
         help="pose history kept per car [Hz] (0: every pose)",
     )
     p.add_argument("--advisory-hz", type=float, default=10.0, help="V2I advisories per car [Hz]")
+    p.add_argument(
+        "--clock",
+        choices=("wall", "sim"),
+        default="wall",
+        help="the lights' clock (yellow, all-red, programs, actuated holds): this machine's "
+        "(a real town), or the simulator's SIM_CLOCK (a simulated one, whatever its speed)",
+    )
     p.add_argument("--build", default=None, help="build dir with the LCM types")
     p.add_argument("--log-level", default="warning", help="uvicorn's log level")
     a = p.parse_args(argv)
@@ -114,7 +122,14 @@ def serve(argv: list[str]) -> int:
         print(f"autodrive-scm: {err}", file=sys.stderr)
         return 2
     scm = Scm(
-        m, engine, find_build(a.build), a.lcm_url, a.vehicle_list, a.history_hz, a.advisory_hz
+        m,
+        engine,
+        find_build(a.build),
+        a.lcm_url,
+        a.vehicle_list,
+        a.history_hz,
+        a.advisory_hz,
+        a.clock,
     )
     app = create_app(scm)
     config = uvicorn.Config(

@@ -36,7 +36,11 @@ EYE_PREFERRED_S = 0.5  # an Eye pose this recent [s] wins over the EKF's
 QUEUE_M = 1.2  # a car this close to a red light's stop line [m] is queued on its approach
 COMMAND_HOLD_S = 2.0  # each light command holds this long [s]; refreshed every REFRESH_S
 REFRESH_S = 0.5
+# The simulator publishes every light at 10 Hz of sim time and each change at once; a light
+# not heard of for this long [s, wall] (the simulator gone, not merely slowed) is unknown.
+LIGHT_UNKNOWN_S = 5.0
 VEHICLE_PATTERN = "[A-Z][A-Z0-9]*"  # a vehicle name: capitals and digits
+CLOCKS = ("wall", "sim")  # the lights' clock: this machine's, or the simulator's SIM_CLOCK
 
 
 def now_us() -> int:
@@ -72,8 +76,13 @@ class Scm:
         vehicles: list[str],
         history_hz: float = 10.0,
         advisory_hz: float = 10.0,
+        clock: str = "wall",
     ) -> None:
+        if clock not in CLOCKS:
+            raise ValueError(f"clock must be one of {CLOCKS}, got {clock!r}")
         self.map = m
+        self.clock = clock
+        self.sim_now_s: float | None = None  # the latest SIM_CLOCK [s of sim time]
         self.engine = engine
         self.sessions = sessions(engine)
         self.types = lcmtypes.load(build)
@@ -155,6 +164,8 @@ class Scm:
         self.receiver.start()  # before the threads below: a process of its own for the poses
         self.lc.subscribe(channels.channel("TRAFFIC_LIGHT_STATE"), self._on_light_state)
         self.lc.subscribe(channels.channel("V2V"), self._on_v2v)
+        if self.clock == "sim":
+            self.lc.subscribe(channels.channel("SIM_CLOCK"), self._on_sim_clock)
         self.event("server", "start", "scm", {"map": self.map.name, "vehicles": self.vehicles})
         loops = ((self._lcm_loop, "scm-lcm"), (self._ingest_loop, "scm-ingest"),
                  (self._control_loop, "scm-control"))  # fmt: skip
@@ -162,6 +173,17 @@ class Scm:
             t = threading.Thread(target=target, name=name, daemon=True)
             t.start()
             self._threads.append(t)
+
+    def ready(self) -> bool:
+        """Started and every part of it alive: the LCM, ingest and control threads, the pose
+        receiver process and the database writer."""
+        return (
+            bool(self._threads)
+            and all(t.is_alive() for t in self._threads)
+            and self.receiver.proc.is_alive()
+            and self.writer.alive()
+            and not self._stop.is_set()
+        )
 
     def stop(self) -> None:
         self._stop.set()
@@ -207,6 +229,20 @@ class Scm:
                 car.route = msg.route
                 self.writer.vehicle(car.name, {"route": car.route})
 
+    def _on_sim_clock(self, _chan: str, data: bytes) -> None:
+        msg = self._decode(self.types.sim_clock_t, data)
+        if msg is not None:
+            with self.lock:  # forward only: a late message never turns the lights' clock back
+                self.sim_now_s = max(self.sim_now_s or 0.0, msg.utime * 1e-6)
+
+    def city_now(self) -> float | None:
+        """The lights' clock [s]: wall time, or with clock 'sim' the simulator's SIM_CLOCK, so
+        that yellow, all-red and the programs last what they should in the simulated world
+        however fast or slowly the simulator runs (in lockstep on a loaded machine it may run at
+        half real time, or several times faster on a quiet one); None before the first
+        SIM_CLOCK (the lights are then neither commanded nor timed)."""
+        return time.time() if self.clock == "wall" else self.sim_now_s
+
     def _on_light_state(self, _chan: str, data: bytes) -> None:
         msg = self._decode(self.types.traffic_light_state_t, data)
         if msg is None or not 0 <= msg.state < len(STATES):
@@ -215,7 +251,9 @@ class Scm:
         with self.lock:
             before = self.sim_states.get(msg.light_id)
             self.sim_states[msg.light_id] = (state, float(msg.time_remaining_s), t)
-            self.controller.observed(msg.light_id, state, t)
+            tc = self.city_now()
+            if tc is not None:
+                self.controller.observed(msg.light_id, state, tc)
             if (before is None or before[0] != state) and msg.light_id in self.controller.lights:
                 self.writer.light(msg.light_id, {"sim_state": state, "updated_us": now_us()})
 
@@ -279,21 +317,26 @@ class Scm:
     def _control_loop(self) -> None:
         next_adv = next_refresh = time.monotonic()
         next_vehicles = next_adv
+        refreshed_c = -math.inf  # the lights' clock at the last refresh [s]
         while not self._stop.wait(0.05):
             t = time.time()
             mono = time.monotonic()
             with self.lock:
+                tc = self.city_now()
                 if mono >= next_adv:
                     next_adv += self.advisory_period_s
                     if mono > next_adv:
                         next_adv = mono + self.advisory_period_s
-                    self._advise(t)
-                self._apply(self.controller.tick(t, self._demand()), t)
-                if mono >= next_refresh:
-                    next_refresh = mono + REFRESH_S
-                    for light in self.controller.lights.values():
-                        if light.known:
-                            self._command(light.id, light.state)
+                    self._advise(t, tc)
+                if tc is not None:
+                    self._apply(self.controller.tick(tc, self._demand()))
+                    # each command holds COMMAND_HOLD_S on the simulator's clock: refreshed every
+                    # REFRESH_S of wall time and of the lights' clock, whichever comes first
+                    if mono >= next_refresh or tc - refreshed_c >= REFRESH_S:
+                        next_refresh, refreshed_c = mono + REFRESH_S, tc
+                        for light in self.controller.lights.values():
+                            if light.known:
+                                self._command(light.id, light.state)
                 if mono >= next_vehicles:
                     next_vehicles = mono + 0.2
                     self._vehicle_rows(t)
@@ -306,10 +349,10 @@ class Scm:
                 out[a.light_id] = True
         return out
 
-    def _apply(self, changes: list[Change], t: float) -> None:
+    def _apply(self, changes: list[Change]) -> None:
         for ch in changes:
             self._command(ch.light_id, ch.state)
-            self.writer.light(ch.light_id, {"state": ch.state, "updated_us": int(t * 1e6)})
+            self.writer.light(ch.light_id, {"state": ch.state, "updated_us": now_us()})
             self.event(ch.actor, "light_state", f"light {ch.light_id}", {"state": ch.state})
 
     def _command(self, light_id: int, state: str) -> None:
@@ -323,15 +366,25 @@ class Scm:
         with self.lcm_lock:
             self.lc_out.publish(chan, data)
 
-    def light_view(self, light_id: int, t: float) -> tuple[str, float]:
-        """The state a car should obey (the simulator's, when fresh) and its time left [s]."""
-        own = self.controller.lights[light_id].state
+    def light_view(self, light_id: int, t: float, tc: float | None) -> tuple[str, float]:
+        """The state a car should obey and its time left [s] (< 0: not known). The light is the
+        authority on what it shows: the advisory is the state the simulator (the light) last
+        published on TRAFFIC_LIGHT_STATE, never the SCM's own command, which may not have
+        reached it yet (a loaded machine pauses the simulator in lockstep, so its states come
+        late; a GREEN announced from the command let a car drive off at a red light). The time
+        left is the SCM's (it decides the next change) while the light shows the SCM's state,
+        else unknown (the light is about to follow a command). No state yet, or none for
+        LIGHT_UNKNOWN_S: unknown, advised as RED. t: wall time, tc: the lights' clock [s]."""
         sim = self.sim_states.get(light_id)
-        if sim is not None and t - sim[2] < STALE_S and sim[0] != own:
-            return sim[0], -1.0
-        return own, self.controller.time_left_s(light_id, t)
+        if sim is None or t - sim[2] > LIGHT_UNKNOWN_S:
+            return "RED", -1.0
+        shown = sim[0]
+        light = self.controller.lights[light_id]
+        if shown == light.state and tc is not None:
+            return shown, self.controller.time_left_s(light_id, tc)
+        return shown, -1.0
 
-    def _advise(self, t: float) -> None:
+    def _advise(self, t: float, tc: float | None) -> None:
         for car in self.cars.values():
             fresh = t - car.seen_s < STALE_S
             if not fresh:
@@ -352,7 +405,7 @@ class Scm:
             a = car.ahead
             msg.light_id = a.light_id
             state, left = (
-                self.light_view(a.light_id, t)
+                self.light_view(a.light_id, t, tc)
                 if a.light_id in self.controller.lights
                 else ("OFF", -1.0)
             )
@@ -403,12 +456,14 @@ class Scm:
 
     def set_light(self, light_id: int, state: str, actor: str) -> str:
         with self.lock:
-            t = time.time()
-            what = self.controller.request(light_id, state, actor, t)
+            tc = self.city_now()
+            if tc is None:
+                raise ControlError("the lights follow the simulator's clock: no SIM_CLOCK yet")
+            what = self.controller.request(light_id, state, actor, tc)
             light = self.controller.lights[light_id]
             self.writer.light(light_id, {"mode": "manual"})
             self.event(actor, "light_request", f"light {light_id}", {"state": state, "plan": what})
-            self._apply(self.controller.tick(t, self._demand()), t)  # at once, not next tick
+            self._apply(self.controller.tick(tc, self._demand()))  # at once, not next tick
             self._mode_rows(light.junction)
             return what
 
@@ -434,6 +489,7 @@ class Scm:
     def snapshot(self) -> dict[str, Any]:
         t = time.time()
         with self.lock:
+            tc = self.city_now()
             cars = []
             for c in sorted(self.cars.values(), key=lambda c: c.name):
                 if c.seen_s == 0 and c.name not in self.vehicles:
@@ -467,7 +523,11 @@ class Scm:
                         "target": light.target,
                         "sim_state": sim[0] if sim and t - sim[2] < 2.0 else "",
                         "mode": self.controller.junctions[light.junction].mode,
-                        "time_left_s": round(self.controller.time_left_s(light.id, t), 2),
+                        "time_left_s": (
+                            round(self.controller.time_left_s(light.id, tc), 2)
+                            if tc is not None
+                            else -1.0
+                        ),
                         "program": light.program.to_json(),
                     }
                 )

@@ -34,9 +34,11 @@ RulesOutput CityRules::step(const RulesInput &in) {
       const std::string what = "light " + std::to_string(st.light_id) + " at " + st.name;
       if (ls == LightState::green) {
         yellow_go_.erase(key);
+        red_go_.erase(key);
         continue;
       }
       if (ls == LightState::yellow) {
+        red_go_.erase(key);
         auto it = yellow_go_.find(key);
         if (it == yellow_go_.end()) {
           // Go on only when stopping before the line would need more than comfort braking.
@@ -47,6 +49,14 @@ RulesOutput CityRules::step(const RulesInput &in) {
         limit(stop_profile(s_line, front), "yellow " + what);
       } else {
         yellow_go_.erase(key);
+        auto it = red_go_.find(key);
+        if (it == red_go_.end()) {
+          // Go on only when even a hard stop would leave the front over the line.
+          const double v = std::max(0.0, in.speed_m_s);
+          const double hard_m = v * cfg_.hard_lag_s + v * v / (2.0 * cfg_.hard_decel_m_s2);
+          it = red_go_.emplace(key, hard_m > s_line - front).first;
+        }
+        if (it->second) continue;
         limit(stop_profile(s_line, front),
               (in.advisory.fresh ? "red " : "stale advisory: red ") + what);
       }

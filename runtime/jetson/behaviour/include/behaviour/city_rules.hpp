@@ -4,7 +4,10 @@
 // - Lights: a light is GREEN only when a fresh advisory names that very light as GREEN (or
 //   YELLOW, see below); with a stale advisory, or one about another light, every light is RED.
 //   On RED the car stops with its front stop_margin_m before the stop line; on YELLOW it stops
-//   when it can at comfort_decel_m_s2, else it goes on (decided once per light and pass).
+//   when it can at comfort_decel_m_s2, else it goes on (decided once per light and pass). A RED
+//   (or a stale advisory) that comes when even a hard stop would leave the car standing over
+//   the line (a yellow the car went on, an advisory lost near the line) lets it go on (decided
+//   once per light and pass): standing in the junction helps no one.
 // - Stop signs: a full stop (speed below stopped_m_s) for at least stop_sign_hold_s, then on.
 // - Speed limits (signs, and the advisory's when fresh), curve signs (curve_speed_m_s), and a
 //   gap of at least min_gap_m behind any car ahead on the track.
@@ -28,6 +31,11 @@ struct RulesConfig {
   double cruise_m_s = 0.2;          // desired speed on a free road [m/s]
   double curve_speed_m_s = 0.14;    // after a curve sign, through the curve [m/s]
   double comfort_decel_m_s2 = 0.3;  // planned braking [m/s^2]
+  // A hard stop (throttle to 0 at once): the Nano slews the throttle down at
+  // ACT_THROTTLE_SLEW_PER_S (from cruise to 0 in ~0.19 s, so ~0.1 s at full speed on average),
+  // then the motor brakes. Stopping distance v * hard_lag_s + v^2 / (2 hard_decel_m_s2).
+  double hard_lag_s = 0.1;       // [s]
+  double hard_decel_m_s2 = 1.0;  // [m/s^2]
   // base_link (rear axle) to the front and to the rear bumper [m], from the car's chassis box
   double front_m = AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X + 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X;
   double rear_m = 0.5 * AUTODRIVE_VEHICLE_CHASSIS_SIZE_M_X - AUTODRIVE_VEHICLE_CHASSIS_OFFSET_M_X;
@@ -83,9 +91,11 @@ class CityRules {
   double stop_profile(double s_line_m, double front_s_m) const;
   const Track &track_;
   RulesConfig cfg_;
-  // Per stop and pass (stop index + lap * stops): yellow decided to go; stop sign served;
+  // Per stop and pass (stop index + lap * stops): yellow decided to go; red decided to go
+  // (below); stop sign served;
   // standstill at the stop sign since [us].
   std::map<long, bool> yellow_go_;
+  std::map<long, bool> red_go_;  // RED (or stale) came too late to stop before the line: go on
   std::map<long, int64_t> still_since_us_;
   std::map<long, bool> served_;
   uint64_t stop_signs_served_ = 0;
