@@ -103,7 +103,8 @@ def feed(
     number of frames published."""
     ch = channel("EYE_IMAGE")
     period_s = 1.0 / fps
-    i, counted, t_next = 0, [], time.monotonic()
+    counted: list[int] = []
+    i, t_next = 0, time.monotonic()
     first_pose_deadline = time.monotonic() + FIRST_POSE_TIMEOUT_S
     warm_left = None  # frames still to skip once the Eye has published
     while len(counted) < n:
@@ -137,8 +138,8 @@ def measure(build: Path, n_frames: int = 300, fps: float = 30.0) -> dict[str, fl
         scene_frames = min(n_frames, 120)  # cycled: the cars jump back to the start, a test too
         log(f"rendering the wide-angle scene ({scene_frames} frames, 1280x720, 10 cars)")
         subprocess.run(
-            [build / "bin" / "eye_bench", "--write-wide-scene", tmp, "--frames", str(scene_frames)]
-            + ["--lcm-url", url],
+            [str(build / "bin" / "eye_bench"), "--write-wide-scene", str(tmp)]
+            + ["--frames", str(scene_frames), "--lcm-url", url],
             check=True,
             stdout=subprocess.DEVNULL,
         )
