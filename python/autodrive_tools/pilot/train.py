@@ -33,6 +33,10 @@ from .spec import write_sidecar
 MIN_SPEED_M_S = 0.05  # [m/s] slower frames (standing at the start) are left out
 
 # The input of our networks from the sim's 640x480 front camera: the rows below the horizon
+# (rows 255-270; the car's own red chassis box, whose top is 2 mm below the camera, covers rows
+# ~293-345). Not from 240: the sky does not dim at night, and with it in the frame the per-image
+# normalisation (model.py) squashed the darkened road (night clip, open loop: RMSE 0.111 with
+# rows 240.., 0.060 with 280..).
 DEFAULT_INPUT = InputSpec(
     source_width=640,
     source_height=480,
@@ -58,6 +62,7 @@ class TrainConfig:
     samples_per_epoch: int = 0  # 0: as many as training frames
     stride: int = 1  # every stride-th frame (neighbours at 15-30 Hz are near duplicates)
     balance_max_ratio: float = augment.DEFAULT_MAX_RATIO  # augment.balance_weights
+    channels: int = 1  # input channels the network reads: 1 = luma only, 3 = YUV (model.py)
 
 
 def log(msg: str) -> None:
@@ -139,7 +144,7 @@ def train(
     aug = augment.Augment(gain_per_px=gain)
     weights = augment.balance_weights(steer[idx_train], cfg.balance_max_ratio)
     rng = np.random.default_rng(cfg.seed)
-    net = model.PilotNet(spec.height, spec.width)
+    net = model.PilotNet(spec.height, spec.width, channels=cfg.channels)
     opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
     loss_fn = nn.MSELoss()
     x_val = torch.from_numpy(np.stack([normalise(small[i], spec) for i in idx_val]))
@@ -226,6 +231,8 @@ def train(
         "samples_per_epoch": n_batches * cfg.batch,
         "stride": cfg.stride,
         "balance_max_ratio": cfg.balance_max_ratio,
+        "channels": cfg.channels,
+        "augment": asdict(aug),
         "optimiser": "Adam",
         "loss": "MSE of normalised steering",
         "train_loss": [round(v, 6) for v in history["train"]],
@@ -285,6 +292,9 @@ def report_md(r: dict[str, Any]) -> str:
         f"- seed {r['seed']} (dataset seed {r['dataset_seed']}); {r['epochs']} epochs of "
         f"{r['samples_per_epoch']} balanced, augmented draws (every {r['stride']}. frame), "
         f"{r['optimiser']} lr {r['lr']}, batch {r['batch']}, {r['loss']}",
+        f"- network input: {'the luma (Y) of' if r['channels'] == 1 else 'all three channels of'}"
+        " the sidecar's YUV, normalised per image inside the graph; augmentation "
+        f"{json.dumps(r['augment'])}",
         f"- train loss per epoch: {r['train_loss']}",
         f"- validation loss per epoch: {r['val_loss']} (untrained {r['val_loss_untrained']}); "
         f"validation RMSE {r['val_rmse']} (normalised steering; 1 = 30 deg)",
