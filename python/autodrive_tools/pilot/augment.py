@@ -6,8 +6,12 @@ sidecar's two preprocessing halves; all of it seeded through the numpy Generator
   curves and recoveries. A low cap matters: with a flat histogram (a high cap) the network
   learns curve-sized answers for the frames just before a curve and turns in early.
 - Mirror (p 0.5): flipped left-right, steering negated.
-- Brightness (p 0.5): all levels times U(0.3, 1.3); shadow (p 0.3): a random band darkened.
-- Shift (p 0.5): dx px sideways (and up to 2 px up/down), with a steering correction of
+- Brightness (p 0.5): all levels times U(0.3, 1.3); shadow (p 0.5): a random slanted band
+  darkened to 0.25-0.8 of its levels. A dark band across a solid line makes it look broken,
+  like the dashed centre line, one more way (with the luma-only input, model.py) to keep the
+  network from telling the two lines apart.
+- Shift (p 0.5): up to max_shift_px sideways (and up to 2 px up/down), with a steering
+  correction of
   -gain_per_px * dx: a sideways shift looks like a heading error of dx / fx [rad], which pure
   pursuit answers with (2 wheelbase / lookahead) / steer_limit per rad (normalised)."""
 
@@ -53,10 +57,13 @@ def balance_weights(steering: F64, max_ratio: float = DEFAULT_MAX_RATIO) -> F64:
 @dataclass(frozen=True)
 class Augment:
     gain_per_px: float  # steering correction per px of sideways shift [normalised / px]
-    max_shift_px: float = 8.0
+    # 12 px at the 200 px width: corrections up to ~0.2 on top of the expert's steering, so
+    # the labels reach past the recorded loop's sharpest curve (0.36 normalised)
+    max_shift_px: float = 12.0
     p_mirror: float = 0.5
     p_brightness: float = 0.5
-    p_shadow: float = 0.3
+    p_shadow: float = 0.5
+    shadow_levels: tuple[float, float] = (0.25, 0.8)  # the band's levels times U(a, b)
     p_shift: float = 0.5
 
     def __call__(self, img: U8, steering: float, rng: np.random.Generator) -> tuple[U8, float]:
@@ -79,7 +86,7 @@ class Augment:
                 xs = np.arange(w, dtype=np.float32)[None, :]
                 ys = np.arange(h, dtype=np.float32)[:, None] - h / 2
                 inside = (xs >= x0 + slope * ys) & (xs <= x1 + slope * ys)
-                f[inside] *= np.float32(rng.uniform(0.4, 0.8))
+                f[inside] *= np.float32(rng.uniform(*self.shadow_levels))
             out = np.clip(f, 0, 255).astype(np.uint8)
         if rng.random() < self.p_mirror:
             out = np.ascontiguousarray(out[:, ::-1])

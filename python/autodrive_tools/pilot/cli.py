@@ -78,6 +78,11 @@ def main(argv: list[str] | None = None) -> int:
         help="balancing: a frame is drawn at most this many times as often as one of the "
         "commonest steering (default: the shipped recipe's)",
     )  # fmt: skip
+    t.add_argument(
+        "--channels", type=int, choices=(1, 3), default=1,
+        help="input channels the network reads: 1 = the luma of the YUV input (the shipped "
+        "recipe: colour would let it tell the centre line from the edge line), 3 = all",
+    )  # fmt: skip
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -94,6 +99,11 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--seed", type=int, default=1, help="the recording's seed")
     m.add_argument("--train-seed", type=int, default=0)
     m.add_argument("--epochs", type=int, default=4)
+    m.add_argument(
+        "--logs", type=Path, nargs="+", default=None, metavar="LOG",
+        help="skip the expert: use these recordings of `tools/pilot expert`, which must be the "
+        "recipe's (their LOG.meta.json is checked against --laps and --seed)",
+    )  # fmt: skip
 
     args = ap.parse_args(argv)
     try:
@@ -130,6 +140,7 @@ def _run(args: argparse.Namespace) -> int:
             epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed, name=args.name,
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
+            channels=args.channels,
         )  # fmt: skip
         if args.balance_max_ratio is not None:
             cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
@@ -143,6 +154,7 @@ def _run(args: argparse.Namespace) -> int:
     from .make_model import make_model
 
     make_model(
-        args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs, _build()
-    )
+        args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
+        _build(), args.logs,
+    )  # fmt: skip
     return 0

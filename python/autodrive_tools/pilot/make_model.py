@@ -4,12 +4,14 @@ two recordings at once, one per core (ceil(laps/2) laps with --seed S, the rest 
 rendering the camera is nearly all of a recording's CPU time and one simulator uses one core),
 the logs become one dataset, the network trains (seeded) and is exported, the analysis runs on
 the validation lap, and NAME.onnx, NAME.json, the training report and the figures are copied
-into --out (models/pilot). Wall times of each step go into the report."""
+into --out (models/pilot). Wall times of each step go into the report. --logs reuses
+recordings made before (their meta files must match the recipe's runs field by field)."""
 
 from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import asdict
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -17,7 +19,7 @@ from pathlib import Path
 
 from .analyse import analyse
 from .dataset import record
-from .expert import ExpertRun, default_url, record_expert
+from .expert import ExpertRun, default_url, meta_path, record_expert
 from .train import TrainConfig, train
 
 
@@ -54,9 +56,27 @@ def record_experts(runs: list[ExpertRun], logs: list[Path], build: Path) -> None
             job.result()
 
 
+def check_logs(runs: list[ExpertRun], logs: list[Path]) -> float:
+    """Recordings made before must be the recipe's runs (their LOG.meta.json, field by field);
+    returns their wall time [s] (the longer: they ran at once). ValueError names the log."""
+    if len(logs) != len(runs):
+        raise ValueError(f"--logs: {len(logs)} given, the recipe records {len(runs)}")
+    wall = 0.0
+    for run, logf in zip(runs, logs):
+        try:
+            meta = json.loads(meta_path(logf).read_text())
+        except (OSError, ValueError) as e:
+            raise ValueError(f"{logf}: no readable {meta_path(logf).name} ({e})") from e
+        for key, want in asdict(run).items():
+            if meta.get(key) != want:
+                raise ValueError(f"{logf}: {key} is {meta.get(key)!r}, the recipe's {want!r}")
+        wall = max(wall, float(meta.get("wall_s", 0.0)))
+    return wall
+
+
 def make_model(
     out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
-    build: Path,
+    build: Path, reuse_logs: list[Path] | None = None,
 ) -> None:  # fmt: skip
     stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
     run_dir = work / f"{name}-{stamp}"
@@ -64,11 +84,16 @@ def make_model(
     times: dict[str, float] = {}
     t0 = time.monotonic()
     runs = expert_runs(laps, seed)
-    logs = [run_dir / f"expert_seed{r.seed}.lcmlog" for r in runs]
-    for r, logf in zip(runs, logs):
-        log(f"1/4 expert: {r.laps} laps, seed {r.seed} -> {logf}")
-    record_experts(runs, logs, build)
-    times["expert_s"] = time.monotonic() - t0
+    if reuse_logs:
+        logs = reuse_logs
+        times["expert_s"] = check_logs(runs, logs)
+        log(f"1/4 expert: reusing {', '.join(map(str, logs))} (recorded in {times['expert_s']} s)")
+    else:
+        logs = [run_dir / f"expert_seed{r.seed}.lcmlog" for r in runs]
+        for r, logf in zip(runs, logs):
+            log(f"1/4 expert: {r.laps} laps, seed {r.seed} -> {logf}")
+        record_experts(runs, logs, build)
+        times["expert_s"] = time.monotonic() - t0
     t1 = time.monotonic()
     log("2/4 record")
     record(logs, run_dir / "dataset", build=build)
@@ -91,7 +116,7 @@ def make_model(
     log("4/4 analyse")
     result = analyse(run_dir / "model" / f"{name}.onnx", run_dir / "dataset", run_dir / "analysis")
     times["analyse_s"] = time.monotonic() - t3
-    times["total_s"] = time.monotonic() - t0
+    times["total_s"] = time.monotonic() - t0 + (times["expert_s"] if reuse_logs else 0.0)
     out.mkdir(parents=True, exist_ok=True)
     for f in (f"{name}.onnx", f"{name}.json"):
         shutil.copy2(run_dir / "model" / f, out / f)
@@ -105,6 +130,8 @@ def make_model(
     full[
         "command"
     ] = f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
+    if reuse_logs:
+        full["recordings_reused"] = [str(p) for p in reuse_logs]
     (out / f"{name}_report.json").write_text(json.dumps(full, indent=2) + "\n")
     md = (
         (run_dir / "model" / f"{name}_report.md")

@@ -8,7 +8,9 @@ the C++ `autodrive-pilot` all apply exactly what it says:
 
 `crop_resize` and `normalise` are the two halves (training augments the small BGR image
 between them: flips, brightness and shifts commute with the crop and resize); `preprocess`
-is both."""
+is both. What the network does with this input (the shipped recipe: it reads the Y channel
+only and normalises each frame to mean 0, std 1) is inside the ONNX graph (model.py), so no
+runtime has to repeat it."""
 
 from __future__ import annotations
 
