@@ -90,6 +90,7 @@ class TrainConfig:
     buffer: int = BUFFER  # rollout buffer (n_steps x slots); smaller only for quick tests
     ray_address: str = ""  # rollouts on Ray actors of this cluster ("": local processes)
     shield: bool = False  # train with the shield in the loop (it brakes; the policy steers)
+    shaping: str = "progress"  # the shaping reward (env.SHAPINGS)
 
 
 def linear(lr0: float) -> Any:
@@ -107,7 +108,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
     done_all = 0
     for cars, steps in cfg.stages:
         env = MarlVecEnv(
-            EnvSpec(cars, cfg.action_mode, cfg.shield),
+            EnvSpec(cars, cfg.action_mode, cfg.shield, cfg.shaping),
             cfg.copies,
             cfg.workers,
             cfg.seed + 7 * cars,
@@ -161,6 +162,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
             "gae_lambda": 0.98,
             "n_epochs": 3,
             "gamma": 0.99,
+            "shaping": cfg.shaping,
         },
     }
     return model, curve, info
