@@ -6,6 +6,7 @@ curriculum of stages "cars:steps" (one agent first, then four) continues one mod
 from __future__ import annotations
 
 import json
+import resource
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -93,6 +94,14 @@ class TrainConfig:
     shaping: str = "progress"  # the shaping reward (env.SHAPINGS)
 
 
+def cpu_s() -> float:
+    """User + system CPU time [s] of this process and its reaped children."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
+        resource.RUSAGE_CHILDREN
+    )
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
 def linear(lr0: float) -> Any:
     return lambda progress_remaining: lr0 * progress_remaining
 
@@ -151,6 +160,8 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
         "agent_steps_done": int(model.num_timesteps),
         "curve_last": {k: v[-1] for k, v in asdict(curve).items() if v},
         "wall_s": round(time.monotonic() - t0, 1),
+        # this process and its finished rollout workers (each stage's workers are joined)
+        "cpu_s": round(cpu_s(), 1),
         "config": asdict(cfg),
         "hyperparameters": {
             "net": "3 x 128 MLP (tanh), separate policy and value nets",
