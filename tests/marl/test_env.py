@@ -1,6 +1,6 @@
 """marl.env: the paper's intersection environment passes PettingZoo's own checker
 (parallel_api_test) in its discrete and continuous forms, the same seed gives the same
-episode, the reward follows the paper's terms, and the shield and the rule-based baseline
+episode, the reward follows the paper's terms (and the progress shaping is the distance gained), and the shield and the rule-based baseline
 bring four cars across without a collision on a held-out seed."""
 
 import math
@@ -12,6 +12,7 @@ from pettingzoo.test import parallel_api_test
 from autodrive_tools.marl.baseline import FcfsBaseline
 from autodrive_tools.marl.env import (
     COLLISION_FACTOR,
+    PROGRESS_GAIN,
     SHAPING,
     SHAPING_EPS_M,
     MarlIntersectionEnv,
@@ -33,7 +34,7 @@ def test_api() -> None:
 
 
 def test_seeded_and_reward() -> None:
-    env = MarlIntersectionEnv(cars=4)
+    env = MarlIntersectionEnv(cars=4, shaping="paper")
     runs = []
     for _ in range(2):
         obs, _ = env.reset(seed=7)
@@ -57,6 +58,29 @@ def test_seeded_and_reward() -> None:
     ), "another seed, the same episode"
     env.close()
     print("seeded episodes repeat; shaping reward as the paper's")
+
+
+def test_progress_shaping() -> None:
+    # the default shaping: PROGRESS_GAIN x the distance gained towards the goal this step, so
+    # a car that stands earns nothing (the paper's term would pay it every step)
+    env = MarlIntersectionEnv(cars=1)
+    env.reset(seed=7)
+    d0 = env._goal_distance(0)
+    total = 0.0
+    for _ in range(15):
+        _, rew, _, _, _ = env.step({"nigel1": 1})
+        total += rew["nigel1"]
+    gained = d0 - env._goal_distance(0)
+    assert gained > 0.1, f"the car gained only {gained:.3f} m in 1.5 s"
+    assert math.isclose(total, PROGRESS_GAIN * gained, rel_tol=1e-9), (total, gained)
+    env.close()
+    try:
+        MarlIntersectionEnv(cars=1, shaping="bogus")
+    except ValueError as e:
+        assert "bogus" in str(e)
+    else:
+        raise AssertionError("an unknown shaping was accepted")
+    print(f"progress shaping: {total:.3f} for {gained:.3f} m gained")
 
 
 def run(env: MarlIntersectionEnv, seed: int) -> dict:
@@ -98,5 +122,6 @@ def test_shield_and_baseline() -> None:
 if __name__ == "__main__":
     test_api()
     test_seeded_and_reward()
+    test_progress_shaping()
     test_shield_and_baseline()
     print("marl.env: all passed")

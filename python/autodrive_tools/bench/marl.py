@@ -5,8 +5,8 @@ Progress on stderr; figures on stdout, the last line one JSON object.
 success_rate_4cars_shield / _no_shield / _1car_shield: episodes with every car at its goal;
 collisions_*: cars that collided; shield_interventions_*: steps the shield braked;
 mean_traverse_s_policy (4 cars, shield) vs mean_traverse_s_baseline (FCFS, same seeds) and
-their ratio; steering_rate_rms_* [rad/s]; training_wall_s: the shipped model's training wall
-time (its sidecar); policy_inference_us_p99: one forward pass of 4 observations with OpenCV
+their ratio; steering_rate_rms_* [rad/s]; training_wall_s / training_cpu_s: the shipped
+model's training wall and CPU time (its sidecar; the wall time is inflated on a shared machine); policy_inference_us_p99: one forward pass of 4 observations with OpenCV
 DNN, median of MARL_BENCH_REPEATS runs of 2000. Options: MARL_BENCH_EPISODES (200),
 MARL_BENCH_EPISODES_1CAR (50), MARL_BENCH_WORKERS (2), MARL_BENCH_MODEL."""
 
@@ -89,6 +89,7 @@ def main(argv: list[str]) -> int:
     figures["mean_traverse_s_baseline"] = b["mean_traverse_s"]
     figures["traverse_ratio_policy_over_baseline"] = s["mean_traverse_s"] / b["mean_traverse_s"]
     figures["training_wall_s"] = meta.get("trained", {}).get("wall_s")
+    figures["training_cpu_s"] = meta.get("trained", {}).get("cpu_s")
     figures["training_agent_steps"] = meta.get("trained", {}).get("agent_steps_done")
     figures["policy_inference_us_p99"] = round(p99, 1)
     figures["goals_met"] = {

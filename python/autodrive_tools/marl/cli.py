@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ..paths import REPO_ROOT
+from .env import SHAPINGS
 
 DEFAULT_MODEL = REPO_ROOT / "models" / "marl" / "intersection.onnx"
 HELD_OUT_SEED = 1_000_000_000  # evaluation seeds start here; training seeds stay far below
@@ -61,6 +62,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         max_wall_s=60.0 * a.max_wall_min,
         shield=a.shield,
         ray_address=a.address,
+        shaping=a.shaping,
     )
     try:
         model, curve, info = train(cfg, log)
@@ -109,6 +111,13 @@ def parser() -> argparse.ArgumentParser:
         "--shield",
         action="store_true",
         help="train with the time-to-collision shield in the loop (as deployed)",
+    )
+    t.add_argument(
+        "--shaping",
+        default="progress",
+        choices=SHAPINGS,
+        help="shaping reward: progress (0.3 x m gained towards the goal, default) or paper "
+        "(0.01 / (0.001 + distance) per step, which pays waiting near the goal)",
     )
     t.add_argument("--copies", type=int, default=2, help="environment copies (each N cars)")
     t.add_argument("--workers", type=int, default=2, help="rollout processes (1: in process)")

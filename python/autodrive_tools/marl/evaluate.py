@@ -51,6 +51,7 @@ def run_episodes(
         "rate_n": 0,
         "inference_us": [],
         "failed_seeds": [],
+        "failures": [],
     }
     for seed in seeds:
         obs, _ = env.reset(seed=seed)
@@ -70,6 +71,9 @@ def run_episodes(
         acc["successes"] += int(ok)
         if not ok:
             acc["failed_seeds"].append(seed)
+            acc["failures"].append(
+                {"seed": seed, "routes": env.stats["routes"], "outcome": list(out)}
+            )
         acc["collisions"] += sum(o == "collision" for o in out)
         acc["off_road"] += sum(o == "off_road" for o in out)
         acc["timeouts"] += sum(o == "timeout" for o in out)
@@ -117,7 +121,21 @@ def evaluate(
         else 0.0,
         "policy_inference_us_p99": float(np.percentile(inf, 99)) if inf else None,
         "failed_seeds": [s for p in parts for s in p["failed_seeds"]][:20],
+        # every failed episode: its seed, each car's route and outcome (goal, collision,
+        # off_road, timeout)
+        "failures": [f for p in parts for f in p["failures"]],
+        "failed_episodes_by_kind": failure_kinds([f for p in parts for f in p["failures"]]),
     }
+
+
+def failure_kinds(failures: list[dict[str, Any]]) -> dict[str, int]:
+    """Failed episodes by their worst outcome: collision, else off_road, else timeout."""
+    kinds = {"collision": 0, "off_road": 0, "timeout": 0}
+    for f in failures:
+        out = f["outcome"]
+        kind = next((k for k in kinds if k in out), "timeout")
+        kinds[kind] += 1
+    return kinds
 
 
 def evaluate_all(

@@ -6,6 +6,7 @@ curriculum of stages "cars:steps" (one agent first, then four) continues one mod
 from __future__ import annotations
 
 import json
+import resource
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -90,6 +91,15 @@ class TrainConfig:
     buffer: int = BUFFER  # rollout buffer (n_steps x slots); smaller only for quick tests
     ray_address: str = ""  # rollouts on Ray actors of this cluster ("": local processes)
     shield: bool = False  # train with the shield in the loop (it brakes; the policy steers)
+    shaping: str = "progress"  # the shaping reward (env.SHAPINGS)
+
+
+def cpu_s() -> float:
+    """User + system CPU time [s] of this process and its reaped children."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
+        resource.RUSAGE_CHILDREN
+    )
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def linear(lr0: float) -> Any:
@@ -107,7 +117,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
     done_all = 0
     for cars, steps in cfg.stages:
         env = MarlVecEnv(
-            EnvSpec(cars, cfg.action_mode, cfg.shield),
+            EnvSpec(cars, cfg.action_mode, cfg.shield, cfg.shaping),
             cfg.copies,
             cfg.workers,
             cfg.seed + 7 * cars,
@@ -150,6 +160,8 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
         "agent_steps_done": int(model.num_timesteps),
         "curve_last": {k: v[-1] for k, v in asdict(curve).items() if v},
         "wall_s": round(time.monotonic() - t0, 1),
+        # this process and its finished rollout workers (each stage's workers are joined)
+        "cpu_s": round(cpu_s(), 1),
         "config": asdict(cfg),
         "hyperparameters": {
             "net": "3 x 128 MLP (tanh), separate policy and value nets",
@@ -161,6 +173,7 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
             "gae_lambda": 0.98,
             "n_epochs": 3,
             "gamma": 0.99,
+            "shaping": cfg.shaping,
         },
     }
     return model, curve, info

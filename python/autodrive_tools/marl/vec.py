@@ -30,9 +30,12 @@ class EnvSpec:
     cars: int
     action_mode: str = "discrete"
     shield: bool = False
+    shaping: str = "progress"
 
     def make(self) -> MarlIntersectionEnv:
-        return MarlIntersectionEnv(cars=self.cars, action_mode=self.action_mode, shield=self.shield)
+        return MarlIntersectionEnv(
+            cars=self.cars, action_mode=self.action_mode, shield=self.shield, shaping=self.shaping
+        )
 
 
 class EnvGroup:
