@@ -28,6 +28,7 @@ RAY = root / ".venv" / "bin" / "ray"
 # Two seeds: one job per node (1 CPU each) runs at once, so both nodes are used, and each job
 # has its own LCM port; four seeds checked the same things in twice the time (~6 min in CI).
 SEEDS = 2
+EDGE_DEG = 1.0  # a final heading this close to the goal may fall either side of it [deg]
 # A short scenario: map standing still, no late box (the default demo is the HIL suite's);
 # paced at half real time: under ASan, two runs at once on a 2-core machine leave the autonomy
 # (not in the sim's lockstep) too far behind a sim that runs as fast as the runtime keeps up,
@@ -57,6 +58,23 @@ def check(on_ray: dict[str, Any], serial: dict[str, Any]) -> None:
     for s in (on_ray, serial):
         assert s["runs"] == SEEDS and s["successes"] >= 1, (s["runs"], s["per_seed"])
     diff = sweep.disagreements(on_ray, serial)
+    if diff and diff[0].startswith("ok:"):
+        # Real-time HIL is not bit-repeatable: a seed that ends within EDGE_DEG of the heading
+        # goal may land on either side of it from run to run (seed 2 did: 1.3-1.5 deg one run,
+        # 2.1-2.8 deg another). Such a seed's ok flag is not compared; its figures still are.
+        pa, pb = on_ray["per_seed"], serial["per_seed"]
+        head = "final_heading_error_deg"
+        for seed, oa, ob, ha, hb in zip(pa["seed"], pa["ok"], pb["ok"], pa[head], pb[head]):
+            if oa != ob:
+                edge = [h for h in (ha, hb) if h is not None]
+                near = len(edge) == 2 and all(
+                    abs(h - sweep.GOAL_HEADING_ERROR_DEG) <= EDGE_DEG for h in edge
+                )
+                assert near, f"seed {seed}: ok {oa} vs {ob}, heading {ha} vs {hb} deg: {diff}"
+                print(f"seed {seed} ended on the heading goal's edge: {ha} vs {hb} deg")
+        without_ok = [{"per_seed": {k: v for k, v in x["per_seed"].items() if k != "ok"}}
+                      for x in (on_ray, serial)]  # fmt: skip
+        diff = sweep.disagreements(*without_ok)
     assert not diff, f"the Ray and the serial sweep disagree: {diff}"
     per_ray, per_serial = on_ray["per_seed"], serial["per_seed"]
     assert len(set(per_ray["host"])) == 2, f"the jobs did not use both nodes: {per_ray['host']}"
