@@ -142,6 +142,35 @@ TEST(Physics, ImuAtRestReadsGravityWithinBias) {
   EXPECT_NEAR(n->imu.mag[2], -42 / 0.15, 15);
 }
 
+// The sim computes the accelerometer only in the steps whose value the Nano reads (or a reader
+// asked for): the IMU samples it gives the firmware must be the ones of a sim that computes it
+// in every step, over a drive with turns, braking and 100 IMU samples.
+TEST(Physics, AccelComputedOnlyWhenReadGivesTheSameImuSamples) {
+  const char *drive = "constant:throttle=1,steering=0.8,stop_after=0.6";
+  simtest::Sim lazy(drive), every(drive);
+  ASSERT_NE(lazy.s, nullptr) << lazy.err;
+  ASSERT_NE(every.s, nullptr) << every.err;
+  char e[512];
+  int samples = 0;
+  uint32_t last_read_us = 0;
+  while (sim_time_us(lazy.s) < 1000000) {
+    sim_want_accel(every.s);
+    ASSERT_EQ(sim_step(lazy.s, e, sizeof e), 0) << e;
+    ASSERT_EQ(sim_step(every.s, e, sizeof e), 0) << e;
+    const nigel_t *a = sim_nano(lazy.s, 1), *b = sim_nano(every.s, 1);
+    if (a->imu_read_us == last_read_us) continue;
+    last_read_us = a->imu_read_us;
+    samples++;
+    for (int k = 0; k < 3; k++) {
+      ASSERT_EQ(a->imu.accel[k], b->imu.accel[k]) << "axis " << k << " at " << a->imu_read_us;
+      ASSERT_EQ(a->imu.gyro[k], b->imu.gyro[k]) << "axis " << k << " at " << a->imu_read_us;
+    }
+  }
+  EXPECT_GE(samples, 99);
+  // and the accelerometer moved: the samples compared were not all one resting value
+  EXPECT_GT(abs(sim_nano(lazy.s, 1)->imu.accel[1]) + abs(sim_nano(lazy.s, 1)->imu.accel[0]), 0);
+}
+
 // Distance [m] the car rolls from full speed once the failsafe brakes (shorted motors).
 double braking_distance(const std::string &map, std::string *err) {
   simtest::Sim s("constant:throttle=1,steering=0,stop_after=2", 1, 0, -1, map.c_str());

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
@@ -67,6 +68,12 @@ size_t ptylink_write(ptylink_t *p, const unsigned char *buf, size_t n) {
   if (p->master_fd < 0 || n == 0) return 0;
   ssize_t w = write(p->master_fd, buf, n);
   return w > 0 ? (size_t)w : 0;
+}
+
+size_t ptylink_unread(const ptylink_t *p) {
+  int n = 0;
+  if (p->slave_fd < 0 || ioctl(p->slave_fd, FIONREAD, &n) != 0 || n < 0) return 0;
+  return (size_t)n;
 }
 
 void ptylink_close(ptylink_t *p) {

@@ -20,6 +20,9 @@ int ptylink_open(ptylink_t *p, const char *link_path, char *err, size_t err_sz);
 size_t ptylink_read(ptylink_t *p, unsigned char *buf, size_t cap);
 /* Writes n bytes; returns bytes accepted (fewer when the pty buffer is full). */
 size_t ptylink_write(ptylink_t *p, const unsigned char *buf, size_t n);
+/* Bytes written to the client that it has not read yet [bytes] (FIONREAD on our own slave
+ * descriptor); 0 when unknown. A queue that only grows means nobody reads the pty. */
+size_t ptylink_unread(const ptylink_t *p);
 /* Closes both ends and removes the symlink. Safe on a zeroed or already closed link. */
 void ptylink_close(ptylink_t *p);
 

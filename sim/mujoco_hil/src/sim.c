@@ -145,6 +145,7 @@ struct sim {
   uint64_t seed;                       /* of the current run (sim_create, sim_reset) */
   char script_spec[256];               /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
+  int accel_wanted;      /* sim_want_accel: the next step computes the accelerometer */
   traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
   route_driver_t *route; /* --script route:NAME (car 1), else NULL */
 };
@@ -834,6 +835,11 @@ static void sim_read_host(sim_t *s, sim_car_t *c) {
  * SIM_HOST_IDLE_PERIOD_MS, saving two system calls per period; a client's first bytes are then
  * seen within that time, and the next service that moves bytes ends the idle state. */
 #define SIM_HOST_IDLE_PERIOD_MS 100
+/* Unread bytes [bytes] on the pty above which nobody is reading it: 0.3 s of the Nano's
+ * telemetry. Writing on into the kernel's queue costs tens of microseconds per write (the tty
+ * layer hands each write to a kernel worker), more than the car's whole 1 ms step; a client
+ * that reads keeps the queue near empty. */
+#define SIM_PTY_UNREAD_IDLE_BYTES 2048
 static int sim_host_io_due_car(const sim_t *s, const sim_car_t *c, int io_due) {
   if (!io_due || !c->host_idle) return io_due;
   return (s->time_us / SIM_STEP_US + 1) % SIM_HOST_IDLE_PERIOD_MS == 0;
@@ -867,11 +873,19 @@ static int sim_nano_io(sim_t *s, sim_car_t *c, int io_due_all, char *err, size_t
   } else {
     const size_t room = sizeof c->tx_pending - c->tx_pending_n;
     c->tx_pending_n += uart_pop(&c->tx, SIM_STEP_US, c->tx_pending + c->tx_pending_n, room);
-    if (io_due || c->tx_pending_n == sizeof c->tx_pending) {
-      /* a full pty drops bytes */
-      const size_t sent = ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n);
+    const int full = c->tx_pending_n == sizeof c->tx_pending;
+    if (full && !io_due && c->host_idle) {
+      c->tx_pending_n = 0; /* idle: dropped here, as the full pty would drop them */
+    } else if (io_due || full) {
       const int read_any = c->host_rx_us != rx_before || c->host_frames != frames_before;
-      if (s->host_io_period_steps > 1) c->host_idle = !read_any && c->tx_pending_n > 0 && sent == 0;
+      const int may_idle = s->host_io_period_steps > 1 && !read_any;
+      if (may_idle && ptylink_unread(&c->pty) >= SIM_PTY_UNREAD_IDLE_BYTES) {
+        c->host_idle = 1; /* nobody reads: one ioctl instead of a write into a queue */
+      } else {
+        /* a full pty drops bytes */
+        const size_t sent = ptylink_write(&c->pty, c->tx_pending, c->tx_pending_n);
+        c->host_idle = may_idle && c->tx_pending_n > 0 && sent == 0;
+      }
       c->tx_pending_n = 0;
     }
   }
@@ -1027,6 +1041,43 @@ static void sim_record_contacts(sim_t *s) {
   }
 }
 
+/* Will anyone read the accelerometer after this step? The emulated Nano samples its IMU at
+ * 100 Hz (its own schedule, imu_next_us, read in the next step's nigel_step) and the learning
+ * API asks before the last step of a control period (sim_want_accel). */
+static int sim_accel_due(const sim_t *s) {
+  if (s->accel_wanted) return 1;
+  const uint32_t next_step_us = (uint32_t)(s->time_us + SIM_STEP_US);
+  for (int i = 0; i < s->ncars; i++)
+    if ((int32_t)(next_step_us - s->car[i].nano.imu_next_us) >= 0) return 1;
+  return 0;
+}
+
+/* MuJoCo 2.2's mj_step2 (actuation, acceleration, constraint, acceleration sensors, checks,
+ * integration), except that the acceleration-stage sensors are computed only in the steps
+ * whose values are read: the accelerometer's mj_rnePostConstraint is ~6 % of a step, and the
+ * Nano reads it every 10th step. The values read are the ones mj_step2 would give. */
+static void sim_step2(sim_t *s) {
+  const mjModel *m = s->m;
+  mjData *d = s->d;
+  if (m->opt.integrator == mjINT_IMPLICIT) { /* its integrator is not in 2.2's public API */
+    mj_step2(m, d);
+    s->accel_wanted = 0;
+    return;
+  }
+  mj_fwdActuation(m, d);
+  mj_fwdAcceleration(m, d);
+  mj_fwdConstraint(m, d);
+  if (sim_accel_due(s)) mj_sensorAcc(m, d);
+  s->accel_wanted = 0;
+  mj_checkAcc(m, d);
+  if (mjENABLED(mjENBL_FWDINV)) mj_compareFwdInv(m, d);
+  mj_Euler(m, d); /* mj_step2 integrates RK4 models with Euler too */
+}
+
+void sim_want_accel(sim_t *s) {
+  s->accel_wanted = 1;
+}
+
 int sim_step(sim_t *s, char *err, size_t err_sz) {
   if (s->tl.n > 0) { /* lights: program or command, lamps lit in the model for the cameras */
     tl_update(&s->tl, s->time_us);
@@ -1042,7 +1093,7 @@ int sim_step(sim_t *s, char *err, size_t err_sz) {
     sim_draw_lamps(s, c);
     if (s->tyre_paper) sim_tyres(s, c);
   }
-  mj_step2(s->m, s->d);
+  sim_step2(s);
   sim_record_contacts(s);
   s->time_us += SIM_STEP_US;
   for (int i = 0; i < s->ncars; i++) {

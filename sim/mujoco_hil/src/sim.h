@@ -99,6 +99,10 @@ const struct sim_lidar_scan *sim_lidar_scan_at_once(sim_t *s, int car);
  * nothing): MuJoCo's accelerometer [m/s^2] and gyro [rad/s] at the IMU site, car axes, plus
  * the car's biases. */
 void sim_imu(const sim_t *s, int car, double accel_m_s2[3], double gyro_rad_s[3]);
+/* The next sim_step computes the accelerometer for a reader after it (sim_imu): steps compute
+ * it only when the emulated Nano samples its IMU or a reader asked, so the value sim_imu
+ * gives after a step nobody asked for may be up to one IMU period [10 ms] old. */
+void sim_want_accel(sim_t *s);
 /* Closes ptys, removes symlinks and the generated scene. NULL is fine. */
 void sim_destroy(sim_t *s);
 

@@ -152,8 +152,10 @@ int ad_world_step(ad_world_t *w, int period_ms, char *err, size_t err_sz) {
     snprintf(err, err_sz, "step period %d ms must be 1..60000", period_ms);
     return -1;
   }
-  for (int k = 0; k < period_ms; k++)
+  for (int k = 0; k < period_ms; k++) {
+    if (k == period_ms - 1) sim_want_accel(w->sim); /* observations read the IMU after it */
     if (sim_step(w->sim, err, err_sz) != 0) return -1;
+  }
   return 0;
 }
 

@@ -37,7 +37,8 @@ void tyre_force(const tyre_curve_t *lon, const tyre_curve_t *lat, const tyre_in_
   double fx = grip * tyre_curve_eval(lon, s_long);
   double fy = -grip * tyre_curve_eval(lat, tan_a);
   /* combined slip: keep the resultant inside the friction circle */
-  const double mag = hypot(fx, fy), cap = grip * fmax(lon->ext_value, lat->ext_value);
+  /* forces are a few newtons: sqrt cannot overflow, and hypot costs a libm call per wheel */
+  const double mag = sqrt(fx * fx + fy * fy), cap = grip * fmax(lon->ext_value, lat->ext_value);
   if (mag > cap) {
     fx *= cap / mag;
     fy *= cap / mag;

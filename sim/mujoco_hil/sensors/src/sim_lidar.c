@@ -31,6 +31,8 @@ struct sim_lidar {
   int *bucket_start; /* rays [from, to): candidates of ray from+j are */
   int *bucket;       /*   bucket[bucket_start[j] .. bucket_start[j+1]) */
   size_t bucket_cap;
+  double *ray_cos, *ray_sin;         /* per ray index i: cos, sin of i * 2 pi / num_rays [1]: the
+                                      * rays' fixed angles, so no trig per ray per step */
   float *ranges_m, *quality;         /* revolution being filled */
   float *out_ranges_m, *out_quality; /* last completed revolution */
   sim_lidar_scan_t last;
@@ -135,13 +137,15 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
   l->cand_n = calloc(ng, sizeof *l->cand_n);
   l->bucket_start = calloc((size_t)cfg->num_rays + 1, sizeof *l->bucket_start);
   size_t n = (size_t)cfg->num_rays;
+  l->ray_cos = calloc(n, sizeof(double));
+  l->ray_sin = calloc(n, sizeof(double));
   l->ranges_m = calloc(n, sizeof(float));
   l->quality = calloc(n, sizeof(float));
   l->out_ranges_m = calloc(n, sizeof(float));
   l->out_quality = calloc(n, sizeof(float));
   if (!l->seen || !l->group_first || !l->group_root || !l->group_radius_m || !l->cand ||
       !l->cand_lo || !l->cand_n || !l->bucket_start || !l->ranges_m || !l->quality ||
-      !l->out_ranges_m || !l->out_quality) {
+      !l->out_ranges_m || !l->out_quality || !l->ray_cos || !l->ray_sin) {
     sim_lidar_destroy(l);
     err_set(err, err_len, "out of memory", NULL);
     return NULL;
@@ -151,6 +155,11 @@ sim_lidar_t *sim_lidar_create(const mjModel *m, const char *base_body,
     if (grp < 0 || grp >= mjNGROUP || !cfg->geomgroup[grp]) continue;
     if (m->body_rootid[m->geom_bodyid[g]] == l->root_body) continue; /* the car itself */
     l->seen[l->nseen++] = g;
+  }
+  const double inc = 2.0 * M_PI / cfg->num_rays;
+  for (size_t i = 0; i < n; i++) {
+    l->ray_cos[i] = cos((double)i * inc);
+    l->ray_sin[i] = sin((double)i * inc);
   }
   lidar_group(m, l);
   l->rng = cfg->seed ? cfg->seed : 0x9E3779B97F4A7C15ull;
@@ -171,6 +180,8 @@ void sim_lidar_destroy(sim_lidar_t *l) {
   free(l->group_radius_m);
   free(l->bucket_start);
   free(l->bucket);
+  free(l->ray_cos);
+  free(l->ray_sin);
   free(l->ranges_m);
   free(l->quality);
   free(l->out_ranges_m);
@@ -293,11 +304,10 @@ static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
   mjtNum nrm[3];
   mju_cross(nrm, ax, ay);
   const int span = to - from;
-  const double inc = 2.0 * M_PI / l->cfg.num_rays;
   double ux[LIDAR_FEW_RAYS], uy[LIDAR_FEW_RAYS];
   for (int j = 0; j < span; j++) {
-    ux[j] = cos((from + j) * inc);
-    uy[j] = sin((from + j) * inc);
+    ux[j] = l->ray_cos[from + j];
+    uy[j] = l->ray_sin[from + j];
     l->few_n[j] = 0;
   }
   const size_t need = (size_t)span * (size_t)(l->nseen > 0 ? l->nseen : 1);
@@ -413,8 +423,8 @@ static double lidar_range(const sim_lidar_t *l, mjtNum x) {
   return x;
 }
 
-static void ray_dir(const mjtNum ax[3], const mjtNum ay[3], double angle_rad, mjtNum vec[3]) {
-  double c = cos(angle_rad), s = sin(angle_rad);
+/* The unit ray at cos c, sin s of its angle [1] in the scan plane spanned by ax, ay. */
+static void ray_dir(const mjtNum ax[3], const mjtNum ay[3], double c, double s, mjtNum vec[3]) {
   for (int i = 0; i < 3; i++) vec[i] = c * ax[i] + s * ay[i];
   mju_normalize3(vec);
 }
@@ -423,7 +433,7 @@ double sim_lidar_ray(const mjModel *m, const mjData *d, const sim_lidar_t *l, do
   mjtNum o[3], ax[3], ay[3], vec[3];
   lidar_frame(d, l, o, ax, ay);
   lidar_select(m, d, (sim_lidar_t *)l, o, ax, ay);
-  ray_dir(ax, ay, angle_rad, vec);
+  ray_dir(ax, ay, cos(angle_rad), sin(angle_rad), vec);
   return lidar_range(l, lidar_cast(m, d, l, o, vec, NULL, l->ncand));
 }
 
@@ -453,9 +463,8 @@ static void lidar_cast_rays(const mjModel *m, const mjData *d, sim_lidar_t *l, i
     lidar_select(m, d, l, o, ax, ay);
     bucketed = lidar_bucket(l, from, to) == 0;
   }
-  double inc = 2.0 * M_PI / l->cfg.num_rays;
   for (int i = from; i < to; i++) {
-    ray_dir(ax, ay, i * inc, vec);
+    ray_dir(ax, ay, l->ray_cos[i], l->ray_sin[i], vec);
     const int j = i - from;
     mjtNum x = few        ? lidar_cast(m, d, l, o, vec, l->bucket + j * l->nseen, l->few_n[j])
                : bucketed ? lidar_cast(m, d, l, o, vec, l->bucket + l->bucket_start[j],
