@@ -304,12 +304,8 @@ static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
   mjtNum nrm[3];
   mju_cross(nrm, ax, ay);
   const int span = to - from;
-  double ux[LIDAR_FEW_RAYS], uy[LIDAR_FEW_RAYS];
-  for (int j = 0; j < span; j++) {
-    ux[j] = l->ray_cos[from + j];
-    uy[j] = l->ray_sin[from + j];
-    l->few_n[j] = 0;
-  }
+  const double *ux = l->ray_cos + from, *uy = l->ray_sin + from; /* rays from.. are contiguous */
+  for (int j = 0; j < span; j++) l->few_n[j] = 0;
   const size_t need = (size_t)span * (size_t)(l->nseen > 0 ? l->nseen : 1);
   if (need > l->bucket_cap) {
     int *b = realloc(l->bucket, (need + 64) * sizeof *b);
