@@ -957,10 +957,25 @@ static void sim_apply_point_force(const mjModel *m, mjData *d, int b, const mjtN
 /* Paper tyre forces from the contacts recorded after the previous step, applied at each
  * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
  * forces for this step; the free joint's are the tyres' alone. */
+/* World-frame linear velocity [m/s] of body b's centre of mass into out: what
+ * mj_objectVelocity(mjOBJ_BODY, world frame) gives in its linear half, the same arithmetic
+ * (cvel's linear part moved from the root's subtree CoM to the body's CoM, v - dif x w),
+ * without its rotation bookkeeping: four wheels per car every step. */
+static const mjtNum *sim_body_velocity(const mjModel *m, const mjData *d, int b, mjtNum out[3]) {
+  const mjtNum *cvel = d->cvel + 6 * b, *w = cvel, *v = cvel + 3;
+  const mjtNum *com = d->subtree_com + 3 * m->body_rootid[b], *p = d->xipos + 3 * b;
+  const mjtNum dif[3] = {p[0] - com[0], p[1] - com[1], p[2] - com[2]};
+  out[0] = v[0] - (dif[1] * w[2] - dif[2] * w[1]);
+  out[1] = v[1] - (dif[2] * w[0] - dif[0] * w[2]);
+  out[2] = v[2] - (dif[0] * w[1] - dif[1] * w[0]);
+  return out;
+}
+
 static void sim_tyres(sim_t *s, sim_car_t *c) {
   const vp_params_t *p = &s->p;
   const mjModel *m = s->m;
   mjData *d = s->d;
+  mjtNum vel_buf[3];
   mju_zero(d->qfrc_applied + c->root_dof, 6);
   for (int w = 0; w < W_N; w++) {
     const int b = c->wheel_body[w];
@@ -971,13 +986,12 @@ static void sim_tyres(sim_t *s, sim_car_t *c) {
     mju_cross(fwd, axis, c->normal[w]);
     if (mju_normalize3(fwd) < 1e-9) continue;
     mju_cross(lat, c->normal[w], fwd);
-    mjtNum vel[6];
-    mj_objectVelocity(m, d, mjOBJ_BODY, b, vel, 0); /* [angular, linear] world, at the CoM */
+    const mjtNum *v_lin = sim_body_velocity(m, d, b, vel_buf);
     const double i_spin = m->body_inertia[3 * b + 1] + m->dof_armature[c->wheel_dof[w]];
     const double r = p->wheel_radius_m;
     tyre_in_t in;
-    in.v_x_m_s = mju_dot3(vel + 3, fwd);
-    in.v_y_m_s = mju_dot3(vel + 3, lat);
+    in.v_x_m_s = mju_dot3(v_lin, fwd);
+    in.v_y_m_s = mju_dot3(v_lin, lat);
     in.omega_r_m_s = d->qvel[c->wheel_dof[w]] * r;
     in.fz_n = c->fz_n[w];
     in.mu = c->mu[w];
