@@ -835,11 +835,11 @@ static void sim_read_host(sim_t *s, sim_car_t *c) {
  * SIM_HOST_IDLE_PERIOD_MS, saving two system calls per period; a client's first bytes are then
  * seen within that time, and the next service that moves bytes ends the idle state. */
 #define SIM_HOST_IDLE_PERIOD_MS 100
-/* Unread bytes [bytes] on the pty above which nobody is reading it: 0.3 s of the Nano's
- * telemetry. Writing on into the kernel's queue costs tens of microseconds per write (the tty
+/* Unread bytes [bytes] on the pty above which nobody is reading it (free lockstep only): 40 ms
+ * of the Nano's telemetry. Writing on into the kernel's queue costs tens of microseconds per write (the tty
  * layer hands each write to a kernel worker), more than the car's whole 1 ms step; a client
  * that reads keeps the queue near empty. */
-#define SIM_PTY_UNREAD_IDLE_BYTES 2048
+#define SIM_PTY_UNREAD_IDLE_BYTES 256
 static int sim_host_io_due_car(const sim_t *s, const sim_car_t *c, int io_due) {
   if (!io_due || !c->host_idle) return io_due;
   return (s->time_us / SIM_STEP_US + 1) % SIM_HOST_IDLE_PERIOD_MS == 0;

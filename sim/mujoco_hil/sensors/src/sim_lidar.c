@@ -202,12 +202,26 @@ static void lidar_frame(const mjData *d, const sim_lidar_t *l, mjtNum origin[3],
   }
 }
 
+/* Culling compares squares, without square roots (with 16 cars their latency was most of the
+ * LIDAR's time); this relative slack [1] keeps every geom the exact comparisons would keep,
+ * so the candidates are a superset and the ranges, decided by the exact ray tests, the same. */
+#define LIDAR_CULL_SLACK (1.0 + 1e-9)
+
+/* Out of range [m]: the nearest point of a circle of squared radius r_sq [m^2] at squared
+ * distance dist_sq [m^2] lies beyond the scanner's range (square roots only when it may). */
+static int lidar_out_of_range(const sim_lidar_t *l, mjtNum dist_sq, mjtNum r_sq) {
+  const double range = l->cfg.range_max_m;
+  if (dist_sq <= range * range) return 0;
+  return sqrt(dist_sq) - sqrt(r_sq) > range;
+}
+
 /* Where visible geom g meets the scan plane through origin (normal nrm, axes ax, ay): 0 not
- * within range; 1 its bounding sphere cuts the plane in a circle of radius *r_plane around
- * (*px, *py) in the scanner's axes; 2 it may meet every ray (unbounded, or around origin). */
+ * within range; 1 its bounding sphere cuts the plane in a circle of squared radius *r_sq
+ * [m^2] around (*px, *py) in the scanner's axes; 2 it may meet every ray (unbounded, or around
+ * origin). */
 static int lidar_in_plane(const mjModel *m, const mjData *d, const sim_lidar_t *l, int g,
                           const mjtNum origin[3], const mjtNum nrm[3], const mjtNum ax[3],
-                          const mjtNum ay[3], mjtNum *px, mjtNum *py, mjtNum *r_plane) {
+                          const mjtNum ay[3], mjtNum *px, mjtNum *py, mjtNum *r_sq) {
   const mjtNum rb = m->geom_rbound[g];
   if (rb <= 0) return 2; /* rbound 0 means unbounded (planes) */
   mjtNum rel[3];
@@ -221,12 +235,12 @@ static int lidar_in_plane(const mjModel *m, const mjData *d, const sim_lidar_t *
       hz += fabs(xm[k] * nrm[0] + xm[3 + k] * nrm[1] + xm[6 + k] * nrm[2]) * sz[k];
     if (fabs(dz) > hz) return 0;
   }
-  *r_plane = sqrt(rb * rb - dz * dz); /* sphere cut by the scan plane [m] */
+  *r_sq = rb * rb - dz * dz; /* sphere cut by the scan plane [m^2] */
   *px = mju_dot3(rel, ax);
   *py = mju_dot3(rel, ay);
-  const mjtNum dist = sqrt(*px * *px + *py * *py);
-  if (dist - *r_plane > l->cfg.range_max_m) return 0; /* out of range */
-  return dist > *r_plane ? 1 : 2;
+  const mjtNum dist_sq = *px * *px + *py * *py;
+  if (lidar_out_of_range(l, dist_sq, *r_sq)) return 0;
+  return dist_sq > *r_sq * LIDAR_CULL_SLACK ? 1 : 2;
 }
 
 /* Selects the geoms a ray from origin may hit: visible group, alpha > 0, not the car itself
@@ -245,11 +259,12 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l, cons
     const int g = l->seen[s_i];
     if (m->geom_rgba[4 * g + 3] == 0) continue; /* alpha does: late boxes appear */
     int lo = 0, cnt = n;
-    mjtNum px, py, r_plane;
-    const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
+    mjtNum px, py, r_sq;
+    const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_sq);
     if (where == 0) continue;
     if (where == 1) {
-      const double centre = atan2(py, px), half = asin(r_plane / sqrt(px * px + py * py));
+      const double centre = atan2(py, px),
+                   half = asin(fmin(1.0, sqrt(r_sq) / sqrt(px * px + py * py)));
       lo = (int)ceil((centre - half) / inc - 1e-9);
       const int hi = (int)floor((centre + half) / inc + 1e-9);
       cnt = hi - lo + 1;
@@ -264,12 +279,14 @@ static void lidar_select(const mjModel *m, const mjData *d, sim_lidar_t *l, cons
 }
 
 /* Does any of the span rays (unit directions ux, uy in the scanner's axes) pass within
- * r_plane of the point (px, py), which lies ahead of it? */
-static int lidar_circle_on_rays(mjtNum px, mjtNum py, mjtNum r_plane, const double *ux,
+ * sqrt(r_sq) [m] of the point (px, py), which lies ahead of it? */
+static int lidar_circle_on_rays(mjtNum px, mjtNum py, mjtNum r_sq, const double *ux,
                                 const double *uy, int span, int *hit) {
   int any = 0;
+  const mjtNum r_sq_slack = r_sq * LIDAR_CULL_SLACK;
   for (int j = 0; j < span; j++) {
-    hit[j] = px * ux[j] + py * uy[j] > 0 && fabs(px * uy[j] - py * ux[j]) <= r_plane;
+    const mjtNum off = px * uy[j] - py * ux[j]; /* the point's distance from the ray's line */
+    hit[j] = px * ux[j] + py * uy[j] > 0 && off * off <= r_sq_slack;
     any |= hit[j];
   }
   return any;
@@ -285,11 +302,12 @@ static int lidar_group_reachable(const mjData *d, const sim_lidar_t *l, int k,
   mju_sub3(rel, d->xpos + 3 * l->group_root[k], origin);
   const mjtNum dz = mju_dot3(rel, nrm);
   if (fabs(dz) > r) return 0;
-  const mjtNum r_plane = sqrt(r * r - dz * dz), px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
-  const mjtNum dist = sqrt(px * px + py * py);
-  if (dist - r_plane > l->cfg.range_max_m) return 0;
+  const mjtNum r_sq = r * r - dz * dz, px = mju_dot3(rel, ax), py = mju_dot3(rel, ay);
+  const mjtNum dist_sq = px * px + py * py;
+  if (lidar_out_of_range(l, dist_sq, r_sq)) return 0;
   int hit[LIDAR_FEW_RAYS];
-  return dist <= r_plane || lidar_circle_on_rays(px, py, r_plane, ux, uy, span, hit);
+  return dist_sq <= r_sq * LIDAR_CULL_SLACK ||
+         lidar_circle_on_rays(px, py, r_sq, ux, uy, span, hit);
 }
 
 /* The spinning update casts a few rays per step: for those, lidar_select's sectors (an atan2
@@ -319,13 +337,13 @@ static int lidar_select_few(const mjModel *m, const mjData *d, sim_lidar_t *l,
     for (int s_i = l->group_first[k]; s_i < l->group_first[k + 1]; s_i++) {
       const int g = l->seen[s_i];
       if (m->geom_rgba[4 * g + 3] == 0) continue; /* alpha changes: late boxes appear */
-      mjtNum px, py, r_plane;
-      const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_plane);
+      mjtNum px, py, r_sq;
+      const int where = lidar_in_plane(m, d, l, g, origin, nrm, ax, ay, &px, &py, &r_sq);
       if (where == 0) continue;
       int hit[LIDAR_FEW_RAYS];
       if (where == 2)
         for (int j = 0; j < span; j++) hit[j] = 1;
-      else if (!lidar_circle_on_rays(px, py, r_plane, ux, uy, span, hit))
+      else if (!lidar_circle_on_rays(px, py, r_sq, ux, uy, span, hit))
         continue;
       for (int j = 0; j < span; j++)
         if (hit[j]) l->bucket[j * l->nseen + l->few_n[j]++] = l->ncand;
