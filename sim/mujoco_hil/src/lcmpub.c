@@ -8,12 +8,29 @@
 #include "autodrive_ground_truth_t.h"
 #include "autodrive_sim_clock_t.h"
 
+/* prefix followed by car's decimal digits (car >= 0), into dst of dst_sz >= 16 bytes: 100 ground
+ * truths a car every sim second, where two snprintf calls were ~0.6 % of a 1-car step */
+static void lcmpub_join(char *dst, size_t dst_sz, const char *prefix, int car, const char *suffix) {
+  char digits[12];
+  int n = 0;
+  do {
+    digits[n++] = (char)('0' + car % 10);
+    car /= 10;
+  } while (car > 0 && n < (int)sizeof digits);
+  size_t k = 0;
+  for (const char *p = prefix; *p && k + 1 < dst_sz; p++) dst[k++] = *p;
+  while (n > 0 && k + 1 < dst_sz) dst[k++] = digits[--n];
+  for (const char *p = suffix; *p && k + 1 < dst_sz; p++) dst[k++] = *p;
+  dst[k] = '\0';
+}
+
 int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
-  snprintf(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX "%d", car);
-  snprintf(channel, sizeof channel, "%s" AUTODRIVE_CH_GROUND_TRUTH_SUFFIX, vehicle);
+  lcmpub_join(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX, car, "");
+  lcmpub_join(channel, sizeof channel, AUTODRIVE_VEHICLE_PREFIX, car,
+              AUTODRIVE_CH_GROUND_TRUTH_SUFFIX);
   autodrive_ground_truth_t msg;
   memset(&msg, 0, sizeof msg);
   msg.utime = sim_time_us(s);

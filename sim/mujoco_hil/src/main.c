@@ -33,8 +33,9 @@
  * tens of times faster than real time anyway, and an idle pty then costs no system call in
  * nine steps of ten (tools/bench sim: overhead_ratio) */
 #define MAIN_FREE_LOCKSTEP_IO_MS 10
-#define MAIN_LCM_FLUSH_S 0.001 /* [s] wall: longest a queued LCM message waits */
-#define MAIN_PROGRESS_S 5.0    /* [s] wall time between progress lines */
+#define MAIN_LCM_FLUSH_S 0.001  /* [s] wall: longest a queued LCM message waits */
+#define MAIN_FREE_CLOCK_EVERY 8 /* [steps] free lockstep: 8 ms of sim time, ~0.15 ms of wall */
+#define MAIN_PROGRESS_S 5.0     /* [s] wall time between progress lines */
 
 static volatile sig_atomic_t main_stop = 0;
 /* Largest lag behind the real-time schedule [s] before the schedule slips (see pacing). */
@@ -1005,6 +1006,9 @@ int main(int argc, char **argv) {
       t0 += bare_wall_s;
       next_progress += bare_wall_s;
     }
+    /* free lockstep paces nothing: it reads the clock (for the LCM flush and progress) every
+     * MAIN_FREE_CLOCK_EVERY steps only, as a read costs ~0.5 % of a 1-car step */
+    if (lockstep && !client_sync && step % MAIN_FREE_CLOCK_EVERY != 0) continue;
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
     if (wall >= next_flush) { /* queued LCM messages leave at least every millisecond */
