@@ -33,7 +33,10 @@
  * tens of times faster than real time anyway, and an idle pty then costs no system call in
  * nine steps of ten (tools/bench sim: overhead_ratio) */
 #define MAIN_FREE_LOCKSTEP_IO_MS 10
-#define MAIN_LCM_FLUSH_S 0.001  /* [s] wall: longest a queued LCM message waits */
+#define MAIN_LCM_FLUSH_S 0.001 /* [s] wall: longest a queued LCM message waits */
+/* [s] wall, free lockstep: nothing waits on its messages, and each flush wakes the LCM thread
+ * (a system call, and with it the other core) */
+#define MAIN_FREE_LCM_FLUSH_S 0.004
 #define MAIN_FREE_CLOCK_EVERY 8 /* [steps] free lockstep: 8 ms of sim time, ~0.15 ms of wall */
 #define MAIN_PROGRESS_S 5.0     /* [s] wall time between progress lines */
 
@@ -1013,7 +1016,7 @@ int main(int argc, char **argv) {
     const double wall = main_wall_s();
     if (wall >= next_flush) { /* queued LCM messages leave at least every millisecond */
       lcmq_flush(pubq);
-      next_flush = wall + MAIN_LCM_FLUSH_S;
+      next_flush = wall + (lockstep && !client_sync ? MAIN_FREE_LCM_FLUSH_S : MAIN_LCM_FLUSH_S);
     }
     /* --lockstep-client runs in real time until a client first writes, then in step with it */
     if (!lockstep || (client_sync && !sync.started)) {
