@@ -223,7 +223,19 @@ static int lidar_in_plane(const mjModel *m, const mjData *d, const sim_lidar_t *
                           const mjtNum origin[3], const mjtNum nrm[3], const mjtNum ax[3],
                           const mjtNum ay[3], mjtNum *px, mjtNum *py, mjtNum *r_sq) {
   const mjtNum rb = m->geom_rbound[g];
-  if (rb <= 0) return 2; /* rbound 0 means unbounded (planes) */
+  if (rb <= 0) { /* rbound 0 means unbounded (planes) */
+    if (m->geom_type[g] != mjGEOM_PLANE) return 2;
+    /* A plane is hit from its front only, at h / -(n . ray) from a scanner h in front of it:
+     * no ray of the scan plane comes nearer than h / |n projected on the scan plane|, so a
+     * plane beyond the range that way (the floor under a level car) is left out. */
+    const mjtNum *xm = d->geom_xmat + 9 * g, n[3] = {xm[2], xm[5], xm[8]};
+    mjtNum rel[3];
+    mju_sub3(rel, origin, d->geom_xpos + 3 * g);
+    const mjtNum h = mju_dot3(rel, n), n_ax = mju_dot3(n, ax), n_ay = mju_dot3(n, ay);
+    const double range = l->cfg.range_max_m;
+    if (h <= 0 || h * h > range * range * (n_ax * n_ax + n_ay * n_ay) * LIDAR_CULL_SLACK) return 0;
+    return 2;
+  }
   mjtNum rel[3];
   mju_sub3(rel, d->geom_xpos + 3 * g, origin);
   const mjtNum dz = mju_dot3(rel, nrm);
