@@ -211,8 +211,10 @@ Accuracy accuracy(const Scene &sc, const RunResult &r) {
 
 // The run config of a synthetic scene (camera.yaml and map.yaml beside it), its cars' tags.
 bool write_run_config(const std::string &path, const eye::LocateParams &car, const std::string &url,
-                      const std::vector<eye::VehicleTag> &vehicles, bool reference_tags) {
+                      const std::vector<eye::VehicleTag> &vehicles, bool reference_tags,
+                      int threads = eye::DetectorParams{}.threads) {
   std::ofstream cfg(path);
+  if (threads != eye::DetectorParams{}.threads) cfg << "detector: {threads: " << threads << "}\n";
   cfg << "intrinsics: camera.yaml\nmap: map.yaml\nlcm_url: \"" << url << "\"\n"
       << "tag_size_m: " << car.tag_size_m << "\ntag_offset_m: [" << car.tag_offset_m[0] << ", "
       << car.tag_offset_m[1] << ", " << car.tag_offset_m[2] << "]\n"
@@ -263,6 +265,7 @@ struct WideScene {
 double g_wide_margin = eye::TrackingParams{}.margin;
 float g_wide_sigma = eye::DetectorParams{}.sigma_px;
 double g_wide_noise_k = eye::DetectorParams{}.noise_k;
+int g_wide_threads = eye::DetectorParams{}.threads;
 
 WideScene make_wide_scene(int w, int h, int frames) {
   WideScene sc;
@@ -281,6 +284,7 @@ WideScene make_wide_scene(int w, int h, int frames) {
   sc.cfg.tracking.margin = g_wide_margin;
   sc.cfg.detector.sigma_px = g_wide_sigma;
   sc.cfg.detector.noise_k = g_wide_noise_k;
+  sc.cfg.detector.threads = g_wide_threads;
   for (int k = 1; k <= 10; ++k)
     sc.cfg.vehicles.push_back({AUTODRIVE_VEHICLE_PREFIX + std::to_string(k), k, 0.0});
   sc.cars = eye::synth_wide_drive(sc.s, frames);
@@ -316,8 +320,9 @@ int write_wide_scene(const WideScene &sc, const std::string &dir, const std::str
   for (const auto &r : sc.refs)
     refs << " - {id: " << r.id << ", x_m: " << r.x_m << ", y_m: " << r.y_m << ", z_m: " << r.z_m
          << ", yaw_rad: " << r.yaw_rad << ", size_m: " << r.size_m << "}\n";
-  bool ok = static_cast<bool>(refs) &&
-            write_run_config(dir + "/eye.yaml", sc.cfg.locate, url, sc.cfg.vehicles, true);
+  bool ok =
+      static_cast<bool>(refs) && write_run_config(dir + "/eye.yaml", sc.cfg.locate, url,
+                                                  sc.cfg.vehicles, true, sc.cfg.detector.threads);
   for (size_t i = 0; ok && i < sc.jpeg.size(); ++i) {
     char name[48];
     std::snprintf(name, sizeof name, "/frames/%04zu.jpg", i);
@@ -332,6 +337,7 @@ int write_wide_scene(const WideScene &sc, const std::string &dir, const std::str
 
 struct WideResult {
   std::vector<double> pass_fps, pass_fps_cpu, latency_ms;
+  std::vector<double> frame_cpu_ms;  // thread CPU per frame, decode to publish, every pass
   std::vector<std::vector<eye::CarPose>> est;  // per frame, first pass
   int full_scans = 0;                          // first pass
   double fps() const { return median(pass_fps); }
@@ -346,11 +352,13 @@ WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::
     const double c0 = thread_cpu_s();
     for (size_t i = 0; i < sc.jpeg.size(); ++i) {
       const auto f0 = clock_type::now();
+      const double fc0 = thread_cpu_s();
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
       const auto poses = tr.process(g);
       eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
       r.latency_ms.push_back(
           std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
+      r.frame_cpu_ms.push_back(1e3 * (thread_cpu_s() - fc0));
       if (rep == 0) {
         r.est.push_back(poses);
         r.full_scans += tr.last_was_full_scan();
@@ -463,6 +471,11 @@ int main(int argc, char **argv) {
   app.add_option("--wide-noise-k", g_wide_noise_k,
                  "wide scene: detector contrast / noise sigma (0: libapriltag's 5 grey levels)")
       ->capture_default_str();
+  app.add_option("--wide-threads", g_wide_threads,
+                 "wide scene: detector threads (the written scene's eye.yaml too; the timed "
+                 "passes run on one thread unless --profile-wide)")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   bool profile_wide = false;
   app.add_flag("--profile-wide", profile_wide,
                "only render the wide-angle scene and time the Eye on it (for perf / callgrind)");
@@ -486,6 +499,14 @@ int main(int argc, char **argv) {
   for (const auto &r : planned.scan_plan().regions)
     std::fprintf(stderr, " [%d,%d %dx%d @%.1f]", r.rect.x, r.rect.y, r.rect.width, r.rect.height,
                  static_cast<double>(r.decimate));
+  std::fprintf(stderr, "; staggered bands [rows]:");
+  const int n_bands = wide.cfg.tracking.full_every;
+  for (int k = 0; k < n_bands; ++k) {
+    int rows = 0;
+    for (const auto &r : eye::plan_slice(planned.scan_plan(), k, n_bands, wide.s.in.height_px))
+      rows = std::max(rows, r.rect.height);
+    std::fprintf(stderr, " %d", rows);
+  }
   std::fprintf(stderr, "\n");
   if (profile_wide) {
     const WideResult r = run_wide(wide, lcm, repeats, wide.cfg);
@@ -495,21 +516,31 @@ int main(int argc, char **argv) {
         "heading_rms_deg_wide_angle %.4f\nfps_1280x720_1t_wide_angle %.2f\n"
         "fps_1280x720_1t_wide_angle_cpu %.2f\n",
         a.detect_rate, a.pos_rms_mm, a.heading_rms_deg, r.fps(), r.fps_cpu());
+    // With --wide-threads 2 the CPU figures hold the calling thread only.
+    std::printf("detector_threads %d\n", wide.cfg.detector.threads);
+    std::printf(
+        "frame_cpu_ms_p50_wide_angle %.3f\nframe_cpu_ms_p99_wide_angle %.3f\n"
+        "frame_cpu_ms_max_wide_angle %.3f\nfull_scans_wide_angle %d\n",
+        percentile(r.frame_cpu_ms, 0.5), percentile(r.frame_cpu_ms, 0.99),
+        percentile(r.frame_cpu_ms, 1.0), r.full_scans);
     return 0;
   }
-  eye::RunConfig cfg_prev = wide.cfg, cfg_d1 = wide.cfg;
+  // The fps_*_1t figures: one thread, whatever --wide-threads wrote into the scene.
+  eye::RunConfig cfg_eye = wide.cfg;
+  cfg_eye.detector.threads = 1;
+  eye::RunConfig cfg_prev = cfg_eye, cfg_d1 = cfg_eye;
   cfg_prev.whole_field.enabled = false;
   cfg_d1.whole_field.enabled = false;
   cfg_d1.detector.decimate = 1;
   std::fprintf(stderr, "[eye_bench] wide: Eye (whole field), %d passes\n", repeats);
-  const WideResult w_eye = run_wide(wide, lcm, repeats, wide.cfg);
+  const WideResult w_eye = run_wide(wide, lcm, repeats, cfg_eye);
   std::fprintf(stderr, "[eye_bench] wide: previous default (decimate 2 full scans)\n");
   const WideResult w_prev = run_wide(wide, lcm, repeats, cfg_prev);
   std::fprintf(stderr, "[eye_bench] wide: decimate 1 everywhere\n");
   const WideResult w_d1 = run_wide(wide, lcm, repeats, cfg_d1);
   // The detector alone (every frame scanned whole, no windows to carry a car through): what
   // the whole-field plan finds that the previous default's decimate-2 scan misses.
-  eye::RunConfig cfg_full = wide.cfg, cfg_prev_full = cfg_prev;
+  eye::RunConfig cfg_full = cfg_eye, cfg_prev_full = cfg_prev;
   cfg_full.tracking.roi = false;
   cfg_prev_full.tracking.roi = false;
   std::fprintf(stderr, "[eye_bench] wide: whole-frame scans every frame (Eye, previous)\n");
@@ -545,6 +576,8 @@ int main(int argc, char **argv) {
   std::printf("cpu_fps_ratio_wide_angle_vs_decimate1 %.3f\n", w_eye.fps_cpu() / w_d1.fps_cpu());
   std::printf("frame_to_pose_ms_p50_wide_angle %.3f\n", percentile(w_eye.latency_ms, 0.5));
   std::printf("frame_to_pose_ms_p99_wide_angle %.3f\n", percentile(w_eye.latency_ms, 0.99));
+  std::printf("frame_cpu_ms_p50_wide_angle %.3f\n", percentile(w_eye.frame_cpu_ms, 0.5));
+  std::printf("frame_cpu_ms_p99_wide_angle %.3f\n", percentile(w_eye.frame_cpu_ms, 0.99));
   std::printf("tag_px_min_wide_angle %.1f\ntag_px_max_wide_angle %.1f\n", wide.tag_px_min,
               wide.tag_px_max);
   std::printf("bumped_camera_detected %d\n", bump_frames >= 0 && bump_frames < 30 ? 1 : 0);

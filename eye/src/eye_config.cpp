@@ -70,6 +70,7 @@ RunConfig runconfig_load(const std::string &path) {
         static_cast<float>(d.in_range("min_margin", 0.0, 1000.0, double{c.detector.min_margin}));
     d.read_in_range("min_contrast", c.detector.min_contrast, 0, 255);
     d.read_in_range("noise_k", c.detector.noise_k, 0.0, 50.0);
+    d.read_in_range("threads", c.detector.threads, 1, 2);
     d.reject_unknown();
   }
   if (n.has("tracking")) {

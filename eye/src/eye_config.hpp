@@ -17,7 +17,11 @@ namespace eye {
 struct TrackingParams {
   bool roi = true;      // search cars seen last frame only around their last tag
   int full_every = 10;  // scan the whole frame every this many frames
-  double margin = 1.0;  // window = last tag box grown by this many tag sizes per side
+  // window = last tag box grown by this many tag sizes per side: it must hold the tag's move
+  // away from its predicted place (the last frame's motion) and its turn; 0.5 lost no tag of
+  // the wide-angle bench (240 frames, 10 cars) nor of the pinhole drive, at half the pixels
+  // of 1.0 (windows 5.0 -> 2.6 ms CPU per frame with 10 cars).
+  double margin = 0.5;
 };
 
 struct WholeFieldParams {

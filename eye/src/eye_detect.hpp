@@ -28,6 +28,11 @@ struct DetectorParams {
   // 8 sigma sat on the cliff (sigma 5.2 estimated: 42; 35 still drowned), 10 is past it.
   int min_contrast = 5;   // [grey levels]
   double noise_k = 10.0;  // 0: min_contrast alone
+  // Detector threads of a Tracker (each runs libapriltag on one thread). 2: the staggered band
+  // (or half of a whole-frame scan) runs on a second thread beside the tracking windows, which
+  // shortens a frame's latency on a machine with a core to spare; 1: everything on the caller's
+  // thread (the benchmark's one-thread figures).
+  int threads = 1;
 };
 
 struct Detection {

@@ -62,6 +62,12 @@ ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m
   const cv::Rect frame(0, 0, w, h);
   ScanPlan plan;
   plan.max_tag_px = max_side;
+  plan.strip_px = cell;
+  plan.strip_max_tag_px.assign(static_cast<size_t>(nr), 0.0);
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c)
+      plan.strip_max_tag_px[static_cast<size_t>(r)] = std::max(
+          plan.strip_max_tag_px[static_cast<size_t>(r)], big[static_cast<size_t>(r * nc + c)]);
   std::vector<ScanRegion> &out = plan.regions;
   // The whole frame at the coarse decimation finds every tag big enough for it, wherever it
   // is (also one across cell borders); finer rectangles add the cells where tags are small.
@@ -117,8 +123,20 @@ ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m
 
 std::vector<ScanRegion> plan_slice(const ScanPlan &plan, int k, int n, int height_px) {
   if (n <= 1) return plan.regions;
-  const int pad = static_cast<int>(std::ceil(plan.max_tag_px));
-  const int y0 = k * height_px / n - pad, y1 = (k + 1) * height_px / n + pad;
+  const int y0 = k * height_px / n, core_end = (k + 1) * height_px / n;
+  // A tag whose top row is in [y0, core_end) lies within [y0, core_end + tallest): the largest
+  // side over those rows (every row if the plan has no strips) bounds its height.
+  const double tallest = std::sqrt(2.0) * plan.max_tag_px;
+  double side = plan.max_tag_px;
+  if (!plan.strip_max_tag_px.empty() && plan.strip_px > 0) {
+    side = 0;
+    const int s0 = y0 / plan.strip_px;
+    const int s1 = static_cast<int>(std::ceil((core_end + tallest) / plan.strip_px));
+    for (int s = std::max(0, s0);
+         s < std::min<int>(s1, static_cast<int>(plan.strip_max_tag_px.size())); ++s)
+      side = std::max(side, plan.strip_max_tag_px[static_cast<size_t>(s)]);
+  }
+  const int y1 = core_end + static_cast<int>(std::ceil(std::sqrt(2.0) * side));
   std::vector<ScanRegion> out;
   for (const auto &r : plan.regions) {
     const cv::Rect band = r.rect & cv::Rect(r.rect.x, y0, r.rect.width, y1 - y0);

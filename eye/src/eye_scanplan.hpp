@@ -35,6 +35,10 @@ float decimate_for_side(double side_px, float coarse, double min_px);
 struct ScanPlan {
   std::vector<ScanRegion> regions;
   double max_tag_px = 0;  // the largest tag side anywhere in the frame [px]
+  // The largest tag side per horizontal strip of strip_px rows [px] (empty: max_tag_px
+  // everywhere), so that a band is padded by the tags that can lie across its border only.
+  std::vector<double> strip_max_tag_px;
+  int strip_px = 0;
 };
 
 // Regions whose union finds every tag of the plane in the frame: the whole frame at `coarse`
@@ -46,8 +50,10 @@ struct ScanPlan {
 ScanPlan plan_full_scan(const Intrinsics &in, const CameraPose &pose, double z_m, double tag_size_m,
                         float coarse, const ScanPlanParams &p = ScanPlanParams());
 
-// Slice k of n of a plan: its regions cut to band k of n horizontal bands, each band padded by
-// the largest tag, so scanning slices 0..n-1 in n frames finds every tag that stays put.
+// Slice k of n of a plan: its regions cut to band k of n horizontal bands, each band extended
+// downwards by the tallest tag whose top can lie in it (sqrt(2) x the largest side there: a tag
+// turned 45 deg), so every tag is whole in the band of its top row and scanning slices 0..n-1
+// in n frames finds every tag that stays put.
 std::vector<ScanRegion> plan_slice(const ScanPlan &plan, int k, int n, int height_px);
 
 }  // namespace eye

@@ -141,26 +141,39 @@ class LcmSource : public Source {
   }
   bool next(Frame *f) override {
     auto start = std::chrono::steady_clock::now();
-    while (q_.empty()) {
-      const int r = lcm_.handleTimeout(100);
-      if (r < 0 && errno == EINTR) return false;  // a signal (SIGINT, SIGTERM): the run ends
-      if (r < 0) throw Error("lcm: handle failed on channel " + channel_);
-      const double waited =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      skipped_frames_log().flush();
-      if (q_.empty() && idle_s_ > 0 && waited > idle_s_) return false;
+    for (;;) {
+      while (q_.empty()) {
+        const int r = lcm_.handleTimeout(100);
+        if (r < 0 && errno == EINTR) return false;  // a signal (SIGINT, SIGTERM): the run ends
+        if (r < 0) throw Error("lcm: handle failed on channel " + channel_);
+        const double waited =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        skipped_frames_log().flush();
+        if (q_.empty() && idle_s_ > 0 && waited > idle_s_) return false;
+      }
+      Pending p = std::move(q_.front());
+      q_.pop_front();
+      // Decoded only now: a frame dropped from a full queue costs no decode.
+      try {
+        f->gray = decode_gray(p.data.data(), p.data.size(), p.label);
+      } catch (const Error &e) {
+        skipped_frames_log().event(p.channel, std::string(e.what()) + " (frame skipped)");
+        continue;
+      }
+      f->utime = p.utime;
+      f->label = std::move(p.label);
+      f->wall_clock = false;
+      return true;
     }
-    *f = std::move(q_.front());
-    q_.pop_front();
-    return true;
   }
 
  private:
   void on_image(const lcm::ReceiveBuffer *, const std::string &chan,
                 const autodrive::compressed_image_t *m) {
-    Frame f;
+    Pending f;
     f.utime = m->utime;
     f.label = chan + "@" + std::to_string(m->utime);
+    f.channel = chan;
     // Believe the header only if it names the calibrated size: nothing else is decoded.
     const std::string why = width_px_ > 0 ? check_frame(m->data.data(), m->data.size(), m->format,
                                                         width_px_, height_px_)
@@ -169,12 +182,7 @@ class LcmSource : public Source {
       skipped_frames_log().event(chan, "frame @" + std::to_string(m->utime) + " skipped: " + why);
       return;
     }
-    try {
-      f.gray = decode_gray(m->data.data(), m->data.size(), f.label);
-    } catch (const Error &e) {
-      skipped_frames_log().event(chan, std::string(e.what()) + " (frame skipped)");
-      return;
-    }
+    f.data = m->data;
     if (q_.size() >= 2) q_.pop_front();  // keep the newest
     q_.push_back(std::move(f));
   }
@@ -183,7 +191,12 @@ class LcmSource : public Source {
   double idle_s_;
   int width_px_, height_px_;
   lcm::Subscription *sub_ = nullptr;
-  std::deque<Frame> q_;
+  struct Pending {  // a frame whose header names the calibrated size, not decoded yet
+    int64_t utime = 0;
+    std::string label, channel;
+    std::vector<uint8_t> data;
+  };
+  std::deque<Pending> q_;
 };
 
 }  // namespace

@@ -4,7 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
 
 #include "eye_error.hpp"
 
@@ -31,7 +36,100 @@ std::vector<Detection> merge_detections(const std::vector<Detection> &dets) {
   return out;
 }
 
+// One job at a time on a thread of its own, the thread living as long as the tracker. run()
+// hands a job over; finish() runs it on the caller's thread if the worker has not picked it up
+// yet (a loaded machine may not schedule the worker for several ms: the frame then costs what
+// it costs on one thread, never more), else waits for it, and rethrows what it threw.
+class DetectWorker {
+ public:
+  DetectWorker() : th_([this] { loop(); }) {}
+  ~DetectWorker() {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    th_.join();
+  }
+  void run(std::function<void()> job) {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      job_ = std::move(job);
+      busy_ = true;
+    }
+    cv_.notify_all();
+  }
+  void finish() {
+    std::unique_lock<std::mutex> l(m_);
+    if (job_) {
+      auto job = std::move(job_);
+      job_ = nullptr;
+      busy_ = false;
+      l.unlock();
+      job();
+      return;
+    }
+    cv_.wait(l, [this] { return !busy_; });
+    if (err_) std::rethrow_exception(std::exchange(err_, nullptr));
+  }
+  // Drops a job not yet started, waits for one running; no rethrow (for unwinding).
+  void settle() noexcept {
+    std::unique_lock<std::mutex> l(m_);
+    if (job_) {
+      job_ = nullptr;
+      busy_ = false;
+    }
+    cv_.wait(l, [this] { return !busy_; });
+    err_ = nullptr;
+  }
+
+ private:
+  void loop() {
+    std::unique_lock<std::mutex> l(m_);
+    for (;;) {
+      cv_.wait(l, [this] { return stop_ || job_; });
+      if (stop_) return;
+      auto job = std::move(job_);
+      job_ = nullptr;
+      l.unlock();
+      try {
+        job();
+      } catch (...) {
+        l.lock();
+        err_ = std::current_exception();
+        l.unlock();
+      }
+      l.lock();
+      busy_ = false;
+      cv_.notify_all();
+    }
+  }
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::function<void()> job_;  // handed over, not yet started
+  std::exception_ptr err_;
+  bool busy_ = false, stop_ = false;
+  std::thread th_;
+};
+
+namespace {
+// Settles the worker's job when a scope is left by an exception: the job reads the caller's
+// frame and writes the caller's variables.
+struct SettleOnExit {
+  DetectWorker *w;
+  ~SettleOnExit() {
+    if (w) w->settle();
+  }
+};
+}  // namespace
+
+Tracker::~Tracker() = default;
+
 Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector) {
+  if (c.detector.threads > 1) {
+    det2_ = std::make_unique<Detector>(c.detector);
+    work_ = std::make_unique<DetectWorker>();
+  }
   for (const auto &v : c.vehicles) by_tag_[v.tag_id] = v;
   const double z_roof_m = c.locate.base_link_height_m + c.locate.tag_offset_m[2];
   if (c.whole_field.enabled) {
@@ -49,16 +147,32 @@ void Tracker::hint(int tag_id, const std::array<cv::Point2d, 4> &corners_px) {
   if (by_tag_.count(tag_id) && !tracks_.count(tag_id)) hints_[tag_id] = corners_px;
 }
 
-std::vector<Detection> Tracker::scan_regions(const cv::Mat &gray,
+std::vector<Detection> Tracker::scan_regions(Detector &det, const cv::Mat &gray,
                                              const std::vector<ScanRegion> &rs) {
   std::vector<Detection> dets;
   for (const auto &r : rs) {
     auto d = r.rect.area() == gray.cols * gray.rows && r.decimate == cfg_.detector.decimate
-                 ? det_.detect(gray)
-                 : det_.detect(gray, r.rect, r.decimate);
+                 ? det.detect(gray)
+                 : det.detect(gray, r.rect, r.decimate);
     dets.insert(dets.end(), d.begin(), d.end());
   }
   return rs.size() > 1 ? merge_detections(dets) : dets;
+}
+
+std::vector<Detection> Tracker::full_scan(const cv::Mat &gray) {
+  if (!work_) return scan_regions(det_, gray, plan_.regions);
+  // Two bands of the plan (the upper one extended by the tallest tag across their border).
+  std::vector<Detection> upper;
+  work_->run([&] { upper = scan_regions(*det2_, gray, plan_slice(plan_, 0, 2, gray.rows)); });
+  std::vector<Detection> lower;
+  {
+    SettleOnExit settle{work_.get()};
+    lower = scan_regions(det_, gray, plan_slice(plan_, 1, 2, gray.rows));
+    settle.w = nullptr;
+  }
+  work_->finish();
+  upper.insert(upper.end(), lower.begin(), lower.end());
+  return merge_detections(upper);
 }
 
 std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
@@ -97,12 +211,20 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
   // The camera's noise changes slowly (gain, light): measured once per staggered cycle.
   if (frame % n_bands == 0 && cfg_.detector.noise_k > 0) {
     noise_sigma_ = estimate_noise_sigma(gray);
-    det_.set_min_contrast(
+    const int contrast =
         std::max(cfg_.detector.min_contrast,
-                 static_cast<int>(std::ceil(cfg_.detector.noise_k * noise_sigma_))));
+                 static_cast<int>(std::ceil(cfg_.detector.noise_k * noise_sigma_)));
+    det_.set_min_contrast(contrast);
+    if (det2_) det2_->set_min_contrast(contrast);
   }
   std::vector<Detection> dets;
   if (!last_full_) {
+    // The staggered periodic scan: band (frame mod n) of the full-scan plan, on the second
+    // thread beside the windows if there is one, else after them.
+    const auto slice = plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows);
+    std::vector<Detection> band;
+    SettleOnExit settle{work_.get()};
+    if (work_) work_->run([&] { band = scan_regions(*det2_, gray, slice); });
     for (const auto &[id, t] : tracks_) {
       // Where the tag should be now: last corners moved by the last frame's motion.
       std::array<cv::Point2d, 4> pred = t.corners;
@@ -122,15 +244,15 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
         const auto found = scan_window(gray, id, c, cfg_.tracking.margin);
         dets.insert(dets.end(), found.begin(), found.end());
       }
-      // The staggered periodic scan: band (frame mod n) of the full-scan plan.
-      const auto band = scan_regions(
-          gray, plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows));
-      dets.insert(dets.end(), band.begin(), band.end());
+      if (!work_) band = scan_regions(det_, gray, slice);
     }
+    settle.w = nullptr;
+    if (work_) work_->finish();
+    dets.insert(dets.end(), band.begin(), band.end());
   }
   hints_.clear();
   if (last_full_)
-    dets = scan_regions(gray, plan_.regions);
+    dets = full_scan(gray);
   else
     dets = merge_detections(dets);
   last_dets_ = dets;

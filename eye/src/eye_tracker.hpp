@@ -10,11 +10,13 @@
 // whole frame is scanned whenever no car is tracked; otherwise the periodic scan is staggered,
 // one of full_every horizontal bands per frame (the cost spread evenly, no slow frames), so a
 // new car is found within full_every frames, or at once when another camera hints where it is
-// (multi-camera handover).
+// (multi-camera handover). With detector.threads 2 the band (or half of a whole-frame scan)
+// runs on a second thread with its own detector while the windows run on the caller's.
 #pragma once
 #include <opencv2/core.hpp>
 
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "eye_config.hpp"
@@ -24,9 +26,14 @@
 
 namespace eye {
 
+class DetectWorker;
+
 class Tracker {
  public:
   explicit Tracker(const RunConfig &c);
+  ~Tracker();
+  Tracker(const Tracker &) = delete;
+  Tracker &operator=(const Tracker &) = delete;
   // gray: CV_8UC1 of the calibrated size; throws eye::Error on another size or type.
   std::vector<CarPose> process(const cv::Mat &gray);
   // Another camera sees tag_id where this camera would see these corners [px]: look there in
@@ -50,11 +57,16 @@ class Tracker {
     std::array<cv::Point2d, 4> corners;  // last frame [px]
     cv::Point2d velocity_px{0, 0};       // centre motion over the last frame [px]
   };
-  std::vector<Detection> scan_regions(const cv::Mat &gray, const std::vector<ScanRegion> &rs);
+  std::vector<Detection> scan_regions(Detector &det, const cv::Mat &gray,
+                                      const std::vector<ScanRegion> &rs);
+  // The whole-frame scan, in two halves on two threads when there is a second detector.
+  std::vector<Detection> full_scan(const cv::Mat &gray);
   std::vector<Detection> scan_window(const cv::Mat &gray, int id,
                                      const std::array<cv::Point2d, 4> &corners, double margin);
   RunConfig cfg_;
   Detector det_;
+  std::unique_ptr<Detector> det2_;      // the second thread's (detector.threads 2)
+  std::unique_ptr<DetectWorker> work_;  // runs det2_ beside the caller's thread
   ScanPlan plan_;
   std::map<int, VehicleTag> by_tag_;
   std::map<int, Track> tracks_;                      // tag id -> last frame

@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include <cmath>
+#include <set>
 
 #include "eye_fuse.hpp"
 #include "eye_health.hpp"
@@ -183,6 +184,63 @@ TEST(WholeField, EveryCarAtTheEdgesOfAWideLensIsFound) {
   EXPECT_EQ(seen, total);
   EXPECT_LT(rms, 1.5);
   EXPECT_LT(worst, 5.0);
+}
+
+// Each staggered band reaches down only as far as the tallest tag whose top row lies in it, yet
+// every tag of a frame is whole in some band: scanning the n bands finds every car.
+TEST(WholeField, StaggeredBandsFindEveryTagOfAStillFrame) {
+  const Wide x = wide_scene();
+  const double z = x.cfg.locate.base_link_height_m + x.cfg.locate.tag_offset_m[2];
+  const auto plan = eye::plan_full_scan(x.cfg.in, x.cfg.pose, z, x.cfg.locate.tag_size_m, 2.0f);
+  const auto drive = eye::synth_wide_drive(x.s, 8);
+  eye::DetectorParams dp;
+  dp.min_contrast = 40;  // the noise-adaptive contrast of the tracker at this noise (above)
+  eye::Detector det(dp);
+  const int n = 10;
+  int rows = 0;
+  for (int k = 0; k < n; ++k)
+    for (const auto &r : eye::plan_slice(plan, k, n, x.s.in.height_px))
+      rows = std::max(rows, r.rect.height);
+  // One-sided padding: a band is its share of the frame plus at most sqrt(2) largest tags.
+  std::printf("tallest band %d rows of %d (largest tag %.1f px)\n", rows, x.s.in.height_px,
+              plan.max_tag_px);
+  EXPECT_LE(rows, x.s.in.height_px / n + 1 + std::ceil(std::sqrt(2.0) * plan.max_tag_px));
+  for (size_t f = 0; f < drive.size(); f += 7) {
+    const cv::Mat g = eye::synth_frame(x.s, drive[f], x.refs, 40 + f);
+    std::set<int> found;
+    for (int k = 0; k < n; ++k)
+      for (const auto &r : eye::plan_slice(plan, k, n, x.s.in.height_px))
+        for (const auto &d : det.detect(g, r.rect, r.decimate)) found.insert(d.id);
+    for (const auto &c : drive[f]) EXPECT_TRUE(found.count(c.tag_id)) << "car " << c.tag_id;
+  }
+}
+
+// detector.threads 2 (the band beside the windows, a whole-frame scan in two halves) poses
+// the same cars as one thread, within a small fraction of the error budget.
+TEST(Tracking, TwoDetectorThreadsPoseTheSameCars) {
+  const Wide x = wide_scene();
+  const auto drive = eye::synth_wide_drive(x.s, 40);
+  eye::RunConfig two = x.cfg;
+  two.detector.threads = 2;
+  eye::Tracker t1(x.cfg), t2(two);
+  int fulls = 0;
+  for (size_t i = 0; i < 12; ++i) {
+    // A jump (every car ~300 px on along its loop) at frame 6: windows miss, a whole-frame scan
+    // in halves.
+    const auto &cars = drive[i < 6 ? i : i + 20];
+    const cv::Mat g = eye::synth_frame(x.s, cars, x.refs, 60 + i);
+    const auto p1 = t1.process(g), p2 = t2.process(g);
+    fulls += t2.last_was_full_scan();
+    ASSERT_EQ(p1.size(), cars.size()) << "frame " << i;
+    ASSERT_EQ(p2.size(), cars.size()) << "frame " << i;
+    for (const auto &a : p1)
+      for (const auto &b : p2)
+        if (a.tag_id == b.tag_id) {
+          EXPECT_LT(1000 * std::hypot(a.x_m - b.x_m, a.y_m - b.y_m), 0.5) << "car " << a.tag_id;
+          EXPECT_LT(std::abs(autodrive::angle_wrap_rad(a.yaw_rad - b.yaw_rad)), 0.002);
+        }
+  }
+  EXPECT_GE(fulls, 2);  // the first frame and the jump
 }
 
 // The noise estimate follows the noise added, not the tags' edges or the vignetting.

@@ -7,7 +7,9 @@ the LAST of its cars' `<VEH>_POSE_EYE` messages (utime = that capture time) arri
 figure holds the JPEG's trip over UDP, its decode, detection, pose and the poses' trip back.
 
 The first frames (until the Eye has published a pose, plus WARMUP_FRAMES) are not counted: the
-Eye's first frame is a whole-frame scan with no car tracked yet.
+Eye's first frame is a whole-frame scan with no car tracked yet. The Eye runs with
+`detector.threads` 2 unless --threads 1 (the staggered band beside the windows: the latency
+path; the one-thread figures are eye_bench's fps_*_1t).
 
 CLI: python -m autodrive_tools.bench.eye_latency <build dir> [frames] [fps]. Run by
 `tools/bench eye` (EYE_BENCH_LATENCY_FRAMES, 0: skip) and the test
@@ -126,7 +128,9 @@ def feed(
     return counted, i
 
 
-def measure(build: Path, n_frames: int = 300, fps: float = 30.0) -> dict[str, float]:
+def measure(
+    build: Path, n_frames: int = 300, fps: float = 30.0, threads: int = 2
+) -> dict[str, float]:
     """The capture_to_pose_* figures; RuntimeError when the run cannot be measured."""
     for prog in ("eye_bench", "autodrive-eye"):
         if not os.access(build / "bin" / prog, os.X_OK):
@@ -139,7 +143,8 @@ def measure(build: Path, n_frames: int = 300, fps: float = 30.0) -> dict[str, fl
         log(f"rendering the wide-angle scene ({scene_frames} frames, 1280x720, 10 cars)")
         subprocess.run(
             [str(build / "bin" / "eye_bench"), "--write-wide-scene", str(tmp)]
-            + ["--frames", str(scene_frames), "--lcm-url", url],
+            + ["--frames", str(scene_frames), "--lcm-url", url]
+            + ["--wide-threads", str(threads)],
             check=True,
             stdout=subprocess.DEVNULL,
         )
@@ -188,6 +193,7 @@ def measure(build: Path, n_frames: int = 300, fps: float = 30.0) -> dict[str, fl
         "capture_to_pose_load_avg": round(max(load0, os.getloadavg()[0]), 2),
         "capture_to_pose_feeder_cpu_s": round(feeder_cpu_s, 2),
         "capture_to_pose_eye_cpu_ms_per_frame_sent": round(eye_cpu_ms, 2),
+        "capture_to_pose_detector_threads": float(threads),
     }
 
 
@@ -200,8 +206,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("build", type=Path, help="host build dir")
     p.add_argument("frames", type=int, nargs="?", default=300, help="frames counted")
     p.add_argument("fps", type=float, nargs="?", default=30.0, help="feed rate [Hz]")
+    p.add_argument(
+        "--threads",
+        type=int,
+        choices=(1, 2),
+        default=2,
+        help="the Eye's detector.threads (2: the staggered band beside the windows)",
+    )
     a = p.parse_args(argv)
-    return key_value_main("eye_latency", lambda: measure(a.build, a.frames, a.fps))
+    return key_value_main("eye_latency", lambda: measure(a.build, a.frames, a.fps, a.threads))
 
 
 if __name__ == "__main__":
