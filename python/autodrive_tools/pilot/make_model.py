@@ -1,11 +1,13 @@
 """`tools/pilot make-model`: the one command that makes the shipped model. The expert drives
-5 laps of Driving School's loop_ccw (seeded perturbations, day light, the base camera noise) as
-two recordings at once, one per core (ceil(laps/2) laps with --seed S, the rest with S + 1:
-rendering the camera is nearly all of a recording's CPU time and one simulator uses one core),
-the logs become one dataset, the network trains (seeded) and is exported, the analysis runs on
-the validation lap, and NAME.onnx, NAME.json, the training report and the figures are copied
-into --out (models/pilot). Wall times of each step go into the report. --logs reuses
-recordings made before (their meta files must match the recipe's runs field by field)."""
+5 laps of Driving School in the loop_ccw direction (counter-clockwise; seeded perturbations, day
+light, the base camera noise) as two recordings at once, one per core (rendering the camera is
+nearly all of a recording's CPU time and one simulator uses one core): ceil(laps/2) laps in
+loop_ccw's own lane (the outer one) with --seed S, the rest in the road's other lane (the inner
+one, `lane_shift` 1: lane keeping on either lane of a two-lane road, still counter-clockwise)
+with S + 1. The logs become one dataset, the network trains (seeded) and is exported, the
+analysis runs on the validation lap, and NAME.onnx, NAME.json, the training report and the
+figures are copied into --out (models/pilot). Wall times of each step go into the report. --logs
+reuses recordings made before (their meta files must match the recipe's runs field by field)."""
 
 from __future__ import annotations
 
@@ -28,20 +30,29 @@ def log(msg: str) -> None:
 
 
 # The recipe of the shipped model. The expert's camera renders at ExpertRun's 7.5 Hz of sim time
-# and every frame is trained on (the old recipe rendered 15 Hz and used every 2nd); 4 epochs of 2560 draws, balanced with train's
-# default cap (augment.DEFAULT_MAX_RATIO).
+# and every frame is trained on (the old recipe rendered 15 Hz and used every 2nd); 4 epochs of
+# 2560 draws, balanced with train's default cap (augment.DEFAULT_MAX_RATIO).
 STRIDE = 1
 SAMPLES_PER_EPOCH = 2560
 
 
+# The second recording's lane: the lane left of loop_ccw's, driven counter-clockwise too. The
+# clockwise direction (loop_cw) is never recorded: it is an unseen test condition. Seen in a
+# mirror, this lane's left-hand curves with the centre line on the car's right are the right-hand
+# curves, centre line on the left, of the inner lane driven clockwise (README, "Behavioural
+# cloning": why).
+OTHER_LANE = 1
+
+
 def expert_runs(laps: int, seed: int) -> list[ExpertRun]:
-    """The recordings of `laps` laps: two at once (one per core), seeds seed and seed + 1."""
+    """The recordings of `laps` laps: two at once (one per core), ceil(laps/2) in the route's
+    lane with seed `seed`, the rest in the other lane with seed + 1."""
     if laps < 2:
         raise ValueError(f"--laps {laps}: at least 2 (validation is a whole lap)")
     first = (laps + 1) // 2
     return [
         ExpertRun(laps=first, seed=seed),
-        ExpertRun(laps=laps - first, seed=seed + 1),
+        ExpertRun(laps=laps - first, seed=seed + 1, lane_shift=OTHER_LANE),
     ]
 
 
@@ -91,7 +102,7 @@ def make_model(
     else:
         logs = [run_dir / f"expert_seed{r.seed}.lcmlog" for r in runs]
         for r, logf in zip(runs, logs):
-            log(f"1/4 expert: {r.laps} laps, seed {r.seed} -> {logf}")
+            log(f"1/4 expert: {r.laps} laps, lane shift {r.lane_shift}, seed {r.seed} -> {logf}")
         record_experts(runs, logs, build)
         times["expert_s"] = time.monotonic() - t0
     t1 = time.monotonic()
