@@ -103,6 +103,11 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--laps", type=int, default=5)
     m.add_argument("--seed", type=int, default=1, help="the recording's seed")
     m.add_argument("--train-seed", type=int, default=0)
+    m.add_argument(
+        "--other-lane-laps", type=int, default=0,
+        help="an experiment (the shipped model: 0): this many of the laps in the road's other "
+        "lane, still counter-clockwise (README: the reverse direction)",
+    )  # fmt: skip
     m.add_argument("--epochs", type=int, default=4)
     m.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
@@ -161,6 +166,6 @@ def _run(args: argparse.Namespace) -> int:
 
     make_model(
         args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
-        _build(), args.logs,
+        _build(), args.logs, args.other_lane_laps,
     )  # fmt: skip
     return 0
