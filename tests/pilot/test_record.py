@@ -1,8 +1,10 @@
 """tools/pilot record on a short real run: the simulator's expert (pure pursuit on Driving
 School's loop_ccw with seeded perturbations, front camera at 10 Hz) recorded by lcm-logger over
 UDP multicast; the dataset's manifest and table must match the log frame for frame, labels from
-the ground truth sample at or before each frame. A log without camera frames is refused, and
-the message names the log."""
+the ground truth sample at or before each frame. make-model --other-lane-laps drives the road's
+other lane in loop_ccw's direction (never the clockwise loop_cw, an unseen test condition): the
+car keeps one lane width left of loop_ccw's centre line. A log without camera
+frames is refused, and the message names the log."""
 
 from __future__ import annotations
 
@@ -20,7 +22,9 @@ import cv2
 sys.path.insert(0, str(Path(__file__).parent))
 import gen_log  # noqa: E402
 
-from autodrive_tools import channels, lcmtypes  # noqa: E402
+from autodrive_tools import channels, lcmtypes, maps  # noqa: E402
+from autodrive_tools.missions.lane_watch import LaneWatch  # noqa: E402
+from autodrive_tools.pilot.make_model import expert_runs  # noqa: E402
 from autodrive_tools.pilot.dataset import record  # noqa: E402
 from autodrive_tools.pilot.expert import ExpertRun, record_expert  # noqa: E402
 
@@ -71,6 +75,32 @@ def check_real_run(d: Path) -> None:
     print(f"real run: {len(rows)} frames, {perturbed} perturbed, manifest ok")
 
 
+def check_other_lane(d: Path) -> None:
+    assert {r.lane_shift for r in expert_runs(5, SEED)} == {0}  # the shipped recipe: one lane
+    runs = expert_runs(5, SEED, other_lane_laps=2)
+    assert sum(r.laps for r in runs) == 5 and runs[0].laps == 2, runs
+    assert {r.route for r in runs} == {ExpertRun.route}, runs  # one direction only
+    assert sorted(r.lane_shift for r in runs) == [0, 1], runs  # both lanes of the road
+    log = d / "other_lane.lcmlog"
+    run = ExpertRun(laps=1, seed=SEED, perturb=0.0, camera_fps=5.0, duration_s=4.0,
+                    lane_shift=max(r.lane_shift for r in runs))  # fmt: skip
+    record_expert(run, log, BUILD)
+    record([log], d / "ds_other", build=BUILD, progress=False)
+    route = maps.load(run.map).route(run.route)
+    watch = LaneWatch(route, [])
+    with open(d / "ds_other" / "frames.csv", newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["x_m"] and float(r["speed_m_s"] or 0) > 0.05]
+    assert len(rows) >= 10, f"only {len(rows)} frames of a moving car"
+    offsets = [watch.locate(float(r["x_m"]), float(r["y_m"]))[0] for r in rows]
+    lane_m = 2 * route.half_width_m  # adjacent lanes: centre to centre
+    worst = max(abs(o - lane_m) for o in offsets)
+    assert worst < 0.3 * route.half_width_m, (worst, offsets)  # left of the route, in its lane
+    print(
+        f"other lane: {len(rows)} frames, offset from loop_ccw {min(offsets):.3f}..."
+        f"{max(offsets):.3f} m (one lane {lane_m:.2f} m)"
+    )
+
+
 def check_refusal(d: Path) -> None:
     log = d / "no_camera.lcmlog"
     assert gen_log.write(log, BUILD, laps=1, frames_per_lap=20, cameras=False) == 0
@@ -90,6 +120,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="pilot-record-") as tmp:
         check_refusal(Path(tmp))
         check_real_run(Path(tmp))
+        check_other_lane(Path(tmp))
 
 
 if __name__ == "__main__":

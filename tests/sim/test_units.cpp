@@ -239,8 +239,12 @@ TEST(Script, RouteTakesLapsAndPerturbation) {
   ASSERT_EQ(script_parse(&s, "route:loop_ccw", err, sizeof err), 0) << err;
   EXPECT_EQ(s.laps, 1);  // one lap, no perturbation unless asked
   EXPECT_DOUBLE_EQ(s.perturb, 0.0);
-  for (const char *bad : {"route:a,laps=0", "route:a,laps=1.5", "route:a,perturb=1.5",
-                          "constant:throttle=0.1,laps=2"}) {
+  EXPECT_EQ(s.lane_shift, 0);  // its own lane unless asked
+  ASSERT_EQ(script_parse(&s, "route:loop_ccw,lane_shift=-1", err, sizeof err), 0) << err;
+  EXPECT_EQ(s.lane_shift, -1);
+  for (const char *bad :
+       {"route:a,laps=0", "route:a,laps=1.5", "route:a,perturb=1.5", "constant:throttle=0.1,laps=2",
+        "route:a,lane_shift=0.5", "route:a,lane_shift=4", "constant:throttle=0.1,lane_shift=1"}) {
     EXPECT_EQ(script_parse(&s, bad, err, sizeof err), -1) << bad;
     EXPECT_NE(std::string(err).find(bad), std::string::npos) << err;  // names the spec
   }

@@ -148,6 +148,47 @@ TEST(World, RouteDriverKeepsItsLaneTinyTown) {
   drive_route("tiny_town", "lot_to_east");
 }
 
+// Distance [m] from (x, y) to the polyline's nearest segment.
+double dist_to_polyline(const pp_path_t &p, double x, double y) {
+  double best = 1e9;
+  for (int k = 0; k + 1 < p.n; k++) {
+    const double *a = p.xy_m + 2 * k, *b = a + 2;
+    const double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+    const double t = l2 > 0 ? std::clamp(((x - a[0]) * dx + (y - a[1]) * dy) / l2, 0.0, 1.0) : 0;
+    best = std::min(best, std::hypot(x - a[0] - t * dx, y - a[1] - t * dy));
+  }
+  return best;
+}
+
+// lane_shift=1 on Driving School's loop_ccw (the outer lane) is the inner lane driven the same
+// way round: every point lies on loop_cw's centre line (the map's inner lane), and the car
+// starts on it heading counter-clockwise, i.e. against loop_cw's direction.
+TEST(World, RouteLaneShiftDrivesTheNeighbouringLane) {
+  WorldSim k("driving_school", nullptr, "route:loop_ccw,lane_shift=1");
+  ASSERT_NE(k.s, nullptr) << k.err;
+  const route_driver_t *r = sim_route(k.s);
+  ASSERT_NE(r, nullptr);
+  route_driver_t own{}, inner{};
+  char e[512];
+  ASSERT_EQ(route_driver_init(&own, sim_model(k.s), "loop_ccw", 0.8, 0.2, 0, e, sizeof e), 0) << e;
+  ASSERT_EQ(route_driver_init(&inner, sim_model(k.s), "loop_cw", 0.8, 0.2, 0, e, sizeof e), 0) << e;
+  double worst = 0, off_own = 1e9;
+  for (int i = 0; i < r->path.n; i++) {
+    const double x = r->xy_m[2 * i], y = r->xy_m[2 * i + 1];
+    worst = std::max(worst, dist_to_polyline(inner.path, x, y));
+    off_own = std::min(off_own, dist_to_polyline(own.path, x, y));
+  }
+  EXPECT_LT(worst, 0.002);  // on the inner lane's centre line, curves included
+  EXPECT_NEAR(off_own, 2 * own.half_width_m, 0.002);  // one lane width from its own everywhere
+  EXPECT_NEAR(r->path.length_m, inner.path.length_m, 0.05);
+  double x, y, yaw, yaw_own;
+  route_driver_start(r, &x, &y, &yaw);
+  route_driver_start(&own, &x, &y, &yaw_own);
+  EXPECT_NEAR(std::remainder(yaw - yaw_own, 2 * M_PI), 0.0, 1e-6);  // the route's direction
+  route_driver_free(&own);
+  route_driver_free(&inner);
+}
+
 TEST(World, PhysicsModelLeavesOutVisualGeomsTheCamerasStillSeeThem) {
   WorldSim k("tiny_town", nullptr);
   ASSERT_NE(k.s, nullptr) << k.err;

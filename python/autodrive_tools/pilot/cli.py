@@ -37,6 +37,11 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("--out", type=Path, required=True, help="the LCM log to write")
     e.add_argument("--map", default="driving_school")
     e.add_argument("--route", default="loop_ccw", help="a loop route of the map")
+    e.add_argument(
+        "--lane-shift", type=int, default=0,
+        help="drive the lane this many lane widths left of the route's, in its direction "
+        "(1 on Driving School's loop_ccw: the inner lane, counter-clockwise)",
+    )  # fmt: skip
     e.add_argument("--laps", type=int, default=5)
     e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
     e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
@@ -98,6 +103,11 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--laps", type=int, default=5)
     m.add_argument("--seed", type=int, default=1, help="the recording's seed")
     m.add_argument("--train-seed", type=int, default=0)
+    m.add_argument(
+        "--other-lane-laps", type=int, default=0,
+        help="an experiment (the shipped model: 0): this many of the laps in the road's other "
+        "lane, still counter-clockwise (README: the reverse direction)",
+    )  # fmt: skip
     m.add_argument("--epochs", type=int, default=4)
     m.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
@@ -121,7 +131,8 @@ def _run(args: argparse.Namespace) -> int:
         from .expert import record_expert
 
         run = ExpertRun(
-            map=args.map, route=args.route, laps=args.laps, seed=args.seed, speed=args.speed,
+            map=args.map, route=args.route, lane_shift=args.lane_shift, laps=args.laps,
+            seed=args.seed, speed=args.speed,
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
             light_level=args.light_level, duration_s=args.duration,
         )  # fmt: skip
@@ -155,6 +166,6 @@ def _run(args: argparse.Namespace) -> int:
 
     make_model(
         args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
-        _build(), args.logs,
+        _build(), args.logs, args.other_lane_laps,
     )  # fmt: skip
     return 0

@@ -25,6 +25,9 @@ META_SUFFIX = ".meta.json"
 class ExpertRun:
     map: str = "driving_school"
     route: str = "loop_ccw"
+    # lanes to the route's left, driven in the route's direction (1 on a two-lane loop: its
+    # other lane; the simulator's `lane_shift`)
+    lane_shift: int = 0
     laps: int = 5
     seed: int = 1
     speed: float = 0.8  # throttle, fraction of top speed
@@ -60,6 +63,7 @@ def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
     script = (
         f"route:{run.route},speed={run.speed:g},lookahead={run.lookahead_m:g},"
         f"laps={run.laps},perturb={run.perturb:g}"
+        + (f",lane_shift={run.lane_shift}" if run.lane_shift else "")
     )
     return [
         str(sim_binary(build)),

@@ -5,7 +5,9 @@ rendering the camera is nearly all of a recording's CPU time and one simulator u
 the logs become one dataset, the network trains (seeded) and is exported, the analysis runs on
 the validation lap, and NAME.onnx, NAME.json, the training report and the figures are copied
 into --out (models/pilot). Wall times of each step go into the report. --logs reuses
-recordings made before (their meta files must match the recipe's runs field by field)."""
+recordings made before (their meta files must match the recipe's runs field by field).
+--other-lane-laps N (an experiment; the shipped model has none) drives N of the laps in the
+road's other lane, still counter-clockwise (expert_runs)."""
 
 from __future__ import annotations
 
@@ -28,16 +30,34 @@ def log(msg: str) -> None:
 
 
 # The recipe of the shipped model. The expert's camera renders at ExpertRun's 7.5 Hz of sim time
-# and every frame is trained on (the old recipe rendered 15 Hz and used every 2nd); 4 epochs of 2560 draws, balanced with train's
-# default cap (augment.DEFAULT_MAX_RATIO).
+# and every frame is trained on (the old recipe rendered 15 Hz and used every 2nd); 4 epochs of
+# 2560 draws, balanced with train's default cap (augment.DEFAULT_MAX_RATIO).
 STRIDE = 1
 SAMPLES_PER_EPOCH = 2560
 
 
-def expert_runs(laps: int, seed: int) -> list[ExpertRun]:
-    """The recordings of `laps` laps: two at once (one per core), seeds seed and seed + 1."""
+# --other-lane-laps N (an experiment, not the shipped recipe; README, "Behavioural cloning":
+# the reverse direction): N of the laps in the lane left of loop_ccw's, still driven
+# counter-clockwise. The clockwise direction (loop_cw) is never recorded: it is an unseen test
+# condition. Seen in a mirror, that lane's left-hand curves with the centre line on the car's
+# right are the right-hand curves, centre line on the left, of the inner lane driven clockwise.
+OTHER_LANE = 1
+
+
+def expert_runs(laps: int, seed: int, other_lane_laps: int = 0) -> list[ExpertRun]:
+    """The recordings of `laps` laps, two at once (one per core). Without other-lane laps:
+    ceil(laps/2) with seed `seed`, the rest with seed + 1, all in the route's lane. With N:
+    N laps in the other lane (seed + 1) first, so the seeded validation lap (lap 3 of 5 with
+    --train-seed 0) is one of the route's own lane, then laps - N in the route's lane (seed)."""
     if laps < 2:
         raise ValueError(f"--laps {laps}: at least 2 (validation is a whole lap)")
+    if other_lane_laps:
+        if not 0 < other_lane_laps < laps:
+            raise ValueError(f"--other-lane-laps {other_lane_laps}: 1..{laps - 1} of --laps {laps}")
+        return [
+            ExpertRun(laps=other_lane_laps, seed=seed + 1, lane_shift=OTHER_LANE),
+            ExpertRun(laps=laps - other_lane_laps, seed=seed),
+        ]
     first = (laps + 1) // 2
     return [
         ExpertRun(laps=first, seed=seed),
@@ -68,22 +88,24 @@ def check_logs(runs: list[ExpertRun], logs: list[Path]) -> float:
         except (OSError, ValueError) as e:
             raise ValueError(f"{logf}: no readable {meta_path(logf).name} ({e})") from e
         for key, want in asdict(run).items():
-            if meta.get(key) != want:
-                raise ValueError(f"{logf}: {key} is {meta.get(key)!r}, the recipe's {want!r}")
+            # a recording made before lane_shift existed drove the route's own lane
+            have = meta.get(key, 0 if key == "lane_shift" else None)
+            if have != want:
+                raise ValueError(f"{logf}: {key} is {have!r}, the recipe's {want!r}")
         wall = max(wall, float(meta.get("wall_s", 0.0)))
     return wall
 
 
 def make_model(
     out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
-    build: Path, reuse_logs: list[Path] | None = None,
+    build: Path, reuse_logs: list[Path] | None = None, other_lane_laps: int = 0,
 ) -> None:  # fmt: skip
     stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
     run_dir = work / f"{name}-{stamp}"
     run_dir.mkdir(parents=True, exist_ok=False)
     times: dict[str, float] = {}
     t0 = time.monotonic()
-    runs = expert_runs(laps, seed)
+    runs = expert_runs(laps, seed, other_lane_laps)
     if reuse_logs:
         logs = reuse_logs
         times["expert_s"] = check_logs(runs, logs)
@@ -91,7 +113,7 @@ def make_model(
     else:
         logs = [run_dir / f"expert_seed{r.seed}.lcmlog" for r in runs]
         for r, logf in zip(runs, logs):
-            log(f"1/4 expert: {r.laps} laps, seed {r.seed} -> {logf}")
+            log(f"1/4 expert: {r.laps} laps, lane shift {r.lane_shift}, seed {r.seed} -> {logf}")
         record_experts(runs, logs, build)
         times["expert_s"] = time.monotonic() - t0
     t1 = time.monotonic()
@@ -127,9 +149,10 @@ def make_model(
     for f in result["figures"]:
         shutil.copy2(run_dir / "analysis" / f, figs / f)
     full = dict(report, analysis=result, wall_times_s={k: round(v, 1) for k, v in times.items()})
-    full[
-        "command"
-    ] = f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
+    full["command"] = (
+        f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
+        + (f" --other-lane-laps {other_lane_laps}" if other_lane_laps else "")
+    )
     if reuse_logs:
         full["recordings_reused"] = [str(p) for p in reuse_logs]
     (out / f"{name}_report.json").write_text(json.dumps(full, indent=2) + "\n")

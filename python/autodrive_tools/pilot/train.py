@@ -269,6 +269,7 @@ def train(
 def _conditions(manifest: dict[str, Any]) -> list[dict[str, Any]]:
     keys = (
         "route",
+        "lane_shift",
         "laps",
         "seed",
         "speed",

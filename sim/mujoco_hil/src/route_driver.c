@@ -22,8 +22,33 @@ void route_driver_list(const mjModel *m, char *out, size_t out_sz) {
   if (!len) snprintf(out, out_sz, "none");
 }
 
+/* Moves every point of the polyline `d_m` [m] to the left of its direction of travel (the
+ * tangent from the point before to the point after; one-sided at a repeated point or an open
+ * end). On the map's concentric lane arcs this gives the neighbouring lane's arc exactly. */
+static int route_shift_left(double *xy_m, int n, int loop, double d_m) {
+  double *orig = malloc(sizeof(double) * 2 * (size_t)n);
+  if (!orig) return -1;
+  memcpy(orig, xy_m, sizeof(double) * 2 * (size_t)n);
+  for (int i = 0; i < n; i++) {
+    const int prev = i > 0 ? i - 1 : (loop ? n - 1 : 0);
+    const int next = i < n - 1 ? i + 1 : (loop ? 0 : n - 1);
+    double tx = orig[2 * next] - orig[2 * prev], ty = orig[2 * next + 1] - orig[2 * prev + 1];
+    if (hypot(tx, ty) < 1e-9) { /* a closed loop's repeated end point: the segment after it */
+      const int k = i < n - 1 ? i : i - 1;
+      tx = orig[2 * (k + 1)] - orig[2 * k];
+      ty = orig[2 * (k + 1) + 1] - orig[2 * k + 1];
+    }
+    const double len = hypot(tx, ty);
+    if (len < 1e-9) continue;
+    xy_m[2 * i] = orig[2 * i] - d_m * ty / len;
+    xy_m[2 * i + 1] = orig[2 * i + 1] + d_m * tx / len;
+  }
+  free(orig);
+  return 0;
+}
+
 int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, double speed,
-                      double lookahead_m, char *err, size_t err_sz) {
+                      double lookahead_m, int lanes_left, char *err, size_t err_sz) {
   memset(r, 0, sizeof *r);
   char key[96], routes[1024];
   snprintf(key, sizeof key, "route_%s", name);
@@ -45,6 +70,13 @@ int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, dou
   const int n = line.n, loop = line.loop;
   r->xy_m = line.xy; /* the driver keeps the points; the arc lengths are pure pursuit's own */
   free(line.s_m);
+  /* the map's lanes are adjacent: the neighbouring lane's centre is one lane width away */
+  if (lanes_left && route_shift_left(r->xy_m, n, loop, lanes_left * 2.0 * line.half_width_m)) {
+    snprintf(err, err_sz, "--script route:%s: out of memory", name);
+    free(r->xy_m);
+    r->xy_m = NULL;
+    return -1;
+  }
   char perr[256];
   if (pp_path_init(&r->path, r->xy_m, n, loop, perr, sizeof perr) != 0) {
     snprintf(err, err_sz, "--script route:%s: %s", name, perr);

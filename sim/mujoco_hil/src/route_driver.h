@@ -8,7 +8,8 @@
  * driver now and then adds a seeded steering offset (|offset| in [A/2, A], ROUTE_PERTURB_*
  * durations) to pure pursuit's command, so the car leaves the centre line and pure pursuit's
  * recovery gets recorded; `expert_steering` is always pure pursuit's own (unperturbed) command,
- * the label a cloned driver should learn. */
+ * the label a cloned driver should learn. `lane_shift=K` drives the lane K lane widths to the
+ * route's left in the route's direction (K = 1 on a two-lane road: the oncoming lane). */
 #ifndef SIM_ROUTE_DRIVER_H
 #define SIM_ROUTE_DRIVER_H
 
@@ -51,10 +52,12 @@ typedef struct route_driver {
   long samples;
 } route_driver_t;
 
-/* Loads route `name` from model m. Returns 0, or -1 with a message naming the route (and the
- * routes the map has) in err. */
+/* Loads route `name` from model m, moved `lanes_left` lane widths (2 x the route's half width
+ * [m]) to the left of its direction of travel (0: the route's own lane; 1: the lane to its left
+ * driven in the route's direction, e.g. the other lane of a two-lane road). Returns 0, or -1
+ * with a message naming the route (and the routes the map has) in err. */
 int route_driver_init(route_driver_t *r, const mjModel *m, const char *name, double speed,
-                      double lookahead_m, char *err, size_t err_sz);
+                      double lookahead_m, int lanes_left, char *err, size_t err_sz);
 void route_driver_free(route_driver_t *r);
 
 /* Drive `laps` laps of a loop (>= 1) and add perturbations of amplitude `amplitude` (0: none,

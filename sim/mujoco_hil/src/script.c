@@ -38,7 +38,7 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
     if (!tok || strchr(tok, '=') || strlen(tok) >= sizeof s->route_name) {
       snprintf(err, err_sz,
                "--script '%s': expected "
-               "route:NAME[,speed=F][,start=s][,lookahead=m][,laps=N][,perturb=A]",
+               "route:NAME[,speed=F][,start=s][,lookahead=m][,laps=N][,perturb=A][,lane_shift=K]",
                spec);
       return -1;
     }
@@ -79,6 +79,15 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
       s->laps = (int)laps;
     } else if (s->route && strcmp(tok, "perturb") == 0) {
       rc = script_num(spec, tok, val, 0, 1, &s->perturb, err, err_sz);
+    } else if (s->route && strcmp(tok, "lane_shift") == 0) {
+      double k = 0;
+      rc = script_num(spec, tok, val, -SCRIPT_ROUTE_LANE_SHIFT_MAX, SCRIPT_ROUTE_LANE_SHIFT_MAX, &k,
+                      err, err_sz);
+      if (rc == 0 && k != floor(k)) {
+        snprintf(err, err_sz, "--script '%s': lane_shift='%s' is not a whole number", spec, val);
+        rc = -1;
+      }
+      s->lane_shift = (int)k;
     } else if (!s->route && strcmp(tok, "throttle") == 0) {
       rc = script_num(spec, tok, val, -1, 1, &s->throttle, err, err_sz);
     } else if (!s->route && strcmp(tok, "steering") == 0) {
@@ -89,7 +98,7 @@ int script_parse(script_t *s, const char *spec, char *err, size_t err_sz) {
       rc = script_num(spec, tok, val, 0, 1e6, &stop, err, err_sz);
     } else {
       snprintf(err, err_sz, "--script '%s': unknown key '%s' (%s)", spec, tok,
-               s->route ? "speed, start, stop_after, lookahead, laps, perturb"
+               s->route ? "speed, start, stop_after, lookahead, laps, perturb, lane_shift"
                         : "throttle, steering, start, stop_after");
       return -1;
     }

@@ -683,8 +683,8 @@ static int sim_bind_route(sim_t *s, const sim_config_t *cfg, char *err, size_t e
   }
   s->route = calloc(1, sizeof *s->route);
   if (!s->route) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
-  if (route_driver_init(s->route, s->m, sc.route_name, sc.throttle, sc.lookahead_m, err, err_sz) !=
-      0) {
+  if (route_driver_init(s->route, s->m, sc.route_name, sc.throttle, sc.lookahead_m, sc.lane_shift,
+                        err, err_sz) != 0) {
     free(s->route);
     s->route = NULL;
     return -1;
