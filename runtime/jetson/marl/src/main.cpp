@@ -15,6 +15,7 @@
 #include <autodrive/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
+#include <autodrive/vehicle_state_t.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
@@ -96,6 +97,13 @@ class App {
     have_pose_ = true;
   }
 
+  // The Nano's applied (rate-limited) steering: the wheels' angle for the shield's lane term.
+  void on_state(const lcm::ReceiveBuffer *, const std::string &,
+                const autodrive::vehicle_state_t *m) {
+    steering_now_ = m->steering_applied;
+    have_steering_ = true;
+  }
+
   int64_t now_us() const { return o_.clock == "sim" ? sim_now_us_ : wall_us(); }
   bool clock_ready() const { return o_.clock != "sim" || sim_now_us_ > 0; }
 
@@ -135,8 +143,12 @@ class App {
       }
       if (!o_.no_shield) {
         // The baseline arbitrates the zone by its own rule: its shield is the emergency brake.
+        // The lane term for the policy only: the baseline follows its lane itself.
+        const double steering_now = baseline_ != nullptr ? std::nan("")
+                                    : have_steering_     ? steering_now_
+                                                         : last_steering_;
         const marl::ShieldResult r =
-            core_.shield(own_, throttle, steering, peers, baseline_ != nullptr);
+            core_.shield(own_, throttle, steering, peers, baseline_ != nullptr, steering_now);
         if (r.intervened) {
           ++shield_interventions_;
           if (!last_intervened_)
@@ -235,6 +247,8 @@ class App {
   marl::CarState own_;
   bool have_pose_ = false, last_intervened_ = false;
   double last_steering_ = 0;
+  double steering_now_ = 0;  // <VEH>_STATE's steering_applied, normalised
+  bool have_steering_ = false;
   int64_t sim_now_us_ = 0, start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000,
           goal_us_ = -1;
   int64_t period_us_ = 50000;
@@ -424,6 +438,8 @@ int main(int argc, char **argv) {
   const std::string pose_ch =
       o.vehicle + (origin ? AUTODRIVE_CH_ODOM_SUFFIX : AUTODRIVE_CH_POSE_MAP_SUFFIX);
   autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_pose>(lcm, pose_ch, &app);
+  autodrive_lcm::subscribe<autodrive::vehicle_state_t, App, &App::on_state>(
+      lcm, o.vehicle + AUTODRIVE_CH_STATE_SUFFIX, &app);
   spdlog::info("{} mode {}{} on {}: route {}, pose from {}, V2V loss {} delay {} ms", o.vehicle,
                o.mode, o.no_shield ? " (no shield)" : "", o.lcm_url, o.route, pose_ch, o.v2v_loss,
                o.v2v_delay_ms);
