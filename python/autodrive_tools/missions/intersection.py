@@ -384,6 +384,8 @@ def run(args: argparse.Namespace) -> int:
         "collisions": sum(1 for _p, r, _e in done if r.collided),
         "timeouts": sum(1 for _p, _r, e in done if e == "timeout"),
         "shield_interventions": sum(s.get("shield_interventions", 0) for s in summaries_all),
+        # of them, steps where the shield's lane term replaced the policy's steering
+        "shield_lane_steers": sum(s.get("shield_lane_steers", 0) for s in summaries_all),
         "mean_traverse_s": round(float(np.mean(traverse_s)), 3) if traverse_s else None,
         "steering_rate_rms": round(float(np.sqrt(np.mean(np.square(rates)))), 4) if rates else None,
         "goal_error_true_max_m": (

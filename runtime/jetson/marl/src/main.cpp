@@ -151,9 +151,13 @@ class App {
             core_.shield(own_, throttle, steering, peers, baseline_ != nullptr, steering_now);
         if (r.intervened) {
           ++shield_interventions_;
-          if (!last_intervened_)
+          lane_steers_ += r.steered ? 1 : 0;
+          if (!last_intervened_ && r.peer_id >= 0)
             spdlog::info("shield: brake for NIGEL{}, contact predicted in {:.2f} s", r.peer_id,
                          r.ttc_s);
+          else if (!last_intervened_)
+            spdlog::info("shield: lane term: steering {:.2f} instead of {:.2f}{}", r.steering,
+                         steering, r.throttle != throttle ? ", braking" : "");
         }
         last_intervened_ = r.intervened;
         throttle = r.throttle;
@@ -220,11 +224,13 @@ class App {
         buf, sizeof buf,
         "{\"vehicle\": \"%s\", \"mode\": \"%s\", \"shield\": %s, \"route\": \"%s\", "
         "\"steps\": %llu, \"start_s\": %.3f, \"goal_s\": %.3f, \"shield_interventions\": %llu, "
-        "\"v2v_received\": %llu, \"v2v_lost\": %llu, \"v2v_dropped_stale\": %llu}",
+        "\"shield_lane_steers\": %llu, \"v2v_received\": %llu, \"v2v_lost\": %llu, "
+        "\"v2v_dropped_stale\": %llu}",
         o_.vehicle.c_str(), o_.mode.c_str(), o_.no_shield ? "false" : "true", route_.name.c_str(),
         static_cast<unsigned long long>(steps_), start_us_ >= 0 ? start_us_ * 1e-6 : -1.0,
         goal_us_ >= 0 ? goal_us_ * 1e-6 : -1.0,
         static_cast<unsigned long long>(shield_interventions_),
+        static_cast<unsigned long long>(lane_steers_),
         static_cast<unsigned long long>(link_.received()),
         static_cast<unsigned long long>(link_.lost()),
         static_cast<unsigned long long>(peers_.dropped_stale()));
@@ -253,7 +259,7 @@ class App {
           goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
-  uint64_t steps_ = 0, shield_interventions_ = 0;
+  uint64_t steps_ = 0, shield_interventions_ = 0, lane_steers_ = 0;
   size_t peers_seen_ = 0;
 };
 
