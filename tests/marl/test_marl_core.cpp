@@ -359,3 +359,21 @@ TEST(MarlShield, BacksOutOfTheTurningPathOfAStandingFirstCar) {
   EXPECT_TRUE(rb.intervened);
   EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
 }
+
+TEST(MarlShield, PoseErrorGrowsTheFootprints) {
+  // Two cars passing in opposite lanes 0.28 m apart: clear with exact poses; with each pose
+  // possibly 0.1 m off (HIL on dead reckoning) they might touch, so the one giving way brakes.
+  adm_shield_config_t cfg = nigel_shield();
+  const double v = cfg.top_speed_m_s;
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, -0.14, 0.0, v), b = car(2, 1.0, 0.14, kPi, v);
+  adm_shield_result_t ra, rb;
+  cfg.pose_error_m = 0.1;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(ra.intervened || rb.intervened);
+  cfg.pose_error_m = -0.1;
+  char err[256] = "";
+  EXPECT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("pose error"), std::string::npos) << err;
+}

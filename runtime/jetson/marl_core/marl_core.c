@@ -322,10 +322,11 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
   if (!(cfg->horizon_s > 0.0) || !(cfg->dt_s > 0.0) || cfg->dt_s > cfg->horizon_s ||
       !(cfg->chassis_length_m > 0.0) || !(cfg->chassis_width_m > 0.0) ||
       !(cfg->wheelbase_m > 0.0) || !(cfg->top_speed_m_s > 0.0) || !(cfg->steer_limit_rad > 0.0) ||
-      !(cfg->margin_m >= 0.0) || !(cfg->steer_hold_s >= 0.0) || !isfinite(cfg->brake_throttle))
+      !(cfg->margin_m >= 0.0) || !(cfg->pose_error_m >= 0.0) || !(cfg->steer_hold_s >= 0.0) ||
+      !isfinite(cfg->brake_throttle))
     return fail(err, err_sz,
                 "shield: config needs horizon_s >= dt_s > 0, chassis, wheelbase, steering limit "
-                "and top speed > 0, margin and steer_hold >= 0");
+                "and top speed > 0, margin, pose error and steer_hold >= 0");
   if (!car_ok(self) || !isfinite(intended->throttle) || !isfinite(intended->steering))
     return fail(err, err_sz, "shield: car %d: its pose, speed or command is not finite", self->id);
   for (int i = 0; i < n_peers; i++)
@@ -348,7 +349,8 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
   out->steered = 0;
 
   const double half_len = 0.25 * cfg->chassis_length_m, half_w = 0.5 * cfg->chassis_width_m;
-  const double radius = sqrt(half_len * half_len + half_w * half_w) + cfg->margin_m;
+  const double radius =
+      sqrt(half_len * half_len + half_w * half_w) + cfg->pose_error_m + cfg->margin_m;
   const double contact = 2.0 * radius;
   const double v_self = intended->throttle > 0.0
                             ? fmax(self->speed_m_s, intended->throttle * cfg->top_speed_m_s)

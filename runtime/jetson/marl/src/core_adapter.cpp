@@ -73,6 +73,7 @@ ShieldResult Core::shield(const CarState &own, double throttle, double steering,
   cfg.steer_limit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
   cfg.top_speed_m_s = AUTODRIVE_VEHICLE_MOTOR_NOLOAD_SPEED_RAD_S * AUTODRIVE_VEHICLE_WHEEL_RADIUS_M;
   cfg.steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;
+  cfg.pose_error_m = pose_error_m_;
   const adm_lane_t lane{route_xy_m_.data(), static_cast<int>(route_xy_m_.size() / 2), hint_,
                         half_width_m_, steering_now};
   const bool with_lane = std::isfinite(steering_now) && half_width_m_ > 0.0;

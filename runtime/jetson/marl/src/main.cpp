@@ -57,6 +57,7 @@ struct Options {
   double v2v_loss = 0, v2v_delay_ms = 0, stale_ms = 200, rate_hz = 20, goal_tolerance_m = 0.15;
   uint64_t seed = 1;
   bool no_shield = false;
+  double shield_pose_error_m = 0;
 };
 
 class App {
@@ -78,6 +79,7 @@ class App {
     goal_[1] = route_.points.back().y_m;
     if (!o.goal.empty()) std::sscanf(o.goal.c_str(), "%lf,%lf", &goal_[0], &goal_[1]);
     core_.set_goal(goal_[0], goal_[1]);
+    core_.set_pose_error_m(o.shield_pose_error_m);
     after_goal_.set_path(route_.path());
     period_us_ =
         static_cast<int64_t>(1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
@@ -355,6 +357,10 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   cli.add_option("--seed", o.seed, "seed of the V2V loss")->capture_default_str();
   cli.add_flag("--no-shield", o.no_shield, "send the policy's command unshielded (measuring only)");
+  cli.add_option("--shield-pose-error-m", o.shield_pose_error_m,
+                 "how far each car's pose may be off [m]: the shield grows every footprint by it "
+                 "(default 0: exact poses)")
+      ->check(CLI::NonNegativeNumber);
   cli.add_option("--rate-hz", o.rate_hz, "baseline: command rate [Hz]")
       ->check(CLI::Range(1.0, 200.0))
       ->capture_default_str();

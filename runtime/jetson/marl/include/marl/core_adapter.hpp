@@ -46,6 +46,8 @@ class Core {
   std::vector<float> observation(const CarState &own, const std::vector<CarState> &peers,
                                  double last_steering);
   double remaining_m() const { return remaining_m_; }  // along the route, after observation()
+  // How far each car's pose may be off [m] (the shield grows every footprint by it; 0: exact).
+  void set_pose_error_m(double e) { pose_error_m_ = e; }
   // emergency_only: predict only the core's emergency horizon, so the shield brakes for an
   // imminent contact but does not arbitrate right of way (the baseline has its own rule).
   // steering_now: the wheels' steering now (normalised; the last command where the angle is not
@@ -58,6 +60,7 @@ class Core {
  private:
   std::vector<double> route_xy_m_;
   double half_width_m_ = 0;
+  double pose_error_m_ = 0;
   double goal_xy_m_[2] = {0, 0};
   double lookahead_m_;
   int hint_ = -1;

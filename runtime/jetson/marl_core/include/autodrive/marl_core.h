@@ -68,6 +68,9 @@ typedef struct adm_shield_config {
   double dt_s;             /* prediction step */
   double steer_hold_s;     /* the intended steering is held this long, then the heading */
   double margin_m;         /* clearance added to each car's footprint */
+  double pose_error_m;     /* each car's pose may be this far off (0: true poses, the batch; HIL
+                              without the Eye: the EKF's dead reckoning), added to every
+                              footprint, the bare one of the emergency check too */
   double emergency_s;      /* with the right of way, brake for a touch within this */
   double chassis_length_m; /* the car's footprint (chassis box) */
   double chassis_width_m;
