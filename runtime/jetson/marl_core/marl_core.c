@@ -372,7 +372,8 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
   const double steer = fmax(-1.0, fmin(1.0, out->command.steering)) * cfg->steer_limit_rad;
   const int steps = (int)ceil(cfg->horizon_s / cfg->dt_s);
 
-  const double touch = 2.0 * (radius - cfg->margin_m); /* footprints without the margin */
+  /* the footprints (grown by the pose error) without the margin */
+  const double touch = 2.0 * (radius - cfg->margin_m);
   double best_t = INFINITY;
   int best_peer = -1;
   for (int i = 0; i < n_peers; i++) {
