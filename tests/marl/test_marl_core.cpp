@@ -113,8 +113,8 @@ TEST(MarlShield, BrakesInScriptedHeadOn) {
   const adm_command_t go = {1.0, 0.0};
   adm_shield_result_t ra, rb;
   char err[256] = "";
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, err, sizeof err), 0) << err;
-  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, err, sizeof err), 0) << err;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, err, sizeof err), 0) << err;
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, err, sizeof err), 0) << err;
   EXPECT_TRUE(ra.intervened || rb.intervened) << "neither car brakes head-on";
   const adm_shield_result_t &braked = ra.intervened ? ra : rb;
   EXPECT_EQ(braked.command.throttle, cfg.brake_throttle);
@@ -122,8 +122,8 @@ TEST(MarlShield, BrakesInScriptedHeadOn) {
   EXPECT_LT(braked.ttc_s, cfg.horizon_s);
   // closer in: both brake, whatever the right of way
   const adm_car_t b_near = car(2, 0.5, 0.0, kPi, v);
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b_near, 1, &ra, err, sizeof err), 0);
-  ASSERT_EQ(adm_shield(&cfg, &b_near, &go, &a, 1, &rb, err, sizeof err), 0);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b_near, 1, nullptr, &ra, err, sizeof err), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b_near, &go, &a, 1, nullptr, &rb, err, sizeof err), 0);
   EXPECT_TRUE(ra.intervened && rb.intervened);
   EXPECT_EQ(ra.peer_id, 2);
   EXPECT_EQ(rb.peer_id, 1);
@@ -136,7 +136,7 @@ TEST(MarlShield, BrakesInScriptedHeadOn) {
       double speed[2];
       for (int i = 0; i < 2; i++) {
         adm_shield_result_t r{};
-        ASSERT_EQ(adm_shield(&cfg, &s[i], &go, &s[1 - i], 1, &r, nullptr, 0), 0);
+        ASSERT_EQ(adm_shield(&cfg, &s[i], &go, &s[1 - i], 1, nullptr, &r, nullptr, 0), 0);
         speed[i] = shielded && r.intervened ? 0.0 : v;
       }
       for (int i = 0; i < 2; i++) {
@@ -162,15 +162,15 @@ TEST(MarlShield, BacksOutOfAStandingDeadlock) {
   const adm_car_t a = car(1, 0.0, 0.0, 0.0, 0.0);
   const adm_car_t b = car(2, 0.42, 0.0, kPi, 0.0);
   adm_shield_result_t ra, rb;
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, nullptr, 0), 0);
-  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
   EXPECT_TRUE(ra.intervened);
   EXPECT_EQ(ra.command.throttle, cfg.brake_throttle);
   EXPECT_TRUE(rb.intervened);
   EXPECT_EQ(rb.command.throttle, cfg.back_throttle);
   EXPECT_EQ(rb.command.steering, 0.0);
   const adm_car_t peers[2] = {a, car(3, 0.80, 0.0, kPi, 0.0)};  // right behind b
-  ASSERT_EQ(adm_shield(&cfg, &b, &go, peers, 2, &rb, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, peers, 2, nullptr, &rb, nullptr, 0), 0);
   EXPECT_TRUE(rb.intervened);
   EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
 }
@@ -182,15 +182,15 @@ TEST(MarlShield, LeavesClearAndParallelTrafficAlone) {
   adm_shield_result_t r;
   // opposite lanes 0.28 m apart: passing, not colliding
   const adm_car_t a = car(1, 0.0, -0.14, 0.0, v), b = car(2, 1.0, 0.14, kPi, v);
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &r, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &r, nullptr, 0), 0);
   EXPECT_FALSE(r.intervened);
   EXPECT_EQ(r.peer_id, -1);
   EXPECT_EQ(r.command.throttle, 1.0);
   // a faster follower behind self: its shield's job, not self's
   const adm_car_t follower = car(3, -0.4, -0.14, 0.0, 2 * v);
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &follower, 1, &r, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &follower, 1, nullptr, &r, nullptr, 0), 0);
   EXPECT_FALSE(r.intervened);
-  ASSERT_EQ(adm_shield(&cfg, &follower, &go, &a, 1, &r, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &follower, &go, &a, 1, nullptr, &r, nullptr, 0), 0);
   EXPECT_TRUE(r.intervened);
 }
 
@@ -201,8 +201,8 @@ TEST(MarlShield, CrossingGivesWayToTheNearerCarOnly) {
   // a from the west to the east, b from the south to the north, b nearer the crossing
   const adm_car_t a = car(1, -0.9, 0.0, 0.0, v), b = car(2, 0.0, -0.6, kPi / 2, v);
   adm_shield_result_t ra, rb;
-  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, &ra, nullptr, 0), 0);
-  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, &rb, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
   EXPECT_TRUE(ra.intervened);
   EXPECT_FALSE(rb.intervened);
 }
@@ -214,6 +214,166 @@ TEST(MarlShield, RejectsBadConfig) {
   const adm_command_t go = {1.0, 0.0};
   adm_shield_result_t r;
   char err[256] = "";
-  EXPECT_EQ(adm_shield(&cfg, &a, &go, nullptr, 0, &r, err, sizeof err), -1);
+  EXPECT_EQ(adm_shield(&cfg, &a, &go, nullptr, 0, nullptr, &r, err, sizeof err), -1);
   EXPECT_NE(std::string(err).find("config"), std::string::npos) << err;
+}
+
+namespace {
+
+// A lane along +x to (0, 0), a right turn of radius 0.46 m to (0.46, -0.46), then along -y
+// (Intersection School's right turns are of this size); 5 cm between points on the straights.
+std::vector<double> right_turn_lane() {
+  std::vector<double> xy;
+  for (int i = 0; i < 40; i++) xy.insert(xy.end(), {-2.0 + 0.05 * i, 0.0});
+  const double r = 0.46;
+  for (int k = 0; k <= 12; k++) {
+    const double a = k * kPi / 24;
+    xy.insert(xy.end(), {r * std::sin(a), -r + r * std::cos(a)});
+  }
+  for (int i = 1; i < 40; i++) xy.insert(xy.end(), {r, -r - 0.05 * i});
+  return xy;
+}
+
+// The bare chassis box of a car at c touches a pole of radius 8 mm at (px, py).
+bool chassis_touches(const adm_shield_config_t &cfg, const adm_car_t &c, double px, double py) {
+  const double dx = px - c.x_m, dy = py - c.y_m;
+  const double along = std::cos(c.yaw_rad) * dx + std::sin(c.yaw_rad) * dy - cfg.chassis_offset_m;
+  const double side = -std::sin(c.yaw_rad) * dx + std::cos(c.yaw_rad) * dy;
+  return std::fabs(along) < 0.5 * cfg.chassis_length_m + 0.008 &&
+         std::fabs(side) < 0.5 * cfg.chassis_width_m + 0.008;
+}
+
+struct WeaveRun {
+  bool touched_pole = false;
+  bool lane_steered = false;
+  double end_y_m = 0;  // where the car was at the end (the lane ends at y = -2.41 m)
+};
+
+// A car driving the lane alone with a bang-bang policy (full lock towards a point 0.8 m ahead on
+// the lane, a 0.05 rad dead band: it turns in early and weaves, like the batch's discrete
+// policy), its steering servo slewing at the car's rate, every 0.1 s a command through the
+// shield (with_lane: the lane term on, the measured wheel angle as steering_now). A traffic
+// light's pole stands 0.24 m right of the lane where the turn starts, as on the map.
+WeaveRun weave_through_right_turn(bool with_lane) {
+  adm_shield_config_t cfg = nigel_shield();
+  cfg.steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;
+  const std::vector<double> xy = right_turn_lane();
+  const int n = static_cast<int>(xy.size() / 2);
+  const double pole_x = 0.0, pole_y = -0.24, v = cfg.top_speed_m_s, dt = 0.01;
+  adm_car_t c = car(1, -1.0, 0.0, 0.0, v);
+  double wheel_rad = 0.0;
+  adm_command_t cmd = {1.0, 0.0};
+  int hint = -1;
+  WeaveRun out;
+  for (int k = 0; k < 1500 && c.y_m > -1.2; k++) {
+    if (k % 10 == 0) {
+      double aim[2], remaining;
+      EXPECT_EQ(
+          adm_route_waypoint(xy.data(), n, c.x_m, c.y_m, 0.8, &hint, aim, &remaining, nullptr, 0),
+          0);
+      const double b =
+          std::remainder(std::atan2(aim[1] - c.y_m, aim[0] - c.x_m) - c.yaw_rad, 2 * kPi);
+      const adm_command_t intended = {1.0, std::fabs(b) < 0.05 ? 0.0 : (b > 0 ? 1.0 : -1.0)};
+      cmd = intended;
+      if (with_lane) {
+        const adm_lane_t lane = {xy.data(), n, hint, 0.14, wheel_rad / cfg.steer_limit_rad};
+        adm_shield_result_t r{};
+        EXPECT_EQ(adm_shield(&cfg, &c, &intended, nullptr, 0, &lane, &r, nullptr, 0), 0);
+        out.lane_steered |= r.steered != 0;
+        cmd = r.command;
+      }
+    }
+    const double step = cfg.steer_rate_rad_s * dt;
+    wheel_rad += std::fmax(-step, std::fmin(step, cmd.steering * cfg.steer_limit_rad - wheel_rad));
+    const double speed = cmd.throttle > 0 ? v : 0.0;
+    c.yaw_rad += speed * std::tan(wheel_rad) / cfg.wheelbase_m * dt;
+    c.x_m += speed * std::cos(c.yaw_rad) * dt;
+    c.y_m += speed * std::sin(c.yaw_rad) * dt;
+    out.touched_pole |= chassis_touches(cfg, c, pole_x, pole_y);
+  }
+  out.end_y_m = c.y_m;
+  return out;
+}
+
+}  // namespace
+
+TEST(MarlShield, LaneTermHoldsAWeavingCarOffThePole) {
+  // The batch's 13 collisions: a car alone, weaving into the traffic light's pole at the start
+  // of a right turn. The car-to-car shield cannot see it; the lane term steers it back.
+  const WeaveRun bare = weave_through_right_turn(false);
+  EXPECT_TRUE(bare.touched_pole) << "the scripted weave should hit the pole without the lane term";
+  const WeaveRun held = weave_through_right_turn(true);
+  EXPECT_TRUE(held.lane_steered);
+  EXPECT_FALSE(held.touched_pole);
+  EXPECT_LT(held.end_y_m, -1.2) << "the lane term must not stop the car";
+}
+
+TEST(MarlShield, LaneTermLeavesALaneFollowingCarAlone) {
+  // Straight on in the middle of the lane, or a gentle correction: nothing to do.
+  adm_shield_config_t cfg = nigel_shield();
+  cfg.steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;
+  const std::vector<double> xy = right_turn_lane();
+  const adm_lane_t lane = {xy.data(), static_cast<int>(xy.size() / 2), -1, 0.14, 0.0};
+  const adm_car_t c = car(1, -1.0, 0.02, 0.0, cfg.top_speed_m_s);
+  for (double steering : {0.0, -0.2, 0.2}) {
+    const adm_command_t go = {1.0, steering};
+    adm_shield_result_t r{};
+    ASSERT_EQ(adm_shield(&cfg, &c, &go, nullptr, 0, &lane, &r, nullptr, 0), 0);
+    EXPECT_FALSE(r.intervened) << "steering " << steering;
+    EXPECT_EQ(r.command.steering, steering);
+  }
+  // already turning left (17 deg, the wheels at full left lock): holding full left leaves the
+  // lane, so the lane term steers back (the follower's steering, right of the command)
+  const adm_car_t turning = car(1, -1.0, 0.05, 0.3, cfg.top_speed_m_s);
+  adm_lane_t lane_locked = lane;
+  lane_locked.steering_now = 1.0;
+  const adm_command_t hard_left = {1.0, 1.0};
+  adm_shield_result_t r{};
+  ASSERT_EQ(adm_shield(&cfg, &turning, &hard_left, nullptr, 0, &lane_locked, &r, nullptr, 0), 0);
+  EXPECT_TRUE(r.steered);
+  EXPECT_TRUE(r.intervened);
+  EXPECT_LT(r.command.steering, 0.0);
+  // a bad lane is refused, naming it
+  const adm_lane_t bad = {xy.data(), 1, -1, 0.14, 0.0};
+  char err[256] = "";
+  EXPECT_EQ(adm_shield(&cfg, &turning, &hard_left, nullptr, 0, &bad, &r, err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("lane"), std::string::npos) << err;
+}
+
+TEST(MarlShield, BacksOutOfTheTurningPathOfAStandingFirstCar) {
+  // Car 1 stands facing +x; car 2 (drifted) stands nose-down across car 1's left turn, clear of
+  // car 1's straight path, and waits for car 1: car 1 goes first, so car 2 backs up (batch seed
+  // 1000000106, a ring of standing cars where the back-out rule looked at straight paths only).
+  const adm_shield_config_t cfg = nigel_shield();
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, 0.0, 0.0, 0.0);
+  const adm_car_t b = car(2, 0.25, 0.35, -kPi / 2, 0.0);
+  adm_shield_result_t rb;
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(rb.intervened);
+  EXPECT_EQ(rb.command.throttle, cfg.back_throttle);
+  EXPECT_EQ(rb.command.steering, 0.0);
+  // farther up, out of every path of car 1 within the emergency time: it only waits
+  const adm_car_t b_far = car(2, 0.25, 0.6, -kPi / 2, 0.0);
+  ASSERT_EQ(adm_shield(&cfg, &b_far, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(rb.intervened);
+  EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
+}
+
+TEST(MarlShield, PoseErrorGrowsTheFootprints) {
+  // Two cars passing in opposite lanes 0.28 m apart: clear with exact poses; with each pose
+  // possibly 0.1 m off (HIL on dead reckoning) they might touch, so the one giving way brakes.
+  adm_shield_config_t cfg = nigel_shield();
+  const double v = cfg.top_speed_m_s;
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, -0.14, 0.0, v), b = car(2, 1.0, 0.14, kPi, v);
+  adm_shield_result_t ra, rb;
+  cfg.pose_error_m = 0.1;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(ra.intervened || rb.intervened);
+  cfg.pose_error_m = -0.1;
+  char err[256] = "";
+  EXPECT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("pose error"), std::string::npos) << err;
 }

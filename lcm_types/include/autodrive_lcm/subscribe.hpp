@@ -33,7 +33,9 @@ bool decode(const lcm::ReceiveBuffer *rb, const std::string &channel, Msg *m) {
 template <class Msg, class Obj,
           void (Obj::*Method)(const lcm::ReceiveBuffer *, const std::string &, const Msg *)>
 void member_thunk(const lcm::ReceiveBuffer *rb, const std::string &ch, Obj *o) {
-  Msg m;
+  // value-initialised: decode() writes every field, but GCC cannot see that once a handler is
+  // inlined (-Wmaybe-uninitialized on <VEH>_STATE's steering_applied in autodrive-marl)
+  Msg m{};
   if (decode(rb, ch, &m)) (o->*Method)(rb, ch, &m);
 }
 

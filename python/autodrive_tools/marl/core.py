@@ -70,6 +70,19 @@ class ShieldResult:
     intervened: bool
     peer_id: int
     ttc_s: float
+    steered: bool  # the lane term replaced the steering
+
+
+@dataclass(frozen=True)
+class Lane:
+    """A car's own lane for the shield's lane term: its route as route_buffer() made it, the
+    nearest route point found last (route_waypoint's hint), the lane's half width [m] and the
+    wheels' steering now (normalised: the measured angle where known, else the last command)."""
+
+    route: tuple[Any, int]
+    hint: int
+    half_width_m: float
+    steering_now: float
 
 
 def check_layout() -> None:
@@ -99,6 +112,7 @@ class Core:
         self._wp = ffi.new("double[2]")
         self._cmd = ffi.new("adm_command_t *")
         self._res = ffi.new("adm_shield_result_t *")
+        self._lane = ffi.new("adm_lane_t *")
         self._hint = ffi.new("int *")
         self._remaining = ffi.new("double *")
         self.shield_config = ffi.new("adm_shield_config_t *")
@@ -110,6 +124,7 @@ class Core:
         c.wheelbase_m = v.number("wheelbase_m")
         c.steer_limit_rad = v.number("steer_limit_rad")
         c.top_speed_m_s = top_speed_m_s()
+        c.steer_rate_rad_s = v.number("steer_rate_rad_s")
 
     def _message(self) -> str:
         return str(self.ffi.string(self._err).decode(errors="replace"))
@@ -188,18 +203,32 @@ class Core:
         return self.ffi.new("double[]", pts.ravel().tolist()), len(pts)
 
     def shield(
-        self, me: Car, throttle: float, steering: float, peers: Sequence[Car]
+        self,
+        me: Car,
+        throttle: float,
+        steering: float,
+        peers: Sequence[Car],
+        lane: Lane | None = None,
     ) -> ShieldResult:
-        """The command to send instead of (throttle, steering), and whether the shield braked."""
+        """The command to send instead of (throttle, steering), and whether the shield braked
+        (or, with lane, steered back into the lane)."""
         self._fill(self._self, me)
         self._cmd.throttle, self._cmd.steering = float(throttle), float(steering)
         n = self._fill_peers(peers)
+        lane_c = self.ffi.NULL
+        if lane is not None:
+            lc = self._lane
+            lc.route_xy_m, lc.n_points = lane.route
+            lc.hint_index, lc.half_width_m = lane.hint, lane.half_width_m
+            lc.steering_now = lane.steering_now
+            lane_c = lc
         rc = self.lib.adm_shield(
             self.shield_config,
             self._self,
             self._cmd,
             self._peers,
             n,
+            lane_c,
             self._res,
             self._err,
             ERR_BYTES,
@@ -213,6 +242,7 @@ class Core:
             bool(r.intervened),
             int(r.peer_id),
             float(r.ttc_s),
+            bool(r.steered),
         )
 
 

@@ -33,7 +33,7 @@ from .. import channels
 from ..learn import tasks
 from ..learn.pz_env import ObsArray, StepResult
 from ..learn.world import World
-from .core import OBS_DIM, Car, Core, top_speed_m_s
+from .core import OBS_DIM, Car, Core, Lane, top_speed_m_s
 
 MAP = "intersection_school"
 APPROACHES = ("north", "east", "south", "west")
@@ -76,6 +76,7 @@ class CarRoute:
     goal_xy_m: tuple[float, float]
     start: tuple[float, float, float]
     spawn_s: float
+    half_width_m: float = 0.0
     buffer: Any = None
     hint: int = -1
     remaining_m: float = 0.0
@@ -95,6 +96,7 @@ def plan_route(name: str, spawn_s: float) -> CarRoute:
     yaw = math.atan2(pts[i0 + 1][1] - pts[i0][1], pts[i0 + 1][0] - pts[i0][0])
     return CarRoute(
         name=name,
+        half_width_m=r.half_width_m,
         points_m=pts[i0:].copy(),
         goal_xy_m=(float(pts[ig][0]), float(pts[ig][1])),
         start=(float(pts[i0][0]), float(pts[i0][1]), yaw),
@@ -145,6 +147,7 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
         self.period_s = self.period_ms / 1000.0
         self.world = World(MAP, cars=cars, seed=0)
         self.core = Core()
+        self.steer_limit = float(self.core.shield_config.steer_limit_rad)
         self.possible_agents = [channels.vehicle_name(i + 1).lower() for i in range(cars)]
         self.agents: list[str] = []
         self.rng = np.random.default_rng()
@@ -248,6 +251,7 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
             "outcome": ["running"] * self.n_cars,
             "traverse_s": [math.nan] * self.n_cars,
             "shield_interventions": 0,
+            "shield_lane_steers": 0,
             "steering_rate_sq_sum": 0.0,
             "steering_rate_n": 0,
             "trajectories": [[(c.x_m, c.y_m)] for c in self.cars_now],
@@ -278,9 +282,15 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
                     raise ValueError(f"step: no action for agent '{a}'")
                 throttle, steering = self.command_of(actions[a])
                 if self.use_shield:
-                    r = self.core.shield(me, throttle, steering, self.cars_now)
+                    t = self.trips[i]
+                    lane = Lane(
+                        t.buffer, t.hint, t.half_width_m, steer_before[i] / self.steer_limit
+                    )
+                    r = self.core.shield(me, throttle, steering, self.cars_now, lane)
                     if r.intervened:
                         self.stats["shield_interventions"] += 1
+                    if r.steered:
+                        self.stats["shield_lane_steers"] += 1
                     throttle, steering = r.throttle, r.steering
             sent[i] = steering
             self.world.command(i, throttle, steering)

@@ -1,7 +1,8 @@
 """Seeded held-out episodes in the batch simulator: the shipped ONNX policy (run with OpenCV
 DNN, as the C++ side can) with the shield and without it, and the rule-based baseline, on the
 same seeds. Figures per mode: success_rate (episodes with every car at its goal), collisions
-(cars that collided), off_road, timeouts, shield_interventions (steps the shield braked),
+(cars that collided), off_road, timeouts, shield_interventions (steps the shield braked or, shield_lane_steers, steered back into the
+lane),
 mean_traverse_s (start to goal, cars that arrived), steering_rate_rms (front-wheel angle rate
 [rad/s] over every car's steps), policy_inference_us_p99 (one batched forward pass)."""
 
@@ -46,6 +47,7 @@ def run_episodes(
         "off_road": 0,
         "timeouts": 0,
         "shield_interventions": 0,
+        "shield_lane_steers": 0,
         "traverse_s": [],
         "rate_sq_sum": 0.0,
         "rate_n": 0,
@@ -78,6 +80,7 @@ def run_episodes(
         acc["off_road"] += sum(o == "off_road" for o in out)
         acc["timeouts"] += sum(o == "timeout" for o in out)
         acc["shield_interventions"] += int(env.stats["shield_interventions"])
+        acc["shield_lane_steers"] += int(env.stats["shield_lane_steers"])
         acc["traverse_s"] += [t for t in env.stats["traverse_s"] if not math.isnan(t)]
         acc["rate_sq_sum"] += env.stats["steering_rate_sq_sum"]
         acc["rate_n"] += env.stats["steering_rate_n"]
@@ -115,6 +118,8 @@ def evaluate(
         "off_road": sum(p["off_road"] for p in parts),
         "timeouts": sum(p["timeouts"] for p in parts),
         "shield_interventions": sum(p["shield_interventions"] for p in parts),
+        # of them, steps where the lane term replaced the steering
+        "shield_lane_steers": sum(p["shield_lane_steers"] for p in parts),
         "mean_traverse_s": float(np.mean(trav)) if trav else math.nan,
         "steering_rate_rms": math.sqrt(sum(p["rate_sq_sum"] for p in parts) / rate_n)
         if rate_n

@@ -65,11 +65,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--no-shield", action="store_true", help="send commands unshielded")
     p.add_argument("--v2v-loss", type=float, default=0.0, help="V2V loss probability [0, 1]")
     p.add_argument("--v2v-delay-ms", type=float, default=0.0, help="V2V delay [ms]")
+    p.add_argument(
+        "--shield-pose-error-m",
+        type=float,
+        default=0.0,
+        help="how far each car's EKF pose may be off [m]: the shield grows every footprint by it",
+    )
     args = p.parse_args(argv)
     if args.episodes < 1:
         p.error(f"--episodes {args.episodes}: at least 1")
     if not 0.0 <= args.v2v_loss <= 1.0:
         p.error(f"--v2v-loss {args.v2v_loss}: must be in [0, 1]")
+    if args.shield_pose_error_m < 0:
+        p.error(f"--shield-pose-error-m {args.shield_pose_error_m}: must be >= 0")
     if args.v2v_delay_ms < 0:
         p.error(f"--v2v-delay-ms {args.v2v_delay_ms}: must be >= 0")
     return args
@@ -214,6 +222,7 @@ def run_episode(
             marl += ["--goal-tolerance-m", marl_env.GOAL_REACHED_M]
             marl += ["--waypoint-lookahead-m", marl_env.LOOKAHEAD_M]
             marl += ["--v2v-loss", args.v2v_loss, "--v2v-delay-ms", args.v2v_delay_ms]
+            marl += ["--shield-pose-error-m", args.shield_pose_error_m]
             marl += ["--seed", args.seed * 1000 + ep * 10 + i]
             if args.policy == "rl":
                 marl += ["--policy", args.policy_file]
@@ -377,6 +386,7 @@ def run(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "v2v_loss": args.v2v_loss,
         "v2v_delay_ms": args.v2v_delay_ms,
+        "shield_pose_error_m": args.shield_pose_error_m,
         "episodes": n,
         "episodes_requested": args.episodes,
         "successes": sum(1 for _p, _r, e in done if e == "goal"),
@@ -384,6 +394,8 @@ def run(args: argparse.Namespace) -> int:
         "collisions": sum(1 for _p, r, _e in done if r.collided),
         "timeouts": sum(1 for _p, _r, e in done if e == "timeout"),
         "shield_interventions": sum(s.get("shield_interventions", 0) for s in summaries_all),
+        # of them, steps where the shield's lane term replaced the policy's steering
+        "shield_lane_steers": sum(s.get("shield_lane_steers", 0) for s in summaries_all),
         "mean_traverse_s": round(float(np.mean(traverse_s)), 3) if traverse_s else None,
         "steering_rate_rms": round(float(np.sqrt(np.mean(np.square(rates)))), 4) if rates else None,
         "goal_error_true_max_m": (

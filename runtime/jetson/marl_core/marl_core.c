@@ -157,6 +157,10 @@ void adm_shield_defaults(adm_shield_config_t *cfg) {
       .brake_throttle = 0.0,
       .back_throttle = -0.5,
       .back_check_s = 1.0,
+      .lane_horizon_s = 0.6,
+      .lane_margin_m = 0.03,
+      .lane_lookahead_m = 0.35,
+      .lane_gain = 2.5,
   };
 }
 
@@ -190,20 +194,27 @@ static int standing(const adm_car_t *c) {
 }
 
 /* Self stands in the way of a standing peer that goes first (the lower id): the peer's bare
- * footprint, driven straight on at top speed, touches self's within emergency_s. */
+ * footprint, driven at top speed straight on or at either full lock (its route may turn: batch
+ * seed 1000000106, a ring of four standing cars where the first one's way was a turn), touches
+ * self's within emergency_s. */
 static int blocks_a_first_peer(const adm_shield_config_t *cfg, const adm_car_t *self,
                                const adm_car_t *peers, int n_peers) {
   if (!standing(self)) return 0;
   const double half_len = 0.25 * cfg->chassis_length_m, half_w = 0.5 * cfg->chassis_width_m;
   const double touch = 2.0 * sqrt(half_len * half_len + half_w * half_w);
+  const double yaw_rate = cfg->top_speed_m_s * tan(cfg->steer_limit_rad) / cfg->wheelbase_m;
   for (int i = 0; i < n_peers; i++) {
     const adm_car_t *p = &peers[i];
     if (p->id == self->id || p->id > self->id || !standing(p)) continue;
-    for (double t = cfg->dt_s; t < cfg->emergency_s + 1e-9; t += cfg->dt_s) {
-      const double s = cfg->top_speed_m_s * t;
-      const double qx = p->x_m + s * cos(p->yaw_rad), qy = p->y_m + s * sin(p->yaw_rad);
-      if (footprint_distance(cfg, qx, qy, p->yaw_rad, self->x_m, self->y_m, self->yaw_rad) < touch)
-        return 1;
+    for (int turn = -1; turn <= 1; turn++) {
+      double qx = p->x_m, qy = p->y_m, qyaw = p->yaw_rad;
+      for (double t = cfg->dt_s; t < cfg->emergency_s + 1e-9; t += cfg->dt_s) {
+        qyaw += turn * yaw_rate * cfg->dt_s;
+        qx += cfg->top_speed_m_s * cos(qyaw) * cfg->dt_s;
+        qy += cfg->top_speed_m_s * sin(qyaw) * cfg->dt_s;
+        if (footprint_distance(cfg, qx, qy, qyaw, self->x_m, self->y_m, self->yaw_rad) < touch)
+          return 1;
+      }
     }
   }
   return 0;
@@ -231,9 +242,79 @@ static int way_back_clear(const adm_shield_config_t *cfg, const adm_car_t *self,
   return 1;
 }
 
+/* Distance [m] from (x, y) to the route's polyline, over the segments near hint. */
+static double route_distance(const adm_lane_t *lane, double x, double y) {
+  const int back = 5, ahead = 40; /* search window around the hint [points] */
+  int lo = 0, hi = lane->n_points - 1;
+  if (lane->hint_index >= 0 && lane->hint_index < lane->n_points) {
+    lo = lane->hint_index - back < 0 ? 0 : lane->hint_index - back;
+    hi = lane->hint_index + ahead >= lane->n_points ? lane->n_points - 1 : lane->hint_index + ahead;
+  }
+  double best = INFINITY;
+  for (int i = lo; i < hi; i++) {
+    const double ax = lane->route_xy_m[2 * i], ay = lane->route_xy_m[2 * i + 1];
+    const double dx = lane->route_xy_m[2 * i + 2] - ax, dy = lane->route_xy_m[2 * i + 3] - ay;
+    const double len2 = dx * dx + dy * dy;
+    double u = len2 > 0.0 ? ((x - ax) * dx + (y - ay) * dy) / len2 : 0.0;
+    u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+    const double d = hypot(x - ax - u * dx, y - ay - u * dy);
+    best = d < best ? d : best;
+  }
+  return best;
+}
+
+/* How far [m] the chassis box's farthest corner of a car at (x, y, yaw) is past the bound. */
+static double lane_excess(const adm_shield_config_t *cfg, const adm_lane_t *lane, double x,
+                          double y, double yaw) {
+  const double c = cos(yaw), s = sin(yaw), bound = lane->half_width_m + cfg->lane_margin_m;
+  double worst = -INFINITY;
+  for (int k = 0; k < 4; k++) {
+    const double along = cfg->chassis_offset_m + (k < 2 ? 0.5 : -0.5) * cfg->chassis_length_m;
+    const double side = (k % 2 == 0 ? 0.5 : -0.5) * cfg->chassis_width_m;
+    const double e = route_distance(lane, x + c * along - s * side, y + s * along + c * side);
+    worst = e > worst ? e : worst;
+  }
+  return worst - bound;
+}
+
+/* Self driven at v_m_s with the wheels slewing from lane->steering_now to steering (both
+ * normalised) for lane_horizon_s: 1 if a chassis corner gets past the bound and farther out
+ * than now (a car already outside may still come back in). */
+static int leaves_lane(const adm_shield_config_t *cfg, const adm_lane_t *lane,
+                       const adm_car_t *self, double v_m_s, double steering) {
+  const double now = lane_excess(cfg, lane, self->x_m, self->y_m, self->yaw_rad);
+  const double allowed = (now > 0.0 ? now : 0.0) + 1e-3; /* 1 mm: rounding */
+  const double target = fmax(-1.0, fmin(1.0, steering)) * cfg->steer_limit_rad;
+  double delta = fmax(-1.0, fmin(1.0, lane->steering_now)) * cfg->steer_limit_rad;
+  const double slew = cfg->steer_rate_rad_s > 0.0 ? cfg->steer_rate_rad_s * cfg->dt_s : INFINITY;
+  double px = self->x_m, py = self->y_m, pyaw = self->yaw_rad;
+  for (double t = cfg->dt_s; t < cfg->lane_horizon_s + 1e-9; t += cfg->dt_s) {
+    delta += fmax(-slew, fmin(slew, target - delta));
+    pyaw += v_m_s * tan(delta) / cfg->wheelbase_m * cfg->dt_s;
+    px += v_m_s * cos(pyaw) * cfg->dt_s;
+    py += v_m_s * sin(pyaw) * cfg->dt_s;
+    if (lane_excess(cfg, lane, px, py, pyaw) > allowed) return 1;
+  }
+  return 0;
+}
+
+/* The lane follower's steering (normalised): gain x the bearing of the route point
+ * lane_lookahead_m ahead of the nearest one. */
+static double follow_lane(const adm_shield_config_t *cfg, const adm_lane_t *lane,
+                          const adm_car_t *self) {
+  int hint = lane->hint_index;
+  double aim[2], remaining;
+  if (adm_route_waypoint(lane->route_xy_m, lane->n_points, self->x_m, self->y_m,
+                         cfg->lane_lookahead_m, &hint, aim, &remaining, NULL, 0) != 0)
+    return 0.0;
+  double bearing = atan2(aim[1] - self->y_m, aim[0] - self->x_m) - self->yaw_rad;
+  bearing = atan2(sin(bearing), cos(bearing));
+  return fmax(-1.0, fmin(1.0, cfg->lane_gain * bearing));
+}
+
 int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
-               const adm_car_t *peers, int n_peers, adm_shield_result_t *out, char *err,
-               size_t err_sz) {
+               const adm_car_t *peers, int n_peers, const adm_lane_t *lane,
+               adm_shield_result_t *out, char *err, size_t err_sz) {
   if (cfg == NULL || self == NULL || intended == NULL || out == NULL)
     return fail(err, err_sz, "shield: cfg, self, intended and out must not be NULL");
   if (n_peers < 0 || (n_peers > 0 && peers == NULL))
@@ -241,31 +322,58 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
   if (!(cfg->horizon_s > 0.0) || !(cfg->dt_s > 0.0) || cfg->dt_s > cfg->horizon_s ||
       !(cfg->chassis_length_m > 0.0) || !(cfg->chassis_width_m > 0.0) ||
       !(cfg->wheelbase_m > 0.0) || !(cfg->top_speed_m_s > 0.0) || !(cfg->steer_limit_rad > 0.0) ||
-      !(cfg->margin_m >= 0.0) || !(cfg->steer_hold_s >= 0.0) || !isfinite(cfg->brake_throttle))
+      !(cfg->margin_m >= 0.0) || !(cfg->pose_error_m >= 0.0) || !(cfg->steer_hold_s >= 0.0) ||
+      !isfinite(cfg->brake_throttle))
     return fail(err, err_sz,
                 "shield: config needs horizon_s >= dt_s > 0, chassis, wheelbase, steering limit "
-                "and top speed > 0, margin and steer_hold >= 0");
+                "and top speed > 0, margin, pose error and steer_hold >= 0");
   if (!car_ok(self) || !isfinite(intended->throttle) || !isfinite(intended->steering))
     return fail(err, err_sz, "shield: car %d: its pose, speed or command is not finite", self->id);
   for (int i = 0; i < n_peers; i++)
     if (!car_ok(&peers[i]))
       return fail(err, err_sz, "shield: peer %d: a pose or speed is not finite", peers[i].id);
+  if (lane != NULL && (lane->route_xy_m == NULL || lane->n_points < 2 ||
+                       !(lane->half_width_m > 0.0) || !isfinite(lane->steering_now) ||
+                       !(cfg->lane_horizon_s > 0.0) || !(cfg->lane_margin_m >= 0.0) ||
+                       !(cfg->lane_lookahead_m > 0.0) || !(cfg->steer_rate_rad_s >= 0.0)))
+    return fail(err, err_sz,
+                "shield: car %d: the lane needs a route of >= 2 points, half width > 0 and a "
+                "finite steering; the config lane horizon and lookahead > 0, margin and steering "
+                "rate >= 0",
+                self->id);
 
   out->command = *intended;
   out->intervened = 0;
   out->peer_id = -1;
   out->ttc_s = cfg->horizon_s;
+  out->steered = 0;
 
   const double half_len = 0.25 * cfg->chassis_length_m, half_w = 0.5 * cfg->chassis_width_m;
-  const double radius = sqrt(half_len * half_len + half_w * half_w) + cfg->margin_m;
+  const double radius =
+      sqrt(half_len * half_len + half_w * half_w) + cfg->pose_error_m + cfg->margin_m;
   const double contact = 2.0 * radius;
-  const double steer = fmax(-1.0, fmin(1.0, intended->steering)) * cfg->steer_limit_rad;
   const double v_self = intended->throttle > 0.0
                             ? fmax(self->speed_m_s, intended->throttle * cfg->top_speed_m_s)
                             : self->speed_m_s;
+  int lane_brake = 0;
+  /* The lane term (seeds 1000000009 .. 1000000165 of the batch: a car alone, its discrete
+   * steering and the servo's slew weaving its chassis into a traffic light's pole at the start
+   * of a right turn). Predicted at the driving speed even while standing, so that the wheels
+   * are never set to a lock that would leave the lane at the start. */
+  if (lane != NULL) {
+    const double v_lane = fmax(fabs(v_self), cfg->top_speed_m_s * fmax(intended->throttle, 0.0));
+    if (v_lane > 0.0 && leaves_lane(cfg, lane, self, v_lane, intended->steering)) {
+      out->command.steering = follow_lane(cfg, lane, self);
+      out->steered = 1;
+      out->intervened = 1;
+      lane_brake = leaves_lane(cfg, lane, self, v_lane, out->command.steering);
+    }
+  }
+  const double steer = fmax(-1.0, fmin(1.0, out->command.steering)) * cfg->steer_limit_rad;
   const int steps = (int)ceil(cfg->horizon_s / cfg->dt_s);
 
-  const double touch = 2.0 * (radius - cfg->margin_m); /* footprints without the margin */
+  /* the footprints (grown by the pose error) without the margin */
+  const double touch = 2.0 * (radius - cfg->margin_m);
   double best_t = INFINITY;
   int best_peer = -1;
   for (int i = 0; i < n_peers; i++) {
@@ -319,6 +427,10 @@ int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_
         break;
       }
     }
+  }
+  if (lane_brake && best_peer < 0) {
+    out->command.throttle = cfg->brake_throttle;
+    return 0;
   }
   if (best_peer >= 0 && cfg->back_throttle < 0.0 &&
       blocks_a_first_peer(cfg, self, peers, n_peers) &&

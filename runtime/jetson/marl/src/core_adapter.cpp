@@ -4,6 +4,7 @@
 #include <autodrive_vehicle.h>
 
 #include <cctype>
+#include <cmath>
 #include <stdexcept>
 
 namespace marl {
@@ -32,7 +33,8 @@ int obs_dim() {
   return ADM_OBS_DIM;
 }
 
-Core::Core(const Route &route, double lookahead_m) : lookahead_m_(lookahead_m) {
+Core::Core(const Route &route, double lookahead_m)
+    : half_width_m_(route.half_width_m), lookahead_m_(lookahead_m) {
   for (const auto &p : route.points) {
     route_xy_m_.push_back(p.x_m);
     route_xy_m_.push_back(p.y_m);
@@ -59,7 +61,8 @@ std::vector<float> Core::observation(const CarState &own, const std::vector<CarS
 }
 
 ShieldResult Core::shield(const CarState &own, double throttle, double steering,
-                          const std::vector<CarState> &peers, bool emergency_only) const {
+                          const std::vector<CarState> &peers, bool emergency_only,
+                          double steering_now) const {
   adm_shield_config_t cfg;
   adm_shield_defaults(&cfg);
   if (emergency_only) cfg.horizon_s = cfg.emergency_s;
@@ -69,16 +72,21 @@ ShieldResult Core::shield(const CarState &own, double throttle, double steering,
   cfg.wheelbase_m = AUTODRIVE_VEHICLE_WHEELBASE_M;
   cfg.steer_limit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
   cfg.top_speed_m_s = AUTODRIVE_VEHICLE_MOTOR_NOLOAD_SPEED_RAD_S * AUTODRIVE_VEHICLE_WHEEL_RADIUS_M;
+  cfg.steer_rate_rad_s = AUTODRIVE_VEHICLE_STEER_RATE_RAD_S;
+  cfg.pose_error_m = pose_error_m_;
+  const adm_lane_t lane{route_xy_m_.data(), static_cast<int>(route_xy_m_.size() / 2), hint_,
+                        half_width_m_, steering_now};
+  const bool with_lane = std::isfinite(steering_now) && half_width_m_ > 0.0;
   const adm_car_t self = to_core(own);
   const std::vector<adm_car_t> ps = to_core(peers);
   const adm_command_t intended{throttle, steering};
   adm_shield_result_t r{};
   char err[256] = "";
-  if (adm_shield(&cfg, &self, &intended, ps.data(), static_cast<int>(ps.size()), &r, err,
-                 sizeof err) != 0)
+  if (adm_shield(&cfg, &self, &intended, ps.data(), static_cast<int>(ps.size()),
+                 with_lane ? &lane : nullptr, &r, err, sizeof err) != 0)
     throw std::runtime_error(std::string("marl core: shield: ") + err);
-  return ShieldResult{r.command.throttle, r.command.steering, r.intervened != 0, r.peer_id,
-                      r.ttc_s};
+  return ShieldResult{r.command.throttle, r.command.steering, r.intervened != 0, r.peer_id, r.ttc_s,
+                      r.steered != 0};
 }
 
 }  // namespace marl

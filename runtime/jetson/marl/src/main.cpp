@@ -15,6 +15,7 @@
 #include <autodrive/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
+#include <autodrive/vehicle_state_t.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
@@ -56,6 +57,7 @@ struct Options {
   double v2v_loss = 0, v2v_delay_ms = 0, stale_ms = 200, rate_hz = 20, goal_tolerance_m = 0.15;
   uint64_t seed = 1;
   bool no_shield = false;
+  double shield_pose_error_m = 0;
 };
 
 class App {
@@ -77,6 +79,7 @@ class App {
     goal_[1] = route_.points.back().y_m;
     if (!o.goal.empty()) std::sscanf(o.goal.c_str(), "%lf,%lf", &goal_[0], &goal_[1]);
     core_.set_goal(goal_[0], goal_[1]);
+    core_.set_pose_error_m(o.shield_pose_error_m);
     after_goal_.set_path(route_.path());
     period_us_ =
         static_cast<int64_t>(1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
@@ -94,6 +97,13 @@ class App {
     if (origin_) p = autonomy::pose_compose(*origin_, p);
     own_ = marl::CarState{marl::vehicle_id(o_.vehicle), p.x_m, p.y_m, p.yaw_rad, m->vx_m_s};
     have_pose_ = true;
+  }
+
+  // The Nano's applied (rate-limited) steering: the wheels' angle for the shield's lane term.
+  void on_state(const lcm::ReceiveBuffer *, const std::string &,
+                const autodrive::vehicle_state_t *m) {
+    steering_now_ = m->steering_applied;
+    have_steering_ = true;
   }
 
   int64_t now_us() const { return o_.clock == "sim" ? sim_now_us_ : wall_us(); }
@@ -135,13 +145,21 @@ class App {
       }
       if (!o_.no_shield) {
         // The baseline arbitrates the zone by its own rule: its shield is the emergency brake.
+        // The lane term for the policy only: the baseline follows its lane itself.
+        const double steering_now = baseline_ != nullptr ? std::nan("")
+                                    : have_steering_     ? steering_now_
+                                                         : last_steering_;
         const marl::ShieldResult r =
-            core_.shield(own_, throttle, steering, peers, baseline_ != nullptr);
+            core_.shield(own_, throttle, steering, peers, baseline_ != nullptr, steering_now);
         if (r.intervened) {
           ++shield_interventions_;
-          if (!last_intervened_)
+          lane_steers_ += r.steered ? 1 : 0;
+          if (!last_intervened_ && r.peer_id >= 0)
             spdlog::info("shield: brake for NIGEL{}, contact predicted in {:.2f} s", r.peer_id,
                          r.ttc_s);
+          else if (!last_intervened_)
+            spdlog::info("shield: lane term: steering {:.2f} instead of {:.2f}{}", r.steering,
+                         steering, r.throttle != throttle ? ", braking" : "");
         }
         last_intervened_ = r.intervened;
         throttle = r.throttle;
@@ -208,11 +226,13 @@ class App {
         buf, sizeof buf,
         "{\"vehicle\": \"%s\", \"mode\": \"%s\", \"shield\": %s, \"route\": \"%s\", "
         "\"steps\": %llu, \"start_s\": %.3f, \"goal_s\": %.3f, \"shield_interventions\": %llu, "
-        "\"v2v_received\": %llu, \"v2v_lost\": %llu, \"v2v_dropped_stale\": %llu}",
+        "\"shield_lane_steers\": %llu, \"v2v_received\": %llu, \"v2v_lost\": %llu, "
+        "\"v2v_dropped_stale\": %llu}",
         o_.vehicle.c_str(), o_.mode.c_str(), o_.no_shield ? "false" : "true", route_.name.c_str(),
         static_cast<unsigned long long>(steps_), start_us_ >= 0 ? start_us_ * 1e-6 : -1.0,
         goal_us_ >= 0 ? goal_us_ * 1e-6 : -1.0,
         static_cast<unsigned long long>(shield_interventions_),
+        static_cast<unsigned long long>(lane_steers_),
         static_cast<unsigned long long>(link_.received()),
         static_cast<unsigned long long>(link_.lost()),
         static_cast<unsigned long long>(peers_.dropped_stale()));
@@ -235,11 +255,13 @@ class App {
   marl::CarState own_;
   bool have_pose_ = false, last_intervened_ = false;
   double last_steering_ = 0;
+  double steering_now_ = 0;  // <VEH>_STATE's steering_applied, normalised
+  bool have_steering_ = false;
   int64_t sim_now_us_ = 0, start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000,
           goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
-  uint64_t steps_ = 0, shield_interventions_ = 0;
+  uint64_t steps_ = 0, shield_interventions_ = 0, lane_steers_ = 0;
   size_t peers_seen_ = 0;
 };
 
@@ -335,6 +357,10 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   cli.add_option("--seed", o.seed, "seed of the V2V loss")->capture_default_str();
   cli.add_flag("--no-shield", o.no_shield, "send the policy's command unshielded (measuring only)");
+  cli.add_option("--shield-pose-error-m", o.shield_pose_error_m,
+                 "how far each car's pose may be off [m]: the shield grows every footprint by it "
+                 "(default 0: exact poses)")
+      ->check(CLI::NonNegativeNumber);
   cli.add_option("--rate-hz", o.rate_hz, "baseline: command rate [Hz]")
       ->check(CLI::Range(1.0, 200.0))
       ->capture_default_str();
@@ -424,6 +450,8 @@ int main(int argc, char **argv) {
   const std::string pose_ch =
       o.vehicle + (origin ? AUTODRIVE_CH_ODOM_SUFFIX : AUTODRIVE_CH_POSE_MAP_SUFFIX);
   autodrive_lcm::subscribe<autodrive::odometry_t, App, &App::on_pose>(lcm, pose_ch, &app);
+  autodrive_lcm::subscribe<autodrive::vehicle_state_t, App, &App::on_state>(
+      lcm, o.vehicle + AUTODRIVE_CH_STATE_SUFFIX, &app);
   spdlog::info("{} mode {}{} on {}: route {}, pose from {}, V2V loss {} delay {} ms", o.vehicle,
                o.mode, o.no_shield ? " (no shield)" : "", o.lcm_url, o.route, pose_ch, o.v2v_loss,
                o.v2v_delay_ms);

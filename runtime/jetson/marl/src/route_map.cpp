@@ -61,6 +61,9 @@ Route read_route(const std::string &map_json, const std::string &name) {
     if (n != name) continue;
     Route out;
     out.name = name;
+    out.half_width_m = r.at("half_width_m").get<double>();
+    if (!(out.half_width_m > 0.0))
+      throw std::runtime_error(map_json + ": route " + name + ": half_width_m must be > 0");
     const auto &poly = r.at("polyline_m");
     for (size_t i = 0; i < poly.size(); ++i) {
       autonomy::Pose2 p{poly[i].at(0).get<double>(), poly[i].at(1).get<double>(), 0.0};

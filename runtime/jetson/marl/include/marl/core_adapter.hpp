@@ -4,6 +4,7 @@
 // C++ types into the core's and fills the shield's car figures from vehicle/nigel.params.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ struct ShieldResult {
   bool intervened = false;            // the shield braked instead of the intended command
   int peer_id = -1;                   // the peer it braked for
   double ttc_s = 0;                   // predicted time to collision with it [s]
+  bool steered = false;               // the lane term replaced the steering
 };
 
 class Core {
@@ -44,13 +46,21 @@ class Core {
   std::vector<float> observation(const CarState &own, const std::vector<CarState> &peers,
                                  double last_steering);
   double remaining_m() const { return remaining_m_; }  // along the route, after observation()
+  // How far each car's pose may be off [m] (the shield grows every footprint by it; 0: exact).
+  void set_pose_error_m(double e) { pose_error_m_ = e; }
   // emergency_only: predict only the core's emergency horizon, so the shield brakes for an
   // imminent contact but does not arbitrate right of way (the baseline has its own rule).
+  // steering_now: the wheels' steering now (normalised; the last command where the angle is not
+  // measured): with it, the core's lane term keeps the chassis on the route's lane (the route
+  // point nearest as found by the last observation()); NaN: no lane term.
   ShieldResult shield(const CarState &own, double throttle, double steering,
-                      const std::vector<CarState> &peers, bool emergency_only = false) const;
+                      const std::vector<CarState> &peers, bool emergency_only = false,
+                      double steering_now = std::numeric_limits<double>::quiet_NaN()) const;
 
  private:
   std::vector<double> route_xy_m_;
+  double half_width_m_ = 0;
+  double pose_error_m_ = 0;
   double goal_xy_m_[2] = {0, 0};
   double lookahead_m_;
   int hint_ = -1;

@@ -68,6 +68,9 @@ typedef struct adm_shield_config {
   double dt_s;             /* prediction step */
   double steer_hold_s;     /* the intended steering is held this long, then the heading */
   double margin_m;         /* clearance added to each car's footprint */
+  double pose_error_m;     /* each car's pose may be this far off (0: true poses, the batch; HIL
+                              without the Eye: the EKF's dead reckoning), added to every
+                              footprint, the bare one of the emergency check too */
   double emergency_s;      /* with the right of way, brake for a touch within this */
   double chassis_length_m; /* the car's footprint (chassis box) */
   double chassis_width_m;
@@ -79,13 +82,32 @@ typedef struct adm_shield_config {
   double back_throttle;   /* a standing car blocking a standing car that goes first backs at
                              this (< 0; 0: never backs) */
   double back_check_s;    /* ... if its path back stays clear (margin) for this long */
+  /* The lane term (with an adm_lane_t): the car alone against the road's edge and what stands
+   * beside it (the traffic lights' poles just off the road at the stop lines). */
+  double lane_horizon_s;   /* the intended steering must keep the chassis in bounds this long */
+  double lane_margin_m;    /* a chassis corner may pass its lane's edge by this much */
+  double lane_lookahead_m; /* the fallback lane follower's aim point ahead on the route */
+  double lane_gain;        /* ... its steering = gain x the aim point's bearing [rad], clamped */
+  double steer_rate_rad_s; /* the steering servo's slew (0: instant), the car's figure */
 } adm_shield_config_t;
+
+/* The car's own lane for the shield's lane term: its route polyline, the lane's half width and
+ * the wheels' present steering (the servo slews from there to the command). */
+typedef struct adm_lane {
+  const double *route_xy_m; /* n_points x (x, y) [m], driving order (adm_route_waypoint's) */
+  int n_points;
+  int hint_index;      /* the nearest route point found last (adm_route_waypoint's), -1: any */
+  double half_width_m; /* the lane's half width (the map's) */
+  double steering_now; /* the wheels' steering now, normalised [-1, 1]: the measured angle
+                          where known, else the last command sent */
+} adm_lane_t;
 
 typedef struct adm_shield_result {
   adm_command_t command; /* what to send */
   int intervened;        /* 1: braked (or backed) instead of the intended command */
   int peer_id;           /* the peer it braked for, else -1 */
   double ttc_s;          /* predicted time to collision with it, else the horizon */
+  int steered;           /* 1: the lane term replaced the steering (command.steering) */
 } adm_shield_result_t;
 
 /* Defaults of the shield's tuning (horizon, step, margin ...); the car's figures (chassis,
@@ -101,10 +123,15 @@ void adm_shield_defaults(adm_shield_config_t *cfg);
  * cm, or both standing: the lower id goes first). Giving way, self brakes for any predicted contact
  * (footprints plus margin_m) within the horizon; with the right of way, only for a touch of the
  * bare footprints within emergency_s. A peer behind self at the contact is left to that peer's
- * shield. */
+ * shield.
+ * Lane term (lane not NULL; first, so that the peers are checked with the steering sent): self
+ * driven with the intended steering for lane_horizon_s (the servo slewing at steer_rate_rad_s
+ * from lane->steering_now) must keep every chassis corner within half_width_m + lane_margin_m
+ * of its route, or no farther out than now; else the steering becomes the lane follower's
+ * (steered = 1), and if that path leaves the bounds too, self brakes while the wheels turn. */
 int adm_shield(const adm_shield_config_t *cfg, const adm_car_t *self, const adm_command_t *intended,
-               const adm_car_t *peers, int n_peers, adm_shield_result_t *out, char *err,
-               size_t err_sz);
+               const adm_car_t *peers, int n_peers, const adm_lane_t *lane,
+               adm_shield_result_t *out, char *err, size_t err_sz);
 /* CFFI-END */
 
 #ifdef __cplusplus
