@@ -782,9 +782,8 @@ int main(int argc, char **argv) {
     return 1;
   }
   char err[2048] = "";
-  cfg.host_io_period_ms = host_io_ms                   ? host_io_ms
-                          : (lockstep && !client_sync) ? MAIN_FREE_LOCKSTEP_IO_MS
-                                                       : 1;
+  const int free_lockstep = lockstep && !client_sync; /* as fast as it can, nobody to wait for */
+  cfg.host_io_period_ms = host_io_ms ? host_io_ms : free_lockstep ? MAIN_FREE_LOCKSTEP_IO_MS : 1;
   sim_t *s = sim_create(&cfg, err, sizeof err);
   if (!s) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
@@ -1011,12 +1010,12 @@ int main(int argc, char **argv) {
     }
     /* free lockstep paces nothing: it reads the clock (for the LCM flush and progress) every
      * MAIN_FREE_CLOCK_EVERY steps only, as a read costs ~0.5 % of a 1-car step */
-    if (lockstep && !client_sync && step % MAIN_FREE_CLOCK_EVERY != 0) continue;
+    if (free_lockstep && step % MAIN_FREE_CLOCK_EVERY != 0) continue;
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
-    if (wall >= next_flush) { /* queued LCM messages leave at least every millisecond */
+    if (wall >= next_flush) { /* queued LCM messages leave within the flush period */
       lcmq_flush(pubq);
-      next_flush = wall + (lockstep && !client_sync ? MAIN_FREE_LCM_FLUSH_S : MAIN_LCM_FLUSH_S);
+      next_flush = wall + (free_lockstep ? MAIN_FREE_LCM_FLUSH_S : MAIN_LCM_FLUSH_S);
     }
     /* --lockstep-client runs in real time until a client first writes, then in step with it */
     if (!lockstep || (client_sync && !sync.started)) {

@@ -836,9 +836,9 @@ static void sim_read_host(sim_t *s, sim_car_t *c) {
  * seen within that time, and the next service that moves bytes ends the idle state. */
 #define SIM_HOST_IDLE_PERIOD_MS 100
 /* Unread bytes [bytes] on the pty above which nobody is reading it (free lockstep only): 40 ms
- * of the Nano's telemetry. Writing on into the kernel's queue costs tens of microseconds per write (the tty
- * layer hands each write to a kernel worker), more than the car's whole 1 ms step; a client
- * that reads keeps the queue near empty. */
+ * of the Nano's telemetry. Writing on into the kernel's queue costs tens of microseconds per
+ * write (the tty layer hands each write to a kernel worker), more than the car's whole 1 ms
+ * step; a client that reads keeps the queue near empty. */
 #define SIM_PTY_UNREAD_IDLE_BYTES 256
 static int sim_host_io_due_car(const sim_t *s, const sim_car_t *c, int io_due) {
   if (!io_due || !c->host_idle) return io_due;
@@ -954,28 +954,26 @@ static void sim_apply_point_force(const mjModel *m, mjData *d, int b, const mjtN
   }
 }
 
-/* Paper tyre forces from the contacts recorded after the previous step, applied at each
- * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
- * forces for this step; the free joint's are the tyres' alone. */
 /* World-frame linear velocity [m/s] of body b's centre of mass into out: what
  * mj_objectVelocity(mjOBJ_BODY, world frame) gives in its linear half, the same arithmetic
  * (cvel's linear part moved from the root's subtree CoM to the body's CoM, v - dif x w),
  * without its rotation bookkeeping: four wheels per car every step. */
-static const mjtNum *sim_body_velocity(const mjModel *m, const mjData *d, int b, mjtNum out[3]) {
+static void sim_body_velocity(const mjModel *m, const mjData *d, int b, mjtNum out[3]) {
   const mjtNum *cvel = d->cvel + 6 * b, *w = cvel, *v = cvel + 3;
   const mjtNum *com = d->subtree_com + 3 * m->body_rootid[b], *p = d->xipos + 3 * b;
   const mjtNum dif[3] = {p[0] - com[0], p[1] - com[1], p[2] - com[2]};
   out[0] = v[0] - (dif[1] * w[2] - dif[2] * w[1]);
   out[1] = v[1] - (dif[2] * w[0] - dif[0] * w[2]);
   out[2] = v[2] - (dif[0] * w[1] - dif[1] * w[0]);
-  return out;
 }
 
+/* Paper tyre forces from the contacts recorded after the previous step, applied at each
+ * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
+ * forces for this step; the free joint's are the tyres' alone. */
 static void sim_tyres(sim_t *s, sim_car_t *c) {
   const vp_params_t *p = &s->p;
   const mjModel *m = s->m;
   mjData *d = s->d;
-  mjtNum vel_buf[3];
   mju_zero(d->qfrc_applied + c->root_dof, 6);
   for (int w = 0; w < W_N; w++) {
     const int b = c->wheel_body[w];
@@ -986,7 +984,8 @@ static void sim_tyres(sim_t *s, sim_car_t *c) {
     mju_cross(fwd, axis, c->normal[w]);
     if (mju_normalize3(fwd) < 1e-9) continue;
     mju_cross(lat, c->normal[w], fwd);
-    const mjtNum *v_lin = sim_body_velocity(m, d, b, vel_buf);
+    mjtNum v_lin[3];
+    sim_body_velocity(m, d, b, v_lin);
     const double i_spin = m->body_inertia[3 * b + 1] + m->dof_armature[c->wheel_dof[w]];
     const double r = p->wheel_radius_m;
     tyre_in_t in;
