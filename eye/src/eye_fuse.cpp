@@ -2,8 +2,12 @@
 
 #include <autodrive/angles.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+
+#include "eye_error.hpp"
+#include "eye_source.hpp"
 
 namespace eye {
 
@@ -79,22 +83,67 @@ MultiEye::MultiEye(const std::vector<RunConfig> &cameras,
 }
 
 std::vector<CarPose> MultiEye::process(const std::vector<cv::Mat> &frames, int64_t utime) {
-  moved_now_.clear();
+  auto out = track(frames, utime);
+  const auto late = finish();
+  out.insert(out.end(), late.begin(), late.end());
+  return out;
+}
+
+std::vector<CarPose> MultiEye::track(const std::vector<cv::Mat> &frames, int64_t utime) {
+  std::vector<TrackInput> in;
+  for (const auto &f : frames) in.push_back({f, nullptr});
+  return track(in, utime);
+}
+
+std::vector<CarPose> MultiEye::track(const std::vector<TrackInput> &frames, int64_t utime) {
+  utime_ = utime;
   for (size_t i = 0; i < trackers_.size(); ++i) {
     last_[i].clear();
-    if (i >= frames.size() || frames[i].empty()) continue;
-    last_[i] = trackers_[i]->process(frames[i]);
-    if (health_[i].observe(utime, trackers_[i]->last_detections(), &last_[i]))
-      moved_now_.push_back(i);
+    if (i >= frames.size() || (frames[i].gray.empty() && !frames[i].jpeg)) continue;
+    try {
+      last_[i] = trackers_[i]->track(frames[i]);
+    } catch (const Error &e) {
+      if (!frames[i].jpeg) throw;  // a decoded frame of the wrong size: the caller's error
+      skipped_frames_log().event(cfg_[i].camera_name, std::string(e.what()) + " (frame skipped)");
+      continue;
+    }
+    health_[i].inflate(&last_[i]);
   }
   std::vector<CarPose> fused = fuse_poses(last_);
-  // Handover: a car one camera sees is looked for at once by every other camera whose image
-  // it is in, instead of waiting for that camera's next full scan.
-  for (const auto &car : fused)
+  posed_.clear();
+  for (const auto &car : fused) posed_.push_back(car.vehicle);
+  hand_over(fused, last_);
+  return fused;
+}
+
+std::vector<CarPose> MultiEye::finish() {
+  moved_now_.clear();
+  std::vector<std::vector<CarPose>> found(trackers_.size());
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    found[i] = trackers_[i]->finish();
+    health_[i].inflate(&found[i]);
+    last_[i].insert(last_[i].end(), found[i].begin(), found[i].end());
+    if (health_[i].observe(utime_, trackers_[i]->last_detections(),
+                           static_cast<int>(last_[i].size())))
+      moved_now_.push_back(i);
+  }
+  std::vector<CarPose> fused;
+  for (auto &car : fuse_poses(found))
+    if (std::find(posed_.begin(), posed_.end(), car.vehicle) == posed_.end())
+      fused.push_back(std::move(car));
+  hand_over(fused, last_);
+  return fused;
+}
+
+// Handover: a car one camera sees is looked for at once by every other camera whose image it is
+// in, instead of waiting for that camera's next staggered band.
+void MultiEye::hand_over(const std::vector<CarPose> &cars,
+                         const std::vector<std::vector<CarPose>> &seen) {
+  for (const auto &car : cars)
     for (size_t j = 0; j < trackers_.size(); ++j) {
-      bool seen = false;
-      for (const auto &p : last_[j]) seen = seen || p.vehicle == car.vehicle;
-      if (seen) continue;
+      bool in_view = false;
+      for (const auto &p : seen[j]) in_view = in_view || p.vehicle == car.vehicle;
+      if (in_view) continue;
       for (const auto &v : cfg_[j].vehicles) {
         std::array<cv::Point2d, 4> c;
         if (v.name == car.vehicle &&
@@ -102,7 +151,6 @@ std::vector<CarPose> MultiEye::process(const std::vector<cv::Mat> &frames, int64
           trackers_[j]->hint(v.tag_id, c);
       }
     }
-  return fused;
 }
 
 }  // namespace eye

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "eye_config.hpp"
@@ -30,8 +31,19 @@ class MultiEye {
   // for health (may be empty).
   MultiEye(const std::vector<RunConfig> &cameras, const std::vector<std::vector<RefTag>> &refs,
            const HealthParams &hp = HealthParams());
-  // frames[i]: camera i's frame of this frame time (an empty Mat: none). Fused poses.
+  // frames[i]: camera i's frame of this frame time (an empty Mat: none). Fused poses:
+  // track() then finish().
   std::vector<CarPose> process(const std::vector<cv::Mat> &frames, int64_t utime);
+  // The tracked cars' fused poses (Tracker::track of each camera), to publish at once; health
+  // inflation as of the frames before.
+  std::vector<CarPose> track(const std::vector<cv::Mat> &frames, int64_t utime);
+  // The same for frames that may still be JPEGs (Tracker::track); a frame that does not decode
+  // is logged (skipped_frames_log) and its camera has no frame this time.
+  std::vector<CarPose> track(const std::vector<TrackInput> &frames, int64_t utime);
+  // The rest of the frame time: each camera's staggered band and health. Fused poses of the
+  // cars no camera tracked (a car track() returned is not returned again: one pose per frame
+  // time; another camera's sighting of it joins its fusion from the next frame on).
+  std::vector<CarPose> finish();
   size_t size() const { return trackers_.size(); }
   Tracker &tracker(size_t i) { return *trackers_[i]; }
   CameraHealth &health(size_t i) { return health_[i]; }
@@ -46,6 +58,10 @@ class MultiEye {
   std::vector<CameraHealth> health_;
   std::vector<std::vector<CarPose>> last_;
   std::vector<size_t> moved_now_;
+  int64_t utime_ = 0;               // the frame time between track() and finish()
+  std::vector<std::string> posed_;  // vehicles track() returned
+  // Hints every other camera to look where it should see each of these cars.
+  void hand_over(const std::vector<CarPose> &cars, const std::vector<std::vector<CarPose>> &seen);
 };
 
 }  // namespace eye

@@ -14,10 +14,22 @@ CameraHealth::CameraHealth(std::string camera, const Intrinsics &in, const Camer
 
 bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets,
                            std::vector<CarPose> *poses) {
+  const bool newly_moved = observe(utime, dets, poses ? static_cast<int>(poses->size()) : 0);
+  if (poses) inflate(poses);
+  return newly_moved;
+}
+
+void CameraHealth::inflate(std::vector<CarPose> *poses) const {
+  if (st_.moved)
+    for (auto &c : *poses)
+      for (auto &v : c.cov) v *= st_.cov_scale;
+}
+
+bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets, int cars_seen) {
   st_.utime = utime;
   ++st_.frames;
   st_.tags_seen = static_cast<int>(dets.size());
-  st_.cars_seen = poses ? static_cast<int>(poses->size()) : 0;
+  st_.cars_seen = cars_seen;
   times_.push_back(utime);
   while (times_.size() > 31) times_.pop_front();
   if (times_.size() >= 2 && times_.back() > times_.front())
@@ -59,9 +71,6 @@ bool CameraHealth::observe(int64_t utime, const std::vector<Detection> &dets,
       }
     }
   }
-  if (poses && st_.moved)
-    for (auto &c : *poses)
-      for (auto &v : c.cov) v *= st_.cov_scale;
   return newly_moved;
 }
 

@@ -45,6 +45,10 @@ class CameraHealth {
   // are measured: the tracker's staggered scan sees each within full_every frames), and the
   // car poses, inflated here if moved. Returns true once, at the frame the camera is found moved.
   bool observe(int64_t utime, const std::vector<Detection> &dets, std::vector<CarPose> *poses);
+  // The same without poses to inflate: cars_seen is how many the frame posed.
+  bool observe(int64_t utime, const std::vector<Detection> &dets, int cars_seen);
+  // This camera's poses with the covariance its state calls for (inflated once moved).
+  void inflate(std::vector<CarPose> *poses) const;
   const CameraStatus &status() const { return st_; }
   // Whether a status message is due at this capture time (then marks it sent).
   bool status_due(int64_t utime);

@@ -23,6 +23,13 @@
 
 namespace eye {
 
+int Frame::width_px() const {
+  return jpeg ? jpeg->width_px() : gray.cols;
+}
+int Frame::height_px() const {
+  return jpeg ? jpeg->height_px() : gray.rows;
+}
+
 int64_t now_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
@@ -153,9 +160,15 @@ class LcmSource : public Source {
       }
       Pending p = std::move(q_.front());
       q_.pop_front();
-      // Decoded only now: a frame dropped from a full queue costs no decode.
+      // Decoded only now: a frame dropped from a full queue costs no decode. A JPEG's header
+      // is read here and its rows by the tracker.
       try {
-        f->gray = decode_gray(p.data.data(), p.data.size(), p.label);
+        f->jpeg.reset();
+        f->gray.release();
+        if (p.format == "jpeg")
+          f->jpeg = std::make_shared<RowDecoder>(p.data.data(), p.data.size(), p.label);
+        else
+          f->gray = decode_gray(p.data.data(), p.data.size(), p.label);
       } catch (const Error &e) {
         skipped_frames_log().event(p.channel, std::string(e.what()) + " (frame skipped)");
         continue;
@@ -183,6 +196,7 @@ class LcmSource : public Source {
       return;
     }
     f.data = m->data;
+    f.format = m->format;
     if (q_.size() >= 2) q_.pop_front();  // keep the newest
     q_.push_back(std::move(f));
   }
@@ -193,7 +207,7 @@ class LcmSource : public Source {
   lcm::Subscription *sub_ = nullptr;
   struct Pending {  // a frame whose header names the calibrated size, not decoded yet
     int64_t utime = 0;
-    std::string label, channel;
+    std::string label, channel, format;
     std::vector<uint8_t> data;
   };
   std::deque<Pending> q_;

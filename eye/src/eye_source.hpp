@@ -1,5 +1,6 @@
 // Frame sources for `run`: camera device, GStreamer pipeline, video file, image folder, or an
-// LCM image channel. Each frame is decoded to grey and stamped with its capture time.
+// LCM image channel. Each frame is decoded to grey (an LCM channel's JPEGs are left to the
+// tracker, which decodes them row by row beside its work) and stamped with its capture time.
 #pragma once
 #include <autodrive/log_limiter.hpp>
 #include <opencv2/core.hpp>
@@ -8,10 +9,15 @@
 #include <memory>
 #include <string>
 
+#include "eye_rowdecode.hpp"
+
 namespace eye {
 
 struct Frame {
-  cv::Mat gray;             // CV_8UC1
+  cv::Mat gray;                      // CV_8UC1, or empty while jpeg is not decoded
+  std::shared_ptr<RowDecoder> jpeg;  // an lcm: source's JPEG, decoded by the tracker
+  int width_px() const;
+  int height_px() const;
   int64_t utime = 0;        // capture time [us]
   bool wall_clock = false;  // utime is on the system clock (device, gst): latency is measurable
   std::string label;        // file name or frame counter, for messages

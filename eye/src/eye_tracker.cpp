@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "eye_error.hpp"
+#include "eye_rowdecode.hpp"
 
 namespace eye {
 
@@ -123,7 +125,9 @@ struct SettleOnExit {
 };
 }  // namespace
 
-Tracker::~Tracker() = default;
+Tracker::~Tracker() {
+  if (work_) work_->settle();  // its job reads pending_
+}
 
 Tracker::Tracker(const RunConfig &c) : cfg_(c), det_(c.detector) {
   if (c.detector.threads > 1) {
@@ -175,8 +179,7 @@ std::vector<Detection> Tracker::full_scan(const cv::Mat &gray) {
   return merge_detections(upper);
 }
 
-std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
-                                            const std::array<cv::Point2d, 4> &c, double margin) {
+cv::Rect Tracker::window_rect(const std::array<cv::Point2d, 4> &c, double margin) {
   double x0 = c[0].x, x1 = c[0].x, y0 = c[0].y, y1 = c[0].y;
   for (const auto &p : c) {
     x0 = std::min(x0, p.x);
@@ -185,85 +188,145 @@ std::vector<Detection> Tracker::scan_window(const cv::Mat &gray, int id,
     y1 = std::max(y1, p.y);
   }
   const double grow = margin * std::max(x1 - x0, y1 - y0);
-  const cv::Rect win(
+  return cv::Rect(
       cv::Point(static_cast<int>(std::floor(x0 - grow)), static_cast<int>(std::floor(y0 - grow))),
       cv::Point(static_cast<int>(std::ceil(x1 + grow)) + 1,
                 static_cast<int>(std::ceil(y1 + grow)) + 1));
+}
+
+std::vector<Detection> Tracker::scan_window(Detector &det, const cv::Mat &gray,
+                                            const RowDecoder *rows, int id,
+                                            const std::array<cv::Point2d, 4> &c, double margin) {
+  const cv::Rect win = window_rect(c, margin);
+  // The decode failed: the caller's finish() of the second thread rethrows its error.
+  if (rows && !rows->wait_rows(win.br().y)) throw Error(rows->what() + ": the decode failed");
   // Windows are small: full resolution (measured: at 1.5 a 35 px tag near the image border was
   // lost from its window for 6 frames).
   const float dec = 1.0f;
   std::vector<Detection> out;
-  for (const auto &d : det_.detect(gray, win, dec))
+  for (const auto &d : det.detect(gray, win, dec))
     if (d.id == id) out.push_back(d);
   return out;
 }
 
+void Tracker::update_contrast(const cv::Mat &gray) {
+  noise_sigma_ = estimate_noise_sigma(gray);
+  const int contrast = std::max(cfg_.detector.min_contrast,
+                                static_cast<int>(std::ceil(cfg_.detector.noise_k * noise_sigma_)));
+  det_.set_min_contrast(contrast);
+  if (det2_) det2_->set_min_contrast(contrast);
+}
+
 std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
+  auto out = track(gray);
+  const auto late = finish();
+  out.insert(out.end(), late.begin(), late.end());
+  return out;
+}
+
+std::vector<CarPose> Tracker::track(const TrackInput &in) {
+  if (pending_.active) finish();
+  RowDecoder *const jpeg = in.jpeg.get();
+  const cv::Mat &gray = jpeg ? jpeg->image() : in.gray;
   if (gray.cols != cfg_.in.width_px || gray.rows != cfg_.in.height_px)
     throw Error("frame: size " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
                 " differs from the calibrated " + std::to_string(cfg_.in.width_px) + "x" +
                 std::to_string(cfg_.in.height_px) + " of " + cfg_.intrinsics_path);
-  std::vector<CarPose> out;
-  std::map<int, int> count;
   const int n_bands = std::max(1, cfg_.tracking.full_every);
   last_full_ = !cfg_.tracking.roi || (tracks_.empty() && hints_.empty());
+  // A JPEG is decoded on the second thread while the windows wait for their rows; without
+  // windows or a second thread, whole, here.
+  RowDecoder *const rows = jpeg && work_ && !last_full_ ? jpeg : nullptr;
+  if (jpeg && !rows) jpeg->decode();
   const long frame = frame_++;
-  // The camera's noise changes slowly (gain, light): measured once per staggered cycle.
-  if (frame % n_bands == 0 && cfg_.detector.noise_k > 0) {
-    noise_sigma_ = estimate_noise_sigma(gray);
-    const int contrast =
-        std::max(cfg_.detector.min_contrast,
-                 static_cast<int>(std::ceil(cfg_.detector.noise_k * noise_sigma_)));
-    det_.set_min_contrast(contrast);
-    if (det2_) det2_->set_min_contrast(contrast);
-  }
+  // The camera's noise changes slowly (gain, light): measured once per staggered cycle, in
+  // finish() (off the poses' path) except for the first frame, which needs it now.
+  if (frame == 0 && cfg_.detector.noise_k > 0) update_contrast(gray);
+  Pending &p = pending_;
+  p = Pending();
+  p.gray = gray;
+  p.decoder = in.jpeg;
   std::vector<Detection> dets;
   if (!last_full_) {
-    // The staggered periodic scan: band (frame mod n) of the full-scan plan, on the second
-    // thread beside the windows if there is one, else after them.
-    const auto slice = plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows);
-    std::vector<Detection> band;
-    SettleOnExit settle{work_.get()};
-    if (work_) work_->run([&] { band = scan_regions(*det2_, gray, slice); });
+    // The staggered periodic scan: band (frame mod n) of the full-scan plan, in finish().
+    p.band = plan_slice(plan_, static_cast<int>(frame % n_bands), n_bands, gray.rows);
+    // Where each tag should be now (last corners moved by the last frame's motion), searched
+    // in the order of the windows' lowest rows: the caller's thread takes them from the top,
+    // each once the rows under it are decoded; the second thread decodes, then takes them from
+    // the bottom.
+    std::vector<std::pair<int, std::array<cv::Point2d, 4>>> preds;
     for (const auto &[id, t] : tracks_) {
-      // Where the tag should be now: last corners moved by the last frame's motion.
       std::array<cv::Point2d, 4> pred = t.corners;
-      for (auto &p : pred) p += t.velocity_px;
-      auto found = scan_window(gray, id, pred, cfg_.tracking.margin);
-      // Missing from its window (a sharp turn, a jolt, occlusion): a window 3x as large, then
-      // the whole frame at once; windows only ever save time, never detections.
-      if (found.empty()) found = scan_window(gray, id, pred, 3.0 * cfg_.tracking.margin + 1.0);
-      if (found.empty()) {
-        last_full_ = true;
-        break;
-      }
-      dets.insert(dets.end(), found.begin(), found.end());
+      for (auto &q : pred) q += t.velocity_px;
+      preds.emplace_back(id, pred);
     }
-    if (!last_full_) {
-      for (const auto &[id, c] : hints_) {
-        const auto found = scan_window(gray, id, c, cfg_.tracking.margin);
-        dets.insert(dets.end(), found.begin(), found.end());
+    const double margin = cfg_.tracking.margin;
+    std::sort(preds.begin(), preds.end(), [&](const auto &a, const auto &b) {
+      return window_rect(a.second, margin).br().y < window_rect(b.second, margin).br().y;
+    });
+    std::vector<std::vector<Detection>> found(preds.size());
+    std::mutex take_m;
+    size_t top = 0, bottom = preds.size();
+    std::atomic<bool> lost{false};
+    // Searches windows until none is left or one is lost; from_top: the caller's thread.
+    const auto search = [&](Detector &det, bool from_top) {
+      for (;;) {
+        size_t k = 0;
+        {
+          std::lock_guard<std::mutex> l(take_m);
+          if (top >= bottom || lost) return;
+          k = from_top ? top++ : --bottom;
+        }
+        const auto &[id, pred] = preds[k];
+        found[k] = scan_window(det, gray, from_top ? rows : nullptr, id, pred, margin);
+        // Missing from its window (a sharp turn, a jolt, occlusion): a window 3x as large,
+        // then the whole frame at once; windows only ever save time, never detections.
+        if (found[k].empty())
+          found[k] =
+              scan_window(det, gray, from_top ? rows : nullptr, id, pred, 3.0 * margin + 1.0);
+        if (found[k].empty()) lost = true;
       }
-      if (!work_) band = scan_regions(det_, gray, slice);
+    };
+    SettleOnExit settle{work_.get()};
+    if (work_)
+      work_->run([this, &search] {
+        if (pending_.decoder) pending_.decoder->decode();  // no-op when decoded already
+        search(*det2_, false);
+      });
+    try {
+      search(det_, true);
+    } catch (const Error &) {
+      if (work_) work_->finish();  // the decoder's own error, which says what is wrong
+      throw;
     }
+    if (work_) work_->finish();  // its windows (and the decode's error, if any)
     settle.w = nullptr;
-    if (work_) work_->finish();
-    dets.insert(dets.end(), band.begin(), band.end());
+    last_full_ = lost;
+    for (const auto &f : found) dets.insert(dets.end(), f.begin(), f.end());
+    if (!last_full_)
+      for (const auto &[id, c] : hints_) {
+        const auto f = scan_window(det_, gray, nullptr, id, c, margin);
+        dets.insert(dets.end(), f.begin(), f.end());
+      }
+    // The band looks for cars not tracked yet: finish() scans it once the tracked cars' poses
+    // are out (a whole-frame scan covers it). Not on the second thread meanwhile: whoever
+    // receives the poses on this machine needs a core then.
+    if (last_full_) p.band.clear();
   }
   hints_.clear();
-  if (last_full_)
-    dets = full_scan(gray);
-  else
-    dets = merge_detections(dets);
-  last_dets_ = dets;
+  dets = last_full_ ? full_scan(gray) : merge_detections(dets);
+  p.tracked = dets;
+  p.active = true;
+  std::vector<CarPose> out;
+  std::map<int, int> count;
   std::map<int, Track> tracks;
   for (const auto &d : dets) count[d.id]++;
   for (const auto &d : dets) {
     auto it = by_tag_.find(d.id);
     // A tag seen twice in one frame is ambiguous (a copy, a reflection): publish neither.
     if (it == by_tag_.end() || count[d.id] > 1) continue;
-    if (auto p = locate_car(cfg_.in, cfg_.pose, cfg_.locate, it->second, d)) {
-      out.push_back(*p);
+    if (auto pose = locate_car(cfg_.in, cfg_.pose, cfg_.locate, it->second, d)) {
+      out.push_back(*pose);
       Track t{d.corners_px, {0, 0}};
       auto old = tracks_.find(d.id);
       if (old != tracks_.end()) {
@@ -278,6 +341,40 @@ std::vector<CarPose> Tracker::process(const cv::Mat &gray) {
     }
   }
   tracks_ = std::move(tracks);
+  return out;
+}
+
+std::vector<CarPose> Tracker::finish() {
+  Pending &p = pending_;
+  if (!p.active) return {};
+  p.active = false;
+  if (!p.band.empty()) p.found = scan_regions(det_, p.gray, p.band);
+  std::vector<Detection> all = p.tracked;
+  all.insert(all.end(), p.found.begin(), p.found.end());
+  last_dets_ = p.found.empty() ? std::move(all) : merge_detections(all);
+  std::map<int, int> count;
+  for (const auto &d : last_dets_) count[d.id]++;
+  std::vector<CarPose> out;
+  for (const auto &d : last_dets_) {
+    auto it = by_tag_.find(d.id);
+    if (it == by_tag_.end()) continue;
+    if (count[d.id] > 1) {
+      tracks_.erase(d.id);  // a copy elsewhere: ambiguous from the next frame on
+      continue;
+    }
+    if (tracks_.count(d.id)) continue;  // posed by track()
+    if (auto pose = locate_car(cfg_.in, cfg_.pose, cfg_.locate, it->second, d)) {
+      out.push_back(*pose);
+      tracks_[d.id] = Track{d.corners_px, {0, 0}};
+      hints_.erase(d.id);  // tracked now: its window finds it
+    }
+  }
+  const long frame = frame_ - 1;
+  if (frame > 0 && frame % std::max(1, cfg_.tracking.full_every) == 0 && cfg_.detector.noise_k > 0)
+    update_contrast(p.gray);
+  last_gray_ = p.gray;
+  p.gray.release();
+  p.decoder.reset();
   return out;
 }
 

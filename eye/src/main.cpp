@@ -295,11 +295,11 @@ int main(int argc, char **argv) {
         bool sizes_ok = true;
         for (size_t i = 0; i < fs.size(); ++i) {
           const auto &in = cams[i].in;
-          if (fs[i].gray.cols == in.width_px && fs[i].gray.rows == in.height_px) continue;
+          if (fs[i].width_px() == in.width_px && fs[i].height_px() == in.height_px) continue;
           sizes_ok = false;
           eye::skipped_frames_log().event(
-              cams[i].camera_name, fs[i].label + ": size " + std::to_string(fs[i].gray.cols) + "x" +
-                                       std::to_string(fs[i].gray.rows) +
+              cams[i].camera_name, fs[i].label + ": size " + std::to_string(fs[i].width_px()) +
+                                       "x" + std::to_string(fs[i].height_px()) +
                                        " differs from the calibrated " +
                                        std::to_string(in.width_px) + "x" +
                                        std::to_string(in.height_px) + " (frame skipped)");
@@ -307,13 +307,18 @@ int main(int argc, char **argv) {
         if (!sizes_ok) continue;
         // Cameras of one Eye are triggered together (the simulator renders them at one sim
         // time): the frame time is the first camera's capture time.
-        std::vector<cv::Mat> grays;
-        for (const auto &f : fs) grays.push_back(f.gray);
+        std::vector<eye::TrackInput> grays;
+        for (const auto &f : fs) grays.push_back({f.gray, f.jpeg});
         const int64_t utime = fs[0].utime;
-        const auto poses = multi.process(grays, utime);
+        // The tracked cars' poses go out first; the staggered band (new cars, reference tags
+        // for health) finishes after them.
+        auto poses = multi.track(grays, utime);
         published += eye::publish_poses(lcm, poses, utime);
         if (fs[0].wall_clock)
           latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
+        const auto late = multi.finish();
+        published += eye::publish_poses(lcm, late, utime);
+        poses.insert(poses.end(), late.begin(), late.end());
         for (size_t i : multi.newly_moved()) {
           const auto &st = multi.health(i).status();
           std::fprintf(stderr,
@@ -327,8 +332,8 @@ int main(int argc, char **argv) {
             eye::publish_status(lcm, multi.health(i).status(), cams[i].in.width_px,
                                 cams[i].in.height_px);
         if (!rn_debug.empty() && frames % std::max(1, rn_debug_every) == 0 &&
-            !cv::imwrite(rn_debug,
-                         multi.tracker(0).annotate(fs[0].gray, multi.last_per_camera()[0])))
+            !cv::imwrite(rn_debug, multi.tracker(0).annotate(multi.tracker(0).last_frame(),
+                                                             multi.last_per_camera()[0])))
           throw eye::Error(rn_debug + ": cannot write the debug image");
         if (!rn_quiet) {
           std::printf("%s utime=%lld", fs[0].label.c_str(), static_cast<long long>(utime));

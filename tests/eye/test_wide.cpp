@@ -4,14 +4,18 @@
 
 #include <autodrive/angles.hpp>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <set>
 
+#include "eye_error.hpp"
 #include "eye_fuse.hpp"
 #include "eye_health.hpp"
 #include "eye_render.hpp"
+#include "eye_rowdecode.hpp"
 #include "eye_scanplan.hpp"
+#include "eye_source.hpp"
 #include "eye_synth.hpp"
 #include "eye_test_util.hpp"
 #include "eye_tracker.hpp"
@@ -241,6 +245,94 @@ TEST(Tracking, TwoDetectorThreadsPoseTheSameCars) {
         }
   }
   EXPECT_GE(fulls, 2);  // the first frame and the jump
+}
+
+// A JPEG frame decoded on the second thread while the caller's searches the windows as their
+// rows come in: the same pixels as cv::imdecode, the same poses as a decoded frame on one
+// thread, every tracked car from track() (none left for finish()), a jump (a whole-frame scan)
+// included.
+TEST(Tracking, JpegDecodedBesideTheWindowsPosesTheSameCars) {
+  const Wide x = wide_scene();
+  const auto drive = eye::synth_wide_drive(x.s, 40);
+  eye::RunConfig two = x.cfg;
+  two.detector.threads = 2;
+  eye::Tracker t1(x.cfg), t2(two);
+  int fulls = 0;
+  for (size_t i = 0; i < 12; ++i) {
+    const auto &cars = drive[i < 6 ? i : i + 20];
+    std::vector<uint8_t> jpg;
+    cv::imencode(".jpg", eye::synth_frame(x.s, cars, x.refs, 60 + i), jpg,
+                 {cv::IMWRITE_JPEG_QUALITY, 90});
+    const cv::Mat g = eye::decode_gray(jpg.data(), jpg.size(), "frame");
+    const auto dec = std::make_shared<eye::RowDecoder>(jpg.data(), jpg.size(), "frame");
+    const auto p1 = t1.process(g);
+    auto p2 = t2.track({cv::Mat(), dec});
+    const auto late = t2.finish();
+    fulls += t2.last_was_full_scan();
+    EXPECT_EQ(cv::norm(dec->image(), g, cv::NORM_INF), 0.0) << "frame " << i;
+    EXPECT_TRUE(late.empty()) << "frame " << i;
+    p2.insert(p2.end(), late.begin(), late.end());
+    ASSERT_EQ(p1.size(), cars.size()) << "frame " << i;
+    ASSERT_EQ(p2.size(), cars.size()) << "frame " << i;
+    for (const auto &a : p1)
+      for (const auto &b : p2) {
+        if (a.tag_id == b.tag_id) {
+          EXPECT_LT(1000 * std::hypot(a.x_m - b.x_m, a.y_m - b.y_m), 0.5) << "car " << a.tag_id;
+        }
+      }
+  }
+  EXPECT_GE(fulls, 2);  // the first frame and the jump
+}
+
+// The tracked cars' poses come from track(), before the band: a car that drives into view is
+// found by finish() (the staggered band) within full_every frames, and tracked from then on.
+TEST(Tracking, TrackedCarsComeBeforeTheBandFindsANewOne) {
+  const Wide x = wide_scene();
+  const auto drive = eye::synth_wide_drive(x.s, 20);
+  eye::Tracker t(x.cfg);
+  const size_t arrives = 3;
+  long found_at = -1;
+  std::set<int> before;  // the cars posed in the frame before
+  for (size_t i = 0; i < drive.size(); ++i) {
+    std::vector<eye::SynthCar> cars;
+    for (const auto &c : drive[i])
+      if (c.tag_id != 10 || i >= arrives) cars.push_back(c);
+    const cv::Mat g = eye::synth_frame(x.s, cars, x.refs, 90 + i);
+    std::set<int> tracked, late;
+    for (const auto &p : t.track(g)) tracked.insert(p.tag_id);
+    for (const auto &p : t.finish()) late.insert(p.tag_id);
+    if (i > 0) {
+      EXPECT_EQ(tracked, before) << "frame " << i;
+    }
+    if (late.count(10) && found_at < 0) found_at = static_cast<long>(i);
+    EXPECT_TRUE(late.empty() || late == std::set<int>{10}) << "frame " << i;
+    before = tracked;
+    before.insert(late.begin(), late.end());
+  }
+  ASSERT_GE(found_at, static_cast<long>(arrives));
+  EXPECT_LT(found_at, static_cast<long>(arrives) + x.cfg.tracking.full_every);
+}
+
+// A frame that is not a JPEG is refused with its name before anything is decoded; a colour
+// JPEG decodes to the same grey as cv::imdecode.
+TEST(Tracking, RowDecoderNamesBadDataAndDecodesColourToGrey) {
+  const std::vector<uint8_t> junk = {1, 2, 3, 4, 5, 6, 7, 8};
+  try {
+    eye::RowDecoder d(junk.data(), junk.size(), "EYE_IMAGE@42");
+    FAIL() << "junk decoded";
+  } catch (const eye::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("EYE_IMAGE@42"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(eye::RowDecoder(junk.data(), 0, "empty"), eye::Error);
+  cv::Mat bgr(120, 160, CV_8UC3);
+  cv::randu(bgr, 0, 255);
+  std::vector<uint8_t> jpg;
+  cv::imencode(".jpg", bgr, jpg);
+  eye::RowDecoder d(jpg.data(), jpg.size(), "colour");
+  d.decode();
+  EXPECT_TRUE(d.wait_rows(d.height_px()));
+  EXPECT_EQ(cv::norm(d.image(), eye::decode_gray(jpg.data(), jpg.size(), "colour"), cv::NORM_INF),
+            0.0);
 }
 
 // The noise estimate follows the noise added, not the tags' edges or the vignetting.

@@ -7,7 +7,11 @@ the LAST of its cars' `<VEH>_POSE_EYE` messages (utime = that capture time) arri
 figure holds the JPEG's trip over UDP, its decode, detection, pose and the poses' trip back.
 
 The first frames (until the Eye has published a pose, plus WARMUP_FRAMES) are not counted: the
-Eye's first frame is a whole-frame scan with no car tracked yet. The Eye runs with
+Eye's first frame is a whole-frame scan with no car tracked yet. The scene is rendered long
+enough for the run (PRE_POSE_FRAMES to spare) and, should the run outlast it, played backwards
+from its end, never restarted: a restart would teleport every car at once and time a whole-frame
+re-acquisition, which is not what a camera over moving cars sees (the tests of tracking time
+that case). The Eye runs with
 `detector.threads` 2 unless --threads 1 (the staggered band beside the windows: the latency
 path; the one-thread figures are eye_bench's fps_*_1t).
 
@@ -37,6 +41,7 @@ DEFAULT_PORT = "7800"
 CARS = 10  # the wide scene's cars: tag ids 1..10 are NIGEL1..NIGEL10
 RECV_BUF_BYTES = 4194304  # the socket also gets the JPEG frames
 WARMUP_FRAMES = 10  # one staggered scan cycle (tracking.full_every) after the first pose
+PRE_POSE_FRAMES = 30  # frames sent before the Eye's first pose that the scene is rendered for
 EYE_IDLE_TIMEOUT_S = 3
 FIRST_POSE_TIMEOUT_S = 30.0
 DRAIN_S = 1.0  # after the last frame, for its poses to arrive
@@ -97,10 +102,19 @@ def image(types: Any, jpeg: bytes, utime: int, w: int, h: int) -> bytes:
     return bytes(m.encode())
 
 
+def scene_index(i: int, n: int) -> int:
+    """The i-th frame sent of a scene of n frames played forwards, then backwards, and so on:
+    the cars reverse, they never jump."""
+    if n < 2:
+        return 0
+    k = i % (2 * n - 2)
+    return k if k < n else 2 * n - 2 - k
+
+
 def feed(
     pub: Any, types: Any, frames: list[bytes], n: int, fps: float, poses: PoseTimes
 ) -> tuple[list[int], int]:
-    """Publishes n frames (cycling through `frames`) at fps on a fixed schedule, after the Eye's
+    """Publishes n frames (`frames` by scene_index) at fps on a fixed schedule, after the Eye's
     first pose and WARMUP_FRAMES more; returns the capture times of the counted frames and the
     number of frames published."""
     ch = channel("EYE_IMAGE")
@@ -112,7 +126,7 @@ def feed(
     while len(counted) < n:
         t_next += period_s
         utime = time.time_ns() // 1000
-        pub.publish(ch, image(types, frames[i % len(frames)], utime, 1280, 720))
+        pub.publish(ch, image(types, frames[scene_index(i, len(frames))], utime, 1280, 720))
         i += 1
         if warm_left is None:
             with poses.lock:
@@ -139,7 +153,7 @@ def measure(
     types = lcmtypes.load(build)
     with tempfile.TemporaryDirectory(prefix="eye-latency-") as tmp_s:
         tmp = Path(tmp_s)
-        scene_frames = min(n_frames, 120)  # cycled: the cars jump back to the start, a test too
+        scene_frames = n_frames + WARMUP_FRAMES + PRE_POSE_FRAMES
         log(f"rendering the wide-angle scene ({scene_frames} frames, 1280x720, 10 cars)")
         subprocess.run(
             [str(build / "bin" / "eye_bench"), "--write-wide-scene", str(tmp)]
