@@ -7,7 +7,9 @@ the validation lap, and NAME.onnx, NAME.json, the training report and the figure
 into --out (models/pilot). Wall times of each step go into the report. --logs reuses
 recordings made before (their meta files must match the recipe's runs field by field).
 --other-lane-laps N (an experiment; the shipped model has none) drives N of the laps in the
-road's other lane, still counter-clockwise (expert_runs)."""
+road's other lane, still counter-clockwise (expert_runs). --label-lookahead M (an experiment;
+the shipped model: 0, the expert's own steering) trains on pure pursuit labels at M from each
+frame's pose (labels.py)."""
 
 from __future__ import annotations
 
