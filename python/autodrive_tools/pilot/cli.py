@@ -88,6 +88,12 @@ def main(argv: list[str] | None = None) -> int:
         help="input channels the network reads: 1 = the luma of the YUV input (the shipped "
         "recipe: colour would let it tell the centre line from the edge line), 3 = all",
     )  # fmt: skip
+    t.add_argument(
+        "--label-lookahead", type=float, default=0.0, metavar="M",
+        help="label each frame with pure pursuit's steering at this lookahead [m] from its "
+        "ground-truth pose (a label the picture determines; README) instead of the recorded "
+        "steering (0, the default)",
+    )  # fmt: skip
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -109,6 +115,11 @@ def main(argv: list[str] | None = None) -> int:
         "lane, still counter-clockwise (README: the reverse direction)",
     )  # fmt: skip
     m.add_argument("--epochs", type=int, default=4)
+    m.add_argument(
+        "--label-lookahead", type=float, default=0.0, metavar="M",
+        help="train on pure pursuit labels at this lookahead [m] (tools/pilot train "
+        "--label-lookahead); 0: the expert's recorded steering",
+    )  # fmt: skip
     m.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
         help="skip the expert: use these recordings of `tools/pilot expert`, which must be the "
@@ -151,7 +162,7 @@ def _run(args: argparse.Namespace) -> int:
             epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed, name=args.name,
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
-            channels=args.channels,
+            channels=args.channels, label_lookahead_m=args.label_lookahead,
         )  # fmt: skip
         if args.balance_max_ratio is not None:
             cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
@@ -166,6 +177,6 @@ def _run(args: argparse.Namespace) -> int:
 
     make_model(
         args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
-        _build(), args.logs, args.other_lane_laps,
+        _build(), args.logs, args.other_lane_laps, args.label_lookahead,
     )  # fmt: skip
     return 0

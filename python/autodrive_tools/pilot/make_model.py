@@ -7,7 +7,9 @@ the validation lap, and NAME.onnx, NAME.json, the training report and the figure
 into --out (models/pilot). Wall times of each step go into the report. --logs reuses
 recordings made before (their meta files must match the recipe's runs field by field).
 --other-lane-laps N (an experiment; the shipped model has none) drives N of the laps in the
-road's other lane, still counter-clockwise (expert_runs)."""
+road's other lane, still counter-clockwise (expert_runs). --label-lookahead M (an experiment;
+the shipped model: 0, the expert's own steering) trains on pure pursuit labels at M from each
+frame's pose (labels.py)."""
 
 from __future__ import annotations
 
@@ -99,6 +101,7 @@ def check_logs(runs: list[ExpertRun], logs: list[Path]) -> float:
 def make_model(
     out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
     build: Path, reuse_logs: list[Path] | None = None, other_lane_laps: int = 0,
+    label_lookahead_m: float = 0.0,
 ) -> None:  # fmt: skip
     stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
     run_dir = work / f"{name}-{stamp}"
@@ -131,6 +134,7 @@ def make_model(
             name=name,
             stride=STRIDE,
             samples_per_epoch=SAMPLES_PER_EPOCH,
+            label_lookahead_m=label_lookahead_m,
         ),
     )
     times["train_s"] = time.monotonic() - t2
@@ -152,6 +156,7 @@ def make_model(
     full["command"] = (
         f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
         + (f" --other-lane-laps {other_lane_laps}" if other_lane_laps else "")
+        + f" --label-lookahead {label_lookahead_m:g}"
     )
     if reuse_logs:
         full["recordings_reused"] = [str(p) for p in reuse_logs]

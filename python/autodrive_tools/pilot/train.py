@@ -26,7 +26,7 @@ import torch
 from torch import nn
 
 from .. import vehicle
-from . import augment, dataset, model, plots
+from . import augment, dataset, labels, model, plots
 from .spec import OPSET, F32, InputSpec, Sidecar, crop_resize, decode_jpeg, normalise, sha256_file
 from .spec import write_sidecar
 
@@ -65,6 +65,9 @@ class TrainConfig:
     stride: int = 1  # every stride-th frame (neighbours at 15-30 Hz are near duplicates)
     balance_max_ratio: float = augment.DEFAULT_MAX_RATIO  # augment.balance_weights
     channels: int = 1  # input channels the network reads: 1 = luma only, 3 = YUV (model.py)
+    # [m] > 0: the label is pure pursuit's steering at this lookahead from each frame's pose
+    # (labels.py: one the picture determines); 0: the steering recorded (the expert's)
+    label_lookahead_m: float = 0.0
 
 
 def log(msg: str) -> None:
@@ -75,12 +78,19 @@ def _f(v: str) -> float:
     return float(v) if v != "" else math.nan
 
 
-def shift_gain_per_px(manifest: dict[str, Any], spec: InputSpec) -> float:
-    """Steering per px of sideways shift at the network's width (augment.py explains)."""
+def shift_gain_per_px(
+    manifest: dict[str, Any], spec: InputSpec, label_lookahead_m: float = 0.0
+) -> float:
+    """Steering per px of sideways shift at the network's width (augment.py explains), for
+    the labels' pure pursuit: label_lookahead_m if given, else the expert's."""
     cam = manifest.get("camera") or {}
     fx_px = float(cam.get("fx_px", 0.0))
     metas = [s.get("meta", {}) for s in manifest.get("source_logs", [])]
-    lookahead = [float(m["lookahead_m"]) for m in metas if "lookahead_m" in m]
+    lookahead = (
+        [label_lookahead_m]
+        if label_lookahead_m > 0
+        else [float(m["lookahead_m"]) for m in metas if "lookahead_m" in m]
+    )
     if fx_px <= 0 or not lookahead:
         return 0.0  # unknown camera or expert: shifts keep their label
     v = vehicle.load()
@@ -121,7 +131,15 @@ def train(
         rows = rows[: cfg.max_frames]
     if not rows:
         raise ValueError(f"{data_root}: no frames of a moving car")
-    steer = np.array([float(r["steering"]) for r in rows])
+    if cfg.label_lookahead_m > 0:
+        steer = labels.relabel(rows, ds.manifest, cfg.label_lookahead_m)
+        recorded = np.array([float(r["steering"]) for r in rows])
+        log(
+            f"labels: pure pursuit at {cfg.label_lookahead_m:g} m from the poses (RMS "
+            f"{float(np.sqrt(np.mean((steer - recorded) ** 2))):.3f} from the recorded)"
+        )
+    else:
+        steer = np.array([float(r["steering"]) for r in rows])
     laps = np.array([int(r["lap"]) for r in rows])
     train_laps, val_laps = _split(laps, cfg)
     is_val = np.isin(laps, val_laps)
@@ -142,7 +160,7 @@ def train(
     mean = tuple(float(v) for v in stack.mean(axis=(0, 2, 3)))
     std = tuple(float(max(v, 1e-3)) for v in stack.std(axis=(0, 2, 3)))
     spec = replace(spec, mean=(mean[0], mean[1], mean[2]), std=(std[0], std[1], std[2]))
-    gain = shift_gain_per_px(ds.manifest, spec)
+    gain = shift_gain_per_px(ds.manifest, spec, cfg.label_lookahead_m)
     aug = augment.Augment(gain_per_px=gain)
     weights = augment.balance_weights(steer[idx_train], cfg.balance_max_ratio)
     rng = np.random.default_rng(cfg.seed)
@@ -234,6 +252,11 @@ def train(
         "stride": cfg.stride,
         "balance_max_ratio": cfg.balance_max_ratio,
         "channels": cfg.channels,
+        "label": (
+            f"pure pursuit at {cfg.label_lookahead_m:g} m from the frame's pose (labels.py)"
+            if cfg.label_lookahead_m > 0
+            else ds.manifest.get("label", "the recorded steering")
+        ),
         "augment": asdict(aug),
         "optimiser": "Adam",
         "loss": "MSE of normalised steering",
@@ -295,6 +318,7 @@ def report_md(r: dict[str, Any]) -> str:
         f"- seed {r['seed']} (dataset seed {r['dataset_seed']}); {r['epochs']} epochs of "
         f"{r['samples_per_epoch']} balanced, augmented draws (every {r['stride']}. frame), "
         f"{r['optimiser']} lr {r['lr']}, batch {r['batch']}, {r['loss']}",
+        f"- label: {r['label']}",
         f"- network input: {'the luma (Y) of' if r['channels'] == 1 else 'all three channels of'}"
         " the sidecar's YUV, normalised per image inside the graph; augmentation "
         f"{json.dumps(r['augment'])}",
