@@ -219,69 +219,43 @@ TEST(WholeField, StaggeredBandsFindEveryTagOfAStillFrame) {
   }
 }
 
-// detector.threads 2 (the band beside the windows, a whole-frame scan in two halves) poses
-// the same cars as one thread, within a small fraction of the error budget.
+// detector.threads 2 (windows on both threads, a whole-frame scan in two halves) poses the
+// same cars as one thread, within a small fraction of the error budget, from a decoded frame
+// and from a JPEG decoded on the second thread while the caller's searches the windows as their
+// rows come in (the same pixels as cv::imdecode; every tracked car from track(), none left
+// for finish()).
 TEST(Tracking, TwoDetectorThreadsPoseTheSameCars) {
   const Wide x = wide_scene();
   const auto drive = eye::synth_wide_drive(x.s, 40);
   eye::RunConfig two = x.cfg;
   two.detector.threads = 2;
-  eye::Tracker t1(x.cfg), t2(two);
+  eye::Tracker t1(x.cfg), t2(two), t2_jpeg(two);
   int fulls = 0;
   for (size_t i = 0; i < 12; ++i) {
     // A jump (every car ~300 px on along its loop) at frame 6: windows miss, a whole-frame scan
     // in halves.
-    const auto &cars = drive[i < 6 ? i : i + 20];
-    const cv::Mat g = eye::synth_frame(x.s, cars, x.refs, 60 + i);
-    const auto p1 = t1.process(g), p2 = t2.process(g);
-    fulls += t2.last_was_full_scan();
-    ASSERT_EQ(p1.size(), cars.size()) << "frame " << i;
-    ASSERT_EQ(p2.size(), cars.size()) << "frame " << i;
-    for (const auto &a : p1)
-      for (const auto &b : p2)
-        if (a.tag_id == b.tag_id) {
-          EXPECT_LT(1000 * std::hypot(a.x_m - b.x_m, a.y_m - b.y_m), 0.5) << "car " << a.tag_id;
-          EXPECT_LT(std::abs(autodrive::angle_wrap_rad(a.yaw_rad - b.yaw_rad)), 0.002);
-        }
-  }
-  EXPECT_GE(fulls, 2);  // the first frame and the jump
-}
-
-// A JPEG frame decoded on the second thread while the caller's searches the windows as their
-// rows come in: the same pixels as cv::imdecode, the same poses as a decoded frame on one
-// thread, every tracked car from track() (none left for finish()), a jump (a whole-frame scan)
-// included.
-TEST(Tracking, JpegDecodedBesideTheWindowsPosesTheSameCars) {
-  const Wide x = wide_scene();
-  const auto drive = eye::synth_wide_drive(x.s, 40);
-  eye::RunConfig two = x.cfg;
-  two.detector.threads = 2;
-  eye::Tracker t1(x.cfg), t2(two);
-  int fulls = 0;
-  for (size_t i = 0; i < 12; ++i) {
     const auto &cars = drive[i < 6 ? i : i + 20];
     std::vector<uint8_t> jpg;
     cv::imencode(".jpg", eye::synth_frame(x.s, cars, x.refs, 60 + i), jpg,
                  {cv::IMWRITE_JPEG_QUALITY, 90});
     const cv::Mat g = eye::decode_gray(jpg.data(), jpg.size(), "frame");
     const auto dec = std::make_shared<eye::RowDecoder>(jpg.data(), jpg.size(), "frame");
-    const auto p1 = t1.process(g);
-    auto p2 = t2.track({cv::Mat(), dec});
-    const auto late = t2.finish();
-    fulls += t2.last_was_full_scan();
+    const auto p1 = t1.process(g), p2 = t2.process(g);
+    const auto p3 = t2_jpeg.track({cv::Mat(), dec});
+    const auto late = t2_jpeg.finish();
+    fulls += t2.last_was_full_scan() + t2_jpeg.last_was_full_scan();
     EXPECT_EQ(cv::norm(dec->image(), g, cv::NORM_INF), 0.0) << "frame " << i;
     EXPECT_TRUE(late.empty()) << "frame " << i;
-    p2.insert(p2.end(), late.begin(), late.end());
-    ASSERT_EQ(p1.size(), cars.size()) << "frame " << i;
-    ASSERT_EQ(p2.size(), cars.size()) << "frame " << i;
+    for (const auto *p : {&p1, &p2, &p3}) ASSERT_EQ(p->size(), cars.size()) << "frame " << i;
     for (const auto &a : p1)
-      for (const auto &b : p2) {
-        if (a.tag_id == b.tag_id) {
-          EXPECT_LT(1000 * std::hypot(a.x_m - b.x_m, a.y_m - b.y_m), 0.5) << "car " << a.tag_id;
-        }
-      }
+      for (const auto *p : {&p2, &p3})
+        for (const auto &b : *p)
+          if (a.tag_id == b.tag_id) {
+            EXPECT_LT(1000 * std::hypot(a.x_m - b.x_m, a.y_m - b.y_m), 0.5) << "car " << a.tag_id;
+            EXPECT_LT(std::abs(autodrive::angle_wrap_rad(a.yaw_rad - b.yaw_rad)), 0.002);
+          }
   }
-  EXPECT_GE(fulls, 2);  // the first frame and the jump
+  EXPECT_GE(fulls, 4);  // the first frame and the jump, on both
 }
 
 // The tracked cars' poses come from track(), before the band: a car that drives into view is
