@@ -1,7 +1,8 @@
 """tools/demo --mission intersection in HIL (the simulator with four cars, four unchanged
 autodrive-runtime processes on their ptys, four autodrive-marl, V2V over real LCM): one episode
 of the rule-based baseline crosses with every car at its goal and no collision, and writes the
-report's fields and the trajectory plot; Ctrl-C mid-episode stops every process (exit 130, the
+report's fields and the trajectory plot, with the Eye stand-in (the default) feeding every car's
+EKF at its rate; Ctrl-C mid-episode stops every process (exit 130, the
 report kept, marked interrupted). argv: autodrive-marl, build dir, LCM port."""
 
 import json
@@ -63,4 +64,9 @@ with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
     assert rep["episodes"] == 1 and rep["success_rate"] == 1.0 and rep["collisions"] == 0, rep
     assert rep["v2v_lost"] == 0 and p.returncode == 0, rep
     assert (out / "trajectories.png").stat().st_size > 10000
+    from autodrive_tools.city.eye_standin import PERIOD_US
+
+    # every car's <VEH>_POSE_EYE at the stand-in's rate over most of the episode's sim time
+    want = 0.5 * 4 * rep["per_episode"][0]["sim_s"] / (PERIOD_US * 1e-6)
+    assert rep["eye"].startswith("stand-in") and rep["eye_poses"] >= want, (rep["eye"], want, rep)
 print("ok")

@@ -8,6 +8,11 @@ that is the reset. Routes and spawns are drawn from the seed as in training (aut
 per approach, each turning left, going straight or right, a later spawn further back. The simulator runs in lockstep with the runtimes (--lockstep-client),
 so a loaded machine slows the run down and does not change it much.
 
+Localisation: in the lab the overhead Eye localises every car; here, by default (--eye
+standin), autodrive_tools.city.eye_standin publishes each car's <VEH>_POSE_EYE from the
+simulator's ground truth with the Eye's noise, which the unchanged runtimes' EKFs fuse, as in the
+smart-city mission. --eye none leaves the EKFs on dead reckoning from the start pose.
+
 CLI: tools/demo --mission intersection --help."""
 
 from __future__ import annotations
@@ -42,6 +47,11 @@ DEFAULT_POLICY = REPO_ROOT / "models" / "marl" / "intersection.onnx"
 CARS = 4
 EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
 PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
+EYE_WHAT = {  # --eye: what gives the EKFs their absolute poses (said in the report)
+    "standin": "stand-in: ground truth + the Eye's noise (city.eye_standin)",
+    "none": "none: dead reckoning from the start pose",
+}
+EYES = tuple(EYE_WHAT)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -70,6 +80,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         type=float,
         default=0.0,
         help="how far each car's EKF pose may be off [m]: the shield grows every footprint by it",
+    )
+    p.add_argument(
+        "--eye",
+        choices=EYES,
+        default="standin",
+        help="the cars' absolute poses: standin (default): ground truth + the Eye's noise on "
+        "<VEH>_POSE_EYE (city.eye_standin); none: the EKFs dead-reckon from the start pose",
     )
     args = p.parse_args(argv)
     if args.episodes < 1:
@@ -108,7 +125,8 @@ def plan_episode(seed: int) -> list[CarPlan]:
 
 def write_runtime_config(path: Path, run_dir: Path, url: str, car: int, plan: CarPlan) -> Path:
     """The HIL runtime config of car `car` (1-based): its name and pty, SIM_CLOCK, no LIDAR,
-    its EKF's map filter started at the car's start pose (no Eye here: V2V needs a map pose)."""
+    its EKF's map filter started at the car's start pose (V2V needs a map pose before the
+    first Eye pose, and with --eye none there is none)."""
     cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
     cfg["lcm_url"] = url
     cfg["clock"] = "sim"
@@ -128,6 +146,8 @@ class EpisodeRecord:
     at_goal: set[str] = field(default_factory=set)
     goal_t: dict[str, float] = field(default_factory=dict)  # sim time at the goal [s]
     sim_s: float = 0.0
+    eye_poses: int = 0  # <VEH>_POSE_EYE messages seen, every car
+    ekf: dict[str, list[tuple[float, float, float]]] = field(default_factory=dict)  # t, x, y
 
 
 def ensure_keys(say: Any) -> None:
@@ -176,8 +196,17 @@ def run_episode(
             rec.at_goal.add(m.vehicle)
             rec.goal_t[m.vehicle] = m.utime * 1e-6
 
+    def on_eye(_ch: str, _data: bytes) -> None:
+        rec.eye_poses += 1
+
+    def on_pose_map(ch: str, data: bytes) -> None:
+        m = types.odometry_t.decode(data)
+        rec.ekf.setdefault(ch.split("_")[0], []).append((m.utime * 1e-6, m.x_m, m.y_m))
+
     subs = []
     for p in plans:
+        subs.append(lc.subscribe(channels.channel("POSE_EYE", p.vehicle), on_eye))
+        subs.append(lc.subscribe(channels.channel("POSE_MAP", p.vehicle), on_pose_map))
         subs.append(lc.subscribe(channels.channel("GROUND_TRUTH", p.vehicle), on_truth))
         subs.append(lc.subscribe(channels.channel("COMMAND", p.vehicle), on_command))
         subs.append(lc.subscribe(channels.channel("MISSION", p.vehicle), on_mission))
@@ -199,6 +228,11 @@ def run_episode(
         procs.start("autodrive-sim", sim, ep_dir / "sim.log")
         for i in range(CARS):
             wait_for_path(run_dir / f"nigel{i + 1}-nano", PTY_TIMEOUT_S, procs)
+        if args.eye == "standin":
+            eye: list[object] = [sys.executable, "-m", "autodrive_tools.city.eye_standin"]
+            eye += ["--vehicles", ",".join(p.vehicle for p in plans)]
+            eye += ["--seed", args.seed * 1000 + ep, "--lcm-url", args.lcm_url, "--build", build]
+            procs.start("eye-standin", eye, ep_dir / "eye-standin.log")
         for i, p in enumerate(plans):
             cfg = write_runtime_config(
                 ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1, p
@@ -270,6 +304,22 @@ def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
             after = [(x, y) for t, x, y in rec.truth[p.vehicle] if t >= t_goal]
             if after:
                 out.append(float(math.hypot(after[0][0] - p.goal[0], after[0][1] - p.goal[1])))
+    return out
+
+
+def ekf_errors_m(rec: EpisodeRecord) -> list[float]:
+    """Every car's EKF map pose against the ground truth at the same sim time (interpolated
+    between the truth's samples, inside their span only) [m]: what the shield works on."""
+    out: list[float] = []
+    for v, poses in rec.ekf.items():
+        truth = np.array(rec.truth.get(v, []))
+        if len(truth) < 2 or not poses:
+            continue
+        est = np.array(poses)
+        est = est[(est[:, 0] >= truth[0, 0]) & (est[:, 0] <= truth[-1, 0])]
+        x = np.interp(est[:, 0], truth[:, 0], truth[:, 1])
+        y = np.interp(est[:, 0], truth[:, 0], truth[:, 2])
+        out += np.hypot(est[:, 1] - x, est[:, 2] - y).tolist()
     return out
 
 
@@ -349,6 +399,7 @@ def run(args: argparse.Namespace) -> int:
     traverse_s: list[float] = []
     rates: list[float] = []
     goal_err: list[float] = []
+    ekf_err: list[float] = []
     try:
         for ep in range(args.episodes):
             if interrupted or time.time() - t0 > args.timeout:
@@ -368,10 +419,14 @@ def run(args: argparse.Namespace) -> int:
                     traverse_s.append(s["goal_s"] - s["start_s"])
             rates += steering_rates(rec)
             goal_err += goal_errors_m(plans, rec)
+            errs = ekf_errors_m(rec)
+            ekf_err += errs
+            ekf_max = max(errs, default=math.nan)
             shield = sum(s.get("shield_interventions", 0) for s in summaries)
             say(
                 f"episode {ep + 1}: {ended} ({len(rec.at_goal)}/{CARS} at goal, "
-                f"{len(rec.collided)} collided, {shield} shield interventions, "
+                f"{len(rec.collided)} collided, {shield} shield interventions, EKF error max "
+                f"{ekf_max:.3f} m, "
                 f"{rec.sim_s:.1f} s sim, {time.time() - t0:.0f} s wall so far)"
             )
     finally:
@@ -387,6 +442,8 @@ def run(args: argparse.Namespace) -> int:
         "v2v_loss": args.v2v_loss,
         "v2v_delay_ms": args.v2v_delay_ms,
         "shield_pose_error_m": args.shield_pose_error_m,
+        "eye": EYE_WHAT[args.eye],
+        "eye_poses": sum(r.eye_poses for _p, r, _e in done),
         "episodes": n,
         "episodes_requested": args.episodes,
         "successes": sum(1 for _p, _r, e in done if e == "goal"),
@@ -401,6 +458,9 @@ def run(args: argparse.Namespace) -> int:
         "goal_error_true_max_m": (
             round(max(goal_err), 3) if goal_err else None
         ),  # how far from its goal a car really was when its EKF said it was there
+        # every EKF map pose against the truth then [m] (the shield's input)
+        "ekf_error_true_p95_m": round(float(np.percentile(ekf_err, 95)), 4) if ekf_err else None,
+        "ekf_error_true_max_m": round(max(ekf_err), 4) if ekf_err else None,
         "v2v_lost": sum(s.get("v2v_lost", 0) for s in summaries_all),
         "v2v_dropped_stale": sum(s.get("v2v_dropped_stale", 0) for s in summaries_all),
         "per_episode": [
