@@ -61,17 +61,28 @@ def check(on_ray: dict[str, Any], serial: dict[str, Any]) -> None:
     if diff and diff[0].startswith("ok:"):
         # Real-time HIL is not bit-repeatable: a seed that ends within EDGE_DEG of the heading
         # goal may land on either side of it from run to run (seed 2 did: 1.3-1.5 deg one run,
-        # 2.1-2.8 deg another). Such a seed's ok flag is not compared; its figures still are.
+        # 2.1-2.8 deg another), and the mission's own verdict on a car that stands in its slot
+        # may differ too (seed 2, 2026-11-28: parked at 0.79 deg on Ray; "not parked", exit 1,
+        # at 0.2 cm and 1.93 deg serially). Such a seed's ok flag is not compared; its figures
+        # still are, within AGREE_TOLERANCE.
         pa, pb = on_ray["per_seed"], serial["per_seed"]
-        head = "final_heading_error_deg"
-        for seed, oa, ob, ha, hb in zip(pa["seed"], pa["ok"], pb["ok"], pa[head], pb[head]):
+        head, pos = "final_heading_error_deg", "final_pos_error_m"
+        for seed, oa, ob, ha, hb, xa, xb in zip(
+            pa["seed"], pa["ok"], pb["ok"], pa[head], pb[head], pa[pos], pb[pos]
+        ):
             if oa != ob:
                 edge = [h for h in (ha, hb) if h is not None]
                 near = len(edge) == 2 and all(
                     abs(h - sweep.GOAL_HEADING_ERROR_DEG) <= EDGE_DEG for h in edge
                 )
-                assert near, f"seed {seed}: ok {oa} vs {ob}, heading {ha} vs {hb} deg: {diff}"
-                print(f"seed {seed} ended on the heading goal's edge: {ha} vs {hb} deg")
+                in_slot = None not in (ha, hb, xa, xb) and all(
+                    h <= sweep.GOAL_HEADING_ERROR_DEG + EDGE_DEG and x <= sweep.GOAL_POS_ERROR_M
+                    for h, x in ((ha, xa), (hb, xb))
+                )
+                assert (
+                    near or in_slot
+                ), f"seed {seed}: ok {oa} vs {ob}, heading {ha} vs {hb} deg, position {xa} vs {xb} m: {diff}"
+                print(f"seed {seed}: ok {oa} vs {ob} at {ha} vs {hb} deg, {xa} vs {xb} m")
         without_ok = [{"per_seed": {k: v for k, v in x["per_seed"].items() if k != "ok"}}
                       for x in (on_ray, serial)]  # fmt: skip
         diff = sweep.disagreements(*without_ok)
