@@ -66,9 +66,12 @@ bool read_rows(JpegRows *j, uint8_t *base, size_t step, void (*done)(void *, int
 }  // namespace
 
 RowDecoder::RowDecoder(const uint8_t *data, size_t n, std::string what)
-    : what_(std::move(what)), data_(data, data + n), jpeg_(std::make_unique<JpegRows>()) {
+    : RowDecoder(std::vector<uint8_t>(data, data + n), std::move(what)) {}
+
+RowDecoder::RowDecoder(std::vector<uint8_t> data, std::string what)
+    : what_(std::move(what)), data_(std::move(data)), jpeg_(std::make_unique<JpegRows>()) {
   jpeg_->created = false;
-  if (n == 0) throw Error(what_ + ": empty image data");
+  if (data_.empty()) throw Error(what_ + ": empty image data");
   if (!open_header(jpeg_.get(), data_.data(), data_.size())) {
     const std::string why = jpeg_->message;
     if (jpeg_->created) jpeg_destroy_decompress(&jpeg_->cinfo);

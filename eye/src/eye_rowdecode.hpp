@@ -22,6 +22,8 @@ class RowDecoder {
   // Keeps a copy of the data and reads the header; throws eye::Error naming `what` if it is not
   // a JPEG. The grey image is allocated here and filled by decode().
   RowDecoder(const uint8_t *data, size_t n, std::string what);
+  // The same, taking the data over (a frame from the bus: no second copy).
+  RowDecoder(std::vector<uint8_t> data, std::string what);
   ~RowDecoder();
   RowDecoder(const RowDecoder &) = delete;
   RowDecoder &operator=(const RowDecoder &) = delete;

@@ -166,7 +166,7 @@ class LcmSource : public Source {
         f->jpeg.reset();
         f->gray.release();
         if (p.format == "jpeg")
-          f->jpeg = std::make_shared<RowDecoder>(p.data.data(), p.data.size(), p.label);
+          f->jpeg = std::make_shared<RowDecoder>(std::move(p.data), p.label);
         else
           f->gray = decode_gray(p.data.data(), p.data.size(), p.label);
       } catch (const Error &e) {

@@ -89,8 +89,7 @@ def load_1min() -> float:
 def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
     """Trains with the shipped model's recorded recipe (no wall cap) into dest (.onnx); returns
     the training report (wall_s, cpu_s, agent_steps_done, config, command)."""
-    from ..marl.export import export
-    from ..marl.train import TrainConfig, save_curve, train
+    from ..marl.train import TrainConfig, train, write_results
 
     recorded = json.loads(shipped.with_suffix(".json").read_text()).get("trained", {})
     cfg_rec = recorded.get("config")
@@ -114,11 +113,8 @@ def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
         f"workers {cfg.workers}, shield {cfg.shield}, shaping {cfg.shaping}, seed {cfg.seed}"
     )
     model, curve, info = train(cfg, log)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    save_curve(curve, dest.parent / "learning_curve.json")
     info["command"] = "tools/bench marl (recipe: " + str(recorded.get("command", "?")) + ")"
-    export(model, dest, cfg.action_mode, info)
-    (dest.parent / "train_report.json").write_text(json.dumps(info, indent=2) + "\n")
+    write_results(model, curve, info, dest, dest.parent, cfg.action_mode)
     return info
 
 

@@ -38,8 +38,7 @@ def parse_stages(text: str) -> list[tuple[int, int]]:
 
 
 def cmd_train(a: argparse.Namespace) -> int:
-    from .export import export
-    from .train import TrainConfig, plot_curve, save_curve, train
+    from .train import TrainConfig, plot_curve, train, write_results
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -71,10 +70,8 @@ def cmd_train(a: argparse.Namespace) -> int:
             close_pool(pool)
     info["command"] = " ".join(["tools/marl"] + sys.argv[1:])
     model.save(out / "ppo_policy.zip")
-    save_curve(curve, out / "learning_curve.json")
     plot_curve(curve, out / "learning_curve.png", f"PPO, shared policy, {a.action_mode} actions")
-    sidecar = export(model, Path(a.onnx), a.action_mode, info)
-    (out / "train_report.json").write_text(json.dumps(info, indent=2) + "\n")
+    sidecar = write_results(model, curve, info, Path(a.onnx), out, a.action_mode)
     log(f"wrote {a.onnx}, {sidecar}, {out / 'learning_curve.png'}, {out / 'train_report.json'}")
     print(json.dumps({"wall_s": info["wall_s"], "onnx": str(a.onnx)}))
     return 0

@@ -208,3 +208,17 @@ def plot_curve(curve: Curve, path: Path, title: str) -> None:
 
 def save_curve(curve: Curve, path: Path) -> None:
     path.write_text(json.dumps(asdict(curve)) + "\n")
+
+
+def write_results(
+    model: PPO, curve: Curve, info: dict[str, Any], onnx: Path, out: Path, action_mode: str
+) -> Path:
+    """A training's learning curve (out/learning_curve.json), ONNX policy with its sidecar, and
+    report (out/train_report.json); returns the sidecar's path."""
+    from .export import export
+
+    out.mkdir(parents=True, exist_ok=True)
+    save_curve(curve, out / "learning_curve.json")
+    sidecar = export(model, onnx, action_mode, info)
+    (out / "train_report.json").write_text(json.dumps(info, indent=2) + "\n")
+    return sidecar
