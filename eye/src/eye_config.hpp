@@ -43,6 +43,7 @@ struct RunConfig {
   std::string intrinsics_path;  // resolved against the config file's folder
   std::string map_path;
   std::string lcm_url = AUTODRIVE_LCM_URL_DEFAULT;
+  int realtime_priority = 0;  // SCHED_FIFO priority of `run`'s threads (0: ordinary)
   Intrinsics in;
   CameraPose pose;
   LocateParams locate;

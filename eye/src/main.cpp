@@ -17,6 +17,7 @@
 #include "eye_intrinsics.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
+#include "eye_realtime.hpp"
 #include "eye_source.hpp"
 #include "eye_tracker.hpp"
 
@@ -143,7 +144,7 @@ int main(int argc, char **argv) {
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
   std::string rn_config, rn_source = std::string("lcm:") + AUTODRIVE_CH_EYE_IMAGE, rn_debug, rn_url;
   double rn_fps = 30.0, rn_idle_s = 0.0;
-  int rn_max_frames = 0, rn_debug_every = 1;
+  int rn_max_frames = 0, rn_debug_every = 1, rn_realtime = -1;
   bool rn_quiet = false;
   rn->add_option("-c,--config", rn_config, "run config YAML (see eye/config/eye.yaml)")->required();
   rn->add_option("-s,--source", rn_source,
@@ -152,6 +153,9 @@ int main(int argc, char **argv) {
   rn->add_option("--fps", rn_fps, "video/folder sources: frame rate used to stamp frames [Hz]")
       ->capture_default_str();
   rn->add_option("--lcm-url", rn_url, "override the config's lcm_url");
+  rn->add_option("--realtime-priority", rn_realtime,
+                 "override the config's realtime_priority (SCHED_FIFO 1..98; 0: ordinary)")
+      ->check(CLI::Range(0, 98));
   rn->add_option("--debug-image", rn_debug, "write the annotated frame to this file (png/jpg)");
   rn->add_option("--debug-every", rn_debug_every, "write the debug image every N frames")
       ->capture_default_str();
@@ -247,6 +251,16 @@ int main(int argc, char **argv) {
     if (*rn) {
       eye::RunConfig cfg = eye::runconfig_load(rn_config);
       if (!rn_url.empty()) cfg.lcm_url = rn_url;
+      if (rn_realtime >= 0) cfg.realtime_priority = rn_realtime;
+      // Before any thread starts (LCM's, the sources', the trackers'): they inherit it.
+      const std::string rt_why = eye::request_realtime(cfg.realtime_priority);
+      if (!rt_why.empty())
+        std::fprintf(stderr,
+                     "autodrive-eye: WARNING: %s: realtime_priority %d not granted (%s): running "
+                     "at ordinary priority, poses may be late on a busy machine; grant it "
+                     "(setcap cap_sys_nice+ep on autodrive-eye, or an rtprio limit) or set "
+                     "realtime_priority: 0\n",
+                     rn_config.c_str(), cfg.realtime_priority, rt_why.c_str());
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
       // One source per camera: the config's `source`, else --source (one camera only).

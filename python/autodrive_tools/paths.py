@@ -10,6 +10,7 @@ RUNTIME_CAR_CONFIG: Path = REPO_ROOT / "runtime" / "jetson" / "config" / "nigel_
 AUTONOMY_EXAMPLE_CONFIG: Path = (
     REPO_ROOT / "runtime" / "jetson" / "autonomy" / "config" / "autonomy.example.yaml"
 )
+EYE_CONFIG: Path = REPO_ROOT / "eye" / "config" / "eye.yaml"
 EYE_SIM_CONFIG: Path = REPO_ROOT / "eye" / "config" / "sim" / "eye.yaml"
 RELEASE_BUILD: Path = REPO_ROOT / "build" / "release"
 OUT_DIR: Path = REPO_ROOT / "out"

@@ -517,3 +517,55 @@ TEST(Cli, RunOnGstreamerPipelineStampsSystemClock) {
   for (size_t k = 1; k < played.size(); ++k) EXPECT_GT(played[k], played[k - 1]);
 #endif
 }
+
+// realtime_priority: the running Eye's threads are SCHED_FIFO at that priority; where the
+// system does not grant it (no CAP_SYS_NICE, no rtprio limit) the Eye says so, naming its
+// config, and runs at ordinary priority; an out-of-range value is refused with the key. The
+// lcm source waits 1.5 s for frames (port 7796), so the policy is read while it runs.
+TEST(Cli, RealtimePriorityIsTakenOrNamed) {
+  const std::string d = fresh_dir("eye_cli_realtime");
+  const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
+  eye::intrinsics_save(d + "/camera.yaml", s.in);
+  eye::MapCalib m;
+  m.pose = s.pose;
+  m.width_px = 640;
+  m.height_px = 480;
+  eye::mapcal_save(d + "/map.yaml", m);
+  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7796?ttl=0");
+  // Every thread of the process (LCM's, the trackers') shows its policy in chrt's output.
+  const auto policies = [&](const std::string &prefix, const std::string &args) {
+    const std::string cmd = prefix + " " + EYE_BIN + " run -c " + d +
+                            "/eye.yaml --source lcm:EYE_IMAGE --idle-timeout-s 1.5 " + args +
+                            " 2>&1 & pid=$!; sleep 0.7; for t in /proc/$pid/task/*; do chrt -p "
+                            "${t##*/}; done; wait $pid; echo exit=$?";
+    std::string out;
+    run(cmd, &out);
+    return out;
+  };
+  std::string out;
+  if (run("chrt -f 1 true", &out) == 0) {  // this test may take real-time priority itself
+    out = policies("", "--realtime-priority 7");
+    EXPECT_NE(out.find("SCHED_FIFO"), std::string::npos) << out;
+    EXPECT_NE(out.find("priority: 7"), std::string::npos) << out;
+    EXPECT_EQ(out.find("SCHED_OTHER"), std::string::npos) << "a thread left ordinary: " << out;
+    EXPECT_EQ(out.find("not granted"), std::string::npos) << out;
+    EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
+  }
+  // Without the capability (dropped from the bounding set, so not even root has it).
+  out = policies("setpriv --bounding-set -sys_nice --inh-caps -sys_nice", "--realtime-priority 7");
+  EXPECT_NE(out.find("realtime_priority 7 not granted"), std::string::npos) << out;
+  EXPECT_NE(out.find(d + "/eye.yaml"), std::string::npos) << out;
+  EXPECT_EQ(out.find("SCHED_FIFO"), std::string::npos) << out;
+  EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
+  // 0: ordinary, and nothing said.
+  out = policies("", "--realtime-priority 0");
+  EXPECT_EQ(out.find("SCHED_FIFO"), std::string::npos) << out;
+  EXPECT_EQ(out.find("not granted"), std::string::npos) << out;
+  {
+    std::ofstream f(d + "/eye.yaml", std::ios::app);
+    f << "realtime_priority: 120\n";
+  }
+  EXPECT_EQ(run(std::string(EYE_BIN) + " run -c " + d + "/eye.yaml --max-frames 1", &out), 1);
+  EXPECT_NE(out.find("realtime_priority"), std::string::npos) << out;
+  EXPECT_NE(out.find(d + "/eye.yaml"), std::string::npos) << out;
+}

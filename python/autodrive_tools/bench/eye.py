@@ -87,6 +87,10 @@ def main(argv: list[str]) -> int:
         log(f"capture to pose on LCM: {latency_frames} frames at 30 Hz into autodrive-eye")
         try:
             figures.update(eye_latency.measure(build, latency_frames, 30.0))
+            # the same at ordinary priority: what SCHED_FIFO buys on this machine
+            ordinary = eye_latency.measure(build, latency_frames, 30.0, realtime_priority=0)
+            for q in ("p50", "p99"):
+                figures[f"capture_to_pose_ordinary_ms_{q}"] = ordinary[f"capture_to_pose_ms_{q}"]
         except RuntimeError as e:
             log(f"capture to pose failed: {e}")
     # (option, default sim seconds, what, measure, output prefix) of each simulator run

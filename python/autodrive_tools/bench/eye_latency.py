@@ -3,8 +3,16 @@ wide-angle bench scene (1280x720 JPEG, barrel lens, noise sigma 6, 10 cars, 8 re
 rendered by `eye_bench --write-wide-scene`) at a fixed frame rate over real LCM (UDP
 multicast). Each frame is stamped with the system clock when it is published (its capture
 time: a camera driver stamps a frame when it has it whole); the time of a frame's pose is when
-the LAST of its cars' `<VEH>_POSE_EYE` messages (utime = that capture time) arrives here. So the
-figure holds the JPEG's trip over UDP, its decode, detection, pose and the poses' trip back.
+the LAST of its cars' `<VEH>_POSE_EYE` messages (utime = that capture time) reached the bus: the
+kernel's receive time of its datagram on a socket of this process (lcm_wire.WireTap), which
+does not wait for this process to be scheduled. So the figure holds the JPEG's trip over UDP,
+its decode, detection, pose and the poses' publication. capture_to_pose_read_ms_* is when this
+process's LCM handler had read them: that adds a reader's own scheduling (on a 2-core machine
+shared with the Eye, ~3 ms in 10 % of frames).
+
+The Eye runs at the lab config's realtime_priority (eye/config/eye.yaml: SCHED_FIFO, as an Eye
+machine should run it) unless told otherwise; `tools/bench eye` also times it at ordinary
+priority (capture_to_pose_ordinary_*) in the same run.
 
 The first frames (until the Eye has published a pose, plus WARMUP_FRAMES) are not counted: the
 Eye's first frame is a whole-frame scan with no car tracked yet. The scene is rendered long
@@ -23,6 +31,7 @@ eye.Latency.CaptureToPoseOnLcm (EYE_LATENCY_PORT picks the LCM port). Progress o
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import subprocess
 import sys
@@ -30,10 +39,13 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
-from .. import lcmtypes, proc
+import yaml
+
+from .. import lcm_wire, lcmtypes, proc
 from ..channels import channel, vehicle_name
+from ..paths import EYE_CONFIG
 from . import Progress, key_value_main
 
 # eye's port range 7790-7809: 7800 for the benchmark, EYE_LATENCY_PORT=7794 for the test
@@ -55,26 +67,38 @@ def percentile(values: list[float], q: float) -> float:
 
 
 class PoseTimes:
-    """Arrival time [us, system clock] of the last pose of each capture time, on a thread."""
+    """Per capture time [us]: when the last of its poses reached the bus (the kernel's receive
+    time of its datagram, lcm_wire.WireTap) and when this process had read it (an LCM
+    subscription's handler), both on the system clock [us], and how many poses it got."""
 
     def __init__(self, url: str, types: Any) -> None:
-        self.last: dict[int, int] = {}
+        self.on_bus: dict[int, int] = {}
+        self.read: dict[int, int] = {}
         self.count: dict[int, int] = {}
         self.lock = threading.Lock()
-        self.lc = lcmtypes.bus(f"{url}&recv_buf_size={RECV_BUF_BYTES}")
-        for k in range(1, CARS + 1):
-            self.lc.subscribe(channel("POSE_EYE", vehicle_name(k)), self._on_pose)
         self.types = types
+        self.channels = {channel("POSE_EYE", vehicle_name(k)) for k in range(1, CARS + 1)}
+        self.tap = lcm_wire.WireTap(url, self._on_wire, RECV_BUF_BYTES)
+        self.lc = lcmtypes.bus(f"{url}&recv_buf_size={RECV_BUF_BYTES}")
+        for ch in self.channels:
+            self.lc.subscribe(ch, self._on_pose)
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._pump, daemon=True)
         self.thread.start()
+
+    def _on_wire(self, chan: str, data: bytes, receive_us: int) -> None:
+        if chan not in self.channels:
+            return
+        utime = self.types.pose2d_t.decode(data).utime
+        with self.lock:
+            self.on_bus[utime] = max(receive_us, self.on_bus.get(utime, 0))
+            self.count[utime] = self.count.get(utime, 0) + 1
 
     def _on_pose(self, _channel: str, data: bytes) -> None:
         now_us = time.time_ns() // 1000
         utime = self.types.pose2d_t.decode(data).utime
         with self.lock:
-            self.last[utime] = now_us
-            self.count[utime] = self.count.get(utime, 0) + 1
+            self.read[utime] = now_us
 
     def _pump(self) -> None:
         while not self.stop.is_set():
@@ -83,6 +107,7 @@ class PoseTimes:
     def close(self) -> None:
         self.stop.set()
         self.thread.join()
+        self.tap.close()
 
 
 def cpu_s(pid: int) -> float:
@@ -111,6 +136,24 @@ def scene_index(i: int, n: int) -> int:
     return k if k < n else 2 * n - 2 - k
 
 
+@contextlib.contextmanager
+def camera_priority(priority: int) -> Iterator[None]:
+    """The calling thread (the feeder: the camera's driver) at SCHED_FIFO `priority` while in
+    the block, as a camera driver beside a real-time Eye runs; as it was where not permitted."""
+    if priority <= 0:
+        yield
+        return
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError:
+        yield
+        return
+    try:
+        yield
+    finally:
+        os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+
+
 def feed(
     pub: Any, types: Any, frames: list[bytes], n: int, fps: float, poses: PoseTimes
 ) -> tuple[list[int], int]:
@@ -130,7 +173,7 @@ def feed(
         i += 1
         if warm_left is None:
             with poses.lock:
-                if poses.last:
+                if poses.on_bus:
                     warm_left = WARMUP_FRAMES
             if warm_left is None and time.monotonic() > first_pose_deadline:
                 raise RuntimeError(f"no pose from the Eye within {FIRST_POSE_TIMEOUT_S:g} s")
@@ -142,10 +185,22 @@ def feed(
     return counted, i
 
 
+def lab_realtime_priority() -> int:
+    """The realtime_priority of the lab's Eye config (eye/config/eye.yaml; 0 when unset)."""
+    return int((yaml.safe_load(EYE_CONFIG.read_text()) or {}).get("realtime_priority", 0))
+
+
 def measure(
-    build: Path, n_frames: int = 300, fps: float = 30.0, threads: int = 2
+    build: Path,
+    n_frames: int = 300,
+    fps: float = 30.0,
+    threads: int = 2,
+    realtime_priority: int | None = None,
 ) -> dict[str, float]:
-    """The capture_to_pose_* figures; RuntimeError when the run cannot be measured."""
+    """The capture_to_pose_* figures; RuntimeError when the run cannot be measured.
+    realtime_priority: the Eye's (None: the lab config's, 0: ordinary scheduling)."""
+    if realtime_priority is None:
+        realtime_priority = lab_realtime_priority()
     for prog in ("eye_bench", "autodrive-eye"):
         if not os.access(build / "bin" / prog, os.X_OK):
             raise RuntimeError(f"{build / 'bin' / prog} not built")
@@ -167,7 +222,8 @@ def measure(
         eye = subprocess.Popen(
             [str(build / "bin" / "autodrive-eye"), "run", "-c", str(tmp / "eye.yaml")]
             + ["--source", f"lcm:{channel('EYE_IMAGE')}", "-q"]
-            + ["--idle-timeout-s", str(EYE_IDLE_TIMEOUT_S)],
+            + ["--idle-timeout-s", str(EYE_IDLE_TIMEOUT_S)]
+            + ["--realtime-priority", str(realtime_priority)],
             stderr=subprocess.PIPE,
             text=True,
         )
@@ -177,7 +233,8 @@ def measure(
             pub = lcmtypes.bus(url)
             log(f"feeding {n_frames} frames at {fps:g} Hz (load average {load0:.1f})")
             eye_cpu0 = cpu_s(eye.pid)
-            counted, published = feed(pub, types, frames, n_frames, fps, poses)
+            with camera_priority(realtime_priority):
+                counted, published = feed(pub, types, frames, n_frames, fps, poses)
             time.sleep(DRAIN_S)
             # the Eye's CPU per frame it was sent, its start-up included [ms]
             eye_cpu_ms = 1000 * (cpu_s(eye.pid) - eye_cpu0) / published
@@ -186,13 +243,17 @@ def measure(
             proc.stop(eye, "autodrive-eye", log)
         eye_err = eye.stderr.read() if eye.stderr else ""
         feeder_cpu_s = time.process_time() - cpu0
-    lat_ms, missing, short = [], 0, 0
+    lat_ms, read_ms, missing, short = [], [], 0, 0
     for u in counted:
-        if u not in poses.last:
+        if u not in poses.on_bus:
             missing += 1
             continue
         short += poses.count[u] < CARS
-        lat_ms.append((poses.last[u] - u) / 1000.0)
+        lat_ms.append((poses.on_bus[u] - u) / 1000.0)
+        if u in poses.read:
+            read_ms.append((poses.read[u] - u) / 1000.0)
+        if os.environ.get("EYE_LATENCY_TRACE"):  # per frame, for a look at the slow ones
+            print("frame", u, poses.on_bus[u] - u, poses.read.get(u, 0) - u, file=sys.stderr)
     if not lat_ms:
         raise RuntimeError(f"no counted frame got a pose; autodrive-eye said: {eye_err[-1500:]}")
     log(eye_err.strip().splitlines()[-1] if eye_err.strip() else "eye printed nothing")
@@ -200,6 +261,8 @@ def measure(
         "capture_to_pose_ms_p50": round(percentile(lat_ms, 0.5), 3),
         "capture_to_pose_ms_p99": round(percentile(lat_ms, 0.99), 3),
         "capture_to_pose_ms_max": round(max(lat_ms), 3),
+        "capture_to_pose_read_ms_p50": round(percentile(read_ms, 0.5), 3) if read_ms else -1.0,
+        "capture_to_pose_read_ms_p99": round(percentile(read_ms, 0.99), 3) if read_ms else -1.0,
         "capture_to_pose_frames": float(len(counted)),
         "capture_to_pose_frames_without_pose": float(missing),
         "capture_to_pose_frames_short_of_10_cars": float(short),
@@ -208,6 +271,11 @@ def measure(
         "capture_to_pose_feeder_cpu_s": round(feeder_cpu_s, 2),
         "capture_to_pose_eye_cpu_ms_per_frame_sent": round(eye_cpu_ms, 2),
         "capture_to_pose_detector_threads": float(threads),
+        # SCHED_FIFO priority the Eye asked for, and whether it got it (1/0)
+        "capture_to_pose_realtime_priority": float(realtime_priority),
+        "capture_to_pose_realtime_granted": float(
+            realtime_priority > 0 and "not granted" not in eye_err
+        ),
     }
 
 
@@ -227,8 +295,17 @@ def main(argv: list[str] | None = None) -> int:
         default=2,
         help="the Eye's detector.threads (2: the staggered band beside the windows)",
     )
+    p.add_argument(
+        "--realtime-priority",
+        type=int,
+        default=None,
+        help="the Eye's SCHED_FIFO priority (default: eye/config/eye.yaml's; 0: ordinary)",
+    )
     a = p.parse_args(argv)
-    return key_value_main("eye_latency", lambda: measure(a.build, a.frames, a.fps, a.threads))
+    return key_value_main(
+        "eye_latency",
+        lambda: measure(a.build, a.frames, a.fps, a.threads, a.realtime_priority),
+    )
 
 
 if __name__ == "__main__":

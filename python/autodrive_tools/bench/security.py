@@ -31,7 +31,6 @@ import os
 import random
 import select
 import socket
-import struct
 import subprocess
 import sys
 import tempfile
@@ -43,7 +42,7 @@ from typing import Any
 
 import yaml
 
-from .. import channels, command_auth, demo, lcmtypes
+from .. import channels, command_auth, demo, lcm_wire, lcmtypes
 from ..paths import RUNTIME_CAR_CONFIG
 from ..proc import ProcessGroup
 from . import Progress, build_dir, last_json, out_dir, print_figures
@@ -58,12 +57,6 @@ log = Progress("security")
 
 def url(port: int) -> str:
     return f"udpm://239.255.76.67:{port}?ttl=0"
-
-
-def lcm_packet(channel: str, data: bytes, seqno: int) -> bytes:
-    """One LCM small message ("LC02", sequence number, channel, NUL, payload): what a plain
-    UDP sender writes to the LCM port to look like a publisher."""
-    return struct.pack(">II", 0x4C433032, seqno) + channel.encode() + b"\0" + data
 
 
 class Hostile:
@@ -141,7 +134,9 @@ class Hostile:
             lc.publish(self.channel, unsigned.encode())
             self.sent["unsigned"] += 1
             seqno += 1
-            udp.sendto(lcm_packet(self.channel, unsigned.encode(), seqno), ("127.0.0.1", self.port))
+            udp.sendto(
+                lcm_wire.packet(self.channel, unsigned.encode(), seqno), ("127.0.0.1", self.port)
+            )
             self.sent["unicast"] += 1
             wrong = self.wrong.sign(self._command(WRONG_KEY_THROTTLE, 1.0))
             lc.publish(self.channel, wrong.encode())
