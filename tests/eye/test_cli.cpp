@@ -65,6 +65,18 @@ void write_config(const std::string &path, const eye::SynthScene &s, const std::
     << "vehicles:\n - {name: NIGEL1, tag_id: 1}\n - {name: NIGEL2, tag_id: 2}\n";
 }
 
+// The scene's own calibration (camera.yaml, map.yaml: the synthesised camera exactly) and a run
+// config on url (eye.yaml), in d.
+void write_calibrated(const std::string &d, const eye::SynthScene &s, const std::string &url) {
+  eye::intrinsics_save(d + "/camera.yaml", s.in);
+  eye::MapCalib m;
+  m.pose = s.pose;
+  m.width_px = s.in.width_px;
+  m.height_px = s.in.height_px;
+  eye::mapcal_save(d + "/map.yaml", m);
+  write_config(d + "/eye.yaml", s, url);
+}
+
 // Every "NIGEL1 x=... y=... yaw=..." on the output line of a frame.
 bool find_pose(const std::string &line, const std::string &veh, double *x, double *y, double *yaw) {
   const auto at = line.find("  " + veh + " x=");
@@ -180,16 +192,7 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
   const std::string url = "udpm://239.255.76.67:7790?ttl=0";
   const std::string d = fresh_dir("eye_cli_lcm");
   eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
-  {
-    eye::Intrinsics in = s.in;
-    eye::intrinsics_save(d + "/camera.yaml", in);
-    eye::MapCalib m;
-    m.pose = s.pose;
-    m.width_px = 640;
-    m.height_px = 480;
-    eye::mapcal_save(d + "/map.yaml", m);
-  }
-  write_config(d + "/eye.yaml", s, url);
+  write_calibrated(d, s, url);
 
   lcm::LCM lcm(url);
   ASSERT_TRUE(lcm.good());
@@ -295,13 +298,7 @@ TEST(Cli, RunOnLcmStampsCaptureTime) {
 TEST(Cli, RunOnVideoFile) {
   const std::string d = fresh_dir("eye_cli_video");
   const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
-  eye::intrinsics_save(d + "/camera.yaml", s.in);
-  eye::MapCalib m;
-  m.pose = s.pose;
-  m.width_px = 640;
-  m.height_px = 480;
-  eye::mapcal_save(d + "/map.yaml", m);
-  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7792?ttl=0");
+  write_calibrated(d, s, "udpm://239.255.76.67:7792?ttl=0");
   cv::VideoWriter vw(d + "/drive.avi", cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
                      10, cv::Size(640, 480), false);
   ASSERT_TRUE(vw.isOpened());
@@ -341,15 +338,7 @@ TEST(Cli, RunOnLcmSurvivesWrongSizesBombsAndGarbage) {
   const std::string url = "udpm://239.255.76.67:7792?ttl=0";
   const std::string d = fresh_dir("eye_cli_bad_frames");
   eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
-  {
-    eye::intrinsics_save(d + "/camera.yaml", s.in);
-    eye::MapCalib m;
-    m.pose = s.pose;
-    m.width_px = 640;
-    m.height_px = 480;
-    eye::mapcal_save(d + "/map.yaml", m);
-  }
-  write_config(d + "/eye.yaml", s, url);
+  write_calibrated(d, s, url);
   lcm::LCM lcm(url);
   ASSERT_TRUE(lcm.good());
   std::mutex mu;
@@ -467,13 +456,7 @@ std::vector<long long> gst_run_utimes(const std::string &dir, const std::string 
 TEST(Cli, RunOnGstreamerPipelineStampsSystemClock) {
   const std::string d = fresh_dir("eye_cli_gst");
   const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
-  eye::intrinsics_save(d + "/camera.yaml", s.in);
-  eye::MapCalib m;
-  m.pose = s.pose;
-  m.width_px = 640;
-  m.height_px = 480;
-  eye::mapcal_save(d + "/map.yaml", m);
-  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7793?ttl=0");
+  write_calibrated(d, s, "udpm://239.255.76.67:7793?ttl=0");
   const int n = 6;
   for (int k = 0; k < n; ++k) {
     char name[32];
@@ -525,13 +508,7 @@ TEST(Cli, RunOnGstreamerPipelineStampsSystemClock) {
 TEST(Cli, RealtimePriorityIsTakenOrNamed) {
   const std::string d = fresh_dir("eye_cli_realtime");
   const eye::SynthScene s = eye::synth_scene(640, 480, 0.10);
-  eye::intrinsics_save(d + "/camera.yaml", s.in);
-  eye::MapCalib m;
-  m.pose = s.pose;
-  m.width_px = 640;
-  m.height_px = 480;
-  eye::mapcal_save(d + "/map.yaml", m);
-  write_config(d + "/eye.yaml", s, "udpm://239.255.76.67:7796?ttl=0");
+  write_calibrated(d, s, "udpm://239.255.76.67:7796?ttl=0");
   // Every thread of the process (LCM's, the trackers') shows its policy in chrt's output.
   const auto policies = [&](const std::string &prefix, const std::string &args) {
     const std::string cmd = prefix + " " + EYE_BIN + " run -c " + d +
