@@ -43,11 +43,18 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--unseen-laps", type=int, default=1, help="laps in each unseen condition")
     p.add_argument("--model", help="evaluate this NAME.onnx instead of recording and training")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="train with the curvature augmentation up to DK [1/m] (make-model --curve-max; an "
+        "experiment, 0: the shipped recipe)",
+    )  # fmt: skip
     p.add_argument("--timeout", type=float, default=7200.0, help="per evaluation [wall s]")
     return p.parse_args(argv)
 
 
-def make_model(out: Path, laps: int, seed: int, say: Progress) -> tuple[Path, float]:
+def make_model(
+    out: Path, laps: int, seed: int, say: Progress, curve_max: float = 0.0
+) -> tuple[Path, float]:
     """Records, extracts and trains with pilot-train's tools; (the model, wall s)."""
     if importlib.util.find_spec("autodrive_tools.pilot") is None:
         raise RuntimeError("autodrive_tools.pilot (tools/pilot, branch pilot-train) is missing")
@@ -55,6 +62,8 @@ def make_model(out: Path, laps: int, seed: int, say: Progress) -> tuple[Path, fl
     shutil.rmtree(model_dir, ignore_errors=True)
     argv = [sys.executable, "-m", "autodrive_tools.pilot", "make-model", "--out", str(model_dir)]
     argv += ["--work", str(work), "--laps", str(laps), "--seed", str(seed)]
+    if curve_max > 0:
+        argv += ["--curve-max", f"{curve_max:g}"]
     say(f"record {laps} laps + train: {' '.join(argv)}")
     t0 = time.monotonic()
     subprocess.run(argv, check=True, stdout=sys.stderr)
@@ -110,6 +119,7 @@ def main(argv: list[str]) -> int:
     out = out_dir() / SUITE
     out.mkdir(parents=True, exist_ok=True)
     figures: dict[str, Any] = {"laps": args.laps, "unseen_laps": args.unseen_laps}
+    figures["curve_max"] = args.curve_max
     steps: dict[str, dict[str, float]] = {}  # each step's wall and CPU seconds
     t0, cpu0 = time.monotonic(), cpu_s()
     figures["load_avg_start"] = round(os.getloadavg()[0], 1)
@@ -125,7 +135,7 @@ def main(argv: list[str]) -> int:
         if args.model:
             model, train_s = Path(args.model), None
         else:
-            model, train_s = make_model(out, args.laps, args.seed, say)
+            model, train_s = make_model(out, args.laps, args.seed, say, args.curve_max)
             step("record_train", t0, cpu0)
     except (RuntimeError, subprocess.CalledProcessError) as e:
         say(f"ERROR: {e}")
