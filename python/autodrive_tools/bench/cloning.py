@@ -6,7 +6,9 @@
 2. inference_ms_p50/p99 of autodrive-pilot on one core (taskset -c 0, cv::setNumThreads(1)) on
    front-camera frames of the run (goal p99 <= 5 ms).
 3. The evaluation in the normal condition (goals: autonomy 100 %, cross-track rms <= 0.04 m) and
-   in the three unseen ones, night, noise2x and reverse (goal: autonomy >= 95 % each).
+   in the issue's three unseen ones, night, noise2x and reverse (the recorded route driven the
+   other way; goal: autonomy >= 95 % each), and in one more unseen, other-lane (loop_cw, the
+   inner lane clockwise; reported, with its own goal flag, not one of the issue's).
 Every step's wall time is printed beside its CPU time (this process and all its children: the
 simulators, the runtime, the pilot, training). On a shared machine the wall time includes the
 time the pipeline waited for other jobs' CPU, so it is inflated; the CPU time is its own cost.
@@ -30,7 +32,8 @@ from ..missions import cloning
 from . import Progress, build_dir, out_dir, print_figures
 
 SUITE = "cloning"
-UNSEEN = ("night", "noise2x", "reverse")
+UNSEEN = cloning.UNSEEN  # the issue's: night, noise2x, reverse
+EXTRA = cloning.EXTRA  # other-lane
 FRAMES = 200  # front-camera frames timed on one core
 
 
@@ -40,11 +43,18 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--unseen-laps", type=int, default=1, help="laps in each unseen condition")
     p.add_argument("--model", help="evaluate this NAME.onnx instead of recording and training")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="train with the curvature augmentation up to DK [1/m] (make-model --curve-max; an "
+        "experiment, 0: the shipped recipe)",
+    )  # fmt: skip
     p.add_argument("--timeout", type=float, default=7200.0, help="per evaluation [wall s]")
     return p.parse_args(argv)
 
 
-def make_model(out: Path, laps: int, seed: int, say: Progress) -> tuple[Path, float]:
+def make_model(
+    out: Path, laps: int, seed: int, say: Progress, curve_max: float = 0.0
+) -> tuple[Path, float]:
     """Records, extracts and trains with pilot-train's tools; (the model, wall s)."""
     if importlib.util.find_spec("autodrive_tools.pilot") is None:
         raise RuntimeError("autodrive_tools.pilot (tools/pilot, branch pilot-train) is missing")
@@ -52,6 +62,8 @@ def make_model(out: Path, laps: int, seed: int, say: Progress) -> tuple[Path, fl
     shutil.rmtree(model_dir, ignore_errors=True)
     argv = [sys.executable, "-m", "autodrive_tools.pilot", "make-model", "--out", str(model_dir)]
     argv += ["--work", str(work), "--laps", str(laps), "--seed", str(seed)]
+    if curve_max > 0:
+        argv += ["--curve-max", f"{curve_max:g}"]
     say(f"record {laps} laps + train: {' '.join(argv)}")
     t0 = time.monotonic()
     subprocess.run(argv, check=True, stdout=sys.stderr)
@@ -107,6 +119,7 @@ def main(argv: list[str]) -> int:
     out = out_dir() / SUITE
     out.mkdir(parents=True, exist_ok=True)
     figures: dict[str, Any] = {"laps": args.laps, "unseen_laps": args.unseen_laps}
+    figures["curve_max"] = args.curve_max
     steps: dict[str, dict[str, float]] = {}  # each step's wall and CPU seconds
     t0, cpu0 = time.monotonic(), cpu_s()
     figures["load_avg_start"] = round(os.getloadavg()[0], 1)
@@ -122,7 +135,7 @@ def main(argv: list[str]) -> int:
         if args.model:
             model, train_s = Path(args.model), None
         else:
-            model, train_s = make_model(out, args.laps, args.seed, say)
+            model, train_s = make_model(out, args.laps, args.seed, say, args.curve_max)
             step("record_train", t0, cpu0)
     except (RuntimeError, subprocess.CalledProcessError) as e:
         say(f"ERROR: {e}")
@@ -145,7 +158,7 @@ def main(argv: list[str]) -> int:
     figures["inference_cpu_ms_p50"] = one.get("inference_cpu_ms_p50")
     figures["inference_cpu_ms_p99"] = one.get("inference_cpu_ms_p99")
     figures["inference_frames"] = one.get("frames")
-    for cond in UNSEEN:
+    for cond in UNSEEN + EXTRA:
         say(f"evaluate {args.unseen_laps} lap(s), unseen condition {cond}")
         tc, cpuc = time.monotonic(), cpu_s()
         figures[cond] = evaluate(model, cond, args.unseen_laps, args, out)
@@ -159,13 +172,15 @@ def main(argv: list[str]) -> int:
         "autonomy_100_normal": pct("normal") == 100.0 and normal.get("laps", 0) >= args.laps,
         "cross_track_le_0_04": (normal.get("cross_track_rms_m") or 1.0) <= 0.04,
         "unseen_ge_95": all((pct(c) or 0.0) >= 95.0 for c in UNSEEN),
+        # not one of the issue's goals: the same bar in the extra condition(s)
+        "extra_ge_95": all((pct(c) or 0.0) >= 95.0 for c in EXTRA),
         # on one core: the pilot thread's CPU time (wall time includes a loaded host's queue)
         "inference_p99_le_5ms": (figures["inference_cpu_ms_p99"] or 99.0) <= 5.0,
         "pipeline_le_20min": figures["pipeline_wall_s"] is not None
         and figures["pipeline_wall_s"] <= 1200.0,
     }
     figures["goals"] = goals
-    for c in ("normal", *UNSEEN):
+    for c in ("normal", *UNSEEN, *EXTRA):
         r = figures[c]
         print(f"{c}: laps {r.get('laps')}  interventions {r.get('interventions')}  autonomy "
               f"{r.get('autonomy_pct')} %  cross-track rms {r.get('cross_track_rms_m')} m  mean "

@@ -71,6 +71,12 @@ class Route:
     def length_m(self) -> float:
         return sum(math.dist(a, b) for a, b in zip(self.polyline_m, self.polyline_m[1:]))
 
+    def reversed(self) -> Route:
+        """The same centre line driven the other way (its points in reverse order), named
+        NAME:reversed. Not a lane of the map's traffic: on a two-lane road it is the wrong side."""
+        return Route(f"{self.name}:reversed", self.lanes[::-1], self.loop,
+                     self.polyline_m[::-1], self.half_width_m)  # fmt: skip
+
 
 @dataclass(frozen=True)
 class NamedSpawn:

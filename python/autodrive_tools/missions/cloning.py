@@ -7,8 +7,11 @@ crosses the lane bound it counts an intervention and puts the car back on the ce
 autonomy = 1 - interventions x 6 s / elapsed s (PilotNet). Writes OUT/report.json, laps.png (the
 driven path) and trace.png (steering and offset over time, interventions marked).
 
-Unseen conditions (--condition): night (--light-level), noise2x (twice the camera noise the
-model was trained with), reverse (the loop driven the other way, loop_cw)."""
+Unseen conditions (--condition), issue 16's three: night (--light-level), noise2x (twice the
+camera noise the model was trained with), reverse (the recorded route, loop_ccw's centre line,
+driven the other way: its own points in reverse order, from the normal start turned round, the
+referee on that same lane). One more, not among the issue's: other-lane (loop_cw, the road's
+inner lane driven clockwise: tighter curves than any recorded)."""
 
 from __future__ import annotations
 
@@ -34,8 +37,18 @@ from ..proc import ProcessGroup, wait_for_path
 from . import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
 
 MAP = "driving_school"
-ROUTES = {"normal": "loop_ccw", "night": "loop_ccw", "noise2x": "loop_ccw", "reverse": "loop_cw"}
+TRAINED_ROUTE = ExpertRun.route  # the route tools/pilot make-model records (loop_ccw)
+# condition -> (the map's route, driven against its direction)
+ROUTES = {
+    "normal": (TRAINED_ROUTE, False),
+    "night": (TRAINED_ROUTE, False),
+    "noise2x": (TRAINED_ROUTE, False),
+    "reverse": (TRAINED_ROUTE, True),
+    "other-lane": ("loop_cw", False),
+}
 CONDITIONS = tuple(ROUTES)
+UNSEEN = ("night", "noise2x", "reverse")  # issue 16's conditions not in the training data
+EXTRA = ("other-lane",)  # unseen too, but not one of the issue's
 DEFAULT_MODEL = REPO_ROOT / "models" / "pilot" / "driving_school.onnx"
 PILOT_CONFIG = REPO_ROOT / "runtime" / "jetson" / "pilot" / "config" / "pilot_hil.yaml"
 INTERVENTION_COST_S = 6.0  # PilotNet: each intervention costs 6 s of autonomy
@@ -66,9 +79,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "--condition",
         choices=CONDITIONS,
         default="normal",
-        help="normal (day, the training's camera noise, loop_ccw) or an unseen one: night "
-        f"(light level {NIGHT_LIGHT_LEVEL}), noise2x (twice the training's camera noise), "
-        "reverse (the loop the other way, loop_cw)",
+        help=f"normal (day, the training's camera noise, {TRAINED_ROUTE}) or an unseen one: "
+        f"night (light level {NIGHT_LIGHT_LEVEL}), noise2x (twice the training's camera noise), "
+        f"reverse ({TRAINED_ROUTE}'s own lane driven the other way), other-lane (loop_cw: the "
+        "road's inner lane, clockwise)",
     )
     p.add_argument("--model", default=str(DEFAULT_MODEL), help="NAME.onnx (NAME.json beside it)")
     p.add_argument(
@@ -109,6 +123,18 @@ def trained(model: Path, key: str, default: float) -> float:
         recs.sort(key=_laps_of)
         value = recs[-1].get(key) if recs else None
     return float(value) if isinstance(value, (int, float)) else default
+
+
+def condition_route(condition: str) -> tuple[maps.description.Route, maps.Pose]:
+    """The route the car drives and the referee watches in a condition, and the car's start:
+    START_ALONG_M along the route; driven against the map's direction, the same point as the
+    route's own start there, facing the other way."""
+    name, against = ROUTES[condition]
+    route = maps.load(MAP).route(name)
+    if not against:
+        return route, route.pose_at(START_ALONG_M)
+    back = route.reversed()
+    return back, back.pose_at(back.length_m - START_ALONG_M)
 
 
 def sim_argv(
@@ -280,8 +306,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
     except ValueError as e:
         say(f"ERROR: {e}")
         return 2
-    route = maps.load(MAP).route(ROUTES[args.condition])
-    start = route.pose_at(START_ALONG_M)
+    route, start = condition_route(args.condition)
     run_dir = Path(f"/tmp/autodrive-cloning-{os.getpid()}")
     run_dir.mkdir(parents=True, exist_ok=True)
     runtime_cfg, pilot_cfg = write_configs(out, run_dir, args)
@@ -334,7 +359,8 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
             signal.signal(s, h)
     rep: dict[str, Any] = {"mission": "cloning", "condition": args.condition, "map": MAP,
                            "route": route.name, "seed": args.seed, "laps_requested": args.laps,
-                           "model": str(model)}  # fmt: skip
+                           "model": str(model),
+                           "unseen": args.condition in UNSEEN + EXTRA}  # fmt: skip
     rep.update(referee.figures())
     try:
         stats = json.loads(stats_path.read_text())

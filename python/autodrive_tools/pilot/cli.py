@@ -94,6 +94,11 @@ def main(argv: list[str] | None = None) -> int:
         "ground-truth pose (a label the picture determines; README) instead of the recorded "
         "steering (0, the default)",
     )  # fmt: skip
+    t.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="an experiment (the shipped recipe: 0): bend the ground of half the drawn frames "
+        "by an extra curvature up to +-DK [1/m], the label following (augment.CurveWarp)",
+    )  # fmt: skip
 
     a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
     a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
@@ -119,6 +124,11 @@ def main(argv: list[str] | None = None) -> int:
         "--label-lookahead", type=float, default=0.0, metavar="M",
         help="train on pure pursuit labels at this lookahead [m] (tools/pilot train "
         "--label-lookahead); 0: the expert's recorded steering",
+    )  # fmt: skip
+    m.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="an experiment (the shipped recipe: 0): bend the ground of half the drawn frames "
+        "by an extra curvature up to +-DK [1/m], the label following (augment.CurveWarp)",
     )  # fmt: skip
     m.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
@@ -163,6 +173,7 @@ def _run(args: argparse.Namespace) -> int:
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
             channels=args.channels, label_lookahead_m=args.label_lookahead,
+            curve_max_dk=args.curve_max,
         )  # fmt: skip
         if args.balance_max_ratio is not None:
             cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
@@ -177,6 +188,6 @@ def _run(args: argparse.Namespace) -> int:
 
     make_model(
         args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
-        _build(), args.logs, args.other_lane_laps, args.label_lookahead,
+        _build(), args.logs, args.other_lane_laps, args.label_lookahead, args.curve_max,
     )  # fmt: skip
     return 0

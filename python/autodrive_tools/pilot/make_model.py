@@ -101,7 +101,7 @@ def check_logs(runs: list[ExpertRun], logs: list[Path]) -> float:
 def make_model(
     out: Path, work: Path, name: str, laps: int, seed: int, train_seed: int, epochs: int,
     build: Path, reuse_logs: list[Path] | None = None, other_lane_laps: int = 0,
-    label_lookahead_m: float = 0.0,
+    label_lookahead_m: float = 0.0, curve_max_dk: float = 0.0,
 ) -> None:  # fmt: skip
     stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
     run_dir = work / f"{name}-{stamp}"
@@ -135,6 +135,7 @@ def make_model(
             stride=STRIDE,
             samples_per_epoch=SAMPLES_PER_EPOCH,
             label_lookahead_m=label_lookahead_m,
+            curve_max_dk=curve_max_dk,
         ),
     )
     times["train_s"] = time.monotonic() - t2
@@ -157,6 +158,7 @@ def make_model(
         f"tools/pilot make-model --laps {laps} --seed {seed} --train-seed {train_seed} --epochs {epochs}"
         + (f" --other-lane-laps {other_lane_laps}" if other_lane_laps else "")
         + f" --label-lookahead {label_lookahead_m:g}"
+        + (f" --curve-max {curve_max_dk:g}" if curve_max_dk else "")
     )
     if reuse_logs:
         full["recordings_reused"] = [str(p) for p in reuse_logs]

@@ -68,6 +68,9 @@ class TrainConfig:
     # [m] > 0: the label is pure pursuit's steering at this lookahead from each frame's pose
     # (labels.py: one the picture determines); 0: the steering recorded (the expert's)
     label_lookahead_m: float = 0.0
+    # > 0: the curvature augmentation (augment.CurveWarp) up to this extra curvature [1/m], on
+    # half the draws; 0: off (the shipped recipe)
+    curve_max_dk: float = 0.0
 
 
 def log(msg: str) -> None:
@@ -96,6 +99,29 @@ def shift_gain_per_px(
     v = vehicle.load()
     per_rad = 2.0 * v.number("wheelbase_m") / lookahead[0] / v.number("steer_limit_rad")
     return per_rad / (fx_px * spec.width / spec.source_width)
+
+
+def curve_warp(
+    manifest: dict[str, Any], spec: InputSpec, cfg: TrainConfig
+) -> augment.CurveWarp | None:
+    """The curvature augmentation for the dataset's camera (its manifest's intrinsics, the
+    vehicle's camera mount), or None when cfg.curve_max_dk is 0; ValueError when the manifest
+    has no camera intrinsics."""
+    if cfg.curve_max_dk <= 0:
+        return None
+    cam = manifest.get("camera") or {}
+    if float(cam.get("fx_px", 0.0)) <= 0 or float(cam.get("fy_px", 0.0)) <= 0:
+        raise ValueError("curvature augmentation: the dataset's manifest has no camera fx/fy")
+    v = vehicle.load()
+    ahead, _, height = v.vector("cam_front_pos_m")
+    return augment.CurveWarp(
+        fx_px=float(cam["fx_px"]), fy_px=float(cam["fy_px"]),
+        source_width=spec.source_width, source_height=spec.source_height,
+        crop_top_px=spec.crop_top_px, crop_bottom_px=spec.crop_bottom_px,
+        width=spec.width, height=spec.height, cam_ahead_m=ahead, cam_height_m=height,
+        wheelbase_m=v.number("wheelbase_m"), steer_limit_rad=v.number("steer_limit_rad"),
+        max_dk=cfg.curve_max_dk, p_curve=0.5,
+    )  # fmt: skip
 
 
 def _split(laps: npt.NDArray[np.int64], cfg: TrainConfig) -> tuple[list[int], list[int]]:
@@ -161,7 +187,7 @@ def train(
     std = tuple(float(max(v, 1e-3)) for v in stack.std(axis=(0, 2, 3)))
     spec = replace(spec, mean=(mean[0], mean[1], mean[2]), std=(std[0], std[1], std[2]))
     gain = shift_gain_per_px(ds.manifest, spec, cfg.label_lookahead_m)
-    aug = augment.Augment(gain_per_px=gain)
+    aug = augment.Augment(gain_per_px=gain, curve=curve_warp(ds.manifest, spec, cfg))
     weights = augment.balance_weights(steer[idx_train], cfg.balance_max_ratio)
     rng = np.random.default_rng(cfg.seed)
     net = model.PilotNet(spec.height, spec.width, channels=cfg.channels)
