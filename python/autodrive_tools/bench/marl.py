@@ -20,6 +20,7 @@ seeds without the shield, the FCFS baseline, and 1 car on MARL_BENCH_EPISODES_1C
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import statistics
@@ -98,21 +99,24 @@ def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
             f"[bench marl] ERROR: {shipped.with_suffix('.json')} has no trained.config: "
             "the shipped recipe is unknown"
         )
-    cfg = TrainConfig(
-        [(int(c), int(n)) for c, n in cfg_rec["stages"]],
-        action_mode=cfg_rec["action_mode"],
-        copies=cfg_rec["copies"],
-        workers=cfg_rec["workers"],
-        seed=cfg_rec["seed"],
-        torch_threads=cfg_rec.get("torch_threads", 1),
-        shield=cfg_rec["shield"],
-        shaping=cfg_rec["shaping"],
-    )
+    fields = {f.name for f in dataclasses.fields(TrainConfig)}
+    unknown = sorted(set(cfg_rec) - fields)
+    if unknown:
+        raise SystemExit(
+            f"[bench marl] ERROR: {shipped.with_suffix('.json')}: trained.config has unknown "
+            f"field(s) {', '.join(unknown)}"
+        )
+    # every recorded field is the recipe, the wall cap and checkpoint selection included
+    rec = {k: v for k, v in cfg_rec.items() if k != "ray_address"}
+    rec["stages"] = [(int(c), int(n)) for c, n in cfg_rec["stages"]]
+    cfg = TrainConfig(**rec)
     log(
         f"training from scratch: stages {cfg.stages}, {cfg.action_mode}, copies {cfg.copies}, "
-        f"workers {cfg.workers}, shield {cfg.shield}, shaping {cfg.shaping}, seed {cfg.seed}"
+        f"workers {cfg.workers}, shield {cfg.shield}, shaping {cfg.shaping}, seed {cfg.seed}, "
+        f"wall cap {cfg.max_wall_s} s, validation episodes {cfg.validate_episodes} from "
+        f"{cfg.validate_from} every {cfg.validate_every} steps"
     )
-    model, curve, info = train(cfg, log)
+    model, curve, info = train(cfg, log, dest.parent)
     info["command"] = "tools/bench marl (recipe: " + str(recorded.get("command", "?")) + ")"
     write_results(model, curve, info, dest, dest.parent, cfg.action_mode)
     return info
