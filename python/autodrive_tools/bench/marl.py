@@ -88,8 +88,10 @@ def load_1min() -> float:
 
 
 def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
-    """Trains with the shipped model's recorded recipe (no wall cap) into dest (.onnx); returns
-    the training report (wall_s, cpu_s, agent_steps_done, config, command)."""
+    """Trains with the shipped model's recorded recipe (every field of trained.config, its wall
+    cap and checkpoint selection too) into dest (.onnx, with the curve and report beside it);
+    returns the training report (wall_s, cpu_s, agent_steps_done, validation, config, command).
+    """
     from ..marl.train import TrainConfig, train, write_results
 
     recorded = json.loads(shipped.with_suffix(".json").read_text()).get("trained", {})
