@@ -1,9 +1,11 @@
 """marl.policy: a short PPO run through the shared-parameter vectorisation on two worker
 processes, its ONNX export read by OpenCV DNN (as the C++ side can) matches PyTorch on 100
 observations, the sidecar names the layout, and evaluation runs the exported policy with the
-shield and the baseline on the same seed."""
+shield and the baseline on the same seed; checkpoint selection validates at its steps on its own
+seeds and hands back the weights of the best checkpoint."""
 
 import json
+import math
 import tempfile
 from pathlib import Path
 
@@ -12,7 +14,8 @@ import numpy as np
 from autodrive_tools.marl.core import OBS_DIM, OBS_VERSION
 from autodrive_tools.marl.evaluate import evaluate
 from autodrive_tools.marl.export import OnnxPolicy, export, torch_actions
-from autodrive_tools.marl.train import TrainConfig, train
+from autodrive_tools.marl.cli import HELD_OUT_SEED
+from autodrive_tools.marl.train import VALIDATION_SEED, TrainConfig, train
 
 
 def main() -> None:
@@ -42,7 +45,44 @@ def main() -> None:
             if mode == "baseline":
                 assert r["success_rate"] == 1.0 and r["collisions"] == 0, r
         print("evaluation ran with the shield and the baseline")
+    checkpoint_selection()
     print("marl.policy: all passed")
+
+
+def checkpoint_selection() -> None:
+    cfg = TrainConfig(
+        stages=[(1, 384)],
+        copies=1,
+        workers=1,
+        seed=5,
+        buffer=128,
+        shield=True,
+        validate_episodes=2,
+        validate_from=128,
+        validate_every=128,
+        validate_workers=1,
+    )
+    model, _, info = train(cfg, print)
+    v = info["validation"]
+    # the validation seeds are neither training seeds (far below) nor held-out ones
+    assert v["first_seed"] == VALIDATION_SEED and VALIDATION_SEED + 2 <= HELD_OUT_SEED, v
+    rows = v["checkpoints"]
+    assert [r["agent_steps"] for r in rows] == [128, 256, 384], rows
+
+    def key(r: dict) -> tuple:
+        return (r["collisions"] + r["off_road"] == 0, r["success_rate"], r["agent_steps"])
+
+    assert v["kept"] == max(rows, key=key), v
+    # the model handed back is the kept checkpoint: the same validation episodes again
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "kept.onnx"
+        export(model, path, "discrete", info)
+        r = evaluate(path, 2, 1, VALIDATION_SEED, "shield")
+    again = {k: r[k] for k in ("success_rate", "collisions", "off_road", "timeouts")}
+    assert again == {k: v["kept"][k] for k in again}, (again, v["kept"])
+    t, kept_t = round(r["mean_traverse_s"], 3), v["kept"]["mean_traverse_s"]
+    assert t == kept_t or (math.isnan(t) and math.isnan(kept_t)), (t, kept_t)
+    print(f"checkpoint selection kept {v['kept']['agent_steps']} of {len(rows)} checkpoints")
 
 
 if __name__ == "__main__":

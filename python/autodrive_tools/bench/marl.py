@@ -20,6 +20,7 @@ seeds without the shield, the FCFS baseline, and 1 car on MARL_BENCH_EPISODES_1C
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import statistics
@@ -87,8 +88,10 @@ def load_1min() -> float:
 
 
 def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
-    """Trains with the shipped model's recorded recipe (no wall cap) into dest (.onnx); returns
-    the training report (wall_s, cpu_s, agent_steps_done, config, command)."""
+    """Trains with the shipped model's recorded recipe (every field of trained.config, its wall
+    cap and checkpoint selection too) into dest (.onnx, with the curve and report beside it);
+    returns the training report (wall_s, cpu_s, agent_steps_done, validation, config, command).
+    """
     from ..marl.train import TrainConfig, train, write_results
 
     recorded = json.loads(shipped.with_suffix(".json").read_text()).get("trained", {})
@@ -98,21 +101,24 @@ def train_from_scratch(shipped: Path, dest: Path) -> dict[str, Any]:
             f"[bench marl] ERROR: {shipped.with_suffix('.json')} has no trained.config: "
             "the shipped recipe is unknown"
         )
-    cfg = TrainConfig(
-        [(int(c), int(n)) for c, n in cfg_rec["stages"]],
-        action_mode=cfg_rec["action_mode"],
-        copies=cfg_rec["copies"],
-        workers=cfg_rec["workers"],
-        seed=cfg_rec["seed"],
-        torch_threads=cfg_rec.get("torch_threads", 1),
-        shield=cfg_rec["shield"],
-        shaping=cfg_rec["shaping"],
-    )
+    fields = {f.name for f in dataclasses.fields(TrainConfig)}
+    unknown = sorted(set(cfg_rec) - fields)
+    if unknown:
+        raise SystemExit(
+            f"[bench marl] ERROR: {shipped.with_suffix('.json')}: trained.config has unknown "
+            f"field(s) {', '.join(unknown)}"
+        )
+    # every recorded field is the recipe, the wall cap and checkpoint selection included
+    rec = {k: v for k, v in cfg_rec.items() if k != "ray_address"}
+    rec["stages"] = [(int(c), int(n)) for c, n in cfg_rec["stages"]]
+    cfg = TrainConfig(**rec)
     log(
         f"training from scratch: stages {cfg.stages}, {cfg.action_mode}, copies {cfg.copies}, "
-        f"workers {cfg.workers}, shield {cfg.shield}, shaping {cfg.shaping}, seed {cfg.seed}"
+        f"workers {cfg.workers}, shield {cfg.shield}, shaping {cfg.shaping}, seed {cfg.seed}, "
+        f"wall cap {cfg.max_wall_s} s, validation episodes {cfg.validate_episodes} from "
+        f"{cfg.validate_from} every {cfg.validate_every} steps"
     )
-    model, curve, info = train(cfg, log)
+    model, curve, info = train(cfg, log, dest.parent)
     info["command"] = "tools/bench marl (recipe: " + str(recorded.get("command", "?")) + ")"
     write_results(model, curve, info, dest, dest.parent, cfg.action_mode)
     return info

@@ -38,7 +38,7 @@ def parse_stages(text: str) -> list[tuple[int, int]]:
 
 
 def cmd_train(a: argparse.Namespace) -> int:
-    from .train import TrainConfig, plot_curve, train, write_results
+    from .train import TrainConfig, train, write_results
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -62,15 +62,17 @@ def cmd_train(a: argparse.Namespace) -> int:
         shield=a.shield,
         ray_address=a.address,
         shaping=a.shaping,
+        validate_episodes=a.validate_episodes,
+        validate_from=a.validate_from,
+        validate_every=a.validate_every,
+        validate_workers=a.workers,
     )
     try:
-        model, curve, info = train(cfg, log)
+        model, curve, info = train(cfg, log, out)
     finally:
         if pool is not None:
             close_pool(pool)
     info["command"] = " ".join(["tools/marl"] + sys.argv[1:])
-    model.save(out / "ppo_policy.zip")
-    plot_curve(curve, out / "learning_curve.png", f"PPO, shared policy, {a.action_mode} actions")
     sidecar = write_results(model, curve, info, Path(a.onnx), out, a.action_mode)
     log(f"wrote {a.onnx}, {sidecar}, {out / 'learning_curve.png'}, {out / 'train_report.json'}")
     print(json.dumps({"wall_s": info["wall_s"], "onnx": str(a.onnx)}))
@@ -115,6 +117,25 @@ def parser() -> argparse.ArgumentParser:
         choices=SHAPINGS,
         help="shaping reward: progress (0.3 x m gained towards the goal, default) or paper "
         "(0.01 / (0.001 + distance) per step, which pays waiting near the goal)",
+    )
+    t.add_argument(
+        "--validate-episodes",
+        type=int,
+        default=0,
+        help="checkpoint selection: validation episodes per checkpoint (seeds from 5e8, "
+        "disjoint from training and held-out seeds; 0: keep the last weights)",
+    )
+    t.add_argument(
+        "--validate-from",
+        type=int,
+        default=0,
+        help="checkpoint selection: first checkpoint after this many agent steps (all stages)",
+    )
+    t.add_argument(
+        "--validate-every",
+        type=int,
+        default=50_000,
+        help="checkpoint selection: agent steps between checkpoints (and one at the end)",
     )
     t.add_argument("--copies", type=int, default=2, help="environment copies (each N cars)")
     t.add_argument("--workers", type=int, default=2, help="rollout processes (1: in process)")

@@ -1,7 +1,16 @@
 """PPO (stable-baselines3) with one policy shared by every car, on the paper's
 hyperparameters: 3 x 128 MLP, batch 64, rollout buffer 1024 (n_steps x slots), learning rate
 3e-4 decaying linearly, entropy 1e-3, clip 0.2, GAE lambda 0.98, 3 epochs, gamma 0.99. A
-curriculum of stages "cars:steps" (one agent first, then four) continues one model."""
+curriculum of stages "cars:steps" (one agent first, then four) continues one model.
+
+Checkpoint selection (validate_episodes > 0): from validate_from agent steps on, every
+validate_every agent steps and at the end, the policy is exported and run (argmax, with the
+shield if it trains with it) on validate_episodes seeded episodes of the last stage's car count
+from VALIDATION_SEED, a seed range disjoint from the training seeds (base + copy x 1 000 003 +
+episode, below 1e8) and from the held-out evaluation seeds (from 1e9). The best checkpoint is
+kept: no collision or off road first, then the most successful episodes, then the later one.
+PPO's training rollouts are stochastic and its last update is not its best; the evaluation's
+goal is on argmax episodes, so this selects on what the goal measures."""
 
 from __future__ import annotations
 
@@ -21,6 +30,7 @@ from .vec import EnvSpec, MarlVecEnv
 BUFFER = 1024
 BATCH = 64
 LR = 3e-4
+VALIDATION_SEED = 500_000_000  # checkpoint selection's episodes start here (see the docstring)
 
 
 @dataclass
@@ -39,10 +49,18 @@ class Progress(BaseCallback):
     """Progress lines and the learning curve from the environments' episode infos."""
 
     def __init__(
-        self, curve: Curve, cars: int, total: int, t0: float, log: Any, max_wall_s: float
+        self,
+        curve: Curve,
+        cars: int,
+        total: int,
+        t0: float,
+        log: Any,
+        max_wall_s: float,
+        validator: Validator | None = None,
     ) -> None:
         super().__init__()
         self.max_wall_s = max_wall_s
+        self.validator = validator
         self.curve, self.cars, self.total, self.t0, self.log = curve, cars, total, t0, log
         self.returns: list[float] = []
         self.outcomes: list[str] = []
@@ -59,6 +77,12 @@ class Progress(BaseCallback):
         return time.monotonic() - self.t0 < self.max_wall_s
 
     def _on_rollout_end(self) -> None:
+        self._log_rollout()
+        if self.validator is not None and self.validator.due(int(self.num_timesteps)):
+            assert isinstance(self.model, PPO)
+            self.validator(self.model)
+
+    def _log_rollout(self) -> None:
         if not self.returns:
             return
         c = self.curve
@@ -92,6 +116,81 @@ class TrainConfig:
     ray_address: str = ""  # rollouts on Ray actors of this cluster ("": local processes)
     shield: bool = False  # train with the shield in the loop (it brakes; the policy steers)
     shaping: str = "progress"  # the shaping reward (env.SHAPINGS)
+    validate_episodes: int = 0  # checkpoint selection's episodes per checkpoint (0: off)
+    validate_from: int = 0  # agent steps (whole curriculum) before the first checkpoint
+    validate_every: int = 50_000  # agent steps between checkpoints
+    validate_workers: int = 2  # processes for the validation episodes
+
+
+class Validator:
+    """Checkpoint selection (see the module docstring): runs the validation episodes on the
+    model as it is now and keeps a copy of the best weights."""
+
+    def __init__(self, cfg: TrainConfig, workdir: Path, log: Any) -> None:
+        self.cfg, self.workdir, self.log = cfg, workdir, log
+        self.cars = cfg.stages[-1][0]
+        self.next_at = cfg.validate_from
+        self.results: list[dict[str, Any]] = []
+        self.best_key: tuple[Any, ...] | None = None
+        self.best_state: dict[str, Any] | None = None
+        self.last_steps = -1
+
+    def due(self, steps: int) -> bool:
+        return self.cfg.validate_episodes > 0 and steps >= self.next_at
+
+    def __call__(self, model: PPO) -> None:
+        import copy
+
+        from .evaluate import evaluate
+        from .export import export
+
+        steps = int(model.num_timesteps)
+        if steps == self.last_steps:
+            return
+        self.last_steps = steps
+        while self.next_at <= steps:
+            self.next_at += self.cfg.validate_every
+        t0 = time.monotonic()
+        onnx = self.workdir / "checkpoint.onnx"
+        export(model, onnx, self.cfg.action_mode, {})
+        mode = "shield" if self.cfg.shield else "no_shield"
+        r = evaluate(
+            onnx,
+            self.cfg.validate_episodes,
+            self.cars,
+            VALIDATION_SEED,
+            mode,
+            self.cfg.validate_workers,
+        )
+        row = {
+            "agent_steps": steps,
+            "success_rate": r["success_rate"],
+            "collisions": r["collisions"],
+            "off_road": r["off_road"],
+            "timeouts": r["timeouts"],
+            "mean_traverse_s": round(r["mean_traverse_s"], 3),
+            "wall_s": round(time.monotonic() - t0, 1),
+        }
+        self.results.append(row)
+        key = (r["collisions"] + r["off_road"] == 0, r["success_rate"], steps)
+        best = self.best_key is None or key > self.best_key
+        if best:
+            self.best_key = key
+            self.best_state = copy.deepcopy(model.policy.state_dict())
+        self.log(
+            f"validation at {steps} steps ({self.cfg.validate_episodes} episodes, {mode}): "
+            f"success {row['success_rate']:.3f}, collisions {row['collisions']}, off road "
+            f"{row['off_road']}, timeouts {row['timeouts']} ({row['wall_s']} s)"
+            + (", best so far" if best else "")
+        )
+
+    def restore_best(self, model: PPO) -> dict[str, Any] | None:
+        """Loads the best checkpoint's weights into model; returns its validation row."""
+        if self.best_state is None or self.best_key is None:
+            return None
+        model.policy.load_state_dict(self.best_state)
+        steps = self.best_key[2]
+        return next(r for r in self.results if r["agent_steps"] == steps)
 
 
 def cpu_s() -> float:
@@ -106,7 +205,12 @@ def linear(lr0: float) -> Any:
     return lambda progress_remaining: lr0 * progress_remaining
 
 
-def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
+def train(
+    cfg: TrainConfig, log: Any, workdir: Path | None = None
+) -> tuple[PPO, Curve, dict[str, Any]]:
+    """Runs the curriculum; workdir holds checkpoint selection's exported checkpoint."""
+    import tempfile
+
     import torch
 
     torch.set_num_threads(cfg.torch_threads)
@@ -115,6 +219,9 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
     t0 = time.monotonic()
     total_all = sum(s for _, s in cfg.stages)
     done_all = 0
+    tmp = tempfile.TemporaryDirectory(prefix="marl-validate-") if workdir is None else None
+    where = workdir if tmp is None else Path(tmp.name)
+    validator = Validator(cfg, where, log) if cfg.validate_episodes and where else None
     for cars, steps in cfg.stages:
         env = MarlVecEnv(
             EnvSpec(cars, cfg.action_mode, cfg.shield, cfg.shaping),
@@ -147,7 +254,8 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
             model.policy.load_state_dict(prev.policy.state_dict())
             model.num_timesteps = done_all
         log(f"stage: {cars} car(s), {steps} agent steps, {env.num_envs} slots x {n_steps} steps")
-        cb = Progress(curve, cars, steps, t0, log, cfg.max_wall_s)
+        last = (cars, steps) == cfg.stages[-1] and done_all + steps == total_all
+        cb = Progress(curve, cars, steps, t0, log, cfg.max_wall_s, validator if last else None)
         model.learn(total_timesteps=steps, callback=cb, reset_num_timesteps=False)
         env.close()
         done_all += steps
@@ -155,9 +263,22 @@ def train(cfg: TrainConfig, log: Any) -> tuple[PPO, Curve, dict[str, Any]]:
             log(f"wall-time budget {cfg.max_wall_s:.0f} s reached at {model.num_timesteps} steps")
             break
     assert model is not None
+    chosen = None
+    if validator is not None:
+        validator(model)  # the final weights (skipped if just validated)
+        chosen = validator.restore_best(model)
+        log(f"checkpoint selection: kept the weights of {chosen}")
+    if tmp is not None:
+        tmp.cleanup()
     info = {
         "stages": [{"cars": c, "agent_steps": s} for c, s in cfg.stages],
         "agent_steps_done": int(model.num_timesteps),
+        # checkpoint selection: every validation, and the one whose weights were kept
+        "validation": {
+            "first_seed": VALIDATION_SEED,
+            "checkpoints": validator.results if validator else [],
+            "kept": chosen,
+        },
         "curve_last": {k: v[-1] for k, v in asdict(curve).items() if v},
         "wall_s": round(time.monotonic() - t0, 1),
         # this process and its finished rollout workers (each stage's workers are joined)
@@ -213,12 +334,15 @@ def save_curve(curve: Curve, path: Path) -> None:
 def write_results(
     model: PPO, curve: Curve, info: dict[str, Any], onnx: Path, out: Path, action_mode: str
 ) -> Path:
-    """A training's learning curve (out/learning_curve.json), ONNX policy with its sidecar, and
-    report (out/train_report.json); returns the sidecar's path."""
+    """A training's learning curve (out/learning_curve.json and .png), SB3 model
+    (out/ppo_policy.zip), ONNX policy with its sidecar, and report (out/train_report.json);
+    returns the sidecar's path."""
     from .export import export
 
     out.mkdir(parents=True, exist_ok=True)
+    model.save(out / "ppo_policy.zip")
     save_curve(curve, out / "learning_curve.json")
+    plot_curve(curve, out / "learning_curve.png", f"PPO, shared policy, {action_mode} actions")
     sidecar = export(model, onnx, action_mode, info)
     (out / "train_report.json").write_text(json.dumps(info, indent=2) + "\n")
     return sidecar
