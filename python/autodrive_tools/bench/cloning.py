@@ -4,7 +4,7 @@
    --mission cloning); its wall time (goal <= 20 min). --model M skips recording and training
    and evaluates M (then the pipeline's time is not measured).
 2. inference_ms_p50/p99 of autodrive-pilot on one core (taskset -c 0, cv::setNumThreads(1)) on
-   front-camera frames of the run (goal p99 <= 5 ms).
+   front-camera frames of the run, the median of 5 passes (goal p99 <= 5 ms).
 3. The evaluation in the normal condition (goals: autonomy 100 %, cross-track rms <= 0.04 m) and
    in the issue's three unseen ones, night, noise2x and reverse (the recorded route driven the
    other way; goal: autonomy >= 95 % each), and in one more unseen, other-lane (loop_cw, the
@@ -22,6 +22,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import time
@@ -35,6 +36,7 @@ SUITE = "cloning"
 UNSEEN = cloning.UNSEEN  # the issue's: night, noise2x, reverse
 EXTRA = cloning.EXTRA  # other-lane
 FRAMES = 200  # front-camera frames timed on one core
+INFERENCE_PASSES = 5  # ... this many times: the figures are the passes' medians
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -86,14 +88,26 @@ def evaluate(model: Path, condition: str, laps: int, args: argparse.Namespace, o
 
 
 def one_core_inference(model: Path, frames_dir: Path, out: Path) -> dict[str, Any]:
+    """autodrive-pilot --predict on one core over FRAMES frames, INFERENCE_PASSES times: the
+    median of each pass's figures (the p99 of 200 frames is the 2nd-worst frame, and on a VM a
+    thread's CPU clock runs on while the host has taken the core: single passes vary 3-9 ms),
+    and every pass's p99 beside it."""
     frames = sorted(frames_dir.glob("*.jpg"))[:FRAMES]
     if not frames:
         return {"error": f"no frames in {frames_dir}"}
     stats = out / "inference-one-core.json"
     argv = ["taskset", "-c", "0", str(build_dir(SUITE) / "bin" / "autodrive-pilot")]
     argv += ["--model", str(model), "--stats", str(stats), "--predict", *map(str, frames)]
-    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL)
-    result: dict[str, Any] = json.loads(stats.read_text())
+    passes: list[dict[str, Any]] = []
+    for _ in range(INFERENCE_PASSES):
+        subprocess.run(argv, check=True, stdout=subprocess.DEVNULL)
+        passes.append(json.loads(stats.read_text()))
+    result: dict[str, Any] = {
+        k: statistics.median(p[k] for p in passes)
+        for k, v in passes[0].items()
+        if isinstance(v, (int, float))
+    }
+    result["inference_cpu_ms_p99_passes"] = [p.get("inference_cpu_ms_p99") for p in passes]
     return result
 
 
@@ -158,6 +172,7 @@ def main(argv: list[str]) -> int:
     figures["inference_cpu_ms_p50"] = one.get("inference_cpu_ms_p50")
     figures["inference_cpu_ms_p99"] = one.get("inference_cpu_ms_p99")
     figures["inference_frames"] = one.get("frames")
+    figures["inference_cpu_ms_p99_passes"] = one.get("inference_cpu_ms_p99_passes")
     for cond in UNSEEN + EXTRA:
         say(f"evaluate {args.unseen_laps} lap(s), unseen condition {cond}")
         tc, cpuc = time.monotonic(), cpu_s()
