@@ -377,3 +377,56 @@ TEST(MarlShield, PoseErrorGrowsTheFootprints) {
   EXPECT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, err, sizeof err), -1);
   EXPECT_NE(std::string(err).find("pose error"), std::string::npos) << err;
 }
+
+TEST(MarlShield, KeepsBackingOutOnceRollingBack) {
+  // The nose-to-nose pair of BacksOutOfAStandingDeadlock, car 2 already rolling back at 3 cm/s:
+  // it keeps backing (it used to count as moving and brake, so it backed 0.2 s in every 0.4 s;
+  // batch seed 1000000088). Driving forward, it brakes as before.
+  const adm_shield_config_t cfg = nigel_shield();
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, 0.0, 0.0, 0.0);
+  adm_shield_result_t rb;
+  const adm_car_t rolling_back = car(2, 0.42, 0.0, kPi, -0.03);
+  ASSERT_EQ(adm_shield(&cfg, &rolling_back, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_EQ(rb.command.throttle, cfg.back_throttle);
+  const adm_car_t rolling_on = car(2, 0.42, 0.0, kPi, 0.03);
+  ASSERT_EQ(adm_shield(&cfg, &rolling_on, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
+}
+
+TEST(MarlShield, BacksOutPastACornerItGrazes) {
+  // Batch seed 1000000088: car 2, turning left, stands with its rear corner at car 1's front
+  // corner. Its way back slides past that corner at a near constant distance (0.2 mm closer at
+  // worst): that is not closing, so it backs out instead of both standing for ever.
+  const adm_shield_config_t cfg = nigel_shield();
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, -0.392, -0.149, -1.0 * kPi / 180.0, 0.0);
+  const adm_car_t b = car(2, -0.159, -0.011, 150.0 * kPi / 180.0, 0.0);
+  adm_shield_result_t ra, rb;
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_EQ(rb.command.throttle, cfg.back_throttle);
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  EXPECT_EQ(ra.command.throttle, cfg.brake_throttle);  // car 2 is still in its way
+}
+
+TEST(MarlShield, StandingCarLetsAStandingFirstCarStart) {
+  // Car 1 stands facing +x, car 2 stands south-east of it facing +y: their straight paths cross
+  // 0.45 m ahead of car 1. Car 1 goes first (both stand, lower id); car 2 no longer starts into
+  // its way just because car 1 stands now (batch seed 1000000187: a car that had backed out of a
+  // first car's way drove in again as soon as it was out).
+  const adm_shield_config_t cfg = nigel_shield();
+  const adm_command_t go = {1.0, 0.0};
+  const adm_car_t a = car(1, 0.0, 0.0, 0.0, 0.0);
+  const adm_car_t b = car(2, 0.45, -0.45, kPi / 2, 0.0);
+  adm_shield_result_t ra, rb;
+  ASSERT_EQ(adm_shield(&cfg, &a, &go, &b, 1, nullptr, &ra, nullptr, 0), 0);
+  EXPECT_FALSE(ra.intervened);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_TRUE(rb.intervened);
+  EXPECT_EQ(rb.command.throttle, cfg.brake_throttle);
+  EXPECT_EQ(rb.peer_id, 1);
+  // car 1 behind car 2's start line, facing away: nothing to wait for
+  const adm_car_t a_away = car(1, 0.0, 0.0, kPi, 0.0);
+  ASSERT_EQ(adm_shield(&cfg, &b, &go, &a_away, 1, nullptr, &rb, nullptr, 0), 0);
+  EXPECT_FALSE(rb.intervened);
+}
