@@ -231,6 +231,7 @@ static int way_back_clear(const adm_shield_config_t *cfg, const adm_car_t *self,
   for (double t = cfg->dt_s; t < cfg->back_check_s + 1e-9; t += cfg->dt_s) {
     const double px = self->x_m + v * t * cos(self->yaw_rad);
     const double py = self->y_m + v * t * sin(self->yaw_rad);
+    const int last = t + cfg->dt_s > cfg->back_check_s + 1e-9;
     for (int i = 0; i < n_peers; i++) {
       const adm_car_t *p = &peers[i];
       if (p->id == self->id) continue;
@@ -241,8 +242,9 @@ static int way_back_clear(const adm_shield_config_t *cfg, const adm_car_t *self,
       const double d = footprint_distance(cfg, px, py, self->yaw_rad, qx, qy, p->yaw_rad);
       /* closer than the margin, and closing by more than graze_m: sliding past a corner at a
        * near constant distance is not closing (batch seed 1000000088: a 0.2 mm dip kept a car
-       * from backing out of a standing pair for 30 s) */
-      if (d < contact && d < now - graze_m) return 0;
+       * from backing out of a standing pair for 30 s). But the way must open by its end, else
+       * checks 0.1 s apart could each allow a few mm more. */
+      if (d < contact && d < now - (last ? 0.0 : graze_m)) return 0;
     }
   }
   return 1;

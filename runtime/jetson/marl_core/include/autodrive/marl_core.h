@@ -124,6 +124,11 @@ void adm_shield_defaults(adm_shield_config_t *cfg);
  * (footprints plus margin_m) within the horizon; with the right of way, only for a touch of the
  * bare footprints within emergency_s. A peer behind self at the contact is left to that peer's
  * shield.
+ * Standing cars: while both stand, a peer that goes first is also predicted starting straight on
+ * at top speed, so that self does not start into its way. Self, standing or already rolling
+ * back, that stands within emergency_s of a standing first peer's way (straight on or at either
+ * full lock) backs up straight at back_throttle while its way back stays clear for back_check_s
+ * (sliding past a corner within 5 mm of the distance now counts as clear).
  * Lane term (lane not NULL; first, so that the peers are checked with the steering sent): self
  * driven with the intended steering for lane_horizon_s (the servo slewing at steer_rate_rad_s
  * from lane->steering_now) must keep every chassis corner within half_width_m + lane_margin_m
