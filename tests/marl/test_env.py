@@ -83,6 +83,30 @@ def test_progress_shaping() -> None:
     print(f"progress shaping: {total:.3f} for {gained:.3f} m gained")
 
 
+def test_steer_rate_penalty() -> None:
+    # continuous mode: the reward loses steer_rate_penalty x |steering change| each step (the
+    # progress term is the same with either penalty: same seed, same actions)
+    totals = {}
+    for penalty in (0.0, 0.5):
+        env = MarlIntersectionEnv(cars=1, action_mode="continuous", steer_rate_penalty=penalty)
+        env.reset(seed=7)
+        total = 0.0
+        for k in range(10):
+            _, rew, _, _, _ = env.step({"nigel1": np.array([0.4 if k % 2 else -0.4], np.float32)})
+            total += rew["nigel1"]
+        totals[penalty] = total
+        env.close()
+    # steering -0.4 from 0, then nine changes of 0.8: 7.6 units of change
+    assert math.isclose(totals[0.0] - totals[0.5], 0.5 * 7.6, rel_tol=1e-6), totals
+    try:
+        MarlIntersectionEnv(cars=1, steer_rate_penalty=-1.0)
+    except ValueError as e:
+        assert "steer_rate_penalty" in str(e)
+    else:
+        raise AssertionError("a negative steering-rate penalty was accepted")
+    print(f"steering-rate penalty: {totals}")
+
+
 def run(env: MarlIntersectionEnv, seed: int) -> dict:
     env.reset(seed=seed)
     while env.agents:
@@ -123,5 +147,6 @@ if __name__ == "__main__":
     test_api()
     test_seeded_and_reward()
     test_progress_shaping()
+    test_steer_rate_penalty()
     test_shield_and_baseline()
     print("marl.env: all passed")

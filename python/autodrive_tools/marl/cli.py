@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ..paths import REPO_ROOT
-from .env import SHAPINGS
+from .env import SHAPINGS, STEER_RATE_PENALTY
 
 DEFAULT_MODEL = REPO_ROOT / "models" / "marl" / "intersection.onnx"
 HELD_OUT_SEED = 1_000_000_000  # evaluation seeds start here; training seeds stay far below
@@ -62,6 +62,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         shield=a.shield,
         ray_address=a.address,
         shaping=a.shaping,
+        steer_rate_penalty=a.steer_rate_penalty,
         validate_episodes=a.validate_episodes,
         validate_from=a.validate_from,
         validate_every=a.validate_every,
@@ -117,6 +118,13 @@ def parser() -> argparse.ArgumentParser:
         choices=SHAPINGS,
         help="shaping reward: progress (0.3 x m gained towards the goal, default) or paper "
         "(0.01 / (0.001 + distance) per step, which pays waiting near the goal)",
+    )
+    t.add_argument(
+        "--steer-rate-penalty",
+        type=float,
+        default=STEER_RATE_PENALTY,
+        help="continuous action mode: reward lost per unit of normalised steering change per "
+        f"0.1 s step (default {STEER_RATE_PENALTY})",
     )
     t.add_argument(
         "--validate-episodes",

@@ -128,6 +128,7 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
         max_steps: int = MAX_STEPS,
         render_mode: str | None = None,
         shaping: str = "progress",
+        steer_rate_penalty: float = STEER_RATE_PENALTY,
     ) -> None:
         if not 1 <= cars <= len(APPROACHES):
             raise ValueError(f"cars: {cars}, the intersection takes 1..{len(APPROACHES)}")
@@ -138,6 +139,9 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
         if shaping not in SHAPINGS:
             raise ValueError(f"shaping '{shaping}': one of {', '.join(SHAPINGS)}")
         self.shaping = shaping
+        if not (math.isfinite(steer_rate_penalty) and steer_rate_penalty >= 0.0):
+            raise ValueError(f"steer_rate_penalty {steer_rate_penalty}: a number >= 0")
+        self.steer_rate_penalty = steer_rate_penalty
         self.n_cars = cars
         self.action_mode = action_mode
         self.use_shield = shield
@@ -332,7 +336,7 @@ class MarlIntersectionEnv(ParallelEnv[str, ObsArray, Any]):  # type: ignore[misc
                 self.finished[i] = True
                 done = True
             if self.action_mode == "continuous":
-                reward -= STEER_RATE_PENALTY * abs(sent[i] - self.last_steering[i])
+                reward -= self.steer_rate_penalty * abs(sent[i] - self.last_steering[i])
             self.last_steering[i] = sent[i]
             obs[a] = self._obs(i)
             rew[a] = float(reward)

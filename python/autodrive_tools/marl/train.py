@@ -25,6 +25,7 @@ import numpy as np
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
 
+from .env import STEER_RATE_PENALTY
 from .vec import EnvSpec, MarlVecEnv
 
 BUFFER = 1024
@@ -116,6 +117,7 @@ class TrainConfig:
     ray_address: str = ""  # rollouts on Ray actors of this cluster ("": local processes)
     shield: bool = False  # train with the shield in the loop (it brakes; the policy steers)
     shaping: str = "progress"  # the shaping reward (env.SHAPINGS)
+    steer_rate_penalty: float = STEER_RATE_PENALTY  # continuous mode: per unit of change per step
     validate_episodes: int = 0  # checkpoint selection's episodes per checkpoint (0: off)
     validate_from: int = 0  # agent steps (whole curriculum) before the first checkpoint
     validate_every: int = 50_000  # agent steps between checkpoints
@@ -224,7 +226,7 @@ def train(
     validator = Validator(cfg, where, log) if cfg.validate_episodes and where else None
     for cars, steps in cfg.stages:
         env = MarlVecEnv(
-            EnvSpec(cars, cfg.action_mode, cfg.shield, cfg.shaping),
+            EnvSpec(cars, cfg.action_mode, cfg.shield, cfg.shaping, cfg.steer_rate_penalty),
             cfg.copies,
             cfg.workers,
             cfg.seed + 7 * cars,
@@ -295,6 +297,7 @@ def train(
             "n_epochs": 3,
             "gamma": 0.99,
             "shaping": cfg.shaping,
+            "steer_rate_penalty": cfg.steer_rate_penalty,
         },
     }
     return model, curve, info

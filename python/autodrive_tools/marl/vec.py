@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvObs, VecEnvStepReturn
 
-from .env import MarlIntersectionEnv
+from .env import STEER_RATE_PENALTY, MarlIntersectionEnv
 
 SEED_STRIDE = 1_000_003  # episode e of copy k: base + k * SEED_STRIDE + e
 
@@ -31,10 +31,15 @@ class EnvSpec:
     action_mode: str = "discrete"
     shield: bool = False
     shaping: str = "progress"
+    steer_rate_penalty: float = STEER_RATE_PENALTY
 
     def make(self) -> MarlIntersectionEnv:
         return MarlIntersectionEnv(
-            cars=self.cars, action_mode=self.action_mode, shield=self.shield, shaping=self.shaping
+            cars=self.cars,
+            action_mode=self.action_mode,
+            shield=self.shield,
+            shaping=self.shaping,
+            steer_rate_penalty=self.steer_rate_penalty,
         )
 
 
