@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "nigel_core.h"
-#include "proto.h"
+#include "nano_core.h"
+#include "protocol.h"
 
 class FakeHal {
  public:
@@ -21,7 +21,7 @@ class FakeHal {
     };
     hal_.servo_set_us = [](void *c, uint16_t us) { static_cast<FakeHal *>(c)->servo_us = us; };
     hal_.lamps_set = [](void *c, uint8_t l) { static_cast<FakeHal *>(c)->lamps = l; };
-    hal_.imu_read = [](void *c, nigel_imu_raw_t *out) {
+    hal_.imu_read = [](void *c, nano_core_imu_raw_t *out) {
       auto *h = static_cast<FakeHal *>(c);
       ++h->imu_reads;
       if (h->imu_absent) return -1;
@@ -32,35 +32,35 @@ class FakeHal {
     hal_.serial_write = [](void *c, const uint8_t *d, uint8_t n) {
       auto *h = static_cast<FakeHal *>(c);
       h->tx_bytes += n;
-      proto_parser_feed(&h->rx_parser_, d, n, &FakeHal::OnFrame, h);
+      protocol_parser_feed(&h->rx_parser_, d, n, &FakeHal::OnFrame, h);
     };
-    proto_parser_init(&rx_parser_);
-    imu.accel[2] = PROTO_ACCEL_LSB_PER_G;  // level and still
+    protocol_parser_init(&rx_parser_);
+    imu.accel[2] = PROTOCOL_ACCEL_LSB_PER_G;  // level and still
   }
-  const nigel_hal_t *hal() const { return &hal_; }
+  const nano_core_hal_t *hal() const { return &hal_; }
 
   // What the core transmitted, decoded (every frame must pass CRC to appear here).
-  std::vector<proto_frame_t> frames;
-  std::vector<proto_frame_t> Take(uint8_t id) {
-    std::vector<proto_frame_t> out, rest;
+  std::vector<protocol_frame_t> frames;
+  std::vector<protocol_frame_t> Take(uint8_t id) {
+    std::vector<protocol_frame_t> out, rest;
     for (auto &f : frames) (f.id == id ? out : rest).push_back(f);
     frames = rest;
     return out;
   }
-  const proto_stats_t &tx_stats() const { return rx_parser_.stats; }
+  const protocol_stats_t &tx_stats() const { return rx_parser_.stats; }
 
   uint8_t duty = 0xEE, reverse = 0xEE, brake = 0xEE, lamps = 0xEE;
   uint16_t servo_us = 0;
   unsigned motor_calls = 0, imu_reads = 0;
   size_t tx_bytes = 0;
   bool imu_absent = false;
-  nigel_imu_raw_t imu{};
+  nano_core_imu_raw_t imu{};
   uint16_t battery_mv = 11800;
 
  private:
-  static void OnFrame(const proto_frame_t *f, void *ctx) {
+  static void OnFrame(const protocol_frame_t *f, void *ctx) {
     static_cast<FakeHal *>(ctx)->frames.push_back(*f);
   }
-  nigel_hal_t hal_{};
-  proto_parser_t rx_parser_{};
+  nano_core_hal_t hal_{};
+  protocol_parser_t rx_parser_{};
 };

@@ -9,7 +9,7 @@ if(NOT CMAKE_CROSSCOMPILING AND AUTODRIVE_CLANG14 AND _fuzz_rt_found)
     OUTPUT ${_fuzz_bin}
     COMMAND ${AUTODRIVE_ROOT}/tools/fuzz-parser --build ${_fuzz_bin}
     DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/fuzz_parser.c ${AUTODRIVE_ROOT}/tools/fuzz-parser
-            ${NANO_CORE_SOURCES} ${NANO_PROTO_SOURCES}
+            ${NANO_CORE_SOURCES} ${NANO_PROTOCOL_SOURCES}
     COMMENT "clang-14 libFuzzer build: fuzz_parser"
     VERBATIM)
   add_custom_target(fuzz_parser ALL DEPENDS ${_fuzz_bin})

@@ -1,5 +1,5 @@
 // The serial protocol codec: CRC, pack/unpack round trips, length checks, the schema string
-// against PROTO_LEN_*, and a randomized stream of good, corrupted, truncated frames and
+// against PROTOCOL_LEN_*, and a randomized stream of good, corrupted, truncated frames and
 // garbage through the byte-wise parser.
 #include <gtest/gtest.h>
 
@@ -13,14 +13,14 @@
 #include <vector>
 
 #include "collected_frames.h"
-#include "proto.h"
+#include "protocol.h"
 
 namespace {
 
 std::vector<uint8_t> Encode(uint8_t id, uint8_t seq, const std::vector<uint8_t> &payload) {
-  std::vector<uint8_t> out(PROTO_MAX_FRAME);
-  size_t n = proto_frame_encode(id, seq, payload.data(), static_cast<uint8_t>(payload.size()),
-                                out.data(), out.size());
+  std::vector<uint8_t> out(PROTOCOL_MAX_FRAME);
+  size_t n = protocol_frame_encode(id, seq, payload.data(), static_cast<uint8_t>(payload.size()),
+                                   out.data(), out.size());
   out.resize(n);
   return out;
 }
@@ -28,25 +28,25 @@ std::vector<uint8_t> Encode(uint8_t id, uint8_t seq, const std::vector<uint8_t> 
 TEST(Crc, KnownVectors) {
   // CRC-16/CCITT-FALSE check value of "123456789" is 0x29B1 (the catalogue's check value).
   const char *check = "123456789";
-  EXPECT_EQ(proto_crc16(0xFFFFu, reinterpret_cast<const uint8_t *>(check), 9), 0x29B1u);
-  EXPECT_EQ(proto_crc16(0xFFFFu, nullptr, 0), 0xFFFFu);
+  EXPECT_EQ(protocol_crc16(0xFFFFu, reinterpret_cast<const uint8_t *>(check), 9), 0x29B1u);
+  EXPECT_EQ(protocol_crc16(0xFFFFu, nullptr, 0), 0xFFFFu);
   const uint8_t a = 'A';
-  EXPECT_EQ(proto_crc16(0xFFFFu, &a, 1), 0xB915u);
+  EXPECT_EQ(protocol_crc16(0xFFFFu, &a, 1), 0xB915u);
   // Incremental use equals one pass.
   const uint8_t *c = reinterpret_cast<const uint8_t *>(check);
-  EXPECT_EQ(proto_crc16(proto_crc16(0xFFFFu, c, 4), c + 4, 5), 0x29B1u);
+  EXPECT_EQ(protocol_crc16(protocol_crc16(0xFFFFu, c, 4), c + 4, 5), 0x29B1u);
 }
 
 TEST(Frame, LayoutByteByByte) {
-  std::vector<uint8_t> f = Encode(PROTO_ID_HELLO_REQUEST, 0x42, {});
-  ASSERT_EQ(f.size(), PROTO_OVERHEAD);
+  std::vector<uint8_t> f = Encode(PROTOCOL_ID_HELLO_REQUEST, 0x42, {});
+  ASSERT_EQ(f.size(), PROTOCOL_OVERHEAD);
   EXPECT_EQ(f[0], 0xA5);
   EXPECT_EQ(f[1], 0x5A);
   EXPECT_EQ(f[2], 0);
   EXPECT_EQ(f[3], 0x03);
   EXPECT_EQ(f[4], 0x42);
   const uint8_t hdr[] = {0x00, 0x03, 0x42};
-  uint16_t crc = proto_crc16(0xFFFFu, hdr, 3);
+  uint16_t crc = protocol_crc16(0xFFFFu, hdr, 3);
   EXPECT_EQ(f[5], crc & 0xFF);  // little-endian CRC
   EXPECT_EQ(f[6], crc >> 8);
 }
@@ -54,82 +54,84 @@ TEST(Frame, LayoutByteByByte) {
 // The worked examples and the hash quoted in PROTOCOL.md: if this fails after a deliberate
 // protocol change, update PROTOCOL.md with the new bytes.
 TEST(Frame, ProtocolDocExamples) {
-  EXPECT_EQ(Encode(PROTO_ID_HELLO_REQUEST, 0, {}),
+  EXPECT_EQ(Encode(PROTOCOL_ID_HELLO_REQUEST, 0, {}),
             (std::vector<uint8_t>{0xA5, 0x5A, 0x00, 0x03, 0x00, 0xCF, 0x99}));
-  proto_command_t c{7, 500, -250, 1, 0, PROTO_CMD_ENGAGED};
-  std::vector<uint8_t> p(PROTO_LEN_COMMAND);
-  proto_command_pack(&c, p.data());
-  EXPECT_EQ(Encode(PROTO_ID_COMMAND, 7, p),
+  protocol_command_t c{7, 500, -250, 1, 0, PROTOCOL_CMD_ENGAGED};
+  std::vector<uint8_t> p(PROTOCOL_LEN_COMMAND);
+  protocol_command_pack(&c, p.data());
+  EXPECT_EQ(Encode(PROTOCOL_ID_COMMAND, 7, p),
             (std::vector<uint8_t>{0xA5, 0x5A, 0x09, 0x01, 0x07, 0x07, 0x00, 0xF4, 0x01, 0x06, 0xFF,
                                   0x01, 0x00, 0x01, 0xF5, 0xE3}));
-  EXPECT_EQ(proto_schema_hash(), 0x265771ABu) << "schema changed: update PROTOCOL.md section 5";
-  EXPECT_EQ(std::string(PROTO_SCHEMA).size(), 715u);
+  EXPECT_EQ(protocol_schema_hash(), 0x265771ABu) << "schema changed: update PROTOCOL.md section 5";
+  EXPECT_EQ(std::string(PROTOCOL_SCHEMA).size(), 715u);
 }
 
 TEST(Frame, EncodeRejectsOversizeAndSmallBuffers) {
-  uint8_t payload[PROTO_MAX_PAYLOAD + 1] = {0};
-  uint8_t out[PROTO_MAX_FRAME + 8];
-  EXPECT_EQ(proto_frame_encode(1, 0, payload, PROTO_MAX_PAYLOAD + 1, out, sizeof out), 0u);
-  EXPECT_EQ(proto_frame_encode(1, 0, payload, 10, out, 10 + PROTO_OVERHEAD - 1), 0u);
-  EXPECT_EQ(proto_frame_encode(1, 0, payload, 10, out, 10 + PROTO_OVERHEAD), 10u + PROTO_OVERHEAD);
-  EXPECT_EQ(proto_frame_encode(1, 0, payload, PROTO_MAX_PAYLOAD, out, sizeof out), PROTO_MAX_FRAME);
+  uint8_t payload[PROTOCOL_MAX_PAYLOAD + 1] = {0};
+  uint8_t out[PROTOCOL_MAX_FRAME + 8];
+  EXPECT_EQ(protocol_frame_encode(1, 0, payload, PROTOCOL_MAX_PAYLOAD + 1, out, sizeof out), 0u);
+  EXPECT_EQ(protocol_frame_encode(1, 0, payload, 10, out, 10 + PROTOCOL_OVERHEAD - 1), 0u);
+  EXPECT_EQ(protocol_frame_encode(1, 0, payload, 10, out, 10 + PROTOCOL_OVERHEAD),
+            10u + PROTOCOL_OVERHEAD);
+  EXPECT_EQ(protocol_frame_encode(1, 0, payload, PROTOCOL_MAX_PAYLOAD, out, sizeof out),
+            PROTOCOL_MAX_FRAME);
 }
 
 TEST(Messages, CommandRoundTripAndLength) {
-  proto_command_t c{0xBEEF, -1000, 734, 2, 3, PROTO_CMD_ENGAGED};
-  uint8_t p[PROTO_LEN_COMMAND];
-  proto_command_pack(&c, p);
+  protocol_command_t c{0xBEEF, -1000, 734, 2, 3, PROTOCOL_CMD_ENGAGED};
+  uint8_t p[PROTOCOL_LEN_COMMAND];
+  protocol_command_pack(&c, p);
   EXPECT_EQ(p[0], 0xEF);
   EXPECT_EQ(p[1], 0xBE);
   EXPECT_EQ(p[2], 0x18);  // -1000 = 0xFC18
   EXPECT_EQ(p[3], 0xFC);
-  proto_command_t d{};
-  ASSERT_EQ(proto_command_unpack(p, PROTO_LEN_COMMAND, &d), 0);
+  protocol_command_t d{};
+  ASSERT_EQ(protocol_command_unpack(p, PROTOCOL_LEN_COMMAND, &d), 0);
   EXPECT_EQ(d.seq, c.seq);
   EXPECT_EQ(d.throttle_milli, c.throttle_milli);
   EXPECT_EQ(d.steering_milli, c.steering_milli);
   EXPECT_EQ(d.headlights, c.headlights);
   EXPECT_EQ(d.indicators, c.indicators);
   EXPECT_EQ(d.flags, c.flags);
-  EXPECT_EQ(proto_command_unpack(p, PROTO_LEN_COMMAND - 1, &d), -1);
-  EXPECT_EQ(proto_command_unpack(p, PROTO_LEN_COMMAND + 1, &d), -1);
+  EXPECT_EQ(protocol_command_unpack(p, PROTOCOL_LEN_COMMAND - 1, &d), -1);
+  EXPECT_EQ(protocol_command_unpack(p, PROTOCOL_LEN_COMMAND + 1, &d), -1);
 }
 
 TEST(Messages, ConfigHelloNackRoundTrip) {
-  proto_config_t c{-200, 1000, 150}, c2{};
-  uint8_t pc[PROTO_LEN_CONFIG];
-  proto_config_pack(&c, pc);
-  ASSERT_EQ(proto_config_unpack(pc, PROTO_LEN_CONFIG, &c2), 0);
+  protocol_config_t c{-200, 1000, 150}, c2{};
+  uint8_t pc[PROTOCOL_LEN_CONFIG];
+  protocol_config_pack(&c, pc);
+  ASSERT_EQ(protocol_config_unpack(pc, PROTOCOL_LEN_CONFIG, &c2), 0);
   EXPECT_EQ(c2.servo_trim_us, -200);
   EXPECT_EQ(c2.telemetry_period_ms, 1000);
   EXPECT_EQ(c2.failsafe_timeout_ms, 150);
-  EXPECT_EQ(proto_config_unpack(pc, 5, &c2), -1);
+  EXPECT_EQ(protocol_config_unpack(pc, 5, &c2), -1);
 
-  proto_hello_t h{1, 2, 3, PROTO_VERSION, 0xDEADBEEFu, 0x01020304u}, h2{};
-  uint8_t ph[PROTO_LEN_HELLO];
-  proto_hello_pack(&h, ph);
+  protocol_hello_t h{1, 2, 3, PROTOCOL_VERSION, 0xDEADBEEFu, 0x01020304u}, h2{};
+  uint8_t ph[PROTOCOL_LEN_HELLO];
+  protocol_hello_pack(&h, ph);
   EXPECT_EQ(ph[4], 0xEF);
   EXPECT_EQ(ph[7], 0xDE);
-  ASSERT_EQ(proto_hello_unpack(ph, PROTO_LEN_HELLO, &h2), 0);
+  ASSERT_EQ(protocol_hello_unpack(ph, PROTOCOL_LEN_HELLO, &h2), 0);
   EXPECT_EQ(h2.fw_major, 1);
   EXPECT_EQ(h2.fw_minor, 2);
   EXPECT_EQ(h2.fw_patch, 3);
   EXPECT_EQ(h2.schema_hash, 0xDEADBEEFu);
   EXPECT_EQ(h2.build_id, 0x01020304u);
-  EXPECT_EQ(proto_hello_unpack(ph, 0, &h2), -1);
+  EXPECT_EQ(protocol_hello_unpack(ph, 0, &h2), -1);
 
-  proto_nack_t k{PROTO_ID_COMMAND, PROTO_NACK_OUT_OF_RANGE, 777}, k2{};
-  uint8_t pk[PROTO_LEN_NACK];
-  proto_nack_pack(&k, pk);
-  ASSERT_EQ(proto_nack_unpack(pk, PROTO_LEN_NACK, &k2), 0);
-  EXPECT_EQ(k2.rejected_id, PROTO_ID_COMMAND);
-  EXPECT_EQ(k2.reason, PROTO_NACK_OUT_OF_RANGE);
+  protocol_nack_t k{PROTOCOL_ID_COMMAND, PROTOCOL_NACK_OUT_OF_RANGE, 777}, k2{};
+  uint8_t pk[PROTOCOL_LEN_NACK];
+  protocol_nack_pack(&k, pk);
+  ASSERT_EQ(protocol_nack_unpack(pk, PROTOCOL_LEN_NACK, &k2), 0);
+  EXPECT_EQ(k2.rejected_id, PROTOCOL_ID_COMMAND);
+  EXPECT_EQ(k2.reason, PROTOCOL_NACK_OUT_OF_RANGE);
   EXPECT_EQ(k2.seq, 777);
-  EXPECT_EQ(proto_nack_unpack(pk, 3, &k2), -1);
+  EXPECT_EQ(protocol_nack_unpack(pk, 3, &k2), -1);
 }
 
 TEST(Messages, StateRoundTripEveryField) {
-  proto_state_t s{};
+  protocol_state_t s{};
   // Distinct values in every field so a swapped or misplaced field shows.
   s.nano_time_us = 0xF1E2D3C4u;
   s.enc_counts[0] = -123456789;
@@ -146,79 +148,79 @@ TEST(Messages, StateRoundTripEveryField) {
   for (int i = 0; i < 4; ++i) s.quat_q14[i] = static_cast<int16_t>(16384 - 1000 * i);
   s.battery_mv = 11100;
   s.lights = 0xA5;
-  s.mode = PROTO_MODE_FAILSAFE;
+  s.mode = PROTOCOL_MODE_FAILSAFE;
   s.faults = 0x7F;
   s.last_cmd_seq = 65535;
   s.frames_ok = 1;
   s.frames_bad_crc = 2;
   s.frames_dropped = 3;
-  uint8_t p[PROTO_LEN_STATE];
-  proto_state_pack(&s, p);
+  uint8_t p[PROTOCOL_LEN_STATE];
+  protocol_state_pack(&s, p);
   EXPECT_EQ(p[0], 0xC4);  // nano_time_us little-endian at offset 0
   EXPECT_EQ(p[3], 0xF1);
   EXPECT_EQ(p[46], 11100 & 0xFF);  // battery_mv at offset 46
   EXPECT_EQ(p[48], 0xA5);          // lights at 48
-  EXPECT_EQ(p[49], PROTO_MODE_FAILSAFE);
+  EXPECT_EQ(p[49], PROTOCOL_MODE_FAILSAFE);
   EXPECT_EQ(p[58], 3);  // frames_dropped at 58
-  proto_state_t d{};
-  ASSERT_EQ(proto_state_unpack(p, PROTO_LEN_STATE, &d), 0);
+  protocol_state_t d{};
+  ASSERT_EQ(protocol_state_unpack(p, PROTOCOL_LEN_STATE, &d), 0);
   EXPECT_EQ(0, std::memcmp(&s, &d, sizeof s));
-  EXPECT_EQ(proto_state_unpack(p, PROTO_LEN_STATE - 1, &d), -1);
+  EXPECT_EQ(protocol_state_unpack(p, PROTOCOL_LEN_STATE - 1, &d), -1);
 }
 
 TEST(Messages, RangeChecks) {
-  proto_command_t c{1, 1000, -1000, 2, 3, PROTO_CMD_ENGAGED};
-  EXPECT_TRUE(proto_command_valid(&c));
+  protocol_command_t c{1, 1000, -1000, 2, 3, PROTOCOL_CMD_ENGAGED};
+  EXPECT_TRUE(protocol_command_valid(&c));
   c.throttle_milli = 1001;
-  EXPECT_FALSE(proto_command_valid(&c));
+  EXPECT_FALSE(protocol_command_valid(&c));
   c.throttle_milli = -1001;
-  EXPECT_FALSE(proto_command_valid(&c));
+  EXPECT_FALSE(protocol_command_valid(&c));
   c.throttle_milli = 0;
   c.steering_milli = -1001;
-  EXPECT_FALSE(proto_command_valid(&c));
+  EXPECT_FALSE(protocol_command_valid(&c));
   c.steering_milli = 0;
   c.headlights = 3;
-  EXPECT_FALSE(proto_command_valid(&c));
+  EXPECT_FALSE(protocol_command_valid(&c));
   c.headlights = 0;
   c.indicators = 4;
-  EXPECT_FALSE(proto_command_valid(&c));
+  EXPECT_FALSE(protocol_command_valid(&c));
   c.indicators = 0;
   c.flags = 0x02;
-  EXPECT_FALSE(proto_command_valid(&c));
-  proto_config_t k{0, 10, 100};
-  EXPECT_TRUE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_command_valid(&c));
+  protocol_config_t k{0, 10, 100};
+  EXPECT_TRUE(protocol_config_valid(&k));
   k.failsafe_timeout_ms = 151;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
   k.failsafe_timeout_ms = 19;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
   k.failsafe_timeout_ms = 100;
   k.telemetry_period_ms = 4;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
   k.telemetry_period_ms = 1001;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
   k.telemetry_period_ms = 10;
   k.servo_trim_us = 201;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
   k.servo_trim_us = -201;
-  EXPECT_FALSE(proto_config_valid(&k));
+  EXPECT_FALSE(protocol_config_valid(&k));
 }
 
-// Parses PROTO_SCHEMA ("v1;01 command:u16 seq,...;...") and sums the field sizes.
+// Parses PROTOCOL_SCHEMA ("v1;01 command:u16 seq,...;...") and sums the field sizes.
 TEST(Schema, StringMatchesLengthsAndIds) {
-  const std::string schema = PROTO_SCHEMA;
+  const std::string schema = PROTOCOL_SCHEMA;
   std::stringstream ss(schema);
   std::string part;
   ASSERT_TRUE(std::getline(ss, part, ';'));
-  EXPECT_EQ(part, "v" + std::to_string(PROTO_VERSION));
+  EXPECT_EQ(part, "v" + std::to_string(PROTOCOL_VERSION));
   const std::map<std::string, size_t> size_of = {{"u8", 1},  {"i8", 1},  {"u16", 2},
                                                  {"i16", 2}, {"u32", 4}, {"i32", 4}};
   const std::map<std::string, std::pair<int, size_t>> expect = {
-      {"command", {PROTO_ID_COMMAND, PROTO_LEN_COMMAND}},
-      {"config", {PROTO_ID_CONFIG, PROTO_LEN_CONFIG}},
-      {"hello_request", {PROTO_ID_HELLO_REQUEST, PROTO_LEN_HELLO_REQUEST}},
-      {"hello", {PROTO_ID_HELLO, PROTO_LEN_HELLO}},
-      {"state", {PROTO_ID_STATE, PROTO_LEN_STATE}},
-      {"nack", {PROTO_ID_NACK, PROTO_LEN_NACK}}};
+      {"command", {PROTOCOL_ID_COMMAND, PROTOCOL_LEN_COMMAND}},
+      {"config", {PROTOCOL_ID_CONFIG, PROTOCOL_LEN_CONFIG}},
+      {"hello_request", {PROTOCOL_ID_HELLO_REQUEST, PROTOCOL_LEN_HELLO_REQUEST}},
+      {"hello", {PROTOCOL_ID_HELLO, PROTOCOL_LEN_HELLO}},
+      {"state", {PROTOCOL_ID_STATE, PROTOCOL_LEN_STATE}},
+      {"nack", {PROTOCOL_ID_NACK, PROTOCOL_LEN_NACK}}};
   std::map<std::string, bool> seen;
   while (std::getline(ss, part, ';')) {
     if (part.empty()) continue;
@@ -235,10 +237,10 @@ TEST(Schema, StringMatchesLengthsAndIds) {
       ASSERT_TRUE(size_of.count(type)) << "unknown type '" << type << "' in " << part;
       total += size_of.at(type);
     }
-    ASSERT_TRUE(expect.count(name)) << "message not in proto.h: " << name;
+    ASSERT_TRUE(expect.count(name)) << "message not in protocol.h: " << name;
     EXPECT_EQ(id, expect.at(name).first) << name;
     EXPECT_EQ(total, expect.at(name).second) << name;
-    EXPECT_LE(total, PROTO_MAX_PAYLOAD) << name;
+    EXPECT_LE(total, PROTOCOL_MAX_PAYLOAD) << name;
     seen[name] = true;
   }
   EXPECT_EQ(seen.size(), expect.size());
@@ -246,24 +248,24 @@ TEST(Schema, StringMatchesLengthsAndIds) {
 
 TEST(Schema, HashIsFnv1aOfTheString) {
   uint32_t h = 2166136261u;
-  for (char c : std::string(PROTO_SCHEMA)) {
+  for (char c : std::string(PROTOCOL_SCHEMA)) {
     h ^= static_cast<uint8_t>(c);
     h *= 16777619u;
   }
-  EXPECT_EQ(proto_schema_hash(), h);
+  EXPECT_EQ(protocol_schema_hash(), h);
   EXPECT_NE(h, 0u);
 }
 
 TEST(Parser, ByteByByteAndCounters) {
-  proto_parser_t p;
-  proto_parser_init(&p);
+  protocol_parser_t p;
+  protocol_parser_init(&p);
   CollectedFrames got;
   std::vector<uint8_t> stream;
   for (uint8_t s = 0; s < 5; ++s) {
-    auto f = Encode(PROTO_ID_COMMAND, static_cast<uint8_t>(s * 2), std::vector<uint8_t>(9, s));
+    auto f = Encode(PROTOCOL_ID_COMMAND, static_cast<uint8_t>(s * 2), std::vector<uint8_t>(9, s));
     stream.insert(stream.end(), f.begin(), f.end());
   }
-  for (uint8_t b : stream) proto_parser_feed(&p, &b, 1, collect_frame, &got);
+  for (uint8_t b : stream) protocol_parser_feed(&p, &b, 1, collect_frame, &got);
   ASSERT_EQ(got.frames.size(), 5u);
   EXPECT_EQ(got.frames[3].seq, 6);
   EXPECT_EQ(got.frames[3].payload[0], 3);
@@ -273,16 +275,16 @@ TEST(Parser, ByteByByteAndCounters) {
 }
 
 TEST(Parser, BadCrcAndOversizeLengthCounted) {
-  proto_parser_t p;
-  proto_parser_init(&p);
+  protocol_parser_t p;
+  protocol_parser_init(&p);
   CollectedFrames got;
-  auto good = Encode(PROTO_ID_CONFIG, 1, std::vector<uint8_t>(6, 7));
+  auto good = Encode(PROTOCOL_ID_CONFIG, 1, std::vector<uint8_t>(6, 7));
   auto bad = good;
   bad[7] ^= 0x10;
   const uint8_t oversize[] = {0xA5, 0x5A, 200};
-  proto_parser_feed(&p, bad.data(), bad.size(), collect_frame, &got);
-  proto_parser_feed(&p, oversize, sizeof oversize, collect_frame, &got);
-  proto_parser_feed(&p, good.data(), good.size(), collect_frame, &got);
+  protocol_parser_feed(&p, bad.data(), bad.size(), collect_frame, &got);
+  protocol_parser_feed(&p, oversize, sizeof oversize, collect_frame, &got);
+  protocol_parser_feed(&p, good.data(), good.size(), collect_frame, &got);
   ASSERT_EQ(got.frames.size(), 1u);
   EXPECT_EQ(p.stats.bad_crc, 1u);
   EXPECT_EQ(p.stats.bad_length, 1u);
@@ -300,7 +302,7 @@ TEST(Parser, RandomizedStreamResync) {
     std::vector<std::vector<uint8_t>> expected;  // encoded untouched frames, in order
     std::set<std::vector<uint8_t>> sent;         // every frame as encoded before damage
     for (int i = 0; i < 3000; ++i) {
-      uint8_t len = static_cast<uint8_t>(2 + rng() % (PROTO_MAX_PAYLOAD - 1));
+      uint8_t len = static_cast<uint8_t>(2 + rng() % (PROTOCOL_MAX_PAYLOAD - 1));
       std::vector<uint8_t> payload(len);
       for (auto &b : payload) b = static_cast<uint8_t>(rng());
       payload[0] = static_cast<uint8_t>(i);  // tag so a match is unambiguous
@@ -335,13 +337,13 @@ TEST(Parser, RandomizedStreamResync) {
       }
       stream.insert(stream.end(), f.begin(), f.end());
     }
-    proto_parser_t p;
-    proto_parser_init(&p);
+    protocol_parser_t p;
+    protocol_parser_init(&p);
     CollectedFrames got;
     // Feed in random chunk sizes like a UART driver would.
     for (size_t pos = 0; pos < stream.size();) {
       size_t n = std::min<size_t>(1 + rng() % 32, stream.size() - pos);
-      proto_parser_feed(&p, stream.data() + pos, n, collect_frame, &got);
+      protocol_parser_feed(&p, stream.data() + pos, n, collect_frame, &got);
       pos += n;
     }
     stat_bad_crc += p.stats.bad_crc;

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstdint>
 
-#include "act.h"
+#include "actuation.h"
 #include "ahrs.h"
-#include "enc.h"
-#include "fs.h"
-#include "proto.h"
-#include "wspd.h"
+#include "encoder.h"
+#include "failsafe.h"
+#include "protocol.h"
+#include "wheel_speed.h"
 
 namespace {
 
@@ -20,34 +20,34 @@ struct Quad {
   uint8_t a() const { return (phase == 1 || phase == 2) ? 1 : 0; }
   uint8_t b() const { return (phase == 2 || phase == 3) ? 1 : 0; }
   // Steps one phase; calls the decoder on A edges only (like the AVR ISR on INT0 CHANGE).
-  void Step(enc_t *e, int dir) {
+  void Step(encoder_t *e, int dir) {
     uint8_t a0 = a();
     phase = (phase + (dir > 0 ? 1 : 3)) % 4;
-    if (a() != a0) enc_edge_a(e, a(), b());
+    if (a() != a0) encoder_edge_a(e, a(), b());
   }
 };
 
-TEST(Enc, ForwardBackwardAndCountsPerRev) {
-  enc_t e;
-  enc_init(&e, 0);
+TEST(Encoder, ForwardBackwardAndCountsPerRev) {
+  encoder_t e;
+  encoder_init(&e, 0);
   Quad q;
   // 1920 counts = 960 A cycles = 3840 phase steps
   for (int i = 0; i < 3840; ++i) q.Step(&e, +1);
-  EXPECT_EQ(e.counts, ENC_COUNTS_PER_REV);
+  EXPECT_EQ(e.counts, ENCODER_COUNTS_PER_REV);
   for (int i = 0; i < 3840; ++i) q.Step(&e, -1);
   EXPECT_EQ(e.counts, 0);
   for (int i = 0; i < 10; ++i) q.Step(&e, -1);
   EXPECT_EQ(e.counts, -5);
 }
 
-TEST(Enc, InvertedSideAndJitterCancels) {
-  enc_t e;
-  enc_init(&e, 1);
+TEST(Encoder, InvertedSideAndJitterCancels) {
+  encoder_t e;
+  encoder_init(&e, 1);
   Quad q;
   for (int i = 0; i < 400; ++i) q.Step(&e, +1);
   EXPECT_EQ(e.counts, -200);
   // a wheel rocking on an A edge: every + is undone by the matching -
-  enc_init(&e, 0);
+  encoder_init(&e, 0);
   for (int i = 0; i < 100; ++i) {
     q.Step(&e, +1);
     q.Step(&e, -1);
@@ -55,31 +55,31 @@ TEST(Enc, InvertedSideAndJitterCancels) {
   EXPECT_EQ(e.counts, 0);
 }
 
-TEST(Wspd, ConstantSpeedConverges) {
-  wspd_t w;
-  wspd_init(&w);
+TEST(WheelSpeed, ConstantSpeedConverges) {
+  wheel_speed_t w;
+  wheel_speed_init(&w);
   int32_t c = 0;
   for (uint32_t t = 0; t <= 500000; t += 1000) {
-    wspd_update(&w, c, -c, t);
+    wheel_speed_update(&w, c, -c, t);
     c += 4;  // 4000 counts/s = 13.09 rad/s (about top speed)
   }
-  EXPECT_NEAR(wspd_mrad_s(&w, 0), 13090, 30);
-  EXPECT_NEAR(wspd_mrad_s(&w, 1), -13090, 30);
+  EXPECT_NEAR(wheel_speed_mrad_s(&w, 0), 13090, 30);
+  EXPECT_NEAR(wheel_speed_mrad_s(&w, 1), -13090, 30);
   // stops: decays to zero
-  for (uint32_t t = 501000; t <= 1000000; t += 1000) wspd_update(&w, c, -c, t);
-  EXPECT_EQ(wspd_mrad_s(&w, 0), 0);
-  EXPECT_EQ(wspd_mrad_s(&w, 1), 0);
+  for (uint32_t t = 501000; t <= 1000000; t += 1000) wheel_speed_update(&w, c, -c, t);
+  EXPECT_EQ(wheel_speed_mrad_s(&w, 0), 0);
+  EXPECT_EQ(wheel_speed_mrad_s(&w, 1), 0);
 }
 
-TEST(Wspd, SlowWheelIsNotLostToQuantisation) {
-  wspd_t w;
-  wspd_init(&w);
+TEST(WheelSpeed, SlowWheelIsNotLostToQuantisation) {
+  wheel_speed_t w;
+  wheel_speed_init(&w);
   int64_t c_milli = 0;
   for (uint32_t t = 0; t <= 2000000; t += 1000) {
-    wspd_update(&w, static_cast<int32_t>(c_milli / 1000), 0, t);
+    wheel_speed_update(&w, static_cast<int32_t>(c_milli / 1000), 0, t);
     c_milli += 150;  // 150 counts/s = 0.491 rad/s: 1.5 counts per window
   }
-  EXPECT_NEAR(wspd_mrad_s(&w, 0), 491, 120);
+  EXPECT_NEAR(wheel_speed_mrad_s(&w, 0), 491, 120);
 }
 
 float Angle(const float a[4], const float b[4]) {
@@ -96,7 +96,7 @@ TEST(Ahrs, LevelAndStillStaysIdentityWithUnitNorm) {
   EXPECT_LT(Angle(a.q, id), 0.01f);
   int16_t q14[4];
   ahrs_quat_q14(&a, q14);
-  EXPECT_NEAR(q14[0], PROTO_QUAT_ONE, 2);
+  EXPECT_NEAR(q14[0], PROTOCOL_QUAT_ONE, 2);
 }
 
 TEST(Ahrs, ConvergesToRollFromGravity) {
@@ -116,7 +116,7 @@ TEST(Ahrs, YawFollowsGyroWithoutMagnetometer) {
   ahrs_t a;
   ahrs_init(&a);
   const int16_t acc[3] = {0, 0, 8192}, mag[3] = {0, 0, 0};
-  const int16_t gyr[3] = {0, 0, static_cast<int16_t>(90 * PROTO_GYRO_LSB_PER_DPS)};  // 90 deg/s
+  const int16_t gyr[3] = {0, 0, static_cast<int16_t>(90 * PROTOCOL_GYRO_LSB_PER_DPS)};  // 90 deg/s
   for (uint32_t t = 0; t <= 1000000; t += 10000) ahrs_update(&a, acc, gyr, mag, t);
   // 1 s at 90 deg/s about z
   const float yaw = 2.0f * std::atan2(a.q[3], a.q[0]);
@@ -150,48 +150,48 @@ TEST(Ahrs, GarbageInputNeverBreaksTheQuaternion) {
   EXPECT_NEAR(n2, 1.0f, 1e-3f);
 }
 
-TEST(Fs, StateMachineEdges) {
-  fs_t f;
-  fs_init(&f, 100);
-  EXPECT_EQ(f.mode, PROTO_MODE_DISARMED);
-  EXPECT_FALSE(fs_may_drive(&f));
-  EXPECT_EQ(fs_on_command(&f, 1, 0), 0);  // engaged without disengaged first
-  EXPECT_EQ(f.mode, PROTO_MODE_DISARMED);
-  EXPECT_EQ(fs_on_command(&f, 0, 10000), 0);
-  EXPECT_EQ(fs_on_command(&f, 1, 20000), 1);
-  EXPECT_TRUE(fs_may_drive(&f));
-  EXPECT_EQ(fs_on_command(&f, 1, 30000), 0);  // already engaged: not a new arming
-  fs_update(&f, 129999);
-  EXPECT_EQ(f.mode, PROTO_MODE_ENGAGED);
-  fs_update(&f, 130000);
-  EXPECT_EQ(f.mode, PROTO_MODE_FAILSAFE);
+TEST(Failsafe, StateMachineEdges) {
+  failsafe_t f;
+  failsafe_init(&f, 100);
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_DISARMED);
+  EXPECT_FALSE(failsafe_may_drive(&f));
+  EXPECT_EQ(failsafe_on_command(&f, 1, 0), 0);  // engaged without disengaged first
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_DISARMED);
+  EXPECT_EQ(failsafe_on_command(&f, 0, 10000), 0);
+  EXPECT_EQ(failsafe_on_command(&f, 1, 20000), 1);
+  EXPECT_TRUE(failsafe_may_drive(&f));
+  EXPECT_EQ(failsafe_on_command(&f, 1, 30000), 0);  // already engaged: not a new arming
+  failsafe_update(&f, 129999);
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_ENGAGED);
+  failsafe_update(&f, 130000);
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_FAILSAFE);
   EXPECT_EQ(f.link_lost, 1);
-  fs_update(&f, 5000000);  // stays
-  EXPECT_EQ(f.mode, PROTO_MODE_FAILSAFE);
-  EXPECT_EQ(fs_on_command(&f, 0, 5000000), 0);
-  EXPECT_EQ(f.mode, PROTO_MODE_FAILSAFE);
-  EXPECT_EQ(fs_on_command(&f, 1, 5010000), 1);
+  failsafe_update(&f, 5000000);  // stays
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_FAILSAFE);
+  EXPECT_EQ(failsafe_on_command(&f, 0, 5000000), 0);
+  EXPECT_EQ(f.mode, PROTOCOL_MODE_FAILSAFE);
+  EXPECT_EQ(failsafe_on_command(&f, 1, 5010000), 1);
   EXPECT_EQ(f.link_lost, 0);
-  fs_set_timeout_ms(&f, 20);
+  failsafe_set_timeout_ms(&f, 20);
   EXPECT_EQ(f.timeout_us, 20000u);
 }
 
-TEST(Act, DutyRoundingBrakeAndStop) {
-  act_t a;
-  act_init(&a, 0);
+TEST(Actuation, DutyRoundingBrakeAndStop) {
+  actuation_t a;
+  actuation_init(&a, 0);
   EXPECT_EQ(a.brake, 1);
   uint32_t t = 0;
-  for (int i = 0; i < 1000; ++i) act_update(&a, 500, 0, 0, t += 1000);
+  for (int i = 0; i < 1000; ++i) actuation_update(&a, 500, 0, 0, t += 1000);
   EXPECT_EQ(a.duty, 128);  // 0.5 * 255 = 127.5 -> 128
   EXPECT_EQ(a.brake, 0);
   EXPECT_EQ(a.decelerating, 0);
-  act_update(&a, 500, 0, 1, t += 1000);  // stop: immediate
+  actuation_update(&a, 500, 0, 1, t += 1000);  // stop: immediate
   EXPECT_EQ(a.duty, 0);
   EXPECT_EQ(a.brake, 1);
-  EXPECT_EQ(act_throttle_milli(&a), 0);
+  EXPECT_EQ(actuation_throttle_milli(&a), 0);
   // a long gap is clamped: at most 50 ms worth of slew (0.2) in one update
-  act_update(&a, 1000, 0, 0, t += 1000000);
-  EXPECT_EQ(act_throttle_milli(&a), 200);
+  actuation_update(&a, 1000, 0, 0, t += 1000000);
+  EXPECT_EQ(actuation_throttle_milli(&a), 200);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "collected_frames.h"
-#include "proto.h"
+#include "protocol.h"
 
 namespace {
 
@@ -30,7 +30,7 @@ TEST(Portability, PlatformFacts) {
 // (sync 0xA5, CRC bytes, negative fields) arrive through a `char` buffer, as a read() into
 // char storage would hand them, and must parse to the same values everywhere.
 TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
-  proto_state_t s{};
+  protocol_state_t s{};
   s.nano_time_us = 0xFEDCBA98u;
   s.enc_counts[0] = -1;
   s.enc_counts[1] = INT32_MIN;
@@ -45,25 +45,25 @@ TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
   s.mode = 0x80u;
   s.faults = 0x8001u;
   s.frames_bad_crc = 0xFF80u;
-  uint8_t payload[PROTO_LEN_STATE];
-  proto_state_pack(&s, payload);
-  uint8_t frame[PROTO_MAX_FRAME];
-  const size_t n =
-      proto_frame_encode(PROTO_ID_STATE, 0xFFu, payload, PROTO_LEN_STATE, frame, sizeof frame);
-  ASSERT_EQ(n, PROTO_LEN_STATE + PROTO_OVERHEAD);
+  uint8_t payload[PROTOCOL_LEN_STATE];
+  protocol_state_pack(&s, payload);
+  uint8_t frame[PROTOCOL_MAX_FRAME];
+  const size_t n = protocol_frame_encode(PROTOCOL_ID_STATE, 0xFFu, payload, PROTOCOL_LEN_STATE,
+                                         frame, sizeof frame);
+  ASSERT_EQ(n, PROTOCOL_LEN_STATE + PROTOCOL_OVERHEAD);
 
   std::vector<char> as_chars(n);
   std::memcpy(as_chars.data(), frame, n);
   std::vector<uint8_t> back(n);
   for (size_t i = 0; i < n; ++i) back[i] = static_cast<uint8_t>(as_chars[i]);
 
-  proto_parser_t p;
-  proto_parser_init(&p);
+  protocol_parser_t p;
+  protocol_parser_init(&p);
   CollectedFrames got;
-  ASSERT_EQ(proto_parser_feed(&p, back.data(), back.size(), collect_frame, &got), 1u);
+  ASSERT_EQ(protocol_parser_feed(&p, back.data(), back.size(), collect_frame, &got), 1u);
   ASSERT_EQ(got.frames.size(), 1u);
-  proto_state_t d{};
-  ASSERT_EQ(proto_state_unpack(got.frames[0].payload, got.frames[0].len, &d), 0);
+  protocol_state_t d{};
+  ASSERT_EQ(protocol_state_unpack(got.frames[0].payload, got.frames[0].len, &d), 0);
   EXPECT_EQ(d.nano_time_us, 0xFEDCBA98u);
   EXPECT_EQ(d.enc_counts[0], -1);
   EXPECT_EQ(d.enc_counts[1], INT32_MIN);
@@ -83,16 +83,16 @@ TEST(Portability, HighBytesThroughCharBufferParseTheSame) {
 // The wire bytes themselves, written out from PROTOCOL.md (little-endian, two's complement):
 // the same on the Nano, amd64 and aarch64 whatever their char or long.
 TEST(Portability, CommandBytesAreThePublishedLayout) {
-  proto_command_t c{};
+  protocol_command_t c{};
   c.seq = 0x8081u;
   c.throttle_milli = -1000;  // 0xFC18
   c.steering_milli = -2;     // 0xFFFE
   c.headlights = 2;
   c.indicators = 3;
-  c.flags = PROTO_CMD_ENGAGED;
-  uint8_t out[PROTO_LEN_COMMAND];
-  proto_command_pack(&c, out);
-  const uint8_t want[PROTO_LEN_COMMAND] = {0x81, 0x80, 0x18, 0xFC, 0xFE, 0xFF, 2, 3, 1};
+  c.flags = PROTOCOL_CMD_ENGAGED;
+  uint8_t out[PROTOCOL_LEN_COMMAND];
+  protocol_command_pack(&c, out);
+  const uint8_t want[PROTOCOL_LEN_COMMAND] = {0x81, 0x80, 0x18, 0xFC, 0xFE, 0xFF, 2, 3, 1};
   EXPECT_EQ(std::memcmp(out, want, sizeof want), 0);
 }
 
@@ -101,22 +101,22 @@ TEST(Portability, CommandBytesAreThePublishedLayout) {
 TEST(Portability, Bit31FieldsRoundTrip) {
   const uint32_t values[] = {0x80000000u, 0xFFFFFFFFu, 0x7FFFFFFFu, 0x00000080u, 0x00008000u};
   for (uint32_t v : values) {
-    proto_hello_t h{};
+    protocol_hello_t h{};
     h.schema_hash = v;
     h.build_id = ~v;
-    uint8_t buf[PROTO_LEN_HELLO];
-    proto_hello_pack(&h, buf);
-    proto_hello_t d{};
-    ASSERT_EQ(proto_hello_unpack(buf, PROTO_LEN_HELLO, &d), 0);
+    uint8_t buf[PROTOCOL_LEN_HELLO];
+    protocol_hello_pack(&h, buf);
+    protocol_hello_t d{};
+    ASSERT_EQ(protocol_hello_unpack(buf, PROTOCOL_LEN_HELLO, &d), 0);
     EXPECT_EQ(d.schema_hash, v);
     EXPECT_EQ(d.build_id, static_cast<uint32_t>(~v));
-    proto_state_t s{};
+    protocol_state_t s{};
     s.nano_time_us = v;
     s.enc_counts[0] = static_cast<int32_t>(v);
-    uint8_t sb[PROTO_LEN_STATE];
-    proto_state_pack(&s, sb);
-    proto_state_t sd{};
-    ASSERT_EQ(proto_state_unpack(sb, PROTO_LEN_STATE, &sd), 0);
+    uint8_t sb[PROTOCOL_LEN_STATE];
+    protocol_state_pack(&s, sb);
+    protocol_state_t sd{};
+    ASSERT_EQ(protocol_state_unpack(sb, PROTOCOL_LEN_STATE, &sd), 0);
     EXPECT_EQ(sd.nano_time_us, v);
     EXPECT_EQ(sd.enc_counts[0], static_cast<int32_t>(v));
   }
@@ -127,29 +127,29 @@ TEST(Portability, Bit31FieldsRoundTrip) {
 // decoder that cast the pointer to uint32_t* would fault on strict-alignment targets and is
 // caught by UBSan's alignment check here.
 TEST(Portability, PayloadAtEveryOffset) {
-  proto_state_t s{};
+  protocol_state_t s{};
   s.nano_time_us = 0x12345678u;
   s.enc_counts[0] = -123456;
   s.enc_counts[1] = 654321;
   s.gyro_raw[1] = -300;
   s.last_cmd_seq = 0xBEEFu;
-  uint8_t ref[PROTO_LEN_STATE];
-  proto_state_pack(&s, ref);
-  alignas(8) uint8_t storage[PROTO_LEN_STATE + 16];
+  uint8_t ref[PROTOCOL_LEN_STATE];
+  protocol_state_pack(&s, ref);
+  alignas(8) uint8_t storage[PROTOCOL_LEN_STATE + 16];
   for (size_t off = 0; off < 8; ++off) {
     uint8_t *at = storage + off;
     std::memset(storage, 0xCC, sizeof storage);
-    proto_state_pack(&s, at);
-    EXPECT_EQ(std::memcmp(at, ref, PROTO_LEN_STATE), 0) << "pack at offset " << off;
-    proto_state_t d{};
-    ASSERT_EQ(proto_state_unpack(at, PROTO_LEN_STATE, &d), 0) << "offset " << off;
+    protocol_state_pack(&s, at);
+    EXPECT_EQ(std::memcmp(at, ref, PROTOCOL_LEN_STATE), 0) << "pack at offset " << off;
+    protocol_state_t d{};
+    ASSERT_EQ(protocol_state_unpack(at, PROTOCOL_LEN_STATE, &d), 0) << "offset " << off;
     EXPECT_EQ(d.nano_time_us, 0x12345678u) << "offset " << off;
     EXPECT_EQ(d.enc_counts[0], -123456) << "offset " << off;
     EXPECT_EQ(d.enc_counts[1], 654321) << "offset " << off;
     EXPECT_EQ(d.gyro_raw[1], -300) << "offset " << off;
     EXPECT_EQ(d.last_cmd_seq, 0xBEEFu) << "offset " << off;
-    EXPECT_EQ(proto_crc16(0xFFFFu, at, PROTO_LEN_STATE),
-              proto_crc16(0xFFFFu, ref, PROTO_LEN_STATE));
+    EXPECT_EQ(protocol_crc16(0xFFFFu, at, PROTOCOL_LEN_STATE),
+              protocol_crc16(0xFFFFu, ref, PROTOCOL_LEN_STATE));
   }
 }
 

@@ -28,9 +28,9 @@ import time
 from pathlib import Path
 
 STK_GET_SYNC = b"\x30\x20"  # STK500v1 Cmnd_STK_GET_SYNC, Sync_CRC_EOP
-# Frame start of the Nano link and the HELLO / STATE ids (firmware/nano/lib/proto/PROTOCOL.md).
+# Frame start of the Nano link and the HELLO / STATE ids (firmware/nano/core/protocol/PROTOCOL.md).
 FRAME_SYNC = b"\xa5\x5a"
-PROTO_ID_HELLO, PROTO_ID_STATE = 0x81, 0x82
+PROTOCOL_ID_HELLO, PROTOCOL_ID_STATE = 0x81, 0x82
 
 
 def sections(elf: Path) -> dict[str, int]:
@@ -189,9 +189,9 @@ def upload_once(root: Path, work: Path, pio: Path, simavr: Path, bootloader: Pat
             deadline = time.monotonic() + 20
             while time.monotonic() < deadline:
                 ids = frame_ids(got)
-                if PROTO_ID_HELLO in ids and ids.count(PROTO_ID_STATE) >= 10:
+                if PROTOCOL_ID_HELLO in ids and ids.count(PROTOCOL_ID_STATE) >= 10:
                     print(
-                        f"the flashed firmware runs: HELLO and {ids.count(PROTO_ID_STATE)} STATE frames"
+                        f"the flashed firmware runs: HELLO and {ids.count(PROTOCOL_ID_STATE)} STATE frames"
                     )
                     return ""
                 ready, _, _ = select.select([fd], [], [], 0.2)

@@ -1,15 +1,15 @@
 # The portable firmware core's sources and include dirs, shared by the host build
-# (firmware/nano/CMakeLists.txt) and the AVR build. Excludes proto.c (target nano_proto).
-set(_nano_lib "${CMAKE_CURRENT_LIST_DIR}")
+# (firmware/nano/CMakeLists.txt) and the AVR build. Excludes protocol.c (target nano_protocol).
+set(_nano_core "${CMAKE_CURRENT_LIST_DIR}")
 set(NANO_CORE_SOURCES
-  ${_nano_lib}/nigel/nigel_core.c
-  ${_nano_lib}/fs/fs.c
-  ${_nano_lib}/act/act.c
-  ${_nano_lib}/lights/lights.c
-  ${_nano_lib}/batt/batt.c
-  ${_nano_lib}/wspd/wspd.c
-  ${_nano_lib}/ahrs/ahrs.c)
-set(NANO_PROTO_SOURCES ${_nano_lib}/proto/proto.c)
+  ${_nano_core}/nano_core/nano_core.c
+  ${_nano_core}/failsafe/failsafe.c
+  ${_nano_core}/actuation/actuation.c
+  ${_nano_core}/lights/lights.c
+  ${_nano_core}/battery/battery.c
+  ${_nano_core}/wheel_speed/wheel_speed.c
+  ${_nano_core}/ahrs/ahrs.c)
+set(NANO_PROTOCOL_SOURCES ${_nano_core}/protocol/protocol.c)
 set(NANO_CORE_INCLUDE_DIRS
-  ${_nano_lib}/nigel ${_nano_lib}/proto ${_nano_lib}/fs ${_nano_lib}/act ${_nano_lib}/lights
-  ${_nano_lib}/batt ${_nano_lib}/wspd ${_nano_lib}/ahrs ${_nano_lib}/enc)
+  ${_nano_core}/nano_core ${_nano_core}/protocol ${_nano_core}/failsafe ${_nano_core}/actuation ${_nano_core}/lights
+  ${_nano_core}/battery ${_nano_core}/wheel_speed ${_nano_core}/ahrs ${_nano_core}/encoder)

@@ -1,23 +1,23 @@
 /* Wheel encoders: channel A on INT0 (left, D2) / INT1 (right, D3), any edge; channel B
- * (D4 / D5) is read inside the ISR and decoded by lib/enc (x2: one count per A edge, + when
+ * (D4 / D5) is read inside the ISR and decoded by core/encoder (x2: one count per A edge, + when
  * A != B after the edge, i.e. A leads B). 1920 counts per wheel revolution. */
-#ifndef NIGEL_FW_ENC_H
-#define NIGEL_FW_ENC_H
+#ifndef AUTODRIVE_HAL_AVR_ENCODER_H
+#define AUTODRIVE_HAL_AVR_ENCODER_H
 #include <stdint.h>
 
 /* 1: that side's encoder is mounted mirrored (set to match the car's wiring). */
-#ifndef FW_ENC_LEFT_INVERT
-#define FW_ENC_LEFT_INVERT 0u
+#ifndef HAL_AVR_ENCODER_LEFT_INVERT
+#define HAL_AVR_ENCODER_LEFT_INVERT 0u
 #endif
-#ifndef FW_ENC_RIGHT_INVERT
-#define FW_ENC_RIGHT_INVERT 0u
+#ifndef HAL_AVR_ENCODER_RIGHT_INVERT
+#define HAL_AVR_ENCODER_RIGHT_INVERT 0u
 #endif
 #ifdef __cplusplus
 extern "C" {
 #endif
-void fw_enc_init(void);
+void hal_avr_encoder_init(void);
 /* Atomic snapshot of both counters [counts]. */
-void fw_enc_read(int32_t *left_counts, int32_t *right_counts);
+void hal_avr_encoder_read(int32_t *left_counts, int32_t *right_counts);
 #ifdef __cplusplus
 }
 #endif

@@ -1,8 +1,8 @@
-#include "fw_imu.h"
+#include "hal_avr_imu.h"
 
 #include <stdint.h>
 
-#include "fw_twi.h"
+#include "hal_avr_twi.h"
 
 #define MPU_ADDR 0x68u
 #define AK_ADDR 0x0Cu
@@ -22,7 +22,7 @@ static uint8_t s_state, s_step, s_reg;
 static uint8_t s_buf[14];
 static uint32_t s_txn_start_us, s_last_ok_us, s_retry_at_us, s_sample_start_us;
 static uint8_t s_have_sample;
-static nigel_imu_raw_t s_sample;
+static nano_core_imu_raw_t s_sample;
 
 static int16_t be16(const uint8_t *p) {
   return (int16_t)((uint16_t)p[0] << 8 | p[1]);
@@ -37,49 +37,49 @@ static void begin(uint8_t state, uint32_t now_us) {
   switch (state) {
     case ST_PROBE:
       s_reg = MPU_WHO_AM_I;
-      fw_twi_start(MPU_ADDR, &s_reg, 1, s_buf, 1);
+      hal_avr_twi_start(MPU_ADDR, &s_reg, 1, s_buf, 1);
       break;
-    case ST_INIT: fw_twi_start(k_init[s_step][0], &k_init[s_step][1], 2, 0, 0); break;
+    case ST_INIT: hal_avr_twi_start(k_init[s_step][0], &k_init[s_step][1], 2, 0, 0); break;
     case ST_ACCEL:
       s_sample_start_us = now_us;
       s_reg = 0x3Bu; /* ACCEL_XOUT_H .. GYRO_ZOUT_L, big-endian */
-      fw_twi_start(MPU_ADDR, &s_reg, 1, s_buf, 14);
+      hal_avr_twi_start(MPU_ADDR, &s_reg, 1, s_buf, 14);
       break;
     case ST_MAG:
       s_reg = 0x03u; /* HXL .. HZH, ST2 (reading ST2 releases the next sample) */
-      fw_twi_start(AK_ADDR, &s_reg, 1, s_buf, 7);
+      hal_avr_twi_start(AK_ADDR, &s_reg, 1, s_buf, 7);
       break;
     default: break;
   }
 }
 
 static void fail(uint32_t now_us) {
-  fw_twi_abort();
+  hal_avr_twi_abort();
   s_state = ST_WAIT_RETRY;
-  s_retry_at_us = now_us + FW_IMU_RETRY_US;
+  s_retry_at_us = now_us + HAL_AVR_IMU_RETRY_US;
 }
 
-void fw_imu_init(uint32_t now_us) {
-  fw_twi_init();
+void hal_avr_imu_init(uint32_t now_us) {
+  hal_avr_twi_init();
   s_have_sample = 0;
   begin(ST_PROBE, now_us);
 }
 
-void fw_imu_poll(uint32_t now_us) {
+void hal_avr_imu_poll(uint32_t now_us) {
   if (s_state == ST_IDLE) {
-    if (now_us - s_sample_start_us >= FW_IMU_PERIOD_US) begin(ST_ACCEL, now_us);
+    if (now_us - s_sample_start_us >= HAL_AVR_IMU_PERIOD_US) begin(ST_ACCEL, now_us);
     return;
   }
   if (s_state == ST_WAIT_RETRY) {
     if ((int32_t)(now_us - s_retry_at_us) >= 0) begin(ST_PROBE, now_us);
     return;
   }
-  uint8_t st = fw_twi_status();
-  if (st == FW_TWI_BUSY) {
-    if (now_us - s_txn_start_us > FW_IMU_TXN_TIMEOUT_US) fail(now_us);
+  uint8_t st = hal_avr_twi_status();
+  if (st == HAL_AVR_TWI_BUSY) {
+    if (now_us - s_txn_start_us > HAL_AVR_IMU_TXN_TIMEOUT_US) fail(now_us);
     return;
   }
-  if (st == FW_TWI_ERROR) {
+  if (st == HAL_AVR_TWI_ERROR) {
     fail(now_us);
     return;
   }
@@ -120,8 +120,8 @@ void fw_imu_poll(uint32_t now_us) {
   }
 }
 
-int fw_imu_read(uint32_t now_us, nigel_imu_raw_t *out) {
-  if (!s_have_sample || now_us - s_last_ok_us > FW_IMU_STALE_US) return -1;
+int hal_avr_imu_read(uint32_t now_us, nano_core_imu_raw_t *out) {
+  if (!s_have_sample || now_us - s_last_ok_us > HAL_AVR_IMU_STALE_US) return -1;
   *out = s_sample;
   return 0;
 }

@@ -1,17 +1,17 @@
-#include "fw_io.h"
+#include "hal_avr_io.h"
 
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <avr/wdt.h>
 
-#include "fw_pins.h"
-#include "nigel_hal.h"
+#include "hal_avr_pins.h"
+#include "nano_core_hal.h"
 
 /* Timer1 mode 14 (fast PWM, TOP = ICR1), prescaler 8: 0.5 us per tick, 20 ms period. */
 #define SERVO_TICKS_PER_US 2u
 #define SERVO_PERIOD_TICKS 40000u
 
-void fw_io_init(void) {
+void hal_avr_io_init(void) {
   /* motor: DIR D7 low, BRK D8 high (braked), PWM D6 duty 0 on Timer0 (set up by init()) */
   PORTD &= (uint8_t) ~(_BV(PD6) | _BV(PD7));
   DDRD |= _BV(PD6) | _BV(PD7);
@@ -34,17 +34,17 @@ void fw_io_init(void) {
   DDRC |= _BV(PC0) | _BV(PC1);
 
   /* battery ADC: AVcc reference, ADC7, prescaler 128 (125 kHz), first conversion started */
-  ADMUX = _BV(REFS0) | FW_BATT_ADC_CHANNEL;
+  ADMUX = _BV(REFS0) | HAL_AVR_BATTERY_ADC_CHANNEL;
   ADCSRA = _BV(ADEN) | _BV(ADSC) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
 }
 
-void fw_servo_set_us(uint16_t pulse_us) {
+void hal_avr_servo_set_us(uint16_t pulse_us) {
   if (pulse_us < 1000u) pulse_us = 1000u;
   if (pulse_us > 2000u) pulse_us = 2000u;
   OCR1A = (uint16_t)(pulse_us * SERVO_TICKS_PER_US); /* double-buffered: applied at BOTTOM */
 }
 
-void fw_motor_set(uint8_t duty, uint8_t reverse, uint8_t brake) {
+void hal_avr_motor_set(uint8_t duty, uint8_t reverse, uint8_t brake) {
   if (brake) {
     duty = 0;
     PORTB |= _BV(PB0);
@@ -65,15 +65,15 @@ void fw_motor_set(uint8_t duty, uint8_t reverse, uint8_t brake) {
   }
 }
 
-void fw_lamps_set(uint8_t lamps) {
+void hal_avr_lamps_set(uint8_t lamps) {
   uint8_t b = PORTB & (uint8_t) ~(_BV(PB2) | _BV(PB3) | _BV(PB4) | _BV(PB5));
-  if (lamps & NIGEL_LAMP_HEAD_LOW) b |= _BV(PB2);
-  if (lamps & NIGEL_LAMP_HEAD_HIGH) b |= _BV(PB3);
-  if (lamps & NIGEL_LAMP_TAIL) b |= _BV(PB4);
-  if (lamps & NIGEL_LAMP_REVERSE) b |= _BV(PB5);
+  if (lamps & NANO_CORE_LAMP_HEAD_LOW) b |= _BV(PB2);
+  if (lamps & NANO_CORE_LAMP_HEAD_HIGH) b |= _BV(PB3);
+  if (lamps & NANO_CORE_LAMP_TAIL) b |= _BV(PB4);
+  if (lamps & NANO_CORE_LAMP_REVERSE) b |= _BV(PB5);
   uint8_t c = PORTC & (uint8_t) ~(_BV(PC0) | _BV(PC1));
-  if (lamps & NIGEL_LAMP_IND_LEFT) c |= _BV(PC0);
-  if (lamps & NIGEL_LAMP_IND_RIGHT) c |= _BV(PC1);
+  if (lamps & NANO_CORE_LAMP_IND_LEFT) c |= _BV(PC0);
+  if (lamps & NANO_CORE_LAMP_IND_RIGHT) c |= _BV(PC1);
   uint8_t sreg = SREG; /* PORTB/PORTC are shared with no ISR, but keep the write atomic */
   cli();
   PORTB = b;
@@ -83,12 +83,13 @@ void fw_lamps_set(uint8_t lamps) {
 
 static uint16_t s_battery_mv;
 
-uint16_t fw_battery_read_mv(void) {
+uint16_t hal_avr_battery_read_mv(void) {
   if (!(ADCSRA & _BV(ADSC))) {
     uint32_t adc = ADC; /* 0..1023 */
-    uint32_t mv_at_pin = adc * FW_ADC_REF_MV / 1023u;
+    uint32_t mv_at_pin = adc * HAL_AVR_ADC_REF_MV / 1023u;
     s_battery_mv =
-        (uint16_t)(mv_at_pin * (FW_BATT_R_TOP_OHM + FW_BATT_R_BOTTOM_OHM) / FW_BATT_R_BOTTOM_OHM);
+        (uint16_t)(mv_at_pin * (HAL_AVR_BATTERY_R_TOP_OHM + HAL_AVR_BATTERY_R_BOTTOM_OHM) /
+                   HAL_AVR_BATTERY_R_BOTTOM_OHM);
     ADCSRA |= _BV(ADSC);
   }
   return s_battery_mv;
@@ -97,21 +98,21 @@ uint16_t fw_battery_read_mv(void) {
 /* MCUSR must be read and cleared before the watchdog can be turned off after a WDT reset
  * (WDRF forces WDE on): done in .init3, before main() and the C++ constructors. */
 static uint8_t s_mcusr __attribute__((section(".noinit")));
-void fw_io_capture_mcusr(void) __attribute__((naked, used, section(".init3")));
-void fw_io_capture_mcusr(void) {
+void hal_avr_io_capture_mcusr(void) __attribute__((naked, used, section(".init3")));
+void hal_avr_io_capture_mcusr(void) {
   s_mcusr = MCUSR;
   MCUSR = 0;
   wdt_disable();
 }
 
-uint8_t fw_reset_cause(void) {
+uint8_t hal_avr_reset_cause(void) {
   return s_mcusr;
 }
 
-void fw_wdt_start(void) {
+void hal_avr_wdt_start(void) {
   wdt_enable(WDTO_250MS);
 }
 
-void fw_wdt_kick(void) {
+void hal_avr_wdt_kick(void) {
   wdt_reset();
 }

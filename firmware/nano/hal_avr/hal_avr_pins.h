@@ -18,15 +18,15 @@
  *   A7  ADC7       battery through a 10k:3.3k divider (11.1 V 3S pack -> ~2.8 V)
  *   D0/D1          UART0 at 500000 baud (U2X, UBRR0 = 3, exact at 16 MHz)
  */
-#ifndef NIGEL_FW_PINS_H
-#define NIGEL_FW_PINS_H
+#ifndef AUTODRIVE_HAL_AVR_PINS_H
+#define AUTODRIVE_HAL_AVR_PINS_H
 
-#define FW_F_CPU_HZ 16000000ul
+#define HAL_AVR_F_CPU_HZ 16000000ul
 
 /* Battery divider: V_pack = V_adc * (R_top + R_bottom) / R_bottom, AVcc = 5.0 V reference. */
-#define FW_BATT_R_TOP_OHM 10000ul
-#define FW_BATT_R_BOTTOM_OHM 3300ul
-#define FW_ADC_REF_MV 5000ul
-#define FW_BATT_ADC_CHANNEL 7u
+#define HAL_AVR_BATTERY_R_TOP_OHM 10000ul
+#define HAL_AVR_BATTERY_R_BOTTOM_OHM 3300ul
+#define HAL_AVR_ADC_REF_MV 5000ul
+#define HAL_AVR_BATTERY_ADC_CHANNEL 7u
 
 #endif

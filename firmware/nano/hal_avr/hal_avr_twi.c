@@ -1,4 +1,4 @@
-#include "fw_twi.h"
+#include "hal_avr_twi.h"
 
 #include <avr/interrupt.h>
 #include <avr/io.h>
@@ -12,16 +12,16 @@ static uint8_t s_nw, s_nr, s_iw, s_ir;
 
 #define TWCR_RUN (_BV(TWEN) | _BV(TWIE) | _BV(TWINT))
 
-void fw_twi_init(void) {
+void hal_avr_twi_init(void) {
   PORTC |= _BV(PC4) | _BV(PC5); /* weak internal pull-ups; the IMU board has its own */
   TWSR = 0;                     /* prescaler 1 */
   TWBR = 12;                    /* 16 MHz / (16 + 2 * 12) = 400 kHz */
   TWCR = _BV(TWEN);
-  s_status = FW_TWI_IDLE;
+  s_status = HAL_AVR_TWI_IDLE;
 }
 
-int fw_twi_start(uint8_t addr7, const uint8_t *wr, uint8_t nw, uint8_t *rd, uint8_t nr) {
-  if (s_status == FW_TWI_BUSY) return -1;
+int hal_avr_twi_start(uint8_t addr7, const uint8_t *wr, uint8_t nw, uint8_t *rd, uint8_t nr) {
+  if (s_status == HAL_AVR_TWI_BUSY) return -1;
   s_addr7 = addr7;
   s_wr = wr;
   s_nw = nw;
@@ -29,12 +29,12 @@ int fw_twi_start(uint8_t addr7, const uint8_t *wr, uint8_t nw, uint8_t *rd, uint
   s_nr = nr;
   s_iw = 0;
   s_ir = 0;
-  s_status = FW_TWI_BUSY;
+  s_status = HAL_AVR_TWI_BUSY;
   TWCR = TWCR_RUN | _BV(TWSTA);
   return 0;
 }
 
-uint8_t fw_twi_status(void) {
+uint8_t hal_avr_twi_status(void) {
   return s_status;
 }
 
@@ -43,12 +43,12 @@ static void finish(uint8_t status) {
   s_status = status;
 }
 
-void fw_twi_abort(void) {
+void hal_avr_twi_abort(void) {
   uint8_t sreg = SREG;
   cli();
   TWCR = 0; /* disabling the TWI releases SDA/SCL and clears its state */
   TWCR = _BV(TWEN);
-  s_status = FW_TWI_ERROR;
+  s_status = HAL_AVR_TWI_ERROR;
   SREG = sreg;
 }
 
@@ -67,7 +67,7 @@ ISR(TWI_vect) {
       } else if (s_nr > 0) {
         TWCR = TWCR_RUN | _BV(TWSTA); /* repeated START for the read */
       } else {
-        finish(FW_TWI_DONE);
+        finish(HAL_AVR_TWI_DONE);
       }
       break;
     case TW_MR_SLA_ACK: TWCR = s_nr > 1 ? (TWCR_RUN | _BV(TWEA)) : TWCR_RUN; break;
@@ -77,8 +77,10 @@ ISR(TWI_vect) {
       break;
     case TW_MR_DATA_NACK:
       s_rd[s_ir++] = TWDR;
-      finish(FW_TWI_DONE);
+      finish(HAL_AVR_TWI_DONE);
       break;
-    default: /* NACK on address or data, arbitration lost, bus error */ finish(FW_TWI_ERROR); break;
+    default: /* NACK on address or data, arbitration lost, bus error */
+      finish(HAL_AVR_TWI_ERROR);
+      break;
   }
 }

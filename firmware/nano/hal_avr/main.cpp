@@ -1,16 +1,16 @@
-/* Arduino glue of the Nigel Nano firmware: wires the AVR HAL (fw_*.c) to the portable core
- * (firmware/nano/lib/nigel) and runs it. setup()/loop() so that PlatformIO's Arduino framework
+/* Arduino glue of the Nigel Nano firmware: wires the AVR HAL (hal_avr_*.c) to the portable core
+ * (firmware/nano/core/nano_core) and runs it. setup()/loop() so that PlatformIO's Arduino framework
  * and the CMake build (firmware/nano/avr) build the same file. */
 #include <Arduino.h>
 #include <avr/interrupt.h>
 #include <avr/sleep.h>
 
-#include "enc.h"
-#include "fw_enc.h"
-#include "fw_imu.h"
-#include "fw_io.h"
-#include "fw_uart.h"
-#include "nigel_core.h"
+#include "encoder.h"
+#include "hal_avr_encoder.h"
+#include "hal_avr_imu.h"
+#include "hal_avr_io.h"
+#include "hal_avr_uart.h"
+#include "nano_core.h"
 
 #if defined(__has_include)
 #if __has_include("fw_build_id.h")
@@ -21,29 +21,29 @@
 #define NIGEL_BUILD_ID 0ul /* neither the CMake stamp nor the PlatformIO build flag */
 #endif
 
-static nigel_t g_nigel;
+static nano_core_t g_nigel;
 static uint32_t g_now_us; /* time of the current loop pass, for the HAL callbacks */
 
 static void hal_motor_set(void *, uint8_t duty, uint8_t reverse, uint8_t brake) {
-  fw_motor_set(duty, reverse, brake);
+  hal_avr_motor_set(duty, reverse, brake);
 }
 static void hal_servo_set_us(void *, uint16_t pulse_us) {
-  fw_servo_set_us(pulse_us);
+  hal_avr_servo_set_us(pulse_us);
 }
 static void hal_lamps_set(void *, uint8_t lamps) {
-  fw_lamps_set(lamps);
+  hal_avr_lamps_set(lamps);
 }
-static int hal_imu_read(void *, nigel_imu_raw_t *out) {
-  return fw_imu_read(g_now_us, out);
+static int hal_imu_read(void *, nano_core_imu_raw_t *out) {
+  return hal_avr_imu_read(g_now_us, out);
 }
 static uint16_t hal_battery_read_mv(void *) {
-  return fw_battery_read_mv();
+  return hal_avr_battery_read_mv();
 }
 static void hal_serial_write(void *, const uint8_t *data, uint8_t n) {
-  fw_uart_write(data, n);
+  hal_avr_uart_write(data, n);
 }
 
-static const nigel_hal_t k_hal = {
+static const nano_core_hal_t k_hal = {
     nullptr,      hal_motor_set,       hal_servo_set_us, hal_lamps_set,
     hal_imu_read, hal_battery_read_mv, hal_serial_write,
 };
@@ -51,37 +51,38 @@ static const nigel_hal_t k_hal = {
 #ifdef NIGEL_FW_TEST_HOOKS
 /* Test builds only (nigel_nano_test.elf): the simavr harness sets this flag in RAM to hang
  * the main loop and prove that the watchdog resets the board into the safe state. */
-extern "C" volatile uint8_t fw_test_hang;
-volatile uint8_t fw_test_hang;
+extern "C" volatile uint8_t hal_avr_test_hang;
+volatile uint8_t hal_avr_test_hang;
 #endif
 
 /* One main-loop pass; not inlined so that the simavr harness can time it by its address. */
-extern "C" void fw_loop_once(void) __attribute__((noinline, used));
-extern "C" void fw_loop_once(void) {
+extern "C" void hal_avr_loop_once(void) __attribute__((noinline, used));
+extern "C" void hal_avr_loop_once(void) {
   uint8_t rx[32];
   int32_t left_counts, right_counts;
   g_now_us = micros();
-  uint8_t n = fw_uart_read(rx, sizeof rx);
-  if (n > 0) nigel_rx(&g_nigel, rx, n, g_now_us);
-  fw_imu_poll(g_now_us);
-  fw_enc_read(&left_counts, &right_counts);
-  nigel_step(&g_nigel, g_now_us, left_counts, right_counts);
+  uint8_t n = hal_avr_uart_read(rx, sizeof rx);
+  if (n > 0) nano_core_rx(&g_nigel, rx, n, g_now_us);
+  hal_avr_imu_poll(g_now_us);
+  hal_avr_encoder_read(&left_counts, &right_counts);
+  nano_core_step(&g_nigel, g_now_us, left_counts, right_counts);
 #ifdef NIGEL_FW_TEST_HOOKS
-  while (fw_test_hang) {
+  while (hal_avr_test_hang) {
   }
 #endif
-  fw_wdt_kick();
+  hal_avr_wdt_kick();
 }
 
 void setup() {
-  uint8_t reset_cause = fw_reset_cause();
-  fw_io_init(); /* safe state first: brake on, servo centred, lamps off */
-  fw_enc_init();
-  fw_uart_init();
-  fw_wdt_start();
+  uint8_t reset_cause = hal_avr_reset_cause();
+  hal_avr_io_init(); /* safe state first: brake on, servo centred, lamps off */
+  hal_avr_encoder_init();
+  hal_avr_uart_init();
+  hal_avr_wdt_start();
   g_now_us = micros();
-  fw_imu_init(g_now_us);
-  nigel_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0), NIGEL_BUILD_ID);
+  hal_avr_imu_init(g_now_us);
+  nano_core_init(&g_nigel, &k_hal, g_now_us, (uint8_t)((reset_cause & _BV(WDRF)) != 0),
+                 NIGEL_BUILD_ID);
 }
 
 /* Arduino core (wiring.c): Timer0 overflows so far, one every 1.024 ms (millis/micros). */
@@ -93,14 +94,14 @@ extern "C" volatile unsigned long timer0_overflow_count;
  * other interrupts (a sent byte, an encoder edge, a TWI step) do their work in their ISR and
  * the CPU goes back to sleep; encoder counts and the TWI state are read at the next pass. The
  * CPU does not spin, which saves power on the car and lets simavr skip the idle cycles
- * (nano-simavr keeps up with real time). Telemetry keeps its 10 ms mean period: nigel_step
+ * (nano-simavr keeps up with real time). Telemetry keeps its 10 ms mean period: nano_core_step
  * schedules it drift-free, the tick only adds jitter below 1.024 ms. */
-static void fw_sleep_until_work(void) {
+static void hal_avr_sleep_until_work(void) {
   const uint8_t tick = (uint8_t)timer0_overflow_count; /* one byte: read atomically */
   set_sleep_mode(SLEEP_MODE_IDLE);
   for (;;) {
     cli();
-    if (fw_uart_rx_pending() || (uint8_t)timer0_overflow_count != tick) break;
+    if (hal_avr_uart_rx_pending() || (uint8_t)timer0_overflow_count != tick) break;
     sleep_enable();
     sei(); /* the instruction after SEI runs before any interrupt: no wake-up is missed */
     sleep_cpu();
@@ -110,6 +111,6 @@ static void fw_sleep_until_work(void) {
 }
 
 void loop() {
-  fw_loop_once();
-  fw_sleep_until_work();
+  hal_avr_loop_once();
+  hal_avr_sleep_until_work();
 }

@@ -96,7 +96,7 @@ LoadFigures measure_load(const std::string &elf, double edges_hz, uint64_t durat
   b.encoder_rate(edges_hz, +1);
   b.reset_cycle_stats();
   b.record_loop_cycles(true);
-  const size_t states0 = b.count(PROTO_ID_STATE);
+  const size_t states0 = b.count(PROTOCOL_ID_STATE);
   const uint64_t passes0 = b.loop_passes();
   const uint64_t t0 = b.now_us();
   for (uint64_t t = 0; t < duration_us; t += 10 * kMs) {
@@ -106,7 +106,7 @@ LoadFigures measure_load(const std::string &elf, double edges_hz, uint64_t durat
   }
   LoadFigures f;
   const double secs = static_cast<double>(b.now_us() - t0) / 1e6;
-  f.telemetry_hz = static_cast<double>(b.count(PROTO_ID_STATE) - states0) / secs;
+  f.telemetry_hz = static_cast<double>(b.count(PROTOCOL_ID_STATE) - states0) / secs;
   f.loop_hz = static_cast<double>(b.loop_passes() - passes0) / secs;
   f.loop_cycles_max = b.loop_cycles_max();
   std::vector<uint32_t> passes = b.loop_cycles();
@@ -131,7 +131,7 @@ bool edges_all_counted(const std::string &elf, double edges_hz) {
   stream(b, seq, 250 * kMs, 300, 0, true);
   b.encoder_rate(0);
   stream(b, seq, 30 * kMs, 300, 0, true);
-  proto_state_t s{};
+  protocol_state_t s{};
   if (!b.last_state(&s)) return false;
   return s.enc_counts[0] == b.encoder_injected(0) && s.enc_counts[1] == b.encoder_injected(1);
 }

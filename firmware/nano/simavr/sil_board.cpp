@@ -15,7 +15,7 @@ extern "C" {
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
 #include <simavr/sim_io.h>
-#include "nigel_hal.h"
+#include "nano_core_hal.h"
 }
 
 namespace sil {
@@ -46,7 +46,7 @@ void quiet_logger(avr_t *, const int level, const char *format, va_list ap) {
   if (level <= LOG_ERROR) std::vfprintf(stderr, format, ap);
 }
 
-void on_frame(const proto_frame_t *f, void *ctx) {
+void on_frame(const protocol_frame_t *f, void *ctx) {
   auto *b = static_cast<std::pair<Board *, std::vector<Frame> *> *>(ctx);
   b->second->push_back(Frame{b->first->cycle(), *f});
 }
@@ -77,7 +77,7 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   free(fw.symbol);
   free(fw.flash);  // copied into the core by avr_load_firmware
   free(fw.eeprom);
-  loop_addr_ = symbol("fw_loop_once");
+  loop_addr_ = symbol("hal_avr_loop_once");
   quiet_uart(avr_);
   uart_in_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
   avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
@@ -92,7 +92,7 @@ Board::Board(const std::string &elf_path, bool imu_present) {
   }
   imu_ = std::make_unique<Mpu9250>(avr_, imu_present);
   set_adc7_mv(2850);  // ~12.1 V pack through the 10k:3.3k divider
-  proto_parser_init(&parser_);
+  protocol_parser_init(&parser_);
 }
 
 // Intel HEX data records into flash (types 00 data, 01 end, 02/04 extended addresses; 03/05
@@ -195,7 +195,7 @@ void Board::on_uart_byte(uint8_t b) {
   uart_bytes_out_++;
   if (uart_sink_) uart_sink_(b, cycle());
   std::pair<Board *, std::vector<Frame> *> ctx{this, &frames_};
-  proto_parser_feed(&parser_, &b, 1, on_frame, &ctx);
+  protocol_parser_feed(&parser_, &b, 1, on_frame, &ctx);
 }
 
 void Board::send(const uint8_t *data, size_t n) {
@@ -205,32 +205,33 @@ void Board::send(const uint8_t *data, size_t n) {
 
 void Board::send_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
   static uint8_t seq = 0;
-  uint8_t buf[PROTO_MAX_FRAME];
-  size_t n = proto_frame_encode(id, seq++, payload, len, buf, sizeof buf);
+  uint8_t buf[PROTOCOL_MAX_FRAME];
+  size_t n = protocol_frame_encode(id, seq++, payload, len, buf, sizeof buf);
   if (n == 0) throw std::runtime_error("send_frame: payload too long");
   send(buf, n);
 }
 
-void Board::send_command(const proto_command_t &c) {
-  uint8_t p[PROTO_LEN_COMMAND];
-  proto_command_pack(&c, p);
-  send_frame(PROTO_ID_COMMAND, p, PROTO_LEN_COMMAND);
+void Board::send_command(const protocol_command_t &c) {
+  uint8_t p[PROTOCOL_LEN_COMMAND];
+  protocol_command_pack(&c, p);
+  send_frame(PROTOCOL_ID_COMMAND, p, PROTOCOL_LEN_COMMAND);
 }
 
-std::vector<proto_state_t> Board::states() const {
-  std::vector<proto_state_t> out;
+std::vector<protocol_state_t> Board::states() const {
+  std::vector<protocol_state_t> out;
   for (const auto &fr : frames_) {
-    proto_state_t s;
-    if (fr.f.id == PROTO_ID_STATE && proto_state_unpack(fr.f.payload, fr.f.len, &s) == 0) {
+    protocol_state_t s;
+    if (fr.f.id == PROTOCOL_ID_STATE && protocol_state_unpack(fr.f.payload, fr.f.len, &s) == 0) {
       out.push_back(s);
     }
   }
   return out;
 }
 
-bool Board::last_state(proto_state_t *out) const {
+bool Board::last_state(protocol_state_t *out) const {
   for (auto it = frames_.rbegin(); it != frames_.rend(); ++it) {
-    if (it->f.id == PROTO_ID_STATE) return proto_state_unpack(it->f.payload, it->f.len, out) == 0;
+    if (it->f.id == PROTOCOL_ID_STATE)
+      return protocol_state_unpack(it->f.payload, it->f.len, out) == 0;
   }
   return false;
 }
@@ -294,12 +295,12 @@ bool Board::motor_brake() const {
 uint8_t Board::lamp_pins() const {
   const uint8_t b = avr_->data[kPortb], c = avr_->data[kPortc];
   uint8_t l = 0;
-  if (b & 0x04) l |= NIGEL_LAMP_HEAD_LOW;
-  if (b & 0x08) l |= NIGEL_LAMP_HEAD_HIGH;
-  if (b & 0x10) l |= NIGEL_LAMP_TAIL;
-  if (b & 0x20) l |= NIGEL_LAMP_REVERSE;
-  if (c & 0x01) l |= NIGEL_LAMP_IND_LEFT;
-  if (c & 0x02) l |= NIGEL_LAMP_IND_RIGHT;
+  if (b & 0x04) l |= NANO_CORE_LAMP_HEAD_LOW;
+  if (b & 0x08) l |= NANO_CORE_LAMP_HEAD_HIGH;
+  if (b & 0x10) l |= NANO_CORE_LAMP_TAIL;
+  if (b & 0x20) l |= NANO_CORE_LAMP_REVERSE;
+  if (c & 0x01) l |= NANO_CORE_LAMP_IND_LEFT;
+  if (c & 0x02) l |= NANO_CORE_LAMP_IND_RIGHT;
   return l;
 }
 
@@ -421,15 +422,15 @@ bool Board::run_us(uint64_t us, const std::function<bool()> &pred) {
   return true;
 }
 
-proto_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
-                             bool engaged, uint8_t headlights, uint8_t indicators) {
-  proto_command_t c{};
+protocol_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
+                                bool engaged, uint8_t headlights, uint8_t indicators) {
+  protocol_command_t c{};
   c.seq = seq;
   c.throttle_milli = throttle_milli;
   c.steering_milli = steering_milli;
   c.headlights = headlights;
   c.indicators = indicators;
-  c.flags = engaged ? PROTO_CMD_ENGAGED : 0;
+  c.flags = engaged ? PROTOCOL_CMD_ENGAGED : 0;
   return c;
 }
 

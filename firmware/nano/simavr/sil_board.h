@@ -2,7 +2,7 @@
 // with the Nano's surroundings emulated at the pin/peripheral level: UART0 bytes paced at the
 // wire rate (500000 baud), quadrature encoder edges on D2-D5, an MPU-9250 on TWI, and readers
 // for the servo (OCR1A), motor (OCR0A, D7 DIR, D8 BRK) and lamp pins. It also counts cycles
-// per ISR (INT0/INT1) and per main-loop pass (entries of the fw_loop_once symbol).
+// per ISR (INT0/INT1) and per main-loop pass (entries of the hal_avr_loop_once symbol).
 #pragma once
 #include <cstdint>
 #include <deque>
@@ -12,8 +12,8 @@
 #include <vector>
 
 extern "C" {
-#include "nigel_hal.h"
-#include "proto.h"
+#include "nano_core_hal.h"
+#include "protocol.h"
 }
 #include "sil_imu.h"
 
@@ -27,7 +27,7 @@ constexpr uint64_t kCyclesPerUs = kCpuHz / 1000000;
 
 struct Frame {
   uint64_t cycle;  // when its last byte left the AVR
-  proto_frame_t f;
+  protocol_frame_t f;
 };
 
 struct PwmChange {  // an actuator register changed
@@ -64,7 +64,7 @@ class Board {
   // UART into the AVR: bytes go out on the wire one byte-time apart.
   void send(const uint8_t *data, size_t n);
   void send_frame(uint8_t id, const uint8_t *payload, uint8_t len);
-  void send_command(const proto_command_t &c);
+  void send_command(const protocol_command_t &c);
   bool tx_idle() const { return tx_queue_.empty(); }
   uint64_t last_tx_byte_cycle() const { return last_tx_cycle_; }
 
@@ -73,10 +73,10 @@ class Board {
   void clear_frames() { frames_.clear(); }
   // Also hands every byte the AVR sends to sink (cycle = when it left the UART).
   void set_uart_sink(std::function<void(uint8_t, uint64_t)> sink) { uart_sink_ = std::move(sink); }
-  std::vector<proto_state_t> states() const;
-  bool last_state(proto_state_t *out) const;
+  std::vector<protocol_state_t> states() const;
+  bool last_state(protocol_state_t *out) const;
   size_t count(uint8_t id) const;
-  const proto_stats_t &rx_stats() const { return parser_.stats; }
+  const protocol_stats_t &rx_stats() const { return parser_.stats; }
   size_t uart_bytes_out() const { return uart_bytes_out_; }
 
   // Encoders: one edge on channel A of a side (0 left, 1 right), direction + forward.
@@ -91,7 +91,7 @@ class Board {
   uint8_t motor_duty() const;
   bool motor_reverse() const;
   bool motor_brake() const;
-  uint8_t lamp_pins() const;  // NIGEL_LAMP_* bits from the pin levels
+  uint8_t lamp_pins() const;  // NANO_CORE_LAMP_* bits from the pin levels
   const std::vector<PwmChange> &pwm_changes() const { return pwm_changes_; }
   // Hands over (and forgets) the changes recorded so far, for long runs.
   std::vector<PwmChange> take_pwm_changes() {
@@ -148,7 +148,7 @@ class Board {
   uint64_t loop_sleep_cycles_ = 0;  // cycles asleep since the last loop pass began  // address
                                     // only: the cycle-timer tag of run_us's end
   void wake_at(uint64_t at_cycle, void *tag);
-  proto_parser_t parser_{};
+  protocol_parser_t parser_{};
   std::vector<Frame> frames_;
   size_t uart_bytes_out_ = 0;
   double enc_rate_ = 0;
@@ -169,7 +169,7 @@ class Board {
 };
 
 // Builds the payload of a COMMAND.
-proto_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
-                             bool engaged, uint8_t headlights = 0, uint8_t indicators = 0);
+protocol_command_t make_command(uint16_t seq, int16_t throttle_milli, int16_t steering_milli,
+                                bool engaged, uint8_t headlights = 0, uint8_t indicators = 0);
 
 }  // namespace sil

@@ -6,8 +6,8 @@
 #include <avr/sleep.h>
 #include <stdint.h>
 
-#include "enc.h"
-#include "nigel_core.h"
+#include "encoder.h"
+#include "nano_core.h"
 
 enum {
   R_INIT,
@@ -64,7 +64,7 @@ static void lamps_set(void *c, uint8_t l) {
   (void)c;
   (void)l;
 }
-static int imu_read(void *c, nigel_imu_raw_t *o) {
+static int imu_read(void *c, nano_core_imu_raw_t *o) {
   (void)c;
   o->accel[0] = 120;
   o->accel[1] = -340;
@@ -87,10 +87,10 @@ static void serial_write(void *c, const uint8_t *d, uint8_t n) {
   sink = d[n - 1];
 }
 
-static const nigel_hal_t hal = {0,        motor_set,       servo_set_us, lamps_set,
-                                imu_read, battery_read_mv, serial_write};
-static nigel_t core;
-static enc_t enc;
+static const nano_core_hal_t hal = {0,        motor_set,       servo_set_us, lamps_set,
+                                    imu_read, battery_read_mv, serial_write};
+static nano_core_t core;
+static encoder_t enc;
 
 static void put_max(uint8_t i, uint32_t v) {
   if (v > core_results[i]) core_results[i] = v;
@@ -99,8 +99,8 @@ static void put_max(uint8_t i, uint32_t v) {
 int main(void) {
   uint32_t now = 0, t;
   uint16_t i;
-  uint8_t frame[PROTO_MAX_FRAME], payload[PROTO_LEN_COMMAND];
-  proto_command_t cmd = {1, 500, 300, 1, 1, PROTO_CMD_ENGAGED};
+  uint8_t frame[PROTOCOL_MAX_FRAME], payload[PROTOCOL_LEN_COMMAND];
+  protocol_command_t cmd = {1, 500, 300, 1, 1, PROTOCOL_CMD_ENGAGED};
   uint8_t flen;
   TCCR1A = 0;
   TCCR1B = _BV(CS10);
@@ -108,23 +108,23 @@ int main(void) {
   sei();
 
   t_start();
-  nigel_init(&core, &hal, now, 0, 1);
+  nano_core_init(&core, &hal, now, 0, 1);
   core_results[R_INIT] = t_stop();
   t_start();
-  (void)proto_schema_hash();
+  (void)protocol_schema_hash();
   core_results[R_SCHEMA_HASH] = t_stop();
 
   /* arm so the engaged paths run: engaged=0 then engaged=1 */
   cmd.flags = 0;
-  proto_command_pack(&cmd, payload);
-  flen = (uint8_t)proto_frame_encode(PROTO_ID_COMMAND, 0, payload, PROTO_LEN_COMMAND, frame,
-                                     sizeof frame);
-  nigel_rx(&core, frame, flen, now);
-  cmd.flags = PROTO_CMD_ENGAGED;
+  protocol_command_pack(&cmd, payload);
+  flen = (uint8_t)protocol_frame_encode(PROTOCOL_ID_COMMAND, 0, payload, PROTOCOL_LEN_COMMAND,
+                                        frame, sizeof frame);
+  nano_core_rx(&core, frame, flen, now);
+  cmd.flags = PROTOCOL_CMD_ENGAGED;
   cmd.seq = 2;
-  proto_command_pack(&cmd, payload);
-  flen = (uint8_t)proto_frame_encode(PROTO_ID_COMMAND, 1, payload, PROTO_LEN_COMMAND, frame,
-                                     sizeof frame);
+  protocol_command_pack(&cmd, payload);
+  flen = (uint8_t)protocol_frame_encode(PROTOCOL_ID_COMMAND, 1, payload, PROTOCOL_LEN_COMMAND,
+                                        frame, sizeof frame);
 
   /* 300 loop passes at 1 kHz with a command every 20 ms; classify each pass by the periodic
    * work due in it (phases: battery at 2.5 ms, IMU at 5 ms, telemetry at 0 ms mod 10 ms). */
@@ -133,11 +133,11 @@ int main(void) {
     now += 1000;
     if (i % 20 == 0) {
       t_start();
-      nigel_rx(&core, frame, flen, now);
+      nano_core_rx(&core, frame, flen, now);
       put_max(R_RX_COMMAND, t_stop());
     }
     t_start();
-    nigel_step(&core, now, (int32_t)i * 2, (int32_t)i * 2);
+    nano_core_step(&core, now, (int32_t)i * 2, (int32_t)i * 2);
     t = t_stop();
     phase_us = (uint16_t)(now % 10000u);
     if (phase_us == 0u)
@@ -157,9 +157,9 @@ int main(void) {
       core_results[R_STEP_IDLE] = t; /* last one: typical */
     }
   }
-  enc_init(&enc, 0);
+  encoder_init(&enc, 0);
   t_start();
-  enc_edge_a(&enc, 1, 0);
+  encoder_edge_a(&enc, 1, 0);
   core_results[R_ENC_EDGE] = t_stop();
   core_done = 1;
   cli();

@@ -13,132 +13,162 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
-LIB = os.path.join(ROOT, "firmware", "nano", "lib")
+CORE = os.path.join(ROOT, "firmware", "nano", "core")
 TESTS = os.path.join(ROOT, "tests", "firmware_host")
-MODULES = ["nigel", "proto", "fs", "act", "lights", "batt", "wspd", "ahrs", "enc"]
+MODULES = [
+    "nano_core",
+    "protocol",
+    "failsafe",
+    "actuation",
+    "lights",
+    "battery",
+    "wheel_speed",
+    "ahrs",
+    "encoder",
+]
 C_SOURCES = [
-    "proto/proto.c",
-    "nigel/nigel_core.c",
-    "fs/fs.c",
-    "act/act.c",
+    "protocol/protocol.c",
+    "nano_core/nano_core.c",
+    "failsafe/failsafe.c",
+    "actuation/actuation.c",
     "lights/lights.c",
-    "batt/batt.c",
-    "wspd/wspd.c",
+    "battery/battery.c",
+    "wheel_speed/wheel_speed.c",
     "ahrs/ahrs.c",
 ]
 
 # (file, exact text, replacement, what the bug means)
 MUTANTS = [
-    ("fs/fs.c", "< f->timeout_us) return;", "<= f->timeout_us) return;", "timeout one tick late"),
-    ("fs/fs.c", "    f->link_lost = 1;\n", "", "link loss not latched"),
     (
-        "fs/fs.c",
-        "  fs_update(f, now_us);\n  f->last_cmd_us",
+        "failsafe/failsafe.c",
+        "< f->timeout_us) return;",
+        "<= f->timeout_us) return;",
+        "timeout one tick late",
+    ),
+    ("failsafe/failsafe.c", "    f->link_lost = 1;\n", "", "link loss not latched"),
+    (
+        "failsafe/failsafe.c",
+        "  failsafe_update(f, now_us);\n  f->last_cmd_us",
         "  f->last_cmd_us",
         "late command hides the gap",
     ),
-    ("fs/fs.c", "  if (!f->prev_disengaged) return 0;", "", "arming without the engaged=0 edge"),
     (
-        "fs/fs.c",
-        "  f->prev_disengaged = 0;\n  if (f->mode == PROTO_MODE_ENGAGED) {",
-        "  if (f->mode == PROTO_MODE_ENGAGED) {",
+        "failsafe/failsafe.c",
+        "  if (!f->prev_disengaged) return 0;",
+        "",
+        "arming without the engaged=0 edge",
+    ),
+    (
+        "failsafe/failsafe.c",
+        "  f->prev_disengaged = 0;\n  if (f->mode == PROTOCOL_MODE_ENGAGED) {",
+        "  if (f->mode == PROTOCOL_MODE_ENGAGED) {",
         "stale engaged=0 still arms",
     ),
     (
-        "fs/fs.c",
-        "    if (f->mode == PROTO_MODE_ENGAGED) f->mode = PROTO_MODE_DISARMED;",
+        "failsafe/failsafe.c",
+        "    if (f->mode == PROTOCOL_MODE_ENGAGED) f->mode = PROTOCOL_MODE_DISARMED;",
         "",
         "disengage ignored",
     ),
-    ("fs/fs.c", "  f->link_lost = 0;\n  return 1;", "  return 1;", "re-arm keeps the fault"),
     (
-        "fs/fs.c",
-        "    f->mode = PROTO_MODE_FAILSAFE;",
-        "    f->mode = PROTO_MODE_DISARMED;",
+        "failsafe/failsafe.c",
+        "  f->link_lost = 0;\n  return 1;",
+        "  return 1;",
+        "re-arm keeps the fault",
+    ),
+    (
+        "failsafe/failsafe.c",
+        "    f->mode = PROTOCOL_MODE_FAILSAFE;",
+        "    f->mode = PROTOCOL_MODE_DISARMED;",
         "link loss without failsafe mode",
     ),
-    ("nigel/nigel_core.c", "  if (!proto_command_valid(&c)) {", "  if (0) {", "no range check"),
     (
-        "nigel/nigel_core.c",
-        "    n->faults_latched |= PROTO_FAULT_CMD_INVALID;\n",
+        "nano_core/nano_core.c",
+        "  if (!protocol_command_valid(&c)) {",
+        "  if (0) {",
+        "no range check",
+    ),
+    (
+        "nano_core/nano_core.c",
+        "    n->faults_latched |= PROTOCOL_FAULT_CMD_INVALID;\n",
         "",
         "invalid command not flagged",
     ),
-    ("nigel/nigel_core.c", "  n->cmd = c;\n}", "}", "valid command not applied"),
+    ("nano_core/nano_core.c", "  n->cmd = c;\n}", "}", "valid command not applied"),
     (
-        "nigel/nigel_core.c",
-        "  if (n->batt.cutoff) act_flags |= ACT_STOP;",
+        "nano_core/nano_core.c",
+        "  if (n->battery.cutoff) actuation_flags |= ACTUATION_STOP;",
         "",
         "battery cut-off ignored",
     ),
     (
-        "nigel/nigel_core.c",
-        "  if (!fs_may_drive(&n->fs)) act_flags = ACT_STOP | ACT_HOLD_STEERING;",
-        "  if (!fs_may_drive(&n->fs)) act_flags = ACT_HOLD_STEERING;",
+        "nano_core/nano_core.c",
+        "  if (!failsafe_may_drive(&n->failsafe)) actuation_flags = ACTUATION_STOP | ACTUATION_HOLD_STEERING;",
+        "  if (!failsafe_may_drive(&n->failsafe)) actuation_flags = ACTUATION_HOLD_STEERING;",
         "drives while not engaged",
     ),
     (
-        "nigel/nigel_core.c",
-        "n->fs.mode == PROTO_MODE_FAILSAFE ? 3u : n->cmd.indicators",
+        "nano_core/nano_core.c",
+        "n->failsafe.mode == PROTOCOL_MODE_FAILSAFE ? 3u : n->cmd.indicators",
         "n->cmd.indicators",
         "no hazards in failsafe",
     ),
     (
-        "nigel/nigel_core.c",
-        "  fs_update(&n->fs, now_us);\n",
+        "nano_core/nano_core.c",
+        "  failsafe_update(&n->failsafe, now_us);\n",
         "",
         "failsafe not checked in the loop",
     ),
     (
-        "nigel/nigel_core.c",
-        "  fs_set_timeout_ms(&n->fs, c.failsafe_timeout_ms);",
+        "nano_core/nano_core.c",
+        "  failsafe_set_timeout_ms(&n->failsafe, c.failsafe_timeout_ms);",
         "",
         "timeout config ignored",
     ),
     (
-        "nigel/nigel_core.c",
-        "  if (!proto_config_valid(&c)) {",
+        "nano_core/nano_core.c",
+        "  if (!protocol_config_valid(&c)) {",
         "  if (0) {",
         "config not validated",
     ),
     (
-        "act/act.c",
+        "actuation/actuation.c",
         "    a->throttle_u = 0; /* stopping is never slew-limited */",
         "    a->throttle_u = move_toward(a->throttle_u, 0, (int32_t)dt_us * 4);",
         "stop is slew-limited",
     ),
     (
-        "act/act.c",
+        "actuation/actuation.c",
         "  a->brake = (uint8_t)(stop || a->duty == 0u);",
         "  a->brake = (uint8_t)(a->duty == 0u && !stop);",
         "no brake on stop",
     ),
     (
-        "act/act.c",
-        "(int32_t)dt_us * (ACT_THROTTLE_SLEW_PER_S / 1000000L)",
+        "actuation/actuation.c",
+        "(int32_t)dt_us * (ACTUATION_THROTTLE_SLEW_PER_S / 1000000L)",
         "(int32_t)dt_us * 40",
         "slew limit 10x too loose",
     ),
     (
-        "act/act.c",
-        "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 14)",
-        "(int32_t)((dt_us * (uint32_t)ACT_STEER_RATE_Q14) >> 12)",
+        "actuation/actuation.c",
+        "(int32_t)((dt_us * (uint32_t)ACTUATION_STEER_RATE_Q14) >> 14)",
+        "(int32_t)((dt_us * (uint32_t)ACTUATION_STEER_RATE_Q14) >> 12)",
         "steering rate 4x too fast",
     ),
     (
-        "act/act.c",
-        "  if (pulse > ACT_SERVO_MAX_US) pulse = ACT_SERVO_MAX_US;",
+        "actuation/actuation.c",
+        "  if (pulse > ACTUATION_SERVO_MAX_US) pulse = ACTUATION_SERVO_MAX_US;",
         "",
         "no servo saturation",
     ),
     (
-        "batt/batt.c",
-        "  else if (mv > BATT_CUTOFF_CLEAR_MV) b->cutoff = 0;",
+        "battery/battery.c",
+        "  else if (mv > BATTERY_CUTOFF_CLEAR_MV) b->cutoff = 0;",
         "  else b->cutoff = 0;",
         "no cut-off hysteresis",
     ),
-    ("lights/lights.c", "  if (braking) lamps |= NIGEL_LAMP_TAIL;", "", "no taillights"),
-    ("proto/proto.c", "    if (crc != crc_rx) {", "    if (0) {", "CRC not checked"),
+    ("lights/lights.c", "  if (braking) lamps |= NANO_CORE_LAMP_TAIL;", "", "no taillights"),
+    ("protocol/protocol.c", "    if (crc != crc_rx) {", "    if (0) {", "CRC not checked"),
 ]
 
 
@@ -160,7 +190,7 @@ def main():
         o = os.path.join(work, t + ".o")
         r = run(
             ["g++", "-std=c++17", "-O1", "-c", os.path.join(TESTS, t), "-o", o, "-I" + TESTS]
-            + ["-I" + os.path.join(LIB, m) for m in MODULES]
+            + ["-I" + os.path.join(CORE, m) for m in MODULES]
         )
         if r.returncode != 0:
             print(r.stdout)
@@ -168,13 +198,13 @@ def main():
         objs.append(o)
     results = []
     # the unmutated core first: it must pass, or every "kill" below would mean nothing
-    baseline = [("fs/fs.c", "", "", "baseline (no mutation)")]
+    baseline = [("failsafe/failsafe.c", "", "", "baseline (no mutation)")]
     for i, (f, old, new, what) in enumerate(baseline + MUTANTS):
         i -= 1
         lib = os.path.join(work, "lib%d" % i)
         if os.path.exists(lib):
             shutil.rmtree(lib)
-        shutil.copytree(LIB, lib)
+        shutil.copytree(CORE, lib)
         path = os.path.join(lib, f)
         src = open(path).read()
         if i >= 0 and src.count(old) != 1:

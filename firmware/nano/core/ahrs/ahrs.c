@@ -5,10 +5,10 @@
 
 #include <math.h>
 
-#include "proto.h"
+#include "protocol.h"
 
-/* [rad/s per LSB]: pi/180 / PROTO_GYRO_LSB_PER_DPS, one constant so it costs one multiply */
-#define GYRO_RAD_S_PER_LSB ((float)(3.14159265358979 / 180.0 / PROTO_GYRO_LSB_PER_DPS))
+/* [rad/s per LSB]: pi/180 / PROTOCOL_GYRO_LSB_PER_DPS, one constant so it costs one multiply */
+#define GYRO_RAD_S_PER_LSB ((float)(3.14159265358979 / 180.0 / PROTOCOL_GYRO_LSB_PER_DPS))
 
 void ahrs_init(ahrs_t *a) {
   a->q[0] = 1.0f;
@@ -140,7 +140,7 @@ void ahrs_integrate(ahrs_t *a) {
 void ahrs_quat_q14(const ahrs_t *a, int16_t out[4]) {
   int i;
   for (i = 0; i < 4; ++i) {
-    float v = a->q[i] * (float)PROTO_QUAT_ONE;
+    float v = a->q[i] * (float)PROTOCOL_QUAT_ONE;
     if (v > 32767.0f) v = 32767.0f;
     if (v < -32767.0f) v = -32767.0f;
     out[i] = (int16_t)(v < 0.0f ? v - 0.5f : v + 0.5f);

@@ -30,7 +30,7 @@ typedef struct ahrs {
 } ahrs_t;
 
 void ahrs_init(ahrs_t *a);
-/* One sample in raw LSB (PROTO_ACCEL_LSB_PER_G, PROTO_GYRO_LSB_PER_DPS, mag any scale; an
+/* One sample in raw LSB (PROTOCOL_ACCEL_LSB_PER_G, PROTOCOL_GYRO_LSB_PER_DPS, mag any scale; an
  * all-zero mag means "no magnetometer"). */
 void ahrs_update(ahrs_t *a, const int16_t accel[3], const int16_t gyro[3], const int16_t mag[3],
                  uint32_t now_us);
@@ -41,7 +41,7 @@ void ahrs_update(ahrs_t *a, const int16_t accel[3], const int16_t gyro[3], const
 void ahrs_correct(ahrs_t *a, const int16_t accel[3], const int16_t gyro[3], uint32_t now_us);
 void ahrs_correct_mag(ahrs_t *a, const int16_t mag[3]);
 void ahrs_integrate(ahrs_t *a);
-/* The quaternion in Q14 (PROTO_QUAT_ONE = 1.0). */
+/* The quaternion in Q14 (PROTOCOL_QUAT_ONE = 1.0). */
 void ahrs_quat_q14(const ahrs_t *a, int16_t out[4]);
 
 #ifdef __cplusplus

@@ -1,35 +1,35 @@
-/* Battery monitor; see batt.h. */
-#include "batt.h"
+/* Battery monitor; see battery.h. */
+#include "battery.h"
 
-void batt_init(batt_t *b) {
+void battery_init(battery_t *b) {
   b->mv_x256 = 0;
   b->have = 0;
   b->low = 0;
   b->cutoff = 0;
 }
 
-uint16_t batt_mv(const batt_t *b) {
+uint16_t battery_mv(const battery_t *b) {
   return (uint16_t)((b->mv_x256 + 128u) >> 8);
 }
 
-void batt_update(batt_t *b, uint16_t raw_mv) {
+void battery_update(battery_t *b, uint16_t raw_mv) {
   uint32_t raw_x256 = (uint32_t)raw_mv << 8;
   uint16_t mv;
   if (!b->have) {
     b->mv_x256 = raw_x256; /* the first sample decides at once: no drive on a flat pack */
     b->have = 1;
   } else if (raw_x256 >= b->mv_x256) {
-    b->mv_x256 += (raw_x256 - b->mv_x256) >> BATT_FILTER_SHIFT;
+    b->mv_x256 += (raw_x256 - b->mv_x256) >> BATTERY_FILTER_SHIFT;
   } else {
-    b->mv_x256 -= (b->mv_x256 - raw_x256) >> BATT_FILTER_SHIFT;
+    b->mv_x256 -= (b->mv_x256 - raw_x256) >> BATTERY_FILTER_SHIFT;
   }
-  mv = batt_mv(b);
-  if (mv < BATT_WARN_MV)
+  mv = battery_mv(b);
+  if (mv < BATTERY_WARN_MV)
     b->low = 1;
-  else if (mv > BATT_WARN_CLEAR_MV)
+  else if (mv > BATTERY_WARN_CLEAR_MV)
     b->low = 0;
-  if (mv < BATT_CUTOFF_MV)
+  if (mv < BATTERY_CUTOFF_MV)
     b->cutoff = 1;
-  else if (mv > BATT_CUTOFF_CLEAR_MV)
+  else if (mv > BATTERY_CUTOFF_CLEAR_MV)
     b->cutoff = 0;
 }

@@ -1,8 +1,8 @@
 /* Lights logic; see lights.h. */
 #include "lights.h"
 
-#include "nigel_hal.h"
-#include "proto.h"
+#include "nano_core_hal.h"
+#include "protocol.h"
 
 void lights_init(lights_t *l, uint32_t now_us) {
   l->phase_us = now_us;
@@ -27,22 +27,22 @@ uint8_t lights_update(lights_t *l, uint8_t headlights, uint8_t indicators, uint8
     if ((uint32_t)(now_us - l->phase_us) >= LIGHTS_BLINK_HALF_US) l->phase_us = now_us;
     l->blink_on = (uint8_t)!l->blink_on;
   }
-  if (headlights == 1u) lamps |= NIGEL_LAMP_HEAD_LOW;
-  if (headlights >= 2u) lamps |= NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH;
-  if (braking) lamps |= NIGEL_LAMP_TAIL;
-  if (reversing) lamps |= NIGEL_LAMP_REVERSE;
-  state = (uint8_t)((headlights > 2u ? 2u : headlights) & PROTO_LIGHTS_HEAD_MASK);
-  state |= (uint8_t)(indicators << PROTO_LIGHTS_IND_SHIFT);
-  if (braking) state |= PROTO_LIGHTS_TAIL;
-  if (reversing) state |= PROTO_LIGHTS_REVERSE;
+  if (headlights == 1u) lamps |= NANO_CORE_LAMP_HEAD_LOW;
+  if (headlights >= 2u) lamps |= NANO_CORE_LAMP_HEAD_LOW | NANO_CORE_LAMP_HEAD_HIGH;
+  if (braking) lamps |= NANO_CORE_LAMP_TAIL;
+  if (reversing) lamps |= NANO_CORE_LAMP_REVERSE;
+  state = (uint8_t)((headlights > 2u ? 2u : headlights) & PROTOCOL_LIGHTS_HEAD_MASK);
+  state |= (uint8_t)(indicators << PROTOCOL_LIGHTS_IND_SHIFT);
+  if (braking) state |= PROTOCOL_LIGHTS_TAIL;
+  if (reversing) state |= PROTOCOL_LIGHTS_REVERSE;
   if (l->blink_on) {
     if (indicators & 1u) {
-      lamps |= NIGEL_LAMP_IND_LEFT;
-      state |= PROTO_LIGHTS_BLINK_LEFT;
+      lamps |= NANO_CORE_LAMP_IND_LEFT;
+      state |= PROTOCOL_LIGHTS_BLINK_LEFT;
     }
     if (indicators & 2u) {
-      lamps |= NIGEL_LAMP_IND_RIGHT;
-      state |= PROTO_LIGHTS_BLINK_RIGHT;
+      lamps |= NANO_CORE_LAMP_IND_RIGHT;
+      state |= PROTOCOL_LIGHTS_BLINK_RIGHT;
     }
   }
   l->lamps = lamps;

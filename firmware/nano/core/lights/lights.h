@@ -15,8 +15,8 @@ typedef struct lights {
   uint32_t phase_us; /* [us] start of the current blink half period */
   uint8_t blink_on;  /* indicator lamps lit in this half period */
   uint8_t ind_prev;  /* indicator mode of the last update (0..3) */
-  uint8_t lamps;     /* NIGEL_LAMP_* of the last update */
-  uint8_t state;     /* PROTO_LIGHTS_* of the last update */
+  uint8_t lamps;     /* NANO_CORE_LAMP_* of the last update */
+  uint8_t state;     /* PROTOCOL_LIGHTS_* of the last update */
 } lights_t;
 
 void lights_init(lights_t *l, uint32_t now_us);

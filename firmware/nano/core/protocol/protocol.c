@@ -1,5 +1,5 @@
-/* Serial protocol codec; see proto.h and PROTOCOL.md. */
-#include "proto.h"
+/* Serial protocol codec; see protocol.h and PROTOCOL.md. */
+#include "protocol.h"
 
 #include <string.h>
 
@@ -53,7 +53,7 @@ static const uint8_t *get_i32(const uint8_t *p, int32_t *v) {
 }
 
 /* ---- messages -------------------------------------------------------------------------- */
-void proto_command_pack(const proto_command_t *m, uint8_t *o) {
+void protocol_command_pack(const protocol_command_t *m, uint8_t *o) {
   o = put_u16(o, m->seq);
   o = put_i16(o, m->throttle_milli);
   o = put_i16(o, m->steering_milli);
@@ -61,8 +61,8 @@ void proto_command_pack(const proto_command_t *m, uint8_t *o) {
   o = put_u8(o, m->indicators);
   put_u8(o, m->flags);
 }
-int proto_command_unpack(const uint8_t *p, uint8_t len, proto_command_t *m) {
-  if (len != PROTO_LEN_COMMAND) return -1;
+int protocol_command_unpack(const uint8_t *p, uint8_t len, protocol_command_t *m) {
+  if (len != PROTOCOL_LEN_COMMAND) return -1;
   p = get_u16(p, &m->seq);
   p = get_i16(p, &m->throttle_milli);
   p = get_i16(p, &m->steering_milli);
@@ -72,20 +72,20 @@ int proto_command_unpack(const uint8_t *p, uint8_t len, proto_command_t *m) {
   return 0;
 }
 
-void proto_config_pack(const proto_config_t *m, uint8_t *o) {
+void protocol_config_pack(const protocol_config_t *m, uint8_t *o) {
   o = put_i16(o, m->servo_trim_us);
   o = put_u16(o, m->telemetry_period_ms);
   put_u16(o, m->failsafe_timeout_ms);
 }
-int proto_config_unpack(const uint8_t *p, uint8_t len, proto_config_t *m) {
-  if (len != PROTO_LEN_CONFIG) return -1;
+int protocol_config_unpack(const uint8_t *p, uint8_t len, protocol_config_t *m) {
+  if (len != PROTOCOL_LEN_CONFIG) return -1;
   p = get_i16(p, &m->servo_trim_us);
   p = get_u16(p, &m->telemetry_period_ms);
   get_u16(p, &m->failsafe_timeout_ms);
   return 0;
 }
 
-void proto_hello_pack(const proto_hello_t *m, uint8_t *o) {
+void protocol_hello_pack(const protocol_hello_t *m, uint8_t *o) {
   o = put_u8(o, m->fw_major);
   o = put_u8(o, m->fw_minor);
   o = put_u8(o, m->fw_patch);
@@ -93,8 +93,8 @@ void proto_hello_pack(const proto_hello_t *m, uint8_t *o) {
   o = put_u32(o, m->schema_hash);
   put_u32(o, m->build_id);
 }
-int proto_hello_unpack(const uint8_t *p, uint8_t len, proto_hello_t *m) {
-  if (len != PROTO_LEN_HELLO) return -1;
+int protocol_hello_unpack(const uint8_t *p, uint8_t len, protocol_hello_t *m) {
+  if (len != PROTOCOL_LEN_HELLO) return -1;
   p = get_u8(p, &m->fw_major);
   p = get_u8(p, &m->fw_minor);
   p = get_u8(p, &m->fw_patch);
@@ -104,7 +104,7 @@ int proto_hello_unpack(const uint8_t *p, uint8_t len, proto_hello_t *m) {
   return 0;
 }
 
-void proto_state_pack(const proto_state_t *m, uint8_t *o) {
+void protocol_state_pack(const protocol_state_t *m, uint8_t *o) {
   int i;
   o = put_u32(o, m->nano_time_us);
   o = put_i32(o, m->enc_counts[0]);
@@ -126,9 +126,9 @@ void proto_state_pack(const proto_state_t *m, uint8_t *o) {
   o = put_u16(o, m->frames_bad_crc);
   put_u16(o, m->frames_dropped);
 }
-int proto_state_unpack(const uint8_t *p, uint8_t len, proto_state_t *m) {
+int protocol_state_unpack(const uint8_t *p, uint8_t len, protocol_state_t *m) {
   int i;
-  if (len != PROTO_LEN_STATE) return -1;
+  if (len != PROTOCOL_LEN_STATE) return -1;
   p = get_u32(p, &m->nano_time_us);
   p = get_i32(p, &m->enc_counts[0]);
   p = get_i32(p, &m->enc_counts[1]);
@@ -151,34 +151,34 @@ int proto_state_unpack(const uint8_t *p, uint8_t len, proto_state_t *m) {
   return 0;
 }
 
-void proto_nack_pack(const proto_nack_t *m, uint8_t *o) {
+void protocol_nack_pack(const protocol_nack_t *m, uint8_t *o) {
   o = put_u8(o, m->rejected_id);
   o = put_u8(o, m->reason);
   put_u16(o, m->seq);
 }
-int proto_nack_unpack(const uint8_t *p, uint8_t len, proto_nack_t *m) {
-  if (len != PROTO_LEN_NACK) return -1;
+int protocol_nack_unpack(const uint8_t *p, uint8_t len, protocol_nack_t *m) {
+  if (len != PROTOCOL_LEN_NACK) return -1;
   p = get_u8(p, &m->rejected_id);
   p = get_u8(p, &m->reason);
   get_u16(p, &m->seq);
   return 0;
 }
 
-int proto_command_valid(const proto_command_t *m) {
-  return m->throttle_milli >= -PROTO_MILLI && m->throttle_milli <= PROTO_MILLI &&
-         m->steering_milli >= -PROTO_MILLI && m->steering_milli <= PROTO_MILLI &&
+int protocol_command_valid(const protocol_command_t *m) {
+  return m->throttle_milli >= -PROTOCOL_MILLI && m->throttle_milli <= PROTOCOL_MILLI &&
+         m->steering_milli >= -PROTOCOL_MILLI && m->steering_milli <= PROTOCOL_MILLI &&
          m->headlights <= 2u && m->indicators <= 3u &&
-         (m->flags & (uint8_t)~PROTO_CMD_KNOWN_FLAGS) == 0u;
+         (m->flags & (uint8_t)~PROTOCOL_CMD_KNOWN_FLAGS) == 0u;
 }
 
-int proto_config_valid(const proto_config_t *m) {
+int protocol_config_valid(const protocol_config_t *m) {
   return m->servo_trim_us >= -200 && m->servo_trim_us <= 200 && m->telemetry_period_ms >= 5u &&
          m->telemetry_period_ms <= 1000u && m->failsafe_timeout_ms >= 20u &&
          m->failsafe_timeout_ms <= 150u;
 }
 
 /* ---- frames ---------------------------------------------------------------------------- */
-uint16_t proto_crc16(uint16_t crc, const uint8_t *data, size_t n) {
+uint16_t protocol_crc16(uint16_t crc, const uint8_t *data, size_t n) {
   size_t i;
   for (i = 0; i < n; ++i) {
     /* Byte-at-a-time form of the bitwise MSB-first division by 0x1021 (same result as
@@ -192,18 +192,18 @@ uint16_t proto_crc16(uint16_t crc, const uint8_t *data, size_t n) {
   return crc;
 }
 
-size_t proto_frame_encode(uint8_t id, uint8_t seq, const uint8_t *payload, uint8_t len,
-                          uint8_t *out, size_t cap) {
-  size_t total = (size_t)len + PROTO_OVERHEAD;
+size_t protocol_frame_encode(uint8_t id, uint8_t seq, const uint8_t *payload, uint8_t len,
+                             uint8_t *out, size_t cap) {
+  size_t total = (size_t)len + PROTOCOL_OVERHEAD;
   uint16_t crc;
-  if (len > PROTO_MAX_PAYLOAD || cap < total) return 0;
-  out[0] = PROTO_SYNC0;
-  out[1] = PROTO_SYNC1;
+  if (len > PROTOCOL_MAX_PAYLOAD || cap < total) return 0;
+  out[0] = PROTOCOL_SYNC0;
+  out[1] = PROTOCOL_SYNC1;
   out[2] = len;
   out[3] = id;
   out[4] = seq;
   if (len) memcpy(out + 5, payload, len);
-  crc = proto_crc16(0xFFFFu, out + 2, (size_t)len + 3u);
+  crc = protocol_crc16(0xFFFFu, out + 2, (size_t)len + 3u);
   put_u16(out + 5 + len, crc);
   return total;
 }
@@ -211,10 +211,10 @@ size_t proto_frame_encode(uint8_t id, uint8_t seq, const uint8_t *payload, uint8
 #ifdef __AVR__
 /* On the AVR the ~900-byte schema string stays in flash, not in the 2 KiB of RAM. */
 #include <avr/pgmspace.h>
-static const char schema_text[] PROGMEM = PROTO_SCHEMA;
+static const char schema_text[] PROGMEM = PROTOCOL_SCHEMA;
 #define SCHEMA_BYTE(i) ((uint8_t)pgm_read_byte(&schema_text[i]))
 #else
-static const char schema_text[] = PROTO_SCHEMA;
+static const char schema_text[] = PROTOCOL_SCHEMA;
 #define SCHEMA_BYTE(i) ((uint8_t)schema_text[i])
 #endif
 
@@ -231,7 +231,7 @@ static uint32_t schema_fnv1a(void) {
 #ifdef __AVR__
 /* Cached on the AVR: hashing ~900 flash bytes costs ~4.5 ms, too long for every HELLO. The
  * firmware is single-threaded, so a plain static is safe there (not on a threaded host). */
-uint32_t proto_schema_hash(void) {
+uint32_t protocol_schema_hash(void) {
   static uint32_t cached;
   static uint8_t have;
   if (!have) {
@@ -241,47 +241,47 @@ uint32_t proto_schema_hash(void) {
   return cached;
 }
 #else
-uint32_t proto_schema_hash(void) {
+uint32_t protocol_schema_hash(void) {
   return schema_fnv1a();
 }
 #endif
 
 /* ---- parser ---------------------------------------------------------------------------- */
-void proto_parser_init(proto_parser_t *p) {
+void protocol_parser_init(protocol_parser_t *p) {
   memset(p, 0, sizeof *p);
 }
 
-static void drop_front(proto_parser_t *p, uint8_t k) {
+static void drop_front(protocol_parser_t *p, uint8_t k) {
   memmove(p->buf, p->buf + k, (size_t)(p->n - k));
   p->n = (uint8_t)(p->n - k);
 }
 
 /* Consumes what it can of buf; returns the number of good frames dispatched. */
-static unsigned scan(proto_parser_t *p, proto_frame_cb cb, void *ctx) {
+static unsigned scan(protocol_parser_t *p, protocol_frame_cb cb, void *ctx) {
   unsigned good = 0;
   for (;;) {
     uint8_t i = 0, len, total;
     uint16_t crc_rx, crc;
-    while (i < p->n && p->buf[i] != PROTO_SYNC0) ++i;
+    while (i < p->n && p->buf[i] != PROTOCOL_SYNC0) ++i;
     p->stats.skipped_bytes += i;
     if (i) drop_front(p, i);
     if (p->n < 2u) return good;
-    if (p->buf[1] != PROTO_SYNC1) {
+    if (p->buf[1] != PROTOCOL_SYNC1) {
       ++p->stats.skipped_bytes;
       drop_front(p, 1);
       continue;
     }
     if (p->n < 3u) return good;
     len = p->buf[2];
-    if (len > PROTO_MAX_PAYLOAD) {
+    if (len > PROTOCOL_MAX_PAYLOAD) {
       ++p->stats.bad_length;
       ++p->stats.skipped_bytes;
       drop_front(p, 1);
       continue;
     }
-    total = (uint8_t)(len + PROTO_OVERHEAD);
+    total = (uint8_t)(len + PROTOCOL_OVERHEAD);
     if (p->n < total) return good;
-    crc = proto_crc16(0xFFFFu, p->buf + 2, (size_t)len + 3u);
+    crc = protocol_crc16(0xFFFFu, p->buf + 2, (size_t)len + 3u);
     crc_rx = (uint16_t)((uint16_t)p->buf[5 + len] | (uint16_t)((uint16_t)p->buf[6 + len] << 8));
     if (crc != crc_rx) {
       /* Drop only the sync byte: a real frame may start inside the bad one. */
@@ -291,7 +291,7 @@ static unsigned scan(proto_parser_t *p, proto_frame_cb cb, void *ctx) {
       continue;
     }
     {
-      proto_frame_t f;
+      protocol_frame_t f;
       f.id = p->buf[3];
       f.seq = p->buf[4];
       f.len = len;
@@ -307,14 +307,14 @@ static unsigned scan(proto_parser_t *p, proto_frame_cb cb, void *ctx) {
   }
 }
 
-unsigned proto_parser_feed(proto_parser_t *p, const uint8_t *data, size_t n, proto_frame_cb cb,
-                           void *ctx) {
+unsigned protocol_parser_feed(protocol_parser_t *p, const uint8_t *data, size_t n,
+                              protocol_frame_cb cb, void *ctx) {
   unsigned good = 0;
   size_t k;
   for (k = 0; k < n; ++k) {
     /* buf never holds a complete frame after scan(), so one more byte always fits. */
     p->buf[p->n++] = data[k];
-    if (p->buf[0] == PROTO_SYNC0 && p->n < 3u) continue; /* fast path while in a header */
+    if (p->buf[0] == PROTOCOL_SYNC0 && p->n < 3u) continue; /* fast path while in a header */
     good += scan(p, cb, ctx);
   }
   return good;

@@ -1,7 +1,7 @@
 /* Wheel speeds from encoder counts: a difference over a fixed window, then a first-order
  * low-pass. Integer only. */
-#ifndef AUTODRIVE_WSPD_H
-#define AUTODRIVE_WSPD_H
+#ifndef AUTODRIVE_WHEEL_SPEED_H
+#define AUTODRIVE_WHEEL_SPEED_H
 
 #include <stdint.h>
 
@@ -9,20 +9,21 @@
 extern "C" {
 #endif
 
-#define WSPD_PERIOD_US 10000ul /* [us] difference window */
-#define WSPD_FILTER_SHIFT 2u   /* IIR weight 1/4 per window: ~35 ms time constant */
+#define WHEEL_SPEED_PERIOD_US 10000ul /* [us] difference window */
+#define WHEEL_SPEED_FILTER_SHIFT 2u   /* IIR weight 1/4 per window: ~35 ms time constant */
 
-typedef struct wspd {
+typedef struct wheel_speed {
   int32_t prev_counts[2]; /* [counts] at the start of the window */
   int32_t speed_x16[2];   /* filtered speed [mrad/s / 16] */
   uint32_t last_us;       /* [us] start of the window */
   uint8_t have;           /* prev_counts is valid */
-} wspd_t;
+} wheel_speed_t;
 
-void wspd_init(wspd_t *w);
+void wheel_speed_init(wheel_speed_t *w);
 /* Call every loop pass; computes a new speed when a window has elapsed. */
-void wspd_update(wspd_t *w, int32_t left_counts, int32_t right_counts, uint32_t now_us);
-int16_t wspd_mrad_s(const wspd_t *w, uint8_t wheel); /* 0 left, 1 right [mrad/s] */
+void wheel_speed_update(wheel_speed_t *w, int32_t left_counts, int32_t right_counts,
+                        uint32_t now_us);
+int16_t wheel_speed_mrad_s(const wheel_speed_t *w, uint8_t wheel); /* 0 left, 1 right [mrad/s] */
 
 #ifdef __cplusplus
 }
