@@ -15,7 +15,6 @@ s#\bact/act\.([ch])\b#actuation/actuation.\1#g
 s#\benc/enc\.h\b#encoder/encoder.h#g
 s#\bbatt/batt\.([ch])\b#battery/battery.\1#g
 s#\bproto/proto\.([ch])\b#protocol/protocol.\1#g
-s#\bproto/PROTOCOL\.md\b#protocol/PROTOCOL.md#g
 s#\bnigel/nigel_core\.([ch])\b#nano_core/nano_core.\1#g
 s#\bnigel/nigel_hal\.h\b#nano_core/nano_core_hal.h#g
 s#(^|[^$A-Za-z0-9_])lib/(fs|wspd|act|enc|batt|proto|nigel)\b#\1core/\2#g
