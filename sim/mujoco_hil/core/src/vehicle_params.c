@@ -1,5 +1,5 @@
-/* Table-driven loader of the vehicle parameter file (see vparams.h). */
-#include "vparams.h"
+/* Table-driven loader of the vehicle parameter file (see vehicle_params.h). */
+#include "vehicle_params.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -9,16 +9,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct vp_key {
+typedef struct vehicle_params_key {
   const char *name;
-  size_t offset; /* into vp_params_t */
+  size_t offset; /* into vehicle_params_t */
   int count;     /* numbers expected; 0 = the tyre model word */
   int positive;  /* 1: every value must be > 0 */
-} vp_key_t;
+} vehicle_params_key_t;
 
 #define K(field, n, pos) \
-  { #field, offsetof(vp_params_t, field), n, pos }
-static const vp_key_t vp_keys[] = {
+  { #field, offsetof(vehicle_params_t, field), n, pos }
+static const vehicle_params_key_t vehicle_params_keys[] = {
     K(mass_kg, 1, 1),
     K(yaw_inertia_kg_m2, 1, 1),
     K(roll_pitch_inertia_kg_m2, 2, 1),
@@ -68,9 +68,9 @@ static const vp_key_t vp_keys[] = {
     K(cam_rear_pos_m, 3, 0),
 };
 #undef K
-#define VP_NKEYS (sizeof vp_keys / sizeof vp_keys[0])
+#define VP_NKEYS (sizeof vehicle_params_keys / sizeof vehicle_params_keys[0])
 
-static int vp_fail(char *err, size_t err_sz, const char *fmt, ...) {
+static int vehicle_params_fail(char *err, size_t err_sz, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(err, err_sz, fmt, ap);
@@ -78,7 +78,7 @@ static int vp_fail(char *err, size_t err_sz, const char *fmt, ...) {
   return -1;
 }
 
-static char *vp_trim(char *s) {
+static char *vehicle_params_trim(char *s) {
   while (isspace((unsigned char)*s)) s++;
   char *e = s + strlen(s);
   while (e > s && isspace((unsigned char)e[-1])) *--e = '\0';
@@ -86,27 +86,27 @@ static char *vp_trim(char *s) {
 }
 
 /* Cross-field checks the per-key table cannot express. */
-static int vp_check(const char *path, const vp_params_t *p, char *err, size_t err_sz) {
+static int vehicle_params_check(const char *path, const vehicle_params_t *p, char *err, size_t err_sz) {
   if (p->com_to_front_m >= p->wheelbase_m)
-    return vp_fail(err, err_sz, "%s: key 'com_to_front_m': %g m is not inside the wheelbase %g m",
+    return vehicle_params_fail(err, err_sz, "%s: key 'com_to_front_m': %g m is not inside the wheelbase %g m",
                    path, p->com_to_front_m, p->wheelbase_m);
   if (p->long_asymptote[0] <= p->long_extremum[0])
-    return vp_fail(err, err_sz, "%s: key 'long_asymptote': slip must exceed the extremum slip",
+    return vehicle_params_fail(err, err_sz, "%s: key 'long_asymptote': slip must exceed the extremum slip",
                    path);
   if (p->lat_asymptote[0] <= p->lat_extremum[0])
-    return vp_fail(err, err_sz, "%s: key 'lat_asymptote': slip must exceed the extremum slip",
+    return vehicle_params_fail(err, err_sz, "%s: key 'lat_asymptote': slip must exceed the extremum slip",
                    path);
   if (p->steer_limit_rad >= 1.2)
-    return vp_fail(err, err_sz, "%s: key 'steer_limit_rad': %g rad is beyond a real steering lock",
+    return vehicle_params_fail(err, err_sz, "%s: key 'steer_limit_rad': %g rad is beyond a real steering lock",
                    path, p->steer_limit_rad);
   if (4.0 * p->wheel_mass_kg >= p->mass_kg)
-    return vp_fail(err, err_sz, "%s: key 'wheel_mass_kg': four wheels outweigh the car", path);
+    return vehicle_params_fail(err, err_sz, "%s: key 'wheel_mass_kg': four wheels outweigh the car", path);
   return 0;
 }
 
-int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz) {
+int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t err_sz) {
   FILE *f = fopen(path, "r");
-  if (!f) return vp_fail(err, err_sz, "%s: cannot open: %s", path, strerror(errno));
+  if (!f) return vehicle_params_fail(err, err_sz, "%s: cannot open: %s", path, strerror(errno));
   memset(p, 0, sizeof *p);
   int seen[VP_NKEYS] = {0};
   char line[512];
@@ -115,63 +115,63 @@ int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz) {
   while (rc == 0 && fgets(line, sizeof line, f)) {
     lineno++;
     if (!strchr(line, '\n') && !feof(f)) {
-      rc = vp_fail(err, err_sz, "%s:%d: line longer than %zu characters", path, lineno,
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: line longer than %zu characters", path, lineno,
                    sizeof line - 2);
       break;
     }
     char *hash = strchr(line, '#');
     if (hash) *hash = '\0';
-    char *s = vp_trim(line);
+    char *s = vehicle_params_trim(line);
     if (*s == '\0') continue;
     char *eq = strchr(s, '=');
     if (!eq) {
-      rc = vp_fail(err, err_sz, "%s:%d: expected 'key = value', got '%s'", path, lineno, s);
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: expected 'key = value', got '%s'", path, lineno, s);
       break;
     }
     *eq = '\0';
-    char *key = vp_trim(s), *val = vp_trim(eq + 1);
+    char *key = vehicle_params_trim(s), *val = vehicle_params_trim(eq + 1);
     size_t k = 0;
-    while (k < VP_NKEYS && strcmp(vp_keys[k].name, key) != 0) k++;
+    while (k < VP_NKEYS && strcmp(vehicle_params_keys[k].name, key) != 0) k++;
     if (k == VP_NKEYS) {
-      rc = vp_fail(err, err_sz, "%s:%d: key '%s': unknown key", path, lineno, key);
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': unknown key", path, lineno, key);
       break;
     }
     if (seen[k]) {
-      rc = vp_fail(err, err_sz, "%s:%d: key '%s': given twice", path, lineno, key);
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': given twice", path, lineno, key);
       break;
     }
     seen[k] = 1;
-    if (vp_keys[k].count == 0) { /* tyre_model */
+    if (vehicle_params_keys[k].count == 0) { /* tyre_model */
       if (strcmp(val, "paper") == 0)
         p->tyre_model_paper = 1;
       else if (strcmp(val, "mujoco") == 0)
         p->tyre_model_paper = 0;
       else
-        rc = vp_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'", path, lineno,
+        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'", path, lineno,
                      key, val);
       continue;
     }
-    double *dst = (double *)((char *)p + vp_keys[k].offset);
+    double *dst = (double *)((char *)p + vehicle_params_keys[k].offset);
     char *cur = val;
-    for (int i = 0; i < vp_keys[k].count && rc == 0; i++) {
+    for (int i = 0; i < vehicle_params_keys[k].count && rc == 0; i++) {
       char *end;
       errno = 0;
       double v = strtod(cur, &end);
       if (end == cur || errno != 0 || !isfinite(v))
-        rc = vp_fail(err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'", path,
-                     lineno, key, vp_keys[k].count, i + 1, *cur ? cur : "(missing)");
-      else if (vp_keys[k].positive && v <= 0.0)
-        rc = vp_fail(err, err_sz, "%s:%d: key '%s': must be > 0, got %g", path, lineno, key, v);
+        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'", path,
+                     lineno, key, vehicle_params_keys[k].count, i + 1, *cur ? cur : "(missing)");
+      else if (vehicle_params_keys[k].positive && v <= 0.0)
+        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': must be > 0, got %g", path, lineno, key, v);
       dst[i] = v;
       cur = end;
     }
-    if (rc == 0 && *vp_trim(cur) != '\0')
-      rc = vp_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path, lineno, key,
-                   vp_trim(cur));
+    if (rc == 0 && *vehicle_params_trim(cur) != '\0')
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path, lineno, key,
+                   vehicle_params_trim(cur));
   }
   fclose(f);
   for (size_t k = 0; rc == 0 && k < VP_NKEYS; k++)
-    if (!seen[k]) rc = vp_fail(err, err_sz, "%s: key '%s': missing", path, vp_keys[k].name);
-  if (rc == 0) rc = vp_check(path, p, err, err_sz);
+    if (!seen[k]) rc = vehicle_params_fail(err, err_sz, "%s: key '%s': missing", path, vehicle_params_keys[k].name);
+  if (rc == 0) rc = vehicle_params_check(path, p, err, err_sz);
   return rc;
 }

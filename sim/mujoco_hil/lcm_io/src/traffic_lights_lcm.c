@@ -1,7 +1,7 @@
-/* Traffic lights on LCM (see tl_lcm.h). */
-#include "tl_lcm.h"
+/* Traffic lights on LCM (see traffic_lights_lcm.h). */
+#include "traffic_lights_lcm.h"
 
-#include "lcm_rxfilter.h"
+#include "lcm_receive_filter.h"
 
 #include <autodrive_channels.h>
 #include <autodrive_traffic_light_command_t.h>
@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-struct tl_lcm {
+struct traffic_lights_lcm {
   lcm_t *lcm;
   traffic_lights_t *t;
   autodrive_traffic_light_command_t_subscription_t *sub;
@@ -19,7 +19,7 @@ struct tl_lcm {
   long commands, refused;
 };
 
-static void tl_lcm_send(tl_lcm_t *k, const tl_light_t *l, int64_t now_us) {
+static void traffic_lights_lcm_send(traffic_lights_lcm_t *k, const tl_light_t *l, int64_t now_us) {
   autodrive_traffic_light_state_t msg;
   msg.utime = now_us;
   msg.light_id = l->id;
@@ -28,11 +28,11 @@ static void tl_lcm_send(tl_lcm_t *k, const tl_light_t *l, int64_t now_us) {
   autodrive_traffic_light_state_t_publish(k->lcm, AUTODRIVE_CH_TRAFFIC_LIGHT_STATE, &msg);
 }
 
-static void tl_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
+static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
                               const autodrive_traffic_light_command_t *msg, void *user) {
   (void)rbuf;
   (void)channel;
-  tl_lcm_t *k = user;
+  traffic_lights_lcm_t *k = user;
   char why[256];
   k->commands++;
   if (tl_command(k->t, msg->light_id, msg->state, msg->duration_s, k->now_us, why, sizeof why) !=
@@ -45,13 +45,13 @@ static void tl_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
   }
   tl_update(k->t, k->now_us); /* the light shows it now: publish its new state at once */
   for (int i = 0; i < k->t->n; i++)
-    if (k->t->light[i].changed) tl_lcm_send(k, &k->t->light[i], k->now_us);
+    if (k->t->light[i].changed) traffic_lights_lcm_send(k, &k->t->light[i], k->now_us);
 }
 
-tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus, char *err,
+traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus, char *err,
                         size_t err_sz) {
   if (t->n == 0) return NULL;
-  tl_lcm_t *k = calloc(1, sizeof *k);
+  traffic_lights_lcm_t *k = calloc(1, sizeof *k);
   if (!k) {
     snprintf(err, err_sz, "out of memory");
     return NULL;
@@ -59,7 +59,7 @@ tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int fi
   k->lcm = lcm;
   k->t = t;
   k->sub = autodrive_traffic_light_command_t_subscribe(lcm, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND,
-                                                       tl_lcm_on_command, k);
+                                                       traffic_lights_lcm_on_command, k);
   if (!k->sub) {
     snprintf(err, err_sz, "cannot subscribe to " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND);
     free(k);
@@ -69,18 +69,18 @@ tl_lcm_t *tl_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int fi
   /* The kernel filter keeps one channel only: a simulator that also obeys SIM_TELEPORT (or any
    * other subscription) must read the whole bus. */
   if (filter_bus &&
-      lcmrx_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why, sizeof why) < 0)
+      lcm_receive_filter_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why, sizeof why) < 0)
     fprintf(stderr, "[autodrive-sim] %s: receiving every message on the bus instead\n", why);
   return k;
 }
 
-void tl_lcm_destroy(tl_lcm_t *k) {
+void traffic_lights_lcm_destroy(traffic_lights_lcm_t *k) {
   if (!k) return;
   autodrive_traffic_light_command_t_unsubscribe(k->lcm, k->sub);
   free(k);
 }
 
-void tl_lcm_poll(tl_lcm_t *k, int64_t now_us) {
+void traffic_lights_lcm_poll(traffic_lights_lcm_t *k, int64_t now_us) {
   if (!k) return;
   k->now_us = now_us;
   struct pollfd p = {lcm_get_fileno(k->lcm), POLLIN, 0};
@@ -88,15 +88,15 @@ void tl_lcm_poll(tl_lcm_t *k, int64_t now_us) {
     if (lcm_handle(k->lcm) != 0) break;
 }
 
-void tl_lcm_publish(tl_lcm_t *k, int64_t now_us) {
+void traffic_lights_lcm_publish(traffic_lights_lcm_t *k, int64_t now_us) {
   if (!k) return;
   const int all = now_us >= k->next_all_us;
-  if (all) k->next_all_us = now_us + TL_LCM_STATE_PERIOD_US;
+  if (all) k->next_all_us = now_us + TRAFFIC_LIGHTS_LCM_STATE_PERIOD_US;
   for (int i = 0; i < k->t->n; i++)
-    if (all || k->t->light[i].changed) tl_lcm_send(k, &k->t->light[i], now_us);
+    if (all || k->t->light[i].changed) traffic_lights_lcm_send(k, &k->t->light[i], now_us);
 }
 
-long tl_lcm_commands(const tl_lcm_t *k, long *refused) {
+long traffic_lights_lcm_commands(const traffic_lights_lcm_t *k, long *refused) {
   if (refused) *refused = k ? k->refused : 0;
   return k ? k->commands : 0;
 }

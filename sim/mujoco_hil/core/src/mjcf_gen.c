@@ -33,7 +33,7 @@ static void mg_rel_from(const char *scene_path, const char *abs_path, char *out,
 
 /* physics_only: leave out the car's visual-only lamps and wheel discs (drawn in the render
  * model; in the physics model they would only cost collision tests) */
-static void mg_car(FILE *f, const vp_params_t *p, int i, const char *tag_geom, int physics_only) {
+static void mg_car(FILE *f, const vehicle_params_t *p, int i, const char *tag_geom, int physics_only) {
   const double L = p->wheelbase_m, hw = 0.5 * p->track_m, r = p->wheel_radius_m;
   const double mw = p->wheel_mass_kg, mk = MG_KNUCKLE_KG, M = p->mass_kg;
   const double mc = M - 4.0 * mw - 2.0 * mk;
@@ -209,7 +209,7 @@ int mg_write_physics_map(const char *map_path, const char *out_path, const char 
   return dropped;
 }
 
-int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
+int mg_write_scene(const char *out_path, const vehicle_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz) {
   FILE *f = fopen(out_path, "w");
   if (!f) {

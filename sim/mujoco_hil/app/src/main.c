@@ -13,12 +13,12 @@
 #include <lcm/lcm.h>
 
 #include "camera_fx.h"
-#include "lcmpub.h"
+#include "lcm_publish.h"
 #include "route_driver.h"
 #include "script.h"
 #include "sim.h"
 #include "teleport_lcm.h"
-#include "tl_lcm.h"
+#include "traffic_lights_lcm.h"
 
 #include "bench_pairs.h"
 #include "sim_camera.h"
@@ -861,8 +861,8 @@ int main(int argc, char **argv) {
   main_cams_fx(&cams, camera_noise, camera_blur, cfg.seed);
   const int64_t cam_period_us = (int64_t)llround(1e6 / camera_fps);
   /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
-  tl_lcm_t *lights =
-      tl_lcm_create(lcm, url, sim_traffic_lights(s), !allow_teleport, err, sizeof err);
+  traffic_lights_lcm_t *lights =
+      traffic_lights_lcm_create(lcm, url, sim_traffic_lights(s), !allow_teleport, err, sizeof err);
   if (!lights && err[0]) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     main_cams_close(&cams);
@@ -874,7 +874,7 @@ int main(int argc, char **argv) {
   teleport_lcm_t *teleport = allow_teleport ? teleport_lcm_create(lcm, s, err, sizeof err) : NULL;
   if (allow_teleport && !teleport) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
-    tl_lcm_destroy(lights);
+    traffic_lights_lcm_destroy(lights);
     main_cams_close(&cams);
     sim_destroy(s);
     if (tlog) fclose(tlog);
@@ -891,8 +891,8 @@ int main(int argc, char **argv) {
     lcm_destroy(lcm);
     return 1;
   }
-  /* ground truth and SIM_CLOCK leave through a worker thread (lcmq.h) */
-  lcmq_t *pubq = lcmq_create(lcm, err, sizeof err);
+  /* ground truth and SIM_CLOCK leave through a worker thread (publish_queue.h) */
+  publish_queue_t *pubq = publish_queue_create(lcm, err, sizeof err);
   if (!pubq) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     main_view_close(&viewer);
@@ -944,19 +944,19 @@ int main(int argc, char **argv) {
     fprintf(stderr, "autodrive-sim: --bench: out of memory for the bare mj_step blocks\n");
     rc = 1;
   }
-  if (frame_sync) lcmpub_clock(pubq, 0, 0.0, 0); /* the client's first tick */
+  if (frame_sync) publish_sim_clock(pubq, 0, 0.0, 0); /* the client's first tick */
   while (rc == 0 && !main_stop && (end_us < 0 || sim_time_us(s) < end_us)) {
     if (frame_sync) {
       if (sim_time_us(s) % MAIN_FRAME_TICK_US == 0) {
-        lcmq_flush(pubq); /* this tick's SIM_CLOCK: the client answers it with a frame */
+        publish_queue_flush(pubq); /* this tick's SIM_CLOCK: the client answers it with a frame */
         main_frame_wait(s, &sync);
       }
     } else if (client_sync) {
-      lcmq_flush(pubq); /* the client may be waiting for the SIM_CLOCK we queued */
+      publish_queue_flush(pubq); /* the client may be waiting for the SIM_CLOCK we queued */
       main_sync_wait(s, &sync);
     }
     /* light commands: every step, but every host-I/O period in free lockstep (a system call) */
-    if (lights && step % cfg.host_io_period_ms == 0) tl_lcm_poll(lights, sim_time_us(s));
+    if (lights && step % cfg.host_io_period_ms == 0) traffic_lights_lcm_poll(lights, sim_time_us(s));
     if (teleport && step % cfg.host_io_period_ms == 0) teleport_lcm_poll(teleport);
     if (sim_step(s, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
@@ -966,13 +966,13 @@ int main(int argc, char **argv) {
     step++;
     const int64_t now_us = sim_time_us(s);
     main_report_late_boxes(s);
-    tl_lcm_publish(lights, now_us);
+    traffic_lights_lcm_publish(lights, now_us);
     if (route && route->st.done) {
       printf("route %s done at t = %.3f s\n", route->name, now_us * 1e-6);
       break;
     }
     if (step % MAIN_TRUTH_EVERY == 0)
-      for (int c = 1; c <= sim_cars(s); c++) lcmpub_truth(pubq, s, c, tlog);
+      for (int c = 1; c <= sim_cars(s); c++) publish_ground_truth(pubq, s, c, tlog);
     for (int c = 1; c <= sim_cars(s); c++) {
       const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
       /* while the runtime's RPLIDAR driver scans on the pty it publishes <VEH>_LIDAR itself:
@@ -980,7 +980,7 @@ int main(int argc, char **argv) {
       if (scan && lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
         char ch[32];
         snprintf(ch, sizeof ch, AUTODRIVE_VEHICLE_PREFIX "%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
-        lcmpub_lidar(pubq, ch, "laser", scan);
+        publish_lidar_scan(pubq, ch, "laser", scan);
       }
     }
     if (now_us % cam_period_us < SIM_STEP_US &&
@@ -1000,7 +1000,7 @@ int main(int argc, char **argv) {
     }
     if ((lockstep || rtf_given) && step % MAIN_CLOCK_EVERY == 0) {
       const double since = main_wall_s() - t0; /* average rtf of the run so far */
-      lcmpub_clock(pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
+      publish_sim_clock(pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
     }
     if (viewer.v && main_view_frame(&viewer, s, &t0) != 0) break;
     if (paired) { /* the bare block is not part of the run: its time moves the start on */
@@ -1014,7 +1014,7 @@ int main(int argc, char **argv) {
     /* pacing: real time or rtf x real time; lockstep runs free */
     const double wall = main_wall_s();
     if (wall >= next_flush) { /* queued LCM messages leave within the flush period */
-      lcmq_flush(pubq);
+      publish_queue_flush(pubq);
       next_flush = wall + (free_lockstep ? MAIN_FREE_LCM_FLUSH_S : MAIN_LCM_FLUSH_S);
     }
     /* --lockstep-client runs in real time until a client first writes, then in step with it */
@@ -1044,8 +1044,8 @@ int main(int argc, char **argv) {
   /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
   const double step_cpu_s =
       sim_clock_s(CLOCK_THREAD_CPUTIME_ID) - step_cpu0 - bench_pairs_bare_cpu_s(&pairs);
-  const uint64_t lcm_failures = lcmq_failures(pubq);
-  lcmq_destroy(pubq); /* sends what is still queued: part of the run's time */
+  const uint64_t lcm_failures = publish_queue_failures(pubq);
+  publish_queue_destroy(pubq); /* sends what is still queued: part of the run's time */
   const double wall_s = main_wall_s() - t0,
                cpu_s = main_cpu_s() - cpu0 - bench_pairs_bare_cpu_s(&pairs);
   if (lcm_failures)
@@ -1078,12 +1078,12 @@ int main(int argc, char **argv) {
           route->name, route->st.done ? "true" : "false", route->path.length_m, n, rms, max);
     }
     long refused = 0;
-    const long commands = tl_lcm_commands(lights, &refused);
+    const long commands = traffic_lights_lcm_commands(lights, &refused);
     printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld}\n",
            sim_traffic_lights(s)->n, commands, refused);
   }
   bench_pairs_free(&pairs);
-  tl_lcm_destroy(lights);
+  traffic_lights_lcm_destroy(lights);
   teleport_lcm_destroy(teleport);
   main_view_close(&viewer);
   if (threaded) main_render_stop(&rthread);

@@ -1,8 +1,8 @@
 /* Vehicle parameter file: "key = value [value...]" lines, '#' comments, SI units in the key
  * names. The MJCF of Nigel and every model constant (motor, servo, tyres, IMU) come from it.
  * A missing, unknown, duplicated or malformed key is an error naming the file and the key. */
-#ifndef SIM_VPARAMS_H
-#define SIM_VPARAMS_H
+#ifndef SIM_VEHICLE_PARAMS_H
+#define SIM_VEHICLE_PARAMS_H
 
 #include <stddef.h>
 
@@ -10,7 +10,7 @@
 extern "C" {
 #endif
 
-typedef struct vp_params {
+typedef struct vehicle_params {
   /* body */
   double mass_kg;           /* whole car incl. wheels */
   double yaw_inertia_kg_m2; /* whole car about the CoM */
@@ -49,10 +49,10 @@ typedef struct vp_params {
   /* sensor mounts, for the sensors library */
   double lidar_pos_m[3], tag_pos_m[3], tag_size_m;
   double cam_front_pos_m[3], cam_rear_pos_m[3];
-} vp_params_t;
+} vehicle_params_t;
 
 /* Loads path into p. Returns 0, or -1 with a message in err ("<file>:<line>: key '<k>': ..."). */
-int vp_load(const char *path, vp_params_t *p, char *err, size_t err_sz);
+int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t err_sz);
 
 #ifdef __cplusplus
 }

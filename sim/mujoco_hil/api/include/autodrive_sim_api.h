@@ -19,6 +19,10 @@
 extern "C" {
 #endif
 
+/* The library is compiled with -fvisibility=hidden: what this header declares is its whole
+ * export list (tests/sim checks nm -D). A pragma rather than a macro on each declaration,
+ * because cffi parses the declarations below without a preprocessor. */
+#pragma GCC visibility push(default)
 /* CFFI-BEGIN */
 #define AD_MAX_CARS 32
 #define AD_PHYSICS_STEP_US 1000
@@ -111,6 +115,7 @@ int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n, d
  * model and state (MuJoCo alone, the baseline of api_overhead_ratio). */
 double ad_world_bare_mj_step_s(const ad_world_t *w, int steps);
 /* CFFI-END */
+#pragma GCC visibility pop
 
 #ifdef __cplusplus
 }

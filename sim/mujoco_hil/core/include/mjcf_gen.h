@@ -16,7 +16,7 @@
 #include <stddef.h>
 
 #include "scenario.h"
-#include "vparams.h"
+#include "vehicle_params.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,7 +47,7 @@ int mg_write_physics_map(const char *map_path, const char *out_path, const char 
 int mg_tag_id(int car);
 
 /* Writes the scene to out_path. Returns 0, or -1 with a message in err. */
-int mg_write_scene(const char *out_path, const vp_params_t *p, const mg_options_t *o, char *err,
+int mg_write_scene(const char *out_path, const vehicle_params_t *p, const mg_options_t *o, char *err,
                    size_t err_sz);
 
 #ifdef __cplusplus

@@ -1,6 +1,6 @@
-/* LCM publishing (see lcmpub.h). */
+/* LCM publishing (see lcm_publish.h). */
 #include <autodrive_channels.h>
-#include "lcmpub.h"
+#include "lcm_publish.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -24,7 +24,7 @@ static void lcmpub_join(char *dst, size_t dst_sz, const char *prefix, int car, c
   dst[k] = '\0';
 }
 
-int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
+int publish_ground_truth(publish_queue_t *q, const sim_t *s, int car, FILE *log) {
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
@@ -54,29 +54,29 @@ int lcmpub_truth(lcmq_t *q, const sim_t *s, int car, FILE *log) {
     fwrite(buf, 1, (size_t)n, log);
   }
   if (!q) return 0;
-  uint8_t *out = lcmq_reserve(q, channel, (size_t)n);
+  uint8_t *out = publish_queue_reserve(q, channel, (size_t)n);
   if (!out) return -1;
   memcpy(out, buf, (size_t)n);
-  lcmq_commit(q);
+  publish_queue_commit(q);
   return 0;
 }
 
-int lcmpub_clock(lcmq_t *q, int64_t utime, double rtf, int paused) {
+int publish_sim_clock(publish_queue_t *q, int64_t utime, double rtf, int paused) {
   if (!q) return 0;
   autodrive_sim_clock_t msg = {utime, rtf, (int8_t)paused};
   const int n = autodrive_sim_clock_t_encoded_size(&msg);
-  uint8_t *out = lcmq_reserve(q, AUTODRIVE_CH_SIM_CLOCK, (size_t)n);
+  uint8_t *out = publish_queue_reserve(q, AUTODRIVE_CH_SIM_CLOCK, (size_t)n);
   if (!out || autodrive_sim_clock_t_encode(out, 0, n, &msg) != n) return -1;
-  lcmq_commit(q);
+  publish_queue_commit(q);
   return 0;
 }
 
-int lcmpub_lidar(lcmq_t *q, const char *channel, const char *frame_id,
+int publish_lidar_scan(publish_queue_t *q, const char *channel, const char *frame_id,
                  const sim_lidar_scan_t *scan) {
   const int n = sim_lidar_encoded_size(frame_id, scan);
   if (n <= 0) return -1;
-  uint8_t *out = lcmq_reserve(q, channel, (size_t)n);
+  uint8_t *out = publish_queue_reserve(q, channel, (size_t)n);
   if (!out || sim_lidar_encode(out, n, frame_id, scan) != n) return -1;
-  lcmq_commit(q);
+  publish_queue_commit(q);
   return 0;
 }

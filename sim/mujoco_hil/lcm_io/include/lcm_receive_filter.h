@@ -6,8 +6,8 @@
  * simulated second, then woke that thread for each of its own messages (thousands a second
  * of wall time in lockstep) only to find the rare TRAFFIC_LIGHT_COMMAND. With the filter the
  * kernel drops them before they are queued: no wake-up, no copy, no system call. */
-#ifndef SIM_LCM_RXFILTER_H
-#define SIM_LCM_RXFILTER_H
+#ifndef SIM_LCM_RECEIVE_FILTER_H
+#define SIM_LCM_RECEIVE_FILTER_H
 
 #include <stddef.h>
 
@@ -21,7 +21,7 @@ extern "C" {
  * channel). Returns 1 when attached, 0 when there is nothing to filter (not udpm://), -1 with a
  * message in err (the socket was not found, or the kernel refused the filter). Fragmented
  * messages ("LC03") of the channel are dropped too: keep it to messages under 1400 bytes. */
-int lcmrx_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz);
+int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz);
 
 #ifdef __cplusplus
 }

@@ -25,7 +25,7 @@
 #include "traffic_lights.h"
 #include "tyre.h"
 #include "uart.h"
-#include "vparams.h"
+#include "vehicle_params.h"
 
 #include "sim_lidar.h"
 #include "sim_rplidar.h"
@@ -110,7 +110,7 @@ typedef struct sim_car {
 } sim_car_t;
 
 struct sim {
-  vp_params_t p;
+  vehicle_params_t p;
   mjModel *m; /* physics: the map without its visual-only geoms */
   mjData *d;
   /* render model: the whole map (road tiles, lamps, sign faces), kept in step with the physics
@@ -315,7 +315,7 @@ static int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
 
 /* The upright prism around car i's chassis and wheels at its current pose. */
 static void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
-  const vp_params_t *p = &s->p;
+  const vehicle_params_t *p = &s->p;
   const double *co = p->chassis_offset_m, *cs = p->chassis_size_m;
   const double r = p->wheel_radius_m, wy = 0.5 * (p->track_m + p->wheel_width_m);
   const double x0 = fmin(co[0] - 0.5 * cs[0], -r),
@@ -729,7 +729,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
     }
     snprintf(s->script_spec, sizeof s->script_spec, "%s", cfg->script);
   }
-  if (vp_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
+  if (vehicle_params_load(cfg->params_path, &s->p, err, err_sz) != 0) goto fail;
   if (cfg->tyre_model >= 0) s->p.tyre_model_paper = cfg->tyre_model;
   s->tyre_paper = s->p.tyre_model_paper;
   s->host_io_period_steps = cfg->host_io_period_ms > 1 ? cfg->host_io_period_ms : 1;
@@ -752,7 +752,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   s->geom_tyre = malloc(sizeof(int) * (size_t)s->m->ngeom);
   if (!s->car || !s->geom_tyre) goto fail;
   for (int g = 0; g < s->m->ngeom; g++) s->geom_tyre[g] = -1;
-  const vp_params_t *p = &s->p;
+  const vehicle_params_t *p = &s->p;
   s->lon = (tyre_curve_t){p->long_extremum[0], p->long_extremum[1], p->long_asymptote[0],
                           p->long_asymptote[1]};
   s->lat = (tyre_curve_t){p->lat_extremum[0], p->lat_extremum[1], p->lat_asymptote[0],
@@ -909,7 +909,7 @@ static void sim_draw_lamps(sim_t *s, sim_car_t *c) {
 }
 
 static void sim_actuate(sim_t *s, sim_car_t *c) {
-  const vp_params_t *p = &s->p;
+  const vehicle_params_t *p = &s->p;
   mjData *d = s->d;
   mjModel *m = s->m;
   const double dt = m->opt.timestep;
@@ -971,7 +971,7 @@ static void sim_body_velocity(const mjModel *m, const mjData *d, int b, mjtNum o
  * contact point of the wheel body. sim_actuate has set the wheel and steering dofs' own
  * forces for this step; the free joint's are the tyres' alone. */
 static void sim_tyres(sim_t *s, sim_car_t *c) {
-  const vp_params_t *p = &s->p;
+  const vehicle_params_t *p = &s->p;
   const mjModel *m = s->m;
   mjData *d = s->d;
   mju_zero(d->qfrc_applied + c->root_dof, 6);

@@ -1,5 +1,5 @@
-/* Kernel-side channel filter for LCM's receive socket (see lcm_rxfilter.h). */
-#include "lcm_rxfilter.h"
+/* Kernel-side channel filter for LCM's receive socket (see lcm_receive_filter.h). */
+#include "lcm_receive_filter.h"
 
 #include <dirent.h>
 #include <linux/filter.h>
@@ -49,7 +49,7 @@ static int lcmrx_find_socket(int port) {
   return found;
 }
 
-int lcmrx_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz) {
+int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz) {
   const int port = lcmrx_port(url);
   if (port == 0) return 0;
   const size_t n = strlen(channel) + 1; /* with its NUL */
