@@ -29,3 +29,10 @@ s/\bSIM_VPARAMS_H\b/SIM_VEHICLE_PARAMS_H/g
 s/\blcmrx_keep_only\b/lcm_receive_filter_keep_only/g
 s/\blcm_rxfilter\.(h|c)\b/lcm_receive_filter.\1/g
 s/\bSIM_LCM_RXFILTER_H\b/SIM_LCM_RECEIVE_FILTER_H/g
+# the scene generator (was mg_) and the footprint clearance checks (was cl_)
+s/\bmg_options_t\b/mjcf_gen_options_t/g
+s/\bstruct mg_options\b/struct mjcf_gen_options/g
+s/\bmg_(write_scene|write_physics_map|tag_id|car|geom_named|late_box|rel_from)\b/mjcf_gen_\1/g
+s/\bcl_prism_t\b/clearance_prism_t/g
+s/\bstruct cl_prism\b/struct clearance_prism/g
+s/\bcl_(check_on_map|corners|geom_prism|name|on_plane|prisms_overlap|radius)\b/clearance_\1/g

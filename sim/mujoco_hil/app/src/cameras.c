@@ -57,8 +57,7 @@ static int cameras_open_eyes(cameras_t *k, const mjModel *m, char *err, size_t e
   return 0;
 }
 
-int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, char *err,
-                          size_t err_sz) {
+int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, char *err, size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
   const mjModel *m = sim_render_model(s);
@@ -99,8 +98,8 @@ int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, char *err,
   return 0;
 }
 
-int cameras_publish(cameras_t *k, const mjModel *mv, mjData *dv, lcm_t *lcm,
-                             int64_t now_us, char *err, size_t err_sz) {
+int cameras_publish(cameras_t *k, const mjModel *mv, mjData *dv, lcm_t *lcm, int64_t now_us,
+                    char *err, size_t err_sz) {
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
   for (int i = 0; i < k->n; i++) {

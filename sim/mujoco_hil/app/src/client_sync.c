@@ -32,8 +32,8 @@ void client_sync_wait_bytes(sim_t *s, client_sync_t *st) {
   }
 }
 
-/* --lockstep-frames: at every CLIENT_SYNC_FRAME_TICK_US of sim time (0 included) the sim waits until
- * the client on each car's Nano pty has written one more whole frame, and hands it to the
+/* --lockstep-frames: at every CLIENT_SYNC_FRAME_TICK_US of sim time (0 included) the sim waits
+ * until the client on each car's Nano pty has written one more whole frame, and hands it to the
  * emulated Nano at that step. A runtime whose bridge sends one frame per SIM_CLOCK tick
  * (bridge.sync_to_sim_clock) then reaches the firmware at the same sim steps in every run, so
  * a HIL run with a seed gives the same ground truth twice. A client silent for CLIENT_SYNC_LOST_S
@@ -44,7 +44,8 @@ void client_sync_wait_frame(sim_t *s, client_sync_t *st) {
   for (int c = 1; c <= sim_cars(s); c++) {
     if (st->lost_rx_us[c] != 0) continue;
     const uint32_t before = st->frames[c];
-    const double t_give_up = app_wall_s() + (before ? CLIENT_SYNC_LOST_S : CLIENT_SYNC_FRAME_FIRST_S);
+    const double t_give_up =
+        app_wall_s() + (before ? CLIENT_SYNC_LOST_S : CLIENT_SYNC_FRAME_FIRST_S);
     while (!app_stop_requested() && (st->frames[c] = sim_host_frames(s, c)) == before) {
       if (app_wall_s() > t_give_up) {
         fprintf(stderr,

@@ -102,8 +102,8 @@ static void options_usage(FILE *f) {
       "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
       SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-      SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT, SCRIPT_ROUTE_SPEED_DEFAULT,
-      SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
+      SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT,
+      SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
 }
 
 static int options_number(const char *opt, const char *v, double lo, double hi, double *out) {
@@ -354,8 +354,9 @@ int app_options_parse(app_options_t *o, int argc, char **argv) {
     i += took;
   }
   const int free_lockstep = app_options_free_lockstep(o);
-  o->cfg.host_io_period_ms =
-      o->host_io_ms ? o->host_io_ms : free_lockstep ? OPTIONS_FREE_LOCKSTEP_IO_MS : 1;
+  o->cfg.host_io_period_ms = o->host_io_ms   ? o->host_io_ms
+                             : free_lockstep ? OPTIONS_FREE_LOCKSTEP_IO_MS
+                                             : 1;
   return options_check(o);
 }
 

@@ -18,8 +18,8 @@ static void *render_thread_run(void *arg) {
     mjData *snap = t->snap[t->head];
     const int64_t frame_us = t->frame_us[t->head];
     pthread_mutex_unlock(&t->mu);
-    const int r = cameras_publish(&t->cams, sim_render_model(t->s), snap, t->lcm, frame_us, err,
-                                    sizeof err);
+    const int r =
+        cameras_publish(&t->cams, sim_render_model(t->s), snap, t->lcm, frame_us, err, sizeof err);
     pthread_mutex_lock(&t->mu);
     if (r != 0) {
       t->failed = 1;
@@ -34,8 +34,7 @@ static void *render_thread_run(void *arg) {
   return NULL;
 }
 
-int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err,
-                             size_t err_sz) {
+int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err, size_t err_sz) {
   t->s = s;
   t->lcm = lcm;
   for (int i = 0; i < RENDER_THREAD_QUEUE; i++)
@@ -58,7 +57,7 @@ int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err,
 }
 
 int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, char *err,
-                              size_t err_sz) {
+                         size_t err_sz) {
   pthread_mutex_lock(&t->mu);
   const int failed = t->failed;
   if (failed) {

@@ -15,8 +15,8 @@
 #include "lcm_publish.h"
 #include "route_driver.h"
 
-#define LOOP_TRUTH_EVERY 10 /* steps between ground-truth messages: 100 Hz */
-#define LOOP_CLOCK_EVERY 10 /* steps between SIM_CLOCK messages: 100 Hz */
+#define LOOP_TRUTH_EVERY 10    /* steps between ground-truth messages: 100 Hz */
+#define LOOP_CLOCK_EVERY 10    /* steps between SIM_CLOCK messages: 100 Hz */
 #define LOOP_LCM_FLUSH_S 0.001 /* [s] wall: longest a queued LCM message waits */
 /* [s] wall, free lockstep: nothing waits on its messages, and each flush wakes the LCM thread
  * (a system call, and with it the other core) */
@@ -27,8 +27,8 @@
 #define LOOP_MAX_LAG_S 0.02
 
 typedef struct loop {
-  int64_t end_us;      /* --duration in sim time, -1: none */
-  double t0;           /* wall start, moved forward by pauses in the viewer and bare blocks */
+  int64_t end_us; /* --duration in sim time, -1: none */
+  double t0;      /* wall start, moved forward by pauses in the viewer and bare blocks */
   double next_progress, next_flush;
   int64_t last_progress_us;
   long step, slips;
@@ -37,7 +37,6 @@ typedef struct loop {
   bench_pairs_t pairs; /* --bench in free lockstep: sim blocks paired with bare mj_step blocks */
   int paired;
 } loop_t;
-
 
 /* One line on stdout per late box as it appears (scenario logs, tests). */
 static void app_report_late_boxes(const sim_t *s) {
@@ -93,8 +92,8 @@ static void loop_publish_sensors(app_t *a, const loop_t *l) {
 static int loop_cameras(app_t *a, int64_t now_us, char *err, size_t err_sz) {
   sim_t *s = a->sim;
   if (now_us % a->cam_period_us < SIM_STEP_US &&
-      ((a->cams.n > 0 && cameras_publish(&a->cams, sim_render_model(s), sim_render_data(s),
-                                         a->lcm, now_us, err, err_sz) != 0) ||
+      ((a->cams.n > 0 && cameras_publish(&a->cams, sim_render_model(s), sim_render_data(s), a->lcm,
+                                         now_us, err, err_sz) != 0) ||
        (a->render && render_thread_submit(a->render, s, now_us, err, err_sz) != 0)))
     return -1;
   if (a->render) { /* slow down while frames wait to be rendered */
@@ -131,8 +130,8 @@ static void loop_pace(app_t *a, loop_t *l, int64_t now_us) {
     }
   }
   if (wall >= l->next_progress) {
-    const double rtf_now = (now_us - l->last_progress_us) * 1e-6 /
-                           (wall - l->next_progress + LOOP_PROGRESS_S);
+    const double rtf_now =
+        (now_us - l->last_progress_us) * 1e-6 / (wall - l->next_progress + LOOP_PROGRESS_S);
     l->last_progress_us = now_us;
     l->next_progress = wall + LOOP_PROGRESS_S;
     if (!o->quiet)

@@ -13,7 +13,7 @@
 #include "route_driver.h"
 
 static int app_place_given_cars(sim_t *s, uint64_t seed, const scn_pose_t *pose, const int *given,
-                           char *err, size_t err_sz) {
+                                char *err, size_t err_sz) {
   int any = 0;
   double poses[3 * SIM_MAX_CARS];
   for (int i = 0; i < sim_cars(s); i++) {
@@ -39,8 +39,8 @@ static int app_check_starts(app_t *a, char *err, size_t err_sz) {
   int bad_starts = o->nstarts > 1 && o->nstarts != o->cfg.cars;
   if (bad_starts)
     snprintf(err, err_sz,
-             "--start given %d times for %d cars: give it once (car 1) or once per car",
-             o->nstarts, o->cfg.cars);
+             "--start given %d times for %d cars: give it once (car 1) or once per car", o->nstarts,
+             o->cfg.cars);
   if (!bad_starts && o->nstarts > 1) { /* one start pose per car: car k at the k-th --start */
     double poses[3 * SIM_MAX_CARS];
     for (int k = 0; k < o->nstarts; k++) {
@@ -79,8 +79,8 @@ static int app_build_world(app_t *a, char *err, size_t err_sz) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 2;
   }
-  if (app_place_given_cars(a->sim, o->cfg.seed, o->car_start, o->car_start_given, err,
-                           err_sz) != 0) {
+  if (app_place_given_cars(a->sim, o->cfg.seed, o->car_start, o->car_start_given, err, err_sz) !=
+      0) {
     fprintf(stderr, "autodrive-sim: --car-start: %s\n", err);
     return 2;
   }

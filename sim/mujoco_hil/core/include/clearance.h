@@ -19,20 +19,20 @@
 extern "C" {
 #endif
 
-typedef struct cl_prism {
+typedef struct clearance_prism {
   double centre_m[2];    /* x, y in the world [m] */
   double yaw_rad;        /* direction of its own x axis [rad] */
   double half_m[2];      /* half lengths along its own x and y [m] */
   double z_lo_m, z_hi_m; /* height band in the world [m] */
-} cl_prism_t;
+} clearance_prism_t;
 
 /* 1 when the two prisms overlap (touching faces do not). */
-int cl_prisms_overlap(const cl_prism_t *a, const cl_prism_t *b);
+int clearance_prisms_overlap(const clearance_prism_t *a, const clearance_prism_t *b);
 
 /* 0 when p fits (see above), or -1 with what is in the way in err ("overlaps geom 'box_a'",
  * "is outside the floor 'floor' ...", "is behind the wall plane 'wall_n'"). d needs the
  * kinematics of the model (mj_forward or mj_kinematics). */
-int cl_check_on_map(const mjModel *m, const mjData *d, const cl_prism_t *p, int contype,
+int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p, int contype,
                     int conaffinity, char *err, size_t err_sz);
 
 #ifdef __cplusplus

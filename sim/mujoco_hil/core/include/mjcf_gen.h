@@ -22,7 +22,7 @@
 extern "C" {
 #endif
 
-typedef struct mg_options {
+typedef struct mjcf_gen_options {
   int cars;                        /* >= 1 */
   const char *map_path;            /* absolute path of the map MJCF */
   const char *tag_asset_xml;       /* NULL, or <texture>/<material> elements of the roof tags */
@@ -31,7 +31,7 @@ typedef struct mg_options {
   const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
   const char *texture_dir;         /* NULL: the map's folder; else where its textures are */
   int physics_only; /* 1: without the cars' visual-only lamps, wheel discs and roof tags */
-} mg_options_t;
+} mjcf_gen_options_t;
 
 #define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */
 
@@ -40,15 +40,15 @@ typedef struct mg_options {
  * drop_names (space-separated, or NULL): the physics model's map, as every world geom costs
  * MuJoCo 2.2 narrow-phase time each step against every car geom. Returns the number of geoms
  * left out, or -1 with a message. */
-int mg_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
+int mjcf_gen_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
                          char *err, size_t err_sz);
 
 /* Roof tag id of car i (1-based): tag36h11 id i. */
-int mg_tag_id(int car);
+int mjcf_gen_tag_id(int car);
 
 /* Writes the scene to out_path. Returns 0, or -1 with a message in err. */
-int mg_write_scene(const char *out_path, const vehicle_params_t *p, const mg_options_t *o, char *err,
-                   size_t err_sz);
+int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p, const mjcf_gen_options_t *o,
+                   char *err, size_t err_sz);
 
 #ifdef __cplusplus
 }

@@ -8,7 +8,8 @@ static const struct {
   const char *name;
   uint8_t bits;
   float on[3], off[3];
-} sim_lamp[SIM_LAMPS] = { /* each lamp geom, the NIGEL_LAMP_* bits and colours that drive it */
+} sim_lamp[SIM_LAMPS] = {
+    /* each lamp geom, the NIGEL_LAMP_* bits and colours that drive it */
     {"lamp_head_l",
      NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH,
      {1, 1, 0.85f},

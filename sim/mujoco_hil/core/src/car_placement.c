@@ -18,7 +18,6 @@ void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row
   mju_copy(s->m->qpos0 + s->car[i].root_qpos, qp, 7);
 }
 
-
 /* Car 1 stands at --start, else at the map's "spawn" site (or the origin); the others side
  * by side to its right. With --start they stay in that one row and sim_check_scenario judges
  * it; at the spawn site a car that would stand on a wall, an obstacle or off the floor takes
@@ -56,10 +55,10 @@ int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
         return -1;
       }
       sim_set_car_pose(s, i, base, yaw, place / SIM_PLACES_PER_ROW, place % SIM_PLACES_PER_ROW);
-      cl_prism_t pr;
+      clearance_prism_t pr;
       sim_car_prism(s, i, &pr);
       char why[512];
-      if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) break;
+      if (clearance_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) break;
     }
     place++;
   }
@@ -67,7 +66,7 @@ int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
 }
 
 /* The upright prism around car i's chassis and wheels at its current pose. */
-void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
+void sim_car_prism(const sim_t *s, int i, clearance_prism_t *out) {
   const vehicle_params_t *p = &s->p;
   const double *co = p->chassis_offset_m, *cs = p->chassis_size_m;
   const double r = p->wheel_radius_m, wy = 0.5 * (p->track_m + p->wheel_width_m);
@@ -87,7 +86,7 @@ void sim_car_prism(const sim_t *s, int i, cl_prism_t *out) {
   out->z_hi_m = qp[2] + co[2] + 0.5 * cs[2];
 }
 
-void sim_box_prism(const scn_late_box_t *b, cl_prism_t *out) {
+void sim_box_prism(const scn_late_box_t *b, clearance_prism_t *out) {
   out->centre_m[0] = b->x_m;
   out->centre_m[1] = b->y_m;
   out->yaw_rad = b->yaw_rad;
@@ -102,10 +101,10 @@ int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
   const int ct = m->geom_contype[s->car[0].chassis_geom],
             ca = m->geom_conaffinity[s->car[0].chassis_geom];
   char why[512];
-  cl_prism_t pr;
+  clearance_prism_t pr;
   for (int i = 0; s->has_start && i < s->ncars; i++) {
     sim_car_prism(s, i, &pr);
-    if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
+    if (clearance_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
     const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
     char who[96] = "";
     if (i > 0)
@@ -118,7 +117,7 @@ int sim_check_scenario(const sim_t *s, char *err, size_t err_sz) {
   for (int k = 0; k < s->nbox; k++) {
     const scn_late_box_t *b = &s->box[k];
     sim_box_prism(b, &pr);
-    if (cl_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
+    if (clearance_check_on_map(m, s->d, &pr, ct, ca, why, sizeof why) == 0) continue;
     if (b->name[0])
       snprintf(err, err_sz, "map late obstacle '%s' at x %g, y %g m: the box %s", b->name, b->x_m,
                b->y_m, why);
@@ -148,10 +147,10 @@ int sim_reset(sim_t *s, uint64_t seed, const double *poses, char *err, size_t er
     const int ct = s->m->geom_contype[s->car[0].chassis_geom],
               ca = s->m->geom_conaffinity[s->car[0].chassis_geom];
     for (int i = 0; i < s->ncars; i++) {
-      cl_prism_t pr;
+      clearance_prism_t pr;
       char why[512];
       sim_car_prism(s, i, &pr);
-      if (cl_check_on_map(s->m, s->d, &pr, ct, ca, why, sizeof why) != 0) {
+      if (clearance_check_on_map(s->m, s->d, &pr, ct, ca, why, sizeof why) != 0) {
         snprintf(err, err_sz, "reset pose of car %d (x %.3f, y %.3f m, yaw %.3f rad): %s", i,
                  poses[3 * i], poses[3 * i + 1], poses[3 * i + 2], why);
         for (int j = 0; j < s->ncars; j++)
@@ -189,10 +188,10 @@ int sim_teleport(sim_t *s, int car, double x_m, double y_m, double yaw_rad, char
   const double base[3] = {x_m, y_m, 0.0};
   sim_set_car_pose(s, car - 1, base, yaw_rad, 0, 0);
   mju_copy(s->m->qpos0 + c->root_qpos, saved0, 7); /* the start pose stays the reset's */
-  cl_prism_t pr;
+  clearance_prism_t pr;
   char why[512];
   sim_car_prism(s, car - 1, &pr);
-  if (cl_check_on_map(s->m, s->d, &pr, s->m->geom_contype[c->chassis_geom],
+  if (clearance_check_on_map(s->m, s->d, &pr, s->m->geom_contype[c->chassis_geom],
                       s->m->geom_conaffinity[c->chassis_geom], why, sizeof why) != 0) {
     mju_copy(qp, saved, 7);
     snprintf(err, err_sz, "(x %.3f, y %.3f m, yaw %.3f rad): %s", x_m, y_m, yaw_rad, why);

@@ -50,8 +50,7 @@ int sim_car_boot(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   return 0;
 }
 
-int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err,
-                         size_t err_sz) {
+int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err, size_t err_sz) {
   c->sim = s;
   sim_hal_bind(c);
   if (cfg->open_ptys) {

@@ -9,24 +9,24 @@
 #define CL_EPS_M 1e-9        /* overlaps smaller than this are touching [m] */
 
 /* Projection radius of prism p on the unit direction n [m]. */
-static double cl_radius(const cl_prism_t *p, const double n[2]) {
+static double clearance_radius(const clearance_prism_t *p, const double n[2]) {
   const double c = cos(p->yaw_rad), s = sin(p->yaw_rad);
   return p->half_m[0] * fabs(c * n[0] + s * n[1]) + p->half_m[1] * fabs(-s * n[0] + c * n[1]);
 }
 
-int cl_prisms_overlap(const cl_prism_t *a, const cl_prism_t *b) {
+int clearance_prisms_overlap(const clearance_prism_t *a, const clearance_prism_t *b) {
   if (a->z_hi_m <= b->z_lo_m + CL_EPS_M || b->z_hi_m <= a->z_lo_m + CL_EPS_M) return 0;
   const double d[2] = {b->centre_m[0] - a->centre_m[0], b->centre_m[1] - a->centre_m[1]};
   const double yaw[2] = {a->yaw_rad, b->yaw_rad};
   for (int k = 0; k < 4; k++) { /* separating axes: both rectangles' x and y */
     const double t = yaw[k / 2] + (k % 2) * 0.5 * M_PI;
     const double n[2] = {cos(t), sin(t)};
-    if (fabs(d[0] * n[0] + d[1] * n[1]) >= cl_radius(a, n) + cl_radius(b, n) - CL_EPS_M) return 0;
+    if (fabs(d[0] * n[0] + d[1] * n[1]) >= clearance_radius(a, n) + clearance_radius(b, n) - CL_EPS_M) return 0;
   }
   return 1;
 }
 
-static void cl_corners(const cl_prism_t *p, double out[4][2]) {
+static void clearance_corners(const clearance_prism_t *p, double out[4][2]) {
   const double c = cos(p->yaw_rad), s = sin(p->yaw_rad);
   for (int k = 0; k < 4; k++) {
     const double a = (k & 1 ? 1 : -1) * p->half_m[0], b = (k & 2 ? 1 : -1) * p->half_m[1];
@@ -35,7 +35,7 @@ static void cl_corners(const cl_prism_t *p, double out[4][2]) {
   }
 }
 
-static void cl_name(const mjModel *m, int g, char *out, size_t sz) {
+static void clearance_name(const mjModel *m, int g, char *out, size_t sz) {
   const char *n = mj_id2name(m, mjOBJ_GEOM, g);
   if (n && *n)
     snprintf(out, sz, "'%s'", n);
@@ -44,7 +44,7 @@ static void cl_name(const mjModel *m, int g, char *out, size_t sz) {
 }
 
 /* An upright prism bounding static geom g (exact for upright boxes). */
-static void cl_geom_prism(const mjModel *m, const mjData *d, int g, cl_prism_t *p) {
+static void clearance_geom_prism(const mjModel *m, const mjData *d, int g, clearance_prism_t *p) {
   const mjtNum *R = d->geom_xmat + 9 * g, *pos = d->geom_xpos + 3 * g, *sz = m->geom_size + 3 * g;
   double ext[3];
   p->yaw_rad = 0.0;
@@ -84,17 +84,17 @@ static void cl_geom_prism(const mjModel *m, const mjData *d, int g, cl_prism_t *
 }
 
 /* Is point c on the drawn area of upward plane g? */
-static int cl_on_plane(const mjModel *m, const mjData *d, int g, const double c[2]) {
+static int clearance_on_plane(const mjModel *m, const mjData *d, int g, const double c[2]) {
   const mjtNum *R = d->geom_xmat + 9 * g, *pos = d->geom_xpos + 3 * g, *sz = m->geom_size + 3 * g;
   const double r[2] = {c[0] - pos[0], c[1] - pos[1]};
   const double lx = r[0] * R[0] + r[1] * R[3], ly = r[0] * R[1] + r[1] * R[4];
   return fabs(lx) <= sz[0] + CL_EPS_M && fabs(ly) <= sz[1] + CL_EPS_M;
 }
 
-int cl_check_on_map(const mjModel *m, const mjData *d, const cl_prism_t *p, int contype,
+int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p, int contype,
                     int conaffinity, char *err, size_t err_sz) {
   double corner[4][2];
-  cl_corners(p, corner);
+  clearance_corners(p, corner);
   char name[96];
   int floors = 0, first_floor = -1, corner_on[4] = {0, 0, 0, 0};
   for (int g = 0; g < m->ngeom; g++) {
@@ -107,11 +107,11 @@ int cl_check_on_map(const mjModel *m, const mjData *d, const cl_prism_t *p, int 
       if (n[2] > CL_UPRIGHT_COS && m->geom_size[3 * g] > 0 && m->geom_size[3 * g + 1] > 0) {
         floors++;
         if (first_floor < 0) first_floor = g;
-        for (int k = 0; k < 4; k++) corner_on[k] |= cl_on_plane(m, d, g, corner[k]);
+        for (int k = 0; k < 4; k++) corner_on[k] |= clearance_on_plane(m, d, g, corner[k]);
       } else if (fabs(n[2]) < CL_VERTICAL_NZ && touches) {
         for (int k = 0; k < 4; k++)
           if ((corner[k][0] - pos[0]) * n[0] + (corner[k][1] - pos[1]) * n[1] < -CL_EPS_M) {
-            cl_name(m, g, name, sizeof name);
+            clearance_name(m, g, name, sizeof name);
             snprintf(err, err_sz, "is behind the wall plane %s (corner at %.3f, %.3f m)", name,
                      corner[k][0], corner[k][1]);
             return -1;
@@ -120,10 +120,10 @@ int cl_check_on_map(const mjModel *m, const mjData *d, const cl_prism_t *p, int 
       continue;
     }
     if (!touches) continue;
-    cl_prism_t q;
-    cl_geom_prism(m, d, g, &q);
-    if (cl_prisms_overlap(p, &q)) {
-      cl_name(m, g, name, sizeof name);
+    clearance_prism_t q;
+    clearance_geom_prism(m, d, g, &q);
+    if (clearance_prisms_overlap(p, &q)) {
+      clearance_name(m, g, name, sizeof name);
       snprintf(err, err_sz, "overlaps geom %s (around %.3f, %.3f m)", name, q.centre_m[0],
                q.centre_m[1]);
       return -1;
@@ -131,7 +131,7 @@ int cl_check_on_map(const mjModel *m, const mjData *d, const cl_prism_t *p, int 
   }
   for (int k = 0; floors > 0 && k < 4; k++)
     if (!corner_on[k]) {
-      cl_name(m, first_floor, name, sizeof name);
+      clearance_name(m, first_floor, name, sizeof name);
       const mjtNum *sz = m->geom_size + 3 * first_floor, *pos = d->geom_xpos + 3 * first_floor;
       snprintf(err, err_sz,
                "is outside the floor %s (corner at %.3f, %.3f m; the floor spans %.3g x %.3g m "

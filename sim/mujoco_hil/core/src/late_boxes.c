@@ -42,11 +42,11 @@ void sim_place_late_boxes(sim_t *s) {
     sim_move_late_box(s, k, pos);
     s->box_placed[k] = s->box_new[k] = 1;
     s->box_at_us[k] = s->time_us;
-    cl_prism_t bp, cp;
+    clearance_prism_t bp, cp;
     sim_box_prism(b, &bp);
     for (int i = 0; i < s->ncars && !s->box_car_below[k]; i++) {
       sim_car_prism(s, i, &cp);
-      if (cl_prisms_overlap(&bp, &cp)) s->box_car_below[k] = i + 1;
+      if (clearance_prisms_overlap(&bp, &cp)) s->box_car_below[k] = i + 1;
     }
   }
 }

@@ -7,13 +7,13 @@
 
 #define MG_KNUCKLE_KG 0.005 /* steering knuckle mass [kg] */
 
-int mg_tag_id(int car) {
+int mjcf_gen_tag_id(int car) {
   return car;
 }
 
 /* MJCF <include>/<texture> paths are relative to the scene file's directory and MuJoCo 2.2
  * refuses absolute ones; "../" at "/" stays at "/", so enough of them reach any absolute path. */
-static void mg_rel_from(const char *scene_path, const char *abs_path, char *out, size_t sz) {
+static void mjcf_gen_rel_from(const char *scene_path, const char *abs_path, char *out, size_t sz) {
   int depth = 0;
   for (const char *c = scene_path; *c; c++) depth += (*c == '/');
   out[0] = '\0';
@@ -33,7 +33,8 @@ static void mg_rel_from(const char *scene_path, const char *abs_path, char *out,
 
 /* physics_only: leave out the car's visual-only lamps and wheel discs (drawn in the render
  * model; in the physics model they would only cost collision tests) */
-static void mg_car(FILE *f, const vehicle_params_t *p, int i, const char *tag_geom, int physics_only) {
+static void mjcf_gen_car(FILE *f, const vehicle_params_t *p, int i, const char *tag_geom,
+                   int physics_only) {
   const double L = p->wheelbase_m, hw = 0.5 * p->track_m, r = p->wheel_radius_m;
   const double mw = p->wheel_mass_kg, mk = MG_KNUCKLE_KG, M = p->mass_kg;
   const double mc = M - 4.0 * mw - 2.0 * mk;
@@ -151,7 +152,7 @@ static void mg_car(FILE *f, const vehicle_params_t *p, int i, const char *tag_ge
  * bits and surface, coloured apart from the map's boxes, parked out of sight until the sim moves
  * it in (MuJoCo 2.2 cannot add geoms at run time). A world geom, not a mocap body: world geoms
  * never collide with each other, and a parked body cost Tiny Town 2 % of a step. */
-static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
+static void mjcf_gen_late_box(FILE *f, int k, const scn_late_box_t *b) {
   fprintf(f,
           "  <geom name=\"scenario/late_box%d\" type=\"box\" pos=\"0 0 %g\" euler=\"0 0 %.9g\" "
           "size=\"%.6g %.6g %.6g\" contype=\"1\" conaffinity=\"6\" "
@@ -160,7 +161,7 @@ static void mg_late_box(FILE *f, int k, const scn_late_box_t *b) {
 }
 
 /* Whether line is a one-line <geom> named one of the names (a space-separated list). */
-static int mg_geom_named(const char *line, const char *names) {
+static int mjcf_gen_geom_named(const char *line, const char *names) {
   const char *at = strstr(line, "<geom name=\"");
   if (!names || !at) return 0;
   at += strlen("<geom name=\"");
@@ -176,7 +177,7 @@ static int mg_geom_named(const char *line, const char *names) {
   return 0;
 }
 
-int mg_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
+int mjcf_gen_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
                          char *err, size_t err_sz) {
   FILE *in = fopen(map_path, "r");
   if (!in) {
@@ -195,7 +196,7 @@ int mg_write_physics_map(const char *map_path, const char *out_path, const char 
     const int whole = strchr(line, '\n') != NULL || feof(in);
     const int one_line_geom = whole && strstr(line, "<geom ") && strstr(line, "/>");
     if (one_line_geom && ((strstr(line, "contype=\"0\"") && strstr(line, "conaffinity=\"0\"")) ||
-                          mg_geom_named(line, drop_names))) {
+                          mjcf_gen_geom_named(line, drop_names))) {
       dropped++;
       continue;
     }
@@ -209,21 +210,21 @@ int mg_write_physics_map(const char *map_path, const char *out_path, const char 
   return dropped;
 }
 
-int mg_write_scene(const char *out_path, const vehicle_params_t *p, const mg_options_t *o, char *err,
-                   size_t err_sz) {
+int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p, const mjcf_gen_options_t *o,
+                   char *err, size_t err_sz) {
   FILE *f = fopen(out_path, "w");
   if (!f) {
     snprintf(err, err_sz, "cannot write scene '%s': %s", out_path, strerror(errno));
     return -1;
   }
   char rel[4096], map_dir[4096], rel_dir[4096];
-  mg_rel_from(out_path, o->map_path, rel, sizeof rel);
+  mjcf_gen_rel_from(out_path, o->map_path, rel, sizeof rel);
   /* MuJoCo 2.2 reads an included file's textures relative to THIS file's folder: point it at
    * the map's folder (maps write file="textures/<name>.png") */
   snprintf(map_dir, sizeof map_dir, "%s", o->texture_dir ? o->texture_dir : o->map_path);
   char *slash = strrchr(map_dir, '/');
   if (slash && !o->texture_dir) slash[1] = '\0';
-  mg_rel_from(out_path, map_dir, rel_dir, sizeof rel_dir);
+  mjcf_gen_rel_from(out_path, map_dir, rel_dir, sizeof rel_dir);
   const int ncon = 64 + 16 * o->cars;
   fprintf(f, "<mujoco model=\"autodrive\">\n");
   fprintf(f, " <compiler angle=\"radian\" autolimits=\"true\" texturedir=\"%s\"/>\n", rel_dir);
@@ -239,8 +240,8 @@ int mg_write_scene(const char *out_path, const vehicle_params_t *p, const mg_opt
   if (o->tag_asset_xml) fprintf(f, " <asset>\n%s\n </asset>\n", o->tag_asset_xml);
   fprintf(f, " <worldbody>\n");
   for (int i = 1; i <= o->cars; i++)
-    mg_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL, o->physics_only);
-  for (int k = 0; k < o->late_boxes; k++) mg_late_box(f, k + 1, &o->late_box[k]);
+    mjcf_gen_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL, o->physics_only);
+  for (int k = 0; k < o->late_boxes; k++) mjcf_gen_late_box(f, k + 1, &o->late_box[k]);
   fprintf(f, " </worldbody>\n");
   fprintf(f, " <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */

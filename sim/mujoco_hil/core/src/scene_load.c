@@ -38,9 +38,9 @@ static int sim_tag_snippets(sim_t *s, int cars, char **asset, char ***geoms, cha
   if (!*asset || !*geoms) return sim_fail(err, err_sz, "%s%s", "out of memory", "");
   for (int i = 1; i <= cars; i++) {
     char png[700], file[64], prefix[32], a[asz];
-    snprintf(file, sizeof file, "tag36h11_%d.png", mg_tag_id(i));
+    snprintf(file, sizeof file, "tag36h11_%d.png", mjcf_gen_tag_id(i));
     snprintf(png, sizeof png, "%s/%s", s->scene_dir, file);
-    if (sim_tags_write_png(png, mg_tag_id(i), 8, err, err_sz) != 0) return -1;
+    if (sim_tags_write_png(png, mjcf_gen_tag_id(i), 8, err, err_sz) != 0) return -1;
     snprintf(prefix, sizeof prefix, "nigel%d/", i);
     (*geoms)[i - 1] = malloc(1024);
     /* the tag's PNG by its absolute path: the scene's texturedir is the map's folder (its
@@ -62,13 +62,13 @@ int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) 
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
   if (sim_check_map(s, map_abs, !cfg->no_map_late_boxes, err, err_sz) != 0) return -1;
-  mg_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
+  mjcf_gen_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   o.map_path = map_abs;
   char *asset = NULL, **geoms = NULL;
   int rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);
   o.tag_asset_xml = asset;
   o.tag_geom_xml = (const char *const *)geoms;
-  if (rc == 0) rc = mg_write_scene(s->scene_path, &s->p, &o, err, err_sz);
+  if (rc == 0) rc = mjcf_gen_write_scene(s->scene_path, &s->p, &o, err, err_sz);
   /* the physics scene: the same with a copy of the map without visual-only geoms */
   char map_dir[4096], phys_map[700], phys_scene[700];
   snprintf(map_dir, sizeof map_dir, "%s", map_abs);
@@ -79,14 +79,14 @@ int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) 
   int dropped = 0;
   /* the paper tyres read the terrain's friction from s->terrain: its geoms need not collide */
   const char *drop = s->tyre_paper ? s->terrain.names : NULL;
-  if (rc == 0 && (dropped = mg_write_physics_map(map_abs, phys_map, drop, err, err_sz)) < 0)
+  if (rc == 0 && (dropped = mjcf_gen_write_physics_map(map_abs, phys_map, drop, err, err_sz)) < 0)
     rc = -1;
   if (rc == 0 && dropped > 0) {
-    mg_options_t po = o;
+    mjcf_gen_options_t po = o;
     po.map_path = phys_map;
     po.texture_dir = map_dir;
     po.physics_only = 1;
-    rc = mg_write_scene(phys_scene, &s->p, &po, err, err_sz);
+    rc = mjcf_gen_write_scene(phys_scene, &s->p, &po, err, err_sz);
   }
   if (geoms)
     for (int i = 0; i < cfg->cars; i++) free(geoms[i]);

@@ -30,8 +30,6 @@
 #include "sim_lidar.h"
 #include "sim_rplidar.h"
 
-
-
 #define SIM_BUILD_ID 0x51A00001u /* reported in HELLO: "sim" build */
 #define SIM_CAR_SPACING_M 0.35   /* cars spawn side by side at this pitch */
 #define SIM_CAR_ROW_PITCH_M 0.45 /* and in rows this far behind one another */
@@ -42,7 +40,7 @@
  * obstacles, when checking a start pose or a late box [m] */
 #define SIM_GROUND_CLEARANCE_M 0.005
 
-enum { W_FL = 0, W_FR, W_RL, W_RR, W_N };
+enum { W_FL = 0, W_FR, W_RL, W_RR, W_N }; /* wheels: front left, front right, rear left, rear right */
 
 #define SIM_LAMPS 9 /* lamp geoms per car (car_lamps.c) */
 /* 115200 baud moves 11.5 bytes/ms: 100 ms of Nano output fits, so a batch never drops */
@@ -140,8 +138,8 @@ void sim_draw_lamps(sim_t *s, sim_car_t *c);
 /* car_placement.c: start poses and the footprints the scenario checks test */
 void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row, int col);
 int sim_place_cars(sim_t *s, char *err, size_t err_sz);
-void sim_car_prism(const sim_t *s, int i, cl_prism_t *out);
-void sim_box_prism(const scn_late_box_t *b, cl_prism_t *out);
+void sim_car_prism(const sim_t *s, int i, clearance_prism_t *out);
+void sim_box_prism(const scn_late_box_t *b, clearance_prism_t *out);
 
 /* late_boxes.c */
 int sim_read_map_late_boxes(sim_t *s, const mjModel *mm, const char *path, char *err,

@@ -86,21 +86,25 @@ static char *vehicle_params_trim(char *s) {
 }
 
 /* Cross-field checks the per-key table cannot express. */
-static int vehicle_params_check(const char *path, const vehicle_params_t *p, char *err, size_t err_sz) {
+static int vehicle_params_check(const char *path, const vehicle_params_t *p, char *err,
+                                size_t err_sz) {
   if (p->com_to_front_m >= p->wheelbase_m)
-    return vehicle_params_fail(err, err_sz, "%s: key 'com_to_front_m': %g m is not inside the wheelbase %g m",
-                   path, p->com_to_front_m, p->wheelbase_m);
+    return vehicle_params_fail(err, err_sz,
+                               "%s: key 'com_to_front_m': %g m is not inside the wheelbase %g m",
+                               path, p->com_to_front_m, p->wheelbase_m);
   if (p->long_asymptote[0] <= p->long_extremum[0])
-    return vehicle_params_fail(err, err_sz, "%s: key 'long_asymptote': slip must exceed the extremum slip",
-                   path);
+    return vehicle_params_fail(
+        err, err_sz, "%s: key 'long_asymptote': slip must exceed the extremum slip", path);
   if (p->lat_asymptote[0] <= p->lat_extremum[0])
-    return vehicle_params_fail(err, err_sz, "%s: key 'lat_asymptote': slip must exceed the extremum slip",
-                   path);
+    return vehicle_params_fail(err, err_sz,
+                               "%s: key 'lat_asymptote': slip must exceed the extremum slip", path);
   if (p->steer_limit_rad >= 1.2)
-    return vehicle_params_fail(err, err_sz, "%s: key 'steer_limit_rad': %g rad is beyond a real steering lock",
-                   path, p->steer_limit_rad);
+    return vehicle_params_fail(err, err_sz,
+                               "%s: key 'steer_limit_rad': %g rad is beyond a real steering lock",
+                               path, p->steer_limit_rad);
   if (4.0 * p->wheel_mass_kg >= p->mass_kg)
-    return vehicle_params_fail(err, err_sz, "%s: key 'wheel_mass_kg': four wheels outweigh the car", path);
+    return vehicle_params_fail(err, err_sz, "%s: key 'wheel_mass_kg': four wheels outweigh the car",
+                               path);
   return 0;
 }
 
@@ -116,7 +120,7 @@ int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t
     lineno++;
     if (!strchr(line, '\n') && !feof(f)) {
       rc = vehicle_params_fail(err, err_sz, "%s:%d: line longer than %zu characters", path, lineno,
-                   sizeof line - 2);
+                               sizeof line - 2);
       break;
     }
     char *hash = strchr(line, '#');
@@ -125,7 +129,8 @@ int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t
     if (*s == '\0') continue;
     char *eq = strchr(s, '=');
     if (!eq) {
-      rc = vehicle_params_fail(err, err_sz, "%s:%d: expected 'key = value', got '%s'", path, lineno, s);
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: expected 'key = value', got '%s'", path, lineno,
+                               s);
       break;
     }
     *eq = '\0';
@@ -147,8 +152,8 @@ int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t
       else if (strcmp(val, "mujoco") == 0)
         p->tyre_model_paper = 0;
       else
-        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'", path, lineno,
-                     key, val);
+        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': '%s' is not 'paper' or 'mujoco'",
+                                 path, lineno, key, val);
       continue;
     }
     double *dst = (double *)((char *)p + vehicle_params_keys[k].offset);
@@ -158,20 +163,24 @@ int vehicle_params_load(const char *path, vehicle_params_t *p, char *err, size_t
       errno = 0;
       double v = strtod(cur, &end);
       if (end == cur || errno != 0 || !isfinite(v))
-        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'", path,
-                     lineno, key, vehicle_params_keys[k].count, i + 1, *cur ? cur : "(missing)");
+        rc = vehicle_params_fail(
+            err, err_sz, "%s:%d: key '%s': expected %d number(s), value %d is '%s'", path, lineno,
+            key, vehicle_params_keys[k].count, i + 1, *cur ? cur : "(missing)");
       else if (vehicle_params_keys[k].positive && v <= 0.0)
-        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': must be > 0, got %g", path, lineno, key, v);
+        rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': must be > 0, got %g", path, lineno,
+                                 key, v);
       dst[i] = v;
       cur = end;
     }
     if (rc == 0 && *vehicle_params_trim(cur) != '\0')
-      rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path, lineno, key,
-                   vehicle_params_trim(cur));
+      rc = vehicle_params_fail(err, err_sz, "%s:%d: key '%s': unexpected trailing text '%s'", path,
+                               lineno, key, vehicle_params_trim(cur));
   }
   fclose(f);
   for (size_t k = 0; rc == 0 && k < VP_NKEYS; k++)
-    if (!seen[k]) rc = vehicle_params_fail(err, err_sz, "%s: key '%s': missing", path, vehicle_params_keys[k].name);
+    if (!seen[k])
+      rc = vehicle_params_fail(err, err_sz, "%s: key '%s': missing", path,
+                               vehicle_params_keys[k].name);
   if (rc == 0) rc = vehicle_params_check(path, p, err, err_sz);
   return rc;
 }

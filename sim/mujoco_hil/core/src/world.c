@@ -141,7 +141,7 @@ void sim_destroy(sim_t *s) {
     snprintf(path, sizeof path, "%s/map_physics.xml", s->scene_dir);
     unlink(path);
     for (int i = 1; i <= s->ntag_files; i++) {
-      snprintf(path, sizeof path, "%s/tag36h11_%d.png", s->scene_dir, mg_tag_id(i));
+      snprintf(path, sizeof path, "%s/tag36h11_%d.png", s->scene_dir, mjcf_gen_tag_id(i));
       unlink(path);
     }
     rmdir(s->scene_dir);

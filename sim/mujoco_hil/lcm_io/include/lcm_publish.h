@@ -20,6 +20,6 @@ int publish_ground_truth(publish_queue_t *q, const sim_t *s, int car, FILE *log)
 int publish_sim_clock(publish_queue_t *q, int64_t utime, double rtf, int paused);
 /* Queues a LIDAR scan on channel (the send leaves the stepping thread, like ground truth). */
 int publish_lidar_scan(publish_queue_t *q, const char *channel, const char *frame_id,
-                 const sim_lidar_scan_t *scan);
+                       const sim_lidar_scan_t *scan);
 
 #endif

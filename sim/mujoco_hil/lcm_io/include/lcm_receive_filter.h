@@ -21,7 +21,8 @@ extern "C" {
  * channel). Returns 1 when attached, 0 when there is nothing to filter (not udpm://), -1 with a
  * message in err (the socket was not found, or the kernel refused the filter). Fragmented
  * messages ("LC03") of the channel are dropped too: keep it to messages under 1400 bytes. */
-int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz);
+int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err,
+                                 size_t err_sz);
 
 #ifdef __cplusplus
 }

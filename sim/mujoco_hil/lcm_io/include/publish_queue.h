@@ -2,7 +2,8 @@
  * worker thread sends it. A UDP send costs tens of microseconds of system time, as much as a
  * tenth of a physics step; moved off the stepping thread it overlaps with the physics on the
  * second core. Messages leave in the order they were queued. A full queue makes the caller
- * wait (nothing is dropped), and publish_queue_destroy sends everything still queued before it returns.
+ * wait (nothing is dropped), and publish_queue_destroy sends everything still queued before it
+ * returns.
  *
  * Use: uint8_t *buf = publish_queue_reserve(q, channel, n); type_encode(buf, 0, n, &msg);
  *      publish_queue_commit(q); ... publish_queue_flush(q); */

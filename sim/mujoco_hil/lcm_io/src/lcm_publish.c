@@ -10,7 +10,7 @@
 
 /* prefix followed by car's decimal digits (car >= 0), into dst of dst_sz >= 16 bytes: 100 ground
  * truths a car every sim second, where two snprintf calls were ~0.6 % of a 1-car step */
-static void lcmpub_join(char *dst, size_t dst_sz, const char *prefix, int car, const char *suffix) {
+static void publish_join_name(char *dst, size_t dst_sz, const char *prefix, int car, const char *suffix) {
   char digits[12];
   int n = 0;
   do {
@@ -28,8 +28,8 @@ int publish_ground_truth(publish_queue_t *q, const sim_t *s, int car, FILE *log)
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   char vehicle[16], channel[48];
-  lcmpub_join(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX, car, "");
-  lcmpub_join(channel, sizeof channel, AUTODRIVE_VEHICLE_PREFIX, car,
+  publish_join_name(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX, car, "");
+  publish_join_name(channel, sizeof channel, AUTODRIVE_VEHICLE_PREFIX, car,
               AUTODRIVE_CH_GROUND_TRUTH_SUFFIX);
   autodrive_ground_truth_t msg;
   memset(&msg, 0, sizeof msg);
@@ -72,7 +72,7 @@ int publish_sim_clock(publish_queue_t *q, int64_t utime, double rtf, int paused)
 }
 
 int publish_lidar_scan(publish_queue_t *q, const char *channel, const char *frame_id,
-                 const sim_lidar_scan_t *scan) {
+                       const sim_lidar_scan_t *scan) {
   const int n = sim_lidar_encoded_size(frame_id, scan);
   if (n <= 0) return -1;
   uint8_t *out = publish_queue_reserve(q, channel, (size_t)n);

@@ -10,26 +10,26 @@
 #include <string.h>
 #include <sys/socket.h>
 
-#define LCMRX_DEFAULT_PORT 7667       /* LCM's default udpm port */
-#define LCMRX_MAGIC_SHORT 0x4C433032u /* "LC02": a message in one datagram */
+#define RECEIVE_FILTER_DEFAULT_PORT 7667       /* LCM's default udpm port */
+#define RECEIVE_FILTER_MAGIC_SHORT 0x4C433032u /* "LC02": a message in one datagram */
 /* Offsets in the datagram as a UDP socket filter sees it (from the UDP header, 8 bytes): the
  * LCM magic, then its sequence number, then the NUL-terminated channel name. */
-#define LCMRX_OFF_MAGIC 8u
-#define LCMRX_OFF_CHANNEL 16u
-#define LCMRX_MAX_CHANNEL 63
+#define RECEIVE_FILTER_OFF_MAGIC 8u
+#define RECEIVE_FILTER_OFF_CHANNEL 16u
+#define RECEIVE_FILTER_MAX_CHANNEL 63
 
 /* The port of a udpm:// URL ("udpm://239.255.76.67:7667?ttl=0"); 0 for other providers. */
-static int lcmrx_port(const char *url) {
+static int receive_filter_port(const char *url) {
   if (!url || strncmp(url, "udpm://", 7) != 0) return 0;
   const char *host = url + 7, *end = host + strcspn(host, "?");
   const char *colon = memchr(host, ':', (size_t)(end - host));
-  if (!colon) return LCMRX_DEFAULT_PORT;
+  if (!colon) return RECEIVE_FILTER_DEFAULT_PORT;
   const long p = strtol(colon + 1, NULL, 10);
   return p > 0 && p < 65536 ? (int)p : 0;
 }
 
 /* The process's UDP socket bound to port (LCM's receive socket: its send socket is unbound). */
-static int lcmrx_find_socket(int port) {
+static int receive_filter_find_socket(int port) {
   DIR *dir = opendir("/proc/self/fd");
   if (!dir) return -1;
   int found = -1;
@@ -49,28 +49,29 @@ static int lcmrx_find_socket(int port) {
   return found;
 }
 
-int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err, size_t err_sz) {
-  const int port = lcmrx_port(url);
+int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channel, char *err,
+                                 size_t err_sz) {
+  const int port = receive_filter_port(url);
   if (port == 0) return 0;
   const size_t n = strlen(channel) + 1; /* with its NUL */
-  if (n - 1 > LCMRX_MAX_CHANNEL) {
-    snprintf(err, err_sz, "LCM filter: channel '%s' longer than %d", channel, LCMRX_MAX_CHANNEL);
+  if (n - 1 > RECEIVE_FILTER_MAX_CHANNEL) {
+    snprintf(err, err_sz, "LCM filter: channel '%s' longer than %d", channel, RECEIVE_FILTER_MAX_CHANNEL);
     return -1;
   }
   (void)lcm_get_fileno(lcm); /* the receive socket exists once this returns */
-  const int fd = lcmrx_find_socket(port);
+  const int fd = receive_filter_find_socket(port);
   if (fd < 0) {
     snprintf(err, err_sz, "LCM filter: no receive socket on port %d (%s)", port, url);
     return -1;
   }
   /* magic, then the channel's bytes 4 at a time, the rest 1 at a time; any mismatch drops */
-  struct sock_filter prog[2 + 2 * (LCMRX_MAX_CHANNEL + 1) + 2];
+  struct sock_filter prog[2 + 2 * (RECEIVE_FILTER_MAX_CHANNEL + 1) + 2];
   unsigned k = 0;
   const unsigned words = (unsigned)(n / 4), bytes = (unsigned)(n % 4);
   const unsigned total = 2 + 2 * (words + bytes) + 2, drop = total - 1;
-  prog[k] = (struct sock_filter)BPF_STMT(BPF_LD | BPF_W | BPF_ABS, LCMRX_OFF_MAGIC);
+  prog[k] = (struct sock_filter)BPF_STMT(BPF_LD | BPF_W | BPF_ABS, RECEIVE_FILTER_OFF_MAGIC);
   k++;
-  prog[k] = (struct sock_filter)BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, LCMRX_MAGIC_SHORT, 0,
+  prog[k] = (struct sock_filter)BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, RECEIVE_FILTER_MAGIC_SHORT, 0,
                                          (uint8_t)(drop - k - 1));
   k++;
   for (unsigned i = 0; i < n; i += (i + 4 <= n - bytes) ? 4 : 1) {
@@ -78,7 +79,7 @@ int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channe
     uint32_t v = 0;
     for (unsigned b = 0; b < (word ? 4u : 1u); b++) v = (v << 8) | (uint8_t)channel[i + b];
     prog[k] = (struct sock_filter)BPF_STMT(BPF_LD | (word ? BPF_W : BPF_B) | BPF_ABS,
-                                           LCMRX_OFF_CHANNEL + i);
+                                           RECEIVE_FILTER_OFF_CHANNEL + i);
     k++;
     prog[k] =
         (struct sock_filter)BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, v, 0, (uint8_t)(drop - k - 1));

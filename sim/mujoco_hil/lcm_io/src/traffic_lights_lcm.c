@@ -29,7 +29,8 @@ static void traffic_lights_lcm_send(traffic_lights_lcm_t *k, const tl_light_t *l
 }
 
 static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
-                              const autodrive_traffic_light_command_t *msg, void *user) {
+                                          const autodrive_traffic_light_command_t *msg,
+                                          void *user) {
   (void)rbuf;
   (void)channel;
   traffic_lights_lcm_t *k = user;
@@ -48,8 +49,8 @@ static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char
     if (k->t->light[i].changed) traffic_lights_lcm_send(k, &k->t->light[i], k->now_us);
 }
 
-traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t, int filter_bus, char *err,
-                        size_t err_sz) {
+traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t,
+                                                int filter_bus, char *err, size_t err_sz) {
   if (t->n == 0) return NULL;
   traffic_lights_lcm_t *k = calloc(1, sizeof *k);
   if (!k) {
@@ -68,8 +69,8 @@ traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, tra
   char why[256];
   /* The kernel filter keeps one channel only: a simulator that also obeys SIM_TELEPORT (or any
    * other subscription) must read the whole bus. */
-  if (filter_bus &&
-      lcm_receive_filter_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why, sizeof why) < 0)
+  if (filter_bus && lcm_receive_filter_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why,
+                                                 sizeof why) < 0)
     fprintf(stderr, "[autodrive-sim] %s: receiving every message on the bus instead\n", why);
   return k;
 }
