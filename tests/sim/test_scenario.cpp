@@ -25,7 +25,7 @@
 #include "autodrive_lidar_scan_t.h"
 #include "scenario.h"
 #include "sim_test_util.h"
-#include "vparams.h"
+#include "vehicle_params.h"
 
 #include "sim_camera.h"
 #include "sim_render.h"
@@ -160,10 +160,10 @@ std::pair<int, std::string> run_cli(const std::string &args) {
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
 }
 
-vp_params_t params() {
-  vp_params_t p;
+vehicle_params_t params() {
+  vehicle_params_t p;
   char err[512] = "";
-  EXPECT_EQ(vp_load(simtest::params_path().c_str(), &p, err, sizeof err), 0) << err;
+  EXPECT_EQ(vehicle_params_load(simtest::params_path().c_str(), &p, err, sizeof err), 0) << err;
   return p;
 }
 
@@ -299,7 +299,7 @@ TEST(Scenario, StartPutsGroundTruthAtThePoseAndCar2BesideIt) {
 TEST(Scenario, LidarSeesTheLateBoxOnlyAfterItsTime) {
   // car 1 at yaw 20 deg; the box 1 m from the scanner at a bearing of +25 deg (world 45 deg),
   // where the far wall is ~6.3 m away; half sizes 0.08 x 0.05 m
-  const vp_params_t p = params();
+  const vehicle_params_t p = params();
   const double cx = -1.0, cy = -0.5, yaw = 20 * kDeg, t_box_s = 1.0;
   const double ox = cx + p.lidar_pos_m[0] * cos(yaw), oy = cy + p.lidar_pos_m[0] * sin(yaw);
   const double bx = ox + cos(45 * kDeg), by = oy + sin(45 * kDeg), hx = 0.08, hy = 0.05;
@@ -345,7 +345,7 @@ TEST(Scenario, LidarSeesTheLateBoxOnlyAfterItsTime) {
 TEST(Scenario, DrivingIntoTheLateBoxSetsTheCollisionFlag) {
   // full throttle from x = -1 (front bumper at about -0.81 m) towards a box at -0.6 that
   // appears at 0.3 s, when the car has covered < 0.08 m
-  const vp_params_t p = params();
+  const vehicle_params_t p = params();
   const double face_x = -0.6 - 0.06, t_box_s = 0.3;
   SimRun r(7752,
            "--rtf 5 --duration 3 --start -1,-0.5,0 --late-box -0.6,-0.5,0.3 "

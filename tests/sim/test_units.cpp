@@ -13,7 +13,7 @@
 #include "sim_test_util.h"
 #include "tyre.h"
 #include "uart.h"
-#include "vparams.h"
+#include "vehicle_params.h"
 
 namespace {
 
@@ -37,18 +37,18 @@ std::string load_modified(const std::string &find, const std::string &repl, int 
   }
   const std::string dir = simtest::temp_dir(), path = dir + "/bad.params";
   std::ofstream(path) << text;
-  vp_params_t p;
+  vehicle_params_t p;
   char err[512] = "";
-  *rc = vp_load(path.c_str(), &p, err, sizeof err);
+  *rc = vehicle_params_load(path.c_str(), &p, err, sizeof err);
   unlink(path.c_str());
   rmdir(dir.c_str());
   return err;
 }
 
 TEST(Params, DefaultFileLoadsWithReferenceFigures) {
-  vp_params_t p;
+  vehicle_params_t p;
   char err[512] = "";
-  ASSERT_EQ(vp_load(simtest::params_path().c_str(), &p, err, sizeof err), 0) << err;
+  ASSERT_EQ(vehicle_params_load(simtest::params_path().c_str(), &p, err, sizeof err), 0) << err;
   EXPECT_DOUBLE_EQ(p.wheelbase_m, 0.14154);
   EXPECT_DOUBLE_EQ(p.track_m, 0.153);
   EXPECT_DOUBLE_EQ(p.wheel_radius_m, 0.0325);
@@ -91,9 +91,9 @@ TEST(Params, BadFilesNameFileAndKey) {
   EXPECT_EQ(rc, -1);
   EXPECT_NE(e.find("'com_to_front_m'"), std::string::npos) << e;
 
-  vp_params_t p;
+  vehicle_params_t p;
   char err[256];
-  EXPECT_EQ(vp_load("/nonexistent/x.params", &p, err, sizeof err), -1);
+  EXPECT_EQ(vehicle_params_load("/nonexistent/x.params", &p, err, sizeof err), -1);
   EXPECT_NE(std::string(err).find("/nonexistent/x.params"), std::string::npos);
 }
 

@@ -21,7 +21,13 @@ from pathlib import Path
 from . import last_json
 
 # the sim's per-step work: the step itself and what the main loop encodes for LCM each step
-STEP_FUNCTIONS = ("sim_step", "lcmpub_truth", "lcmpub_clock", "lcmpub_lidar", "tl_lcm_publish")
+STEP_FUNCTIONS = (
+    "sim_step",
+    "publish_ground_truth",
+    "publish_sim_clock",
+    "publish_lidar_scan",
+    "traffic_lights_lcm_publish",
+)
 BARE_FUNCTION = "sim_bare_run"
 LINE = re.compile(r"^\s*([\d,]+)\s+\([^)]*\)\s+\S*?:(\w+)\s")
 

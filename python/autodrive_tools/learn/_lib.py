@@ -13,7 +13,7 @@ import cffi
 
 from ..paths import REPO_ROOT
 
-HEADER = REPO_ROOT / "sim" / "mujoco_hil" / "include" / "autodrive_sim_api.h"
+HEADER = REPO_ROOT / "sim" / "mujoco_hil" / "api" / "include" / "autodrive_sim_api.h"
 LIB_NAME = "libautodrive_sim_core.so"
 PRESETS = ("release", "dev", "asan")
 

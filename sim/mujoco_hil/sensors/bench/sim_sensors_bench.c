@@ -120,10 +120,15 @@ static void usage(FILE *out) {
           "Defaults: --scans 300 --frames 200 --width 640 --height 480 --backend auto\n");
 }
 
-int main(int argc, char **argv) {
-  int scans = 300, frames = 200, w = 640, h = 480;
-  sim_render_backend_t backend = SIM_RENDER_AUTO;
-  char *map = NULL; /* realpath of --map, or NULL for the built-in scene */
+typedef struct bench_args {
+  int scans, frames, w, h;
+  sim_render_backend_t backend;
+  char *map; /* realpath of --map, or NULL for the built-in scene */
+} bench_args_t;
+
+/* Returns -1 to run, else the exit status (0 after --help, 2 for a bad option). */
+static int parse_args(int argc, char **argv, bench_args_t *a) {
+  *a = (bench_args_t){300, 200, 640, 480, SIM_RENDER_AUTO, NULL};
   static const struct option opts[] = {
       {"scans", required_argument, 0, 's'},   {"frames", required_argument, 0, 'f'},
       {"width", required_argument, 0, 'w'},   {"height", required_argument, 0, 'H'},
@@ -132,25 +137,25 @@ int main(int argc, char **argv) {
   int o;
   while ((o = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
     switch (o) {
-      case 's': scans = atoi(optarg); break;
-      case 'f': frames = atoi(optarg); break;
-      case 'w': w = atoi(optarg); break;
-      case 'H': h = atoi(optarg); break;
+      case 's': a->scans = atoi(optarg); break;
+      case 'f': a->frames = atoi(optarg); break;
+      case 'w': a->w = atoi(optarg); break;
+      case 'H': a->h = atoi(optarg); break;
       case 'b':
         if (!strcmp(optarg, "auto"))
-          backend = SIM_RENDER_AUTO;
+          a->backend = SIM_RENDER_AUTO;
         else if (!strcmp(optarg, "egl"))
-          backend = SIM_RENDER_EGL;
+          a->backend = SIM_RENDER_EGL;
         else if (!strcmp(optarg, "osmesa"))
-          backend = SIM_RENDER_OSMESA;
+          a->backend = SIM_RENDER_OSMESA;
         else {
           fprintf(stderr, "sim-sensors-bench: --backend '%s' is not auto, egl or osmesa\n", optarg);
           return 2;
         }
         break;
       case 'm':
-        map = realpath(optarg, NULL);
-        if (!map) {
+        a->map = realpath(optarg, NULL);
+        if (!a->map) {
           fprintf(stderr, "sim-sensors-bench: --map '%s': no such file\n", optarg);
           return 2;
         }
@@ -159,36 +164,51 @@ int main(int argc, char **argv) {
       default: usage(stderr); return 2;
     }
   }
-  if (scans < 1 || frames < 1 || w < 16 || h < 16 || w > 4096 || h > 4096) {
+  if (a->scans < 1 || a->frames < 1 || a->w < 16 || a->h < 16 || a->w > 4096 || a->h > 4096) {
     fprintf(stderr, "sim-sensors-bench: --scans/--frames must be >= 1 and the size 16..4096 px\n");
     return 2;
   }
+  return -1;
+}
+
+/* The bench scene (the built-in one, or map with the bench cars), compiled; NULL on error. */
+static mjModel *load_scene(const char *map) {
   char dir[] = "/tmp/sim_sensors_bench_XXXXXX", path[64], map_copy[64];
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sim-sensors-bench: cannot make a temp dir in /tmp\n");
-    return 1;
+    return NULL;
   }
   snprintf(path, sizeof path, "%s/scene.xml", dir);
   snprintf(map_copy, sizeof map_copy, "%s/map.xml", dir);
   if (map && copy_file(map, map_copy) != 0) {
     fprintf(stderr, "sim-sensors-bench: cannot read map %s\n", map);
     rmdir(dir);
-    return 1;
+    return NULL;
   }
   if (write_scene(path, map) != 0) {
     fprintf(stderr, "sim-sensors-bench: cannot write the scene file %s\n", path);
-    return 1;
+    return NULL;
   }
   char err[1000] = "";
   mjModel *m = mj_loadXML(path, NULL, err, sizeof err);
   unlink(path);
   unlink(map_copy);
   rmdir(dir);
-  if (!m) {
+  if (!m)
     fprintf(stderr, "sim-sensors-bench: scene%s%s does not load: %s\n", map ? " with map " : "",
             map ? map : "", err);
-    return 1;
-  }
+  return m;
+}
+
+int main(int argc, char **argv) {
+  bench_args_t args;
+  const int rc = parse_args(argc, argv, &args);
+  if (rc >= 0) return rc;
+  const int scans = args.scans, frames = args.frames, w = args.w, h = args.h;
+  char *map = args.map;
+  mjModel *m = load_scene(map);
+  if (!m) return 1;
+  char err[1000] = "";
   mjData *d = mj_makeData(m);
   mj_forward(m, d);
   fprintf(stderr, "scene: %d geoms, %d bodies\n", m->ngeom, m->nbody);
@@ -221,7 +241,7 @@ int main(int argc, char **argv) {
   fprintf(stderr, "lidar: median %.2f us per 1 ms physics step (7 Hz spin)\n", lidar_step_us);
 
   /* camera */
-  sim_render_t *r = sim_render_create(m, w, h, backend, err, sizeof err);
+  sim_render_t *r = sim_render_create(m, w, h, args.backend, err, sizeof err);
   if (!r) {
     fprintf(stderr, "sim-sensors-bench: %s\n", err);
     return 1;

@@ -1,0 +1,38 @@
+/* autodrive-sim's command line: every option, its checks and --help (README.md's table). */
+#ifndef SIM_APP_OPTIONS_H
+#define SIM_APP_OPTIONS_H
+
+#include "scenario.h"
+#include "sim.h"
+
+/* free lockstep serves the ptys every 10 ms of sim time: a client there sees the sim run
+ * tens of times faster than real time anyway, and an idle pty then costs no system call in
+ * nine steps of ten (tools/bench sim: overhead_ratio) */
+#define OPTIONS_FREE_LOCKSTEP_IO_MS 10
+
+typedef struct app_options {
+  sim_config_t cfg; /* its paths point into this struct: parse in place, never copy */
+  char params[1024], map[1024];
+  const char *url, *truth_log;
+  int lockstep, client_sync, frame_sync, allow_teleport, rtf_given;
+  int host_io_ms; /* --host-io-ms; 0: the mode's default */
+  double rtf, duration_s;
+  int bench, quiet, lidar_lcm, view;
+  int cameras, eye; /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */
+  double camera_fps, light_level, camera_noise, camera_blur;
+  scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
+  int nstarts;
+  scn_pose_t car_start[SIM_MAX_CARS]; /* --car-start I,...: car I alone */
+  int car_start_given[SIM_MAX_CARS];
+  scn_late_box_t late_box[SCN_MAX_LATE_BOXES];
+} app_options_t;
+
+/* Parses argv into o (defaults first). Returns -1 to run, else the exit status: 0 after
+ * --help, 2 for a bad option or value (the message is on stderr). */
+int app_options_parse(app_options_t *o, int argc, char **argv);
+/* Free lockstep: as fast as it can, nobody to wait for. */
+int app_options_free_lockstep(const app_options_t *o);
+/* The mode in words, for the start-up line. */
+const char *app_options_mode(const app_options_t *o);
+
+#endif

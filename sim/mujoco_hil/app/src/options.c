@@ -1,0 +1,372 @@
+/* autodrive-sim's command line (options.h). */
+#include "options.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <autodrive_channels.h>
+
+#include "camera_fx.h"
+#include "cameras.h"
+#include "script.h"
+
+#define OPTIONS_BAD 2      /* a bad option or value: the exit status */
+#define OPTIONS_UNKNOWN -2 /* not an option of this group */
+
+static void options_usage(FILE *f) {
+  fprintf(
+      f,
+      "usage: autodrive-sim [options]\n"
+      "MuJoCo 2.2 HIL simulator of the AutoDRIVE Nigel car. Each car's emulated Nano (the real\n"
+      "firmware core) speaks the serial protocol on a pty at <run-dir>/nigel<i>-nano.\n\n"
+      "  --cars N            cars (1..%d), vehicle names NIGEL1..NIGELN (default 1)\n"
+      "  --map NAME|FILE     parking_school (default), driving_school, intersection_school,\n"
+      "                      tiny_town, or an MJCF map file\n"
+      "  --params FILE       vehicle description (default %s/vehicle/nigel.params)\n"
+      "  --seed N            seed of IMU biases and noise (default 1)\n"
+      "  --start X,Y,YAW_DEG car 1's start pose instead of the map's spawn site (given once per\n"
+      "                      car with --cars N: car k at the k-th): x, y [m] of\n"
+      "                      its rear-axle centre (base_link), yaw [deg] from +x; the other\n"
+      "                      cars line up to its right as usual. Refused when a car would\n"
+      "                      be off the floor or overlap a wall or obstacle (at the spawn\n"
+      "                      site such a car takes the next free place, in rows behind)\n"
+      "  --car-start I,X,Y,YAW_DEG\n"
+      "                      car I (1..--cars) starts at this pose instead (repeatable; the\n"
+      "                      intersection demo places each car on its approach). Refused like\n"
+      "                      --start when a car would be off the floor or on an obstacle\n"
+      "  --late-box X,Y,T[,SX,SY[,R]]\n"
+      "                      a box obstacle (half sizes SX, SY [m], default %g; %g m tall)\n"
+      "                      that appears at x, y [m] at sim time T [s]: a change to the\n"
+      "                      place after it was mapped. With R [m], not before car 1's\n"
+      "                      base_link is within R of it (one stepping out in front of\n"
+      "                      the car). Up to %d; LIDAR, cameras and the collision flag\n"
+      "                      see it once it is there\n"
+      "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
+      "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
+      "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
+      "                      keeps up; real time until it first writes; publish SIM_CLOCK\n"
+      "  --lockstep-frames   lockstep frame by frame (repeatable HIL): at 0 and every 20 ms\n"
+      "                      of sim time the sim waits for one more frame from the client\n"
+      "                      on each Nano pty (a runtime with bridge.sync_to_sim_clock);\n"
+      "                      publish SIM_CLOCK\n"
+      "  --allow-teleport    (lockstep modes only) obey SIM_TELEPORT: a pose2d_t naming a\n"
+      "                      car puts it there, standing still (evaluations that put a car\n"
+      "                      back on its lane after an intervention)\n"
+      "  --rtf X             run at X times real time (e.g. 4), publish SIM_CLOCK\n"
+      "                      (default: real time, 1 sim second per wall second)\n"
+      "  --host-io-ms N      serve the ptys every N ms of sim time, like a USB-serial\n"
+      "                      adapter's latency timer (default: %d with --lockstep, else 1:\n"
+      "                      every step)\n"
+      "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
+      "  --lcm-url URL       LCM provider (default %s)\n"
+      "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
+      "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
+      "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
+      "                      or route:NAME[,speed=F][,start=s][,lookahead=M][,laps=N]\n"
+      "                      [,perturb=A]: pure pursuit on the map's route NAME at F of top\n"
+      "                      speed (default %g), lookahead M [m] (default %g), from the\n"
+      "                      route's start (--cars 1); the run ends when the route does (N\n"
+      "                      laps of a loop, default 1); A > 0 adds seeded steering\n"
+      "                      perturbations up to A (normalised) now and then (expert\n"
+      "                      recordings with recoveries, tools/pilot)\n"
+      "  --no-pty            do not open ptys (with --script)\n"
+      "  --no-lidar          do not simulate the LIDAR\n"
+      "  --late-box-stay S   the --late-box before it leaves again S s after it appeared\n"
+      "                      (an obstacle that goes away)\n"
+      "  --no-late-obstacles leave out the map's late_obstacles (--late-box boxes stay)\n"
+      "  --no-lidar-lcm      never publish NIGEL<i>_LIDAR (by default the sim publishes it\n"
+      "                      unless a client is scanning on the RPLIDAR pty)\n"
+      "  --cameras           render each car's front and rear camera (640x480 JPEG) on LCM\n"
+      "  --front-camera      render only each car's front camera (half the rendering)\n"
+      "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE,\n"
+      "                      or, on a map with eye_cameras (Tiny Town), each of those on\n"
+      "                      <CAM>_IMAGE (EYE1_IMAGE, ...) and <CAM>_CAMERA_INFO\n"
+      "  --camera-fps F      camera frame rate in sim time (default 30)\n"
+      "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
+      "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
+      "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
+      "                      (noise and blur are seeded by --seed: a run repeats)\n"
+      "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
+      "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
+      "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
+      "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
+      "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
+      "  --quiet             no progress lines\n"
+      "  -h, --help          this text\n"
+      "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors),\n"
+      "SIM_CLOCK (100 Hz, with --lockstep or --rtf) and, on maps with traffic lights,\n"
+      "TRAFFIC_LIGHT_STATE (10 Hz per light and on each change); obeys TRAFFIC_LIGHT_COMMAND.\n"
+      "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
+      "not fit the map); 1 any other error (files, map, LCM, physics).\n",
+      SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
+      SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT,
+      SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
+}
+
+static int options_number(const char *opt, const char *v, double lo, double hi, double *out) {
+  char *end;
+  errno = 0;
+  const double x = v ? strtod(v, &end) : 0.0;
+  if (!v || end == v || *end || errno || !isfinite(x) || x < lo || x > hi) {
+    fprintf(stderr, "autodrive-sim: %s '%s': expected a number in [%g, %g]\n", opt, v ? v : "", lo,
+            hi);
+    return -1;
+  }
+  *out = x;
+  return 0;
+}
+
+static void options_defaults(app_options_t *o) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->params, sizeof o->params, "%s/vehicle/nigel.params", AUTODRIVE_ROOT_DIR);
+  snprintf(o->map, sizeof o->map, "%s/maps/parking_school.xml", AUTODRIVE_SIM_DIR);
+  o->cfg.params_path = o->params;
+  o->cfg.map_path = o->map;
+  o->cfg.run_dir = "/tmp/autodrive-sim";
+  o->cfg.cars = 1;
+  o->cfg.seed = 1;
+  o->cfg.open_ptys = 1;
+  o->cfg.lidar = 1;
+  o->cfg.tyre_model = -1;
+  o->url = AUTODRIVE_LCM_URL_DEFAULT;
+  o->lidar_lcm = 1;
+  o->camera_fps = 30.0;
+  o->light_level = -1.0;
+  o->rtf = 1.0;
+}
+
+/* --start X,Y,YAW_DEG: once for car 1, or once per car. */
+static int options_start(app_options_t *o, const char *v) {
+  char perr[512];
+  if (o->nstarts == SIM_MAX_CARS) {
+    fprintf(stderr, "autodrive-sim: --start: more than %d given\n", SIM_MAX_CARS);
+    return OPTIONS_BAD;
+  }
+  if (scn_parse_start(v, &o->starts[o->nstarts], perr, sizeof perr) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", perr);
+    return OPTIONS_BAD;
+  }
+  o->cfg.start = &o->starts[0];
+  o->nstarts++;
+  return 1;
+}
+
+/* --car-start "I,X,Y,YAW_DEG": the car number, then what --start takes. */
+static int options_car_start(app_options_t *o, const char *v) {
+  char perr[512];
+  char *rest = NULL;
+  const long car = v ? strtol(v, &rest, 10) : 0;
+  if (!v || rest == v || *rest != ',' || car < 1 || car > SIM_MAX_CARS ||
+      scn_parse_start(rest + 1, &o->car_start[car - 1], perr, sizeof perr) != 0) {
+    fprintf(stderr, "autodrive-sim: --car-start '%s': want I,X,Y,YAW_DEG (I = 1..%d)%s%s\n",
+            v ? v : "", SIM_MAX_CARS, rest && *rest == ',' ? ": " : "",
+            rest && *rest == ',' ? perr : "");
+    return OPTIONS_BAD;
+  }
+  o->car_start_given[car - 1] = 1;
+  return 1;
+}
+
+/* --late-box X,Y,T[,SX,SY[,R]] and --late-box-stay S (for the --late-box before it). */
+static int options_late_box(app_options_t *o, const char *a, const char *v) {
+  char perr[512];
+  double x;
+  if (!strcmp(a, "--late-box-stay")) {
+    if (o->cfg.late_boxes == 0) {
+      fprintf(stderr, "autodrive-sim: --late-box-stay: give it after the --late-box it is for\n");
+      return OPTIONS_BAD;
+    }
+    if (options_number(a, v, 0.01, 1e6, &x)) return OPTIONS_BAD;
+    o->late_box[o->cfg.late_boxes - 1].stay_s = x;
+    return 1;
+  }
+  if (o->cfg.late_boxes == SCN_MAX_LATE_BOXES) {
+    fprintf(stderr, "autodrive-sim: --late-box '%s': at most %d late boxes\n", v ? v : "",
+            SCN_MAX_LATE_BOXES);
+    return OPTIONS_BAD;
+  }
+  if (scn_parse_late_box(v, &o->late_box[o->cfg.late_boxes], perr, sizeof perr) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", perr);
+    return OPTIONS_BAD;
+  }
+  o->cfg.late_boxes++;
+  o->cfg.late_box = o->late_box;
+  return 1;
+}
+
+/* The world: cars, map, vehicle, seed, start poses, late boxes, tyres, ptys, LIDAR, driver.
+ * Returns how many values it took (0 or 1), OPTIONS_BAD or OPTIONS_UNKNOWN. */
+static int options_world(app_options_t *o, const char *a, const char *v) {
+  double x;
+  if (!strcmp(a, "--cars")) {
+    if (options_number(a, v, 1, SIM_MAX_CARS, &x)) return OPTIONS_BAD;
+    o->cfg.cars = (int)x;
+    return 1;
+  } else if (!strcmp(a, "--map") && v) {
+    if (strchr(v, '/') || strstr(v, ".xml"))
+      snprintf(o->map, sizeof o->map, "%s", v);
+    else
+      snprintf(o->map, sizeof o->map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
+    return 1;
+  } else if (!strcmp(a, "--params") && v) {
+    snprintf(o->params, sizeof o->params, "%s", v);
+    return 1;
+  } else if (!strcmp(a, "--seed")) {
+    if (options_number(a, v, 0, 4e18, &x)) return OPTIONS_BAD;
+    o->cfg.seed = (uint64_t)x;
+    return 1;
+  } else if (!strcmp(a, "--start")) {
+    return options_start(o, v);
+  } else if (!strcmp(a, "--car-start")) {
+    return options_car_start(o, v);
+  } else if (!strcmp(a, "--late-box") || !strcmp(a, "--late-box-stay")) {
+    return options_late_box(o, a, v);
+  } else if (!strcmp(a, "--script") && v) {
+    o->cfg.script = v;
+    return 1;
+  } else if (!strcmp(a, "--no-pty")) {
+    o->cfg.open_ptys = 0;
+  } else if (!strcmp(a, "--no-lidar")) {
+    o->cfg.lidar = 0;
+  } else if (!strcmp(a, "--no-late-obstacles")) {
+    o->cfg.no_map_late_boxes = 1;
+  } else if (!strcmp(a, "--tyre-model") && v) {
+    if (!strcmp(v, "paper")) {
+      o->cfg.tyre_model = 1;
+    } else if (!strcmp(v, "mujoco")) {
+      o->cfg.tyre_model = 0;
+    } else {
+      fprintf(stderr, "autodrive-sim: --tyre-model '%s': expected paper or mujoco\n", v);
+      return OPTIONS_BAD;
+    }
+    return 1;
+  } else {
+    return OPTIONS_UNKNOWN;
+  }
+  return 0;
+}
+
+/* The run: clock mode, duration, LCM, run dir, host I/O period, logs and reports. */
+static int options_run(app_options_t *o, const char *a, const char *v) {
+  double x;
+  if (!strcmp(a, "--lockstep")) {
+    o->lockstep = 1;
+  } else if (!strcmp(a, "--lockstep-client")) {
+    o->lockstep = o->client_sync = 1;
+  } else if (!strcmp(a, "--allow-teleport")) {
+    o->allow_teleport = 1;
+  } else if (!strcmp(a, "--lockstep-frames")) {
+    o->lockstep = o->client_sync = o->frame_sync = 1;
+  } else if (!strcmp(a, "--rtf")) {
+    if (options_number(a, v, 0.01, 1e6, &o->rtf)) return OPTIONS_BAD;
+    o->rtf_given = 1;
+    return 1;
+  } else if (!strcmp(a, "--duration")) {
+    return options_number(a, v, 0, 1e9, &o->duration_s) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--lcm-url") && v) {
+    o->url = v;
+    return 1;
+  } else if (!strcmp(a, "--run-dir") && v) {
+    o->cfg.run_dir = v;
+    return 1;
+  } else if (!strcmp(a, "--host-io-ms")) {
+    if (options_number(a, v, 1, 100, &x)) return OPTIONS_BAD;
+    o->host_io_ms = (int)x;
+    return 1;
+  } else if (!strcmp(a, "--truth-log") && v) {
+    o->truth_log = v;
+    return 1;
+  } else if (!strcmp(a, "--bench")) {
+    o->bench = 1;
+  } else if (!strcmp(a, "--quiet")) {
+    o->quiet = 1;
+  } else {
+    return OPTIONS_UNKNOWN;
+  }
+  return 0;
+}
+
+/* What is rendered and published: LIDAR on LCM, cameras, the Eye, the window, camera effects. */
+static int options_output(app_options_t *o, const char *a, const char *v) {
+  if (!strcmp(a, "--no-lidar-lcm")) {
+    o->lidar_lcm = 0;
+  } else if (!strcmp(a, "--cameras")) {
+    o->cameras = CAMERAS_ALL;
+  } else if (!strcmp(a, "--front-camera")) {
+    o->cameras = CAMERAS_FRONT;
+  } else if (!strcmp(a, "--eye")) {
+    o->eye = 1;
+  } else if (!strcmp(a, "--view")) {
+    o->view = 1;
+  } else if (!strcmp(a, "--camera-fps")) {
+    return options_number(a, v, 0.1, 1000, &o->camera_fps) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--light-level")) {
+    return options_number(a, v, 0, 1, &o->light_level) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--camera-noise")) {
+    return options_number(a, v, 0, CFX_MAX_NOISE, &o->camera_noise) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--camera-blur")) {
+    return options_number(a, v, 0, CFX_MAX_BLUR_PX, &o->camera_blur) ? OPTIONS_BAD : 1;
+  } else {
+    return OPTIONS_UNKNOWN;
+  }
+  return 0;
+}
+
+/* Options that exclude or need each other. */
+static int options_check(const app_options_t *o) {
+  if (o->lockstep && o->rtf_given) {
+    fprintf(stderr, "autodrive-sim: --lockstep%s and --rtf exclude each other\n",
+            o->client_sync ? "-client" : "");
+    return OPTIONS_BAD;
+  }
+  if (o->allow_teleport && !o->lockstep) {
+    fprintf(stderr,
+            "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
+            "--lockstep-frames (a car never jumps in a real-time run)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->client_sync && !o->cfg.open_ptys) {
+    fprintf(stderr, "autodrive-sim: --lockstep-client needs the ptys (drop --no-pty)\n");
+    return OPTIONS_BAD;
+  }
+  return -1;
+}
+
+int app_options_parse(app_options_t *o, int argc, char **argv) {
+  options_defaults(o);
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i], *v = (i + 1 < argc) ? argv[i + 1] : NULL;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      options_usage(stdout);
+      return 0;
+    }
+    int took = options_world(o, a, v);
+    if (took == OPTIONS_UNKNOWN) took = options_run(o, a, v);
+    if (took == OPTIONS_UNKNOWN) took = options_output(o, a, v);
+    if (took == OPTIONS_BAD) return OPTIONS_BAD;
+    if (took == OPTIONS_UNKNOWN) {
+      fprintf(stderr, "autodrive-sim: unknown option or missing value: '%s' (see --help)\n", a);
+      return OPTIONS_BAD;
+    }
+    i += took;
+  }
+  const int free_lockstep = app_options_free_lockstep(o);
+  o->cfg.host_io_period_ms = o->host_io_ms   ? o->host_io_ms
+                             : free_lockstep ? OPTIONS_FREE_LOCKSTEP_IO_MS
+                                             : 1;
+  return options_check(o);
+}
+
+int app_options_free_lockstep(const app_options_t *o) {
+  return o->lockstep && !o->client_sync;
+}
+
+const char *app_options_mode(const app_options_t *o) {
+  return o->frame_sync    ? "lockstep with the client, frame by frame"
+         : o->client_sync ? "lockstep with the client"
+         : o->lockstep    ? "lockstep"
+                          : (o->rtf_given ? "rtf" : "real time");
+}
