@@ -1,10 +1,10 @@
 // AMCL with KLD sampling converges from a wrong start on the saved map.
 #include <gtest/gtest.h>
 
-#include "autonomy/amcl.hpp"
+#include <autodrive/autonomy/amcl.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 

@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "autonomy/autonomy_node.hpp"
+#include <autodrive/autonomy/autonomy_node.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {

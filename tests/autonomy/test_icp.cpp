@@ -1,10 +1,10 @@
 // Laser odometry: scan-to-scan ICP recovers a known motion.
 #include <gtest/gtest.h>
 
-#include "autonomy/icp.hpp"
+#include <autodrive/autonomy/icp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 TEST(Icp, RecoversKnownMotions) {
   const auto world = synth::World::parking_lot();

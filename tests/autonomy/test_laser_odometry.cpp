@@ -3,10 +3,10 @@
 
 #include <cmath>
 
-#include "autonomy/laser_odometry.hpp"
+#include <autodrive/autonomy/laser_odometry.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 const Pose2 kLidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0.0, 0.0};

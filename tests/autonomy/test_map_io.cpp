@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "autonomy/map_io.hpp"
+#include <autodrive/autonomy/map_io.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {

@@ -1,12 +1,12 @@
 // Planning for a car-like vehicle: Reeds-Shepp, grid A*, Hybrid A* into a parking slot.
 #include <gtest/gtest.h>
 
-#include "autonomy/grid_search.hpp"
-#include "autonomy/hybrid_astar.hpp"
-#include "autonomy/reeds_shepp.hpp"
+#include <autodrive/autonomy/grid_search.hpp>
+#include <autodrive/autonomy/hybrid_astar.hpp>
+#include <autodrive/autonomy/reeds_shepp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 

@@ -21,10 +21,10 @@
 #include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
-#include "autonomy/map_io.hpp"
+#include <autodrive/autonomy/map_io.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {

@@ -1,10 +1,10 @@
 // Hector-style multi-resolution scan matching and SLAM on simulated scans.
 #include <gtest/gtest.h>
 
-#include "autonomy/slam.hpp"
+#include <autodrive/autonomy/slam.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 

@@ -1,11 +1,11 @@
 // Pure pursuit on a kinematic bicycle (speed lag, Nigel's steering rate limit).
 #include <gtest/gtest.h>
 
-#include "autonomy/pure_pursuit.hpp"
-#include "autonomy/reeds_shepp.hpp"
+#include <autodrive/autonomy/pure_pursuit.hpp>
+#include <autodrive/autonomy/reeds_shepp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 
