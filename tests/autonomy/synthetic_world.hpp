@@ -11,7 +11,7 @@
 #include <autodrive/autonomy/grid_map.hpp>
 #include <autodrive/autonomy/path.hpp>
 
-namespace synth {
+namespace autodrive::synthetic_world {
 
 using autodrive::autonomy::Pose2;
 
@@ -56,8 +56,8 @@ struct World {
   }
 
   // A 360-ray, 1-degree scan like the RPLIDAR A1, from the LIDAR at lidar_in_base.
-  autodrive::autonomy::Scan scan(const Pose2 &base, const Pose2 &lidar_in_base, double noise_m = 0.0,
-                      std::mt19937 *rng = nullptr) const {
+  autodrive::autonomy::Scan scan(const Pose2 &base, const Pose2 &lidar_in_base,
+                                 double noise_m = 0.0, std::mt19937 *rng = nullptr) const {
     autodrive::autonomy::Scan s;
     s.angle_min_rad = -autodrive::autonomy::kPi;
     s.angle_increment_rad = 2.0 * autodrive::autonomy::kPi / 360.0;
@@ -78,7 +78,7 @@ struct World {
   // unknown outside; the grid spans [-0.5, 4.5] x [-0.5, 3.5].
   autodrive::autonomy::GridMap rasterize(double res_m) const {
     autodrive::autonomy::GridMap g(static_cast<int>(std::round(5.0 / res_m)),
-                        static_cast<int>(std::round(4.0 / res_m)), res_m, -0.5, -0.5);
+                                   static_cast<int>(std::round(4.0 / res_m)), res_m, -0.5, -0.5);
     for (int cy = 0; cy < g.height_cells; ++cy) {
       for (int cx = 0; cx < g.width_cells; ++cx) {
         const Eigen::Vector2d c = g.cell_center_m(cx, cy);
@@ -129,4 +129,4 @@ inline double distance_to_path_m(const autodrive::autonomy::Path &path, const Ei
   return best;
 }
 
-}  // namespace synth
+}  // namespace autodrive::synthetic_world

@@ -87,7 +87,8 @@ TEST(Preprocess, RefusesAFrameOfAnotherSize) {
   EXPECT_EQ(blob.size[1], 3);
   EXPECT_EQ(blob.size[2], 66);
   EXPECT_EQ(blob.size[3], 200);
-  EXPECT_THROW(autodrive::pilot::preprocess(cv::Mat(240, 320, CV_8UC3), spec), autodrive::InputError);
+  EXPECT_THROW(autodrive::pilot::preprocess(cv::Mat(240, 320, CV_8UC3), spec),
+               autodrive::InputError);
 }
 
 TEST(OnnxOpset, ReadsTheDefaultDomainAndRefusesTruncatedBytes) {
@@ -101,7 +102,8 @@ TEST(OnnxOpset, ReadsTheDefaultDomainAndRefusesTruncatedBytes) {
   } catch (const autodrive::InputError &e) {
     EXPECT_NE(std::string(e.what()).find("m.onnx: truncated"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(autodrive::pilot::onnx_opset("m.onnx", std::string("\x08\x07", 2)), autodrive::InputError);
+  EXPECT_THROW(autodrive::pilot::onnx_opset("m.onnx", std::string("\x08\x07", 2)),
+               autodrive::InputError);
 }
 
 }  // namespace

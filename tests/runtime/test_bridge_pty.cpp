@@ -136,7 +136,7 @@ class BridgeHarness {
   }
 
   std::string link_;
-  rtest::FakeNano nano;
+  autodrive::devtools::FakeNano nano;
   TestKey key;
   autodrive::config::Config config;
   lcm::LCM lcm;
@@ -307,7 +307,8 @@ TEST(BridgePty, ReconnectsAfterDeviceDisappears) {
 TEST(BridgePty, MissingDeviceRetriedUntilItAppears) {
   BridgeHarness h(7766);
   h.start();  // no device yet
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::no_device; }, 5));
+  ASSERT_TRUE(
+      h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::no_device; }, 5));
   h.nano.open();
   ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 2; }));
   EXPECT_EQ(h.status().opens, 1u);

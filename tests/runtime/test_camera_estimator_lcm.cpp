@@ -62,10 +62,11 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
     ASSERT_TRUE(w.isOpened());
     for (int i = 0; i < 20; ++i) w.write(cv::Mat(240, 320, CV_8UC3, cv::Scalar(200, 120, 10)));
   }
-  const autodrive::config::Config c = autodrive::config::parse(base_yaml(7774) + "cameras:\n  - {source: " + video +
-                                       ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
-                                       "     height_px: 120, jpeg_quality: 90}\n",
-                                   "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7774) + "cameras:\n  - {source: " + video +
+                                   ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
+                                   "     height_px: 120, jpeg_quality: 90}\n",
+                               "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(
@@ -114,7 +115,8 @@ TEST(CameraLcm, MissingSourceIsRetriedNotFatal) {
 }
 
 TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
-  const autodrive::config::Config c = autodrive::config::parse(base_yaml(7776) + "estimator: {rate_hz: 100}\n", "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7776) + "estimator: {rate_hz: 100}\n", "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
@@ -165,7 +167,8 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
 // Probe findings: a forged POSE_EYE stream moved the map pose 1,000 m; an encoder jump gave
 // an odometry speed of 1,063 m/s. Both are refused by the running estimator and counted.
 TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
-  const autodrive::config::Config c = autodrive::config::parse(base_yaml(7786) + "estimator: {rate_hz: 100}\n", "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7786) + "estimator: {rate_hz: 100}\n", "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);

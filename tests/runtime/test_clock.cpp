@@ -51,7 +51,8 @@ TEST(Clock, SimClockBackwardsOrFarAheadIsRefusedAndCounted) {
   EXPECT_EQ(c.now_us(), 5000000);
   tick(4999999);  // backwards
   EXPECT_EQ(c.now_us(), 5000000);
-  tick(5000000 + autodrive::clock::Clock::kMaxSimStepUs + 1);  // far ahead: would freeze every later tick
+  tick(5000000 + autodrive::clock::Clock::kMaxSimStepUs +
+       1);  // far ahead: would freeze every later tick
   EXPECT_EQ(c.now_us(), 5000000);
   EXPECT_EQ(c.sim_ticks_refused(), 3u);
   tick(5010000);  // the honest next tick still moves it

@@ -131,8 +131,10 @@ TEST_F(GateTest, ReplaysAndStaleCountersDropped) {
   EXPECT_EQ(admit(c, 0), autodrive::bridge::Drop::none);
   EXPECT_EQ(admit(c, 1000), autodrive::bridge::Drop::replay);  // the same counter again
   const auto later = cmd(autonomy, true);
-  EXPECT_EQ(gate.admit(later, 2000, later.counter + 2000000).drop, autodrive::bridge::Drop::replay);  // old
-  EXPECT_EQ(gate.admit(later, 2000, later.counter - 2000000).drop, autodrive::bridge::Drop::replay);  // future
+  EXPECT_EQ(gate.admit(later, 2000, later.counter + 2000000).drop,
+            autodrive::bridge::Drop::replay);  // old
+  EXPECT_EQ(gate.admit(later, 2000, later.counter - 2000000).drop,
+            autodrive::bridge::Drop::replay);  // future
   EXPECT_EQ(gate.counters().dropped_replay, 3);
 }
 
@@ -154,7 +156,8 @@ TEST_F(GateTest, ReplayOfACommandSignedBeforeARestartDropped) {
 }
 
 TEST_F(GateTest, FirstEngagedSourceTakesAFreeLeaseIdleOnesDoNot) {
-  EXPECT_EQ(admit(cmd(teleop, false), 0), autodrive::bridge::Drop::idle);  // an idle teleop asks for nothing
+  EXPECT_EQ(admit(cmd(teleop, false), 0),
+            autodrive::bridge::Drop::idle);  // an idle teleop asks for nothing
   EXPECT_EQ(gate.holder(), "");
   EXPECT_EQ(admit(cmd(autonomy, true), 0), autodrive::bridge::Drop::none);
   EXPECT_EQ(gate.holder(), "autonomy");

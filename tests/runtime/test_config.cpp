@@ -91,8 +91,8 @@ TEST(Config, SyncToSimClockNeedsTheSimClock) {
       replace(kGood, "command_timeout_ms: 200", "command_timeout_ms: 200, sync_to_sim_clock: true");
   EXPECT_EQ(error_of(sync),
             "test.yaml: bridge.sync_to_sim_clock: needs clock: sim (it sends on SIM_CLOCK ticks)");
-  EXPECT_TRUE(
-      autodrive::config::parse(replace(sync, "clock: wall", "clock: sim"), "test.yaml").bridge.sync_to_sim_clock);
+  EXPECT_TRUE(autodrive::config::parse(replace(sync, "clock: wall", "clock: sim"), "test.yaml")
+                  .bridge.sync_to_sim_clock);
 }
 
 TEST(Config, UnknownKeyRefused) {

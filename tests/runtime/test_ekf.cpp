@@ -35,7 +35,8 @@ Eigen::Matrix3d eye_cov(double pos_std, double yaw_std) {
 // Runs a 30 s loop (straight, left arc, right arc) with odometry speed scaled by
 // `speed_scale` and a gyro bias; Eye poses every 100 ms delayed by `eye_delay_us` if
 // `with_eye`. Returns the final position error [m].
-double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us, autodrive::estimator::EkfStats *stats) {
+double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us,
+                autodrive::estimator::EkfStats *stats) {
   autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   std::mt19937 rng(7);
@@ -167,10 +168,11 @@ TEST(Ekf, NonFiniteRejected) {
 TEST(Ekf, WheelSpeedFromEncodersAcrossClockWrap) {
   double v = 0;
   // One wheel revolution on both wheels in 0.1 s, across the Nano's 32-bit clock wrap.
-  ASSERT_TRUE(
-      autodrive::estimator::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000, 1920, 0.0325, &v));
+  ASSERT_TRUE(autodrive::estimator::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000,
+                                                              1920, 0.0325, &v));
   EXPECT_NEAR(v, 2 * M_PI * 0.0325 / 0.1, 1e-9);
-  EXPECT_FALSE(autodrive::estimator::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
+  EXPECT_FALSE(
+      autodrive::estimator::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
 }
 
 // ---- The pose gate (probe finding: one forged POSE_EYE stream moved the map pose 1,000 m) ----

@@ -252,7 +252,8 @@ struct Turns {
     for (int turn = 0; turn < 3; ++turn)
       for (int k = 0; k < 360; ++k) {
         uint8_t b[5];
-        autodrive::rplidar::encode_node({k == 0, 10, double((360 + step_deg * k) % 360), 1000.0 + k}, b);
+        autodrive::rplidar::encode_node(
+            {k == 0, 10, double((360 + step_deg * k) % 360), 1000.0 + k}, b);
         d.feed(b, 5);
       }
   }

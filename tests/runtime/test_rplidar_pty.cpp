@@ -32,7 +32,7 @@ double room_m(int deg_cw) {
 // A1 emulation: answers GET_HEALTH with `health_status`, streams nodes after SCAN.
 struct FakeRplidar {
   explicit FakeRplidar(const std::string &link) : pty(link) {}
-  rtest::PtyPeer pty;
+  autodrive::devtools::PtyPeer pty;
   uint8_t health_status = 0;
   bool scanning = false;
   int resets = 0, scans = 0, healths = 0;
@@ -67,7 +67,8 @@ struct FakeRplidar {
     std::vector<uint8_t> out;
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (int k = 0; k < 40; ++k) {  // 40 nodes per pump
-      autodrive::rplidar::Node n{angle == 0, 40, static_cast<double>(angle), room_m(angle) * 1000.0};
+      autodrive::rplidar::Node n{angle == 0, 40, static_cast<double>(angle),
+                                 room_m(angle) * 1000.0};
       uint8_t b[5];
       autodrive::rplidar::encode_node(n, b);
       if (u(rng) < corrupt_fraction) b[rng() % 5] ^= static_cast<uint8_t>(1u << (rng() % 8));
@@ -86,13 +87,14 @@ struct LidarHarness {
   explicit LidarHarness(int port)
       : link("/tmp/adr-rt-lidar-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         fake(link),
-        config(autodrive::config::parse("lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
-                              "?ttl=0\"\n"
-                              "clock: wall\n"
-                              "vehicle: {name: TESTCAR}\n"
-                              "lidar: {device: " +
-                              link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
-                          "test config")),
+        config(autodrive::config::parse(
+            "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+                "?ttl=0\"\n"
+                "clock: wall\n"
+                "vehicle: {name: TESTCAR}\n"
+                "lidar: {device: " +
+                link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
+            "test config")),
         lcm(config.lcm_url) {
     autodrive_lcm::subscribe<autodrive::lidar_scan_t, LidarHarness, &LidarHarness::on_scan>(
         lcm, "TESTCAR_LIDAR", this);

@@ -213,7 +213,7 @@ int main(int argc, char **argv) {
       "LCM"};
   std::string config_path, url_override, vehicle_override, replay_in, replay_out, key_file;
   cli.add_option("--config", config_path,
-                 "YAML configuration (see runtime/jetson/autonomy/config/)")
+                 "YAML configuration (see runtime/jetson/config/autonomy.example.yaml)")
       ->required();
   cli.add_option("--lcm-url", url_override, "override lcm_url of the config");
   cli.add_option("--vehicle", vehicle_override, "override vehicle (e.g. NIGEL1)");

@@ -86,8 +86,8 @@ class Driver {
       in.obstacle_ahead_m = obstacle_.ahead_m(track_, s_local_);
     }
     for (const auto &peer : peers_.fresh(m->utime)) {
-      const auto q =
-          autodrive::behaviour::project(track_, peer.x_m, peer.y_m, s_local_, 0.0, o_.rules.peer_horizon_m);
+      const auto q = autodrive::behaviour::project(track_, peer.x_m, peer.y_m, s_local_, 0.0,
+                                                   o_.rules.peer_horizon_m);
       double ahead = q.s_m - s_local_;
       if (track_.loop && ahead < 0) ahead += track_.length_m;
       if (q.dist_m < o_.rules.peer_corridor_m && ahead > 0 && ahead < o_.rules.peer_horizon_m)

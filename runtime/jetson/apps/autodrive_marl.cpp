@@ -64,7 +64,8 @@ class App {
  public:
   App(const Options &o, lcm::LCM &lcm, autodrive::auth::Signer signer,
       std::unique_ptr<autodrive::marl::Policy> policy, autodrive::marl::Route route,
-      std::unique_ptr<autodrive::marl::FcfsBaseline> baseline, std::optional<autodrive::autonomy::Pose2> origin)
+      std::unique_ptr<autodrive::marl::FcfsBaseline> baseline,
+      std::optional<autodrive::autonomy::Pose2> origin)
       : o_(o),
         lcm_(lcm),
         signer_(std::move(signer)),
@@ -95,7 +96,8 @@ class App {
   void on_pose(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
     autodrive::autonomy::Pose2 p{m->x_m, m->y_m, m->yaw_rad};
     if (origin_) p = autodrive::autonomy::pose_compose(*origin_, p);
-    own_ = autodrive::marl::CarState{autodrive::marl::vehicle_id(o_.vehicle), p.x_m, p.y_m, p.yaw_rad, m->vx_m_s};
+    own_ = autodrive::marl::CarState{autodrive::marl::vehicle_id(o_.vehicle), p.x_m, p.y_m,
+                                     p.yaw_rad, m->vx_m_s};
     have_pose_ = true;
   }
 
@@ -123,7 +125,8 @@ class App {
     const std::vector<autodrive::v2v_state_t> fresh = peers_.fresh(now);
     std::vector<autodrive::marl::CarState> peers;
     for (const auto &s : fresh)
-      peers.push_back({autodrive::marl::vehicle_id(s.vehicle), s.x_m, s.y_m, s.yaw_rad, s.speed_m_s});
+      peers.push_back(
+          {autodrive::marl::vehicle_id(s.vehicle), s.x_m, s.y_m, s.yaw_rad, s.speed_m_s});
     const bool at_goal = std::hypot(own_.x_m - goal_[0], own_.y_m - goal_[1]) < o_.goal_tolerance_m;
     if (at_goal && goal_us_ < 0) {
       goal_us_ = now;
@@ -171,7 +174,8 @@ class App {
       // in training), braking only for an emergency.
       const autodrive::autonomy::TrackerCommand tc =
           after_goal_.step({own_.x_m, own_.y_m, own_.yaw_rad}, dt_s, own_.speed_m_s);
-      const autodrive::marl::ShieldResult r = core_.shield(own_, tc.throttle, tc.steering, peers, true);
+      const autodrive::marl::ShieldResult r =
+          core_.shield(own_, tc.throttle, tc.steering, peers, true);
       throttle = r.throttle;
       steering = r.steering;
     }
@@ -423,8 +427,8 @@ int main(int argc, char **argv) {
   try {
     route = autodrive::marl::read_route(o.map_json, o.route);
     if (o.mode == "baseline")
-      baseline = std::make_unique<autodrive::marl::FcfsBaseline>(o.vehicle, route,
-                                                      autodrive::marl::read_conflict_zone(o.map_json, 0.1));
+      baseline = std::make_unique<autodrive::marl::FcfsBaseline>(
+          o.vehicle, route, autodrive::marl::read_conflict_zone(o.map_json, 0.1));
     origin = parse_origin(o.odom_origin);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "autodrive-marl: %s\n", e.what());

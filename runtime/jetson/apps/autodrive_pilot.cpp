@@ -63,8 +63,8 @@ double percentile(std::vector<double> v, double q) {
 
 class PilotNode {
  public:
-  PilotNode(const autodrive::pilot::PilotConfig &cfg, lcm::LCM &lcm, autodrive::pilot::PilotModel &model,
-            autodrive::auth::Signer signer)
+  PilotNode(const autodrive::pilot::PilotConfig &cfg, lcm::LCM &lcm,
+            autodrive::pilot::PilotModel &model, autodrive::auth::Signer signer)
       : cfg_(cfg),
         lcm_(lcm),
         model_(model),
@@ -234,7 +234,8 @@ int main(int argc, char **argv) {
   std::string config_path, model_override, url_override, vehicle_override, key_file, stats_path;
   std::vector<std::string> predict_images;
   bool check_only = false;
-  cli.add_option("--config", config_path, "YAML configuration (runtime/jetson/pilot/config/)");
+  cli.add_option("--config", config_path,
+                 "YAML configuration (runtime/jetson/config/pilot_*.yaml)");
   cli.add_option("--model", model_override,
                  "the model NAME.onnx (its NAME.json beside it); "
                  "overrides the config's model");

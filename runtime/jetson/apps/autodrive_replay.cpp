@@ -33,8 +33,8 @@ int main(int argc, char **argv) {
     return 2;
   }
   config.lcm_url = "file://" + std::filesystem::absolute(in_path).string() + "?speed=0";
-  autodrive::estimator::EstimatorNode node(config,
-                          "file://" + std::filesystem::absolute(out_path).string() + "?mode=w");
+  autodrive::estimator::EstimatorNode node(
+      config, "file://" + std::filesystem::absolute(out_path).string() + "?mode=w");
   if (const std::string e = node.init_error(); !e.empty()) {
     std::fprintf(stderr, "autodrive-replay: %s\n", e.c_str());
     return 2;

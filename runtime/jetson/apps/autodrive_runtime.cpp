@@ -32,7 +32,8 @@ int main(int argc, char **argv) {
       "EKF estimator) over LCM. The same binary drives the car, the simulator's ptys "
       "and the firmware in simavr: only the device paths in the config change."};
   std::string config_path, only, route, level = "info";
-  app.add_option("--config", config_path, "YAML config (runtime/jetson/config/*.yaml)")->required();
+  app.add_option("--config", config_path, "YAML config (runtime/jetson/config/nigel_*.yaml)")
+      ->required();
   app.add_option("--only", only,
                  "comma-separated subset of: bridge,lidar,camera,estimator,v2v (default: every "
                  "component with a section in the config; v2v with the estimator unless "

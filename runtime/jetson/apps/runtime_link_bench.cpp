@@ -71,7 +71,7 @@ autodrive::vehicle_command_t make_cmd(int32_t seq, float throttle, float steerin
 // ---- flood ---------------------------------------------------------------------------
 int run_flood(const std::string &url, const std::string &vehicle, const std::string &pty,
               double seconds, double flood_hz) {
-  rtest::FakeNano nano(pty);
+  autodrive::devtools::FakeNano nano(pty);
   nano.open();
   proto_state_t st{};
   st.quat_q14[0] = PROTO_QUAT_ONE;
@@ -128,7 +128,8 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
   while (autodrive::clock::monotonic_us() < t0 + static_cast<int64_t>(seconds * 1e6)) {
     service();
     if (autodrive::clock::monotonic_us() >= next_print) {
-      progress("flood: %.0f s, %.0f COMMAND frames so far\n", (autodrive::clock::monotonic_us() - t0) * 1e-6,
+      progress("flood: %.0f s, %.0f COMMAND frames so far\n",
+               (autodrive::clock::monotonic_us() - t0) * 1e-6,
                static_cast<double>(nano.commands.size() - n0));
       next_print += 1000000;
     }
@@ -147,7 +148,7 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
 int run_serial(const std::string &url, const std::string &vehicle, const std::string &pty,
                int samples) {
   lcm::LCM lcm(url);
-  rtest::FakeNano nano(pty);
+  autodrive::devtools::FakeNano nano(pty);
   nano.open();
   proto_state_t st{};
   st.quat_q14[0] = PROTO_QUAT_ONE;
@@ -172,7 +173,8 @@ int run_serial(const std::string &url, const std::string &vehicle, const std::st
   int32_t seq = 0;
   for (int k = 0; k < samples; ++k) {
     // Spread the publish times over the heartbeat period.
-    const int64_t pause_end = autodrive::clock::monotonic_us() + 30000 + static_cast<int64_t>(rng() % 20000);
+    const int64_t pause_end =
+        autodrive::clock::monotonic_us() + 30000 + static_cast<int64_t>(rng() % 20000);
     while (autodrive::clock::monotonic_us() < pause_end) service();
     const int16_t milli = static_cast<int16_t>(100 + (k % 2) * 400 + k % 7);
     const std::size_t mark = nano.commands.size();

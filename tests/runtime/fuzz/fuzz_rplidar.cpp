@@ -1,4 +1,4 @@
-// libFuzzer target: the RPLIDAR A1 decoder and scan assembler (runtime/jetson/rplidar), fed
+// libFuzzer target: the RPLIDAR A1 decoder and scan assembler (runtime/jetson/drivers/rplidar), fed
 // what a noisy or hostile serial line can carry. The input is a script:
 //   op 0: n raw bytes, fed in one chunk                        [0, n, bytes...]
 //   op 1: a valid scan descriptor (A5 5A 05 00 00 40 81)        [1]

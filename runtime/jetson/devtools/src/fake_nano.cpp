@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-namespace rtest {
+namespace autodrive::devtools {
 
 void PtyPeer::open() {
   close();
@@ -106,4 +106,4 @@ void FakeNano::send_state(const proto_state_t &s) {
   pty.write(std::vector<uint8_t>(frame, frame + n));
 }
 
-}  // namespace rtest
+}  // namespace autodrive::devtools

@@ -39,7 +39,8 @@ struct CameraDriver::Impl {
   std::atomic<uint64_t> published{0};
   std::string error;
 
-  Impl(const autodrive::config::Config &c, std::size_t i) : config(c), lcm(c.lcm_url), clock(c.clock) {
+  Impl(const autodrive::config::Config &c, std::size_t i)
+      : config(c), lcm(c.lcm_url), clock(c.clock) {
     if (i >= c.cameras.size()) {
       error = c.file + ": cameras[" + std::to_string(i) + "]: missing";
       return;
@@ -111,7 +112,8 @@ struct CameraDriver::Impl {
       if (is_file && now < next_frame_us)
         std::this_thread::sleep_for(std::chrono::microseconds(next_frame_us - now));
       next_frame_us += period_us;
-      if (next_frame_us < autodrive::clock::monotonic_us()) next_frame_us = autodrive::clock::monotonic_us() + period_us;
+      if (next_frame_us < autodrive::clock::monotonic_us())
+        next_frame_us = autodrive::clock::monotonic_us() + period_us;
       if (frame.type() != CV_8UC3) cv::cvtColor(frame, frame, cv::COLOR_GRAY2BGR);
       cv::Mat cont = frame.isContinuous() ? frame : frame.clone();
       autodrive::compressed_image_t img{};

@@ -5,8 +5,8 @@
 
 namespace autodrive::bridge {
 
-void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh, const HostLinkStats &host,
-                int64_t utime_us, autodrive::vehicle_state_t *out) {
+void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
+                const HostLinkStats &host, int64_t utime_us, autodrive::vehicle_state_t *out) {
   out->utime = utime_us;
   out->nano_time_us = s.nano_time_us;
   for (int i = 0; i < 2; ++i) {

@@ -495,7 +495,8 @@ struct NanoBridge::Impl {
   }
 };
 
-NanoBridge::NanoBridge(const autodrive::config::Config &config) : impl_(std::make_unique<Impl>(config)) {}
+NanoBridge::NanoBridge(const autodrive::config::Config &config)
+    : impl_(std::make_unique<Impl>(config)) {}
 NanoBridge::~NanoBridge() = default;
 
 std::string NanoBridge::init_error() const {

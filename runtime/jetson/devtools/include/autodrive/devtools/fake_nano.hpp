@@ -9,7 +9,7 @@
 
 #include "proto.h"
 
-namespace rtest {
+namespace autodrive::devtools {
 
 // A pty whose slave is reachable at `link` (a symlink). close() makes the device disappear.
 class PtyPeer {
@@ -57,4 +57,4 @@ class FakeNano {
   uint8_t seq_ = 0;
 };
 
-}  // namespace rtest
+}  // namespace autodrive::devtools

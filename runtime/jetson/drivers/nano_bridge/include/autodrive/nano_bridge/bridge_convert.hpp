@@ -23,8 +23,8 @@ struct HostLinkStats {
   uint32_t dropped = 0;
 };
 
-void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh, const HostLinkStats &host,
-                int64_t utime_us, autodrive::vehicle_state_t *out);
+void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
+                const HostLinkStats &host, int64_t utime_us, autodrive::vehicle_state_t *out);
 
 // Converts raw MPU-9250 LSB with the proto.h scales; covariances are diagonal from config.
 void fill_imu(const proto_state_t &s, const autodrive::config::Bridge &br, int64_t utime_us,

@@ -1,6 +1,6 @@
-// RPLIDAR A1 driver: serial I/O around autodrive::rplidar::Decoder. STOP, GET_HEALTH (RESET on error),
-// SCAN, then publishes <VEH>_LIDAR each turn. Restarts the scan when nodes stop arriving and
-// reopens the device when it disappears.
+// RPLIDAR A1 driver: serial I/O around autodrive::rplidar::Decoder. STOP, GET_HEALTH (RESET on
+// error), SCAN, then publishes <VEH>_LIDAR each turn. Restarts the scan when nodes stop arriving
+// and reopens the device when it disappears.
 #pragma once
 
 #include <atomic>

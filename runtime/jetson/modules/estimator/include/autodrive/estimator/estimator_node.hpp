@@ -2,7 +2,8 @@
 // + <VEH>_POSE_EYE -> <VEH>_ODOM (odometry only, continuous) and <VEH>_POSE_MAP (with the
 // Eye, in the map frame). Publishes at each STATE, at most at estimator.rate_hz.
 // Its only clock is the messages' stamps (wall or SIM_CLOCK time, given by the bridge's
-// autodrive::clock::Clock), so an LCM log replayed through file:// gives the outputs of the run again.
+// autodrive::clock::Clock), so an LCM log replayed through file:// gives the outputs of the run
+// again.
 #pragma once
 
 #include <atomic>
@@ -34,7 +35,8 @@ struct InputStats {
 class EstimatorNode {
  public:
   // Inputs from config.lcm_url; outputs there too, or to output_url if given (replay).
-  explicit EstimatorNode(const autodrive::config::Config &config, const std::string &output_url = "");
+  explicit EstimatorNode(const autodrive::config::Config &config,
+                         const std::string &output_url = "");
   ~EstimatorNode();
   std::string init_error() const;
   void run(const std::atomic<bool> &stop);

@@ -1,5 +1,5 @@
 // The one place autodrive-marl calls the MARL core (autodrive_marl_core, <autodrive/marl_core.h>,
-// runtime/jetson/marl_core/): the observation builder and the time-to-collision shield, so the
+// common/marl_core/): the observation builder and the time-to-collision shield, so the
 // C++ program and Python's training and batch evaluation share them. This wrapper only turns
 // C++ types into the core's and fills the shield's car figures from vehicle/nigel.params.
 #pragma once

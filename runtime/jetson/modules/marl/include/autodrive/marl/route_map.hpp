@@ -11,10 +11,11 @@ namespace autodrive::marl {
 
 struct Route {
   std::string name;
-  std::vector<autodrive::autonomy::Pose2> points;  // along the lane centre, yaw = direction of travel
-  std::vector<double> s_m;              // arc length at each point [m]
-  double half_width_m = 0;              // the lane's half width [m] (the shield's lane term)
-  autodrive::autonomy::Path path() const;          // for the pure-pursuit tracker, forward only
+  std::vector<autodrive::autonomy::Pose2>
+      points;                              // along the lane centre, yaw = direction of travel
+  std::vector<double> s_m;                 // arc length at each point [m]
+  double half_width_m = 0;                 // the lane's half width [m] (the shield's lane term)
+  autodrive::autonomy::Path path() const;  // for the pure-pursuit tracker, forward only
   // Index of the point nearest to (x, y) [m].
   size_t nearest(double x_m, double y_m) const;
 };

@@ -1,4 +1,4 @@
-// autodrive-pilot's configuration (runtime/jetson/pilot/config/*.yaml), read strictly: unknown
+// autodrive-pilot's configuration (runtime/jetson/config/pilot_*.yaml), read strictly: unknown
 // or missing keys and out-of-range numbers are refused naming the file and the dotted key.
 #pragma once
 
