@@ -17,10 +17,10 @@ s#runtime/jetson/behaviour/src/city_driver_main\.cpp#runtime/jetson/apps/autodri
 s#runtime/jetson/marl/src/main\.cpp#runtime/jetson/apps/autodrive_marl.cpp#g
 s#runtime/jetson/tools/replay_main\.cpp#runtime/jetson/apps/autodrive_replay.cpp#g
 s#runtime/jetson/tools/link_bench\.cpp#runtime/jetson/apps/runtime_link_bench.cpp#g
-# the fake Nano: devtools/
+# the fake Nano: devtools/; the rest of tools/ (runtime-link-bench, autodrive-replay): apps/
 s#runtime/jetson/tools/fake_nano\.(hpp)#runtime/jetson/devtools/include/autodrive/devtools/fake_nano.\1#g
 s#runtime/jetson/tools/fake_nano\.(cpp)#runtime/jetson/devtools/src/fake_nano.\1#g
-s#runtime/jetson/tools\b#runtime/jetson/devtools#g
+s#runtime/jetson/tools\b#runtime/jetson/apps#g
 # runtime/jetson/common: the runtime's core part (config, clock, serial port)
 s#runtime/jetson/common/(\w+)\.hpp#runtime/jetson/core/include/autodrive/core/\1.hpp#g
 s#runtime/jetson/common/(\w+)\.cpp#runtime/jetson/core/src/\1.cpp#g

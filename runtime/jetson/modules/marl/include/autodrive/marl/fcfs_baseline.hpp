@@ -11,7 +11,7 @@
 #pragma once
 
 #include <autodrive/v2v_state_t.hpp>
-#include <autonomy/pure_pursuit.hpp>
+#include <autodrive/autonomy/pure_pursuit.hpp>
 
 #include <cstdint>
 #include <map>

@@ -2,7 +2,7 @@
 // (sim/mujoco_hil/maps/<map>.json, written by tools/gen-maps: the one source of routes).
 #pragma once
 
-#include <autonomy/path.hpp>
+#include <autodrive/autonomy/path.hpp>
 
 #include <string>
 #include <vector>
