@@ -8,7 +8,7 @@ CHANNEL_TABLE: Path = REPO_ROOT / "lcm_types" / "channels.yaml"
 RUNTIME_HIL_CONFIG: Path = REPO_ROOT / "runtime" / "jetson" / "config" / "nigel_hil.yaml"
 RUNTIME_CAR_CONFIG: Path = REPO_ROOT / "runtime" / "jetson" / "config" / "nigel_car.yaml"
 AUTONOMY_EXAMPLE_CONFIG: Path = (
-    REPO_ROOT / "runtime" / "jetson" / "autonomy" / "config" / "autonomy.example.yaml"
+    REPO_ROOT / "runtime" / "jetson" / "config" / "autonomy.example.yaml"
 )
 EYE_CONFIG: Path = REPO_ROOT / "eye" / "config" / "eye.yaml"
 EYE_SIM_CONFIG: Path = REPO_ROOT / "eye" / "config" / "sim" / "eye.yaml"

@@ -43,7 +43,7 @@ from .runfiles import read_columns
 DEFAULT_LCM_URL = "udpm://239.255.76.67:7846?ttl=0"
 # The files a job sends back (the LCM log and its MCAP only with --keep-logs: megabytes).
 BULKY_FILES = ("run.lcmlog", "run.mcap")
-# Goals of issue 7 (runtime/jetson/autonomy/README.md).
+# Goals of issue 7 (runtime/jetson/modules/autonomy/README.md).
 GOAL_RUNS = 10
 GOAL_POS_ERROR_M = 0.02
 GOAL_HEADING_ERROR_DEG = 2.0

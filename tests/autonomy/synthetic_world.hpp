@@ -8,12 +8,12 @@
 #include <Eigen/Core>
 #include <autodrive_vehicle.h>
 
-#include "autonomy/grid_map.hpp"
-#include "autonomy/path.hpp"
+#include <autodrive/autonomy/grid_map.hpp>
+#include <autodrive/autonomy/path.hpp>
 
-namespace synth {
+namespace autodrive::synthetic_world {
 
-using autonomy::Pose2;
+using autodrive::autonomy::Pose2;
 
 struct Segment {
   Eigen::Vector2d a, b;
@@ -56,14 +56,14 @@ struct World {
   }
 
   // A 360-ray, 1-degree scan like the RPLIDAR A1, from the LIDAR at lidar_in_base.
-  autonomy::Scan scan(const Pose2 &base, const Pose2 &lidar_in_base, double noise_m = 0.0,
-                      std::mt19937 *rng = nullptr) const {
-    autonomy::Scan s;
-    s.angle_min_rad = -autonomy::kPi;
-    s.angle_increment_rad = 2.0 * autonomy::kPi / 360.0;
+  autodrive::autonomy::Scan scan(const Pose2 &base, const Pose2 &lidar_in_base,
+                                 double noise_m = 0.0, std::mt19937 *rng = nullptr) const {
+    autodrive::autonomy::Scan s;
+    s.angle_min_rad = -autodrive::autonomy::kPi;
+    s.angle_increment_rad = 2.0 * autodrive::autonomy::kPi / 360.0;
     s.range_min_m = 0.15;
     s.range_max_m = 12.0;
-    const Pose2 lidar = autonomy::pose_compose(base, lidar_in_base);
+    const Pose2 lidar = autodrive::autonomy::pose_compose(base, lidar_in_base);
     std::normal_distribution<double> n(0.0, 1.0);
     for (int i = 0; i < 360; ++i) {
       const double a = lidar.yaw_rad + s.angle_min_rad + i * s.angle_increment_rad;
@@ -76,9 +76,9 @@ struct World {
 
   // Occupied where a wall passes through the cell, free elsewhere inside [0,4]x[0,3],
   // unknown outside; the grid spans [-0.5, 4.5] x [-0.5, 3.5].
-  autonomy::GridMap rasterize(double res_m) const {
-    autonomy::GridMap g(static_cast<int>(std::round(5.0 / res_m)),
-                        static_cast<int>(std::round(4.0 / res_m)), res_m, -0.5, -0.5);
+  autodrive::autonomy::GridMap rasterize(double res_m) const {
+    autodrive::autonomy::GridMap g(static_cast<int>(std::round(5.0 / res_m)),
+                                   static_cast<int>(std::round(4.0 / res_m)), res_m, -0.5, -0.5);
     for (int cy = 0; cy < g.height_cells; ++cy) {
       for (int cx = 0; cx < g.width_cells; ++cx) {
         const Eigen::Vector2d c = g.cell_center_m(cx, cy);
@@ -111,12 +111,12 @@ struct Bicycle {
     const double ds =
         std::clamp(cmd_steer_rad - steer_rad, -steer_rate_rad_s * dt_s, steer_rate_rad_s * dt_s);
     steer_rad += ds;
-    pose = autonomy::arc_step(pose, speed_m_s * dt_s, std::tan(steer_rad) / wheelbase_m);
+    pose = autodrive::autonomy::arc_step(pose, speed_m_s * dt_s, std::tan(steer_rad) / wheelbase_m);
   }
 };
 
 // Distance from a point to a sampled path (to its polyline) [m].
-inline double distance_to_path_m(const autonomy::Path &path, const Eigen::Vector2d &p) {
+inline double distance_to_path_m(const autodrive::autonomy::Path &path, const Eigen::Vector2d &p) {
   double best = 1e9;
   for (size_t i = 1; i < path.size(); ++i) {
     const Eigen::Vector2d a(path[i - 1].pose.x_m, path[i - 1].pose.y_m),
@@ -129,4 +129,4 @@ inline double distance_to_path_m(const autonomy::Path &path, const Eigen::Vector
   return best;
 }
 
-}  // namespace synth
+}  // namespace autodrive::synthetic_world

@@ -1,10 +1,10 @@
 // AMCL with KLD sampling converges from a wrong start on the saved map.
 #include <gtest/gtest.h>
 
-#include "autonomy/amcl.hpp"
+#include <autodrive/autonomy/amcl.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 
@@ -25,7 +25,7 @@ struct Drive {
 }  // namespace
 
 TEST(Amcl, ConvergesFromAWrongStartAndAdaptsTheParticleCount) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const GridMap map = world.rasterize(0.02);
   AmclConfig cfg;
   cfg.seed = 11;
@@ -53,7 +53,7 @@ TEST(Amcl, ConvergesFromAWrongStartAndAdaptsTheParticleCount) {
 }
 
 TEST(Amcl, DoesNotUpdateWithoutMotionUnlessForced) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const GridMap map = world.rasterize(0.02);
   Amcl amcl(map, AmclConfig{});
   const Pose2 p{1.5, 1.0, 0.0};
@@ -65,7 +65,7 @@ TEST(Amcl, DoesNotUpdateWithoutMotionUnlessForced) {
 }
 
 TEST(Amcl, LikelihoodPeaksAtTheTruePose) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const GridMap map = world.rasterize(0.02);
   AmclConfig cfg;
   Amcl amcl(map, cfg);

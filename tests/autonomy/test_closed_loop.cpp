@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "autonomy/autonomy_node.hpp"
+#include <autodrive/autonomy/autonomy_node.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {
@@ -29,7 +29,8 @@ struct Outcome {
 };
 
 // Distance from the true car body (rectangle) to the nearest wall point [m]; 0 = touching.
-double body_clearance_m(const synth::World &w, const Pose2 &base, const Footprint &fp) {
+double body_clearance_m(const autodrive::synthetic_world::World &w, const Pose2 &base,
+                        const Footprint &fp) {
   const double c = std::cos(base.yaw_rad), s = std::sin(base.yaw_rad);
   double best = 1e9;
   for (const auto &seg : w.walls) {
@@ -48,7 +49,7 @@ double body_clearance_m(const synth::World &w, const Pose2 &base, const Footprin
 
 Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose2> &route = {},
                     double yaw_tolerance_rad = -1.0, double retry_backoff_m = 0.0) {
-  synth::World world = synth::World::parking_lot();
+  autodrive::synthetic_world::World world = autodrive::synthetic_world::World::parking_lot();
   const Pose2 lidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0.0, 0.0};
   NodeConfig cfg;
   const fs::path dir = fs::temp_directory_path() /
@@ -67,7 +68,7 @@ Outcome run_mission(bool add_box, const std::string &tag, const std::vector<Pose
   cfg.retry_backoff_m = retry_backoff_m;
   AutonomyNode node(cfg);
 
-  synth::Bicycle car;
+  autodrive::synthetic_world::Bicycle car;
   car.pose = cfg.start_pose;
   Pose2 odom{0, 0, 0};
   std::mt19937 rng(9);

@@ -1,13 +1,13 @@
 // Laser odometry: scan-to-scan ICP recovers a known motion.
 #include <gtest/gtest.h>
 
-#include "autonomy/icp.hpp"
+#include <autodrive/autonomy/icp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 TEST(Icp, RecoversKnownMotions) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const Pose2 lidar{0, 0, 0};  // points in the LIDAR frame
   std::mt19937 rng(5);
   const Pose2 a{1.6, 1.1, 0.4};
@@ -26,7 +26,7 @@ TEST(Icp, RecoversKnownMotions) {
 }
 
 TEST(Icp, ChainedOdometryStaysCloseOverADrive) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const Pose2 lidar{0, 0, 0};
   std::mt19937 rng(7);
   Pose2 truth{0.8, 1.2, 0.0}, est = truth;

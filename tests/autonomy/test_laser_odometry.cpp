@@ -3,10 +3,10 @@
 
 #include <cmath>
 
-#include "autonomy/laser_odometry.hpp"
+#include <autodrive/autonomy/laser_odometry.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 const Pose2 kLidar{AUTODRIVE_VEHICLE_LIDAR_POS_M_X, 0.0, 0.0};
@@ -25,7 +25,7 @@ Pose2 scaled(const Pose2 &m, double k) {
 // Wheel odometry 10 % long (a worn tyre, a wrong wheel radius): the laser odometry follows the
 // true motion, not the guess, over a 1.2 m S-curve.
 TEST(LaserOdometry, FollowsTheTruthWhenTheOdometryIsScaled) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   std::mt19937 rng(11);
   LaserOdometry lo(lo_config());
   const Pose2 start{0.8, 1.2, 0.0};
@@ -49,7 +49,7 @@ TEST(LaserOdometry, FollowsTheTruthWhenTheOdometryIsScaled) {
 
 // 100 noisy scans standing still: registered on one keyframe, the noise does not add up.
 TEST(LaserOdometry, StandingStillDoesNotDrift) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   std::mt19937 rng(3);
   LaserOdometry lo(lo_config());
   const Pose2 p{1.5, 1.0, 0.3};
@@ -60,7 +60,7 @@ TEST(LaserOdometry, StandingStillDoesNotDrift) {
 
 // A scan with no returns (a blinded LIDAR) cannot be registered: the odometry is used, counted.
 TEST(LaserOdometry, FallsBackToTheOdometryWhenIcpCannotWork) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   LaserOdometry lo(lo_config());
   const Pose2 p{1.5, 1.0, 0.0};
   lo.update(world.scan(p, kLidar), Pose2{});

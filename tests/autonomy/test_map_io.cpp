@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "autonomy/map_io.hpp"
+#include <autodrive/autonomy/map_io.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {
@@ -42,7 +42,7 @@ const char *kGoodYaml =
 }  // namespace
 
 TEST(MapIo, RoundTripKeepsEveryCellAndTheGeometry) {
-  GridMap m = synth::World::parking_lot().rasterize(0.04);
+  GridMap m = autodrive::synthetic_world::World::parking_lot().rasterize(0.04);
   // Some unknown cells inside too.
   for (int cx = 10; cx < 20; ++cx) m.log_odds[m.index(cx, 30)] = 0.0f;
   const fs::path d = tmp_dir("rt");

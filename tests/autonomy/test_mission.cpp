@@ -1,9 +1,9 @@
 // Mission state machine transitions.
 #include <gtest/gtest.h>
 
-#include "autonomy/mission.hpp"
+#include <autodrive/autonomy/mission.hpp>
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 TEST(Mission, HappyPathVisitsEveryStateInOrder) {
   Mission m(MissionConfig{}, 0.0);

@@ -1,9 +1,9 @@
 // OdomHistory: odometry looked up at a scan's time, interpolated, clamped and reset.
 #include <gtest/gtest.h>
 
-#include "autonomy/odom_history.hpp"
+#include <autodrive/autonomy/odom_history.hpp>
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 TEST(OdomHistory, InterpolatesBetweenSamplesAcrossTheHeadingWrap) {
   OdomHistory h;

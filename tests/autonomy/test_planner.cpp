@@ -1,12 +1,12 @@
 // Planning for a car-like vehicle: Reeds-Shepp, grid A*, Hybrid A* into a parking slot.
 #include <gtest/gtest.h>
 
-#include "autonomy/grid_search.hpp"
-#include "autonomy/hybrid_astar.hpp"
-#include "autonomy/reeds_shepp.hpp"
+#include <autodrive/autonomy/grid_search.hpp>
+#include <autodrive/autonomy/hybrid_astar.hpp>
+#include <autodrive/autonomy/reeds_shepp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 
@@ -70,7 +70,7 @@ TEST(ReedsShepp, PureReverseIsAStraightBackwards) {
 }
 
 TEST(GridAStar, FindsARouteAroundABoxAndNoneIntoAClosedRoom) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const GridMap map = world.rasterize(0.04);
   std::vector<uint8_t> passable(map.log_odds.size());
   for (int cy = 0; cy < map.height_cells; ++cy)
@@ -90,7 +90,7 @@ TEST(GridAStar, FindsARouteAroundABoxAndNoneIntoAClosedRoom) {
 }
 
 TEST(HybridAStar, ReversesIntoASlotWithinTheTurningRadiusAndClearOfObstacles) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const GridMap map = world.rasterize(0.02);
   const CollisionChecker cc(map, nigel());
   const Pose2 start{0.5, 1.0, 0.0};
@@ -111,7 +111,7 @@ TEST(HybridAStar, ReversesIntoASlotWithinTheTurningRadiusAndClearOfObstacles) {
 }
 
 TEST(HybridAStar, GoesAroundAnObstacleAcrossTheDirectWay) {
-  auto world = synth::World::parking_lot();
+  auto world = autodrive::synthetic_world::World::parking_lot();
   world.add_box(1.4, 0.0, 1.6, 1.5);  // a wall of boxes across the lower lot
   const GridMap map = world.rasterize(0.02);
   const CollisionChecker cc(map, nigel());
@@ -126,7 +126,7 @@ TEST(HybridAStar, GoesAroundAnObstacleAcrossTheDirectWay) {
 }
 
 TEST(HybridAStar, FailsCleanlyOnAnUnreachableOrBlockedGoal) {
-  auto world = synth::World::parking_lot();
+  auto world = autodrive::synthetic_world::World::parking_lot();
   world.add_box(2.31, 0.36, 2.59, 0.40);  // the slot's mouth is closed
   const GridMap map = world.rasterize(0.02);
   const CollisionChecker cc(map, nigel());

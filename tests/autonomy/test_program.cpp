@@ -21,10 +21,10 @@
 #include <autodrive/command_auth.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 
-#include "autonomy/map_io.hpp"
+#include <autodrive/autonomy/map_io.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 namespace fs = std::filesystem;
 
 namespace {
@@ -130,7 +130,7 @@ TEST(Program, OutOfRangeConfigValuesAreRefusedNamingTheKey) {
 }
 
 TEST(Program, LocalisesPlansAndCommandsOverLcm) {
-  const synth::World world = synth::World::parking_lot();
+  const autodrive::synthetic_world::World world = autodrive::synthetic_world::World::parking_lot();
   const fs::path dir = fs::temp_directory_path() / ("autonomy_program_" + std::to_string(getpid()));
   fs::create_directories(dir);
   map_save(world.rasterize(0.02), (dir / "map.yaml").string());

@@ -1,10 +1,10 @@
 // Hector-style multi-resolution scan matching and SLAM on simulated scans.
 #include <gtest/gtest.h>
 
-#include "autonomy/slam.hpp"
+#include <autodrive/autonomy/slam.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 
@@ -22,7 +22,7 @@ SlamConfig lot_config() {
 }  // namespace
 
 TEST(ScanMatch, RecoversAKnownOffset) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const SlamConfig cfg = lot_config();
   const Pose2 truth{1.5, 1.0, 0.3};
   HectorSlam slam(cfg, truth);
@@ -40,7 +40,7 @@ TEST(ScanMatch, RecoversAKnownOffset) {
 }
 
 TEST(ScanMatch, CoarseLevelsWidenTheBasin) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const SlamConfig cfg = lot_config();
   const Pose2 truth{1.5, 1.0, 0.3};
   HectorSlam slam(cfg, truth);
@@ -56,7 +56,7 @@ TEST(ScanMatch, CoarseLevelsWidenTheBasin) {
 }
 
 TEST(Slam, TracksADriveWithoutOdometryAndBuildsTheMap) {
-  const auto world = synth::World::parking_lot();
+  const auto world = autodrive::synthetic_world::World::parking_lot();
   const SlamConfig cfg = lot_config();
   std::mt19937 rng(3);
   Pose2 truth{0.6, 0.8, 0.0};

@@ -1,11 +1,11 @@
 // Pure pursuit on a kinematic bicycle (speed lag, Nigel's steering rate limit).
 #include <gtest/gtest.h>
 
-#include "autonomy/pure_pursuit.hpp"
-#include "autonomy/reeds_shepp.hpp"
+#include <autodrive/autonomy/pure_pursuit.hpp>
+#include <autodrive/autonomy/reeds_shepp.hpp>
 #include "synthetic_world.hpp"
 
-using namespace autonomy;
+using namespace autodrive::autonomy;
 
 namespace {
 
@@ -44,7 +44,7 @@ struct RunResult {
 RunResult run(const Path &path, const Pose2 &start, double settle_m = 0.0) {
   PurePursuit pp;
   pp.set_path(path);
-  synth::Bicycle car;
+  autodrive::synthetic_world::Bicycle car;
   car.pose = start;
   RunResult r;
   const double dt = 0.02;
@@ -63,8 +63,9 @@ RunResult run(const Path &path, const Pose2 &start, double settle_m = 0.0) {
     car.step(c.throttle * 0.267, c.steering * AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, dt);
     travelled += std::hypot(car.pose.x_m - before.x_m, car.pose.y_m - before.y_m);
     if (travelled > settle_m)
-      r.max_cross_track_m = std::max(r.max_cross_track_m,
-                                     synth::distance_to_path_m(path, {car.pose.x_m, car.pose.y_m}));
+      r.max_cross_track_m = std::max(
+          r.max_cross_track_m,
+          autodrive::synthetic_world::distance_to_path_m(path, {car.pose.x_m, car.pose.y_m}));
     r.sim_s += dt;
   }
   const Pose2 g = path.back().pose;
@@ -140,7 +141,7 @@ TEST(PurePursuit, SpeedProfileSlowsToAStopAndRespectsTopSpeed) {
   const Path p = straight({0, 0, 0}, 1.5, 1);
   PurePursuit pp;
   pp.set_path(p);
-  synth::Bicycle car;
+  autodrive::synthetic_world::Bicycle car;
   double peak = 0;
   double last_speed_near_end = 1;
   for (int i = 0; i < 3000; ++i) {
@@ -166,7 +167,7 @@ TEST(PurePursuit, StallBoostGetsAStickyCarToTheEnd) {
   auto drive = [&](bool feedback) {
     PurePursuit pp;
     pp.set_path(p);
-    synth::Bicycle car;
+    autodrive::synthetic_world::Bicycle car;
     double max_boost = 0;
     for (int i = 0; i < 3000; ++i) {  // 60 s at 50 Hz
       const TrackerCommand c = pp.step(car.pose, 0.02, feedback ? car.speed_m_s : std::nan(""));
@@ -191,7 +192,7 @@ TEST(PurePursuit, NoBoostWhileTheCarKeepsUp) {
   const Path p = straight({0, 0, 0}, 0.8, 1);
   PurePursuit pp;
   pp.set_path(p);
-  synth::Bicycle car;
+  autodrive::synthetic_world::Bicycle car;
   for (int i = 0; i < 3000 && !pp.done(); ++i) {
     const TrackerCommand c = pp.step(car.pose, 0.02, car.speed_m_s);
     EXPECT_EQ(pp.boost(), 0.0) << "at step " << i;

@@ -3,11 +3,11 @@
 
 #include <fstream>
 
-#include "behaviour/city_map.hpp"
-#include "behaviour/city_rules.hpp"
-#include "behaviour/obstacle.hpp"
+#include <autodrive/behaviour/city_map.hpp>
+#include <autodrive/behaviour/city_rules.hpp>
+#include <autodrive/behaviour/obstacle.hpp>
 
-using namespace behaviour;
+using namespace autodrive::behaviour;
 
 namespace {
 

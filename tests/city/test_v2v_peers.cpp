@@ -1,9 +1,9 @@
 // V2V peer table: own broadcasts ignored, newest state per peer kept, states older than the
 // stale limit dropped and counted, and the runtime config's V2V keys read strictly.
-#include <autodrive/v2v_peers.hpp>
+#include <autodrive/v2v/v2v_peers.hpp>
 #include <gtest/gtest.h>
 
-#include "common/config.hpp"
+#include <autodrive/core/config.hpp>
 
 namespace {
 
@@ -68,12 +68,12 @@ const char *kBase =
 }
 
 TEST(RuntimeConfigV2v, DefaultsAndKeys) {
-  auto c = cfg::parse(std::string(kBase) + "}\n", "t.yaml");
+  auto c = autodrive::config::parse(std::string(kBase) + "}\n", "t.yaml");
   EXPECT_DOUBLE_EQ(c.v2v_hz, 20.0);
   EXPECT_EQ(c.v2v_stale_ms, 200);
   EXPECT_EQ(c.route, "");
   EXPECT_FALSE(c.estimator.has_initial_pose_map);
-  c = cfg::parse(
+  c = autodrive::config::parse(
       std::string(kBase) + ", initial_pose_map: [1.5, -2.0, 0.5]}\nv2v_hz: 10\nroute: loop_cw\n",
       "t.yaml");
   EXPECT_DOUBLE_EQ(c.v2v_hz, 10.0);
@@ -84,15 +84,15 @@ TEST(RuntimeConfigV2v, DefaultsAndKeys) {
 
 TEST(RuntimeConfigV2v, BadValuesNameTheKey) {
   try {
-    cfg::parse(std::string(kBase) + "}\nv2v_hz: 500\n", "t.yaml");
+    autodrive::config::parse(std::string(kBase) + "}\nv2v_hz: 500\n", "t.yaml");
     FAIL() << "accepted v2v_hz 500";
-  } catch (const cfg::Error &e) {
+  } catch (const autodrive::config::Error &e) {
     EXPECT_NE(std::string(e.what()).find("v2v_hz"), std::string::npos) << e.what();
   }
   try {
-    cfg::parse(std::string(kBase) + ", initial_pose_map: [1, 2]}\n", "t.yaml");
+    autodrive::config::parse(std::string(kBase) + ", initial_pose_map: [1, 2]}\n", "t.yaml");
     FAIL() << "accepted a 2-number pose";
-  } catch (const cfg::Error &e) {
+  } catch (const autodrive::config::Error &e) {
     EXPECT_NE(std::string(e.what()).find("estimator.initial_pose_map"), std::string::npos)
         << e.what();
   }

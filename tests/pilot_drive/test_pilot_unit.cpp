@@ -7,16 +7,16 @@
 #include <fstream>
 #include <string>
 
-#include "pilot/pilot_model.hpp"
-#include "pilot/speed_rule.hpp"
+#include <autodrive/pilot/pilot_model.hpp>
+#include <autodrive/pilot/speed_rule.hpp>
 
 namespace {
 
 TEST(SpeedRule, SlowsForSteeringAndHoldsTheSetSpeed) {
-  pilot::SpeedRuleConfig c;
+  autodrive::pilot::SpeedRuleConfig c;
   c.set_speed_m_s = 0.2;
   c.min_speed_m_s = 0.1;
-  pilot::SpeedRule r(c);
+  autodrive::pilot::SpeedRule r(c);
   EXPECT_DOUBLE_EQ(r.target_m_s(0.0), 0.2);
   EXPECT_DOUBLE_EQ(r.target_m_s(-1.0), 0.1);
   EXPECT_DOUBLE_EQ(r.target_m_s(0.5), 0.15);
@@ -48,13 +48,13 @@ TEST(Sidecar, ErrorsNameTheFileAndTheKey) {
       "crop_bottom_px": 40, "width": 200, "height": 66, "colour": "yuv", "scale": 0.00392156862745098,
       "mean": [0.5, 0.5, 0.5], "std": [0.25, 0.25, 0.25]}, "opset": 11,
       "onnx_sha256": "0000000000000000000000000000000000000000000000000000000000000000"})";
-  const auto spec = pilot::read_sidecar(write("good.json", good), opset, sha);
+  const auto spec = autodrive::pilot::read_sidecar(write("good.json", good), opset, sha);
   EXPECT_EQ(spec.height_px, 66);
   EXPECT_EQ(opset, 11);
   auto refused = [&](const std::string &text, const std::string &words) {
     const std::string path = write("bad.json", text);
     try {
-      pilot::read_sidecar(path, opset, sha);
+      autodrive::pilot::read_sidecar(path, opset, sha);
       ADD_FAILURE() << "accepted: " << text;
     } catch (const autodrive::InputError &e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
@@ -70,38 +70,40 @@ TEST(Sidecar, ErrorsNameTheFileAndTheKey) {
           "input.crop_bottom_px");
   s = good;
   refused(s.replace(s.find("[0.25, 0.25, 0.25]"), 18, "[0.25, 0, 0.25]"), "input.std");
-  EXPECT_THROW(pilot::read_sidecar(::testing::TempDir() + "none.json", opset, sha),
+  EXPECT_THROW(autodrive::pilot::read_sidecar(::testing::TempDir() + "none.json", opset, sha),
                autodrive::InputError);
 }
 
 TEST(Preprocess, RefusesAFrameOfAnotherSize) {
-  pilot::InputSpec spec;
+  autodrive::pilot::InputSpec spec;
   spec.source_width_px = 640;
   spec.source_height_px = 480;
   spec.width_px = 200;
   spec.height_px = 66;
   spec.std = {1, 1, 1};
   const cv::Mat ok(480, 640, CV_8UC3, cv::Scalar(10, 20, 30));
-  const cv::Mat blob = pilot::preprocess(ok, spec);
+  const cv::Mat blob = autodrive::pilot::preprocess(ok, spec);
   ASSERT_EQ(blob.dims, 4);
   EXPECT_EQ(blob.size[1], 3);
   EXPECT_EQ(blob.size[2], 66);
   EXPECT_EQ(blob.size[3], 200);
-  EXPECT_THROW(pilot::preprocess(cv::Mat(240, 320, CV_8UC3), spec), autodrive::InputError);
+  EXPECT_THROW(autodrive::pilot::preprocess(cv::Mat(240, 320, CV_8UC3), spec),
+               autodrive::InputError);
 }
 
 TEST(OnnxOpset, ReadsTheDefaultDomainAndRefusesTruncatedBytes) {
   // ModelProto: ir_version (1) = 7; opset_import (8) {domain "" , version 12}; a graph (7) of 3
   // bytes
   const std::string model("\x08\x07\x42\x02\x10\x0c\x3a\x03\x0a\x01\x78", 11);
-  EXPECT_EQ(pilot::onnx_opset("m.onnx", model), 12);
+  EXPECT_EQ(autodrive::pilot::onnx_opset("m.onnx", model), 12);
   try {
-    pilot::onnx_opset("m.onnx", model.substr(0, 9));
+    autodrive::pilot::onnx_opset("m.onnx", model.substr(0, 9));
     ADD_FAILURE() << "truncated bytes accepted";
   } catch (const autodrive::InputError &e) {
     EXPECT_NE(std::string(e.what()).find("m.onnx: truncated"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(pilot::onnx_opset("m.onnx", std::string("\x08\x07", 2)), autodrive::InputError);
+  EXPECT_THROW(autodrive::pilot::onnx_opset("m.onnx", std::string("\x08\x07", 2)),
+               autodrive::InputError);
 }
 
 }  // namespace

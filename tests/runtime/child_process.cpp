@@ -12,7 +12,7 @@
 
 extern char **environ;
 
-namespace rtest {
+namespace autodrive::child_process {
 
 Child::Child(const std::vector<std::string> &argv, const std::string &log_path) {
   std::vector<char *> args;
@@ -56,4 +56,4 @@ void Child::stop() {
   pid_ = -1;
 }
 
-}  // namespace rtest
+}  // namespace autodrive::child_process

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace rtest {
+namespace autodrive::child_process {
 
 class Child {
  public:
@@ -23,4 +23,4 @@ class Child {
   pid_t pid_ = -1;
 };
 
-}  // namespace rtest
+}  // namespace autodrive::child_process

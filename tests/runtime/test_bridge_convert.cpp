@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "bridge/bridge_convert.hpp"
+#include <autodrive/nano_bridge/bridge_convert.hpp>
 
 namespace {
 proto_state_t sample_state() {
@@ -33,10 +33,10 @@ proto_state_t sample_state() {
 }  // namespace
 
 TEST(BridgeConvert, StateFieldsInSiUnits) {
-  cfg::Vehicle veh;
-  bridge::HostLinkStats host{500, 7, 1};
+  autodrive::config::Vehicle veh;
+  autodrive::bridge::HostLinkStats host{500, 7, 1};
   autodrive::vehicle_state_t out{};
-  bridge::fill_state(sample_state(), veh, host, 42, &out);
+  autodrive::bridge::fill_state(sample_state(), veh, host, 42, &out);
   EXPECT_EQ(out.utime, 42);
   EXPECT_EQ(out.nano_time_us, 123456789);
   EXPECT_EQ(out.encoder_counts[0], 1920);
@@ -63,10 +63,10 @@ TEST(BridgeConvert, StateFieldsInSiUnits) {
 }
 
 TEST(BridgeConvert, ImuScalesAndCovariances) {
-  cfg::Bridge br;
+  autodrive::config::Bridge br;
   br.imu_gyro_var_rad2_s2 = 0.25;
   autodrive::imu_t m{};
-  bridge::fill_imu(sample_state(), br, 7, &m);
+  autodrive::bridge::fill_imu(sample_state(), br, 7, &m);
   EXPECT_NEAR(m.linear_acceleration_m_s2[0], 9.80665, 1e-9);
   EXPECT_NEAR(m.linear_acceleration_m_s2[2], -4.903325, 1e-9);
   EXPECT_NEAR(m.angular_velocity_rad_s[2], 10.0 * M_PI / 180.0, 1e-9);
@@ -83,7 +83,7 @@ TEST(BridgeConvert, ImuQuaternionRenormalised) {
   s.quat_q14[0] = 8000;  // w = x, not unit length on the wire
   s.quat_q14[1] = 8000;
   autodrive::imu_t m{};
-  bridge::fill_imu(s, cfg::Bridge{}, 0, &m);
+  autodrive::bridge::fill_imu(s, autodrive::config::Bridge{}, 0, &m);
   EXPECT_NEAR(m.orientation_wxyz[0], std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(m.orientation_wxyz[1], std::sqrt(0.5), 1e-9);
 }
@@ -95,7 +95,7 @@ TEST(BridgeConvert, FreshCommandForwarded) {
   c.headlights = 1;
   c.indicators = 2;
   c.engaged = true;
-  const proto_command_t m = bridge::make_command(&c, true, 9);
+  const proto_command_t m = autodrive::bridge::make_command(&c, true, 9);
   EXPECT_EQ(m.seq, 9);
   EXPECT_EQ(m.throttle_milli, 500);
   EXPECT_EQ(m.steering_milli, -250);
@@ -112,7 +112,7 @@ TEST(BridgeConvert, StaleCommandDisengagesKeepsLights) {
   c.headlights = 2;
   c.indicators = 3;
   c.engaged = true;
-  const proto_command_t m = bridge::make_command(&c, false, 1);
+  const proto_command_t m = autodrive::bridge::make_command(&c, false, 1);
   EXPECT_EQ(m.throttle_milli, 0);
   EXPECT_EQ(m.steering_milli, 0);
   EXPECT_EQ(m.flags, 0);
@@ -121,25 +121,25 @@ TEST(BridgeConvert, StaleCommandDisengagesKeepsLights) {
 }
 
 TEST(BridgeConvert, NoCommandYetIsSilent) {
-  const proto_command_t m = bridge::make_command(nullptr, true, 0);
+  const proto_command_t m = autodrive::bridge::make_command(nullptr, true, 0);
   EXPECT_EQ(m.throttle_milli, 0);
   EXPECT_EQ(m.flags, 0);
 }
 
 TEST(BridgeConvert, OutOfRangeCommandsNamed) {
   autodrive::vehicle_command_t c{};
-  EXPECT_EQ(bridge::command_problem(c), "");
+  EXPECT_EQ(autodrive::bridge::command_problem(c), "");
   c.throttle = 1.5f;
-  EXPECT_NE(bridge::command_problem(c).find("throttle"), std::string::npos);
+  EXPECT_NE(autodrive::bridge::command_problem(c).find("throttle"), std::string::npos);
   c.throttle = NAN;
-  EXPECT_NE(bridge::command_problem(c).find("throttle"), std::string::npos);
+  EXPECT_NE(autodrive::bridge::command_problem(c).find("throttle"), std::string::npos);
   c.throttle = 0;
   c.steering = -2;
-  EXPECT_NE(bridge::command_problem(c).find("steering"), std::string::npos);
+  EXPECT_NE(autodrive::bridge::command_problem(c).find("steering"), std::string::npos);
   c.steering = 0;
   c.headlights = 3;
-  EXPECT_NE(bridge::command_problem(c).find("headlights"), std::string::npos);
+  EXPECT_NE(autodrive::bridge::command_problem(c).find("headlights"), std::string::npos);
   c.headlights = 0;
   c.indicators = -1;
-  EXPECT_NE(bridge::command_problem(c).find("indicators"), std::string::npos);
+  EXPECT_NE(autodrive::bridge::command_problem(c).find("indicators"), std::string::npos);
 }

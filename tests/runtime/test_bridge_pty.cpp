@@ -23,10 +23,10 @@
 #include <memory>
 #include <thread>
 
-#include "bridge/nano_bridge.hpp"
-#include "common/config.hpp"
+#include <autodrive/nano_bridge/nano_bridge.hpp>
+#include <autodrive/core/config.hpp>
 #include <autodrive_lcm/subscribe.hpp>
-#include "fake_nano.hpp"
+#include <autodrive/devtools/fake_nano.hpp>
 
 namespace {
 
@@ -67,7 +67,7 @@ class BridgeHarness {
       : link_("/tmp/adr-rt-test-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         nano(link_, hash),
         key(link_ + ".key"),
-        config(cfg::parse(config_yaml(port, link_, key.path), "test config")),
+        config(autodrive::config::parse(config_yaml(port, link_, key.path), "test config")),
         lcm(config.lcm_url),
         signer(key.key, "TESTCAR", "test-autonomy", autodrive::auth::kAuthorityMachine) {
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
@@ -82,11 +82,11 @@ class BridgeHarness {
     if (thread_.joinable()) thread_.join();
   }
   void start() {
-    bridge_ = std::make_unique<bridge::NanoBridge>(config);
+    bridge_ = std::make_unique<autodrive::bridge::NanoBridge>(config);
     ASSERT_EQ(bridge_->init_error(), "");
     thread_ = std::thread([this] { bridge_->run(stop_); });
   }
-  bridge::Status status() const { return bridge_->status(); }
+  autodrive::bridge::Status status() const { return bridge_->status(); }
 
   // Runs the fake Nano (telemetry every ~10 ms once it said hello) and the LCM side until
   // pred() holds; false after max_s seconds.
@@ -136,9 +136,9 @@ class BridgeHarness {
   }
 
   std::string link_;
-  rtest::FakeNano nano;
+  autodrive::devtools::FakeNano nano;
   TestKey key;
-  cfg::Config config;
+  autodrive::config::Config config;
   lcm::LCM lcm;
   autodrive::auth::Signer signer;
   std::vector<autodrive::control_status_t> controls;
@@ -151,7 +151,7 @@ class BridgeHarness {
   void on_state(const autodrive::vehicle_state_t *m) { states.push_back(*m); }
   void on_imu(const autodrive::imu_t *m) { imus.push_back(*m); }
   void on_control(const autodrive::control_status_t *m) { controls.push_back(*m); }
-  std::unique_ptr<bridge::NanoBridge> bridge_;
+  std::unique_ptr<autodrive::bridge::NanoBridge> bridge_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   int state_count_ = 0;
@@ -171,7 +171,7 @@ TEST(BridgePty, HandshakeThenStateAndImuPublished) {
   h.nano.open();
   h.start();
   ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 5 && h.imus.size() >= 5; }));
-  EXPECT_EQ(h.status().state, bridge::LinkState::linked);
+  EXPECT_EQ(h.status().state, autodrive::bridge::LinkState::linked);
   EXPECT_GE(h.nano.hello_requests, 1);
   // CONFIG sent after the handshake with the configured telemetry period.
   EXPECT_GE(h.nano.configs, 1);
@@ -195,8 +195,8 @@ TEST(BridgePty, SchemaMismatchRefused) {
   // Keep the peer talking (HELLOs and STATE frames) for several more retries.
   const int hellos = h.nano.hello_requests;
   ASSERT_TRUE(h.wait_for([&] { return h.nano.hello_requests >= hellos + 3; }));
-  const bridge::Status st = h.status();
-  EXPECT_EQ(st.state, bridge::LinkState::refused);
+  const autodrive::bridge::Status st = h.status();
+  EXPECT_EQ(st.state, autodrive::bridge::LinkState::refused);
   EXPECT_TRUE(h.nano.commands.empty()) << "commands sent to a mismatched Nano";
   EXPECT_TRUE(h.states.empty()) << "telemetry published from a mismatched Nano";
   // The message names both schema hashes and versions.
@@ -213,7 +213,7 @@ TEST(BridgePty, CommandsForwarded) {
   BridgeHarness h(7762);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   // Heartbeat before any LCM command: frames flow, never engaged.
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= 3; }));
   EXPECT_EQ(count_engaged(h.nano.commands), 0);
@@ -234,7 +234,7 @@ TEST(BridgePty, StaleCommandsDisengage) {
   BridgeHarness h(7763);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   ASSERT_TRUE(h.wait_for([&] {
     h.publish_command(0.4f, 0.1f, true);
     return count_engaged(h.nano.commands) >= 3;
@@ -269,7 +269,7 @@ TEST(BridgePty, InvalidCommandsRejectedNotForwarded) {
   BridgeHarness h(7764);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   ASSERT_TRUE(h.wait_for([&] {
     h.publish_command(3.0f, 0.0f, true);  // throttle out of range
     return h.status().commands_rejected >= 3;
@@ -285,15 +285,15 @@ TEST(BridgePty, ReconnectsAfterDeviceDisappears) {
   // Unplug: the device and its symlink vanish.
   h.nano.close();
   ASSERT_TRUE(h.wait_for([&] { return h.status().disconnects >= 1; }));
-  EXPECT_EQ(h.status().state, bridge::LinkState::no_device);
+  EXPECT_EQ(h.status().state, autodrive::bridge::LinkState::no_device);
   // Replug (a new pty, as after a sim restart) with new telemetry values.
   h.enc_left = 5000;
   h.nano.hellos_sent = 0;
   h.nano.open();
   ASSERT_TRUE(
       h.wait_for([&] { return !h.states.empty() && h.states.back().encoder_counts[0] == 5000; }));
-  const bridge::Status st = h.status();
-  EXPECT_EQ(st.state, bridge::LinkState::linked);
+  const autodrive::bridge::Status st = h.status();
+  EXPECT_EQ(st.state, autodrive::bridge::LinkState::linked);
   EXPECT_GE(st.opens, 2u);
   EXPECT_GE(st.handshakes, 2u);
   // Commands flow to the new device.
@@ -307,7 +307,8 @@ TEST(BridgePty, ReconnectsAfterDeviceDisappears) {
 TEST(BridgePty, MissingDeviceRetriedUntilItAppears) {
   BridgeHarness h(7766);
   h.start();  // no device yet
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::no_device; }, 5));
+  ASSERT_TRUE(
+      h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::no_device; }, 5));
   h.nano.open();
   ASSERT_TRUE(h.wait_for([&] { return h.states.size() >= 2; }));
   EXPECT_EQ(h.status().opens, 1u);
@@ -328,9 +329,9 @@ TEST(BridgePty, GarbageFromTheNanoIsCountedAndStateStillFlows) {
     const std::size_t before = h.states.size();
     ASSERT_TRUE(h.wait_for([&] { return h.states.size() > before; }));
   }
-  const bridge::Status st = h.status();
+  const autodrive::bridge::Status st = h.status();
   EXPECT_GE(st.rx_skipped_bytes + st.rx_bad_crc + st.rx_bad_length, 20u);
-  EXPECT_EQ(st.state, bridge::LinkState::linked);
+  EXPECT_EQ(st.state, autodrive::bridge::LinkState::linked);
   // A STATE claiming 30x full steering is implausible: dropped and counted.
   h.send_states = false;
   proto_state_t bad{};
@@ -358,7 +359,7 @@ TEST(BridgeAuth, UnsignedAndWrongKeyCommandsIgnored) {
   BridgeHarness h(7767);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   // A hostile publisher: full throttle at full lock, unsigned ...
   ASSERT_TRUE(h.wait_for([&] {
     auto c = h.command(0.9f, -1.0f, true);
@@ -397,7 +398,7 @@ TEST(BridgeAuth, ReplayedCommandsIgnored) {
   BridgeHarness h(7768);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   // A recorded command of the real source ...
   auto recorded = h.command(0.35f, 0.2f, true);
   h.signer.sign(recorded);
@@ -434,7 +435,7 @@ TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
   BridgeHarness h(7769);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   autodrive::auth::Signer teleop(h.key.key, "TESTCAR", "test-teleop",
                                  autodrive::auth::kAuthorityPerson);
   auto teleop_cmd = [&](float throttle, bool engaged) {
@@ -492,7 +493,7 @@ TEST(BridgeAuth, FloodDoesNotRaiseTheSerialRate) {
   BridgeHarness h(7778);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   ASSERT_TRUE(h.wait_for([&] {
     h.publish_command(0.2f, 0.0f, true);
     return count_engaged(h.nano.commands) >= 1;
@@ -519,7 +520,7 @@ TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
   BridgeHarness h(7783);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= 3; }));
   // One burst of a few commands, then silence: the bridge may repeat the command only while it
   // is younger than command_timeout_ms (200 ms at 50 Hz: about 10 frames), then disengages and
@@ -536,7 +537,7 @@ TEST(BridgeAuth, UnicastUdpToTheLcmPortDoesNotDrive) {
   BridgeHarness h(7787);
   h.nano.open();
   h.start();
-  ASSERT_TRUE(h.wait_for([&] { return h.status().state == bridge::LinkState::linked; }));
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   // Not a publisher at all: a plain UDP socket writes LCM's "LC02" packet of an engaged
   // full-throttle command to 127.0.0.1:<port>, which LCM's receive socket accepts.
   auto c = h.command(1.0f, 1.0f, true);

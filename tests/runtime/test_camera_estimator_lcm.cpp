@@ -19,10 +19,10 @@
 #include <functional>
 #include <thread>
 
-#include "camera/camera_driver.hpp"
-#include "common/config.hpp"
+#include <autodrive/camera/camera_driver.hpp>
+#include <autodrive/core/config.hpp>
 #include <autodrive_lcm/subscribe.hpp>
-#include "estimator/estimator_node.hpp"
+#include <autodrive/estimator/estimator_node.hpp>
 
 namespace {
 std::string base_yaml(int port) {
@@ -62,17 +62,18 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
     ASSERT_TRUE(w.isOpened());
     for (int i = 0; i < 20; ++i) w.write(cv::Mat(240, 320, CV_8UC3, cv::Scalar(200, 120, 10)));
   }
-  const cfg::Config c = cfg::parse(base_yaml(7774) + "cameras:\n  - {source: " + video +
-                                       ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
-                                       "     height_px: 120, jpeg_quality: 90}\n",
-                                   "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7774) + "cameras:\n  - {source: " + video +
+                                   ", channel: CAM_FRONT, rate_hz: 30, width_px: 160,\n"
+                                   "     height_px: 120, jpeg_quality: 90}\n",
+                               "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::compressed_image_t, Sink, &Sink::on_image>(
       lcm, "TESTCAR_CAM_FRONT", &sink);
   autodrive_lcm::subscribe<autodrive::camera_info_t, Sink, &Sink::on_info>(
       lcm, "TESTCAR_CAM_FRONT_INFO", &sink);
-  cam::CameraDriver driver(c, 0);
+  autodrive::camera::CameraDriver driver(c, 0);
   ASSERT_EQ(driver.init_error(), "");
   std::atomic<bool> stop{false};
   std::thread th([&] { driver.run(stop); });
@@ -99,11 +100,11 @@ TEST(CameraLcm, VideoFilePublishedAsJpeg) {
 }
 
 TEST(CameraLcm, MissingSourceIsRetriedNotFatal) {
-  const cfg::Config c = cfg::parse(
+  const autodrive::config::Config c = autodrive::config::parse(
       base_yaml(7775) +
           "cameras:\n  - {source: /nonexistent/video.avi, channel: CAM_FRONT, rate_hz: 30}\n",
       "test config");
-  cam::CameraDriver driver(c, 0);
+  autodrive::camera::CameraDriver driver(c, 0);
   ASSERT_EQ(driver.init_error(), "");
   std::atomic<bool> stop{false};
   std::thread th([&] { driver.run(stop); });
@@ -114,13 +115,14 @@ TEST(CameraLcm, MissingSourceIsRetriedNotFatal) {
 }
 
 TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
-  const cfg::Config c = cfg::parse(base_yaml(7776) + "estimator: {rate_hz: 100}\n", "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7776) + "estimator: {rate_hz: 100}\n", "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP",
                                                                        &sink);
-  est::EstimatorNode node(c);
+  autodrive::estimator::EstimatorNode node(c);
   ASSERT_EQ(node.init_error(), "");
   std::atomic<bool> stop{false};
   std::thread th([&] { node.run(stop); });
@@ -165,13 +167,14 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
 // Probe findings: a forged POSE_EYE stream moved the map pose 1,000 m; an encoder jump gave
 // an odometry speed of 1,063 m/s. Both are refused by the running estimator and counted.
 TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
-  const cfg::Config c = cfg::parse(base_yaml(7786) + "estimator: {rate_hz: 100}\n", "test config");
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7786) + "estimator: {rate_hz: 100}\n", "test config");
   lcm::LCM lcm(c.lcm_url);
   Sink sink;
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
   autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP",
                                                                        &sink);
-  est::EstimatorNode node(c);
+  autodrive::estimator::EstimatorNode node(c);
   ASSERT_EQ(node.init_error(), "");
   std::atomic<bool> stop{false};
   std::thread th([&] { node.run(stop); });
@@ -217,7 +220,7 @@ TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
   EXPECT_LT(max_speed, 0.5);
   EXPECT_LT(max_map_x, 2.05);
   EXPECT_NEAR(sink.map.back().x_m, 2.0, 0.05);
-  const est::InputStats st = node.input_stats();
+  const autodrive::estimator::InputStats st = node.input_stats();
   EXPECT_GE(st.wheel_dropped, 1u);
   EXPECT_LE(st.wheel_dropped, 2u);  // the jump and the step back
   EXPECT_GE(st.poses_gated, 150u);

@@ -4,11 +4,11 @@
 
 #include <autodrive/sim_clock_t.hpp>
 
-#include "common/clock.hpp"
+#include <autodrive/core/clock.hpp>
 
 TEST(Clock, WallModeIsSystemTime) {
-  clk::Clock c(cfg::ClockMode::wall);
-  const int64_t a = clk::wall_us();
+  autodrive::clock::Clock c(autodrive::config::ClockMode::wall);
+  const int64_t a = autodrive::clock::wall_us();
   const int64_t t = c.now_us();
   EXPECT_GE(t, a);
   EXPECT_FALSE(c.sim());
@@ -17,7 +17,7 @@ TEST(Clock, WallModeIsSystemTime) {
 TEST(Clock, SimModeFollowsSimClock) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  clk::Clock c(cfg::ClockMode::sim);
+  autodrive::clock::Clock c(autodrive::config::ClockMode::sim);
   c.attach(lcm);
   EXPECT_EQ(c.now_us(), 0);  // no SIM_CLOCK yet
   autodrive::sim_clock_t m{};
@@ -37,7 +37,7 @@ TEST(Clock, SimModeFollowsSimClock) {
 TEST(Clock, SimClockBackwardsOrFarAheadIsRefusedAndCounted) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  clk::Clock c(cfg::ClockMode::sim);
+  autodrive::clock::Clock c(autodrive::config::ClockMode::sim);
   c.attach(lcm);
   autodrive::sim_clock_t m{};
   auto tick = [&](int64_t t_us) {
@@ -51,7 +51,8 @@ TEST(Clock, SimClockBackwardsOrFarAheadIsRefusedAndCounted) {
   EXPECT_EQ(c.now_us(), 5000000);
   tick(4999999);  // backwards
   EXPECT_EQ(c.now_us(), 5000000);
-  tick(5000000 + clk::Clock::kMaxSimStepUs + 1);  // far ahead: would freeze every later tick
+  tick(5000000 + autodrive::clock::Clock::kMaxSimStepUs +
+       1);  // far ahead: would freeze every later tick
   EXPECT_EQ(c.now_us(), 5000000);
   EXPECT_EQ(c.sim_ticks_refused(), 3u);
   tick(5010000);  // the honest next tick still moves it
@@ -61,13 +62,13 @@ TEST(Clock, SimClockBackwardsOrFarAheadIsRefusedAndCounted) {
 TEST(Clock, SimClockIgnoredInWallMode) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  clk::Clock c(cfg::ClockMode::wall);
+  autodrive::clock::Clock c(autodrive::config::ClockMode::wall);
   c.attach(lcm);
   autodrive::sim_clock_t m{};
   m.utime = 0;
   lcm.publish("SIM_CLOCK", &m);
   lcm.handleTimeout(50);
-  const int64_t before = clk::wall_us();
+  const int64_t before = autodrive::clock::wall_us();
   EXPECT_GE(c.now_us(), before);  // still the wall clock, not 0
   EXPECT_EQ(c.sim_ticks_refused(), 0u);
 }

@@ -9,7 +9,7 @@
 
 #include <fstream>
 
-#include "bridge/command_gate.hpp"
+#include <autodrive/nano_bridge/command_gate.hpp>
 
 namespace {
 
@@ -92,7 +92,7 @@ TEST(CommandAuth, KeyFilesAreCheckedAndNamed) {
 // A gate with a 1 s replay window and a 300 ms lease, started long ago; times in us.
 struct GateTest : ::testing::Test {
   auth::Key key = key_of(std::string(64, '7'));
-  bridge::CommandGate gate{key, "NIGEL1", 1000000, 300000, 0};
+  autodrive::bridge::CommandGate gate{key, "NIGEL1", 1000000, 300000, 0};
   auth::Signer autonomy{key, "NIGEL1", "autonomy", auth::kAuthorityMachine};
   auth::Signer policy{key, "NIGEL1", "policy", auth::kAuthorityMachine};
   auth::Signer teleop{key, "NIGEL1", "teleop", auth::kAuthorityPerson};
@@ -109,7 +109,7 @@ struct GateTest : ::testing::Test {
     s.sign(c);
     return c;
   }
-  bridge::Drop admit(const vehicle_command_t &c, int64_t mono_us) {
+  autodrive::bridge::Drop admit(const vehicle_command_t &c, int64_t mono_us) {
     return gate.admit(c, mono_us, c.counter).drop;  // wall clock == the signer's, here
   }
 };
@@ -117,10 +117,10 @@ struct GateTest : ::testing::Test {
 TEST_F(GateTest, UnsignedAndBadMacDropped) {
   vehicle_command_t c{};
   c.engaged = true;
-  EXPECT_EQ(admit(c, 0), bridge::Drop::unsigned_cmd);
+  EXPECT_EQ(admit(c, 0), autodrive::bridge::Drop::unsigned_cmd);
   c = cmd(autonomy, true);
   c.mac[3] ^= 0x10;
-  EXPECT_EQ(admit(c, 0), bridge::Drop::bad_mac);
+  EXPECT_EQ(admit(c, 0), autodrive::bridge::Drop::bad_mac);
   EXPECT_EQ(gate.counters().dropped_unsigned, 1);
   EXPECT_EQ(gate.counters().dropped_bad_mac, 1);
   EXPECT_EQ(gate.holder(), "");
@@ -128,11 +128,13 @@ TEST_F(GateTest, UnsignedAndBadMacDropped) {
 
 TEST_F(GateTest, ReplaysAndStaleCountersDropped) {
   const auto c = cmd(autonomy, true);
-  EXPECT_EQ(admit(c, 0), bridge::Drop::none);
-  EXPECT_EQ(admit(c, 1000), bridge::Drop::replay);  // the same counter again
+  EXPECT_EQ(admit(c, 0), autodrive::bridge::Drop::none);
+  EXPECT_EQ(admit(c, 1000), autodrive::bridge::Drop::replay);  // the same counter again
   const auto later = cmd(autonomy, true);
-  EXPECT_EQ(gate.admit(later, 2000, later.counter + 2000000).drop, bridge::Drop::replay);  // old
-  EXPECT_EQ(gate.admit(later, 2000, later.counter - 2000000).drop, bridge::Drop::replay);  // future
+  EXPECT_EQ(gate.admit(later, 2000, later.counter + 2000000).drop,
+            autodrive::bridge::Drop::replay);  // old
+  EXPECT_EQ(gate.admit(later, 2000, later.counter - 2000000).drop,
+            autodrive::bridge::Drop::replay);  // future
   EXPECT_EQ(gate.counters().dropped_replay, 3);
 }
 
@@ -140,50 +142,51 @@ TEST_F(GateTest, ReplaysAndStaleCountersDropped) {
 // started, still inside the window, must not pass as new (nor take the free lease).
 TEST_F(GateTest, ReplayOfACommandSignedBeforeARestartDropped) {
   const auto before = cmd(autonomy, true);  // recorded by an attacker ...
-  EXPECT_EQ(admit(before, 0), bridge::Drop::none);
+  EXPECT_EQ(admit(before, 0), autodrive::bridge::Drop::none);
   // the bridge restarts right after it was signed
-  bridge::CommandGate restarted{key, "NIGEL1", 1000000, 300000, before.counter};
+  autodrive::bridge::CommandGate restarted{key, "NIGEL1", 1000000, 300000, before.counter};
   const int64_t wall = before.counter + 200000;  // ... and the attacker replays it 0.2 s later
-  EXPECT_EQ(restarted.admit(before, 0, wall).drop, bridge::Drop::replay);
+  EXPECT_EQ(restarted.admit(before, 0, wall).drop, autodrive::bridge::Drop::replay);
   EXPECT_EQ(restarted.holder(), "");
   // the source's next command (its counter only grows) passes and takes the lease
   const auto fresh = cmd(autonomy, true);
-  EXPECT_EQ(restarted.admit(fresh, 1000, fresh.counter).drop, bridge::Drop::none);
+  EXPECT_EQ(restarted.admit(fresh, 1000, fresh.counter).drop, autodrive::bridge::Drop::none);
   EXPECT_EQ(restarted.holder(), "autonomy");
   EXPECT_EQ(restarted.counters().dropped_replay, 1);
 }
 
 TEST_F(GateTest, FirstEngagedSourceTakesAFreeLeaseIdleOnesDoNot) {
-  EXPECT_EQ(admit(cmd(teleop, false), 0), bridge::Drop::idle);  // an idle teleop asks for nothing
+  EXPECT_EQ(admit(cmd(teleop, false), 0),
+            autodrive::bridge::Drop::idle);  // an idle teleop asks for nothing
   EXPECT_EQ(gate.holder(), "");
-  EXPECT_EQ(admit(cmd(autonomy, true), 0), bridge::Drop::none);
+  EXPECT_EQ(admit(cmd(autonomy, true), 0), autodrive::bridge::Drop::none);
   EXPECT_EQ(gate.holder(), "autonomy");
   // Another machine may not take it while the lease lives ...
-  EXPECT_EQ(admit(cmd(policy, true), 100000), bridge::Drop::not_holder);
+  EXPECT_EQ(admit(cmd(policy, true), 100000), autodrive::bridge::Drop::not_holder);
   // ... the holder renews it with every command, engaged or not ...
-  EXPECT_EQ(admit(cmd(autonomy, false), 250000), bridge::Drop::none);
-  EXPECT_EQ(admit(cmd(policy, true), 500000), bridge::Drop::not_holder);
+  EXPECT_EQ(admit(cmd(autonomy, false), 250000), autodrive::bridge::Drop::none);
+  EXPECT_EQ(admit(cmd(policy, true), 500000), autodrive::bridge::Drop::not_holder);
   // ... and once it lapses the next engaged source takes it.
   EXPECT_TRUE(gate.expire(551000));
   EXPECT_EQ(gate.holder(), "");
-  EXPECT_EQ(admit(cmd(policy, true), 552000), bridge::Drop::none);
+  EXPECT_EQ(admit(cmd(policy, true), 552000), autodrive::bridge::Drop::none);
   EXPECT_EQ(gate.holder(), "policy");
   EXPECT_EQ(gate.counters().holder_changes, 3);
 }
 
 TEST_F(GateTest, PersonTakesFromMachineMachineNeverFromPerson) {
-  EXPECT_EQ(admit(cmd(autonomy, true), 0), bridge::Drop::none);
-  EXPECT_EQ(admit(cmd(teleop, false), 10000), bridge::Drop::idle);  // dead-man not held
+  EXPECT_EQ(admit(cmd(autonomy, true), 0), autodrive::bridge::Drop::none);
+  EXPECT_EQ(admit(cmd(teleop, false), 10000), autodrive::bridge::Drop::idle);  // dead-man not held
   EXPECT_EQ(gate.holder(), "autonomy");
   const auto v = gate.admit(cmd(teleop, true, 0.5f), 20000, wall0);
-  EXPECT_EQ(v.drop, bridge::Drop::none);
+  EXPECT_EQ(v.drop, autodrive::bridge::Drop::none);
   EXPECT_TRUE(v.holder_changed);
   EXPECT_EQ(gate.holder(), "teleop");
   EXPECT_EQ(gate.holder_authority(), auth::kAuthorityPerson);
   // Dead-man released: the person still holds control; the autonomy cannot take it.
   for (int64_t t = 30000; t < 2000000; t += 100000) {
-    EXPECT_EQ(admit(cmd(teleop, false), t), bridge::Drop::none);
-    EXPECT_EQ(admit(cmd(autonomy, true), t + 50000), bridge::Drop::not_holder);
+    EXPECT_EQ(admit(cmd(teleop, false), t), autodrive::bridge::Drop::none);
+    EXPECT_EQ(admit(cmd(autonomy, true), t + 50000), autodrive::bridge::Drop::not_holder);
   }
   EXPECT_EQ(gate.holder(), "teleop");
 }

@@ -5,7 +5,7 @@
 
 #include <autodrive_channels.h>
 
-#include "common/config.hpp"
+#include <autodrive/core/config.hpp>
 
 namespace {
 const char *kGood = R"(
@@ -17,8 +17,8 @@ bridge: {device: /dev/ttyUSB0, baud: 500000, heartbeat_hz: 50, command_timeout_m
 
 std::string error_of(const std::string &text) {
   try {
-    cfg::parse(text, "test.yaml");
-  } catch (const cfg::Error &e) {
+    autodrive::config::parse(text, "test.yaml");
+  } catch (const autodrive::config::Error &e) {
     return e.what();
   }
   return "";
@@ -32,13 +32,13 @@ std::string replace(std::string s, const std::string &from, const std::string &t
 }  // namespace
 
 TEST(Config, GoodConfigParses) {
-  const cfg::Config c = cfg::parse(kGood, "test.yaml");
+  const autodrive::config::Config c = autodrive::config::parse(kGood, "test.yaml");
   EXPECT_EQ(c.vehicle.name, "NIGEL1");
   EXPECT_TRUE(c.has_bridge);
   EXPECT_FALSE(c.has_lidar);
   EXPECT_EQ(c.bridge.device, "/dev/ttyUSB0");
   EXPECT_EQ(c.bridge.baud, 500000);
-  EXPECT_EQ(c.clock, cfg::ClockMode::wall);
+  EXPECT_EQ(c.clock, autodrive::config::ClockMode::wall);
 }
 
 TEST(Config, MissingKeyNamesFileAndKey) {
@@ -66,14 +66,14 @@ TEST(Config, CarFigureInConfigRefused) {
 }
 
 TEST(Config, VehicleFiguresComeFromTheDescription) {
-  const cfg::Config c = cfg::parse(kGood, "test.yaml");
+  const autodrive::config::Config c = autodrive::config::parse(kGood, "test.yaml");
   EXPECT_DOUBLE_EQ(c.vehicle.wheelbase_m, AUTODRIVE_VEHICLE_WHEELBASE_M);
   EXPECT_DOUBLE_EQ(c.vehicle.wheel_radius_m, AUTODRIVE_VEHICLE_WHEEL_RADIUS_M);
   EXPECT_GT(c.vehicle.encoder_counts_per_rev, 0);
 }
 
 TEST(Config, CameraChannelComesFromTheTable) {
-  const cfg::Config c = cfg::parse(
+  const autodrive::config::Config c = autodrive::config::parse(
       std::string(kGood) + "cameras:\n  - {source: v.avi, channel: CAM_REAR, rate_hz: 30}\n",
       "test.yaml");
   ASSERT_EQ(c.cameras.size(), 1u);
@@ -91,8 +91,8 @@ TEST(Config, SyncToSimClockNeedsTheSimClock) {
       replace(kGood, "command_timeout_ms: 200", "command_timeout_ms: 200, sync_to_sim_clock: true");
   EXPECT_EQ(error_of(sync),
             "test.yaml: bridge.sync_to_sim_clock: needs clock: sim (it sends on SIM_CLOCK ticks)");
-  EXPECT_TRUE(
-      cfg::parse(replace(sync, "clock: wall", "clock: sim"), "test.yaml").bridge.sync_to_sim_clock);
+  EXPECT_TRUE(autodrive::config::parse(replace(sync, "clock: wall", "clock: sim"), "test.yaml")
+                  .bridge.sync_to_sim_clock);
 }
 
 TEST(Config, UnknownKeyRefused) {
@@ -111,9 +111,9 @@ TEST(Config, MalformedYamlRefused) {
 
 TEST(Config, MissingFileNamed) {
   try {
-    cfg::load("/nonexistent/runtime.yaml");
+    autodrive::config::load("/nonexistent/runtime.yaml");
     FAIL() << "no error";
-  } catch (const cfg::Error &e) {
+  } catch (const autodrive::config::Error &e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/runtime.yaml: cannot be opened");
   }
 }
@@ -122,7 +122,7 @@ TEST(Config, ShippedConfigsParse) {
   for (const char *name : {"nigel_car.yaml", "nigel_hil.yaml", "nigel_simavr.yaml"}) {
     const std::string path = std::string(AUTODRIVE_ROOT) + "/runtime/jetson/config/" + name;
     SCOPED_TRACE(path);
-    const cfg::Config c = cfg::load(path);
+    const autodrive::config::Config c = autodrive::config::load(path);
     EXPECT_TRUE(c.has_bridge);
     EXPECT_TRUE(c.has_estimator);
   }

@@ -113,13 +113,13 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
     if (b.name == "sim")
       argv = {AUTODRIVE_SIM_EXE, "--run-dir", dir_, "--lcm-url", url_, "--quiet"};
 #endif
-    backend_ = std::make_unique<rtest::Child>(
+    backend_ = std::make_unique<autodrive::child_process::Child>(
         argv, dir_ + "/backend-" + std::to_string(++starts_) + ".log");
     ASSERT_TRUE(wait_for([&] { return exists(nano_link_); }, 60)) << "no pty at " << nano_link_;
   }
   void start_runtime() {
     const std::string only = GetParam().has_lidar ? "bridge,lidar" : "bridge";
-    runtime_ = std::make_unique<rtest::Child>(
+    runtime_ = std::make_unique<autodrive::child_process::Child>(
         std::vector<std::string>{AUTODRIVE_RUNTIME_EXE, "--config", dir_ + "/runtime.yaml",
                                  "--only", only},
         dir_ + "/runtime.log");
@@ -163,7 +163,7 @@ class BackendE2E : public ::testing::TestWithParam<Backend> {
 
   std::string dir_, url_, nano_link_, lidar_link_, pwm_log_;
   std::unique_ptr<lcm::LCM> lcm_;
-  std::unique_ptr<rtest::Child> backend_, runtime_;
+  std::unique_ptr<autodrive::child_process::Child> backend_, runtime_;
   std::vector<autodrive::vehicle_state_t> states_;
   std::vector<autodrive::lidar_scan_t> scans_, sim_scans_;
   int32_t seq_ = 0;

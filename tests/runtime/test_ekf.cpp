@@ -7,8 +7,8 @@
 
 #include <autodrive/angles.hpp>
 
-#include "estimator/ekf.hpp"
-#include "estimator/estimator_node.hpp"
+#include <autodrive/estimator/ekf.hpp>
+#include <autodrive/estimator/estimator_node.hpp>
 
 namespace {
 constexpr double kL = AUTODRIVE_VEHICLE_WHEELBASE_M;  // wheelbase [m]
@@ -35,8 +35,9 @@ Eigen::Matrix3d eye_cov(double pos_std, double yaw_std) {
 // Runs a 30 s loop (straight, left arc, right arc) with odometry speed scaled by
 // `speed_scale` and a gyro bias; Eye poses every 100 ms delayed by `eye_delay_us` if
 // `with_eye`. Returns the final position error [m].
-double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us, est::EkfStats *stats) {
-  est::Ekf ekf;
+double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us,
+                autodrive::estimator::EkfStats *stats) {
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   std::mt19937 rng(7);
   std::normal_distribution<double> eye_noise(0.0, 0.005), gyro_noise(0.0, 0.01);
@@ -60,7 +61,7 @@ double run_loop(bool with_eye, double speed_scale, int64_t eye_delay_us, est::Ek
     }
   }
   if (stats) *stats = ekf.stats();
-  const est::Estimate e = ekf.latest();
+  const autodrive::estimator::Estimate e = ekf.latest();
   return std::hypot(e.x(0) - t.x, e.x(1) - t.y);
 }
 }  // namespace
@@ -73,20 +74,20 @@ TEST(Ekf, WrapAngle) {
 }
 
 TEST(Ekf, StraightLineFromOdometry) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   for (int k = 1; k <= 500; ++k) {
     ekf.add_wheel(k * 10000, 0.2, 0.0);
     ekf.add_gyro(k * 10000, 0.0);
   }
-  const est::Estimate e = ekf.latest();
+  const autodrive::estimator::Estimate e = ekf.latest();
   EXPECT_NEAR(e.x(0), 1.0, 0.01);  // 5 s at 0.2 m/s
   EXPECT_NEAR(e.x(1), 0.0, 1e-6);
   EXPECT_NEAR(e.x(3), 0.2, 1e-3);
 }
 
 TEST(Ekf, CircleMatchesAckermannGeometry) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   Truth t;
   const double v = 0.2, delta = 0.25;
@@ -95,7 +96,7 @@ TEST(Ekf, CircleMatchesAckermannGeometry) {
     ekf.add_wheel(k * 10000, v, delta);
     ekf.add_gyro(k * 10000, v * std::tan(delta) / kL);
   }
-  const est::Estimate e = ekf.latest();
+  const autodrive::estimator::Estimate e = ekf.latest();
   EXPECT_NEAR(e.x(0), t.x, 0.01);
   EXPECT_NEAR(e.x(1), t.y, 0.01);
   EXPECT_NEAR(autodrive::angle_wrap_rad(e.x(2) - t.yaw), 0.0, 0.01);
@@ -110,7 +111,7 @@ TEST(Ekf, EyePosesBoundBiasedOdometryDrift) {
 }
 
 TEST(Ekf, LatePosesAreReplayed) {
-  est::EkfStats late_stats;
+  autodrive::estimator::EkfStats late_stats;
   const double on_time = run_loop(true, 1.05, 0, nullptr);
   const double late = run_loop(true, 1.05, 150000, &late_stats);
   EXPECT_GT(late_stats.replays, 100u);
@@ -120,9 +121,9 @@ TEST(Ekf, LatePosesAreReplayed) {
 }
 
 TEST(Ekf, TooOldPoseDropped) {
-  est::EkfParams p;
+  autodrive::estimator::EkfParams p;
   p.history_us = 200000;
-  est::Ekf ekf(p);
+  autodrive::estimator::Ekf ekf(p);
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   for (int k = 1; k <= 100; ++k) ekf.add_wheel(k * 10000, 0.1, 0.0);
   ekf.add_pose(100000, 5.0, 5.0, 0.0, eye_cov(0.01, 0.01));  // 0.9 s late > 0.2 s history
@@ -131,17 +132,17 @@ TEST(Ekf, TooOldPoseDropped) {
 }
 
 TEST(Ekf, MissingMeasurementsGrowCovariance) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   ekf.add_wheel(10000, 0.2, 0.0);
-  const est::Estimate a = ekf.estimate_at(110000);
-  const est::Estimate b = ekf.estimate_at(1010000);
+  const autodrive::estimator::Estimate a = ekf.estimate_at(110000);
+  const autodrive::estimator::Estimate b = ekf.estimate_at(1010000);
   EXPECT_GT(b.P(0, 0), a.P(0, 0));
   EXPECT_GT(b.x(0), a.x(0));  // keeps predicting with the last speed
 }
 
 TEST(Ekf, FirstPosePlacesUninitialisedFilter) {
-  est::Ekf ekf;  // no reset: the first Eye pose must place the car
+  autodrive::estimator::Ekf ekf;  // no reset: the first Eye pose must place the car
   ekf.add_pose(0, 2.0, -1.0, 3.0, eye_cov(0.01, 0.02));
   EXPECT_NEAR(ekf.latest().x(0), 2.0, 1e-3);
   EXPECT_NEAR(ekf.latest().x(1), -1.0, 1e-3);
@@ -149,7 +150,7 @@ TEST(Ekf, FirstPosePlacesUninitialisedFilter) {
 }
 
 TEST(Ekf, HeadingUpdateAcrossPi) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, M_PI - 0.01, 1e-4, 0.01);
   ekf.add_pose(10000, 0, 0, -M_PI + 0.01, eye_cov(0.01, 0.01));
   // The innovation is +0.02 rad across the wrap, not -2 pi + 0.02.
@@ -157,7 +158,7 @@ TEST(Ekf, HeadingUpdateAcrossPi) {
 }
 
 TEST(Ekf, NonFiniteRejected) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 1e-6, 1e-6);
   ekf.add_wheel(10000, NAN, 0.0);
   EXPECT_EQ(ekf.stats().rejected, 1u);
@@ -167,10 +168,11 @@ TEST(Ekf, NonFiniteRejected) {
 TEST(Ekf, WheelSpeedFromEncodersAcrossClockWrap) {
   double v = 0;
   // One wheel revolution on both wheels in 0.1 s, across the Nano's 32-bit clock wrap.
-  ASSERT_TRUE(
-      est::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000, 1920, 0.0325, &v));
+  ASSERT_TRUE(autodrive::estimator::wheel_speed_from_encoders(0, 0, 4294917296LL, 1920, 1920, 50000,
+                                                              1920, 0.0325, &v));
   EXPECT_NEAR(v, 2 * M_PI * 0.0325 / 0.1, 1e-9);
-  EXPECT_FALSE(est::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
+  EXPECT_FALSE(
+      autodrive::estimator::wheel_speed_from_encoders(0, 0, 5, 10, 10, 5, 1920, 0.0325, &v));
 }
 
 // ---- The pose gate (probe finding: one forged POSE_EYE stream moved the map pose 1,000 m) ----
@@ -181,8 +183,8 @@ namespace {
 // odometry speed scaled by `speed_scale`. Returns the final position error [m].
 template <class EyeOn, class ForgedOn>
 double run_gate(EyeOn eye_on, ForgedOn forged_on, double forged_offset_m, double speed_scale,
-                est::EkfStats *stats, double duration_s = 30.0) {
-  est::Ekf ekf;
+                autodrive::estimator::EkfStats *stats, double duration_s = 30.0) {
+  autodrive::estimator::Ekf ekf;
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.005);
   Truth t;
@@ -211,7 +213,7 @@ const auto never = [](double) { return false; };
 }  // namespace
 
 TEST(EkfGate, HonestEyeIsNeverRejectedAndTheFirstFixPlacesTheCar) {
-  est::EkfStats st;
+  autodrive::estimator::EkfStats st;
   // The car starts 2.2 m from the filter's origin: the first fix must pass the gate.
   EXPECT_LT(run_gate(always, never, 0.0, 1.1, &st), 0.02);
   EXPECT_EQ(st.gated, 0u);
@@ -221,7 +223,7 @@ TEST(EkfGate, HonestEyeIsNeverRejectedAndTheFirstFixPlacesTheCar) {
 
 TEST(EkfGate, ForgedPoseStreamIsRejectedAndCounted) {
   for (double offset_m : {1000.0, 10.0, 1.0, 0.3}) {
-    est::EkfStats st;
+    autodrive::estimator::EkfStats st;
     // Honest Eye all along; from 5 s on, a forged stream at 100 Hz (10x the Eye's rate).
     const double err = run_gate(
         always, [](double s) { return s > 5.0; }, offset_m, 1.0, &st);
@@ -232,7 +234,7 @@ TEST(EkfGate, ForgedPoseStreamIsRejectedAndCounted) {
 }
 
 TEST(EkfGate, ReacquiresTheRealEyeAfterALongGap) {
-  est::EkfStats st;
+  autodrive::estimator::EkfStats st;
   // Eye lost from 3 s to 23 s while the odometry over-reads by 20 %: ~1 m of drift, far
   // outside the gate when the Eye comes back; a steady run of poses re-places the car.
   const double err = run_gate([](double s) { return s < 3.0 || s > 23.0; }, never, 0.0, 1.2, &st);
@@ -241,9 +243,9 @@ TEST(EkfGate, ReacquiresTheRealEyeAfterALongGap) {
 }
 
 TEST(EkfGate, AForgedPoseHeldStillWhileTheCarDrivesNeverReplacesIt) {
-  est::EkfStats st;
+  autodrive::estimator::EkfStats st;
   // No real Eye after 3 s (the worst case): a forged stream 1 m off, not moving with the car.
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   Truth t;
   for (int k = 1; k <= 3000; ++k) {
     step(t, 0.25, 0.0, 0.01);
@@ -260,7 +262,7 @@ TEST(EkfGate, AForgedPoseHeldStillWhileTheCarDrivesNeverReplacesIt) {
 }
 
 TEST(EkfGate, DistanceIsMahalanobis) {
-  est::Ekf ekf;
+  autodrive::estimator::Ekf ekf;
   ekf.reset(0, 0, 0, 0, 0.01 * 0.01, 1e-4);
   const Eigen::Matrix3d r = eye_cov(0.01, 0.01);
   // S = diag(2e-4, 2e-4, 2e-4): 0.02 m in x is 2 sigma -> d2 = 2.

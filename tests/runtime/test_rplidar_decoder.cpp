@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "rplidar/rplidar_decoder.hpp"
+#include <autodrive/rplidar/rplidar_decoder.hpp>
 
 namespace {
 using Bytes = std::vector<uint8_t>;
@@ -22,25 +22,25 @@ std::vector<Bytes> node_bytes(int turns) {
   std::vector<Bytes> out;
   for (int t = 0; t < turns; ++t)
     for (int a = 0; a < 360; ++a) {
-      rplidar::Node n;
+      autodrive::rplidar::Node n;
       n.start = a == 0;
       n.quality = 47;
       n.angle_deg = a;
       n.distance_mm = (a % 45 == 7) ? 0.0 : room_mm(a);  // a few "no return" rays
       Bytes b(5);
-      rplidar::encode_node(n, b.data());
+      autodrive::rplidar::encode_node(n, b.data());
       out.push_back(b);
     }
   return out;
 }
 
 struct Collector {
-  rplidar::Decoder dec;
-  rplidar::ScanAssembler asm_{rplidar::ScanParams{}};
+  autodrive::rplidar::Decoder dec;
+  autodrive::rplidar::ScanAssembler asm_{autodrive::rplidar::ScanParams{}};
   std::vector<autodrive::lidar_scan_t> scans;
   int64_t t_us = 0;
   Collector() {
-    dec.on_node = [this](const rplidar::Node &n) {
+    dec.on_node = [this](const autodrive::rplidar::Node &n) {
       autodrive::lidar_scan_t s;
       t_us += 400;
       if (asm_.add(n, t_us, &s)) scans.push_back(s);
@@ -65,12 +65,12 @@ int matching_bins(const autodrive::lidar_scan_t &s) {
 }  // namespace
 
 TEST(RplidarDecoder, NodeRoundTrip) {
-  rplidar::Node n{true, 15, 123.453125, 2345.25}, m;
+  autodrive::rplidar::Node n{true, 15, 123.453125, 2345.25}, m;
   uint8_t b[5];
-  rplidar::encode_node(n, b);
+  autodrive::rplidar::encode_node(n, b);
   EXPECT_EQ(b[0] & 0x03, 0x01);  // S=1, !S=0
   EXPECT_EQ(b[1] & 0x01, 0x01);  // C=1
-  ASSERT_TRUE(rplidar::Decoder::decode_node(b, &m));
+  ASSERT_TRUE(autodrive::rplidar::Decoder::decode_node(b, &m));
   EXPECT_TRUE(m.start);
   EXPECT_EQ(m.quality, 15);
   EXPECT_DOUBLE_EQ(m.angle_deg, 123.453125);
@@ -79,18 +79,18 @@ TEST(RplidarDecoder, NodeRoundTrip) {
 
 TEST(RplidarDecoder, RejectsBadCheckBits) {
   uint8_t b[5];
-  rplidar::encode_node(rplidar::Node{false, 10, 10.0, 500.0}, b);
-  rplidar::Node m;
+  autodrive::rplidar::encode_node(autodrive::rplidar::Node{false, 10, 10.0, 500.0}, b);
+  autodrive::rplidar::Node m;
   uint8_t bad[5];
   std::copy(b, b + 5, bad);
   bad[0] |= 0x03;  // S and !S both set
-  EXPECT_FALSE(rplidar::Decoder::decode_node(bad, &m));
+  EXPECT_FALSE(autodrive::rplidar::Decoder::decode_node(bad, &m));
   std::copy(b, b + 5, bad);
   bad[1] &= 0xFE;  // C cleared
-  EXPECT_FALSE(rplidar::Decoder::decode_node(bad, &m));
+  EXPECT_FALSE(autodrive::rplidar::Decoder::decode_node(bad, &m));
   std::copy(b, b + 5, bad);
   bad[2] = 0xFF;  // angle >= 360 deg
-  EXPECT_FALSE(rplidar::Decoder::decode_node(bad, &m));
+  EXPECT_FALSE(autodrive::rplidar::Decoder::decode_node(bad, &m));
 }
 
 TEST(RplidarDecoder, GoodStreamGivesFullScans) {
@@ -181,9 +181,9 @@ TEST(RplidarDecoder, SurvivesRandomCorruption) {
 }
 
 TEST(RplidarDecoder, HealthAnswerParsed) {
-  rplidar::Decoder d;
-  std::vector<rplidar::Health> got;
-  d.on_health = [&](const rplidar::Health &h) { got.push_back(h); };
+  autodrive::rplidar::Decoder d;
+  std::vector<autodrive::rplidar::Health> got;
+  d.on_health = [&](const autodrive::rplidar::Health &h) { got.push_back(h); };
   const Bytes health = {0xA5, 0x5A, 0x03, 0x00, 0x00, 0x00, 0x06, 0x02, 0x34, 0x12};
   d.feed(health.data(), health.size());
   ASSERT_EQ(got.size(), 1u);
@@ -193,15 +193,15 @@ TEST(RplidarDecoder, HealthAnswerParsed) {
 }
 
 TEST(RplidarDecoder, RequestBytes) {
-  EXPECT_EQ(rplidar::request(rplidar::kCmdScan), (Bytes{0xA5, 0x20}));
-  EXPECT_EQ(rplidar::request(rplidar::kCmdGetHealth), (Bytes{0xA5, 0x52}));
+  EXPECT_EQ(autodrive::rplidar::request(autodrive::rplidar::kCmdScan), (Bytes{0xA5, 0x20}));
+  EXPECT_EQ(autodrive::rplidar::request(autodrive::rplidar::kCmdGetHealth), (Bytes{0xA5, 0x52}));
 }
 
 TEST(RplidarAssembler, MountYawAndRangeLimits) {
-  rplidar::ScanParams p;
+  autodrive::rplidar::ScanParams p;
   p.mount_yaw_rad = M_PI / 2;  // sensor 0 deg points left
   p.range_max_m = 2.0;
-  rplidar::ScanAssembler a(p);
+  autodrive::rplidar::ScanAssembler a(p);
   autodrive::lidar_scan_t s;
   auto range_at = [](int deg_cw) {
     if (deg_cw == 0) return 1000.0;
@@ -223,7 +223,7 @@ TEST(RplidarAssembler, MountYawAndRangeLimits) {
 }
 
 TEST(RplidarAssembler, FakeStartFlagMidTurnIgnored) {
-  rplidar::ScanAssembler a(rplidar::ScanParams{});
+  autodrive::rplidar::ScanAssembler a(autodrive::rplidar::ScanParams{});
   autodrive::lidar_scan_t s;
   int emitted = 0;
   for (int t = 0; t < 3; ++t)
@@ -238,12 +238,12 @@ TEST(RplidarAssembler, FakeStartFlagMidTurnIgnored) {
 // Three turns of an A1 whose angle steps by step_deg per node (+1: clockwise, as the device
 // turns); node k carries 1000 + k mm.
 struct Turns {
-  rplidar::Decoder d;
-  rplidar::ScanAssembler a{rplidar::ScanParams{}};
+  autodrive::rplidar::Decoder d;
+  autodrive::rplidar::ScanAssembler a{autodrive::rplidar::ScanParams{}};
   std::vector<autodrive::lidar_scan_t> scans;
   int64_t t = 0;
   explicit Turns(int step_deg) {
-    d.on_node = [this](const rplidar::Node &n) {
+    d.on_node = [this](const autodrive::rplidar::Node &n) {
       autodrive::lidar_scan_t s;
       if (a.add(n, t += 1000, &s)) scans.push_back(s);
     };
@@ -252,7 +252,8 @@ struct Turns {
     for (int turn = 0; turn < 3; ++turn)
       for (int k = 0; k < 360; ++k) {
         uint8_t b[5];
-        rplidar::encode_node({k == 0, 10, double((360 + step_deg * k) % 360), 1000.0 + k}, b);
+        autodrive::rplidar::encode_node(
+            {k == 0, 10, double((360 + step_deg * k) % 360), 1000.0 + k}, b);
         d.feed(b, 5);
       }
   }

@@ -17,11 +17,11 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
-#include "common/config.hpp"
+#include <autodrive/core/config.hpp>
 #include <autodrive_lcm/subscribe.hpp>
-#include "fake_nano.hpp"
-#include "rplidar/rplidar_decoder.hpp"
-#include "rplidar/rplidar_driver.hpp"
+#include <autodrive/devtools/fake_nano.hpp>
+#include <autodrive/rplidar/rplidar_decoder.hpp>
+#include <autodrive/rplidar/rplidar_driver.hpp>
 
 namespace {
 
@@ -32,7 +32,7 @@ double room_m(int deg_cw) {
 // A1 emulation: answers GET_HEALTH with `health_status`, streams nodes after SCAN.
 struct FakeRplidar {
   explicit FakeRplidar(const std::string &link) : pty(link) {}
-  rtest::PtyPeer pty;
+  autodrive::devtools::PtyPeer pty;
   uint8_t health_status = 0;
   bool scanning = false;
   int resets = 0, scans = 0, healths = 0;
@@ -45,19 +45,19 @@ struct FakeRplidar {
   void pump() {
     const auto in = pty.read(2);
     for (std::size_t i = 0; i + 1 < in.size(); ++i) {
-      if (in[i] != rplidar::kCmdSync) continue;
+      if (in[i] != autodrive::rplidar::kCmdSync) continue;
       const uint8_t cmd = in[i + 1];
-      if (cmd == rplidar::kCmdGetHealth) {
+      if (cmd == autodrive::rplidar::kCmdGetHealth) {
         ++healths;
         pty.write({0xA5, 0x5A, 0x03, 0x00, 0x00, 0x00, 0x06, health_status, 0x01, 0x00});
         if (health_status == 2 && !sticky_error) health_status = 0;  // healthy after a reset
-      } else if (cmd == rplidar::kCmdScan) {
+      } else if (cmd == autodrive::rplidar::kCmdScan) {
         ++scans;
         scanning = true;
         pty.write({0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81});
-      } else if (cmd == rplidar::kCmdStop) {
+      } else if (cmd == autodrive::rplidar::kCmdStop) {
         scanning = false;
-      } else if (cmd == rplidar::kCmdReset) {
+      } else if (cmd == autodrive::rplidar::kCmdReset) {
         ++resets;
         scanning = false;
       }
@@ -67,9 +67,10 @@ struct FakeRplidar {
     std::vector<uint8_t> out;
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (int k = 0; k < 40; ++k) {  // 40 nodes per pump
-      rplidar::Node n{angle == 0, 40, static_cast<double>(angle), room_m(angle) * 1000.0};
+      autodrive::rplidar::Node n{angle == 0, 40, static_cast<double>(angle),
+                                 room_m(angle) * 1000.0};
       uint8_t b[5];
-      rplidar::encode_node(n, b);
+      autodrive::rplidar::encode_node(n, b);
       if (u(rng) < corrupt_fraction) b[rng() % 5] ^= static_cast<uint8_t>(1u << (rng() % 8));
       out.insert(out.end(), b, b + 5);
       angle = (angle + 1) % 360;
@@ -86,13 +87,14 @@ struct LidarHarness {
   explicit LidarHarness(int port)
       : link("/tmp/adr-rt-lidar-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         fake(link),
-        config(cfg::parse("lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
-                              "?ttl=0\"\n"
-                              "clock: wall\n"
-                              "vehicle: {name: TESTCAR}\n"
-                              "lidar: {device: " +
-                              link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
-                          "test config")),
+        config(autodrive::config::parse(
+            "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
+                "?ttl=0\"\n"
+                "clock: wall\n"
+                "vehicle: {name: TESTCAR}\n"
+                "lidar: {device: " +
+                link + ", baud: 115200, range_min_m: 0.15, range_max_m: 12.0}\n",
+            "test config")),
         lcm(config.lcm_url) {
     autodrive_lcm::subscribe<autodrive::lidar_scan_t, LidarHarness, &LidarHarness::on_scan>(
         lcm, "TESTCAR_LIDAR", this);
@@ -102,7 +104,7 @@ struct LidarHarness {
     if (th.joinable()) th.join();
   }
   void start() {
-    driver = std::make_unique<rplidar::Driver>(config);
+    driver = std::make_unique<autodrive::rplidar::Driver>(config);
     ASSERT_EQ(driver->init_error(), "");
     th = std::thread([this] { driver->run(stop); });
   }
@@ -125,10 +127,10 @@ struct LidarHarness {
 
   std::string link;
   FakeRplidar fake;
-  cfg::Config config;
+  autodrive::config::Config config;
   lcm::LCM lcm;
   std::vector<autodrive::lidar_scan_t> scans;
-  std::unique_ptr<rplidar::Driver> driver;
+  std::unique_ptr<autodrive::rplidar::Driver> driver;
   std::atomic<bool> stop{false};
   std::thread th;
 };

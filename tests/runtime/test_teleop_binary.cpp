@@ -60,9 +60,10 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
     k << std::string(64, 'c') << "\n";
   }
   ::chmod(key_file.c_str(), 0600);
-  rtest::Child teleop({AUTODRIVE_TELEOP_EXE, "--vehicle", "JS1", "--lcm-url", url, "--joystick",
-                       fifo, "--no-keyboard", "--max-throttle", "0.5", "--key-file", key_file},
-                      fifo + ".log");
+  autodrive::child_process::Child teleop(
+      {AUTODRIVE_TELEOP_EXE, "--vehicle", "JS1", "--lcm-url", url, "--joystick", fifo,
+       "--no-keyboard", "--max-throttle", "0.5", "--key-file", key_file},
+      fifo + ".log");
   // Released: commands flow, disengaged.
   ASSERT_TRUE(pump_until(lcm, [&] { return cmds.got.size() >= 5; }));
   EXPECT_FALSE(cmds.got.back().engaged);

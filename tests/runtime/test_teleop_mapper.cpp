@@ -1,19 +1,19 @@
 // Teleop mapping: dead-man on keyboard (auto-repeat) and gamepad, lights, quit.
 #include <gtest/gtest.h>
 
-#include "teleop/teleop_mapper.hpp"
+#include <autodrive/teleop/teleop_mapper.hpp>
 
 TEST(Teleop, NothingHeldIsDisengaged) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   const auto c = m.command(0);
   EXPECT_FALSE(c.engaged);
   EXPECT_EQ(c.throttle, 0.0f);
 }
 
 TEST(Teleop, KeyHeldDrivesReleaseStops) {
-  teleop::Params p;
+  autodrive::teleop::Params p;
   p.key_hold_us = 600000;
-  teleop::Mapper m(p);
+  autodrive::teleop::Mapper m(p);
   m.key('w', 1000000);
   auto c = m.command(1100000);
   EXPECT_TRUE(c.engaged);
@@ -27,7 +27,7 @@ TEST(Teleop, KeyHeldDrivesReleaseStops) {
 }
 
 TEST(Teleop, SpaceStopsAtOnce) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   m.key('s', 0);
   EXPECT_LT(m.command(1000).throttle, 0.0f);
   m.key(' ', 2000);
@@ -35,7 +35,7 @@ TEST(Teleop, SpaceStopsAtOnce) {
 }
 
 TEST(Teleop, SteeringAloneDoesNotDrive) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   m.key('a', 0);
   const auto c = m.command(1000);
   EXPECT_FLOAT_EQ(c.steering, 1.0f);
@@ -44,8 +44,8 @@ TEST(Teleop, SteeringAloneDoesNotDrive) {
 }
 
 TEST(Teleop, GamepadNeedsDeadman) {
-  teleop::Params p;
-  teleop::Mapper m(p);
+  autodrive::teleop::Params p;
+  autodrive::teleop::Mapper m(p);
   m.js_axis(p.throttle_axis, -32767);  // stick fully up
   m.js_axis(p.steering_axis, 16384);   // half right
   EXPECT_FALSE(m.command(0).engaged);
@@ -61,8 +61,8 @@ TEST(Teleop, GamepadNeedsDeadman) {
 }
 
 TEST(Teleop, GamepadLostStops) {
-  teleop::Params p;
-  teleop::Mapper m(p);
+  autodrive::teleop::Params p;
+  autodrive::teleop::Mapper m(p);
   m.js_button(p.deadman_button, true);
   m.js_axis(p.throttle_axis, -32767);
   m.js_lost();
@@ -70,7 +70,7 @@ TEST(Teleop, GamepadLostStops) {
 }
 
 TEST(Teleop, LightsCycleAndToggle) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   m.key('h', 0);
   m.key('h', 0);
   EXPECT_EQ(m.command(0).headlights, 2);
@@ -85,13 +85,13 @@ TEST(Teleop, LightsCycleAndToggle) {
 }
 
 TEST(Teleop, QuitKey) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   EXPECT_TRUE(m.key('w', 0));
   EXPECT_FALSE(m.key('q', 0));
 }
 
 TEST(Teleop, SeqIncrements) {
-  teleop::Mapper m;
+  autodrive::teleop::Mapper m;
   EXPECT_EQ(m.command(0).seq, 0);
   EXPECT_EQ(m.command(0).seq, 1);
 }

@@ -1,6 +1,6 @@
 """cffi binding (ABI mode) of autodrive_marl_core, the observation builder and time-to-collision
 shield that the C++ autodrive-marl uses too. The declarations come from the one header,
-runtime/jetson/marl_core/include/autodrive/marl_core.h, between its CFFI markers."""
+common/marl_core/include/autodrive/marl_core.h, between its CFFI markers."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from .. import vehicle
 from ..learn._lib import declarations, find_library
 from ..paths import REPO_ROOT
 
-HEADER = REPO_ROOT / "runtime" / "jetson" / "marl_core" / "include" / "autodrive" / "marl_core.h"
+HEADER = REPO_ROOT / "common" / "marl_core" / "include" / "autodrive" / "marl_core.h"
 LIB_NAME = "libautodrive_marl_core.so"
 ERR_BYTES = 512
 

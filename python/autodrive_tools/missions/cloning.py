@@ -50,7 +50,7 @@ CONDITIONS = tuple(ROUTES)
 UNSEEN = ("night", "noise2x", "reverse")  # issue 16's conditions not in the training data
 EXTRA = ("other-lane",)  # unseen too, but not one of the issue's
 DEFAULT_MODEL = REPO_ROOT / "models" / "pilot" / "driving_school.onnx"
-PILOT_CONFIG = REPO_ROOT / "runtime" / "jetson" / "pilot" / "config" / "pilot_hil.yaml"
+PILOT_CONFIG = REPO_ROOT / "runtime" / "jetson" / "config" / "pilot_hil.yaml"
 INTERVENTION_COST_S = 6.0  # PilotNet: each intervention costs 6 s of autonomy
 NIGHT_LIGHT_LEVEL = 0.25  # the scene's light level at "night" (1 = day)
 # The camera noise [sigma, 8-bit levels] and frame rate [Hz of sim time] the model was trained

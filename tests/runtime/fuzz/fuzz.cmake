@@ -6,9 +6,13 @@ find_program(AUTODRIVE_CLANGXX14 clang++-14)
 file(GLOB _rt_fuzz_rt "/usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a")
 if(AUTODRIVE_CLANGXX14 AND _rt_fuzz_rt)
   set(_rt "${AUTODRIVE_ROOT}/runtime/jetson")
-  set(_deps_bridge_rx ${_rt}/bridge/bridge_convert.cpp ${_rt}/bridge/bridge_convert.hpp
-      ${_rt}/common/config.hpp ${AUTODRIVE_ROOT}/firmware/nano/lib/proto/proto.c)
-  set(_deps_rplidar ${_rt}/rplidar/rplidar_decoder.cpp ${_rt}/rplidar/rplidar_decoder.hpp)
+  set(_bridge ${_rt}/drivers/nano_bridge)
+  set(_rplidar ${_rt}/drivers/rplidar)
+  set(_deps_bridge_rx ${_bridge}/src/bridge_convert.cpp
+      ${_bridge}/include/autodrive/nano_bridge/bridge_convert.hpp
+      ${_rt}/core/include/autodrive/core/config.hpp ${AUTODRIVE_ROOT}/firmware/nano/lib/proto/proto.c)
+  set(_deps_rplidar ${_rplidar}/src/rplidar_decoder.cpp
+      ${_rplidar}/include/autodrive/rplidar/rplidar_decoder.hpp)
   foreach(t bridge_rx rplidar)
     set(_bin "${CMAKE_CURRENT_BINARY_DIR}/fuzz/fuzz_${t}")
     add_custom_command(

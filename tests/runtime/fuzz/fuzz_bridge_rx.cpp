@@ -14,7 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "bridge/bridge_convert.hpp"
+#include <autodrive/nano_bridge/bridge_convert.hpp>
 #include "proto.h"
 
 namespace {
@@ -26,8 +26,8 @@ namespace {
     }               \
   } while (0)
 
-cfg::Vehicle vehicle;
-cfg::Bridge bridge_cfg;
+autodrive::config::Vehicle vehicle;
+autodrive::config::Bridge bridge_cfg;
 
 bool finite_within(double v, double bound) {
   return std::isfinite(v) && std::abs(v) <= bound;
@@ -37,9 +37,9 @@ void check_state(const proto_frame_t &f) {
   proto_state_t s{};
   const int r = proto_state_unpack(f.payload, f.len, &s);
   CHECK((r == 0) == (f.len == PROTO_LEN_STATE));
-  if (r != 0 || !bridge::state_problem(s).empty()) return;
+  if (r != 0 || !autodrive::bridge::state_problem(s).empty()) return;
   autodrive::vehicle_state_t vs{};
-  bridge::fill_state(s, vehicle, bridge::HostLinkStats{}, 123, &vs);
+  autodrive::bridge::fill_state(s, vehicle, autodrive::bridge::HostLinkStats{}, 123, &vs);
   CHECK(finite_within(vs.throttle_applied, 1.0));
   CHECK(finite_within(vs.steering_applied, 1.0));
   CHECK(finite_within(vs.steering_angle_rad, vehicle.steering_limit_rad + 1e-6));
@@ -48,7 +48,7 @@ void check_state(const proto_frame_t &f) {
   CHECK(vs.headlights >= 0 && vs.headlights <= 2 && vs.indicators >= 0 && vs.indicators <= 3);
   for (int i = 0; i < 2; ++i) CHECK(finite_within(vs.wheel_speed_rad_s[i], 32.769));
   autodrive::imu_t imu{};
-  bridge::fill_imu(s, bridge_cfg, 123, &imu);
+  autodrive::bridge::fill_imu(s, bridge_cfg, 123, &imu);
   double n2 = 0;
   for (double q : imu.orientation_wxyz) {
     CHECK(std::isfinite(q));

@@ -1,4 +1,4 @@
-// libFuzzer target: the RPLIDAR A1 decoder and scan assembler (runtime/jetson/rplidar), fed
+// libFuzzer target: the RPLIDAR A1 decoder and scan assembler (runtime/jetson/drivers/rplidar), fed
 // what a noisy or hostile serial line can carry. The input is a script:
 //   op 0: n raw bytes, fed in one chunk                        [0, n, bytes...]
 //   op 1: a valid scan descriptor (A5 5A 05 00 00 40 81)        [1]
@@ -13,7 +13,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "rplidar/rplidar_decoder.hpp"
+#include <autodrive/rplidar/rplidar_decoder.hpp>
 
 namespace {
 
@@ -27,11 +27,11 @@ namespace {
 int64_t t_us = 0;
 
 struct Run {
-  rplidar::Decoder dec;
-  rplidar::ScanAssembler asm_{rplidar::ScanParams{"laser", 0.3, 0.15, 12.0}};
+  autodrive::rplidar::Decoder dec;
+  autodrive::rplidar::ScanAssembler asm_{autodrive::rplidar::ScanParams{"laser", 0.3, 0.15, 12.0}};
   uint64_t scans = 0, healths = 0;
   Run() {
-    dec.on_node = [this](const rplidar::Node &n) {
+    dec.on_node = [this](const autodrive::rplidar::Node &n) {
       CHECK(std::isfinite(n.angle_deg) && n.angle_deg >= 0.0 && n.angle_deg < 360.0);
       CHECK(std::isfinite(n.distance_mm) && n.distance_mm >= 0.0);
       CHECK(n.quality <= 63);
@@ -39,7 +39,7 @@ struct Run {
       t_us += 250;
       if (asm_.add(n, t_us, &s)) check_scan(s);
     };
-    dec.on_health = [this](const rplidar::Health &) { ++healths; };
+    dec.on_health = [this](const autodrive::rplidar::Health &) { ++healths; };
   }
   void check_scan(const autodrive::lidar_scan_t &s) {
     ++scans;
@@ -60,7 +60,7 @@ struct Run {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   Run run;
-  rplidar::DecoderStats before{};
+  autodrive::rplidar::DecoderStats before{};
   size_t i = 0;
   while (i < size) {
     const uint8_t op = data[i++] % 5u;
@@ -79,14 +79,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       i += 3;
     } else if (op == 3) {
       if (i + 7 > size) break;
-      rplidar::Node n;
+      autodrive::rplidar::Node n;
       n.start = data[i] & 1u;
       n.quality = static_cast<uint8_t>(data[i + 1] % 64u);
       const unsigned angle_q6 = (data[i + 2] | (data[i + 3] << 8)) % (360u * 64u);
       n.angle_deg = angle_q6 / 64.0;
       n.distance_mm = (data[i + 4] | (data[i + 5] << 8)) / 4.0;
       uint8_t out[5];
-      rplidar::encode_node(n, out);
+      autodrive::rplidar::encode_node(n, out);
       bytes.assign(out, out + 5);
       i += 7;
     } else {
@@ -94,7 +94,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       continue;
     }
     run.dec.feed(bytes.data(), bytes.size());
-    const rplidar::DecoderStats &now = run.dec.stats();
+    const autodrive::rplidar::DecoderStats &now = run.dec.stats();
     CHECK(now.nodes >= before.nodes && now.bad_nodes >= before.bad_nodes &&
           now.skipped_bytes >= before.skipped_bytes && now.descriptors >= before.descriptors);
     before = now;

@@ -21,8 +21,8 @@
 namespace autodrive {
 
 // Bad input from a user: a config, a calibration, a map, a device. The message names the input
-// and what is wrong; programs print it and exit non-zero. The runtime's cfg::Error and the
-// Eye's eye::Error are this type.
+// and what is wrong; programs print it and exit non-zero. The runtime's autodrive::config::Error
+// and the Eye's eye::Error are this type.
 class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
