@@ -1,5 +1,7 @@
 // The one pure pursuit (<autodrive/pure_pursuit.h>, <autodrive/pure_pursuit.hpp>): the steering
 // law, the two goal rules, projection with progress, and the vehicle limits.
+#include <autodrive/angle_wrap.h>
+#include <autodrive/angles.hpp>
 #include <autodrive/pure_pursuit.h>
 #include <autodrive/pure_pursuit.hpp>
 #include <autodrive_vehicle.h>
@@ -141,6 +143,16 @@ TEST(Path, ClosedLoopBicycleConvergesOntoACircle) {
     if (i > 500) worst_late_m = std::max(worst_late_m, std::abs(std::hypot(x, y) - r_m));
   }
   EXPECT_LT(worst_late_m, 0.005);
+}
+
+// The C wrap (<autodrive/angle_wrap.h>) is the C++ one (<autodrive/angles.hpp>), bit for bit.
+TEST(AngleWrap, CIsTheCppWrapInto_MinusPiPi) {
+  for (double a = -20.0; a <= 20.0; a += 0.01)
+    EXPECT_EQ(autodrive_angle_wrap_rad(a), autodrive::angle_wrap_rad(a)) << a;
+  EXPECT_DOUBLE_EQ(autodrive_angle_wrap_rad(kPi), kPi);  // (-pi, pi]: +pi stays
+  EXPECT_DOUBLE_EQ(autodrive_angle_wrap_rad(-kPi), kPi);
+  EXPECT_NEAR(autodrive_angle_wrap_rad(3 * kPi / 2), -kPi / 2, 1e-12);
+  EXPECT_NEAR(autodrive_angle_wrap_rad(-7.0), -7.0 + 2 * kPi, 1e-12);
 }
 
 }  // namespace
