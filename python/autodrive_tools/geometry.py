@@ -15,7 +15,8 @@ Rect = tuple[float, float, float, float, float]
 
 
 def wrap(angle_rad: float) -> float:
-    """The angle in [-pi, pi] (atan2's range)."""
+    """The angle in [-pi, pi] (atan2's range) [rad]: the one angle wrap of the Python code (the
+    generated maps' headings depend on its last bits)."""
     return math.atan2(math.sin(angle_rad), math.cos(angle_rad))
 
 

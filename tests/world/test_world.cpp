@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "camera_fx.h"
-#include "pure_pursuit.h"
+#include <autodrive/pure_pursuit.h>
 #include "route_driver.h"
 #include "sim.h"
 #include "sim_camera.h"
@@ -391,8 +391,9 @@ TEST(World, PurePursuitSteersACircleExactly) {
   pp_reset(&st, &p, R, 0.0);
   pp_project(&st, &p, R, 0.0);
   EXPECT_NEAR(st.cross_track_m, 0.0, 1e-9);
+  const pp_vehicle_t car = {L, 1.0};
   for (double ld : {0.1, 0.2, 0.4})
-    EXPECT_NEAR(pp_steer(&st, &p, R, 0.0, M_PI / 2, ld, L, 1.0), atan(L / R), 2e-3) << ld;
+    EXPECT_NEAR(pp_steer(&st, &p, R, 0.0, M_PI / 2, ld, &car), atan(L / R), 2e-3) << ld;
   pp_project(&st, &p, R + 0.01, 0.0);  // 1 cm outside the CCW circle: right of it
   EXPECT_NEAR(st.cross_track_m, -0.01, 1e-4);
   pp_path_free(&p);

@@ -2,6 +2,8 @@
  * (<autodrive/marl_core.h>). Pure arithmetic: no allocation, no I/O, no state. */
 #include <autodrive/marl_core.h>
 
+#include <autodrive/angle_wrap.h>
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -316,7 +318,7 @@ static double follow_lane(const adm_shield_config_t *cfg, const adm_lane_t *lane
                          cfg->lane_lookahead_m, &hint, aim, &remaining, NULL, 0) != 0)
     return 0.0;
   double bearing = atan2(aim[1] - self->y_m, aim[0] - self->x_m) - self->yaw_rad;
-  bearing = atan2(sin(bearing), cos(bearing));
+  bearing = autodrive_angle_wrap_rad(bearing);
   return fmax(-1.0, fmin(1.0, cfg->lane_gain * bearing));
 }
 

@@ -25,6 +25,7 @@ from typing import Any
 
 from .. import channels, lcmtypes
 from ..channels import channel
+from ..geometry import wrap
 from ..maps.loader import MAPS_DIR
 from ..paths import RELEASE_BUILD
 
@@ -74,7 +75,7 @@ def targets(map_json: Path) -> tuple[list[Target], list[Target]]:
 def ahead(pose: tuple[float, float, float], t: Target) -> float | None:
     """Distance [m] along the lane from the car to t when t is ahead on the car's lane, else None."""
     x, y, yaw = pose
-    if abs(math.remainder(yaw - t.heading_rad, math.tau)) > HEADING_TOL_RAD:
+    if abs(wrap(yaw - t.heading_rad)) > HEADING_TOL_RAD:
         return None
     c, s = math.cos(t.heading_rad), math.sin(t.heading_rad)
     along = (t.x_m - x) * c + (t.y_m - y) * s

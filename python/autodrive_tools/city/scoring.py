@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import vehicle
+from ..geometry import wrap
 
 HEADING_TOL_RAD = math.radians(45.0)
 LATERAL_TOL_M = 0.2  # a car within this of a stop line's centre is on its lane
@@ -46,7 +47,7 @@ def front_past_m(x: float, y: float, yaw: float, p: StopPoint) -> float:
 
 def on_approach(x: float, y: float, yaw: float, p: StopPoint) -> bool:
     """The car drives p's lane near p (heading and lateral offset)."""
-    if abs(math.remainder(yaw - p.heading_rad, math.tau)) > HEADING_TOL_RAD:
+    if abs(wrap(yaw - p.heading_rad)) > HEADING_TOL_RAD:
         return False
     lateral = -(x - p.x_m) * math.sin(p.heading_rad) + (y - p.y_m) * math.cos(p.heading_rad)
     return abs(lateral) < LATERAL_TOL_M
@@ -222,7 +223,7 @@ class Scorer:
         self.last[car] = (x, y, yaw)
         for other, (ox, oy, oyaw) in self.last.items():
             # cars going the same way (one behind the other), not cars passing in the other lane
-            if other != car and abs(math.remainder(yaw - oyaw, math.tau)) < HEADING_TOL_RAD:
+            if other != car and abs(wrap(yaw - oyaw)) < HEADING_TOL_RAD:
                 self.min_gap_m = min(self.min_gap_m, math.dist((x, y), (ox, oy)))
 
     def report(self) -> dict[str, Any]:

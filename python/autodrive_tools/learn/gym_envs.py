@@ -12,6 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import mapfacts
+from ..geometry import wrap
 from . import tasks
 from .world import SimError, World
 
@@ -28,10 +29,6 @@ def _period_ms(control_hz: float) -> int:
     if period < 1:
         raise ValueError(f"control_hz {control_hz}: the period must be >= 1 ms")
     return period
-
-
-def _wrap(a: float) -> float:
-    return math.remainder(a, 2.0 * math.pi)
 
 
 class _CarEnv(gym.Env[ObsArray, ObsArray]):
@@ -214,7 +211,7 @@ class ParkingEnv(_CarEnv):
     def _goal_in_car(self, o: Any) -> tuple[float, float, float]:
         dx, dy = self.goal[0] - o.pos_m[0], self.goal[1] - o.pos_m[1]
         c, s = math.cos(o.yaw_rad), math.sin(o.yaw_rad)
-        return c * dx + s * dy, -s * dx + c * dy, _wrap(self.goal[2] - o.yaw_rad)
+        return c * dx + s * dy, -s * dx + c * dy, wrap(self.goal[2] - o.yaw_rad)
 
     def _obs(self) -> tuple[ObsArray, Any, float]:
         o = self.world.observe_raw(0)

@@ -12,6 +12,7 @@ from typing import Any, Union
 import yaml
 
 from . import geometry, tiles
+from ..geometry import wrap
 from .description import MapDescription
 from .model import Kit, MapDescriptionError, MapFile, Vec2, rect_corners
 from .schema import build, fail
@@ -216,7 +217,7 @@ class _Checker:
                 if not any(
                     name != c.spec.name
                     and math.dist(p, q[2]) <= TILE_JOIN_TOLERANCE_M
-                    and abs(math.remainder(yaw - q[3], 2 * math.pi)) <= TILE_JOIN_TOLERANCE_RAD
+                    and abs(wrap(yaw - q[3])) <= TILE_JOIN_TOLERANCE_RAD
                     for name, q in others
                 ):
                     what = "enters" if end == "start" else "leaves"
@@ -247,7 +248,7 @@ class _Checker:
             for j, (a, b) in enumerate(pairs):
                 pa, pb = self.m.centre_line(a)[-1], self.m.centre_line(b)[0]
                 gap = math.dist(pa[:2], pb[:2])
-                turn = abs(math.remainder(pa[2] - pb[2], 2 * math.pi))
+                turn = abs(wrap(pa[2] - pb[2]))
                 if gap > TILE_JOIN_TOLERANCE_M or turn > TILE_JOIN_TOLERANCE_RAD:
                     raise self.err(
                         f"{key}.lanes[{(j + 1) % len(r.lanes)}]",

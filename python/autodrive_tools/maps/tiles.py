@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from ..geometry import wrap
 from .geometry import piece_point
 from .model import Arc, Lane, LaneSpec, Line, ParkingSlot, Piece, Road, StopLine, TileKit
 from .model import TileSpec, Vec2
@@ -134,7 +135,7 @@ class _Builder:
     def arc(self, name: str, centre: Vec2, start: Vec2, sweep_deg: float) -> Piece:
         r = math.dist(centre, start)
         a0 = math.degrees(math.atan2(start[1] - centre[1], start[0] - centre[0]))
-        a0 = math.degrees(math.remainder(math.radians(a0 + math.degrees(self.rot)), 2 * math.pi))
+        a0 = math.degrees(wrap(math.radians(a0 + math.degrees(self.rot))))
         return Piece(name=name, arc=Arc(self.world(centre), r, round(a0, 9), sweep_deg))
 
     def movement(self, a: str, b: str, i: int, d_m: float) -> list[Piece]:
@@ -235,7 +236,7 @@ class _Builder:
     # --- slots ----------------------------------------------------------------------------------
 
     def slot(self, name: str, centre: Vec2, yaw_local_rad: float, size: Vec2) -> None:
-        yaw = math.degrees(math.remainder(yaw_local_rad + self.rot, 2 * math.pi))
+        yaw = math.degrees(wrap(yaw_local_rad + self.rot))
         self.out.slots.append(ParkingSlot(name, self.world(centre), round(yaw, 9), size))
 
     def lot_slots(self) -> None:

@@ -30,6 +30,7 @@ import numpy.typing as npt
 from pettingzoo import ParallelEnv
 
 from .. import channels
+from ..geometry import wrap
 from ..learn import tasks
 from ..learn.pz_env import ObsArray, StepResult
 from ..learn.world import World
@@ -106,8 +107,7 @@ def plan_route(name: str, spawn_s: float) -> CarRoute:
 
 def follow_steering(car: Car, waypoint: tuple[float, float]) -> float:
     """The lane follower (baseline, finished cars): steer to the waypoint's bearing."""
-    bearing = math.atan2(waypoint[1] - car.y_m, waypoint[0] - car.x_m) - car.yaw_rad
-    bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
+    bearing = wrap(math.atan2(waypoint[1] - car.y_m, waypoint[0] - car.x_m) - car.yaw_rad)
     return float(np.clip(FOLLOW_GAIN * bearing, -1.0, 1.0))
 
 

@@ -10,7 +10,7 @@ import select
 import time
 from typing import Any
 
-from .. import command_auth, lcmtypes, vehicle
+from .. import command_auth, lcmtypes, pure_pursuit
 from ..channels import channel
 from ..geometry import Point, to_world
 from . import MissionContext
@@ -44,8 +44,7 @@ def stadium_track(step_m: float = 0.02) -> tuple[list[Point], list[Point]]:
 
 def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str, Any]:
     types = lcmtypes.load(ctx.build)
-    car = vehicle.load()
-    wheelbase_m, steer_limit_rad = car.number("wheelbase_m"), car.number("steer_limit_rad")
+    car = pure_pursuit.default_vehicle()
     lc = lcmtypes.bus(ctx.lcm_url)
     try:
         signer = command_auth.signer_for(ctx.vehicle, "demo-loop")
@@ -79,6 +78,7 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
     origin = (start["x"], start["y"], start["yaw"])
     lead, lap = stadium_track()
     path = [to_world(origin, (p[0], p[1], 0.0))[:2] for p in lead + lap]
+    track = pure_pursuit.Polyline(path)
     idx = 0
     seq = 0
     laps = 0
@@ -110,19 +110,14 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
             lc.handle()
             continue
         next_cmd += COMMAND_PERIOD_S
-        # Pure pursuit: advance the target index along the path to the lookahead distance.
+        # Pure pursuit (the one, in C): the goal is the first sample the lookahead away from
+        # the target index on; past the track's end the index goes back to the lap's start.
         x, y, yaw = pose["x"], pose["y"], pose["yaw"]
-        while math.hypot(path[idx][0] - x, path[idx][1] - y) < LOOKAHEAD_M:
-            idx += 1
-            if idx >= len(path):
-                idx = len(lead)
-                laps += 1
-        tx, ty = path[idx]
-        dx, dy = tx - x, ty - y
-        ly = -math.sin(yaw) * dx + math.cos(yaw) * dy
-        ld2 = dx * dx + dy * dy
-        delta = math.atan(2.0 * wheelbase_m * ly / max(ld2, 1e-6))
-        cmd = command(True, THROTTLE, max(-1.0, min(1.0, delta / steer_limit_rad)))
+        while (idx := track.goal_index(idx, x, y, LOOKAHEAD_M)) >= len(path):
+            idx = len(lead)
+            laps += 1
+        delta = pure_pursuit.steer_to((x, y, yaw), path[idx], car)
+        cmd = command(True, THROTTLE, delta / car.steer_limit_rad)
         cmd.headlights = 1
         cmd.indicators = (
             INDICATOR_LEFT

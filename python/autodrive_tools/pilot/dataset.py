@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import channels, lcmtypes
+from ..geometry import wrap
 from ..paths import RELEASE_BUILD
 from .expert import meta_path
 
@@ -166,7 +167,7 @@ def record(
                 if first:
                     yaw0 = prev_yaw = s.yaw
                     first = False
-                d = math.remainder(s.yaw - prev_yaw, 2.0 * math.pi)
+                d = wrap(s.yaw - prev_yaw)
                 unwrapped += d
                 prev_yaw = s.yaw
                 lap = int(abs(unwrapped) // (2.0 * math.pi))

@@ -7,8 +7,8 @@ ahead, a point below the picture: every frame from "curve 0.41 m ahead" to "0.2 
 looks alike but carries a label that changes, so the network learns the track's timing by
 heart. With a lookahead at or past the camera's near edge, the label depends on the lane the
 frame shows. The expert still drives (and perturbs) with its own 0.2 m lookahead; only the
-label changes. Pure pursuit here is the simulator's (`pure_pursuit.c`: the goal `lookahead`
-along the path from the nearest point, delta = atan2(2 wheelbase sin(alpha), d)); the lane of
+label changes. Pure pursuit here is the simulator's (the one, common/path_tracking through cffi: the goal
+`lookahead` along the path from the nearest point, delta = atan(2 wheelbase y / d^2)); the lane of
 a recording with `lane_shift` is the route moved sideways as the simulator moves it
 (`route_driver.c`)."""
 
@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .. import maps, vehicle
+from .. import maps, pure_pursuit
 
 F64 = npt.NDArray[np.float64]
 
@@ -48,27 +48,11 @@ def pursuit_steering(poses: F64, line: F64, loop: bool, lookahead_m: float) -> F
     """Normalised steering of pure pursuit at lookahead_m for each pose (x, y, yaw) [m, rad]."""
     if lookahead_m <= 0:
         raise ValueError(f"label lookahead {lookahead_m} m: must be > 0")
-    v = vehicle.load()
-    wheelbase, limit = v.number("wheelbase_m"), v.number("steer_limit_rad")
-    a, d = line[:-1], np.diff(line, axis=0)
-    len2 = np.maximum((d**2).sum(axis=1), 1e-12)
-    seg = np.sqrt(len2)
-    s0 = np.r_[0.0, np.cumsum(seg)]
-    total = s0[-1]
+    path = pure_pursuit.PathTracker([(float(x), float(y)) for x, y in line], loop)
+    limit = pure_pursuit.default_vehicle().steer_limit_rad
     out = np.empty(len(poses))
     for k, (x, y, yaw) in enumerate(poses):
-        p = np.array([x, y])
-        t = np.clip(((p - a) * d).sum(axis=1) / len2, 0.0, 1.0)
-        i = int(np.argmin((((a + t[:, None] * d) - p) ** 2).sum(axis=1)))
-        s = s0[i] + t[i] * seg[i] + lookahead_m
-        s = s % total if loop else min(s, total)
-        j = min(int(np.searchsorted(s0, s, side="right")) - 1, len(d) - 1)
-        g = a[j] + (s - s0[j]) / seg[j] * d[j]
-        dx, dy = g[0] - x, g[1] - y
-        dist = math.hypot(dx, dy)
-        alpha = math.atan2(dy, dx) - yaw
-        delta = math.atan2(2.0 * wheelbase * math.sin(alpha), dist) if dist > 1e-6 else 0.0
-        out[k] = max(-1.0, min(1.0, delta / limit))
+        out[k] = path.steer_nearest((float(x), float(y), float(yaw)), lookahead_m) / limit
     return out
 
 

@@ -165,7 +165,7 @@ class RoadNet:
         near = np.nonzero(d < 0.35)[0]
         if len(near) == 0:
             return None
-        dh = np.abs((self._all[near, 2] - yaw_rad + math.pi) % (2 * math.pi) - math.pi)
+        dh = np.abs([wrap(a) for a in self._all[near, 2] - yaw_rad])
         near = near[dh < MAX_HEADING_RAD]
         best: dict[int, tuple[float, int]] = {}
         for i in near:

@@ -30,6 +30,7 @@
 #include <autodrive/behaviour/city_map.hpp>
 #include <autodrive/behaviour/city_rules.hpp>
 #include <autodrive/behaviour/obstacle.hpp>
+#include <autodrive/pure_pursuit.hpp>
 
 namespace {
 
@@ -102,11 +103,9 @@ class Driver {
           std::clamp(out.speed_m_s / top_m_s + o_.speed_kp * (out.speed_m_s - m->vx_m_s), 0.0, 1.0);
     // Steering: pure pursuit on the track point one lookahead ahead.
     const auto goal = autodrive::behaviour::point_at(track_, s_local_ + o_.lookahead_m);
-    const double dx = goal.x_m - m->x_m, dy = goal.y_m - m->y_m;
-    const double ly = -std::sin(m->yaw_rad) * dx + std::cos(m->yaw_rad) * dy;
-    const double ld2 = std::max(dx * dx + dy * dy, 1e-6);
-    const double delta = std::atan(2.0 * AUTODRIVE_VEHICLE_WHEELBASE_M * ly / ld2);
-    send(true, throttle, std::clamp(delta / AUTODRIVE_VEHICLE_STEER_LIMIT_RAD, -1.0, 1.0));
+    const double delta =
+        autodrive::pursuit_steer_rad(m->x_m, m->y_m, m->yaw_rad, goal.x_m, goal.y_m);
+    send(true, throttle, delta / AUTODRIVE_VEHICLE_STEER_LIMIT_RAD);
     if (m->utime - last_status_us_ >= static_cast<int64_t>(o_.status_period_s * 1e6)) {
       last_status_us_ = m->utime;
       std::printf("[city-driver] %s t=%.1f s lap %ld s=%.2f/%.2f m v=%.3f m/s -> %.3f m/s (%s)%s\n",

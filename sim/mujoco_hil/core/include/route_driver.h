@@ -1,8 +1,8 @@
 /* Route driver: the scripted driver `--script route:NAME[,speed=F][,start=S][,lookahead=M]`
  * follows the map's named route (MJCF numeric `route_<NAME>` = "loop half_width_m x0 y0 x1 y1
- * ...", contract with the map side) by pure pursuit (pure_pursuit.h) with the car's wheelbase
- * and steering limit from <autodrive_vehicle.h>, at throttle F (the fraction of top speed),
- * and keeps the cross-track error statistics of the rear-axle centre (base_link). Its
+ * ...", contract with the map side) by pure pursuit (<autodrive/pure_pursuit.h>) with the car's
+ * wheelbase and steering limit from <autodrive_vehicle.h>, at throttle F (the fraction of top
+ * speed), and keeps the cross-track error statistics of the rear-axle centre (base_link). Its
  * throttle and steering reach the emulated Nano as real COMMAND frames (script.h).
  * Perturbations (the expert of behavioural cloning, issue 16): with an amplitude A > 0 the
  * driver now and then adds a seeded steering offset (|offset| in [A/2, A], ROUTE_PERTURB_*
@@ -17,7 +17,7 @@
 
 #include <mujoco/mujoco.h>
 
-#include "pure_pursuit.h"
+#include <autodrive/pure_pursuit.h>
 #include "rng.h"
 
 #ifdef __cplusplus

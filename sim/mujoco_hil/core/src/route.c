@@ -1,6 +1,8 @@
 /* Routes and lanes as polylines (see route.h). */
 #include "route.h"
 
+#include <autodrive/angle_wrap.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -107,7 +109,7 @@ void route_locate(const route_t *r, double x, double y, double yaw_rad, route_wh
     /* cross product sign: + when the point is left of the segment's direction */
     const double cross = len > 0.0 ? (dx * (y - ay) - dy * (x - ax)) / len : 0.0;
     out->lateral_m = (cross >= 0.0 ? 1.0 : -1.0) * sqrt(d2);
-    out->heading_err_rad = remainder(yaw_rad - atan2(dy, dx), 2.0 * M_PI);
+    out->heading_err_rad = autodrive_angle_wrap_rad(yaw_rad - atan2(dy, dx));
     out->progress_m = r->s_m[i] + t * len;
   }
 }

@@ -145,8 +145,8 @@ void route_driver_update(route_driver_t *r, double x_m, double y_m, double yaw_r
   r->sum_sq_m2 += e * e;
   if (e > r->max_abs_m) r->max_abs_m = e;
   r->samples++;
-  const double delta = pp_steer(&r->st, &r->path, x_m, y_m, yaw_rad, r->lookahead_m,
-                                AUTODRIVE_VEHICLE_WHEELBASE_M, AUTODRIVE_VEHICLE_STEER_LIMIT_RAD);
+  const pp_vehicle_t car = pp_vehicle_default();
+  const double delta = pp_steer(&r->st, &r->path, x_m, y_m, yaw_rad, r->lookahead_m, &car);
   *throttle = r->speed;
   r->expert_steering = delta / AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;
   const double cmd = r->expert_steering + route_driver_perturbation(r);

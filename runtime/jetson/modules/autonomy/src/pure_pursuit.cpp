@@ -1,5 +1,7 @@
 #include <autodrive/autonomy/pure_pursuit.hpp>
 
+#include <autodrive/pure_pursuit.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -8,6 +10,7 @@ namespace autodrive::autonomy {
 void PurePursuit::set_path(const Path &path) {
   path_ = path;
   segments_.clear();
+  segments_xy_.clear();
   offsets_.clear();
   size_t begin = 0;
   for (size_t i = 1; i <= path.size(); ++i) {
@@ -19,6 +22,9 @@ void PurePursuit::set_path(const Path &path) {
       if (seg.size() >= 2) {
         segments_.push_back(seg);
         offsets_.push_back(begin);
+        std::vector<double> xy;
+        for (const auto &p : seg) xy.insert(xy.end(), {p.pose.x_m, p.pose.y_m});
+        segments_xy_.push_back(std::move(xy));
       }
       begin = i;
     }
@@ -104,18 +110,15 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
   v = std::max(v, cfg_.min_speed_m_s);
   v = std::min(v, speed_m_s_ + cfg_.accel_m_s2 * dt_s);
   speed_m_s_ = v;
-  // Lookahead point: along the samples, or on the end tangent extended past the end.
-  const double ld = cfg_.lookahead_min_m + cfg_.lookahead_time_s * v;
+  // Lookahead point: the first sample ld away, or on the last arc extended past the end.
+  const double ld = pp_lookahead_m(cfg_.lookahead_min_m, cfg_.lookahead_time_s, v);
+  const int n = static_cast<int>(seg.size());
+  const int goal = pp_goal_index(segments_xy_[seg_].data(), n, static_cast<int>(nearest_), pose.x_m,
+                                 pose.y_m, ld);
   Eigen::Vector2d target = pt(seg.size() - 1);
-  bool found = false;
-  for (size_t i = nearest_; i < seg.size(); ++i) {
-    if ((pt(i) - pos).norm() >= ld) {
-      target = pt(i);
-      found = true;
-      break;
-    }
-  }
-  if (!found) {
+  if (goal < n) {
+    target = pt(static_cast<size_t>(goal));
+  } else {
     // Past the end: continue the last arc (not the tangent, which would cut the final turn
     // and leave the heading short) until the point is ld away.
     const double k_end = seg[seg.size() >= 2 ? seg.size() - 2 : 0].curvature_1pm;
@@ -124,15 +127,9 @@ TrackerCommand PurePursuit::step(const Pose2 &pose, double dt_s, double measured
       q = arc_step(q, dir * 0.005, k_end);
     target = {q.x_m, q.y_m};
   }
-  // Same formula forward and reverse: curvature of the rear axle = 2 y / d^2 in the car frame
-  // (in reverse the travel frame is flipped and tan(steer)/L changes sign, which cancels).
-  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
-  const Eigen::Vector2d d = target - pos;
-  const double yv = -s * d.x() + c * d.y();
-  const double d2 = std::max(1e-6, d.squaredNorm());
-  const double k = 2.0 * yv / d2;
-  cmd.steer_rad =
-      std::clamp(std::atan(k * cfg_.wheelbase_m), -cfg_.max_steer_rad, cfg_.max_steer_rad);
+  // The one pure pursuit law, the same forward and reverse (see <autodrive/pure_pursuit.h>).
+  const pp_vehicle_t car = {cfg_.wheelbase_m, cfg_.max_steer_rad};
+  cmd.steer_rad = pp_steer_to(pose.x_m, pose.y_m, pose.yaw_rad, target.x(), target.y(), &car);
   cmd.steering = cmd.steer_rad / cfg_.max_steer_rad;
   last_steer_rad_ = cmd.steer_rad;
   cmd.speed_m_s = dir * v;

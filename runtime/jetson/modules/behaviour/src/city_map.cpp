@@ -1,5 +1,7 @@
 #include <autodrive/behaviour/city_map.hpp>
 
+#include <autodrive/angles.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -31,10 +33,6 @@ std::string str(const json &j, const char *key, const std::string &where) {
   const json &v = need(j, key, where);
   if (!v.is_string()) throw Error(where + ": '" + key + "' is not a string");
   return v.get<std::string>();
-}
-
-double wrap(double a) {
-  return std::atan2(std::sin(a), std::cos(a));
 }
 
 // Arc length along the lane's centre line of the point nearest to (x, y).
@@ -206,8 +204,8 @@ Track build_track(const CityMap &m, const std::string &name, const std::vector<s
       for (size_t k = 0; k < placed.size() * 2 && s1 < 0; ++k) {
         const auto &[s0, l] = placed[k % placed.size()];
         const double base = s0 + (k >= placed.size() ? t.length_m : 0.0);
-        const double turn =
-            std::abs(wrap(l->centre_line.back().heading_rad - l->centre_line.front().heading_rad));
+        const double turn = std::abs(autodrive::angle_wrap_rad(l->centre_line.back().heading_rad -
+                                                               l->centre_line.front().heading_rad));
         if (base + 1e-6 >= s_sign && turn > kCurveRad) s1 = base + lane_length(*l);
         if (!loop && k + 1 >= placed.size()) break;
       }

@@ -1,5 +1,7 @@
 #include <autodrive/marl/route_map.hpp>
 
+#include <autodrive/angles.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -28,7 +30,7 @@ autodrive::autonomy::Path Route::path() const {
     q.pose = points[i];
     if (i + 1 < points.size()) {
       const double ds = s_m[i + 1] - s_m[i];
-      const double dyaw = std::remainder(points[i + 1].yaw_rad - points[i].yaw_rad, 2 * M_PI);
+      const double dyaw = autodrive::angle_wrap_rad(points[i + 1].yaw_rad - points[i].yaw_rad);
       q.curvature_1pm = ds > 1e-9 ? dyaw / ds : 0.0;
     }
     p.push_back(q);

@@ -1,6 +1,7 @@
-// pp_: path tracking by pure pursuit on the rear axle, forward and reverse, with a speed
-// profile (accelerate, cruise, slow for curvature, brake to a stop at every cusp and at the
-// goal) and a short standstill at each cusp before the direction changes.
+// Path tracking on the rear axle, forward and reverse, by the one pure pursuit
+// (<autodrive/pure_pursuit.h>: the goal sample, the steering law), with a speed profile
+// (accelerate, cruise, slow for curvature, brake to a stop at every cusp and at the goal) and
+// a short standstill at each cusp before the direction changes.
 // Output is the vehicle_command_t convention: throttle and steering in [-1, 1].
 // Throttle-to-speed map (assumed, linear, no deadband): throttle 1.0 -> top_speed_m_s
 // (0.267 m/s, Nigel's top speed), so throttle = speed / top_speed_m_s, sign = direction.
@@ -60,7 +61,8 @@ class PurePursuit {
   void update_stall_boost(double along_m_s, double target_m_s, double dt_s);
   TrackerConfig cfg_;
   Path path_;
-  std::vector<Path> segments_;  // split at cusps
+  std::vector<Path> segments_;                    // split at cusps
+  std::vector<std::vector<double>> segments_xy_;  // their samples, x0 y0 x1 y1 ... [m]
   std::vector<size_t> offsets_;
   size_t seg_ = 0, seg_offset_ = 0, nearest_ = 0;
   double speed_m_s_ = 0.0;  // magnitude of the last commanded speed

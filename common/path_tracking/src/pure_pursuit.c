@@ -1,11 +1,47 @@
 /* Pure pursuit (see pure_pursuit.h). */
-#include "pure_pursuit.h"
+#include "autodrive/pure_pursuit.h"
+
+#include <autodrive_vehicle.h>
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #define PP_SEARCH_M 1.0 /* a projection moves at most this far per call [m] */
+
+pp_vehicle_t pp_vehicle_default(void) {
+  const pp_vehicle_t v = {AUTODRIVE_VEHICLE_WHEELBASE_M, AUTODRIVE_VEHICLE_STEER_LIMIT_RAD};
+  return v;
+}
+
+double pp_lookahead_m(double min_m, double time_s, double speed_m_s) {
+  return min_m + time_s * fabs(speed_m_s);
+}
+
+double pp_curvature_to(double x_m, double y_m, double yaw_rad, double gx_m, double gy_m) {
+  const double dx = gx_m - x_m, dy = gy_m - y_m;
+  const double lateral_m = -sin(yaw_rad) * dx + cos(yaw_rad) * dy;
+  const double d2 = dx * dx + dy * dy;
+  return 2.0 * lateral_m / (d2 > 1e-6 ? d2 : 1e-6);
+}
+
+double pp_steer_for_curvature(double k_1pm, const pp_vehicle_t *v) {
+  const double delta = atan(k_1pm * v->wheelbase_m);
+  if (delta > v->steer_limit_rad) return v->steer_limit_rad;
+  if (delta < -v->steer_limit_rad) return -v->steer_limit_rad;
+  return delta;
+}
+
+double pp_steer_to(double x_m, double y_m, double yaw_rad, double gx_m, double gy_m,
+                   const pp_vehicle_t *v) {
+  return pp_steer_for_curvature(pp_curvature_to(x_m, y_m, yaw_rad, gx_m, gy_m), v);
+}
+
+int pp_goal_index(const double *xy_m, int n, int from, double x_m, double y_m, double lookahead_m) {
+  for (int i = from < 0 ? 0 : from; i < n; i++)
+    if (hypot(xy_m[2 * i] - x_m, xy_m[2 * i + 1] - y_m) >= lookahead_m) return i;
+  return n;
+}
 
 static int pp_segments(const pp_path_t *p) {
   return p->loop ? p->n : p->n - 1;
@@ -162,15 +198,9 @@ void pp_point_at(const pp_path_t *p, double s_m, double out_xy[2]) {
 }
 
 double pp_steer(const pp_state_t *st, const pp_path_t *p, double x_m, double y_m, double yaw_rad,
-                double lookahead_m, double wheelbase_m, double steer_limit_rad) {
+                double lookahead_m, const pp_vehicle_t *v) {
   double goal[2];
   pp_point_at(p, st->s_m + lookahead_m, goal);
-  const double dx = goal[0] - x_m, dy = goal[1] - y_m;
-  const double d = hypot(dx, dy);
-  if (d < 1e-6) return 0.0;
-  const double alpha = atan2(dy, dx) - yaw_rad;
-  double delta = atan2(2.0 * wheelbase_m * sin(alpha), d);
-  if (delta > steer_limit_rad) delta = steer_limit_rad;
-  if (delta < -steer_limit_rad) delta = -steer_limit_rad;
-  return delta;
+  if (hypot(goal[0] - x_m, goal[1] - y_m) < 1e-6) return 0.0;
+  return pp_steer_to(x_m, y_m, yaw_rad, goal[0], goal[1], v);
 }
