@@ -1,4 +1,4 @@
-// Bridge conversions: proto.h fixed point -> SI LCM fields, and LCM command -> COMMAND frame.
+// Bridge conversions: protocol.h fixed point -> SI LCM fields, and LCM command -> COMMAND frame.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <autodrive/nano_bridge/bridge_convert.hpp>
 
 namespace {
-proto_state_t sample_state() {
-  proto_state_t s{};
+protocol_state_t sample_state() {
+  protocol_state_t s{};
   s.nano_time_us = 123456789u;
   s.enc_counts[0] = 1920;
   s.enc_counts[1] = -960;
@@ -21,9 +21,9 @@ proto_state_t sample_state() {
   s.mag_raw[0] = 100;      // 15 uT
   s.quat_q14[0] = 16384;   // identity
   s.battery_mv = 11100;
-  s.lights = 2 | (3u << PROTO_LIGHTS_IND_SHIFT) | PROTO_LIGHTS_TAIL;
-  s.mode = PROTO_MODE_ENGAGED;
-  s.faults = PROTO_FAULT_BATTERY_LOW;
+  s.lights = 2 | (3u << PROTOCOL_LIGHTS_IND_SHIFT) | PROTOCOL_LIGHTS_TAIL;
+  s.mode = PROTOCOL_MODE_ENGAGED;
+  s.faults = PROTOCOL_FAULT_BATTERY_LOW;
   s.last_cmd_seq = 77;
   s.frames_ok = 1000;
   s.frames_bad_crc = 3;
@@ -52,7 +52,7 @@ TEST(BridgeConvert, StateFieldsInSiUnits) {
   EXPECT_TRUE(out.taillights_on);
   EXPECT_FALSE(out.reverse_lights_on);
   EXPECT_EQ(out.mode, 1);
-  EXPECT_EQ(out.fault_flags, PROTO_FAULT_BATTERY_LOW);
+  EXPECT_EQ(out.fault_flags, PROTOCOL_FAULT_BATTERY_LOW);
   EXPECT_EQ(out.last_command_seq, 77);
   EXPECT_EQ(out.nano_frames_ok, 1000);
   EXPECT_EQ(out.nano_frames_bad_crc, 3);
@@ -79,7 +79,7 @@ TEST(BridgeConvert, ImuScalesAndCovariances) {
 }
 
 TEST(BridgeConvert, ImuQuaternionRenormalised) {
-  proto_state_t s = sample_state();
+  protocol_state_t s = sample_state();
   s.quat_q14[0] = 8000;  // w = x, not unit length on the wire
   s.quat_q14[1] = 8000;
   autodrive::imu_t m{};
@@ -95,14 +95,14 @@ TEST(BridgeConvert, FreshCommandForwarded) {
   c.headlights = 1;
   c.indicators = 2;
   c.engaged = true;
-  const proto_command_t m = autodrive::bridge::make_command(&c, true, 9);
+  const protocol_command_t m = autodrive::bridge::make_command(&c, true, 9);
   EXPECT_EQ(m.seq, 9);
   EXPECT_EQ(m.throttle_milli, 500);
   EXPECT_EQ(m.steering_milli, -250);
   EXPECT_EQ(m.headlights, 1);
   EXPECT_EQ(m.indicators, 2);
-  EXPECT_EQ(m.flags, PROTO_CMD_ENGAGED);
-  EXPECT_TRUE(proto_command_valid(&m));
+  EXPECT_EQ(m.flags, PROTOCOL_CMD_ENGAGED);
+  EXPECT_TRUE(protocol_command_valid(&m));
 }
 
 TEST(BridgeConvert, StaleCommandDisengagesKeepsLights) {
@@ -112,7 +112,7 @@ TEST(BridgeConvert, StaleCommandDisengagesKeepsLights) {
   c.headlights = 2;
   c.indicators = 3;
   c.engaged = true;
-  const proto_command_t m = autodrive::bridge::make_command(&c, false, 1);
+  const protocol_command_t m = autodrive::bridge::make_command(&c, false, 1);
   EXPECT_EQ(m.throttle_milli, 0);
   EXPECT_EQ(m.steering_milli, 0);
   EXPECT_EQ(m.flags, 0);
@@ -121,7 +121,7 @@ TEST(BridgeConvert, StaleCommandDisengagesKeepsLights) {
 }
 
 TEST(BridgeConvert, NoCommandYetIsSilent) {
-  const proto_command_t m = autodrive::bridge::make_command(nullptr, true, 0);
+  const protocol_command_t m = autodrive::bridge::make_command(nullptr, true, 0);
   EXPECT_EQ(m.throttle_milli, 0);
   EXPECT_EQ(m.flags, 0);
 }

@@ -63,7 +63,7 @@ std::string config_yaml(int port, const std::string &device, const std::string &
 
 class BridgeHarness {
  public:
-  BridgeHarness(int port, uint32_t hash = proto_schema_hash())
+  BridgeHarness(int port, uint32_t hash = protocol_schema_hash())
       : link_("/tmp/adr-rt-test-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         nano(link_, hash),
         key(link_ + ".key"),
@@ -98,15 +98,15 @@ class BridgeHarness {
       else
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       if (send_states && nano.hellos_sent > 0 && nano.pty.is_open()) {
-        proto_state_t s{};
+        protocol_state_t s{};
         s.nano_time_us = static_cast<uint32_t>(10000u * ++state_count_);
         s.enc_counts[0] = enc_left;
         s.enc_counts[1] = 2 * enc_left;
         s.throttle_milli = 250;
         s.gyro_raw[2] = 655;
-        s.quat_q14[0] = PROTO_QUAT_ONE;
+        s.quat_q14[0] = PROTOCOL_QUAT_ONE;
         s.battery_mv = 11700;
-        s.mode = PROTO_MODE_ENGAGED;
+        s.mode = PROTOCOL_MODE_ENGAGED;
         nano.send_state(s);
       }
       lcm.handleTimeout(1);
@@ -158,9 +158,10 @@ class BridgeHarness {
   int32_t cmd_seq_ = 0;
 };
 
-int count_engaged(const std::vector<proto_command_t> &cmds, std::size_t from = 0) {
+int count_engaged(const std::vector<protocol_command_t> &cmds, std::size_t from = 0) {
   int n = 0;
-  for (std::size_t i = from; i < cmds.size(); ++i) n += (cmds[i].flags & PROTO_CMD_ENGAGED) ? 1 : 0;
+  for (std::size_t i = from; i < cmds.size(); ++i)
+    n += (cmds[i].flags & PROTOCOL_CMD_ENGAGED) ? 1 : 0;
   return n;
 }
 
@@ -188,7 +189,7 @@ TEST(BridgePty, HandshakeThenStateAndImuPublished) {
 }
 
 TEST(BridgePty, SchemaMismatchRefused) {
-  BridgeHarness h(7761, proto_schema_hash() ^ 0x5A5A5A5Au);
+  BridgeHarness h(7761, protocol_schema_hash() ^ 0x5A5A5A5Au);
   h.nano.open();
   h.start();
   ASSERT_TRUE(h.wait_for([&] { return h.status().refusals >= 1; }));
@@ -201,8 +202,8 @@ TEST(BridgePty, SchemaMismatchRefused) {
   EXPECT_TRUE(h.states.empty()) << "telemetry published from a mismatched Nano";
   // The message names both schema hashes and versions.
   char ours[16], theirs[16];
-  std::snprintf(ours, sizeof ours, "0x%08x", proto_schema_hash());
-  std::snprintf(theirs, sizeof theirs, "0x%08x", proto_schema_hash() ^ 0x5A5A5A5Au);
+  std::snprintf(ours, sizeof ours, "0x%08x", protocol_schema_hash());
+  std::snprintf(theirs, sizeof theirs, "0x%08x", protocol_schema_hash() ^ 0x5A5A5A5Au);
   EXPECT_NE(st.last_refusal.find(ours), std::string::npos) << st.last_refusal;
   EXPECT_NE(st.last_refusal.find(theirs), std::string::npos) << st.last_refusal;
   EXPECT_NE(st.last_refusal.find("firmware 1.2.3"), std::string::npos) << st.last_refusal;
@@ -220,7 +221,7 @@ TEST(BridgePty, CommandsForwarded) {
   auto found = [&] {
     for (const auto &c : h.nano.commands)
       if (c.throttle_milli == 500 && c.steering_milli == -250 && c.headlights == 1 &&
-          c.indicators == 2 && (c.flags & PROTO_CMD_ENGAGED))
+          c.indicators == 2 && (c.flags & PROTOCOL_CMD_ENGAGED))
         return true;
     return false;
   };
@@ -244,14 +245,14 @@ TEST(BridgePty, StaleCommandsDisengage) {
   auto disengaged_after_mark = [&] {
     for (std::size_t i = mark; i < h.nano.commands.size(); ++i) {
       const auto &c = h.nano.commands[i];
-      if (!(c.flags & PROTO_CMD_ENGAGED) && c.throttle_milli == 0) return true;
+      if (!(c.flags & PROTOCOL_CMD_ENGAGED) && c.throttle_milli == 0) return true;
     }
     return false;
   };
   ASSERT_TRUE(h.wait_for(disengaged_after_mark));
   // Once disengaged it stays so while no command arrives.
   std::size_t first = mark;
-  while (first < h.nano.commands.size() && (h.nano.commands[first].flags & PROTO_CMD_ENGAGED))
+  while (first < h.nano.commands.size() && (h.nano.commands[first].flags & PROTOCOL_CMD_ENGAGED))
     ++first;
   const std::size_t target = h.nano.commands.size() + 5;
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= target; }));
@@ -334,9 +335,9 @@ TEST(BridgePty, GarbageFromTheNanoIsCountedAndStateStillFlows) {
   EXPECT_EQ(st.state, autodrive::bridge::LinkState::linked);
   // A STATE claiming 30x full steering is implausible: dropped and counted.
   h.send_states = false;
-  proto_state_t bad{};
+  protocol_state_t bad{};
   bad.steering_milli = 30000;
-  bad.quat_q14[0] = PROTO_QUAT_ONE;
+  bad.quat_q14[0] = PROTOCOL_QUAT_ONE;
   const uint64_t bad_before = h.status().rx_bad_payload;
   h.nano.send_state(bad);
   ASSERT_TRUE(h.wait_for([&] { return h.status().rx_bad_payload > bad_before; }));
@@ -347,10 +348,10 @@ TEST(BridgePty, GarbageFromTheNanoIsCountedAndStateStillFlows) {
 // ---- Command authentication (issue: only an authorised source can drive a car) ---------------
 
 namespace {
-bool any_frame_with_throttle(const std::vector<proto_command_t> &cmds, int16_t milli,
+bool any_frame_with_throttle(const std::vector<protocol_command_t> &cmds, int16_t milli,
                              std::size_t from = 0) {
   for (std::size_t i = from; i < cmds.size(); ++i)
-    if (cmds[i].throttle_milli == milli && (cmds[i].flags & PROTO_CMD_ENGAGED)) return true;
+    if (cmds[i].throttle_milli == milli && (cmds[i].flags & PROTOCOL_CMD_ENGAGED)) return true;
   return false;
 }
 }  // namespace
@@ -406,7 +407,7 @@ TEST(BridgeAuth, ReplayedCommandsIgnored) {
   ASSERT_TRUE(h.wait_for([&] { return any_frame_with_throttle(h.nano.commands, 350); }));
   // ... went stale (disengaged frames) ...
   ASSERT_TRUE(h.wait_for([&] {
-    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTOCOL_CMD_ENGAGED);
   }));
   const std::size_t mark = h.nano.commands.size();
   // ... and is replayed, byte for byte, many times.
@@ -466,7 +467,7 @@ TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
   ASSERT_TRUE(h.wait_for([&] {
     h.publish_command(0.3f, 0.0f, true);
     teleop_cmd(0.0f, false);
-    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+    return !h.nano.commands.empty() && !(h.nano.commands.back().flags & PROTOCOL_CMD_ENGAGED);
   }));
   mark = h.nano.commands.size();
   const int64_t not_holder0 = h.status().control.dropped_not_holder;
@@ -530,7 +531,7 @@ TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
   ASSERT_TRUE(h.wait_for([&] { return count_engaged(h.nano.commands, mark) >= 1; }));
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= mark + 40; }));
   EXPECT_LE(count_engaged(h.nano.commands, mark), 200 / 20 + 2);
-  EXPECT_FALSE(h.nano.commands.back().flags & PROTO_CMD_ENGAGED);
+  EXPECT_FALSE(h.nano.commands.back().flags & PROTOCOL_CMD_ENGAGED);
 }
 
 TEST(BridgeAuth, UnicastUdpToTheLcmPortDoesNotDrive) {

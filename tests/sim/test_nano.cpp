@@ -1,4 +1,4 @@
-// The emulated Nano: protocol conformance on the real pty with the shared parser (proto.h),
+// The emulated Nano: protocol conformance on the real pty with the shared parser (protocol.h),
 // wire pacing, and the failsafe when the client goes quiet. Sim time only.
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "proto.h"
+#include "protocol.h"
 #include "sim_test_util.h"
 
 namespace {
@@ -17,8 +17,8 @@ namespace {
 // A client on the sim's pty symlink that collects the frames the emulated Nano sends.
 struct Client {
   int fd = -1;
-  proto_parser_t parser;
-  std::vector<proto_frame_t> frames;
+  protocol_parser_t parser;
+  std::vector<protocol_frame_t> frames;
   uint8_t seq = 0;
   uint16_t cmd_seq = 0;
 
@@ -30,7 +30,7 @@ struct Client {
       cfmakeraw(&t);
       tcsetattr(fd, TCSANOW, &t);
     }
-    proto_parser_init(&parser);
+    protocol_parser_init(&parser);
   }
   ~Client() {
     if (fd >= 0) close(fd);
@@ -39,36 +39,36 @@ struct Client {
     uint8_t buf[1024];
     ssize_t n;
     while ((n = read(fd, buf, sizeof buf)) > 0)
-      proto_parser_feed(
+      protocol_parser_feed(
           &parser, buf, (size_t)n,
-          [](const proto_frame_t *f, void *ctx) {
+          [](const protocol_frame_t *f, void *ctx) {
             static_cast<Client *>(ctx)->frames.push_back(*f);
           },
           this);
   }
   void send(uint8_t id, const uint8_t *payload, uint8_t len) {
-    uint8_t out[PROTO_MAX_FRAME];
-    const size_t n = proto_frame_encode(id, seq++, payload, len, out, sizeof out);
+    uint8_t out[PROTOCOL_MAX_FRAME];
+    const size_t n = protocol_frame_encode(id, seq++, payload, len, out, sizeof out);
     ASSERT_EQ(write(fd, out, n), (ssize_t)n);
   }
   void command(int16_t throttle, int16_t steering, bool engaged) {
-    proto_command_t c = {};
+    protocol_command_t c = {};
     c.seq = ++cmd_seq;
     c.throttle_milli = throttle;
     c.steering_milli = steering;
-    c.flags = engaged ? PROTO_CMD_ENGAGED : 0;
-    uint8_t p[PROTO_LEN_COMMAND];
-    proto_command_pack(&c, p);
-    send(PROTO_ID_COMMAND, p, sizeof p);
+    c.flags = engaged ? PROTOCOL_CMD_ENGAGED : 0;
+    uint8_t p[PROTOCOL_LEN_COMMAND];
+    protocol_command_pack(&c, p);
+    send(PROTOCOL_ID_COMMAND, p, sizeof p);
   }
   int count(uint8_t id) const {
     int n = 0;
     for (const auto &f : frames) n += f.id == id;
     return n;
   }
-  bool last_state(proto_state_t *st) const {
+  bool last_state(protocol_state_t *st) const {
     for (auto it = frames.rbegin(); it != frames.rend(); ++it)
-      if (it->id == PROTO_ID_STATE) return proto_state_unpack(it->payload, it->len, st) == 0;
+      if (it->id == PROTOCOL_ID_STATE) return protocol_state_unpack(it->payload, it->len, st) == 0;
     return false;
   }
 };
@@ -98,49 +98,49 @@ TEST(Nano, ProtocolConformanceOnThePty) {
   ASSERT_GE(c.fd, 0) << link;
 
   // handshake: HELLO carries our protocol version and schema hash
-  c.send(PROTO_ID_HELLO_REQUEST, nullptr, 0);
+  c.send(PROTOCOL_ID_HELLO_REQUEST, nullptr, 0);
   sim_nano_wait_input(s.s, 1, 1000);
   pump(s, c, 100);
-  ASSERT_GE(c.count(PROTO_ID_HELLO), 1);
-  proto_hello_t h = {};
+  ASSERT_GE(c.count(PROTOCOL_ID_HELLO), 1);
+  protocol_hello_t h = {};
   for (const auto &f : c.frames) {
-    if (f.id == PROTO_ID_HELLO) {
-      ASSERT_EQ(proto_hello_unpack(f.payload, f.len, &h), 0);
+    if (f.id == PROTOCOL_ID_HELLO) {
+      ASSERT_EQ(protocol_hello_unpack(f.payload, f.len, &h), 0);
     }
   }
-  EXPECT_EQ(h.proto_version, PROTO_VERSION);
-  EXPECT_EQ(h.schema_hash, proto_schema_hash());
+  EXPECT_EQ(h.proto_version, PROTOCOL_VERSION);
+  EXPECT_EQ(h.schema_hash, protocol_schema_hash());
 
   // telemetry at 100 Hz of sim time, no bad frames
   c.frames.clear();
   pump(s, c, 500);
-  EXPECT_GE(c.count(PROTO_ID_STATE), 45);
-  EXPECT_LE(c.count(PROTO_ID_STATE), 51);
+  EXPECT_GE(c.count(PROTOCOL_ID_STATE), 45);
+  EXPECT_LE(c.count(PROTOCOL_ID_STATE), 51);
   EXPECT_EQ(c.parser.stats.bad_crc, 0u);
-  proto_state_t st = {};
+  protocol_state_t st = {};
   ASSERT_TRUE(c.last_state(&st));
-  EXPECT_EQ(st.mode, PROTO_MODE_DISARMED);
-  EXPECT_NEAR(st.accel_raw[2], PROTO_ACCEL_LSB_PER_G, 250);  // sim IMU through the firmware
+  EXPECT_EQ(st.mode, PROTOCOL_MODE_DISARMED);
+  EXPECT_NEAR(st.accel_raw[2], PROTOCOL_ACCEL_LSB_PER_G, 250);  // sim IMU through the firmware
 
   // arm (engaged=0 then 1) and drive: the STATE reflects the command and the car moves
   pump(s, c, 40, 0, 0, -1);
   pump(s, c, 1500, 500, 200, 1);
   ASSERT_TRUE(c.last_state(&st));
-  EXPECT_EQ(st.mode, PROTO_MODE_ENGAGED);
+  EXPECT_EQ(st.mode, PROTOCOL_MODE_ENGAGED);
   EXPECT_EQ(st.throttle_milli, 500);
   EXPECT_EQ(st.steering_milli, 200);
-  EXPECT_EQ(st.faults & PROTO_FAULT_LINK_LOST, 0);
+  EXPECT_EQ(st.faults & PROTOCOL_FAULT_LINK_LOST, 0);
   EXPECT_GT(s.truth().vel_body_m_s[0], 0.08);
   EXPECT_GT(st.enc_counts[0], 100);
   EXPECT_GT(st.wheel_speed_mrad_s[0], 1000);
 
   // a corrupted frame is counted by the Nano's parser and reported
   const uint16_t bad_before = st.frames_bad_crc;
-  uint8_t junk[PROTO_MAX_FRAME];
-  proto_command_t cmd = {};
-  uint8_t p[PROTO_LEN_COMMAND];
-  proto_command_pack(&cmd, p);
-  const size_t n = proto_frame_encode(PROTO_ID_COMMAND, 200, p, sizeof p, junk, sizeof junk);
+  uint8_t junk[PROTOCOL_MAX_FRAME];
+  protocol_command_t cmd = {};
+  uint8_t p[PROTOCOL_LEN_COMMAND];
+  protocol_command_pack(&cmd, p);
+  const size_t n = protocol_frame_encode(PROTOCOL_ID_COMMAND, 200, p, sizeof p, junk, sizeof junk);
   junk[n - 1] ^= 0xFF;
   ASSERT_EQ(write(c.fd, junk, n), (ssize_t)n);
   sim_nano_wait_input(s.s, 1, 1000);
@@ -152,8 +152,8 @@ TEST(Nano, ProtocolConformanceOnThePty) {
   c.frames.clear();
   pump(s, c, 300);
   ASSERT_TRUE(c.last_state(&st));
-  EXPECT_EQ(st.mode, PROTO_MODE_FAILSAFE);
-  EXPECT_NE(st.faults & PROTO_FAULT_LINK_LOST, 0);
+  EXPECT_EQ(st.mode, PROTOCOL_MODE_FAILSAFE);
+  EXPECT_NE(st.faults & PROTOCOL_FAULT_LINK_LOST, 0);
   EXPECT_EQ(st.throttle_milli, 0);
 }
 
@@ -166,7 +166,7 @@ TEST(Nano, BytesArriveAtTheWireRate) {
   // the firmware, so no step may deliver more than 4 frames and all take >= 6 steps
   for (int i = 0; i < 20; i++) c.command(0, 0, false);
   sim_nano_wait_input(s.s, 1, 1000);
-  const nigel_t *n = sim_nano(s.s, 1);
+  const nano_core_t *n = sim_nano(s.s, 1);
   const uint32_t base = n->parser.stats.frames_ok;
   int steps_with_frames = 0, max_per_step = 0;
   for (int k = 0; k < 5000 && n->parser.stats.frames_ok - base < 20; k++) {
@@ -185,12 +185,12 @@ TEST(Nano, FailsafeStopsTheCarWhenTheDriverGoesQuiet) {
   simtest::Sim s("constant:throttle=0.8,steering=0,stop_after=1.5");
   ASSERT_NE(s.s, nullptr) << s.err;
   ASSERT_TRUE(s.run_to(1.5)) << s.err;
-  const nigel_t *n = sim_nano(s.s, 1);
-  EXPECT_EQ(n->fs.mode, PROTO_MODE_ENGAGED);
+  const nano_core_t *n = sim_nano(s.s, 1);
+  EXPECT_EQ(n->failsafe.mode, PROTOCOL_MODE_ENGAGED);
   EXPECT_GT(s.truth().vel_body_m_s[0], 0.15);
   ASSERT_TRUE(s.run_to(1.7)) << s.err;
-  EXPECT_EQ(n->fs.mode, PROTO_MODE_FAILSAFE);
-  EXPECT_NE(nigel_faults(n) & PROTO_FAULT_LINK_LOST, 0);
+  EXPECT_EQ(n->failsafe.mode, PROTOCOL_MODE_FAILSAFE);
+  EXPECT_NE(nano_core_faults(n) & PROTOCOL_FAULT_LINK_LOST, 0);
   uint8_t duty, rev, brake;
   uint16_t servo;
   sim_motor_outputs(s.s, 1, &duty, &rev, &brake, &servo);

@@ -120,7 +120,7 @@ TEST(Physics, EncodersCount1920PerWheelRevolution) {
   ASSERT_TRUE(s.run_to(4.0)) << s.err;
   const double wheel_rad = sim_data(s.s)->qpos[sim_model(s.s)->jnt_qposadr[mj_name2id(
       sim_model(s.s), mjOBJ_JOINT, "nigel1/wheel_rl")]];
-  const nigel_t *n = sim_nano(s.s, 1);
+  const nano_core_t *n = sim_nano(s.s, 1);
   EXPECT_GT(n->enc[0], 1000);
   // the firmware sampled the wheel one 1 ms step before the end of the run (about one count
   // at this speed) and floors its angle (under one count): 2.5 counts bound both
@@ -134,7 +134,7 @@ TEST(Physics, ImuAtRestReadsGravityWithinBias) {
   simtest::Sim s(nullptr);
   ASSERT_NE(s.s, nullptr) << s.err;
   ASSERT_TRUE(s.run_to(0.5)) << s.err;
-  const nigel_t *n = sim_nano(s.s, 1);
+  const nano_core_t *n = sim_nano(s.s, 1);
   // +-4 g range: 8192 LSB per g on z (specific force points up at rest)
   EXPECT_NEAR(n->imu.accel[2], 8192, 8192 * 0.05 / 9.80665 * 1.5 + 40);
   EXPECT_LT(abs(n->imu.accel[0]), 120);
@@ -157,7 +157,7 @@ TEST(Physics, AccelComputedOnlyWhenReadGivesTheSameImuSamples) {
     sim_want_accel(every.s);
     ASSERT_EQ(sim_step(lazy.s, e, sizeof e), 0) << e;
     ASSERT_EQ(sim_step(every.s, e, sizeof e), 0) << e;
-    const nigel_t *a = sim_nano(lazy.s, 1), *b = sim_nano(every.s, 1);
+    const nano_core_t *a = sim_nano(lazy.s, 1), *b = sim_nano(every.s, 1);
     if (a->imu_read_us == last_read_us) continue;
     last_read_us = a->imu_read_us;
     samples++;

@@ -196,21 +196,21 @@ TEST(Script, ArmsThenDrivesAndParsesErrors) {
   ASSERT_EQ(script_parse(&s, "constant:throttle=0.5,steering=-0.25,stop_after=1", err, sizeof err),
             0)
       << err;
-  proto_parser_t p;
-  proto_parser_init(&p);
+  protocol_parser_t p;
+  protocol_parser_init(&p);
   struct Got {
     int n = 0;
-    proto_command_t last{};
+    protocol_command_t last{};
   } got;
-  uint8_t buf[2 * PROTO_MAX_FRAME];
+  uint8_t buf[2 * PROTOCOL_MAX_FRAME];
   for (int64_t t = 0; t < 2000000; t += 1000) {
     const size_t n = script_poll(&s, t, buf, sizeof buf);
-    proto_parser_feed(
+    protocol_parser_feed(
         &p, buf, n,
-        [](const proto_frame_t *f, void *ctx) {
+        [](const protocol_frame_t *f, void *ctx) {
           auto *g = static_cast<Got *>(ctx);
-          ASSERT_EQ(f->id, PROTO_ID_COMMAND);
-          ASSERT_EQ(proto_command_unpack(f->payload, f->len, &g->last), 0);
+          ASSERT_EQ(f->id, PROTOCOL_ID_COMMAND);
+          ASSERT_EQ(protocol_command_unpack(f->payload, f->len, &g->last), 0);
           if (g->n < 3) {
             EXPECT_EQ(g->last.flags, 0);  // arming: engaged=0 first
           }
@@ -219,7 +219,7 @@ TEST(Script, ArmsThenDrivesAndParsesErrors) {
         &got);
   }
   EXPECT_EQ(got.n, 50);  // 50 Hz for 1 s, then quiet
-  EXPECT_EQ(got.last.flags, PROTO_CMD_ENGAGED);
+  EXPECT_EQ(got.last.flags, PROTOCOL_CMD_ENGAGED);
   EXPECT_EQ(got.last.throttle_milli, 500);
   EXPECT_EQ(got.last.steering_milli, -250);
   EXPECT_EQ(p.stats.bad_crc, 0u);

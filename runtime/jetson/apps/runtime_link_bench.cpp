@@ -73,8 +73,8 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
               double seconds, double flood_hz) {
   autodrive::devtools::FakeNano nano(pty);
   nano.open();
-  proto_state_t st{};
-  st.quat_q14[0] = PROTO_QUAT_ONE;
+  protocol_state_t st{};
+  st.quat_q14[0] = PROTOCOL_QUAT_ONE;
   int64_t next_state = 0;
   auto service = [&] {
     nano.pump(1);
@@ -150,8 +150,8 @@ int run_serial(const std::string &url, const std::string &vehicle, const std::st
   lcm::LCM lcm(url);
   autodrive::devtools::FakeNano nano(pty);
   nano.open();
-  proto_state_t st{};
-  st.quat_q14[0] = PROTO_QUAT_ONE;
+  protocol_state_t st{};
+  st.quat_q14[0] = PROTOCOL_QUAT_ONE;
   int64_t next_state = 0;
   auto service = [&] {
     nano.pump(1);

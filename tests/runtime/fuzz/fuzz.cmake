@@ -10,7 +10,7 @@ if(AUTODRIVE_CLANGXX14 AND _rt_fuzz_rt)
   set(_rplidar ${_rt}/drivers/rplidar)
   set(_deps_bridge_rx ${_bridge}/src/bridge_convert.cpp
       ${_bridge}/include/autodrive/nano_bridge/bridge_convert.hpp
-      ${_rt}/core/include/autodrive/core/config.hpp ${AUTODRIVE_ROOT}/firmware/nano/lib/proto/proto.c)
+      ${_rt}/core/include/autodrive/core/config.hpp ${AUTODRIVE_ROOT}/firmware/nano/core/protocol/protocol.c)
   set(_deps_rplidar ${_rplidar}/src/rplidar_decoder.cpp
       ${_rplidar}/include/autodrive/rplidar/rplidar_decoder.hpp)
   foreach(t bridge_rx rplidar)

@@ -15,7 +15,7 @@
 #include <cstring>
 
 #include <autodrive/nano_bridge/bridge_convert.hpp>
-#include "proto.h"
+#include "protocol.h"
 
 namespace {
 
@@ -33,10 +33,10 @@ bool finite_within(double v, double bound) {
   return std::isfinite(v) && std::abs(v) <= bound;
 }
 
-void check_state(const proto_frame_t &f) {
-  proto_state_t s{};
-  const int r = proto_state_unpack(f.payload, f.len, &s);
-  CHECK((r == 0) == (f.len == PROTO_LEN_STATE));
+void check_state(const protocol_frame_t &f) {
+  protocol_state_t s{};
+  const int r = protocol_state_unpack(f.payload, f.len, &s);
+  CHECK((r == 0) == (f.len == PROTOCOL_LEN_STATE));
   if (r != 0 || !autodrive::bridge::state_problem(s).empty()) return;
   autodrive::vehicle_state_t vs{};
   autodrive::bridge::fill_state(s, vehicle, autodrive::bridge::HostLinkStats{}, 123, &vs);
@@ -44,7 +44,7 @@ void check_state(const proto_frame_t &f) {
   CHECK(finite_within(vs.steering_applied, 1.0));
   CHECK(finite_within(vs.steering_angle_rad, vehicle.steering_limit_rad + 1e-6));
   CHECK(finite_within(vs.battery_voltage_v, 65.536));
-  CHECK(vs.mode >= 0 && vs.mode <= PROTO_MODE_FAILSAFE);
+  CHECK(vs.mode >= 0 && vs.mode <= PROTOCOL_MODE_FAILSAFE);
   CHECK(vs.headlights >= 0 && vs.headlights <= 2 && vs.indicators >= 0 && vs.indicators <= 3);
   for (int i = 0; i < 2; ++i) CHECK(finite_within(vs.wheel_speed_rad_s[i], 32.769));
   autodrive::imu_t imu{};
@@ -60,30 +60,30 @@ void check_state(const proto_frame_t &f) {
   for (double a : imu.linear_acceleration_m_s2) CHECK(std::isfinite(a));
 }
 
-void on_frame(const proto_frame_t *f, void *) {
-  if (f->id == PROTO_ID_HELLO) {
-    proto_hello_t h{};
-    CHECK((proto_hello_unpack(f->payload, f->len, &h) == 0) == (f->len == PROTO_LEN_HELLO));
-  } else if (f->id == PROTO_ID_STATE) {
+void on_frame(const protocol_frame_t *f, void *) {
+  if (f->id == PROTOCOL_ID_HELLO) {
+    protocol_hello_t h{};
+    CHECK((protocol_hello_unpack(f->payload, f->len, &h) == 0) == (f->len == PROTOCOL_LEN_HELLO));
+  } else if (f->id == PROTOCOL_ID_STATE) {
     check_state(*f);
-  } else if (f->id == PROTO_ID_NACK) {
-    proto_nack_t n{};
-    CHECK((proto_nack_unpack(f->payload, f->len, &n) == 0) == (f->len == PROTO_LEN_NACK));
+  } else if (f->id == PROTOCOL_ID_NACK) {
+    protocol_nack_t n{};
+    CHECK((protocol_nack_unpack(f->payload, f->len, &n) == 0) == (f->len == PROTOCOL_LEN_NACK));
   }
 }
 
-const uint8_t kIds[] = {PROTO_ID_HELLO, PROTO_ID_STATE, PROTO_ID_NACK};
+const uint8_t kIds[] = {PROTOCOL_ID_HELLO, PROTOCOL_ID_STATE, PROTOCOL_ID_NACK};
 uint8_t right_len(uint8_t id) {
-  return id == PROTO_ID_HELLO   ? PROTO_LEN_HELLO
-         : id == PROTO_ID_STATE ? PROTO_LEN_STATE
-                                : PROTO_LEN_NACK;
+  return id == PROTOCOL_ID_HELLO   ? PROTOCOL_LEN_HELLO
+         : id == PROTOCOL_ID_STATE ? PROTOCOL_LEN_STATE
+                                   : PROTOCOL_LEN_NACK;
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-  proto_parser_t parser;
-  proto_parser_init(&parser);
+  protocol_parser_t parser;
+  protocol_parser_init(&parser);
   uint8_t seq = 0;
   size_t i = 0;
   while (i < size) {
@@ -92,7 +92,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       if (i >= size) break;
       size_t n = data[i++];
       if (n > size - i) n = size - i;
-      proto_parser_feed(&parser, data + i, n, on_frame, nullptr);
+      protocol_parser_feed(&parser, data + i, n, on_frame, nullptr);
       i += n;
     } else {
       if (i + 2 > size) break;
@@ -102,18 +102,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         len = right_len(id);
       } else {
         id = kIds[id % 3u];
-        len = static_cast<uint8_t>(len % (PROTO_MAX_PAYLOAD + 1u));
+        len = static_cast<uint8_t>(len % (PROTOCOL_MAX_PAYLOAD + 1u));
       }
-      uint8_t payload[PROTO_MAX_PAYLOAD] = {0};
+      uint8_t payload[PROTOCOL_MAX_PAYLOAD] = {0};
       const size_t avail = size - i < len ? size - i : len;
       std::memcpy(payload, data + i, avail);
       i += avail;
-      uint8_t frame[PROTO_MAX_FRAME];
-      const size_t fn = proto_frame_encode(id, seq++, payload, len, frame, sizeof frame);
+      uint8_t frame[PROTOCOL_MAX_FRAME];
+      const size_t fn = protocol_frame_encode(id, seq++, payload, len, frame, sizeof frame);
       CHECK(fn > 0);
-      proto_parser_feed(&parser, frame, fn, on_frame, nullptr);
+      protocol_parser_feed(&parser, frame, fn, on_frame, nullptr);
     }
-    CHECK(parser.n < PROTO_MAX_FRAME);
+    CHECK(parser.n < PROTOCOL_MAX_FRAME);
   }
   return 0;
 }

@@ -71,38 +71,38 @@ void PtyPeer::write(const std::vector<uint8_t> &bytes) {
 }
 
 FakeNano::FakeNano(const std::string &link, uint32_t hash) : pty(link), schema_hash(hash) {
-  proto_parser_init(&parser_);
+  protocol_parser_init(&parser_);
 }
 
-void FakeNano::on_frame(const proto_frame_t *f, void *ctx) {
+void FakeNano::on_frame(const protocol_frame_t *f, void *ctx) {
   auto *self = static_cast<FakeNano *>(ctx);
-  if (f->id == PROTO_ID_HELLO_REQUEST) {
+  if (f->id == PROTOCOL_ID_HELLO_REQUEST) {
     ++self->hello_requests;
-    proto_hello_t h{1, 2, 3, PROTO_VERSION, self->schema_hash, 0xB1D};
-    uint8_t payload[PROTO_LEN_HELLO], frame[PROTO_MAX_FRAME];
-    proto_hello_pack(&h, payload);
-    const size_t n = proto_frame_encode(PROTO_ID_HELLO, self->seq_++, payload, PROTO_LEN_HELLO,
-                                        frame, sizeof frame);
+    protocol_hello_t h{1, 2, 3, PROTOCOL_VERSION, self->schema_hash, 0xB1D};
+    uint8_t payload[PROTOCOL_LEN_HELLO], frame[PROTOCOL_MAX_FRAME];
+    protocol_hello_pack(&h, payload);
+    const size_t n = protocol_frame_encode(PROTOCOL_ID_HELLO, self->seq_++, payload,
+                                           PROTOCOL_LEN_HELLO, frame, sizeof frame);
     self->pty.write(std::vector<uint8_t>(frame, frame + n));
     ++self->hellos_sent;
-  } else if (f->id == PROTO_ID_COMMAND) {
-    proto_command_t c{};
-    if (proto_command_unpack(f->payload, f->len, &c) == 0) self->commands.push_back(c);
-  } else if (f->id == PROTO_ID_CONFIG) {
-    if (proto_config_unpack(f->payload, f->len, &self->last_config) == 0) ++self->configs;
+  } else if (f->id == PROTOCOL_ID_COMMAND) {
+    protocol_command_t c{};
+    if (protocol_command_unpack(f->payload, f->len, &c) == 0) self->commands.push_back(c);
+  } else if (f->id == PROTOCOL_ID_CONFIG) {
+    if (protocol_config_unpack(f->payload, f->len, &self->last_config) == 0) ++self->configs;
   }
 }
 
 void FakeNano::pump(int timeout_ms) {
   const std::vector<uint8_t> in = pty.read(timeout_ms);
-  if (!in.empty()) proto_parser_feed(&parser_, in.data(), in.size(), &FakeNano::on_frame, this);
+  if (!in.empty()) protocol_parser_feed(&parser_, in.data(), in.size(), &FakeNano::on_frame, this);
 }
 
-void FakeNano::send_state(const proto_state_t &s) {
-  uint8_t payload[PROTO_LEN_STATE], frame[PROTO_MAX_FRAME];
-  proto_state_pack(&s, payload);
-  const size_t n =
-      proto_frame_encode(PROTO_ID_STATE, seq_++, payload, PROTO_LEN_STATE, frame, sizeof frame);
+void FakeNano::send_state(const protocol_state_t &s) {
+  uint8_t payload[PROTOCOL_LEN_STATE], frame[PROTOCOL_MAX_FRAME];
+  protocol_state_pack(&s, payload);
+  const size_t n = protocol_frame_encode(PROTOCOL_ID_STATE, seq_++, payload, PROTOCOL_LEN_STATE,
+                                         frame, sizeof frame);
   pty.write(std::vector<uint8_t>(frame, frame + n));
 }
 

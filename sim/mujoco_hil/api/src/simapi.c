@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fs.h"
+#include "failsafe.h"
 #include "route.h"
 #include "sim.h"
 #include "sim_camera.h"
@@ -263,7 +263,7 @@ int ad_world_observe(const ad_world_t *w, int car, ad_obs_t *o) {
   memcpy(o->wheel_speed_rad_s, t.wheel_speed_rad_s, sizeof o->wheel_speed_rad_s);
   sim_imu(w->sim, car + 1, o->imu_accel_m_s2, o->imu_gyro_rad_s);
   o->in_collision = t.in_collision;
-  o->nano_engaged = fs_may_drive(&sim_nano(w->sim, car + 1)->fs);
+  o->nano_engaged = failsafe_may_drive(&sim_nano(w->sim, car + 1)->failsafe);
   api_route_fields(w, car, o);
   return 0;
 }

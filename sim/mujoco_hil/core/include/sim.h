@@ -11,7 +11,7 @@
 
 #include <mujoco/mujoco.h>
 
-#include "nigel_core.h"
+#include "nano_core.h"
 #include "scenario.h"
 
 #ifdef __cplusplus
@@ -140,7 +140,7 @@ int64_t sim_host_rx_us(const sim_t *s, int car);
  * --lockstep-frames holds the sim until this grows. */
 uint32_t sim_host_frames(sim_t *s, int car);
 /* The emulated Nano's firmware state (read-only use, for tests). */
-const nigel_t *sim_nano(const sim_t *s, int car);
+const nano_core_t *sim_nano(const sim_t *s, int car);
 /* Last motor outputs the firmware set through the HAL. */
 void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse, uint8_t *brake,
                        uint16_t *servo_us);

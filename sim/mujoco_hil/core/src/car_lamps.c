@@ -9,22 +9,22 @@ static const struct {
   uint8_t bits;
   float on[3], off[3];
 } sim_lamp[SIM_LAMPS] = {
-    /* each lamp geom, the NIGEL_LAMP_* bits and colours that drive it */
+    /* each lamp geom, the NANO_CORE_LAMP_* bits and colours that drive it */
     {"lamp_head_l",
-     NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH,
+     NANO_CORE_LAMP_HEAD_LOW | NANO_CORE_LAMP_HEAD_HIGH,
      {1, 1, 0.85f},
      {0.25f, 0.25f, 0.22f}},
     {"lamp_head_r",
-     NIGEL_LAMP_HEAD_LOW | NIGEL_LAMP_HEAD_HIGH,
+     NANO_CORE_LAMP_HEAD_LOW | NANO_CORE_LAMP_HEAD_HIGH,
      {1, 1, 0.85f},
      {0.25f, 0.25f, 0.22f}},
-    {"lamp_ind_fl", NIGEL_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
-    {"lamp_ind_fr", NIGEL_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
-    {"lamp_tail_l", NIGEL_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
-    {"lamp_tail_r", NIGEL_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
-    {"lamp_ind_rl", NIGEL_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
-    {"lamp_ind_rr", NIGEL_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
-    {"lamp_reverse", NIGEL_LAMP_REVERSE, {1, 1, 1}, {0.25f, 0.25f, 0.25f}},
+    {"lamp_ind_fl", NANO_CORE_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_ind_fr", NANO_CORE_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_tail_l", NANO_CORE_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
+    {"lamp_tail_r", NANO_CORE_LAMP_TAIL, {1, 0, 0}, {0.3f, 0.02f, 0.02f}},
+    {"lamp_ind_rl", NANO_CORE_LAMP_IND_LEFT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_ind_rr", NANO_CORE_LAMP_IND_RIGHT, {1, 0.55f, 0}, {0.3f, 0.18f, 0.05f}},
+    {"lamp_reverse", NANO_CORE_LAMP_REVERSE, {1, 1, 1}, {0.25f, 0.25f, 0.25f}},
 };
 /* Colours the lamp geoms when the firmware's lamp outputs change. */
 void sim_draw_lamps(sim_t *s, sim_car_t *c) {

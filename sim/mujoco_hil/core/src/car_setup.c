@@ -22,8 +22,8 @@ int sim_car_boot(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
   c->tx_pending_n = 0;
   c->host_idle = 0;
   c->lidar_new = 0;
-  uart_init(&c->rx, PROTO_BAUD);
-  uart_init(&c->tx, PROTO_BAUD);
+  uart_init(&c->rx, PROTOCOL_BAUD);
+  uart_init(&c->tx, PROTOCOL_BAUD);
   /* every car draws its own biases and noise from (seed, car) */
   rng_seed(&c->rng, s->seed * 1000003ull + (uint64_t)c->index);
   for (int k = 0; k < 3; k++) {
@@ -46,7 +46,7 @@ int sim_car_boot(sim_t *s, sim_car_t *c, char *err, size_t err_sz) {
     c->lidar = sim_lidar_create(s->m, body, &lc, err, err_sz);
     if (!c->lidar) return -1;
   }
-  nigel_init(&c->nano, &c->hal, 0, 0, SIM_BUILD_ID);
+  nano_core_init(&c->nano, &c->hal, 0, 0, SIM_BUILD_ID);
   return 0;
 }
 
@@ -59,7 +59,7 @@ int sim_setup_car(sim_t *s, const sim_config_t *cfg, sim_car_t *c, char *err, si
     if (ptylink_open(&c->pty, link, err, err_sz) != 0) return -1;
     c->has_pty = 1;
     c->host_rx_us = -1;
-    proto_parser_init(&c->host_parser);
+    protocol_parser_init(&c->host_parser);
   }
   if (sim_car_boot(s, c, err, err_sz) != 0) return -1;
   if (cfg->lidar && cfg->open_ptys) {

@@ -1,8 +1,8 @@
 /* The world's own structures and the functions its units share (sim.h is the public face).
  * Private to sim_core: core/, hal_sim/ and nano_link/ include it, nothing else does. Per 1 ms
  * step and car: UART bytes in (pty or scripted driver, paced at the wire rate, nano_link/) ->
- * firmware core (nigel_rx, nigel_step with encoder counts, hal_sim/) -> HAL outputs -> servo,
- * Ackermann, motor and tyre forces (core/actuation.c, core/tyre_forces.c) -> mj_step2
+ * firmware core (nano_core_rx, nano_core_step with encoder counts, hal_sim/) -> HAL outputs ->
+ * servo, Ackermann, motor and tyre forces (core/actuation.c, core/tyre_forces.c) -> mj_step2
  * (core/step.c). */
 #ifndef SIM_SIM_INTERNAL_H
 #define SIM_SIM_INTERNAL_H
@@ -14,7 +14,7 @@
 
 #include "clearance.h"
 #include "drive.h"
-#include "nigel_core.h"
+#include "nano_core.h"
 #include "ptylink.h"
 #include "rng.h"
 #include "route_driver.h"
@@ -40,7 +40,13 @@
  * obstacles, when checking a start pose or a late box [m] */
 #define SIM_GROUND_CLEARANCE_M 0.005
 
-enum { W_FL = 0, W_FR, W_RL, W_RR, W_N }; /* wheels: front left, front right, rear left, rear right */
+enum {
+  W_FL = 0,
+  W_FR,
+  W_RL,
+  W_RR,
+  W_N
+}; /* wheels: front left, front right, rear left, rear right */
 
 #define SIM_LAMPS 9 /* lamp geoms per car (car_lamps.c) */
 /* 115200 baud moves 11.5 bytes/ms: 100 ms of Nano output fits, so a batch never drops */
@@ -63,13 +69,13 @@ typedef struct sim_car {
   uint16_t servo_us;
   double steer_rad; /* servo output shaft, as a centre angle [rad] */
   /* emulated Nano */
-  nigel_t nano;
-  nigel_hal_t hal;
+  nano_core_t nano;
+  nano_core_hal_t hal;
   uart_queue_t rx, tx;
   ptylink_t pty;
   int has_pty, has_script;
   int64_t host_rx_us; /* sim time of the last bytes from the pty's client [us], -1: none yet */
-  proto_parser_t host_parser; /* frames the pty's client wrote, counted as they arrive */
+  protocol_parser_t host_parser; /* frames the pty's client wrote, counted as they arrive */
   uint32_t host_frames;
   int host_idle; /* free lockstep: nothing read and the pty refused our bytes last service */
   /* Nano bytes that crossed the wire since the last host-link service, not yet on the pty */

@@ -5,7 +5,7 @@
 #include "sim_internal.h"
 
 /* Will anyone read the accelerometer after this step? The emulated Nano samples its IMU at
- * 100 Hz (its own schedule, imu_next_us, read in the next step's nigel_step) and the learning
+ * 100 Hz (its own schedule, imu_next_us, read in the next step's nano_core_step) and the learning
  * API asks before the last step of a control period (sim_want_accel). */
 static int sim_accel_due(const sim_t *s) {
   if (s->accel_wanted) return 1;

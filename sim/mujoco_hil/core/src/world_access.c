@@ -49,7 +49,7 @@ mjData *sim_render_data(sim_t *s) {
 const char *sim_lidar_link(const sim_t *s, int car) {
   return s->car[car - 1].lidar_link;
 }
-const nigel_t *sim_nano(const sim_t *s, int car) {
+const nano_core_t *sim_nano(const sim_t *s, int car) {
   return &s->car[car - 1].nano;
 }
 void sim_motor_outputs(const sim_t *s, int car, uint8_t *duty, uint8_t *reverse, uint8_t *brake,
@@ -84,8 +84,8 @@ void sim_get_truth(const sim_t *s, int car, sim_truth_t *o) {
   o->steering_rad = (fabs(tl + tr) > 1e-12) ? atan(2.0 * tl * tr / (tl + tr)) : 0.0;
   for (int w = 0; w < W_N; w++) o->wheel_speed_rad_s[w] = d->qvel[c->wheel_dof[w]];
   o->in_collision = c->in_collision;
-  o->command_throttle = c->nano.cmd.throttle_milli / (double)PROTO_MILLI;
-  o->command_steering = c->nano.cmd.steering_milli / (double)PROTO_MILLI;
+  o->command_throttle = c->nano.cmd.throttle_milli / (double)PROTOCOL_MILLI;
+  o->command_steering = c->nano.cmd.steering_milli / (double)PROTOCOL_MILLI;
   o->expert_steering = (car == 1 && s->route) ? s->route->expert_steering : NAN;
 }
 int sim_drive(sim_t *s, int car, double throttle, double steering) {

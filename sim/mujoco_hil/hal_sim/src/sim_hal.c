@@ -1,10 +1,10 @@
-/* The firmware HAL (nigel_hal.h) implemented on the sim: what the emulated Nano's firmware
+/* The firmware HAL (nano_core_hal.h) implemented on the sim: what the emulated Nano's firmware
  * core sees as hardware. Motor, servo and lamp outputs land in the car's state for
  * core/actuation.c; the IMU and battery are read from MuJoCo with the car's noise; serial
  * bytes go onto the Nano's TX wire (nano_link/). */
 #include <math.h>
 
-#include "enc.h"
+#include "encoder.h"
 #include "sim_internal.h"
 
 #define SIM_G_M_S2 9.80665
@@ -32,7 +32,7 @@ static int16_t sim_sat16(double v) {
 
 /* MPU-9250 sample from MuJoCo's accelerometer/gyro/magnetometer at the IMU site (car axes:
  * x forward, y left, z up), plus the car's bias and white noise, in the chip's LSB. */
-static int hal_imu_read(void *ctx, nigel_imu_raw_t *out) {
+static int hal_imu_read(void *ctx, nano_core_imu_raw_t *out) {
   sim_car_t *c = ctx;
   const sim_t *s = c->sim;
   const mjtNum *sd = s->d->sensordata;
@@ -42,9 +42,9 @@ static int hal_imu_read(void *ctx, nigel_imu_raw_t *out) {
     const double w =
         sd[c->gyro_adr + k] + c->gyro_bias[k] + rng_gauss(&c->rng, s->p.gyro_noise_rad_s);
     const double b = sd[c->mag_adr + k] + rng_gauss(&c->rng, s->p.mag_noise_ut);
-    out->accel[k] = sim_sat16(a / SIM_G_M_S2 * PROTO_ACCEL_LSB_PER_G);
-    out->gyro[k] = sim_sat16(w * (180.0 / M_PI) * PROTO_GYRO_LSB_PER_DPS);
-    out->mag[k] = sim_sat16(b / PROTO_MAG_UT_PER_LSB);
+    out->accel[k] = sim_sat16(a / SIM_G_M_S2 * PROTOCOL_ACCEL_LSB_PER_G);
+    out->gyro[k] = sim_sat16(w * (180.0 / M_PI) * PROTOCOL_GYRO_LSB_PER_DPS);
+    out->mag[k] = sim_sat16(b / PROTOCOL_MAG_UT_PER_LSB);
   }
   return 0;
 }
@@ -74,9 +74,9 @@ void sim_hal_bind(sim_car_t *c) {
 void sim_nano_step(sim_t *s, sim_car_t *c) {
   uint8_t buf[255];
   const size_t n = uart_pop(&c->rx, SIM_STEP_US, buf, sizeof buf);
-  if (n > 0) nigel_rx(&c->nano, buf, (uint8_t)n, (uint32_t)s->time_us);
-  const double k = (double)ENC_COUNTS_PER_REV / (2.0 * M_PI);
+  if (n > 0) nano_core_rx(&c->nano, buf, (uint8_t)n, (uint32_t)s->time_us);
+  const double k = (double)ENCODER_COUNTS_PER_REV / (2.0 * M_PI);
   const int32_t enc_l = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RL]] * k);
   const int32_t enc_r = (int32_t)floor(s->d->qpos[c->wheel_qpos[W_RR]] * k);
-  nigel_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);
+  nano_core_step(&c->nano, (uint32_t)s->time_us, enc_l, enc_r);
 }

@@ -19,7 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "proto.h"
+#include "protocol.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,7 +47,7 @@ typedef struct script {
 
 /* Parses spec. Returns 0, or -1 with a message naming the bad part in err. */
 int script_parse(script_t *s, const char *spec, char *err, size_t err_sz);
-/* Frames due at sim time now_us are encoded into out (cap >= 2 * PROTO_MAX_FRAME).
+/* Frames due at sim time now_us are encoded into out (cap >= 2 * PROTOCOL_MAX_FRAME).
  * Returns the number of bytes written. */
 size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap);
 

@@ -11,7 +11,7 @@ int sim_host_io_due(const sim_t *s) {
   return (s->time_us / SIM_STEP_US + 1) % s->host_io_period_steps == 0;
 }
 
-static void sim_count_host_frame(const proto_frame_t *f, void *ctx) {
+static void sim_count_host_frame(const protocol_frame_t *f, void *ctx) {
   (void)f;
   ((sim_car_t *)ctx)->host_frames++;
 }
@@ -24,7 +24,7 @@ void sim_read_host(sim_t *s, sim_car_t *c) {
   if (n == 0) return;
   uart_push(&c->rx, buf, n);
   c->host_rx_us = s->time_us;
-  proto_parser_feed(&c->host_parser, buf, n, sim_count_host_frame, c);
+  protocol_parser_feed(&c->host_parser, buf, n, sim_count_host_frame, c);
 }
 
 /* Unread bytes [bytes] on the pty above which nobody is reading it (free lockstep only): 40 ms

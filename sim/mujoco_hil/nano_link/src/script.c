@@ -114,13 +114,14 @@ size_t script_poll(script_t *s, int64_t now_us, uint8_t *out, size_t cap) {
   if (now_us < s->next_us || (s->stop_us >= 0 && now_us >= s->stop_us)) return 0;
   s->next_us += SCRIPT_PERIOD_US;
   const int engaged = s->sent >= SCRIPT_ARM_FRAMES;
-  proto_command_t c = {0};
+  protocol_command_t c = {0};
   c.seq = s->cmd_seq++;
-  c.throttle_milli = engaged ? (int16_t)lround(s->throttle * PROTO_MILLI) : 0;
-  c.steering_milli = engaged ? (int16_t)lround(s->steering * PROTO_MILLI) : 0;
-  c.flags = engaged ? PROTO_CMD_ENGAGED : 0;
-  uint8_t payload[PROTO_LEN_COMMAND];
-  proto_command_pack(&c, payload);
+  c.throttle_milli = engaged ? (int16_t)lround(s->throttle * PROTOCOL_MILLI) : 0;
+  c.steering_milli = engaged ? (int16_t)lround(s->steering * PROTOCOL_MILLI) : 0;
+  c.flags = engaged ? PROTOCOL_CMD_ENGAGED : 0;
+  uint8_t payload[PROTOCOL_LEN_COMMAND];
+  protocol_command_pack(&c, payload);
   s->sent++;
-  return proto_frame_encode(PROTO_ID_COMMAND, s->frame_seq++, payload, PROTO_LEN_COMMAND, out, cap);
+  return protocol_frame_encode(PROTOCOL_ID_COMMAND, s->frame_seq++, payload, PROTOCOL_LEN_COMMAND,
+                               out, cap);
 }

@@ -5,7 +5,7 @@
 
 namespace autodrive::bridge {
 
-void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
+void fill_state(const protocol_state_t &s, const autodrive::config::Vehicle &veh,
                 const HostLinkStats &host, int64_t utime_us, autodrive::vehicle_state_t *out) {
   out->utime = utime_us;
   out->nano_time_us = s.nano_time_us;
@@ -13,16 +13,16 @@ void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
     out->encoder_counts[i] = s.enc_counts[i];
     out->wheel_speed_rad_s[i] = static_cast<float>(s.wheel_speed_mrad_s[i] / 1000.0);
   }
-  out->throttle_applied = static_cast<float>(s.throttle_milli / double(PROTO_MILLI));
-  out->steering_applied = static_cast<float>(s.steering_milli / double(PROTO_MILLI));
+  out->throttle_applied = static_cast<float>(s.throttle_milli / double(PROTOCOL_MILLI));
+  out->steering_applied = static_cast<float>(s.steering_milli / double(PROTOCOL_MILLI));
   out->steering_angle_rad =
-      static_cast<float>(s.steering_milli / double(PROTO_MILLI) * veh.steering_limit_rad);
+      static_cast<float>(s.steering_milli / double(PROTOCOL_MILLI) * veh.steering_limit_rad);
   out->battery_voltage_v = static_cast<float>(s.battery_mv / 1000.0);
-  out->headlights = static_cast<int8_t>(s.lights & PROTO_LIGHTS_HEAD_MASK);
+  out->headlights = static_cast<int8_t>(s.lights & PROTOCOL_LIGHTS_HEAD_MASK);
   out->indicators =
-      static_cast<int8_t>((s.lights & PROTO_LIGHTS_IND_MASK) >> PROTO_LIGHTS_IND_SHIFT);
-  out->taillights_on = (s.lights & PROTO_LIGHTS_TAIL) != 0;
-  out->reverse_lights_on = (s.lights & PROTO_LIGHTS_REVERSE) != 0;
+      static_cast<int8_t>((s.lights & PROTOCOL_LIGHTS_IND_MASK) >> PROTOCOL_LIGHTS_IND_SHIFT);
+  out->taillights_on = (s.lights & PROTOCOL_LIGHTS_TAIL) != 0;
+  out->reverse_lights_on = (s.lights & PROTOCOL_LIGHTS_REVERSE) != 0;
   out->mode = static_cast<int8_t>(s.mode);
   out->fault_flags = s.faults;
   out->last_command_seq = s.last_cmd_seq;
@@ -34,14 +34,14 @@ void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
   out->host_frames_dropped = static_cast<int32_t>(host.dropped);
 }
 
-void fill_imu(const proto_state_t &s, const autodrive::config::Bridge &br, int64_t utime_us,
+void fill_imu(const protocol_state_t &s, const autodrive::config::Bridge &br, int64_t utime_us,
               autodrive::imu_t *out) {
   out->utime = utime_us;
   out->frame_id = br.imu_frame_id;
   double q[4];
   double norm2 = 0.0;
   for (int i = 0; i < 4; ++i) {
-    q[i] = s.quat_q14[i] / double(PROTO_QUAT_ONE);
+    q[i] = s.quat_q14[i] / double(PROTOCOL_QUAT_ONE);
     norm2 += q[i] * q[i];
   }
   // Fixed point leaves the quaternion a little off unit length; renormalise (identity if 0).
@@ -49,10 +49,10 @@ void fill_imu(const proto_state_t &s, const autodrive::config::Bridge &br, int64
   for (int i = 0; i < 4; ++i) out->orientation_wxyz[i] = norm > 0 ? q[i] / norm : (i == 0);
   const double dps_to_rad = M_PI / 180.0;
   for (int i = 0; i < 3; ++i) {
-    out->angular_velocity_rad_s[i] = s.gyro_raw[i] / PROTO_GYRO_LSB_PER_DPS * dps_to_rad;
+    out->angular_velocity_rad_s[i] = s.gyro_raw[i] / PROTOCOL_GYRO_LSB_PER_DPS * dps_to_rad;
     out->linear_acceleration_m_s2[i] =
-        s.accel_raw[i] / double(PROTO_ACCEL_LSB_PER_G) * kGravity_m_s2;
-    out->magnetic_field_ut[i] = s.mag_raw[i] * PROTO_MAG_UT_PER_LSB;
+        s.accel_raw[i] / double(PROTOCOL_ACCEL_LSB_PER_G) * kGravity_m_s2;
+    out->magnetic_field_ut[i] = s.mag_raw[i] * PROTOCOL_MAG_UT_PER_LSB;
   }
   for (int i = 0; i < 9; ++i) {
     const bool diag = (i % 4) == 0;
@@ -74,30 +74,31 @@ std::string command_problem(const autodrive::vehicle_command_t &c) {
   return "";
 }
 
-std::string state_problem(const proto_state_t &s) {
-  if (s.throttle_milli < -PROTO_MILLI || s.throttle_milli > PROTO_MILLI)
+std::string state_problem(const protocol_state_t &s) {
+  if (s.throttle_milli < -PROTOCOL_MILLI || s.throttle_milli > PROTOCOL_MILLI)
     return "applied throttle " + std::to_string(s.throttle_milli) + " outside +-" +
-           std::to_string(PROTO_MILLI);
-  if (s.steering_milli < -PROTO_MILLI || s.steering_milli > PROTO_MILLI)
+           std::to_string(PROTOCOL_MILLI);
+  if (s.steering_milli < -PROTOCOL_MILLI || s.steering_milli > PROTOCOL_MILLI)
     return "applied steering " + std::to_string(s.steering_milli) + " outside +-" +
-           std::to_string(PROTO_MILLI);
-  if (s.mode > PROTO_MODE_FAILSAFE) return "unknown mode " + std::to_string(s.mode);
-  if ((s.lights & PROTO_LIGHTS_HEAD_MASK) > 2)
-    return "unknown headlight level " + std::to_string(s.lights & PROTO_LIGHTS_HEAD_MASK);
+           std::to_string(PROTOCOL_MILLI);
+  if (s.mode > PROTOCOL_MODE_FAILSAFE) return "unknown mode " + std::to_string(s.mode);
+  if ((s.lights & PROTOCOL_LIGHTS_HEAD_MASK) > 2)
+    return "unknown headlight level " + std::to_string(s.lights & PROTOCOL_LIGHTS_HEAD_MASK);
   return "";
 }
 
-proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh, uint16_t seq) {
-  proto_command_t m{};
+protocol_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh,
+                                uint16_t seq) {
+  protocol_command_t m{};
   m.seq = seq;
   if (latest) {
     m.headlights = static_cast<uint8_t>(latest->headlights);
     m.indicators = static_cast<uint8_t>(latest->indicators);
   }
   if (latest && fresh) {
-    m.throttle_milli = static_cast<int16_t>(std::lround(latest->throttle * PROTO_MILLI));
-    m.steering_milli = static_cast<int16_t>(std::lround(latest->steering * PROTO_MILLI));
-    m.flags = latest->engaged ? PROTO_CMD_ENGAGED : 0;
+    m.throttle_milli = static_cast<int16_t>(std::lround(latest->throttle * PROTOCOL_MILLI));
+    m.steering_milli = static_cast<int16_t>(std::lround(latest->steering * PROTOCOL_MILLI));
+    m.flags = latest->engaged ? PROTOCOL_CMD_ENGAGED : 0;
   }
   return m;
 }

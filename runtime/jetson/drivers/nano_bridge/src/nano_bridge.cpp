@@ -22,7 +22,7 @@
 #include <autodrive/core/clock.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <autodrive/core/serial_port.hpp>
-#include "proto.h"
+#include "protocol.h"
 
 namespace autodrive::bridge {
 
@@ -50,7 +50,7 @@ struct NanoBridge::Impl {
   lcm::LCM lcm;
   autodrive::clock::Clock clock;
   autodrive::serial::SerialPort port;
-  proto_parser_t parser{};
+  protocol_parser_t parser{};
   mutable std::mutex mu;  // guards status
   Status st;
 
@@ -71,7 +71,7 @@ struct NanoBridge::Impl {
   // Receive side: what a noisy or hostile link produces is counted and logged at a limited
   // rate per device, never one line per frame.
   autodrive::LogLimiter rx_log{"receive problems"};
-  proto_stats_t rx_reported{};  // parser counters already logged
+  protocol_stats_t rx_reported{};  // parser counters already logged
   // Command authentication: no key, no gate, and the bridge refuses to run (init_error).
   std::string key_file, key_error;
   std::optional<CommandGate> gate;
@@ -83,7 +83,7 @@ struct NanoBridge::Impl {
 
   explicit Impl(const autodrive::config::Config &c)
       : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
-    proto_parser_init(&parser);
+    protocol_parser_init(&parser);
     key_file = c.bridge.command_key_file.empty() ? autodrive::auth::default_key_path(c.vehicle.name)
                                                  : c.bridge.command_key_file;
     try {
@@ -202,8 +202,8 @@ struct NanoBridge::Impl {
   }
 
   void write_frame(uint8_t id, const uint8_t *payload, uint8_t len) {
-    uint8_t frame[PROTO_MAX_FRAME];
-    const size_t n = proto_frame_encode(id, frame_seq++, payload, len, frame, sizeof frame);
+    uint8_t frame[PROTOCOL_MAX_FRAME];
+    const size_t n = protocol_frame_encode(id, frame_seq++, payload, len, frame, sizeof frame);
     const int r = port.write_all(frame, n);
     if (r < 0)
       lose_device(port.error());
@@ -214,30 +214,31 @@ struct NanoBridge::Impl {
   void send_command(int64_t now_us) {
     const bool fresh = latest_cmd.has_value() &&
                        now_us - latest_cmd_rx_us <= config.bridge.command_timeout_ms * 1000LL;
-    const proto_command_t c = make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
-    uint8_t payload[PROTO_LEN_COMMAND];
-    proto_command_pack(&c, payload);
-    write_frame(PROTO_ID_COMMAND, payload, PROTO_LEN_COMMAND);
+    const protocol_command_t c =
+        make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
+    uint8_t payload[PROTOCOL_LEN_COMMAND];
+    protocol_command_pack(&c, payload);
+    write_frame(PROTOCOL_ID_COMMAND, payload, PROTOCOL_LEN_COMMAND);
     count([&](Status &s) {
       ++s.commands_sent;
-      if (c.flags & PROTO_CMD_ENGAGED) ++s.engaged_sent;
+      if (c.flags & PROTOCOL_CMD_ENGAGED) ++s.engaged_sent;
     });
   }
 
   void send_hello_request() {
-    write_frame(PROTO_ID_HELLO_REQUEST, nullptr, 0);
+    write_frame(PROTOCOL_ID_HELLO_REQUEST, nullptr, 0);
     count([](Status &s) { ++s.hellos_sent; });
   }
 
   void send_config() {
     if (config.bridge.telemetry_period_ms == 0) return;
-    proto_config_t c{};
+    protocol_config_t c{};
     c.servo_trim_us = static_cast<int16_t>(config.bridge.servo_trim_us);
     c.telemetry_period_ms = static_cast<uint16_t>(config.bridge.telemetry_period_ms);
     c.failsafe_timeout_ms = static_cast<uint16_t>(config.bridge.failsafe_timeout_ms);
-    uint8_t payload[PROTO_LEN_CONFIG];
-    proto_config_pack(&c, payload);
-    write_frame(PROTO_ID_CONFIG, payload, PROTO_LEN_CONFIG);
+    uint8_t payload[PROTOCOL_LEN_CONFIG];
+    protocol_config_pack(&c, payload);
+    write_frame(PROTOCOL_ID_CONFIG, payload, PROTOCOL_LEN_CONFIG);
   }
 
   // sync_to_sim_clock: one frame per SIM_CLOCK tick (the heartbeat period of sim time), sent
@@ -287,8 +288,8 @@ struct NanoBridge::Impl {
     open_failure_logged = false;
     spdlog::info("{}opened {} at {} baud; handshaking", tag, config.bridge.device,
                  config.bridge.baud);
-    proto_parser_init(&parser);
-    rx_reported = proto_stats_t{};
+    protocol_parser_init(&parser);
+    rx_reported = protocol_stats_t{};
     count([](Status &s) {
       ++s.opens;
       s.state = LinkState::handshaking;
@@ -317,17 +318,17 @@ struct NanoBridge::Impl {
     return h;
   }
 
-  void on_hello(const proto_frame_t &f, int64_t now_us) {
-    proto_hello_t h{};
-    if (proto_hello_unpack(f.payload, f.len, &h) != 0) return bad_payload("HELLO", f.len);
-    const uint32_t ours = proto_schema_hash();
-    if (h.schema_hash != ours || h.proto_version != PROTO_VERSION) {
+  void on_hello(const protocol_frame_t &f, int64_t now_us) {
+    protocol_hello_t h{};
+    if (protocol_hello_unpack(f.payload, f.len, &h) != 0) return bad_payload("HELLO", f.len);
+    const uint32_t ours = protocol_schema_hash();
+    if (h.schema_hash != ours || h.proto_version != PROTOCOL_VERSION) {
       const std::string msg = "schema mismatch on " + config.bridge.device +
                               ": the Nano (firmware " + std::to_string(h.fw_major) + "." +
                               std::to_string(h.fw_minor) + "." + std::to_string(h.fw_patch) +
                               ") speaks protocol v" + std::to_string(h.proto_version) + " schema " +
                               hex32(h.schema_hash) + ", this runtime speaks protocol v" +
-                              std::to_string(PROTO_VERSION) + " schema " + hex32(ours) +
+                              std::to_string(PROTOCOL_VERSION) + " schema " + hex32(ours) +
                               "; link refused (flash matching firmware or rebuild the runtime)";
       spdlog::error("{}{}", tag, msg);
       count([&](Status &s) {
@@ -353,9 +354,9 @@ struct NanoBridge::Impl {
     next_tx_us = now_us;
   }
 
-  void on_state(const proto_frame_t &f) {
-    proto_state_t s{};
-    if (proto_state_unpack(f.payload, f.len, &s) != 0) return bad_payload("STATE", f.len);
+  void on_state(const protocol_frame_t &f) {
+    protocol_state_t s{};
+    if (protocol_state_unpack(f.payload, f.len, &s) != 0) return bad_payload("STATE", f.len);
     const std::string problem = state_problem(s);
     if (!problem.empty()) {
       count([](Status &st2) { ++st2.rx_bad_payload; });
@@ -366,7 +367,7 @@ struct NanoBridge::Impl {
     autodrive::vehicle_state_t vs{};
     fill_state(s, config.vehicle, host_stats(), t, &vs);
     lcm.publish(config.vehicle.name + AUTODRIVE_CH_STATE_SUFFIX, &vs);
-    bool imu = (s.faults & PROTO_FAULT_IMU_LOST) == 0;
+    bool imu = (s.faults & PROTOCOL_FAULT_IMU_LOST) == 0;
     if (imu) {
       autodrive::imu_t m{};
       fill_imu(s, config.bridge, t, &m);
@@ -387,8 +388,8 @@ struct NanoBridge::Impl {
 
   // Feeds received bytes to the parser; counts and logs (limited) any new garbage.
   void feed(const uint8_t *buf, size_t n) {
-    proto_parser_feed(&parser, buf, n, &Impl::on_frame, this);
-    const proto_stats_t &p = parser.stats;
+    protocol_parser_feed(&parser, buf, n, &Impl::on_frame, this);
+    const protocol_stats_t &p = parser.stats;
     const uint32_t skipped = p.skipped_bytes - rx_reported.skipped_bytes;
     const uint32_t crc = p.bad_crc - rx_reported.bad_crc;
     const uint32_t len = p.bad_length - rx_reported.bad_length;
@@ -404,19 +405,19 @@ struct NanoBridge::Impl {
                              skipped, crc, len));
   }
 
-  static void on_frame(const proto_frame_t *f, void *ctx) {
+  static void on_frame(const protocol_frame_t *f, void *ctx) {
     auto *self = static_cast<Impl *>(ctx);
     const int64_t now = autodrive::clock::monotonic_us();
     self->last_rx_frame_us = now;
     const LinkState s = self->state();
-    if (f->id == PROTO_ID_HELLO) {
+    if (f->id == PROTOCOL_ID_HELLO) {
       self->on_hello(*f, now);
-    } else if (f->id == PROTO_ID_STATE && s == LinkState::linked) {
+    } else if (f->id == PROTOCOL_ID_STATE && s == LinkState::linked) {
       // Telemetry counts only from a Nano whose schema we checked.
       self->on_state(*f);
-    } else if (f->id == PROTO_ID_NACK) {
-      proto_nack_t n{};
-      if (proto_nack_unpack(f->payload, f->len, &n) == 0) {
+    } else if (f->id == PROTOCOL_ID_NACK) {
+      protocol_nack_t n{};
+      if (protocol_nack_unpack(f->payload, f->len, &n) == 0) {
         self->count([](Status &st2) { ++st2.nacks; });
         self->rx_log.event(self->config.bridge.device,
                            fmt::format("Nano refused frame id 0x{:02x} seq {}: reason {}",

@@ -6,7 +6,7 @@
 #include <autodrive_vehicle.h>
 #include <yaml-cpp/yaml.h>
 
-#include "enc.h"
+#include "encoder.h"
 
 #include <array>
 #include <stdexcept>
@@ -27,7 +27,7 @@ struct Vehicle {
   double track_m = AUTODRIVE_VEHICLE_TRACK_M;
   double wheel_radius_m = AUTODRIVE_VEHICLE_WHEEL_RADIUS_M;
   double steering_limit_rad = AUTODRIVE_VEHICLE_STEER_LIMIT_RAD;  // steering = 1.0 maps to this
-  int encoder_counts_per_rev = ENC_COUNTS_PER_REV;
+  int encoder_counts_per_rev = ENCODER_COUNTS_PER_REV;
 };
 
 struct Bridge {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "proto.h"
+#include "protocol.h"
 
 namespace autodrive::devtools {
 
@@ -33,27 +33,27 @@ class PtyPeer {
 // `schema_hash`, records COMMAND/CONFIG frames, sends STATE frames on request.
 class FakeNano {
  public:
-  explicit FakeNano(const std::string &link, uint32_t schema_hash = proto_schema_hash());
+  explicit FakeNano(const std::string &link, uint32_t schema_hash = protocol_schema_hash());
   void open() {
     pty.open();
-    proto_parser_init(&parser_);
+    protocol_parser_init(&parser_);
   }
   void close() { pty.close(); }
   // Reads and handles what arrived (up to timeout_ms for the first byte).
   void pump(int timeout_ms);
-  void send_state(const proto_state_t &s);
+  void send_state(const protocol_state_t &s);
 
   PtyPeer pty;
   uint32_t schema_hash;
   int hello_requests = 0;
   int hellos_sent = 0;
   int configs = 0;
-  std::vector<proto_command_t> commands;
-  proto_config_t last_config{};
+  std::vector<protocol_command_t> commands;
+  protocol_config_t last_config{};
 
  private:
-  static void on_frame(const proto_frame_t *f, void *ctx);
-  proto_parser_t parser_{};
+  static void on_frame(const protocol_frame_t *f, void *ctx);
+  protocol_parser_t parser_{};
   uint8_t seq_ = 0;
 };
 

@@ -1,4 +1,4 @@
-// Pure conversions between the Nano's wire messages (proto.h) and the LCM types. No I/O, so
+// Pure conversions between the Nano's wire messages (protocol.h) and the LCM types. No I/O, so
 // the unit tests check every scale and bit directly.
 #pragma once
 
@@ -10,7 +10,7 @@
 #include <string>
 
 #include <autodrive/core/config.hpp>
-#include "proto.h"
+#include "protocol.h"
 
 namespace autodrive::bridge {
 
@@ -23,22 +23,23 @@ struct HostLinkStats {
   uint32_t dropped = 0;
 };
 
-void fill_state(const proto_state_t &s, const autodrive::config::Vehicle &veh,
+void fill_state(const protocol_state_t &s, const autodrive::config::Vehicle &veh,
                 const HostLinkStats &host, int64_t utime_us, autodrive::vehicle_state_t *out);
 
-// Converts raw MPU-9250 LSB with the proto.h scales; covariances are diagonal from config.
-void fill_imu(const proto_state_t &s, const autodrive::config::Bridge &br, int64_t utime_us,
+// Converts raw MPU-9250 LSB with the protocol.h scales; covariances are diagonal from config.
+void fill_imu(const protocol_state_t &s, const autodrive::config::Bridge &br, int64_t utime_us,
               autodrive::imu_t *out);
 
 // Returns "" if the command is usable, else what is wrong with it.
 std::string command_problem(const autodrive::vehicle_command_t &c);
 // "" if a STATE from the Nano is plausible (applied throttle and steering within
-// [-PROTO_MILLI, PROTO_MILLI], a known mode and headlight level), else what is wrong; such a STATE
-// is dropped.
-std::string state_problem(const proto_state_t &s);
+// [-PROTOCOL_MILLI, PROTOCOL_MILLI], a known mode and headlight level), else what is wrong; such a
+// STATE is dropped.
+std::string state_problem(const protocol_state_t &s);
 
 // The COMMAND frame for the heartbeat. `fresh` is false when the LCM command stream is stale
 // (or absent): then throttle is 0, steering centred and engaged cleared; lights are kept.
-proto_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh, uint16_t seq);
+protocol_command_t make_command(const autodrive::vehicle_command_t *latest, bool fresh,
+                                uint16_t seq);
 
 }  // namespace autodrive::bridge

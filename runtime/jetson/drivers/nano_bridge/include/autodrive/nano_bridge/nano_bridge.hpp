@@ -38,7 +38,7 @@ struct Status {
   // Receive side: garbage on the link is counted (and logged at a limited rate).
   uint64_t rx_skipped_bytes = 0;  // bytes discarded while hunting for a frame
   uint64_t rx_bad_crc = 0;        // frames whose CRC failed
-  uint64_t rx_bad_length = 0;     // length byte above PROTO_MAX_PAYLOAD
+  uint64_t rx_bad_length = 0;     // length byte above PROTOCOL_MAX_PAYLOAD
   uint64_t rx_bad_payload = 0;    // good CRC but a HELLO/STATE/NACK that does not unpack
   std::string last_refusal;       // the refusal message (names both schemas)
   GateCounters control;           // the command gate's counters (as of the last CONTROL status)

@@ -32,8 +32,8 @@ struct RulesConfig {
   double curve_speed_m_s = 0.14;    // after a curve sign, through the curve [m/s]
   double comfort_decel_m_s2 = 0.3;  // planned braking [m/s^2]
   // A hard stop (throttle to 0 at once): the Nano slews the throttle down at
-  // ACT_THROTTLE_SLEW_PER_S (from cruise to 0 in ~0.19 s, so ~0.1 s at full speed on average),
-  // then the motor brakes. Stopping distance v * hard_lag_s + v^2 / (2 hard_decel_m_s2).
+  // ACTUATION_THROTTLE_SLEW_PER_S (from cruise to 0 in ~0.19 s, so ~0.1 s at full speed on
+  // average), then the motor brakes. Stopping distance v * hard_lag_s + v^2 / (2 hard_decel_m_s2).
   double hard_lag_s = 0.1;       // [s]
   double hard_decel_m_s2 = 1.0;  // [m/s^2]
   // base_link (rear axle) to the front and to the rear bumper [m], from the car's chassis box
