@@ -27,7 +27,7 @@ extern "C" {
 typedef struct ad_world ad_world_t;
 
 typedef struct ad_world_config {
-  const char *map;         /* map name (sim/mujoco_hil/maps/<name>.xml) or an MJCF path */
+  const char *map;         /* map name (maps/<name>.xml) or an MJCF path */
   const char *params_path; /* vehicle description; NULL: vehicle/nigel.params of the tree */
   const char *run_dir;     /* where the generated scene is written; NULL: $TMPDIR or /tmp */
   int cars;                /* 1..AD_MAX_CARS */

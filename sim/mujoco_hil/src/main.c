@@ -583,7 +583,7 @@ int main(int argc, char **argv) {
   sim_config_t cfg = {0};
   char params[1024], map[1024];
   snprintf(params, sizeof params, "%s/vehicle/nigel.params", AUTODRIVE_ROOT_DIR);
-  snprintf(map, sizeof map, "%s/maps/parking_school.xml", AUTODRIVE_SIM_DIR);
+  snprintf(map, sizeof map, "%s/parking_school.xml", AUTODRIVE_MAPS_DIR);
   cfg.params_path = params;
   cfg.map_path = map;
   cfg.run_dir = "/tmp/autodrive-sim";
@@ -618,7 +618,7 @@ int main(int argc, char **argv) {
       if (strchr(v, '/') || strstr(v, ".xml"))
         snprintf(map, sizeof map, "%s", v);
       else
-        snprintf(map, sizeof map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
+        snprintf(map, sizeof map, "%s/%s.xml", AUTODRIVE_MAPS_DIR, v);
       i++;
     } else if (!strcmp(a, "--params") && v) {
       snprintf(params, sizeof params, "%s", v);
