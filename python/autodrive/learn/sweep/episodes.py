@@ -73,10 +73,17 @@ def make_policy(env: Any, seed: int, policy: str | None, algo: str = "PPO") -> P
     return fn
 
 
+def _modules_for(env_id: str, register: tuple[str, ...] | list[str]) -> list[str]:
+    """The modules to import before gymnasium.make(env_id): --register's, and autodrive.gym for
+    the package's own ids (autodrive/<Name>-v0, registered when it is imported)."""
+    own = ["autodrive.gym"] if env_id.startswith("autodrive/") else []
+    return own + list(register)
+
+
 def _make_env(env_id: str, register: tuple[str, ...]) -> Any:
     import gymnasium
 
-    for module in register:
+    for module in _modules_for(env_id, register):
         importlib.import_module(module)
     return gymnasium.make(env_id)
 
@@ -206,7 +213,7 @@ def parse_args(kind: str, argv: list[str]) -> argparse.Namespace:
         default=[],
         metavar="MODULE",
         help="import MODULE on each node before gymnasium.make (repeatable), for environments "
-        "it registers",
+        "it registers (autodrive/<Name>-v0 ids need none: autodrive.gym registers them)",
     )
     p.add_argument("--job", default=default_job, help=f"the job function (default {default_job})")
     if kind == "rollouts":
@@ -232,7 +239,7 @@ def parse_args(kind: str, argv: list[str]) -> argparse.Namespace:
 
     try:  # fail here, once, not on every node
         resolve(args.job, "--job")
-        for module in args.register:
+        for module in _modules_for(args.env, args.register):
             importlib.import_module(module)
         if args.policy and not args.policy.endswith(".zip"):
             resolve(args.policy, "--policy")
