@@ -12,43 +12,25 @@ from __future__ import annotations
 import argparse
 import contextlib
 import getpass
-import os
 import signal
 import sys
 import threading
 import time
 from collections.abc import Iterator
-from pathlib import Path
 
 import uvicorn
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels
 from autodrive import maps
-from autodrive.core.settings import settings
-from autodrive.scm.auth import UserError, add_user
-from autodrive.scm.db import DatabaseError, default_url, migrate, open_engine, sessions
-
-
-def find_build(given: str | None) -> Path:
-    """The build dir with the generated Python LCM types: --build, $AUTODRIVE_BUILD, or the
-    first of build/release, build/asan, build/dev that has them."""
-    rel = Path("lcm_types/gen/python") / lcmtypes.PACKAGE / "__init__.py"
-    if given or os.environ.get("AUTODRIVE_BUILD"):
-        path = Path(given or os.environ["AUTODRIVE_BUILD"])
-        if not (path / rel).is_file():
-            sys.exit(
-                f"autodrive-scm: --build {path}: no LCM types there ({rel}); build the "
-                "autodrive_lcm_gen target"
-            )
-        return path
-    for preset in ("release", "asan", "dev"):
-        path = settings().preset_build(preset)
-        if (path / rel).is_file():
-            return path
-    sys.exit(
-        "autodrive-scm: no build with the LCM types (build/release, asan or dev): build the "
-        "autodrive_lcm_gen target or give --build"
-    )
+from autodrive.scm.core.config import (
+    DEFAULT_HOST,
+    DEFAULT_MAP,
+    DEFAULT_PORT,
+    default_url,
+    find_build,
+)
+from autodrive.scm.core.db import DatabaseError, migrate, open_engine, sessions
+from autodrive.scm.core.security import UserError, add_user
 
 
 def parse_serve(argv: list[str]) -> argparse.Namespace:
@@ -58,10 +40,10 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
         "database; light control; V2I advisories on LCM; a REST/WebSocket API (/docs) and a web "
         "app. Users: 'autodrive-scm user add NAME --role operator'.",
     )
-    p.add_argument("--map", default="tiny_town", help="map name or description YAML")
+    p.add_argument("--map", default=DEFAULT_MAP, help="map name or description YAML")
     p.add_argument("--db", default=default_url(), help="sqlite:///PATH or postgresql://...")
-    p.add_argument("--host", default="127.0.0.1")
-    p.add_argument("--port", type=int, default=8765)
+    p.add_argument("--host", default=DEFAULT_HOST)
+    p.add_argument("--port", type=int, default=DEFAULT_PORT)
     p.add_argument("--lcm-url", default=channels.load().url_default)
     p.add_argument(
         "--vehicles",

@@ -23,7 +23,7 @@ from sqlalchemy import Engine, select as sql_select
 
 from autodrive.core import channels, lcmtypes
 from autodrive.maps import MapDescription
-from autodrive.scm.db import sessions
+from autodrive.scm.core.db import sessions
 from autodrive.scm.lights import STATES, Change, ControlError, Controller, Light, Program
 from autodrive.scm.models import Light as LightRow
 from autodrive.scm.models import Sign as SignRow

@@ -1,4 +1,4 @@
-"""Alembic environment of the SCM: run in process by autodrive.scm.db.migrate with an
+"""Alembic environment of the SCM: run in process by autodrive.scm.core.db.migrate with an
 open connection (config.attributes["connection"]); there is no alembic.ini."""
 
 from __future__ import annotations

@@ -14,18 +14,11 @@ from sqlalchemy.engine import make_url
 from sqlalchemy.exc import ArgumentError, OperationalError, SQLAlchemyError
 from sqlalchemy.orm import Session, sessionmaker
 
-from autodrive.core.settings import OUT_DIR
-
-DEFAULT_SQLITE = OUT_DIR / "scm" / "scm.sqlite"
 MIGRATIONS = Path(str(resources.files("autodrive.scm") / "migrations"))  # package data
 
 
 class DatabaseError(RuntimeError):
     """A database URL that cannot be used; the message names the URL and the problem."""
-
-
-def default_url() -> str:
-    return f"sqlite:///{DEFAULT_SQLITE}"
 
 
 def _sqlite_pragmas(dbapi_conn: Any, _record: Any) -> None:
