@@ -22,8 +22,8 @@ def render(car: vehicle.Vehicle, source_name: str) -> str:
     limit = car.number("steer_limit_rad")
     return "\n".join(
         [
-            f"/* Generated from {source_name} by autodrive.devtools.codegen.firmware_header (tools/gen-docs):",
-            " * do not edit. The steering servo's figures as the firmware's integers. */",
+            f"/* Generated from {source_name} by autodrive.devtools.codegen.firmware_header",
+            " * (tools/gen-docs): do not edit. The steering servo's figures as the firmware's integers. */",
             "#ifndef AUTODRIVE_ACT_VEHICLE_H",
             "#define AUTODRIVE_ACT_VEHICLE_H",
             "",
