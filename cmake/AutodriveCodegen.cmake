@@ -1,22 +1,23 @@
 # Build-time generation from the project's one-place descriptions (python -m
-# autodrive_tools.codegen, with the project's venv), like lcm-gen for the message types. Each
+# autodrive.devtools.codegen, with the project's venv), like lcm-gen for the message types. Each
 # target is an INTERFACE library whose include dir holds one generated header.
 
 # autodrive_codegen_header(<target> <what> <header> <source> <source option> <reader.py>):
-# `python -m autodrive_tools.codegen <what> <header> <source option> <source>` at build time.
+# `python -m autodrive.devtools.codegen <what> <header> <source option> <source>` at build time.
 function(autodrive_codegen_header target what header source source_option reader)
   set(python "${AUTODRIVE_ROOT}/.venv/bin/python")
   if(NOT EXISTS "${python}")
     message(FATAL_ERROR "${python} is missing: run tools/setup (it creates the project's venv)")
   endif()
   set(out_dir "${CMAKE_BINARY_DIR}/gen/${target}")
-  file(GLOB generator "${AUTODRIVE_ROOT}/python/autodrive_tools/codegen/*.py")
+  file(GLOB generator "${AUTODRIVE_ROOT}/python/autodrive/devtools/codegen/*.py")
   add_custom_command(
     OUTPUT "${out_dir}/${header}"
     COMMAND ${CMAKE_COMMAND} -E env "PYTHONPATH=${AUTODRIVE_ROOT}/python"
-            "${python}" -m autodrive_tools.codegen ${what} "${out_dir}/${header}"
+            "AUTODRIVE_ROOT=${AUTODRIVE_ROOT}"
+            "${python}" -m autodrive.devtools.codegen ${what} "${out_dir}/${header}"
             ${source_option} "${source}"
-    DEPENDS "${source}" ${generator} "${AUTODRIVE_ROOT}/python/autodrive_tools/${reader}"
+    DEPENDS "${source}" ${generator} "${AUTODRIVE_ROOT}/python/autodrive/${reader}"
     COMMENT "codegen: ${header} from ${source}"
     VERBATIM)
   add_custom_target(${target}_gen DEPENDS "${out_dir}/${header}")
@@ -28,12 +29,12 @@ endfunction()
 # `autodrive_vehicle`: <autodrive_vehicle.h>, the car's figures from vehicle/nigel.params.
 function(autodrive_vehicle_target)
   autodrive_codegen_header(autodrive_vehicle vehicle-header autodrive_vehicle.h
-    "${AUTODRIVE_ROOT}/vehicle/nigel.params" --params vehicle.py)
+    "${AUTODRIVE_ROOT}/vehicle/nigel.params" --params core/vehicle.py)
 endfunction()
 
 # `autodrive_channels`: <autodrive_channels.h>, every LCM channel name from
 # lcm_types/channels.yaml.
 function(autodrive_channels_target)
   autodrive_codegen_header(autodrive_channels channels-header autodrive_channels.h
-    "${AUTODRIVE_ROOT}/lcm_types/channels.yaml" --table channels.py)
+    "${AUTODRIVE_ROOT}/lcm_types/channels.yaml" --table core/channels.py)
 endfunction()

@@ -28,9 +28,9 @@ build_avr() {
     cmake --build "$ROOT/build/avr" || die "AVR firmware build failed"
   fi
 }
-# Makes sure the project venv with autodrive_tools exists (tools/setup creates it).
+# Makes sure the project venv with autodrive exists (tools/setup creates it).
 need_venv() {
-  "$PY" -c 'import autodrive_tools' 2>/dev/null || "$ROOT/tools/setup" >&2 \
+  "$PY" -c 'import autodrive' 2>/dev/null || "$ROOT/tools/setup" >&2 \
     || die "tools/setup failed"
 }
 # The aarch64 (Jetson) cross build in build/aarch64/build: the runtime, the autonomy, the Eye

@@ -11,7 +11,7 @@ using namespace autodrive::behaviour;
 
 namespace {
 
-const std::string kMap = std::string(AUTODRIVE_ROOT) + "/sim/mujoco_hil/maps/tiny_town.json";
+const std::string kMap = std::string(AUTODRIVE_ROOT) + "/maps/tiny_town.json";
 
 const CityMap &city() {
   static const CityMap m = load_city_map(kMap);

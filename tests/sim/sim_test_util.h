@@ -18,10 +18,10 @@ inline std::string temp_dir() {
 inline std::string params_path() {
   return std::string(SIM_DIR) + "/../../vehicle/nigel.params";
 }
-// A map name from sim/mujoco_hil/maps, or a path (with '/') as is.
+// A map name from maps/, or a path (with '/') as is.
 inline std::string map_path(const char *name) {
   if (std::string(name).find('/') != std::string::npos) return name;
-  return std::string(SIM_DIR) + "/maps/" + name + ".xml";
+  return std::string(MAPS_DIR) + "/" + name + ".xml";
 }
 inline std::string fixture(const char *file) {
   return std::string(SIM_TEST_DIR) + "/fixtures/" + file;

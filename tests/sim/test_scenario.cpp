@@ -35,12 +35,12 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kCarSpacingM = 0.35;  // cars 2..N line up to car 1's right at this pitch
 
-// A map's facts from its JSON sidecar (generated from sim/mujoco_hil/maps/<map>.yaml).
+// A map's facts from its JSON sidecar (generated from maps/<map>.yaml).
 const nlohmann::json &map_facts(const std::string &name) {
   static std::map<std::string, nlohmann::json> cache;
   auto it = cache.find(name);
   if (it == cache.end()) {
-    const std::string path = std::string(SIM_DIR) + "/maps/" + name + ".json";
+    const std::string path = std::string(MAPS_DIR) + "/" + name + ".json";
     std::ifstream f(path);
     if (!f) throw std::runtime_error(path + ": cannot read the map sidecar");
     it = cache.emplace(name, nlohmann::json::parse(f)).first;

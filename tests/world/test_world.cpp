@@ -24,7 +24,7 @@ const char *const kMaps[] = {"parking_school", "driving_school", "intersection_s
                              "tiny_town"};
 
 nlohmann::json sidecar(const char *map) {
-  std::ifstream f(std::string(SIM_DIR) + "/maps/" + map + ".json");
+  std::ifstream f(std::string(MAPS_DIR) + "/" + map + ".json");
   return nlohmann::json::parse(f);
 }
 

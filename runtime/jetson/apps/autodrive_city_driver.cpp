@@ -191,7 +191,7 @@ int main(int argc, char **argv) {
       "speed limits and curve signs, keeps a gap behind cars ahead (V2V), and sends signed "
       "commands through the runtime's bridge"};
   Options o;
-  cli.add_option("--map", o.map, "the map's sidecar JSON (sim/mujoco_hil/maps/<map>.json)")
+  cli.add_option("--map", o.map, "the map's sidecar JSON (maps/<map>.json)")
       ->required()
       ->check(CLI::ExistingFile);
   cli.add_option("--route", o.route,

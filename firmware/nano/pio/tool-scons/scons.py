@@ -1,5 +1,5 @@
 # PlatformIO Core runs `<python> <tool-scons>/scons.py ...`; this starts SCons 4.11.1 as
-# installed from PyPI into the project's venv (tools/requirements.txt: scons==4.11.1). PlatformIO
+# installed from PyPI into the project's venv (python/pyproject.toml: scons==4.11.1). PlatformIO
 # runs it with the interpreter it runs under, the venv's, so SCons imports from there.
 import sys
 

@@ -5,7 +5,7 @@
  * COMMAND frames at 50 Hz (armed with engaged 0, then engaged 1), with the firmware's slew
  * and steering-rate limits, exactly as the runtime's bridge writes them on the pty.
  *
- * Plain C types only: Python loads it with cffi (python/autodrive_tools/learn/_lib.py reads
+ * Plain C types only: Python loads it with cffi (python/autodrive/gym/_lib.py reads
  * the declarations between the CFFI markers from this file). Cars are 0-based here. Not
  * thread-safe per world; distinct worlds are independent. Errors: functions that can fail
  * return 0 / -1 (or NULL) and write a message naming the bad input into err. */
@@ -31,7 +31,7 @@ extern "C" {
 typedef struct ad_world ad_world_t;
 
 typedef struct ad_world_config {
-  const char *map;         /* map name (sim/mujoco_hil/maps/<name>.xml) or an MJCF path */
+  const char *map;         /* map name (maps/<name>.xml) or an MJCF path */
   const char *params_path; /* vehicle description; NULL: vehicle/nigel.params of the tree */
   const char *run_dir;     /* where the generated scene is written; NULL: $TMPDIR or /tmp */
   int cars;                /* 1..AD_MAX_CARS */

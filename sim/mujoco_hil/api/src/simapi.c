@@ -73,7 +73,7 @@ ad_world_t *ad_world_create(const ad_world_config_t *cfg, char *err, size_t err_
   if (strchr(cfg->map, '/') || strstr(cfg->map, ".xml"))
     snprintf(map, sizeof map, "%s", cfg->map);
   else
-    snprintf(map, sizeof map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, cfg->map);
+    snprintf(map, sizeof map, "%s/%s.xml", AUTODRIVE_MAPS_DIR, cfg->map);
   if (cfg->params_path)
     snprintf(params, sizeof params, "%s", cfg->params_path);
   else

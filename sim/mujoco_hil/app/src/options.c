@@ -122,7 +122,7 @@ static int options_number(const char *opt, const char *v, double lo, double hi, 
 static void options_defaults(app_options_t *o) {
   memset(o, 0, sizeof *o);
   snprintf(o->params, sizeof o->params, "%s/vehicle/nigel.params", AUTODRIVE_ROOT_DIR);
-  snprintf(o->map, sizeof o->map, "%s/maps/parking_school.xml", AUTODRIVE_SIM_DIR);
+  snprintf(o->map, sizeof o->map, "%s/parking_school.xml", AUTODRIVE_MAPS_DIR);
   o->cfg.params_path = o->params;
   o->cfg.map_path = o->map;
   o->cfg.run_dir = "/tmp/autodrive-sim";
@@ -209,7 +209,7 @@ static int options_world(app_options_t *o, const char *a, const char *v) {
     if (strchr(v, '/') || strstr(v, ".xml"))
       snprintf(o->map, sizeof o->map, "%s", v);
     else
-      snprintf(o->map, sizeof o->map, "%s/maps/%s.xml", AUTODRIVE_SIM_DIR, v);
+      snprintf(o->map, sizeof o->map, "%s/%s.xml", AUTODRIVE_MAPS_DIR, v);
     return 1;
   } else if (!strcmp(a, "--params") && v) {
     snprintf(o->params, sizeof o->params, "%s", v);

@@ -114,7 +114,7 @@ static void usage(FILE *out) {
           "  camera_cpu_us        process CPU time per frame, llvmpipe threads included [us]\n"
           "  jpeg_encode_us       median JPEG encode of one frame (quality 85) [us]\n"
           "  camera_jpeg_fps      frames/s including the JPEG encode (median)\n"
-          "--map FILE uses an MJCF map (e.g. sim/mujoco_hil/maps/driving_school.xml) with the 4\n"
+          "--map FILE uses an MJCF map (e.g. maps/driving_school.xml) with the 4\n"
           "bench cars added near the origin instead of the built-in scene.\n"
           "Progress goes to stderr; the last stdout line is one JSON object.\n"
           "Defaults: --scans 300 --frames 200 --width 640 --height 480 --backend auto\n");

@@ -1,5 +1,5 @@
 // The city as the behaviour layer sees it, read from a map's sidecar JSON (written by
-// tools/gen-maps from sim/mujoco_hil/maps/<map>.yaml; never typed here): lane centre lines,
+// tools/gen-maps from maps/<map>.yaml; never typed here): lane centre lines,
 // named routes, stop lines, traffic lights and signs. A route (a named one, or a chain of lanes)
 // becomes a Track: one polyline with arc length, the stops on it (each light's stop line, each
 // stop sign's stop line) and its speed zones (speed-limit and curve signs).

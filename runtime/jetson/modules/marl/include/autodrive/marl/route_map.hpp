@@ -1,5 +1,5 @@
 // A named route and the intersection's conflict zone, read from a map's JSON sidecar
-// (sim/mujoco_hil/maps/<map>.json, written by tools/gen-maps: the one source of routes).
+// (maps/<map>.json, written by tools/gen-maps: the one source of routes).
 #pragma once
 
 #include <autodrive/autonomy/path.hpp>

@@ -1,0 +1,234 @@
+"""tools/bench sim: simulator speed and fidelity. Progress on stderr; figures on stdout, the
+last line one JSON object. Needs AUTODRIVE_BUILD (a release build).
+
+rtf_N: median real-time factor of `autodrive-sim --lockstep` with N cars (1 kHz physics, the
+emulated Nano of every car on its pty, IMU, LIDAR + RPLIDAR pty, ground truth on LCM);
+bare_mj_step_rtf_N: a bare mj_step loop on the same model in the same process;
+overhead_ratio = bare / rtf_1 (goal <= 1.11) and rtf_N_over_bare = rtf_N / bare (goal for 16
+cars >= 0.85; rtf_16 >= 3), each taken within one run, medians over the runs. The *_cpu
+variants divide by CPU time instead of wall time (the stepping thread's for the ratios: the
+LCM sender has a thread of its own); on a shared, loaded machine they show the cost without
+the waits. Since 2026-11-27 each lockstep run pairs every 1 s block of the sim's steps with a
+1 s block of bare mj_step right after it (bench_pairs.h: both halves see the same load), and
+bare_mj_step_rtf_N and the ratios come from those pairs (overhead_ratio_paired_N: the median of
+the per-pair time ratios).
+*_instructions: the same ratios in instructions per step, counted by valgrind's callgrind on a
+short run (2 s with 1 car, 0.5 s with 16; sim_instructions.py): the load-independent figure.
+rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JPEG-published
+at 30 Hz. turn_radius_error_pct: circle fitted to the ground truth at steering 0.6 vs
+L/tan(delta); *_mujoco_friction: the same with plain MuJoCo contact friction instead of the
+paper tyre model. goals_met: each goal by wall time and by CPU time. lidar_scan_us,
+camera_fps_640x480: from the sensors library's sim-sensors-bench. Options: SIM_BENCH_REPEATS
+(3).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import statistics
+import struct
+import subprocess
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from autodrive.core import lcmtypes, vehicle
+from autodrive.bench import Progress, build_dir, last_json, print_figures, sim_instructions
+
+URL = "udpm://239.255.76.67:7731?ttl=0"  # sim's test/bench port range 7730-7759
+CAR_COUNTS_AND_DURATIONS_S = ((1, 20), (4, 10), (16, 4))
+DRIVE_SCRIPT = "constant:throttle=0.5,steering=0.3"
+TURN_STEERINGS = (0.3, 0.6, 1.0)
+TURN_SETTLE_US = 3e6  # skip the start of the circle
+TOP_SPEED_SETTLE_US = 2e6
+log = Progress("sim")
+
+
+class SimBench:
+    def __init__(self, build: Path) -> None:
+        self.build = build
+        self.sim = build / "bin" / "autodrive-sim"
+        self.types = lcmtypes.load(build)
+        car = vehicle.load()
+        self.wheelbase_m = car.number("wheelbase_m")
+        self.steer_limit_rad = car.number("steer_limit_rad")
+
+    def run(self, args: Sequence[str], url: str) -> dict[str, Any]:
+        with tempfile.TemporaryDirectory(prefix="bench-sim-") as run_dir:
+            argv = [str(self.sim), "--quiet", "--bench", "--run-dir", run_dir, "--lcm-url", url]
+            out = subprocess.run(
+                argv + list(args), check=True, capture_output=True, text=True
+            ).stdout
+        return last_json(out, "autodrive-sim --bench")
+
+    def pick_url(self) -> str:
+        try:
+            self.run(["--lockstep", "--duration", "0.05", "--no-pty"], URL)
+            return URL
+        except subprocess.CalledProcessError:
+            log("udpm LCM unavailable (no multicast route?): using memq://, LCM cost not included")
+            return "memq://"
+
+    def truth_log(self, args: Sequence[str]) -> list[Any]:
+        with tempfile.TemporaryDirectory(prefix="bench-sim-") as d:
+            path = os.path.join(d, "truth.bin")
+            argv = [str(self.sim), "--quiet", "--lockstep", "--no-pty", "--no-lidar"]
+            argv += ["--lcm-url", "memq://", "--run-dir", d, "--truth-log", path]
+            subprocess.run(argv + list(args), check=True, capture_output=True)
+            data = open(path, "rb").read()
+        msgs, i = [], 0
+        while i < len(data):
+            (n,) = struct.unpack(">I", data[i : i + 4])
+            msgs.append(self.types.ground_truth_t.decode(data[i + 4 : i + 4 + n]))
+            i += 4 + n
+        return msgs
+
+    def turn_error_pct(self, tyre: str, steering: float) -> float:
+        script = f"constant:throttle=0.6,steering={steering}"
+        msgs = self.truth_log(["--duration", "10", "--tyre-model", tyre, "--script", script])
+        pts = [(m.position_m[0], m.position_m[1]) for m in msgs if m.utime > TURN_SETTLE_US]
+        r = fit_radius([p[0] for p in pts], [p[1] for p in pts])
+        expect = self.wheelbase_m / math.tan(steering * self.steer_limit_rad)
+        return 100.0 * abs(r - expect) / expect
+
+    def top_speed(self, tyre: str) -> float:
+        script = "constant:throttle=1,steering=0"
+        msgs = self.truth_log(["--duration", "5", "--tyre-model", tyre, "--script", script])
+        v = [m.linear_velocity_m_s[0] for m in msgs if m.utime > TOP_SPEED_SETTLE_US]
+        return float(sum(v) / len(v))
+
+
+def fit_radius(xs: Sequence[float], ys: Sequence[float]) -> float:
+    """Kasa least-squares circle: x^2 + y^2 + D x + E y + F = 0; its radius [m]."""
+    x, y = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+    a = np.column_stack([x, y, np.ones_like(x)])
+    (d, e, f), *_ = np.linalg.lstsq(a, -(x * x + y * y), rcond=None)
+    return math.sqrt(d * d / 4 + e * e / 4 - f)
+
+
+def median(values: Sequence[float]) -> float:
+    return round(statistics.median(values), 2)
+
+
+def speed(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
+    for cars, dur in CAR_COUNTS_AND_DURATIONS_S:
+        runs = []
+        for k in range(repeats):
+            args = ["--lockstep", "--cars", str(cars), "--duration", str(dur)]
+            r = bench.run(args + ["--script", DRIVE_SCRIPT], url)
+            log(
+                f"{cars} car(s), run {k + 1}/{repeats}: rtf {r['rtf']:.1f} (cpu "
+                f"{r['rtf_cpu']:.1f}), bare mj_step {r['bare_mj_step_rtf']:.1f} "
+                f"(cpu {r['bare_mj_step_rtf_cpu']:.1f})"
+            )
+            runs.append(r)
+        res[f"rtf_{cars}"] = median([r["rtf"] for r in runs])
+        res[f"rtf_cpu_{cars}"] = median([r["rtf_cpu"] for r in runs])
+        res[f"rtf_step_thread_cpu_{cars}"] = median([r["rtf_step_thread_cpu"] for r in runs])
+        res[f"bare_mj_step_rtf_{cars}"] = median([r["bare_mj_step_rtf"] for r in runs])
+        res[f"bare_mj_step_rtf_cpu_{cars}"] = median([r["bare_mj_step_rtf_cpu"] for r in runs])
+        # ratios within one run (the same load on the machine), then their median
+        ratios = [r["bare_mj_step_rtf"] / r["rtf"] for r in runs]
+        ratios_cpu = [r["bare_mj_step_rtf_cpu"] / r["rtf_step_thread_cpu"] for r in runs]
+        if "overhead_ratio_paired" in runs[0]:
+            res[f"overhead_ratio_paired_{cars}"] = round(
+                statistics.median([r["overhead_ratio_paired"] for r in runs]), 3
+            )
+        if cars == 1:
+            res["overhead_ratio"] = round(statistics.median(ratios), 3)
+            res["overhead_ratio_cpu"] = round(statistics.median(ratios_cpu), 3)
+        else:
+            res[f"rtf_{cars}_over_bare"] = round(statistics.median([1 / q for q in ratios]), 3)
+            res[f"rtf_{cars}_over_bare_cpu"] = round(
+                statistics.median([1 / q for q in ratios_cpu]), 3
+            )
+    try:
+        args = ["--lockstep", "--cameras", "--duration", "3", "--script", DRIVE_SCRIPT]
+        rtfs = [bench.run(args, url)["rtf"] for _ in range(repeats)]
+        res["rtf_1_two_cameras_30fps"] = median(rtfs)
+        log(f"two cameras at 30 fps: rtf {rtfs}")
+    except subprocess.CalledProcessError as e:
+        log(f"cameras unavailable: {e.stderr.strip() if e.stderr else e}")
+
+
+def instructions(bench: SimBench, res: dict[str, Any]) -> None:
+    if not sim_instructions.available():
+        log("valgrind not installed: no instruction counts")
+        return
+    for cars, dur in ((1, 2.0), (16, 0.5)):
+        log(f"{cars} car(s): counting instructions per step under callgrind ({dur:g} s sim)")
+        args = ["--cars", str(cars), "--script", DRIVE_SCRIPT]
+        n = sim_instructions.measure(bench.sim, args, dur)
+        res[f"instructions_per_step_{cars}"] = round(n.sim_per_step)
+        res[f"bare_instructions_per_step_{cars}"] = round(n.bare_per_step)
+        if cars == 1:
+            res["overhead_ratio_instructions"] = round(n.overhead_ratio, 4)
+        else:
+            res[f"rtf_{cars}_over_bare_instructions"] = round(1.0 / n.overhead_ratio, 4)
+
+
+def fidelity(bench: SimBench, res: dict[str, Any]) -> None:
+    for tyre, suffix in (("paper", ""), ("mujoco", "_mujoco_friction")):
+        errs = [bench.turn_error_pct(tyre, s) for s in TURN_STEERINGS]
+        res["turn_radius_error_pct" + suffix] = round(max(errs), 3)
+        res["top_speed_m_s" + suffix] = round(bench.top_speed(tyre), 4)
+        log(
+            f"tyre model {tyre}: turn radius error at steering 0.3/0.6/1.0 = "
+            f"{', '.join(f'{e:.2f}' for e in errs)} %, top speed "
+            f"{res['top_speed_m_s' + suffix]} m/s"
+        )
+
+
+def sensors(build: Path, res: dict[str, Any]) -> None:
+    sensors_bench = build / "bin" / "sim-sensors-bench"
+    if not os.access(sensors_bench, os.X_OK):
+        log("sim-sensors-bench not built: no lidar/camera figures")
+        return
+    log("running sim-sensors-bench (sensors library)")
+    try:
+        out = subprocess.run(
+            [str(sensors_bench)], check=True, capture_output=True, text=True
+        ).stdout
+        s = last_json(out, "sim-sensors-bench")
+        for k in ("lidar_scan_us", "camera_fps_640x480"):
+            if k in s:
+                res[k] = s[k]
+    except (subprocess.CalledProcessError, ValueError) as e:
+        log(f"sim-sensors-bench failed, no lidar/camera figures: {e}")
+
+
+def goals_met(res: dict[str, Any]) -> dict[str, bool]:
+    """The issue's speed goals, by wall time and by CPU time (a loaded machine)."""
+    out: dict[str, bool] = {}
+    for suffix in ("", "_cpu", "_instructions"):
+        if "overhead_ratio" + suffix in res:
+            out["overhead_ratio" + suffix] = res["overhead_ratio" + suffix] <= 1.11
+        if "rtf_16_over_bare" + suffix in res:
+            out["rtf_16_over_bare" + suffix] = res["rtf_16_over_bare" + suffix] >= 0.85
+    if "rtf_16" in res:
+        out["rtf_16"] = res["rtf_16"] >= 3.0
+        out["rtf_cpu_16"] = res["rtf_cpu_16"] >= 3.0
+    return out
+
+
+def main(argv: list[str]) -> int:
+    if argv:
+        print(__doc__.strip())
+        return 0 if argv[0] in ("-h", "--help") else 2
+    build = build_dir("sim")
+    bench = SimBench(build)
+    repeats = int(os.environ.get("SIM_BENCH_REPEATS", "3"))
+    res: dict[str, Any] = {}
+    url = bench.pick_url()
+    speed(bench, url, repeats, res)
+    instructions(bench, res)
+    fidelity(bench, res)
+    sensors(build, res)
+    res["lcm_url"] = url
+    res["goals_met"] = goals_met(res)
+    print_figures(res, key_value_lines=True)
+    return 0

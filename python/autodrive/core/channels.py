@@ -1,0 +1,155 @@
+"""Reads the channel table (lcm_types/channels.yaml), the one place channel names are written.
+
+Usage: ``channel("COMMAND", "NIGEL1") == "NIGEL1_COMMAND"``, ``channel("SIM_CLOCK")``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import yaml
+
+from autodrive.core.settings import CHANNEL_TABLE
+
+VEH = "<VEH>"
+CAM = "<CAM>"  # an overhead camera of the map (EYE1, EYE2, ...: the map's eye_cameras)
+# Conditions of a channel's optional "when": published only on maps with traffic lights, only
+# when someone acts (a command), only when a runtime knows its map pose (v2v: an Eye or
+# estimator.initial_pose_map), or only while the Smart City Manager runs. "" = every run.
+# eye_cameras: only when the simulator renders a map's several overhead cameras.
+WHEN = frozenset({"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras"})
+
+
+class ChannelTableError(ValueError):
+    """A channel table that cannot be read, or a lookup of a channel it does not list."""
+
+
+@dataclass(frozen=True)
+class Channel:
+    name: str  # pattern, "<VEH>_..." per vehicle, "<CAM>_..." per overhead camera
+    id: str
+    type: str
+    rate: str
+    status: str  # live or planned
+    publishers: tuple[str, ...]
+    subscribers: tuple[str, ...]
+    content: str
+    when: str = ""  # "": every run; else the condition under which it is published
+
+    @property
+    def per_vehicle(self) -> bool:
+        return self.name.startswith(VEH + "_")
+
+    @property
+    def per_camera(self) -> bool:
+        return self.name.startswith(CAM + "_")
+
+    @property
+    def placeholder(self) -> str:
+        """<VEH> or <CAM> for a channel per vehicle or per camera, else ""."""
+        return VEH if self.per_vehicle else CAM if self.per_camera else ""
+
+    def resolve(self, vehicle: str | None = None) -> str:
+        """The concrete channel name; per-vehicle (per-camera) channels need the vehicle
+        (camera) name."""
+        if self.placeholder:
+            if not vehicle:
+                raise ChannelTableError(f"channel {self.name} needs a {self.placeholder} name")
+            return vehicle.upper() + self.name[len(self.placeholder) :]
+        return self.name
+
+
+@dataclass(frozen=True)
+class ChannelTable:
+    source: Path
+    url_default: str
+    vehicle_prefix: str
+    channels: tuple[Channel, ...]
+
+    def by_id(self, channel_id: str) -> Channel:
+        for ch in self.channels:
+            if ch.id == channel_id:
+                return ch
+        raise ChannelTableError(f"{self.source}: no channel with id '{channel_id}'")
+
+    def match(self, concrete: str) -> Channel | None:
+        """The table entry a concrete name (e.g. NIGEL2_ODOM) belongs to, or None."""
+        for ch in self.channels:
+            if ch.placeholder:
+                suffix = ch.name[len(ch.placeholder) :]
+                prefix = concrete[: -len(suffix)] if concrete.endswith(suffix) else ""
+                # a vehicle (camera) name is capitals and digits, no underscore
+                # (NIGEL1_LASER_ODOM is LASER_ODOM of NIGEL1, not ODOM of NIGEL1_LASER)
+                if prefix and prefix.isalnum() and prefix.isupper():
+                    return ch
+            elif ch.name == concrete:
+                return ch
+        return None
+
+
+_FIELDS = (
+    "name",
+    "id",
+    "type",
+    "rate",
+    "status",
+    "publishers",
+    "subscribers",
+    "content",
+)
+
+
+@lru_cache(maxsize=None)
+def load(path: Path | str | None = None) -> ChannelTable:
+    """Reads and checks the table; raises ChannelTableError naming the file and entry."""
+    source = Path(path) if path is not None else CHANNEL_TABLE
+    try:
+        doc = yaml.safe_load(source.read_text())
+    except (OSError, yaml.YAMLError) as err:
+        raise ChannelTableError(f"{source}: cannot read the channel table ({err})") from err
+    if not isinstance(doc, dict) or not isinstance(doc.get("channels"), list):
+        raise ChannelTableError(f"{source}: expected a mapping with a 'channels' list")
+    out = []
+    for i, entry in enumerate(doc["channels"]):
+        missing = [f for f in _FIELDS if not isinstance(entry, dict) or f not in entry]
+        if missing:
+            raise ChannelTableError(f"{source}: channels[{i}] lacks {', '.join(missing)}")
+        if entry.get("when", "") not in WHEN:
+            raise ChannelTableError(
+                f"{source}: channels[{i}] ({entry['name']}): when must be one of {sorted(WHEN)[1:]}"
+            )
+        if entry["status"] not in ("live", "planned"):
+            raise ChannelTableError(
+                f"{source}: channels[{i}] ({entry['name']}): status must be live or planned"
+            )
+        out.append(
+            Channel(
+                name=str(entry["name"]),
+                id=str(entry["id"]),
+                type=str(entry["type"]),
+                rate=str(entry["rate"]),
+                status=str(entry["status"]),
+                publishers=tuple(entry["publishers"]),
+                subscribers=tuple(entry["subscribers"]),
+                content=str(entry["content"]),
+                when=str(entry.get("when", "")),
+            )
+        )
+    return ChannelTable(
+        source=source,
+        url_default=str(doc.get("url_default", "")),
+        vehicle_prefix=str(doc.get("vehicle_prefix", "")),
+        channels=tuple(out),
+    )
+
+
+def channel(channel_id: str, vehicle: str | None = None) -> str:
+    """The concrete name of a channel by its id, e.g. channel("ODOM", "NIGEL1")."""
+    return load().by_id(channel_id).resolve(vehicle)
+
+
+def vehicle_name(car: int = 1) -> str:
+    """The name of the simulator's car number car (1, 2, ...), e.g. "NIGEL1"."""
+    return f"{load().vehicle_prefix}{car}"

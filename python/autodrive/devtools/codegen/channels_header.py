@@ -1,0 +1,38 @@
+"""lcm_types/channels.yaml -> <autodrive_channels.h>: the channel names for C and C++.
+
+A per-vehicle channel "<VEH>_ODOM" becomes AUTODRIVE_CH_ODOM_SUFFIX "_ODOM" (appended to the
+vehicle name: `vehicle + AUTODRIVE_CH_ODOM_SUFFIX`, or "%s" AUTODRIVE_CH_ODOM_SUFFIX in C), and a
+per-camera one "<CAM>_IMAGE" likewise AUTODRIVE_CH_IMAGE_SUFFIX "_IMAGE"; a
+global one becomes AUTODRIVE_CH_<ID> with its whole name. Planned channels are generated too,
+marked as such, so that work in progress spells them from the table as well."""
+
+from __future__ import annotations
+
+from autodrive.core import channels
+from autodrive.devtools.codegen import c_header
+
+GUARD = "AUTODRIVE_CHANNELS_H"
+
+
+def render(table: channels.ChannelTable, source_name: str) -> str:
+    lines = [
+        f'#define AUTODRIVE_LCM_URL_DEFAULT "{table.url_default}"',
+        "/* the simulator's cars are <prefix><i>; one-car programs default to car 1 */",
+        f'#define AUTODRIVE_VEHICLE_PREFIX "{table.vehicle_prefix}"',
+        f'#define AUTODRIVE_VEHICLE_DEFAULT "{table.vehicle_prefix}1"',
+        "",
+    ]
+    for ch in table.channels:
+        note = f"/* {ch.type}, {ch.rate}" + (", planned */" if ch.status == "planned" else " */")
+        if ch.placeholder:
+            suffix = ch.name[len(ch.placeholder) :]
+            lines.append(f'#define AUTODRIVE_CH_{ch.id}_SUFFIX "{suffix}" {note}')
+        else:
+            lines.append(f'#define AUTODRIVE_CH_{ch.id} "{ch.name}" {note}')
+    return c_header.wrap(
+        GUARD,
+        source_name,
+        "autodrive.devtools.codegen.channels_header",
+        "LCM channel names; CHANNELS.md describes each.",
+        lines,
+    )

@@ -1,0 +1,23 @@
+"""The generated files kept in the tree (readable without a build, and needed by PlatformIO,
+which builds the firmware without Python): each one's path and its rendered text."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from autodrive.core import channels, vehicle
+from autodrive.devtools.codegen import channels_doc, firmware_header, vehicle_doc
+
+PARAMS = "vehicle/nigel.params"
+CHANNELS = "lcm_types/channels.yaml"
+
+
+def render_all(root: Path) -> dict[str, str]:
+    """Repository-relative path -> the text it must hold."""
+    car = vehicle.load(root / PARAMS)
+    table = channels.load(root / CHANNELS)
+    return {
+        channels_doc.PATH: channels_doc.render(table, CHANNELS),
+        vehicle_doc.PATH: vehicle_doc.render(car, PARAMS),
+        firmware_header.PATH: firmware_header.render(car, PARAMS),
+    }

@@ -1,0 +1,44 @@
+"""The demo's missions: `loop` (pure pursuit around a stadium track), `parking`, `smart-city`,
+`cloning` and `intersection`, and what they share."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from autodrive.core import channels
+from autodrive.core.settings import OUT_DIR, RELEASE_BUILD
+from autodrive.core.proc import Log, ProcessGroup
+
+PTY_TIMEOUT_S = 30.0  # a started simulator's Nano pty appears within this [s wall]
+EXIT_INTERRUPTED = 130  # a mission stopped by Ctrl-C exits as a shell's SIGINT does
+
+
+def add_run_options(
+    p: argparse.ArgumentParser, mission: str, seed_help: str, timeout_s: float
+) -> None:
+    """The options a mission with its own parser shares with the demo: --mission, --build,
+    --out (default out/demo-MISSION), --seed, --headless, --timeout [s wall], --lcm-url."""
+    p.add_argument("--mission", choices=(mission,), default=mission, help="this mission")
+    p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
+    p.add_argument("--out", default=str(OUT_DIR / f"demo-{mission}"), help="output folder")
+    p.add_argument("--seed", type=int, default=1, help=seed_help)
+    p.add_argument("--headless", action="store_true", help="never open the simulator's window")
+    p.add_argument("--timeout", type=float, default=timeout_s, help="give up after this [s wall]")
+    p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
+
+
+@dataclass
+class MissionContext:
+    """What a mission gets from the demo: the build, the bus, the running children."""
+
+    build: Path
+    out: Path
+    lcm_url: str
+    vehicle: str
+    procs: ProcessGroup
+    stop_requested: Callable[[], bool]
+    say: Log  # a progress line of the demo ("[demo] ..." on its console)
+    echo: Log  # a line as it is (a child's log)

@@ -1,0 +1,99 @@
+"""The cloning evaluation's referee: where a car is on its route's lane, from ground truth and the
+map's lane data (autodrive.maps). Signed offsets of base_link and of the four wheels from
+the route's centre line, a crossing of the lane bound by any wheel (an intervention in the
+PilotNet sense), laps from the distance driven along the route."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from autodrive.core import vehicle
+from autodrive.maps.description import Route
+
+Pose3 = tuple[float, float, float]  # x [m], y [m], yaw [rad]
+
+
+@dataclass
+class LaneWatch:
+    """Follows one car along one route, one ground-truth pose at a time."""
+
+    route: Route
+    wheel_points_m: list[tuple[float, float]]  # wheel contact points in base_link [m]
+    progress_m: float = 0.0  # driven along the route (unwrapped; laps = progress / length)
+    last_s_m: float | None = None
+    offsets_m: list[float] = field(default_factory=list)  # base_link, + left of the line
+    _a: npt.NDArray[np.float64] = field(init=False)
+    _d: npt.NDArray[np.float64] = field(init=False)
+    _len2: npt.NDArray[np.float64] = field(init=False)
+    _s0: npt.NDArray[np.float64] = field(init=False)
+
+    def __post_init__(self) -> None:
+        pts = np.asarray(self.route.polyline_m, dtype=float)
+        self._a = pts[:-1]
+        self._d = pts[1:] - pts[:-1]
+        self._len2 = np.maximum((self._d**2).sum(axis=1), 1e-12)
+        seg = np.sqrt(self._len2)
+        self._s0 = np.concatenate(([0.0], np.cumsum(seg)[:-1]))
+
+    @property
+    def length_m(self) -> float:
+        return float(self._s0[-1] + math.sqrt(self._len2[-1]))
+
+    @property
+    def laps(self) -> float:
+        return self.progress_m / self.length_m
+
+    def locate(self, x: float, y: float) -> tuple[float, float, Pose3]:
+        """(signed offset [m, + left], along [m], nearest centre-line pose) of a point."""
+        p = np.array([x, y])
+        t = np.clip(((p - self._a) * self._d).sum(axis=1) / self._len2, 0.0, 1.0)
+        q = self._a + t[:, None] * self._d
+        dist2 = ((q - p) ** 2).sum(axis=1)
+        i = int(np.argmin(dist2))
+        dx, dy = self._d[i]
+        side = dx * (y - self._a[i][1]) - dy * (x - self._a[i][0])
+        offset = math.copysign(math.sqrt(float(dist2[i])), side)
+        along = float(self._s0[i] + t[i] * math.sqrt(self._len2[i]))
+        return offset, along, (float(q[i][0]), float(q[i][1]), math.atan2(dy, dx))
+
+    def wheels_out(self, pose: Pose3) -> bool:
+        """True when any wheel's contact point is past the lane bound (route half width)."""
+        x, y, yaw = pose
+        c, s = math.cos(yaw), math.sin(yaw)
+        for wx, wy in self.wheel_points_m:
+            off, _, _ = self.locate(x + c * wx - s * wy, y + s * wx + c * wy)
+            if abs(off) > self.route.half_width_m:
+                return True
+        return False
+
+    def update(self, pose: Pose3) -> float:
+        """Follows the car to pose: progress along the route; returns base_link's offset [m]."""
+        off, along, _ = self.locate(pose[0], pose[1])
+        if self.last_s_m is not None:
+            step = along - self.last_s_m
+            if self.route.loop:  # across the loop's seam
+                step = (step + self.length_m / 2) % self.length_m - self.length_m / 2
+            self.progress_m += step
+        self.last_s_m = along
+        self.offsets_m.append(off)
+        return off
+
+    def cross_track_rms_m(self) -> float:
+        if not self.offsets_m:
+            return float("nan")
+        return float(np.sqrt(np.mean(np.square(self.offsets_m))))
+
+
+def for_route(route: Route) -> LaneWatch:
+    """A watch with the car's wheel contact points from the vehicle description: rear wheels on
+    the rear axle (base_link), front wheels a wheelbase ahead, each at half the track plus half a
+    wheel width to the side (the outer edge of the tyre)."""
+    car = vehicle.load()
+    wb, half = car.number("wheelbase_m"), 0.5 * (
+        car.number("track_m") + car.number("wheel_width_m")
+    )
+    return LaneWatch(route, [(0.0, half), (0.0, -half), (wb, half), (wb, -half)])

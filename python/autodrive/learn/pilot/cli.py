@@ -1,0 +1,193 @@
+"""`tools/pilot`: behavioural cloning (issue 16): expert, record, train, analyse, make-model.
+Run `tools/pilot COMMAND --help` for each command's options."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+import os
+import sys
+from pathlib import Path
+
+from autodrive.core.settings import RELEASE_BUILD
+from autodrive.learn.pilot.expert import ExpertRun
+
+DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front camera.
+  expert      drive N laps with the simulator's expert (pure pursuit + perturbations), record an LCM log
+  record      LCM log(s) -> dataset (JPEG frames, frames.csv, manifest.json)
+  train       dataset -> NAME.onnx + NAME.json sidecar, loss curves, report
+  analyse     activation maps, VisualBackProp saliency and a lap of predictions vs the expert
+  make-model  expert 5 laps + record + train + analyse: the shipped models/pilot/driving_school
+A person can drive instead of the expert: autodrive-sim --map driving_school --cameras
+--lockstep-client, the runtime on its pty, autodrive-teleop, and tools/record LOG; then
+`tools/pilot record LOG --map driving_school` (README, Behavioural cloning)."""
+
+
+def _build() -> Path:
+    return Path(os.environ.get("AUTODRIVE_BUILD", str(RELEASE_BUILD)))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="tools/pilot", description=DESCRIPTION, formatter_class=argparse.RawTextHelpFormatter
+    )
+    sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+
+    e = sub.add_parser("expert", help="record the expert driving laps (LCM log + LOG.meta.json)")
+    e.add_argument("--out", type=Path, required=True, help="the LCM log to write")
+    e.add_argument("--map", default="driving_school")
+    e.add_argument("--route", default="loop_ccw", help="a loop route of the map")
+    e.add_argument(
+        "--lane-shift", type=int, default=0,
+        help="drive the lane this many lane widths left of the route's, in its direction "
+        "(1 on Driving School's loop_ccw: the inner lane, counter-clockwise)",
+    )  # fmt: skip
+    e.add_argument("--laps", type=int, default=5)
+    e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
+    e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
+    e.add_argument("--perturb", type=float, default=0.35, help="perturbation amplitude (0..1)")
+    e.add_argument(
+        "--camera-fps", type=float, default=ExpertRun.camera_fps, help="[Hz] of sim time"
+    )
+    e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
+    e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
+    e.add_argument(
+        "--duration", type=float, default=0.0,
+        help="[s] of sim time: stop there (0: when the laps are done); the run is the same up to it",
+    )  # fmt: skip
+    e.add_argument("--lcm-url", default="", help="default: a port of this process's own")
+
+    r = sub.add_parser("record", help="extract a dataset from LCM log(s)")
+    r.add_argument("logs", nargs="+", type=Path, metavar="LOG")
+    r.add_argument("--out", type=Path, required=True, help="the dataset folder")
+    r.add_argument("--map", default=None, help="the map (else from LOG.meta.json)")
+    r.add_argument("--seed", type=int, default=None, help="the recording's seed (else meta)")
+    r.add_argument("--vehicle", default=None, help="default: car 1 (NIGEL1)")
+
+    t = sub.add_parser("train", help="train, export ONNX + sidecar JSON")
+    t.add_argument("dataset", type=Path, metavar="DATASET")
+    t.add_argument("--out", type=Path, required=True)
+    t.add_argument("--name", default="model", help="files NAME.onnx, NAME.json, NAME.pt")
+    t.add_argument("--epochs", type=int, default=4)
+    t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--batch", type=int, default=64)
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--threads", type=int, default=2, help="PyTorch threads")
+    t.add_argument("--max-frames", type=int, default=0, help="use the first N frames (0: all)")
+    t.add_argument(
+        "--samples-per-epoch", type=int, default=0, help="drawn per epoch (0: training frames)"
+    )
+    t.add_argument("--stride", type=int, default=1, help="use every N-th frame")
+    t.add_argument(
+        "--balance-max-ratio", type=float, default=None,
+        help="balancing: a frame is drawn at most this many times as often as one of the "
+        "commonest steering (default: the shipped recipe's)",
+    )  # fmt: skip
+    t.add_argument(
+        "--channels", type=int, choices=(1, 3), default=1,
+        help="input channels the network reads: 1 = the luma of the YUV input (the shipped "
+        "recipe: colour would let it tell the centre line from the edge line), 3 = all",
+    )  # fmt: skip
+    t.add_argument(
+        "--label-lookahead", type=float, default=0.0, metavar="M",
+        help="label each frame with pure pursuit's steering at this lookahead [m] from its "
+        "ground-truth pose (a label the picture determines; README) instead of the recorded "
+        "steering (0, the default)",
+    )  # fmt: skip
+    t.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="an experiment (the shipped recipe: 0): bend the ground of half the drawn frames "
+        "by an extra curvature up to +-DK [1/m], the label following (augment.CurveWarp)",
+    )  # fmt: skip
+
+    a = sub.add_parser("analyse", help="activation maps, saliency, a lap vs the expert (PNGs)")
+    a.add_argument("--model", type=Path, required=True, help="NAME.onnx (NAME.json beside it)")
+    a.add_argument("--dataset", type=Path, required=True)
+    a.add_argument("--out", type=Path, required=True)
+    a.add_argument("--lap", type=int, default=None, help="default: the first validation lap")
+    a.add_argument("--samples", type=int, default=3, help="frames with activation maps")
+
+    m = sub.add_parser("make-model", help="expert + record + train + analyse, one command")
+    m.add_argument("--out", type=Path, default=Path("models/pilot"), help="the shipped files")
+    m.add_argument("--work", type=Path, default=Path("out/pilot"), help="log, dataset, figures")
+    m.add_argument("--name", default="driving_school")
+    m.add_argument("--laps", type=int, default=5)
+    m.add_argument("--seed", type=int, default=1, help="the recording's seed")
+    m.add_argument("--train-seed", type=int, default=0)
+    m.add_argument(
+        "--other-lane-laps", type=int, default=0,
+        help="an experiment (the shipped model: 0): this many of the laps in the road's other "
+        "lane, still counter-clockwise (README: the reverse direction)",
+    )  # fmt: skip
+    m.add_argument("--epochs", type=int, default=4)
+    m.add_argument(
+        "--label-lookahead", type=float, default=0.0, metavar="M",
+        help="train on pure pursuit labels at this lookahead [m] (tools/pilot train "
+        "--label-lookahead); 0: the expert's recorded steering",
+    )  # fmt: skip
+    m.add_argument(
+        "--curve-max", type=float, default=0.0, metavar="DK",
+        help="an experiment (the shipped recipe: 0): bend the ground of half the drawn frames "
+        "by an extra curvature up to +-DK [1/m], the label following (augment.CurveWarp)",
+    )  # fmt: skip
+    m.add_argument(
+        "--logs", type=Path, nargs="+", default=None, metavar="LOG",
+        help="skip the expert: use these recordings of `tools/pilot expert`, which must be the "
+        "recipe's (their LOG.meta.json is checked against --laps and --seed)",
+    )  # fmt: skip
+
+    args = ap.parse_args(argv)
+    try:
+        return _run(args)
+    except KeyboardInterrupt:
+        print("tools/pilot: interrupted", file=sys.stderr)
+        return 130
+    except (ValueError, FileNotFoundError, FileExistsError, RuntimeError) as err:
+        print(f"tools/pilot {args.cmd}: {err}", file=sys.stderr)
+        return 1
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.cmd == "expert":
+        from autodrive.learn.pilot.expert import record_expert
+
+        run = ExpertRun(
+            map=args.map, route=args.route, lane_shift=args.lane_shift, laps=args.laps,
+            seed=args.seed, speed=args.speed,
+            perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
+            light_level=args.light_level, duration_s=args.duration,
+        )  # fmt: skip
+        wall = record_expert(run, args.out, _build(), args.lcm_url)
+        print(f"pilot expert: {args.out} in {wall:.0f} s wall")
+        return 0
+    if args.cmd == "record":
+        from autodrive.learn.pilot.dataset import record
+
+        record(args.logs, args.out, args.map, args.seed, args.vehicle, _build())
+        return 0
+    if args.cmd == "train":
+        from autodrive.learn.pilot.train import TrainConfig, train
+
+        cfg = TrainConfig(
+            epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed, name=args.name,
+            threads=args.threads, max_frames=args.max_frames,
+            samples_per_epoch=args.samples_per_epoch, stride=args.stride,
+            channels=args.channels, label_lookahead_m=args.label_lookahead,
+            curve_max_dk=args.curve_max,
+        )  # fmt: skip
+        if args.balance_max_ratio is not None:
+            cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
+        train(args.dataset, args.out, cfg)
+        return 0
+    if args.cmd == "analyse":
+        from autodrive.learn.pilot.analyse import analyse
+
+        analyse(args.model, args.dataset, args.out, args.lap, args.samples)
+        return 0
+    from autodrive.learn.pilot.make_model import make_model
+
+    make_model(
+        args.out, args.work, args.name, args.laps, args.seed, args.train_seed, args.epochs,
+        _build(), args.logs, args.other_lane_laps, args.label_lookahead, args.curve_max,
+    )  # fmt: skip
+    return 0

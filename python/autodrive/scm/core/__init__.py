@@ -1,0 +1,2 @@
+"""The SCM's configuration (config), database engine and migrations (db) and passwords and
+session secrets (security)."""

@@ -1,0 +1,185 @@
+"""Running the SCM from tests and benchmarks: autodrive-scm as a real process, an HTTP client
+with its session and CSRF token, a throw-away PostgreSQL server (Debian's) and headless
+Chromium (Debian's, through chromedriver and Selenium)."""
+
+from __future__ import annotations
+
+import json
+import os
+import pwd
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import urllib.error
+import urllib.request
+from http.cookiejar import CookieJar
+from pathlib import Path
+from typing import Any
+
+PG_BIN = Path("/usr/lib/postgresql/15/bin")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def scm_command(*args: str) -> list[str]:
+    return [sys.executable, "-m", "autodrive.scm.cli", *args]
+
+
+def add_user(db: str, name: str, role: str, password: str) -> None:
+    subprocess.run(
+        scm_command("user", "add", name, "--role", role, "--db", db, "--password-stdin"),
+        input=password + "\n",
+        text=True,
+        check=True,
+        capture_output=True,
+    )
+
+
+class Server:
+    """autodrive-scm on Tiny Town on a free port; waits for its "SCM ready" line."""
+
+    def __init__(
+        self,
+        db: str,
+        lcm_url: str,
+        build: str,
+        vehicles: str = "NIGEL1,NIGEL2,NIGEL3",
+        extra: list[str] | None = None,
+        port: int | None = None,
+    ) -> None:
+        self.port = port or free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.log = open(f"/tmp/scm-{self.port}.log", "w")
+        cmd = scm_command(
+            "--map", "tiny_town", "--db", db, "--host", "127.0.0.1", "--port", str(self.port),
+            "--lcm-url", lcm_url, "--vehicles", vehicles, "--build", build, *(extra or []),
+        )  # fmt: skip
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, text=True)
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline()
+        if f"SCM ready {self.url}/" not in line:
+            self.stop()
+            raise RuntimeError(f"autodrive-scm did not start: {line!r}; log {self.log.name}")
+
+    def stop(self, kill: bool = False) -> int:
+        if self.proc.poll() is None:
+            if kill:
+                self.proc.kill()
+            else:
+                self.proc.terminate()
+        rc = self.proc.wait(timeout=30)
+        self.log.close()
+        return rc
+
+
+class Client:
+    """An HTTP client with its own cookie jar and the CSRF token of its session."""
+
+    def __init__(self, base: str) -> None:
+        self.base = base
+        self.opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor(CookieJar()))
+        self.csrf = ""
+
+    def call(self, method: str, path: str, body: Any = None, csrf: bool = True) -> tuple[int, Any]:
+        data = json.dumps(body).encode() if body is not None else None
+        req = urllib.request.Request(self.base + path, data=data, method=method)
+        req.add_header("Content-Type", "application/json")
+        if csrf and self.csrf:
+            req.add_header("X-CSRF-Token", self.csrf)
+        try:
+            with self.opener.open(req, timeout=60) as r:
+                return int(r.status), json.loads(r.read() or b"null")
+        except urllib.error.HTTPError as err:
+            return int(err.code), json.loads(err.read() or b"null")
+
+    def login(self, name: str, password: str) -> dict[str, str]:
+        code, body = self.call("POST", "/api/login", {"name": name, "password": password})
+        if code != 200:
+            raise RuntimeError(f"login as {name} failed: {code} {body}")
+        self.csrf = str(body["csrf"])
+        return dict(body)
+
+
+class Postgres:
+    """A throw-away PostgreSQL server (Debian's) in a temp folder on a free port; as root it
+    runs as the 'postgres' user (initdb refuses root). Trust auth, on 127.0.0.1 only."""
+
+    def __init__(self, tmp: str | None = None) -> None:
+        self.own = tmp is None  # a folder of its own (readable by 'postgres'), removed at stop
+        tmp = tmp or tempfile.mkdtemp(prefix="scm-pg-")
+        self.tmp = tmp
+        self.dir = Path(tmp) / "pgdata"
+        self.port = free_port()
+        self.prefix: list[str] = []
+        Path(tmp).mkdir(parents=True, exist_ok=True)
+        if os.geteuid() == 0:
+            self.prefix = ["runuser", "-u", "postgres", "--"]
+            pw = pwd.getpwnam("postgres")
+            os.chmod(tmp, 0o755)
+            self.dir.mkdir()
+            shutil.chown(self.dir, pw.pw_uid, pw.pw_gid)
+        self._run([str(PG_BIN / "initdb"), "-D", str(self.dir), "-U", "scm", "--auth=trust",
+                   "-E", "UTF8", "--no-sync"])  # fmt: skip
+        opts = f"-p {self.port} -k {self.dir} -c listen_addresses=127.0.0.1"
+        self._run([str(PG_BIN / "pg_ctl"), "-D", str(self.dir), "-l", str(self.dir / "log"),
+                   "-w", "-t", "60", "-o", opts, "start"])  # fmt: skip
+        self.url = f"postgresql://scm@127.0.0.1:{self.port}/postgres"
+
+    def _run(self, cmd: list[str]) -> None:
+        r = subprocess.run(self.prefix + cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd[:2])} failed: {r.stdout}{r.stderr}")
+
+    def stop(self) -> None:
+        self._run([str(PG_BIN / "pg_ctl"), "-D", str(self.dir), "-m", "fast", "-w", "stop"])
+        if self.own:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+
+
+def chromium() -> Any:
+    """Debian's Chromium, headless, driven through Debian's chromedriver (Selenium). The window
+    is tall enough to show the whole map (W3C pointer offsets are from the centre of an
+    element's visible part)."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = "/usr/bin/chromium"
+    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
+                "--window-size=1600,1300"):  # fmt: skip
+        opts.add_argument(arg)
+    return webdriver.Chrome(options=opts, service=Service("/usr/bin/chromedriver"))
+
+
+def login_page(driver: Any, base: str, name: str, password: str) -> None:
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    driver.get(base + "/")
+    WebDriverWait(driver, 20).until(lambda d: d.find_element(By.ID, "login-name").is_displayed())
+    driver.find_element(By.ID, "login-name").send_keys(name)
+    driver.find_element(By.ID, "login-password").send_keys(password)
+    driver.find_element(By.ID, "login-submit").click()
+    WebDriverWait(driver, 20).until(lambda d: d.find_element(By.ID, "app").is_displayed())
+    # the tables are built from the first live state (WebSocket)
+    WebDriverWait(driver, 20).until(lambda d: d.execute_script("return scm.state !== null;"))
+    WebDriverWait(driver, 20).until(lambda d: d.find_elements(By.ID, "light-row-1"))
+
+
+def click_light(driver: Any, light_id: int) -> None:
+    """A real pointer click on the light's lamp on the map."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    canvas = driver.find_element(By.ID, "map")
+    u, v = driver.execute_script(f"return scm.lightPixel({light_id});")
+    w, h = canvas.size["width"], canvas.size["height"]
+    ActionChains(driver).move_to_element_with_offset(
+        canvas, int(u - w / 2), int(v - h / 2)
+    ).click().perform()
