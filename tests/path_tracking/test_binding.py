@@ -1,11 +1,11 @@
-"""The Python binding of the one pure pursuit (autodrive_tools.pure_pursuit, cffi on
+"""The Python binding of the one pure pursuit (autodrive.core.pure_pursuit, cffi on
 libautodrive_path_tracking.so) gives the C library's answers."""
 
 from __future__ import annotations
 
 import math
 
-from autodrive_tools import pure_pursuit, vehicle
+from autodrive.core import pure_pursuit, vehicle
 
 
 def test_default_vehicle_is_the_vehicle_description() -> None:

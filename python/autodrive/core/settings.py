@@ -68,7 +68,7 @@ class Settings:
 
     @property
     def autonomy_example_config(self) -> Path:
-        return self.root / "runtime" / "jetson" / "autonomy" / "config" / "autonomy.example.yaml"
+        return self.root / "runtime" / "jetson" / "config" / "autonomy.example.yaml"
 
     @property
     def eye_config(self) -> Path:
@@ -80,7 +80,7 @@ class Settings:
 
     @property
     def pilot_hil_config(self) -> Path:
-        return self.root / "runtime" / "jetson" / "pilot" / "config" / "pilot_hil.yaml"
+        return self.root / "runtime" / "jetson" / "config" / "pilot_hil.yaml"
 
     @property
     def marl_core_header(self) -> Path:

@@ -76,7 +76,7 @@ class OverheadCamera:
 
 def sim_tag_id(car: int) -> int:
     """The roof tag id the simulator gives its car number car (1, 2, ...: mjcf_gen.c
-    mg_tag_id)."""
+    mjcf_gen_tag_id)."""
     return car
 
 

@@ -337,7 +337,7 @@ int main(int argc, char **argv) {
                  "drives on to the route's end");
   cli.add_option("--waypoint-lookahead-m", o.waypoint_lookahead_m,
                  "rl: the route waypoint's distance ahead in the observation [m], as in training "
-                 "(autodrive_tools.marl.env.LOOKAHEAD_M)")
+                 "(autodrive.learn.marl.env.LOOKAHEAD_M)")
       ->check(CLI::Range(0.01, 5.0));
   cli.add_option("--clock", o.clock, "sim (SIM_CLOCK, HIL) or wall")
       ->check(CLI::IsMember({"sim", "wall"}))

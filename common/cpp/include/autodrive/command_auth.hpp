@@ -3,7 +3,7 @@
 // increasing counter (the sender's wall clock [us]) and a truncated HMAC-SHA-256 over canonical
 // bytes with the car's 32-byte key. The canonical byte order is documented once, in
 // lcm_types/autodrive/vehicle_command_t.lcm; tests/foundation/command_auth_vectors.json holds
-// vectors the Python signer (autodrive_tools.command_auth) must match byte for byte.
+// vectors the Python signer (autodrive.core.command_auth) must match byte for byte.
 #pragma once
 
 #include <autodrive/strict_yaml.hpp>

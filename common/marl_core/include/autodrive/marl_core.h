@@ -1,6 +1,6 @@
 /* The multi-agent intersection policy's shared core (C11, no dependencies): the observation
  * builder and the time-to-collision safety shield. Python's batch training and evaluation
- * (cffi, ABI mode: python/autodrive_tools/marl/core.py reads the declarations between the CFFI
+ * (cffi, ABI mode: python/autodrive/learn/marl/core.py reads the declarations between the CFFI
  * markers) and the C++ autodrive-marl both call it, so the observation and the shield exist
  * once.
  *

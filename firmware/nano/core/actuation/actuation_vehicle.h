@@ -1,4 +1,4 @@
-/* Generated from vehicle/nigel.params by autodrive_tools.codegen.firmware_header (tools/gen-docs):
+/* Generated from vehicle/nigel.params by autodrive.devtools.codegen.firmware_header (tools/gen-docs):
  * do not edit. The steering servo's figures as the firmware's integers. */
 #ifndef AUTODRIVE_ACTUATION_VEHICLE_H
 #define AUTODRIVE_ACTUATION_VEHICLE_H

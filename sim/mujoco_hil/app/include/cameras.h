@@ -14,7 +14,7 @@
 
 #define CAMERAS_ALL 1      /* --cameras: front and rear */
 #define CAMERAS_FRONT 2    /* --front-camera: front only */
-#define CAMERAS_MAX_EYES 8 /* a map's eye_cameras (autodrive_tools.maps MAX_EYE_CAMERAS) */
+#define CAMERAS_MAX_EYES 8 /* a map's eye_cameras (autodrive.maps MAX_EYE_CAMERAS) */
 #define CAMERAS_MAX (2 * SIM_MAX_CARS + CAMERAS_MAX_EYES)
 typedef struct cameras {
   int n;

@@ -1,6 +1,6 @@
 // A trained intersection policy: NAME.onnx (input `obs` float32 [N, D], output `action`:
 // logits over a discrete action set, or a continuous steering mean) run with OpenCV DNN, and
-// NAME.json beside it (written by tools/marl's export, python/autodrive_tools/marl/export.py),
+// NAME.json beside it (written by tools/marl's export, python/autodrive/learn/marl/export.py),
 // the one place of what the network means. The keys read here:
 //   {"obs": {"layout_version": V, "dim": D},
 //    "action": {"type": "discrete", "throttle_steering": [[1.0, -1.0], [1.0, 0.0], ...]}
