@@ -7,3 +7,17 @@ if(AUTODRIVE_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# autodrive_python_sanitizer_env(<list var>): appends to the list what a Python test needs to
+# dlopen() this build's shared libraries (cffi) when they are sanitized: the ASan runtime (and
+# libstdc++, whose __cxa_throw ASan intercepts) preloaded. Nothing without AUTODRIVE_SANITIZE.
+function(autodrive_python_sanitizer_env var)
+  if(AUTODRIVE_SANITIZE)
+    execute_process(COMMAND ${CMAKE_C_COMPILER} -print-file-name=libasan.so
+      OUTPUT_VARIABLE asan OUTPUT_STRIP_TRAILING_WHITESPACE)
+    execute_process(COMMAND ${CMAKE_CXX_COMPILER} -print-file-name=libstdc++.so.6
+      OUTPUT_VARIABLE stdcxx OUTPUT_STRIP_TRAILING_WHITESPACE)
+    set(${var} ${${var}} "LD_PRELOAD=${asan}:${stdcxx}"
+      "ASAN_OPTIONS=detect_leaks=0:verify_asan_link_order=0" PARENT_SCOPE)
+  endif()
+endfunction()
