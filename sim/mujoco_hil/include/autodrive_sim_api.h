@@ -5,7 +5,7 @@
  * COMMAND frames at 50 Hz (armed with engaged 0, then engaged 1), with the firmware's slew
  * and steering-rate limits, exactly as the runtime's bridge writes them on the pty.
  *
- * Plain C types only: Python loads it with cffi (python/autodrive_tools/learn/_lib.py reads
+ * Plain C types only: Python loads it with cffi (python/autodrive/gym/_lib.py reads
  * the declarations between the CFFI markers from this file). Cars are 0-based here. Not
  * thread-safe per world; distinct worlds are independent. Errors: functions that can fail
  * return 0 / -1 (or NULL) and write a message naming the bad input into err. */

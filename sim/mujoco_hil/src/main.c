@@ -251,7 +251,7 @@ static void main_report_late_boxes(const sim_t *s) {
 /* Cameras rendered headless (sensors library): front/rear of every car, the overhead Eye. */
 #define MAIN_CAMERAS_ALL 1   /* --cameras: front and rear */
 #define MAIN_CAMERAS_FRONT 2 /* --front-camera: front only */
-#define MAIN_MAX_EYE_CAMS 8  /* a map's eye_cameras (autodrive_tools.maps MAX_EYE_CAMERAS) */
+#define MAIN_MAX_EYE_CAMS 8  /* a map's eye_cameras (autodrive.maps MAX_EYE_CAMERAS) */
 #define MAIN_MAX_CAMS (2 * SIM_MAX_CARS + MAIN_MAX_EYE_CAMS)
 typedef struct main_cams {
   int n;
