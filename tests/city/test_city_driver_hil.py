@@ -1,7 +1,7 @@
 """The smart-city behaviour layer in HIL: autodrive-sim (Tiny Town, lockstep with the runtime),
 the unchanged autodrive-runtime on its ptys (its EKF fed by the Eye stand-in,
-autodrive_tools.city.eye_standin), autodrive-city-driver on Tiny Town's loop city_east (through light
-3 and the stop sign), and the test's own V2I advisory publisher (autodrive_tools.city.advisory),
+autodrive.hil.city.eye_standin), autodrive-city-driver on Tiny Town's loop city_east (through light
+3 and the stop sign), and the test's own V2I advisory publisher (autodrive.hil.city.advisory),
 all on real LCM. Judged from the simulator's ground truth and light states:
 1. light 3 held GREEN, the advisory stopped once the car drives (stale): the car stops with its
    front before the stop line anyway (overshoot <= 3 cm);
@@ -24,11 +24,12 @@ import time
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import command_auth, lcmtypes  # noqa: E402
-from autodrive_tools.channels import channel  # noqa: E402
-from autodrive_tools.city import hil, scoring  # noqa: E402
-from autodrive_tools.maps.loader import MAPS_DIR  # noqa: E402
-from autodrive_tools.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
+from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive.core.channels import channel  # noqa: E402
+from autodrive.hil.city import hil, scoring  # noqa: E402
+from autodrive.maps.loader import MAPS_DIR  # noqa: E402
+from autodrive.core.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
 
 URL = f"udpm://239.255.76.67:{port}?ttl=0"
 MAP = MAPS_DIR / "tiny_town.json"
@@ -155,7 +156,7 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         eye = [
             sys.executable,
             "-m",
-            "autodrive_tools.city.eye_standin",
+            "autodrive.hil.city.eye_standin",
             "--vehicles",
             "NIGEL1",
             "--lcm-url",
@@ -167,7 +168,7 @@ with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
         adv = [
             sys.executable,
             "-m",
-            "autodrive_tools.city.advisory",
+            "autodrive.hil.city.advisory",
             "--map",
             "tiny_town",
             "--vehicles",

@@ -18,11 +18,13 @@ import time
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import command_auth, lcmtypes, vehicle  # noqa: E402
-from autodrive_tools.channels import channel  # noqa: E402
-from autodrive_tools.city import hil, scoring  # noqa: E402
-from autodrive_tools.maps.loader import MAPS_DIR  # noqa: E402
-from autodrive_tools.proc import ProcessGroup, wait_for_path  # noqa: E402
+from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive.core import vehicle  # noqa: E402
+from autodrive.core.channels import channel  # noqa: E402
+from autodrive.hil.city import hil, scoring  # noqa: E402
+from autodrive.maps.loader import MAPS_DIR  # noqa: E402
+from autodrive.core.proc import ProcessGroup, wait_for_path  # noqa: E402
 
 URL = f"udpm://239.255.76.67:{port}?ttl=0"
 MAP = MAPS_DIR / "tiny_town.json"
@@ -118,9 +120,9 @@ with tempfile.TemporaryDirectory(prefix="city-gap-") as tmp:
         py = [sys.executable, "-m"]
         common = ["--vehicles", ",".join(CARS), "--lcm-url", URL, "--build", build]
         procs.start(
-            "eye-standin", [*py, "autodrive_tools.city.eye_standin", *common], out / "eye.log"
+            "eye-standin", [*py, "autodrive.hil.city.eye_standin", *common], out / "eye.log"
         )
-        adv = [*py, "autodrive_tools.city.advisory", "--map", "tiny_town", *common]
+        adv = [*py, "autodrive.hil.city.advisory", "--map", "tiny_town", *common]
         procs.start("advisory", adv, out / "advisory.log")
         for i, car in enumerate(CARS, 1):
             cfg = hil.runtime_config(out, run_dir, URL, i, poses[i - 1], ROUTE, lidar=True)

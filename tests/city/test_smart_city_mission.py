@@ -16,7 +16,7 @@ WALL_GUARD_S = 900  # only a hang guard (--timeout)
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import lcmtypes  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
 
 with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
     out = pathlib.Path(tmp)
@@ -24,7 +24,7 @@ with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
     cmd = [
         sys.executable,
         "-m",
-        "autodrive_tools.demo",
+        "autodrive.hil.demo",
         "--mission",
         "smart-city",
         "--headless",

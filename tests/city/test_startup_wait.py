@@ -1,4 +1,4 @@
-"""The smart-city mission's start-up wait (autodrive_tools.proc.wait_ready with the mission's
+"""The smart-city mission's start-up wait (autodrive.core.proc.wait_ready with the mission's
 readiness probe of autodrive-scm), on real processes: the real autodrive-scm is ready (GET
 /api/status says ready) and the wait returns the CPU time its start took; one whose port is
 taken exits, and the wait says so with its log; a program that never gets ready while it burns
@@ -12,8 +12,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from autodrive_tools.missions.smart_city import scm_ready
-from autodrive_tools.proc import ProcessGroup, wait_ready
+from autodrive.hil.missions.smart_city import scm_ready
+from autodrive.core.proc import ProcessGroup, wait_ready
 
 root, build, port = Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"
@@ -33,7 +33,7 @@ def free_port() -> int:
 
 
 def scm(tmp: Path, http_port: int) -> list[object]:
-    return [PY, "-m", "autodrive_tools.scm.cli", "--map", "tiny_town", "--db",
+    return [PY, "-m", "autodrive.scm.cli", "--map", "tiny_town", "--db",
             f"sqlite:///{tmp}/scm.sqlite", "--port", http_port, "--lcm-url", url,
             "--build", build]  # fmt: skip
 

@@ -13,10 +13,11 @@ import time
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import command_auth, lcmtypes  # noqa: E402
-from autodrive_tools.channels import channel  # noqa: E402
-from autodrive_tools.city import hil  # noqa: E402
-from autodrive_tools.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
+from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive.core.channels import channel  # noqa: E402
+from autodrive.hil.city import hil  # noqa: E402
+from autodrive.core.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
 
 URL = f"udpm://239.255.76.67:{port}?ttl=0"
 ROUTES = ["loop_ccw", "loop_cw"]

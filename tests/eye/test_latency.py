@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """eye.Latency.CaptureToPoseOnLcm: a running autodrive-eye fed the wide-angle scene's 720p
 frames (10 cars) at a fixed rate over real LCM carries each frame's capture stamp to its
-cars' poses (autodrive_tools.bench.eye_latency). Asserts what does not depend on the machine's
+cars' poses (autodrive.bench.eye_latency). Asserts what does not depend on the machine's
 load: poses come back with the stamps of the frames sent, after them, for all 10 cars; the
 latency figures themselves are the benchmark's (tools/bench eye), printed here only.
 Usage: test_latency.py <build dir> <frames> <fps>"""
 import sys
 from pathlib import Path
 
-from autodrive_tools.bench import eye_latency
+from autodrive.bench import eye_latency
 
 build, frames, fps = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
 try:

@@ -2,12 +2,12 @@
 """eye.Sim.BumpedCameraIsFlagged: Tiny Town's cameras calibrated from its reference tags, then
 eye1's calibration moved by 5 mm and 0.3 deg (as if the camera had been bumped after it was
 calibrated): on the simulator's rendered frames the Eye marks eye1 moved within 30 frames,
-inflates its poses' covariance, and marks no other camera (autodrive_tools.bench.eye_multi
+inflates its poses' covariance, and marks no other camera (autodrive.bench.eye_multi
 --bump). Usage: test_sim_bumped.py <build dir>"""
 import sys
 from pathlib import Path
 
-from autodrive_tools.bench import eye_multi
+from autodrive.bench import eye_multi
 
 try:
     fig = eye_multi.bumped_camera(Path(sys.argv[1]))

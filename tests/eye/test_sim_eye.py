@@ -7,7 +7,7 @@ import sys
 
 root, build, dur = sys.argv[1], sys.argv[2], sys.argv[3]
 r = subprocess.run(
-    [sys.executable, "-m", "autodrive_tools.bench.eye_sim", build, dur],
+    [sys.executable, "-m", "autodrive.bench.eye_sim", build, dur],
     capture_output=True,
     text=True,
     timeout=300,
@@ -15,7 +15,7 @@ r = subprocess.run(
 sys.stderr.write(r.stderr)
 print(r.stdout)
 if r.returncode != 0:
-    sys.exit(f"FAIL: autodrive_tools.bench.eye_sim exited {r.returncode}")
+    sys.exit(f"FAIL: autodrive.bench.eye_sim exited {r.returncode}")
 fig = {k: float(v) for k, v in (line.split() for line in r.stdout.splitlines() if line.strip())}
 fails = []
 if fig["sim_frames"] < 10:

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """eye.Sim.SeveralCamerasHandOverWithoutGap: autodrive-sim --map tiny_town --eye renders the
 map's overhead cameras, a scripted car drives through the overlap of two of them, and one
-autodrive-eye serves them all; its poses vs the sim's ground truth (autodrive_tools.bench.
+autodrive-eye serves them all; its poses vs the sim's ground truth (autodrive.bench.
 eye_multi, --drive crossing), each camera calibrated by calibrate-map from the town's reference
 tags first; every camera publishes its status (reference residual within the health threshold,
 none marked moved). Usage: test_sim_eye_multi.py <build dir> <duration_s>"""
 import sys
 from pathlib import Path
 
-from autodrive_tools.bench import eye_multi
+from autodrive.bench import eye_multi
 
 build, dur = sys.argv[1], sys.argv[2]
 try:

@@ -2,12 +2,12 @@
 """eye.Sim.CamerasCalibrateFromReferenceTags: autodrive-sim --map tiny_town --eye renders the
 town's overhead cameras and its reference tags (map description -> tools/gen-maps -> MJCF);
 `autodrive-eye calibrate-map` calibrates every camera from the tags it sees, and reports how
-each pair of neighbours agrees on the tags they share (autodrive_tools.bench.eye_refcal).
+each pair of neighbours agrees on the tags they share (autodrive.bench.eye_refcal).
 Usage: test_sim_refcal.py <build dir>"""
 import sys
 from pathlib import Path
 
-from autodrive_tools.bench import eye_refcal
+from autodrive.bench import eye_refcal
 
 try:
     fig = eye_refcal.measure(Path(sys.argv[1]))

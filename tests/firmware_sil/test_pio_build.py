@@ -232,7 +232,7 @@ def main() -> int:
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     sys.path.insert(0, str(root / "python"))
-    from autodrive_tools.pio_offline import ensure_tool_scons
+    from autodrive.devtools.pio_offline import ensure_tool_scons
 
     ensure_tool_scons(work / "core")
     check_build(root, cmake_elf, work, pio)

@@ -25,7 +25,7 @@ for f in sorted(types_dir.glob("*_t.lcm")):
     types[f.stem] = f
 
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import channels as channel_table  # noqa: E402
+from autodrive.core import channels as channel_table  # noqa: E402
 
 table = channel_table.load(root / "lcm_types" / "channels.yaml")
 channels = {}

@@ -16,7 +16,8 @@ import sys
 import tempfile
 import types
 
-from autodrive_tools import command_auth, keys
+from autodrive.core import command_auth
+from autodrive.core import keys
 
 root = pathlib.Path(sys.argv[1])
 
@@ -116,6 +117,6 @@ exit 0
     assert "route replace" not in calls, "multi-machine use must leave the routes alone"
 setup = (root / "tools" / "setup").read_text()
 assert '"$ROOT/tools/lcm-route" ensure' in setup, "tools/setup does not keep LCM on lo"
-assert "autodrive_tools.keys create --if-missing" in setup, "tools/setup creates no key"
+assert "autodrive.core.keys create --if-missing" in setup, "tools/setup creates no key"
 print("lcm-route: a default route gets 239.0.0.0/8 dev lo; multi-machine only when asked")
 print("command auth ok")

@@ -1,5 +1,5 @@
 """LCM wire interop: PyPI lcm (Python bindings) <-> Debian LCM 1.3.1 (C++), over real UDP
-multicast on loopback; and autodrive_tools.lcm_wire's hand-read packets of the same bus (what
+multicast on loopback; and autodrive.core.lcm_wire's hand-read packets of the same bus (what
 the C++ peer sent, with the kernel's receive time). Run by ctest with PYTHONPATH at the
 generated Python bindings."""
 import os
@@ -9,9 +9,9 @@ import sys
 import time
 
 import lcm
-from autodrive import vehicle_command_t
+from autodrive_msg import vehicle_command_t
 
-from autodrive_tools import lcm_wire
+from autodrive.core import lcm_wire
 
 peer, port = sys.argv[1], int(sys.argv[2])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

@@ -1,4 +1,4 @@
-"""Unit checks of autodrive_tools' pure parts: the one angle wrap, frame changes and their
+"""Unit checks of autodrive' pure parts: the one angle wrap, frame changes and their
 inverse, the alignment of a dead-reckoned track, clearances, the map facts and the slot goal,
 the runtime config the demo writes, and bad input named in the error."""
 
@@ -6,11 +6,14 @@ import math
 import tempfile
 from pathlib import Path
 
-from autodrive_tools import geometry, mapfacts, scoring, vehicle
-from autodrive_tools.city import scoring as city_scoring
-from autodrive_tools.maps.loader import MAPS_DIR
-from autodrive_tools.missions import parking
-from autodrive_tools.runfiles import read_columns
+from autodrive.core import geometry
+from autodrive.maps import facts as mapfacts
+from autodrive.hil import scoring
+from autodrive.core import vehicle
+from autodrive.hil.city import scoring as city_scoring
+from autodrive.maps.loader import MAPS_DIR
+from autodrive.hil.missions import parking
+from autodrive.core.runfiles import read_columns
 
 
 def raises(fn, exc, *texts):

@@ -11,8 +11,8 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from autodrive_tools import vehicle  # noqa: E402
-from autodrive_tools.codegen import tree  # noqa: E402
+from autodrive.core import vehicle  # noqa: E402
+from autodrive.devtools.codegen import tree  # noqa: E402
 
 # Files that may hold the figures: the description itself, files generated from it, tests (which
 # state expected values), and the map files generated from the map descriptions (coordinates).

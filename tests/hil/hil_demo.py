@@ -4,7 +4,8 @@ import os
 import sys
 import tempfile
 
-from autodrive_tools import channels, command_auth
+from autodrive.core import channels
+from autodrive.core import command_auth
 
 _KEY_DIR = None
 
@@ -23,12 +24,12 @@ def use_test_keys(cars=1):
 
 
 def demo_command(build, out, port, *options):
-    """python -m autodrive_tools.demo, headless, into out, on its own LCM port (test keys)."""
+    """python -m autodrive.hil.demo, headless, into out, on its own LCM port (test keys)."""
     use_test_keys()
     return [
         sys.executable,
         "-m",
-        "autodrive_tools.demo",
+        "autodrive.hil.demo",
         "--build",
         str(build),
         "--out",

@@ -1,4 +1,4 @@
-"""HIL: Ctrl-C on tools/demo (autodrive_tools.demo) mid-mission. While the car drives its mapping
+"""HIL: Ctrl-C on tools/demo (autodrive.hil.demo) mid-mission. While the car drives its mapping
 route, SIGINT must stop every child (simulator, runtime, autonomy, lcm-logger), leave a readable
 report and LCM log, end with a disengaged zero command on the bus, and exit 130. Nothing is
 timed: the test waits for the demo's own progress lines."""
@@ -12,8 +12,8 @@ import tempfile
 from hil_demo import demo_command
 import time
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 
 root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 types = lcmtypes.load(build)

@@ -12,8 +12,10 @@ import subprocess
 import sys
 import tempfile
 
-from autodrive_tools import channels, command_auth, lcmtypes
-from autodrive_tools.bench import security
+from autodrive.core import channels
+from autodrive.core import command_auth
+from autodrive.core import lcmtypes
+from autodrive.bench import security
 
 from hil_demo import demo_command, use_test_keys
 

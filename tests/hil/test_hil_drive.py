@@ -1,4 +1,4 @@
-"""HIL integration: tools/demo (autodrive_tools.demo) runs the simulator (Parking School), the
+"""HIL integration: tools/demo (autodrive.hil.demo) runs the simulator (Parking School), the
 unchanged runtime on its ptys and the pure-pursuit driver over real LCM UDP multicast; the run's
 report must show a real drive: the car moved along the track, no collision, telemetry at 100 Hz
 of Nano time, and the runtime's EKF close to the simulator's ground truth."""

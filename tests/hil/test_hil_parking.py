@@ -1,4 +1,4 @@
-"""HIL integration: the full default demo (autodrive_tools.demo: Parking School, the simulator in
+"""HIL integration: the full default demo (autodrive.hil.demo: Parking School, the simulator in
 lockstep with the unchanged runtime, autodrive-autonomy, real UDP LCM, a mapping route, a box
 that steps out after mapping). It must map, localise, see the box and replan, park without a
 collision, and meet issue 7's bounds by the simulator's ground truth. Lockstep makes the run
@@ -13,7 +13,7 @@ import subprocess
 import sys
 import tempfile
 
-from autodrive_tools.inspect import channel_audit
+from autodrive.devtools.inspect import channel_audit
 
 from hil_demo import demo_command
 

@@ -17,9 +17,10 @@ import time
 
 import yaml
 
-from autodrive_tools import command_auth, lcmtypes
-from autodrive_tools.channels import channel
-from autodrive_tools.paths import RUNTIME_HIL_CONFIG
+from autodrive.core import command_auth
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
+from autodrive.core.settings import RUNTIME_HIL_CONFIG
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

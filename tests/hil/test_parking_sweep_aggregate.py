@@ -1,4 +1,4 @@
-"""autodrive_tools.sweep --aggregate-only (tools/bench parking) on synthetic per-seed reports (no
+"""autodrive.learn.sweep.parking --aggregate-only (tools/bench parking) on synthetic per-seed reports (no
 demo runs): a good run, a run without report.json, a collision, a run whose demo exited non-zero
 with an ok report; then ten good runs that meet every goal. Checks counts, medians/maxima, goals,
 per-seed arrays, summary.json == the last stdout line, and that the plot is written."""
@@ -54,7 +54,7 @@ def sweep(out, seeds, first=1):
         [
             sys.executable,
             "-m",
-            "autodrive_tools.sweep",
+            "autodrive.learn.sweep.parking",
             "--aggregate-only",
             "--first-seed",
             str(first),
@@ -112,7 +112,7 @@ with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
     assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
 
     bad = subprocess.run(
-        [sys.executable, "-m", "autodrive_tools.sweep", "--seeds", "0"],
+        [sys.executable, "-m", "autodrive.learn.sweep.parking", "--seeds", "0"],
         capture_output=True,
         text=True,
         timeout=60,

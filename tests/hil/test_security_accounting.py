@@ -8,7 +8,7 @@ import random
 import sys
 
 sys.path.insert(0, str(pathlib.Path(sys.argv[1]) / "python"))
-from autodrive_tools.bench.security import applied_beyond_sent  # noqa: E402
+from autodrive.bench.security import applied_beyond_sent  # noqa: E402
 
 S = 1_000_000  # [us]
 

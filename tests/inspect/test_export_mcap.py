@@ -14,8 +14,9 @@ import lcm
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
-from autodrive_tools import channels, lcmtypes
-from autodrive_tools.inspect.export_mcap import export_mcap
+from autodrive.core import channels
+from autodrive.core import lcmtypes
+from autodrive.devtools.inspect.export_mcap import export_mcap
 
 build = Path(sys.argv[1])
 t = lcmtypes.load(build)

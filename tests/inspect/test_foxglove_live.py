@@ -21,7 +21,8 @@ from typing import Any
 import websockets
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
-from autodrive_tools import channels, lcmtypes
+from autodrive.core import channels
+from autodrive.core import lcmtypes
 
 build, port_lcm = Path(sys.argv[1]), int(sys.argv[2])
 URL = f"udpm://239.255.76.67:{port_lcm}?ttl=0"
@@ -147,7 +148,7 @@ with tempfile.TemporaryDirectory() as tmp:
         [
             sys.executable,
             "-m",
-            "autodrive_tools.inspect.foxglove_live",
+            "autodrive.devtools.inspect.foxglove_live",
             "--lcm-url",
             URL,
             "--port",

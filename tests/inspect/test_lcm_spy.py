@@ -19,9 +19,9 @@ import mss
 import mss.tools
 from PIL import Image
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
-from autodrive_tools.inspect import lcm_spy
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
+from autodrive.devtools.inspect import lcm_spy
 
 build, port = pathlib.Path(sys.argv[1]), int(sys.argv[2])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

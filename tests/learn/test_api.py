@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
-from autodrive_tools.learn import SimError, World, step_worlds
-from autodrive_tools.learn import tasks
+from autodrive.gym import SimError, World
+from autodrive.gym import step_worlds
+from autodrive.gym import tasks
 
 PERIOD_MS = 50  # 20 Hz control
 

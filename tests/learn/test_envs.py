@@ -7,9 +7,9 @@ import numpy as np
 from gymnasium.utils.env_checker import check_env
 from pettingzoo.test import parallel_api_test
 
-from autodrive_tools.learn.gym_envs import LaneKeepingEnv, ParkingEnv
-from autodrive_tools.learn import tasks
-from autodrive_tools.learn.pz_env import IntersectionEnv
+from autodrive.gym.envs import LaneKeepingEnv, ParkingEnv
+from autodrive.gym import tasks
+from autodrive.gym.pz_env import IntersectionEnv
 
 warnings.filterwarnings("ignore", message=".*infinity.*")  # unbounded Box: intended
 

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.learn import World, step_worlds
+from autodrive.core import lcmtypes
+from autodrive.gym import World
+from autodrive.gym import step_worlds
 
 BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 THROTTLE, STEERING, SEED, DURATION_S = 0.7, 0.4, 7, 10

@@ -1,6 +1,6 @@
-"""maps.api: what autodrive_tools.maps answers (spawn, slots, slot goals, obstacles, terrain,
+"""maps.api: what autodrive.maps answers (spawn, slots, slot goals, obstacles, terrain,
 walls, lanes, stop lines) agrees with the generated MJCF, parsed with a real XML parser, and with
-the JSON sidecar; slot goals put the car's envelope (autodrive_tools.vehicle) inside the slot."""
+the JSON sidecar; slot goals put the car's envelope (autodrive.core.vehicle) inside the slot."""
 import json
 import math
 import pathlib
@@ -9,10 +9,11 @@ import unittest
 import xml.etree.ElementTree as ET
 
 ROOT = pathlib.Path(sys.argv[1])
-MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
+MAPS = ROOT / "maps"
 
-from autodrive_tools import maps, vehicle  # noqa: E402
-from autodrive_tools.maps import geometry  # noqa: E402
+from autodrive import maps  # noqa: E402
+from autodrive.core import vehicle  # noqa: E402
+from autodrive.maps import geometry  # noqa: E402
 
 TOL_M = 1e-9
 

@@ -10,7 +10,7 @@ import unittest
 ROOT = pathlib.Path(sys.argv[1])
 FIX = ROOT / "tests" / "maps" / "fixtures"
 
-from autodrive_tools import maps  # noqa: E402
+from autodrive import maps  # noqa: E402
 
 # fixture: (dotted key, words of the problem)
 EXPECTED = {
@@ -68,7 +68,7 @@ class DescriptionErrors(unittest.TestCase):
             self.assertIn(words, str(cm.exception))
 
     def test_kit_mistakes(self) -> None:
-        kit = (ROOT / "sim" / "mujoco_hil" / "maps" / "kit.yaml").read_text()
+        kit = (ROOT / "maps" / "kit.yaml").read_text()
         cases = {
             "line_width_m: 0.02": ("line_width_m: -0.02", "marking.line_width_m", "must be > 0"),
             "arc_segments_per_90deg: 24": (

@@ -11,7 +11,7 @@ import unittest
 
 ROOT = pathlib.Path(sys.argv[1])
 GEN = ROOT / "tools" / "gen-maps"
-MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
+MAPS = ROOT / "maps"
 
 
 def gen(*args: str) -> subprocess.CompletedProcess:
@@ -22,7 +22,7 @@ class GeneratedFresh(unittest.TestCase):
     def test_committed_files_are_fresh(self) -> None:
         r = gen("--check")
         self.assertEqual(r.returncode, 0, r.stderr)
-        from autodrive_tools import maps
+        from autodrive import maps
 
         names = maps.names()
         for want in ("parking_school", "driving_school", "intersection_school", "tiny_town"):

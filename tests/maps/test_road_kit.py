@@ -16,12 +16,13 @@ import unittest
 import xml.etree.ElementTree as ET
 
 ROOT = pathlib.Path(sys.argv[1])
-MAPS = ROOT / "sim" / "mujoco_hil" / "maps"
+MAPS = ROOT / "maps"
 TOOL = ROOT / "tools" / "map"
 
-from autodrive_tools import maps, vehicle  # noqa: E402
-from autodrive_tools.maps import tiles  # noqa: E402
-from autodrive_tools.maps.model import TileSpec  # noqa: E402
+from autodrive import maps  # noqa: E402
+from autodrive.core import vehicle  # noqa: E402
+from autodrive.maps import tiles  # noqa: E402
+from autodrive.maps.model import TileSpec  # noqa: E402
 
 JOIN_M = 0.001
 TYPES = (
@@ -246,7 +247,7 @@ class RoadKit(unittest.TestCase):
                 self.assertLessEqual(len(nm.get("data").split()), 500, nm.get("name"))
 
     def test_light_level_dims_the_map(self) -> None:
-        from autodrive_tools.maps import mjcf
+        from autodrive.maps import mjcf
 
         with tempfile.TemporaryDirectory() as tmp:
             y = pathlib.Path(tmp) / "intersection_school.yaml"

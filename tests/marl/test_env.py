@@ -9,8 +9,8 @@ import warnings
 import numpy as np
 from pettingzoo.test import parallel_api_test
 
-from autodrive_tools.marl.baseline import FcfsBaseline
-from autodrive_tools.marl.env import (
+from autodrive.learn.marl.baseline import FcfsBaseline
+from autodrive.learn.marl.env import (
     COLLISION_FACTOR,
     PROGRESS_GAIN,
     SHAPING,

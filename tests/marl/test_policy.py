@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
-from autodrive_tools.marl.core import OBS_DIM, OBS_VERSION
-from autodrive_tools.marl.evaluate import evaluate
-from autodrive_tools.marl.export import OnnxPolicy, export, torch_actions
-from autodrive_tools.marl.cli import HELD_OUT_SEED
-from autodrive_tools.marl.train import VALIDATION_SEED, TrainConfig, train
+from autodrive.learn.marl.core import OBS_DIM, OBS_VERSION
+from autodrive.learn.marl.evaluate import evaluate
+from autodrive.learn.marl.export import OnnxPolicy, export, torch_actions
+from autodrive.learn.marl.cli import HELD_OUT_SEED
+from autodrive.learn.marl.train import VALIDATION_SEED, TrainConfig, train
 
 
 def main() -> None:

@@ -24,7 +24,7 @@ RAY = root / ".venv" / "bin" / "ray"
 
 
 def train(tmp: pathlib.Path, address: str) -> subprocess.CompletedProcess[str]:
-    argv = [str(PY), "-m", "autodrive_tools.marl", "train", "--address", address]
+    argv = [str(PY), "-m", "autodrive.learn.marl", "train", "--address", address]
     argv += ["--stages", "1:1024", "--copies", "2", "--workers", "2"]
     argv += ["--onnx", str(tmp / "policy.onnx"), "--out", str(tmp / "out")]
     r = subprocess.run(argv, capture_output=True, text=True, timeout=900, env=ENV)

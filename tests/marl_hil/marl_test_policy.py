@@ -13,7 +13,7 @@ LOOKAHEAD_M = 0.35
 
 
 def make_policy(folder: Path, seed: int = 3, throttle: float = 0.6) -> tuple[Path, torch.nn.Module]:
-    """The network and NAME.json in the sidecar format of autodrive_tools.marl.export."""
+    """The network and NAME.json in the sidecar format of autodrive.learn.marl.export."""
     torch.manual_seed(seed)
     net = torch.nn.Sequential(
         torch.nn.Linear(OBS_DIM, 128),

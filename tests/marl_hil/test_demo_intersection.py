@@ -21,7 +21,7 @@ os.environ["AUTODRIVE_KEY_DIR"] = keys.name  # the mission makes the four cars' 
 
 def demo(out: Path, *extra: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
-        [sys.executable, "-m", "autodrive_tools.demo", "--mission", "intersection"]
+        [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection"]
         + ["--build", str(build), "--out", str(out), "--headless", "--policy", "baseline"]
         + ["--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0", *extra],
         stdout=subprocess.PIPE,
@@ -64,7 +64,7 @@ with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
     assert rep["episodes"] == 1 and rep["success_rate"] == 1.0 and rep["collisions"] == 0, rep
     assert rep["v2v_lost"] == 0 and p.returncode == 0, rep
     assert (out / "trajectories.png").stat().st_size > 10000
-    from autodrive_tools.city.eye_standin import PERIOD_US
+    from autodrive.hil.city.eye_standin import PERIOD_US
 
     # every car's <VEH>_POSE_EYE at the stand-in's rate over most of the episode's sim time
     want = 0.5 * 4 * rep["per_episode"][0]["sim_s"] / (PERIOD_US * 1e-6)

@@ -14,8 +14,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from autodrive_tools import channels, command_auth, lcmtypes
-from autodrive_tools.paths import REPO_ROOT
+from autodrive.core import channels
+from autodrive.core import command_auth
+from autodrive.core import lcmtypes
+from autodrive.core.settings import REPO_ROOT
 
 sys.path.insert(0, str(Path(__file__).parent))
 from marl_test_policy import LOOKAHEAD_M, make_policy  # noqa: E402
@@ -23,8 +25,8 @@ from marl_test_policy import LOOKAHEAD_M, make_policy  # noqa: E402
 exe, build, port = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"
 types = lcmtypes.load(build)
-MAP_JSON = REPO_ROOT / "sim" / "mujoco_hil" / "maps" / "intersection_school.json"
-THROTTLE = 1.0  # the trained policies' (autodrive_tools.marl.export)
+MAP_JSON = REPO_ROOT / "maps" / "intersection_school.json"
+THROTTLE = 1.0  # the trained policies' (autodrive.learn.marl.export)
 keys = tempfile.TemporaryDirectory(prefix="marl-keys-")
 os.environ["AUTODRIVE_KEY_DIR"] = keys.name
 command_auth.create_key(command_auth.default_key_path("NIGEL1"))

@@ -12,7 +12,8 @@ import cv2
 import lcm
 import numpy as np
 
-from autodrive_tools import channels, lcmtypes
+from autodrive.core import channels
+from autodrive.core import lcmtypes
 
 
 def lane_image(steering: float, rng: np.random.Generator) -> bytes:

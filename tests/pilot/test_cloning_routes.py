@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from autodrive_tools.bench import cloning as bench
-from autodrive_tools.missions import cloning, lane_watch
-from autodrive_tools.pilot.expert import ExpertRun
+from autodrive.bench import cloning as bench
+from autodrive.hil.missions import cloning, lane_watch
+from autodrive.learn.pilot.expert import ExpertRun
 
 
 def angle_diff(a: float, b: float) -> float:

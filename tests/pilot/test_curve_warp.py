@@ -12,9 +12,9 @@ import math
 import cv2
 import numpy as np
 
-from autodrive_tools import vehicle
-from autodrive_tools.pilot import augment, train
-from autodrive_tools.pilot.spec import crop_resize
+from autodrive.core import vehicle
+from autodrive.learn.pilot import augment, train
+from autodrive.learn.pilot.spec import crop_resize
 
 FX = 530.6765106850642  # [px] the sim's front camera (fovy 48.67 deg at 480 px), as recorded
 SPEC = train.DEFAULT_INPUT

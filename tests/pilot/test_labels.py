@@ -11,8 +11,9 @@ import math
 
 import numpy as np
 
-from autodrive_tools import maps, vehicle
-from autodrive_tools.pilot import labels
+from autodrive import maps
+from autodrive.core import vehicle
+from autodrive.learn.pilot import labels
 
 
 def heading(line: np.ndarray, i: int) -> float:

@@ -22,11 +22,13 @@ import cv2
 sys.path.insert(0, str(Path(__file__).parent))
 import gen_log  # noqa: E402
 
-from autodrive_tools import channels, lcmtypes, maps  # noqa: E402
-from autodrive_tools.missions.lane_watch import LaneWatch  # noqa: E402
-from autodrive_tools.pilot.make_model import expert_runs  # noqa: E402
-from autodrive_tools.pilot.dataset import record  # noqa: E402
-from autodrive_tools.pilot.expert import ExpertRun, record_expert  # noqa: E402
+from autodrive.core import channels  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive import maps  # noqa: E402
+from autodrive.hil.missions.lane_watch import LaneWatch  # noqa: E402
+from autodrive.learn.pilot.make_model import expert_runs  # noqa: E402
+from autodrive.learn.pilot.dataset import record  # noqa: E402
+from autodrive.learn.pilot.expert import ExpertRun, record_expert  # noqa: E402
 
 BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 SEED = 3
@@ -106,7 +108,7 @@ def check_refusal(d: Path) -> None:
     assert gen_log.write(log, BUILD, laps=1, frames_per_lap=20, cameras=False) == 0
     out = d / "refused"
     r = subprocess.run(
-        [sys.executable, "-m", "autodrive_tools.pilot", "record", str(log), "--out", str(out),
+        [sys.executable, "-m", "autodrive.learn.pilot", "record", str(log), "--out", str(out),
          "--map", "driving_school"],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip

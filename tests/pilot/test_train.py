@@ -21,12 +21,12 @@ import torch
 sys.path.insert(0, str(Path(__file__).parent))
 import gen_log  # noqa: E402
 
-from autodrive_tools.pilot import augment, model  # noqa: E402
-from autodrive_tools.pilot.analyse import analyse  # noqa: E402
-from autodrive_tools.pilot.dataset import record  # noqa: E402
-from autodrive_tools.pilot.spec import InputSpec, preprocess, read_sidecar  # noqa: E402
-from autodrive_tools.pilot.spec import sha256_file  # noqa: E402
-from autodrive_tools.pilot.train import TrainConfig, train  # noqa: E402
+from autodrive.learn.pilot import augment, model  # noqa: E402
+from autodrive.learn.pilot.analyse import analyse  # noqa: E402
+from autodrive.learn.pilot.dataset import record  # noqa: E402
+from autodrive.learn.pilot.spec import InputSpec, preprocess, read_sidecar  # noqa: E402
+from autodrive.learn.pilot.spec import sha256_file  # noqa: E402
+from autodrive.learn.pilot.train import TrainConfig, train  # noqa: E402
 
 BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 

@@ -16,8 +16,10 @@ import time
 import yaml
 
 import fixture
-from autodrive_tools import channels, lcmtypes, maps
-from autodrive_tools.paths import RUNTIME_HIL_CONFIG
+from autodrive.core import channels
+from autodrive.core import lcmtypes
+from autodrive import maps
+from autodrive.core.settings import RUNTIME_HIL_CONFIG
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

@@ -18,8 +18,8 @@ from PIL import Image
 
 run, build, out = (pathlib.Path(a) for a in sys.argv[1:4])
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
-from autodrive_tools import lcmtypes  # noqa: E402
-from autodrive_tools.channels import channel  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive.core.channels import channel  # noqa: E402
 
 VEHICLE, WINDOW_S, LEAD_S, MARGIN_CELLS, POOL = "NIGEL1", 8.0, 0.2, 10, 2
 OCCUPIED, FREE, UNKNOWN = 0, 254, 205  # the trinary PGM's cells

@@ -22,8 +22,8 @@ import yaml
 
 root, build = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
 sys.path.insert(0, str(root / "python"))
-from autodrive_tools import lcmtypes  # noqa: E402
-from autodrive_tools.channels import channel  # noqa: E402
+from autodrive.core import lcmtypes  # noqa: E402
+from autodrive.core.channels import channel  # noqa: E402
 
 DATA = root / "tests" / "replay" / "data"
 REFERENCE = DATA / "amcl_reference.json"

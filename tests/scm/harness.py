@@ -15,8 +15,8 @@ from http.cookiejar import CookieJar
 from pathlib import Path
 from typing import Any
 
-from autodrive_tools.scm.light_watch import LightWatch  # noqa: F401  (re-exported)
-from autodrive_tools.scm.testkit import (  # noqa: F401  (re-exported for the tests)
+from autodrive.scm.light_watch import LightWatch  # noqa: F401  (re-exported)
+from autodrive.scm.testkit import (  # noqa: F401  (re-exported for the tests)
     Client,
     Postgres,
     Server,
@@ -57,8 +57,8 @@ class CarFeeder:
     def __init__(self, lc: Any, types: Any, cars: dict[str, tuple[str, float]], speed_m_s: float) -> None:  # fmt: skip
         import threading
 
-        from autodrive_tools import maps
-        from autodrive_tools.channels import channel
+        from autodrive import maps
+        from autodrive.core.channels import channel
 
         m = maps.load("tiny_town")
         self.routes = {v: (m.route(r), s0) for v, (r, s0) in cars.items()}

@@ -29,8 +29,8 @@ from harness import login_page as login
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 
 root, build, port = Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

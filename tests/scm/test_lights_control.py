@@ -1,4 +1,4 @@
-"""Unit tests of the SCM's light control rules (autodrive_tools.scm.lights), on Tiny Town's
+"""Unit tests of the SCM's light control rules (autodrive.scm.lights), on Tiny Town's
 four lights and their conflicts from the map description, with time passed in: GREEN -> RED
 always passes YELLOW for the light's yellow time; a GREEN waits for the all-red time after a
 conflicting light turned RED; a GREEN against a conflicting green is refused naming it; no
@@ -12,8 +12,8 @@ from __future__ import annotations
 import itertools
 import sys
 
-from autodrive_tools import maps
-from autodrive_tools.scm.lights import (
+from autodrive import maps
+from autodrive.scm.lights import (
     ConflictError,
     ControlError,
     Controller,

@@ -14,8 +14,8 @@ import time
 
 from harness import PY, Client, Postgres, Server, add_user, check, wait_for
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 
 root, build, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"
@@ -71,7 +71,7 @@ with tempfile.TemporaryDirectory(prefix="scm-pg-") as tmp:
         pg.stop()
 
     def start_fails(args: list[str]) -> str:
-        r = subprocess.run([PY, "-m", "autodrive_tools.scm.cli", "--build", build, *args],
+        r = subprocess.run([PY, "-m", "autodrive.scm.cli", "--build", build, *args],
                            capture_output=True, text=True, timeout=60)  # fmt: skip
         check(r.returncode == 2, f"exit 2 for {args}: {r.stderr.strip()}")
         return r.stderr

@@ -15,8 +15,9 @@ import time
 
 from harness import Client, Server, add_user, check, start_sim, wait_for
 
-from autodrive_tools import lcmtypes, maps
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive import maps
+from autodrive.core.channels import channel
 
 root, build, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
 url = f"udpm://239.255.76.67:{port}?ttl=0"

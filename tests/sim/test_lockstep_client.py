@@ -10,8 +10,8 @@ import sys
 import tempfile
 import time
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 types = lcmtypes.load(build)

@@ -1,4 +1,4 @@
-"""tools/sweep eval / rollouts (autodrive_tools.sweep_learn) on Gymnasium's CartPole-v1 (the
+"""tools/sweep eval / rollouts (autodrive.learn.sweep.episodes) on Gymnasium's CartPole-v1 (the
 simulator's own learning environments plug in the same way, --register MODULE): the evaluation
 episodes of a random policy on an embedded local Ray with 2 workers equal those run serially,
 seed by seed; so do those of a stable-baselines3 PPO .zip (on Debian's torch); a scripted policy
@@ -26,7 +26,7 @@ ENV = dict(os.environ, RAY_USAGE_STATS_ENABLED="0")
 
 def sweep(*argv: str, code: int = 0) -> tuple[dict[str, Any], str]:
     r = subprocess.run(
-        [PY, "-m", "autodrive_tools.sweep_cli", *argv],
+        [PY, "-m", "autodrive.learn.sweep.cli", *argv],
         capture_output=True,
         text=True,
         timeout=240,
@@ -53,7 +53,7 @@ with tempfile.TemporaryDirectory(prefix="sweep-learn-") as t:
         "eval",
         *common,
         "--policy",
-        "autodrive_tools.sweep_learn:cartpole_balance",
+        "autodrive.learn.sweep.episodes:cartpole_balance",
         "--serial",
         "--out",
         str(tmp / "b"),

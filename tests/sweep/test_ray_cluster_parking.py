@@ -1,7 +1,7 @@
 """A real Ray cluster on loopback: `ray start --head` (1 CPU) plus a second node joining it
 (`ray start --address`, 1 CPU), both in a temp dir; the same 2-seed parking sweep runs through
 it (tools/sweep parking --address) and serially (--serial, no Ray), and the two reports agree
-(autodrive_tools.sweep.disagreements: same seeds, slots, scenario and success per seed, figures
+(autodrive.learn.sweep.parking.disagreements: same seeds, slots, scenario and success per seed, figures
 within tolerance); the jobs ran on the cluster's worker processes and each on its own LCM port.
 The cluster is stopped in a finally block, bounded in time: its processes are found by their
 temp dir, so nothing else on the machine that runs Ray is touched.
@@ -18,7 +18,7 @@ import shutil
 import tempfile
 from typing import Any
 
-from autodrive_tools import sweep
+from autodrive.learn.sweep import parking as sweep
 
 sys.path.insert(0, str(pathlib.Path(__file__).parent))
 from ray_cluster import ENV, start_cluster, stop_cluster  # noqa: E402
@@ -37,7 +37,7 @@ SCENARIO = ["--mapping-route", "", "--no-late-box", "--rtf", "0.5", "--timeout",
 
 
 def sweep_run(out: pathlib.Path, how: list[str]) -> dict[str, Any]:
-    argv = [str(root / ".venv" / "bin" / "python"), "-m", "autodrive_tools.sweep_cli", "parking"]
+    argv = [str(root / ".venv" / "bin" / "python"), "-m", "autodrive.learn.sweep.cli", "parking"]
     argv += ["--seeds", str(SEEDS), "--build", build, "--out", str(out), *how]
     argv += ["--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0", "--extra", *SCENARIO]
     r = subprocess.run(argv, capture_output=True, text=True, timeout=900, env=ENV)

@@ -11,8 +11,8 @@ import tempfile
 import time
 from collections import Counter
 
-from autodrive_tools import lcmtypes
-from autodrive_tools.channels import channel
+from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 
 root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
 types = lcmtypes.load(build)
