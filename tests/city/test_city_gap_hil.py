@@ -27,7 +27,7 @@ from autodrive_tools.proc import ProcessGroup, wait_for_path  # noqa: E402
 def test_gap_keeping(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
 
     URL = lcm_url
     MAP = MAPS_DIR / "tiny_town.json"

@@ -21,7 +21,7 @@ from autodrive_tools import lcmtypes  # noqa: E402
 def test_smart_city_mission_short(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
 
     with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
         out = pathlib.Path(tmp)

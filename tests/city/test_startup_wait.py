@@ -19,7 +19,7 @@ from autodrive_tools.proc import ProcessGroup, wait_ready
 def test_startup_wait_bounded_by_cpu_time(
     root: Path, build_dir: Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, str(build_dir), lcm_port
+    build, port = str(build_dir), lcm_port
     url = lcm_url
     PY = sys.executable
 

@@ -21,7 +21,7 @@ from autodrive_tools.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
 def test_v2v_between_two_runtimes(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
 
     URL = lcm_url
     ROUTES = ["loop_ccw", "loop_cw"]

@@ -33,7 +33,7 @@ from autodrive_tools.channels import channel
 
 
 def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm_url: str) -> None:
-    root, build, port = root, str(build_dir), lcm_port
+    build, port = str(build_dir), lcm_port
     url = lcm_url
     T = lcmtypes.load(build)
     S = T.traffic_light_state_t

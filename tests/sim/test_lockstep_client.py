@@ -16,7 +16,7 @@ from autodrive_tools.channels import channel
 def test_lockstep_client_holds_the_sim(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
     types = lcmtypes.load(build)
 
     url = lcm_url

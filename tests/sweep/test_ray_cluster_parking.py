@@ -19,8 +19,7 @@ from typing import Any
 
 from autodrive_tools import sweep
 
-sys.path.insert(0, str(pathlib.Path(__file__).parent))
-from ray_cluster import ENV, start_cluster, stop_cluster  # noqa: E402
+from pyhelpers.ray_cluster import ENV, start_cluster, stop_cluster
 
 
 def test_cluster_sweep_agrees_with_serial(

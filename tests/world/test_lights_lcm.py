@@ -17,7 +17,7 @@ from autodrive_tools.channels import channel
 def test_traffic_lights_on_lcm(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
     types = lcmtypes.load(build)
     State, Command = types.traffic_light_state_t, types.traffic_light_command_t
 

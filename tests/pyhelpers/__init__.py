@@ -1,4 +1,5 @@
-"""Helpers that several Python test files use (fixtures are in conftest.py)."""
+"""Helpers that several Python test files use (fixtures are in conftest.py); ray_cluster: a
+real Ray cluster on loopback (sweep.ray_cluster_parking, marl.ray_train)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ from pathlib import Path
 from typing import Callable
 
 # The repository (tests/ is in it); the root fixture of conftest.py, for module-level constants.
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 
 
 def raises(fn: Callable[[], object], exc: type[BaseException], *texts: str) -> None:
