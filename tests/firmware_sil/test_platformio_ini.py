@@ -1,17 +1,19 @@
-#!/usr/bin/env python3
 """platformio.ini checked through PlatformIO's own parser: no warnings, the two online Nano envs
 (PlatformIO's atmelavr, which needs its registry) and the two offline ones (the platform in
-firmware/nano/pio), src/lib dirs that exist and hold the firmware.
-usage: test_platformio_ini.py <repo root>"""
+firmware/nano/pio), src/lib dirs that exist and hold the firmware."""
 import os
-import sys
+from pathlib import Path
+
+import pytest
 
 from platformio.project.config import ProjectConfig
 
 
-def main() -> int:
-    root = os.path.abspath(sys.argv[1])
-    os.chdir(root)  # PlatformIO resolves the dirs against the project dir, which is the cwd
+def test_platformio_ini_through_platformio(root: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    root = os.path.abspath(root)
+    monkeypatch.chdir(
+        root
+    )  # PlatformIO resolves the dirs against the project dir, which is the cwd
     cfg = ProjectConfig(os.path.join(root, "platformio.ini"))
     cfg.validate()
     assert cfg.warnings == [], f"platformio.ini warnings: {cfg.warnings}"
@@ -37,8 +39,3 @@ def main() -> int:
     for module in ("nigel", "proto", "enc"):
         assert os.path.isdir(os.path.join(lib, module)), f"lib module {module} missing"
     print("platformio.ini ok:", ", ".join(envs))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

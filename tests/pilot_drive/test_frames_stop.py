@@ -22,7 +22,7 @@ from autodrive_tools.paths import RUNTIME_HIL_CONFIG
 def test_frames_stop_stop_the_car(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
 ) -> None:
-    root, build, port = root, build_dir, lcm_port
+    build, port = build_dir, lcm_port
     url = lcm_url
     types = lcmtypes.load(build)
     veh = channels.vehicle_name(1)

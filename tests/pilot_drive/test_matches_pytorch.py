@@ -13,7 +13,7 @@ import fixture
 
 
 def test_cpp_pilot_matches_pytorch(root: pathlib.Path, build_dir: pathlib.Path) -> None:
-    root, build = root, build_dir
+    build = build_dir
     with tempfile.TemporaryDirectory(prefix="pilot-predict-") as tmp:
         out = pathlib.Path(tmp)
         onnx_path, net = fixture.export(out)

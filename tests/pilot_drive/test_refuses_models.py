@@ -9,7 +9,7 @@ import fixture
 
 
 def test_refuses_bad_models(root: pathlib.Path, build_dir: pathlib.Path) -> None:
-    root, build = root, build_dir
+    build = build_dir
     pilot = str(build / "bin" / "autodrive-pilot")
 
     def refused(model: pathlib.Path, *words: str) -> None:
