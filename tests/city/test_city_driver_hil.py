@@ -22,8 +22,7 @@ import sys
 import tempfile
 import time
 
-root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
-sys.path.insert(0, str(root / "python"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
 from autodrive.core import command_auth  # noqa: E402
 from autodrive.core import lcmtypes  # noqa: E402
 from autodrive.core.channels import channel  # noqa: E402
@@ -31,221 +30,232 @@ from autodrive.hil.city import hil, scoring  # noqa: E402
 from autodrive.maps.loader import MAPS_DIR  # noqa: E402
 from autodrive.core.proc import ProcessGroup, stop, wait_for_path  # noqa: E402
 
-URL = f"udpm://239.255.76.67:{port}?ttl=0"
-MAP = MAPS_DIR / "tiny_town.json"
-LIGHT = 3
-ROUTE = "city_east"  # north through light 3 and the stop sign, round the east half
-SIM_LIMIT_S = 400.0
-# the box: on lane n2_w_e (y 2.86 m, heading east), after the stop sign; half sizes [m]
-# it appears 0.9 m ahead (4.5 s of driving) and stays 12 s: under ASan the driver runs late
-# against the lockstep sim, and a 6 s stay once ran out before the car got there (CI, 16:00 UTC)
-BOX_X, BOX_Y, BOX_HALF_M, BOX_NEAR_M, BOX_STAY_S = 2.2, 2.86, 0.06, 0.9, 12.0
-types = lcmtypes.load(build)
 
+def test_city_driver_obeys(
+    root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
+) -> None:
+    build, port = build_dir, lcm_port
 
-def log(msg):
-    print(f"[city-hil] {msg}", flush=True)
+    URL = lcm_url
+    MAP = MAPS_DIR / "tiny_town.json"
+    LIGHT = 3
+    ROUTE = "city_east"  # north through light 3 and the stop sign, round the east half
+    SIM_LIMIT_S = 400.0
+    # the box: on lane n2_w_e (y 2.86 m, heading east), after the stop sign; half sizes [m]
+    # it appears 0.9 m ahead (4.5 s of driving) and stays 12 s: under ASan the driver runs late
+    # against the lockstep sim, and a 6 s stay once ran out before the car got there (CI, 16:00 UTC)
+    BOX_X, BOX_Y, BOX_HALF_M, BOX_NEAR_M, BOX_STAY_S = 2.2, 2.86, 0.06, 0.9, 12.0
+    types = lcmtypes.load(build)
 
+    def log(msg):
+        print(f"[city-hil] {msg}", flush=True)
 
-with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
-    out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
-    run_dir.mkdir()
-    os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
-    command_auth.create_key(command_auth.default_key_path("NIGEL1"))
-    facts = scoring.MapFacts.load(MAP)
-    line = facts.stop_for_light(LIGHT)
-    sign = facts.stop_sign_points()[0]
-    # Start 1.5 m before the end of the lane that leads into the T-junction before light 3.
-    start = facts.lane_point("s3_e_w", back_from_end_m=1.2)
-    procs = ProcessGroup(log)
-    lc = lcmtypes.bus(URL)
-    truth = {}
-    lights = {}
+    with tempfile.TemporaryDirectory(prefix="city-driver-") as tmp:
+        out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
+        run_dir.mkdir()
+        os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
+        command_auth.create_key(command_auth.default_key_path("NIGEL1"))
+        facts = scoring.MapFacts.load(MAP)
+        line = facts.stop_for_light(LIGHT)
+        sign = facts.stop_sign_points()[0]
+        # Start 1.5 m before the end of the lane that leads into the T-junction before light 3.
+        start = facts.lane_point("s3_e_w", back_from_end_m=1.2)
+        procs = ProcessGroup(log)
+        lc = lcmtypes.bus(URL)
+        truth = {}
+        lights = {}
 
-    track = open(out / "truth.csv", "w")
+        track = open(out / "truth.csv", "w")
 
-    def on_truth(_ch, data):
-        m = types.ground_truth_t.decode(data)
-        track.write(
-            f"{m.utime * 1e-6:.2f},{m.position_m[0]:.4f},{m.position_m[1]:.4f},{m.yaw_rad:.3f}\n"
-        )
-        v = m.linear_velocity_m_s[0]
-        truth.update(t=m.utime * 1e-6, x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=v)
-        if m.in_collision:
-            truth["collisions"] = truth.get("collisions", 0) + 1
+        def on_truth(_ch, data):
+            m = types.ground_truth_t.decode(data)
+            track.write(
+                f"{m.utime * 1e-6:.2f},{m.position_m[0]:.4f},{m.position_m[1]:.4f},{m.yaw_rad:.3f}\n"
+            )
+            v = m.linear_velocity_m_s[0]
+            truth.update(t=m.utime * 1e-6, x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=v)
+            if m.in_collision:
+                truth["collisions"] = truth.get("collisions", 0) + 1
 
-    def on_light(_ch, data):
-        m = types.traffic_light_state_t.decode(data)
-        lights[m.light_id] = m.state
+        def on_light(_ch, data):
+            m = types.traffic_light_state_t.decode(data)
+            lights[m.light_id] = m.state
 
-    lc.subscribe(channel("GROUND_TRUTH", "NIGEL1"), on_truth)
-    lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
+        lc.subscribe(channel("GROUND_TRUTH", "NIGEL1"), on_truth)
+        lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
 
-    def command_light(state):
-        c = types.traffic_light_command_t()
-        c.utime, c.light_id, c.state, c.duration_s = int(time.time() * 1e6), LIGHT, state, 0.0
-        lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), c.encode())
+        def command_light(state):
+            c = types.traffic_light_command_t()
+            c.utime, c.light_id, c.state, c.duration_s = int(time.time() * 1e6), LIGHT, state, 0.0
+            lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), c.encode())
 
-    def spin(seconds):
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < seconds:
-            if select.select([lc.fileno()], [], [], 0.05)[0]:
-                lc.handle()
+        def spin(seconds):
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < seconds:
+                if select.select([lc.fileno()], [], [], 0.05)[0]:
+                    lc.handle()
 
-    def wait_for(what, cond, wall_s=240):
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < wall_s:
-            procs.check()
-            spin(0.1)
-            if truth and cond():
-                return
-            if truth and truth["t"] > SIM_LIMIT_S:
-                break
-        raise AssertionError(f"{what}: not within {wall_s} s wall / {SIM_LIMIT_S} s sim; {truth}")
+        def wait_for(what, cond, wall_s=240):
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < wall_s:
+                procs.check()
+                spin(0.1)
+                if truth and cond():
+                    return
+                if truth and truth["t"] > SIM_LIMIT_S:
+                    break
+            raise AssertionError(
+                f"{what}: not within {wall_s} s wall / {SIM_LIMIT_S} s sim; {truth}"
+            )
 
-    def set_light(state, what):
-        """Commands light 3 until it shows state: the simulator refuses a GREEN while a
-        conflicting light is green on its program, so one command may not do."""
-        sent = [0.0]
+        def set_light(state, what):
+            """Commands light 3 until it shows state: the simulator refuses a GREEN while a
+            conflicting light is green on its program, so one command may not do."""
+            sent = [0.0]
 
-        def shown():
-            if lights.get(LIGHT) != state and time.monotonic() - sent[0] > 0.5:
-                command_light(state)
-                sent[0] = time.monotonic()
-            return lights.get(LIGHT) == state
+            def shown():
+                if lights.get(LIGHT) != state and time.monotonic() - sent[0] > 0.5:
+                    command_light(state)
+                    sent[0] = time.monotonic()
+                return lights.get(LIGHT) == state
 
-        wait_for(what, shown, 60)
+            wait_for(what, shown, 60)
 
-    def past(stop_point):
-        return scoring.front_past_m(truth["x"], truth["y"], truth["yaw"], stop_point)
+        def past(stop_point):
+            return scoring.front_past_m(truth["x"], truth["y"], truth["yaw"], stop_point)
 
-    def stopped_at(stop_point, hold_s):
-        """Waits until the car has stood within 0.25 m before stop_point for hold_s of sim time."""
-        since = None
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < 240:
-            procs.check()
-            spin(0.1)
-            if not truth:
-                continue
-            near = -0.25 < past(stop_point) < 0.1
-            if near and abs(truth["v"]) < 0.01:
-                since = truth["t"] if since is None else since
-                if truth["t"] - since >= hold_s:
-                    return past(stop_point)
-            else:
-                since = None
-        raise AssertionError(f"never stood {hold_s} s at {stop_point.name}: {truth}")
+        def stopped_at(stop_point, hold_s):
+            """Waits until the car has stood within 0.25 m before stop_point for hold_s of sim time."""
+            since = None
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < 240:
+                procs.check()
+                spin(0.1)
+                if not truth:
+                    continue
+                near = -0.25 < past(stop_point) < 0.1
+                if near and abs(truth["v"]) < 0.01:
+                    since = truth["t"] if since is None else since
+                    if truth["t"] - since >= hold_s:
+                        return past(stop_point)
+                else:
+                    since = None
+            raise AssertionError(f"never stood {hold_s} s at {stop_point.name}: {truth}")
 
-    try:
-        sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1"]
-        sim += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
-        sim += ["--lockstep-client", "--run-dir", run_dir, "--lcm-url", URL]
-        # the map's late box appears in the crossroads when a car comes near it; the city driver
-        # does not avoid obstacles (the smart-city mission leaves them out too)
-        sim += ["--duration", SIM_LIMIT_S + 20, "--no-late-obstacles"]
-        sim += ["--late-box", f"{BOX_X},{BOX_Y},0,{BOX_HALF_M},{BOX_HALF_M},{BOX_NEAR_M}"]
-        sim += ["--late-box-stay", BOX_STAY_S]
-        procs.start("autodrive-sim", sim, out / "sim.log")
-        wait_for_path(run_dir / "nigel1-nano", 60, procs)
-        pose0 = hil.start_poses(build, URL, 1)[0]
-        cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE, lidar=True)
-        procs.start(
-            "runtime", [build / "bin" / "autodrive-runtime", "--config", cfg], out / "runtime.log"
-        )
-        eye = [
-            sys.executable,
-            "-m",
-            "autodrive.hil.city.eye_standin",
-            "--vehicles",
-            "NIGEL1",
-            "--lcm-url",
-            URL,
-            "--build",
-            build,
-        ]
-        procs.start("eye-standin", eye, out / "eye.log")
-        adv = [
-            sys.executable,
-            "-m",
-            "autodrive.hil.city.advisory",
-            "--map",
-            "tiny_town",
-            "--vehicles",
-            "NIGEL1",
-            "--lcm-url",
-            URL,
-            "--build",
-            build,
-        ]
-        advisory = procs.start("advisory", adv, out / "advisory.log")
-        spin(1.0)
-        set_light(3, "light 3 GREEN")  # held
-        drv = [
-            build / "bin" / "autodrive-city-driver",
-            "--map",
-            MAP,
-            "--route",
-            ROUTE,
-            "--lcm-url",
-            URL,
-        ]
-        procs.start("city-driver", drv, out / "driver.log")
-        # 1. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway
-        wait_for("driving", lambda: truth["v"] > 0.1)
-        assert stop(advisory, "advisory", log) == 0
-        over_stale = stopped_at(line, 2.0)
-        log(
-            f"1. stale advisory: stood {-over_stale * 100:.1f} cm before the line, light "
-            f"{lights[LIGHT]} (3 = GREEN)"
-        )
-        assert lights[LIGHT] == 3, "the light was not green: the test proves nothing"
-        assert over_stale <= 0.03
-        text = (out / "driver.log").read_text()
-        assert "stale advisory: red light 3" in text, text[-2000:]
-        # 2. the advisory back, RED: the car stays; GREEN: it goes
-        set_light(1, "light 3 RED")
-        procs.start("advisory2", adv, out / "advisory2.log")
-        t_red = truth["t"]
-        wait_for("2 s of red", lambda: truth["t"] > t_red + 2.0 or abs(truth["v"]) > 0.01)
-        assert abs(truth["v"]) < 0.01 and past(line) < 0, f"the car moved on red: {truth}"
-        set_light(3, "light 3 GREEN again")
-        wait_for("across the line on green", lambda: past(line) > 0.3)
-        log("2. red: stayed; green: crossed the stop line")
-        # 3. stop sign: a full stop of >= 1 s, then on
-        over_sign = stopped_at(sign, 1.0)
-        wait_for("on after the stop sign", lambda: past(sign) > 0.3)
-        log(f"3. stop sign: stood >= 1 s, {-over_sign * 100:.1f} cm before it, then went on")
-        assert over_sign <= 0.03
-        # 4. the box on the lane: stand the obstacle margin before it, go on when it is gone
-        rules = re.search(
-            r"rules: min_gap_m=\S+ obstacle_margin_m=([0-9.]+)", (out / "driver.log").read_text()
-        )
-        assert rules, "the driver's log has no rules line"
-        margin = float(rules.group(1))
+        try:
+            sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1"]
+            sim += ["--start", f"{start[0]:.4f},{start[1]:.4f},{math.degrees(start[2]):.3f}"]
+            sim += ["--lockstep-client", "--run-dir", run_dir, "--lcm-url", URL]
+            # the map's late box appears in the crossroads when a car comes near it; the city driver
+            # does not avoid obstacles (the smart-city mission leaves them out too)
+            sim += ["--duration", SIM_LIMIT_S + 20, "--no-late-obstacles"]
+            sim += ["--late-box", f"{BOX_X},{BOX_Y},0,{BOX_HALF_M},{BOX_HALF_M},{BOX_NEAR_M}"]
+            sim += ["--late-box-stay", BOX_STAY_S]
+            procs.start("autodrive-sim", sim, out / "sim.log")
+            wait_for_path(run_dir / "nigel1-nano", 60, procs)
+            pose0 = hil.start_poses(build, URL, 1)[0]
+            cfg = hil.runtime_config(out, run_dir, URL, 1, pose0, ROUTE, lidar=True)
+            procs.start(
+                "runtime",
+                [build / "bin" / "autodrive-runtime", "--config", cfg],
+                out / "runtime.log",
+            )
+            eye = [
+                sys.executable,
+                "-m",
+                "autodrive.hil.city.eye_standin",
+                "--vehicles",
+                "NIGEL1",
+                "--lcm-url",
+                URL,
+                "--build",
+                build,
+            ]
+            procs.start("eye-standin", eye, out / "eye.log")
+            adv = [
+                sys.executable,
+                "-m",
+                "autodrive.hil.city.advisory",
+                "--map",
+                "tiny_town",
+                "--vehicles",
+                "NIGEL1",
+                "--lcm-url",
+                URL,
+                "--build",
+                build,
+            ]
+            advisory = procs.start("advisory", adv, out / "advisory.log")
+            spin(1.0)
+            set_light(3, "light 3 GREEN")  # held
+            drv = [
+                build / "bin" / "autodrive-city-driver",
+                "--map",
+                MAP,
+                "--route",
+                ROUTE,
+                "--lcm-url",
+                URL,
+            ]
+            procs.start("city-driver", drv, out / "driver.log")
+            # 1. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway
+            wait_for("driving", lambda: truth["v"] > 0.1)
+            assert stop(advisory, "advisory", log) == 0
+            over_stale = stopped_at(line, 2.0)
+            log(
+                f"1. stale advisory: stood {-over_stale * 100:.1f} cm before the line, light "
+                f"{lights[LIGHT]} (3 = GREEN)"
+            )
+            assert lights[LIGHT] == 3, "the light was not green: the test proves nothing"
+            assert over_stale <= 0.03
+            text = (out / "driver.log").read_text()
+            assert "stale advisory: red light 3" in text, text[-2000:]
+            # 2. the advisory back, RED: the car stays; GREEN: it goes
+            set_light(1, "light 3 RED")
+            procs.start("advisory2", adv, out / "advisory2.log")
+            t_red = truth["t"]
+            wait_for("2 s of red", lambda: truth["t"] > t_red + 2.0 or abs(truth["v"]) > 0.01)
+            assert abs(truth["v"]) < 0.01 and past(line) < 0, f"the car moved on red: {truth}"
+            set_light(3, "light 3 GREEN again")
+            wait_for("across the line on green", lambda: past(line) > 0.3)
+            log("2. red: stayed; green: crossed the stop line")
+            # 3. stop sign: a full stop of >= 1 s, then on
+            over_sign = stopped_at(sign, 1.0)
+            wait_for("on after the stop sign", lambda: past(sign) > 0.3)
+            log(f"3. stop sign: stood >= 1 s, {-over_sign * 100:.1f} cm before it, then went on")
+            assert over_sign <= 0.03
+            # 4. the box on the lane: stand the obstacle margin before it, go on when it is gone
+            rules = re.search(
+                r"rules: min_gap_m=\S+ obstacle_margin_m=([0-9.]+)",
+                (out / "driver.log").read_text(),
+            )
+            assert rules, "the driver's log has no rules line"
+            margin = float(rules.group(1))
 
-        def box_gap():  # the box's west face less the car's front, along the lane (east) [m]
-            front = truth["x"] + scoring.front_offset_m() * math.cos(truth["yaw"])
-            return BOX_X - BOX_HALF_M - front
+            def box_gap():  # the box's west face less the car's front, along the lane (east) [m]
+                front = truth["x"] + scoring.front_offset_m() * math.cos(truth["yaw"])
+                return BOX_X - BOX_HALF_M - front
 
-        wait_for("standing before the box", lambda: abs(truth["v"]) < 0.01 and 0 < box_gap() < 0.5)
-        gap = box_gap()
-        assert "late box 1 appeared" in (out / "sim.log").read_text()
-        log(
-            f"4. box on the lane: stood {gap * 100:.1f} cm before it (margin {margin * 100:.0f} cm)"
-        )
-        assert margin - 0.03 <= gap <= margin + 0.05, f"stood {gap:.3f} m before the box"
-        wait_for("on past the box once it left", lambda: truth["x"] > BOX_X + 0.3)
-        assert "late box 1 left" in (out / "sim.log").read_text()
-        assert truth.get("collisions", 0) == 0, "the car touched something"
-        log("   the box left; the car went on")
-    finally:
-        procs.stop_all()
-        keep = os.environ.get("CITY_TEST_KEEP")  # a folder to keep the logs in
-        if keep:
-            subprocess.run(["cp", "-r", str(out), keep], check=False)
-        for f in ("driver.log", "runtime.log"):
-            p = out / f
-            if p.exists():
-                print(f"---- {f} (tail)\n" + "\n".join(p.read_text().splitlines()[-15:]))
-print("city driver hil ok")
+            wait_for(
+                "standing before the box", lambda: abs(truth["v"]) < 0.01 and 0 < box_gap() < 0.5
+            )
+            gap = box_gap()
+            assert "late box 1 appeared" in (out / "sim.log").read_text()
+            log(
+                f"4. box on the lane: stood {gap * 100:.1f} cm before it (margin {margin * 100:.0f} cm)"
+            )
+            assert margin - 0.03 <= gap <= margin + 0.05, f"stood {gap:.3f} m before the box"
+            wait_for("on past the box once it left", lambda: truth["x"] > BOX_X + 0.3)
+            assert "late box 1 left" in (out / "sim.log").read_text()
+            assert truth.get("collisions", 0) == 0, "the car touched something"
+            log("   the box left; the car went on")
+        finally:
+            procs.stop_all()
+            keep = os.environ.get("CITY_TEST_KEEP")  # a folder to keep the logs in
+            if keep:
+                subprocess.run(["cp", "-r", str(out), keep], check=False)
+            for f in ("driver.log", "runtime.log"):
+                p = out / f
+                if p.exists():
+                    print(f"---- {f} (tail)\n" + "\n".join(p.read_text().splitlines()[-15:]))
+    print("city driver hil ok")

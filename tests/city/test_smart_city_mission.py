@@ -14,59 +14,64 @@ import tempfile
 SIM_SECONDS = 30  # past a light's cycle (20 s)
 WALL_GUARD_S = 900  # only a hang guard (--timeout)
 
-root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
-sys.path.insert(0, str(root / "python"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
 from autodrive.core import lcmtypes  # noqa: E402
 
-with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
-    out = pathlib.Path(tmp)
-    env = dict(os.environ, AUTODRIVE_KEY_DIR=str(out / "keys"))
-    cmd = [
-        sys.executable,
-        "-m",
-        "autodrive.hil.demo",
-        "--mission",
-        "smart-city",
-        "--headless",
-        "--build",
-        str(build),
-        "--out",
-        str(out / "run"),
-        "--seed",
-        "2",
-        "--timeout",
-        str(WALL_GUARD_S),
-        "--sim-seconds",
-        str(SIM_SECONDS),
-        "--advisory",
-        "standin",
-        "--lcm-url",
-        f"udpm://239.255.76.67:{port}?ttl=0",
-    ]
-    r = subprocess.run(cmd, env=env, timeout=WALL_GUARD_S + 120)
-    rep = json.loads((out / "run" / "report.json").read_text())
-    print(json.dumps(rep, indent=2))
-    assert "error" not in rep, rep.get("error")
-    assert rep["sim_s"] >= SIM_SECONDS
-    assert r.returncode == 1, "a 30 s run cannot finish 3 laps: the mission must say not ok"
-    for key in (
-        "red_light_violations",
-        "stop_sign_violations",
-        "max_stop_line_overshoot_m",
-        "collisions",
-        "min_gap_m",
-        "laps_completed",
-        "mean_lap_s",
-    ):
-        assert key in rep, key
-    assert rep["red_light_violations"] == 0 and rep["stop_sign_violations"] == 0
-    assert rep["collisions"] == 0
-    assert rep["max_stop_line_overshoot_m"] <= 0.03
-    assert set(rep["driven_m"]) == {"NIGEL1", "NIGEL2", "NIGEL3"}
-    assert min(rep["driven_m"].values()) > 1.0, "a car did not drive"
-    assert rep["blocked"] == []
-    assert (out / "run" / "trajectories.png").stat().st_size > 10000
-    seen = {e.channel for e in lcmtypes.events(out / "run" / "run.lcmlog")}
-    for ch in ("V2V", "NIGEL1_V2I", "NIGEL3_COMMAND", "NIGEL2_LIDAR", "TRAFFIC_LIGHT_STATE"):
-        assert ch in seen, f"{ch} not in the log"
-print("smart-city mission ok")
+
+def test_smart_city_mission_short(
+    root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int
+) -> None:
+    build, port = build_dir, lcm_port
+
+    with tempfile.TemporaryDirectory(prefix="city-mission-") as tmp:
+        out = pathlib.Path(tmp)
+        env = dict(os.environ, AUTODRIVE_KEY_DIR=str(out / "keys"))
+        cmd = [
+            sys.executable,
+            "-m",
+            "autodrive.hil.demo",
+            "--mission",
+            "smart-city",
+            "--headless",
+            "--build",
+            str(build),
+            "--out",
+            str(out / "run"),
+            "--seed",
+            "2",
+            "--timeout",
+            str(WALL_GUARD_S),
+            "--sim-seconds",
+            str(SIM_SECONDS),
+            "--advisory",
+            "standin",
+            "--lcm-url",
+            f"udpm://239.255.76.67:{port}?ttl=0",
+        ]
+        r = subprocess.run(cmd, env=env, timeout=WALL_GUARD_S + 120)
+        rep = json.loads((out / "run" / "report.json").read_text())
+        print(json.dumps(rep, indent=2))
+        assert "error" not in rep, rep.get("error")
+        assert rep["sim_s"] >= SIM_SECONDS
+        assert r.returncode == 1, "a 30 s run cannot finish 3 laps: the mission must say not ok"
+        for key in (
+            "red_light_violations",
+            "stop_sign_violations",
+            "max_stop_line_overshoot_m",
+            "collisions",
+            "min_gap_m",
+            "laps_completed",
+            "mean_lap_s",
+        ):
+            assert key in rep, key
+        assert rep["red_light_violations"] == 0 and rep["stop_sign_violations"] == 0
+        assert rep["collisions"] == 0
+        assert rep["max_stop_line_overshoot_m"] <= 0.03
+        assert set(rep["driven_m"]) == {"NIGEL1", "NIGEL2", "NIGEL3"}
+        assert min(rep["driven_m"].values()) > 1.0, "a car did not drive"
+        assert rep["blocked"] == []
+        assert (out / "run" / "trajectories.png").stat().st_size > 10000
+        seen = {e.channel for e in lcmtypes.events(out / "run" / "run.lcmlog")}
+        for ch in ("V2V", "NIGEL1_V2I", "NIGEL3_COMMAND", "NIGEL2_LIDAR", "TRAFFIC_LIGHT_STATE"):
+            assert ch in seen, f"{ch} not in the log"
+    print("smart-city mission ok")

@@ -1,16 +1,14 @@
-#!/usr/bin/env python3
 """nano-simavr end to end over a real pty: the real ELF says HELLO and streams STATE frames,
 accepts COMMAND frames written to the pty, and logs the resulting motor PWM change.
-usage: test_nano_simavr_pty.py <nano-simavr> <elf>
 Timeouts below are liveness bounds only (the machine is shared); nothing asserts on wall time."""
 import os
 import struct
 import subprocess
-import sys
 import tempfile
 import termios
 import time
 import tty
+from typing import Callable
 
 SYNC = b"\xa5\x5a"
 ID_COMMAND, ID_HELLO, ID_STATE = 0x01, 0x81, 0x82
@@ -51,8 +49,8 @@ def parse(buf: bytearray):
             del buf[:1]
 
 
-def main() -> int:
-    exe, elf = sys.argv[1], sys.argv[2]
+def test_nano_simavr_on_a_pty(program: Callable[[str], str], nano_elf: str) -> None:
+    exe, elf = program("nano-simavr"), nano_elf
     with tempfile.TemporaryDirectory() as tmp:
         link, log = os.path.join(tmp, "nano"), os.path.join(tmp, "pwm.log")
         proc = subprocess.Popen(
@@ -113,8 +111,3 @@ def main() -> int:
         duties = [int(l.split()[3]) for l in open(log) if not l.startswith("#")]
         assert max(duties) > 100, f"no motor PWM in the log (max duty {max(duties)})"
     print("nano-simavr pty test passed")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """PlatformIO builds the firmware here, offline (`pio run -e nano_offline`: the platform in
 firmware/nano/pio, Debian's avr-gcc and Arduino core, SCons from PyPI as tool-scons), and its
 ELF matches the CMake AVR build's: the same .text, .data and .bss sizes and the same symbols
@@ -11,7 +10,6 @@ nano-simavr started as a Nano being flashed (its application flash erased, Debia
 bootloader running on a pty); avrdude writes and verifies the image, the bootloader starts it,
 and the flashed firmware must then announce itself with a HELLO frame and stream STATE frames.
 PlatformIO's core and build dirs are private to the test (nothing in ~/.platformio or .pio).
-usage: test_pio_build.py <repo root> <CMake nigel_nano.elf> <work dir> <nano-simavr> <bootloader hex>
 """
 
 from __future__ import annotations
@@ -26,6 +24,9 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Callable
+
+import pytest
 
 STK_GET_SYNC = b"\x30\x20"  # STK500v1 Cmnd_STK_GET_SYNC, Sync_CRC_EOP
 # Frame start of the Nano link and the HELLO / STATE ids (firmware/nano/core/protocol/PROTOCOL.md).
@@ -223,11 +224,17 @@ def check_upload_into_simavr(
     raise AssertionError("upload through the bootloader in simavr failed 3 times:\n" + errors[-1])
 
 
-def main() -> int:
-    if len(sys.argv) != 6:
-        print(__doc__, file=sys.stderr)
-        return 2
-    root, cmake_elf, work, simavr, bootloader = (Path(a).resolve() for a in sys.argv[1:6])
+def test_pio_build_matches_cmake_and_uploads(
+    root: Path, program: Callable[[str], str], nano_elf: str, pytestconfig: pytest.Config
+) -> None:
+    work, bootloader = (
+        Path(pytestconfig.getoption(o)).resolve() for o in ("pio_work_dir", "bootloader_hex")
+    )
+    root, cmake_elf, simavr = (
+        root.resolve(),
+        Path(nano_elf).resolve(),
+        Path(program("nano-simavr")).resolve(),
+    )
     pio = root / ".venv" / "bin" / "pio"
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
@@ -240,8 +247,3 @@ def main() -> int:
     check_upload(root, work, pio, "nano_offline_new", 115200)
     check_upload_into_simavr(root, work, pio, simavr, bootloader)
     print("PlatformIO offline build and upload command ok")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

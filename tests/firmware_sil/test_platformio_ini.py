@@ -1,17 +1,19 @@
-#!/usr/bin/env python3
 """platformio.ini checked through PlatformIO's own parser: no warnings, the two online Nano envs
 (PlatformIO's atmelavr, which needs its registry) and the two offline ones (the platform in
-firmware/nano/pio), src_dir/lib_dir (hal_avr/, core/) that exist and hold the firmware.
-usage: test_platformio_ini.py <repo root>"""
+firmware/nano/pio), src/lib dirs that exist and hold the firmware."""
 import os
-import sys
+from pathlib import Path
+
+import pytest
 
 from platformio.project.config import ProjectConfig
 
 
-def main() -> int:
-    root = os.path.abspath(sys.argv[1])
-    os.chdir(root)  # PlatformIO resolves the dirs against the project dir, which is the cwd
+def test_platformio_ini_through_platformio(root: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    root = os.path.abspath(root)
+    monkeypatch.chdir(
+        root
+    )  # PlatformIO resolves the dirs against the project dir, which is the cwd
     cfg = ProjectConfig(os.path.join(root, "platformio.ini"))
     cfg.validate()
     assert cfg.warnings == [], f"platformio.ini warnings: {cfg.warnings}"
@@ -30,15 +32,10 @@ def main() -> int:
         assert cfg.get(f"env:{env}", "framework") == ["arduino"], f"{env}: framework"
     src = cfg.get("platformio", "src_dir")
     lib = cfg.get("platformio", "lib_dir")
-    assert os.path.samefile(src, os.path.join(root, "firmware/nano/hal_avr")), f"src_dir {src}"
-    assert os.path.samefile(lib, os.path.join(root, "firmware/nano/core")), f"lib_dir {lib}"
+    assert os.path.samefile(src, os.path.join(root, "firmware/nano/src")), f"src_dir {src}"
+    assert os.path.samefile(lib, os.path.join(root, "firmware/nano/lib")), f"lib_dir {lib}"
     main_cpp = open(os.path.join(src, "main.cpp")).read()
     assert "void setup()" in main_cpp and "void loop()" in main_cpp, "src has no Arduino sketch"
-    for module in ("nano_core", "protocol", "encoder"):
+    for module in ("nigel", "proto", "enc"):
         assert os.path.isdir(os.path.join(lib, module)), f"lib module {module} missing"
     print("platformio.ini ok:", ", ".join(envs))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

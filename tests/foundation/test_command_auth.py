@@ -1,9 +1,7 @@
 """The Python command signer against the shared test vectors (the C++ signer checks the same
 file: runtime.unit.CommandAuth.*), the keys tool (mode 0600, no silent overwrite, refuses
 group-readable keys), and tools/lcm-route's decision on a host with a default route (a fake
-`ip` on PATH records what it would change).
-
-Usage: test_command_auth.py ROOT"""
+`ip` on PATH records what it would change)."""
 
 from __future__ import annotations
 
@@ -12,48 +10,55 @@ import os
 import pathlib
 import stat
 import subprocess
-import sys
-import tempfile
 import types
+
+import pytest
 
 from autodrive.core import command_auth
 from autodrive.core import keys
 
-root = pathlib.Path(sys.argv[1])
 
-# --- test vectors ---------------------------------------------------------------------------
-doc = json.loads((root / "tests" / "foundation" / "command_auth_vectors.json").read_text())
-for v in doc["vectors"]:
-    cmd = types.SimpleNamespace(**v["cmd"])
-    m = command_auth.canonical_bytes(cmd, v["vehicle"])
-    assert m.hex() == v["canonical_hex"], f"canonical bytes differ for {v['cmd']['source']}"
-    mac = command_auth.mac_of(bytes.fromhex(v["key"]), m)
-    assert mac.hex() == v["mac_hex"], f"MAC differs for {v['cmd']['source']}"
-    # The Signer gives the same MAC for the same fields and counter.
-    s = command_auth.Signer(bytes.fromhex(v["key"]), v["vehicle"], cmd.source, cmd.authority)
-    s._last = cmd.counter - 1 - 10**18  # the counter is the wall clock: reproduce it exactly
-    signed = s.sign(types.SimpleNamespace(**v["cmd"]))
-    signed.counter = cmd.counter
-    signed.mac = command_auth.mac_of(s.key, command_auth.canonical_bytes(signed, s.vehicle))
-    assert signed.mac == mac
-print(f"{len(doc['vectors'])} test vectors: canonical bytes and MACs agree")
+def vectors(root: pathlib.Path) -> list[dict]:
+    return json.loads((root / "tests" / "foundation" / "command_auth_vectors.json").read_text())[
+        "vectors"
+    ]
 
-# Counters strictly increase, even when the clock does not move.
-s = command_auth.Signer(b"k" * 32, "NIGEL1", "t", command_auth.AUTHORITY_MACHINE)
-c1 = s.sign(types.SimpleNamespace(**doc["vectors"][0]["cmd"]))
-n1 = c1.counter
-c2 = s.sign(types.SimpleNamespace(**doc["vectors"][0]["cmd"]))
-assert c2.counter > n1
-for bad in ("", "x" * 33, "a b"):
-    try:
-        command_auth.Signer(b"k" * 32, "NIGEL1", bad, command_auth.AUTHORITY_MACHINE)
-        raise AssertionError(f"source {bad!r} accepted")
-    except ValueError:
-        pass
 
-# --- keys tool ------------------------------------------------------------------------------
-with tempfile.TemporaryDirectory() as tmp:
-    os.environ["AUTODRIVE_KEY_DIR"] = tmp
+def test_signer_matches_shared_vectors(root: pathlib.Path) -> None:
+    for v in vectors(root):
+        cmd = types.SimpleNamespace(**v["cmd"])
+        m = command_auth.canonical_bytes(cmd, v["vehicle"])
+        assert m.hex() == v["canonical_hex"], f"canonical bytes differ for {v['cmd']['source']}"
+        mac = command_auth.mac_of(bytes.fromhex(v["key"]), m)
+        assert mac.hex() == v["mac_hex"], f"MAC differs for {v['cmd']['source']}"
+        # The Signer gives the same MAC for the same fields and counter.
+        s = command_auth.Signer(bytes.fromhex(v["key"]), v["vehicle"], cmd.source, cmd.authority)
+        s._last = cmd.counter - 1 - 10**18  # the counter is the wall clock: reproduce it exactly
+        signed = s.sign(types.SimpleNamespace(**v["cmd"]))
+        signed.counter = cmd.counter
+        signed.mac = command_auth.mac_of(s.key, command_auth.canonical_bytes(signed, s.vehicle))
+        assert signed.mac == mac
+    print(f"{len(vectors(root))} test vectors: canonical bytes and MACs agree")
+
+
+def test_counters_increase_and_sources_checked(root: pathlib.Path) -> None:
+    # Counters strictly increase, even when the clock does not move.
+    s = command_auth.Signer(b"k" * 32, "NIGEL1", "t", command_auth.AUTHORITY_MACHINE)
+    c1 = s.sign(types.SimpleNamespace(**vectors(root)[0]["cmd"]))
+    n1 = c1.counter
+    c2 = s.sign(types.SimpleNamespace(**vectors(root)[0]["cmd"]))
+    assert c2.counter > n1
+    for bad in ("", "x" * 33, "a b"):
+        try:
+            command_auth.Signer(b"k" * 32, "NIGEL1", bad, command_auth.AUTHORITY_MACHINE)
+            raise AssertionError(f"source {bad!r} accepted")
+        except ValueError:
+            pass
+
+
+def test_keys_tool(tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp = str(tmp_path)
+    monkeypatch.setenv("AUTODRIVE_KEY_DIR", tmp)
     assert keys.main(["create", "NIGEL7"]) == 0
     path = pathlib.Path(tmp) / "NIGEL7.key"
     assert stat.S_IMODE(path.stat().st_mode) == 0o600, oct(path.stat().st_mode)
@@ -72,11 +77,11 @@ with tempfile.TemporaryDirectory() as tmp:
     except ValueError as e:
         assert str(path) in str(e) and "group or others" in str(e), e
     assert keys.main(["check", "NIGEL7"]) == 1
-print("keys tool: mode 0600, no silent overwrite, group-readable keys refused")
+    print("keys tool: mode 0600, no silent overwrite, group-readable keys refused")
 
-# --- tools/lcm-route with a default route ---------------------------------------------------
-with tempfile.TemporaryDirectory() as tmp:
-    fake = pathlib.Path(tmp)
+
+def test_lcm_route_keeps_bus_on_lo(root: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    fake = tmp_path
     (fake / "ip").write_text(
         """#!/usr/bin/env bash
 # A host with a default route: the group goes out of eth0 until 239.0.0.0/8 dev lo is added.
@@ -115,8 +120,8 @@ exit 0
     code, out, calls = route("ensure", AUTODRIVE_LCM_MULTI_MACHINE="1")
     assert code == 0 and "multi-machine" in out and "signed" in out, out
     assert "route replace" not in calls, "multi-machine use must leave the routes alone"
-setup = (root / "tools" / "setup").read_text()
-assert '"$ROOT/tools/lcm-route" ensure' in setup, "tools/setup does not keep LCM on lo"
-assert "autodrive.core.keys create --if-missing" in setup, "tools/setup creates no key"
-print("lcm-route: a default route gets 239.0.0.0/8 dev lo; multi-machine only when asked")
-print("command auth ok")
+    setup = (root / "tools" / "setup").read_text()
+    assert '"$ROOT/tools/lcm-route" ensure' in setup, "tools/setup does not keep LCM on lo"
+    assert "autodrive.core.keys create --if-missing" in setup, "tools/setup creates no key"
+    print("lcm-route: a default route gets 239.0.0.0/8 dev lo; multi-machine only when asked")
+    print("command auth ok")

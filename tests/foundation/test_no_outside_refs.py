@@ -4,7 +4,6 @@ Fails on (1) a reference into a sibling "shared" folder, (2) an absolute path un
 that only exists on a developer's machine (/work, /home, /root, /Users, /mnt, /farm), (3) a
 markdown link whose target is not in the tree, (4) a repo path ending in .md that is cited in
 any file but does not exist, (5) a bare file name ending in .md that no tracked file has.
-usage: test_no_outside_refs.py <repo root>
 A self-check first plants each kind of violation in a scratch tree and requires it to be found.
 """
 
@@ -14,7 +13,6 @@ import os
 import pathlib
 import re
 import subprocess
-import sys
 import tempfile
 
 # Built from pieces so that this file does not match its own patterns.
@@ -129,23 +127,11 @@ def self_check() -> list[str]:
     return missed
 
 
-def main() -> int:
-    if len(sys.argv) != 2:
-        print(__doc__, file=sys.stderr)
-        return 2
+def test_self_check_finds_each_planted_violation() -> None:
     missed = self_check()
-    for m in missed:
-        print(f"SELF-CHECK FAILED: {m}")
-    root = pathlib.Path(sys.argv[1]).resolve()
-    problems = check_tree(root)
-    for p in problems:
-        print(p)
-    if missed or problems:
-        print(f"FAIL: {len(problems)} reference(s) outside the tree")
-        return 1
-    print("ok: no tracked file refers outside the repository")
-    return 0
+    assert not missed, "SELF-CHECK FAILED: " + "; ".join(missed)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def test_no_tracked_file_refers_outside(root: pathlib.Path) -> None:
+    problems = check_tree(root.resolve())
+    assert not problems, f"{len(problems)} reference(s) outside the tree:\n" + "\n".join(problems)

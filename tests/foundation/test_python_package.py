@@ -8,7 +8,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(sys.argv[1] if len(sys.argv) > 1 else os.environ["AUTODRIVE_ROOT"]).resolve()
+ROOT = Path(os.environ["AUTODRIVE_ROOT"]).resolve()
 PACKAGE = ROOT / "python" / "autodrive"
 FORBIDDEN = "__" + "file__"  # spelled apart so that this file does not match its own grep
 
@@ -50,9 +50,3 @@ def test_root_from_editable_install() -> None:
     assert r.returncode == 0 and Path(r.stdout.strip()) == ROOT, r.stdout + r.stderr
     print(f"editable install's repository: {r.stdout.strip()}")
 
-
-if __name__ == "__main__":
-    test_no_path_from_file()
-    test_root_from_environment()
-    test_root_from_editable_install()
-    print("foundation.python_package: all passed")

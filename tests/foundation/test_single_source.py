@@ -1,6 +1,6 @@
 """Each of the car's figures is written in one place, vehicle/nigel.params: no other tracked file
 outside tests/ spells one by hand (generated files and the map sidecars excepted), and the
-generated files in the tree are fresh. Usage: test_single_source.py REPO_ROOT"""
+generated files in the tree are fresh."""
 
 from __future__ import annotations
 
@@ -72,8 +72,8 @@ def offenders(root: Path, files: list[str], figures: dict[str, str]) -> list[str
     return found
 
 
-def main() -> int:
-    root = Path(sys.argv[1]).resolve()
+def test_figures_written_once_and_generated_files_fresh(root: Path) -> None:
+    root = root.resolve()
     car = vehicle.load(root / tree.PARAMS)
     figures = distinctive_figures(car)
     generated = set(tree.render_all(root))
@@ -95,13 +95,7 @@ def main() -> int:
         if not path.is_file() or path.read_text() != text:
             errors.append(f"{rel}: stale or missing generated file (run tools/gen-docs)")
 
-    for e in errors:
-        print("FAIL", e)
     print(
         f"{len(figures)} distinctive figures checked in {len(files)} files: {len(errors)} problem(s)"
     )
-    return 1 if errors else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    assert not errors, "\n".join(errors)

@@ -15,48 +15,48 @@ import time
 from autodrive.core import lcmtypes
 from autodrive.core.channels import channel
 
-root, build, port = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
-types = lcmtypes.load(build)
 
+def test_ctrl_c_mid_mission(root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int) -> None:
+    build, port = str(build_dir), lcm_port
+    types = lcmtypes.load(build)
 
-def alive(pattern):
-    r = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True)
-    return [p for p in r.stdout.split() if p and int(p) != 0]
+    def alive(pattern):
+        r = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True)
+        return [p for p in r.stdout.split() if p and int(p) != 0]
 
-
-with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
-    demo = subprocess.Popen(
-        demo_command(build, tmp, port, "--timeout", "200"),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-    seen = []
-    for line in demo.stdout:
-        seen.append(line)
-        sys.stdout.write(line)
-        if "route leg 1/" in line:  # the car is engaged and moving
-            break
-    assert demo.poll() is None, "the demo ended before the mapping route:\n" + "".join(seen)
-    time.sleep(0.5)  # well into the leg
-    children = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
-    assert len(children) >= 3, f"expected the demo's children running, found {children}"
-    demo.send_signal(signal.SIGINT)
-    rest, _ = demo.communicate(timeout=120)
-    sys.stdout.write(rest)
-    assert demo.returncode == 130, f"demo exited {demo.returncode}, want 130 (interrupted)"
-    assert "interrupted" in rest
-    left = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
-    assert not left, f"processes left behind: {left}"
-    report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
-    assert not report.get("ok"), "an interrupted mission must not report ok"
-    assert report.get("gt_samples", 0) > 100, "the LCM log lost what was recorded"
-    last = None
-    for ev in lcmtypes.events(pathlib.Path(tmp) / "run.lcmlog"):
-        if ev.channel == channel("COMMAND", "NIGEL1"):
-            last = types.vehicle_command_t.decode(ev.data)
-    assert last is not None, "no command in the log"
-    assert (
-        not last.engaged and last.throttle == 0.0
-    ), f"last command engaged={last.engaged} throttle={last.throttle}: the autonomy left no stop"
-print("hil demo interrupt ok")
+    with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
+        demo = subprocess.Popen(
+            demo_command(build, tmp, port, "--timeout", "200"),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        seen = []
+        for line in demo.stdout:
+            seen.append(line)
+            sys.stdout.write(line)
+            if "route leg 1/" in line:  # the car is engaged and moving
+                break
+        assert demo.poll() is None, "the demo ended before the mapping route:\n" + "".join(seen)
+        time.sleep(0.5)  # well into the leg
+        children = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
+        assert len(children) >= 3, f"expected the demo's children running, found {children}"
+        demo.send_signal(signal.SIGINT)
+        rest, _ = demo.communicate(timeout=120)
+        sys.stdout.write(rest)
+        assert demo.returncode == 130, f"demo exited {demo.returncode}, want 130 (interrupted)"
+        assert "interrupted" in rest
+        left = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")
+        assert not left, f"processes left behind: {left}"
+        report = json.loads((pathlib.Path(tmp) / "report.json").read_text())
+        assert not report.get("ok"), "an interrupted mission must not report ok"
+        assert report.get("gt_samples", 0) > 100, "the LCM log lost what was recorded"
+        last = None
+        for ev in lcmtypes.events(pathlib.Path(tmp) / "run.lcmlog"):
+            if ev.channel == channel("COMMAND", "NIGEL1"):
+                last = types.vehicle_command_t.decode(ev.data)
+        assert last is not None, "no command in the log"
+        assert (
+            not last.engaged and last.throttle == 0.0
+        ), f"last command engaged={last.engaged} throttle={last.throttle}: the autonomy left no stop"
+    print("hil demo interrupt ok")

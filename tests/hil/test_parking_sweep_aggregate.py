@@ -8,9 +8,6 @@ import subprocess
 import sys
 import tempfile
 
-root = pathlib.Path(sys.argv[1])
-
-
 GOALS = (
     "goal_all_success_no_collisions",
     "goal_final_pose",
@@ -75,47 +72,50 @@ def sweep(out, seeds, first=1):
     return last, r.stderr
 
 
-with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
-    mixed = pathlib.Path(tmp) / "mixed"
-    put(mixed, 1, report(0.010, 1.0, 0.020, 8.0), exit_code=0)
-    put(mixed, 2, None, exit_code=1, gt=False)  # demo died: no report
-    put(mixed, 3, report(0.050, 3.0, 0.040, 9.0, collisions=2, clearance_m=0.0), exit_code=1)
-    put(mixed, 4, report(0.012, 0.5, 0.025, 130.0), exit_code=1)  # ok report, exit 1
-    s, err = sweep(mixed, 4)
-    print(err)
-    assert s["runs"] == 4 and s["reports"] == 3, s
-    assert s["successes"] == 1, "only seed 1 is ok (seed 4's demo exited 1)"
-    assert s["collisions_total"] == 2
-    assert s["final_pos_error_m_median"] == 0.012 and s["final_pos_error_m_max"] == 0.05
-    assert s["final_heading_error_deg_max"] == 3.0 and s["final_heading_error_deg_median"] == 1.0
-    assert s["localization_rms_m_max"] == 0.04 and s["wall_s_max"] == 130.0
-    assert s["min_clearance_m_min"] == 0.0
-    assert s["per_seed"]["seed"] == [1, 2, 3, 4]
-    assert s["per_seed"]["ok"] == [True, False, False, False]
-    assert s["per_seed"]["final_pos_error_m"] == [0.01, None, 0.05, 0.012]
-    assert s["per_seed"]["error"][1] == "no report.json, demo exit 1"
-    assert s["per_seed"]["error"][2] == "2 collision(s), demo exit 1"
-    assert s["per_seed"]["error"][3] == "demo exit 1"
-    for goal in GOALS:
-        assert s[goal] is False, goal
-    assert "[parking 2/4] seed 2: FAILED (no report.json, demo exit 1)\n" in err, err
+def test_aggregate_of_synthetic_reports() -> None:
+    with tempfile.TemporaryDirectory(prefix="parking-sweep-") as tmp:
+        mixed = pathlib.Path(tmp) / "mixed"
+        put(mixed, 1, report(0.010, 1.0, 0.020, 8.0), exit_code=0)
+        put(mixed, 2, None, exit_code=1, gt=False)  # demo died: no report
+        put(mixed, 3, report(0.050, 3.0, 0.040, 9.0, collisions=2, clearance_m=0.0), exit_code=1)
+        put(mixed, 4, report(0.012, 0.5, 0.025, 130.0), exit_code=1)  # ok report, exit 1
+        s, err = sweep(mixed, 4)
+        print(err)
+        assert s["runs"] == 4 and s["reports"] == 3, s
+        assert s["successes"] == 1, "only seed 1 is ok (seed 4's demo exited 1)"
+        assert s["collisions_total"] == 2
+        assert s["final_pos_error_m_median"] == 0.012 and s["final_pos_error_m_max"] == 0.05
+        assert (
+            s["final_heading_error_deg_max"] == 3.0 and s["final_heading_error_deg_median"] == 1.0
+        )
+        assert s["localization_rms_m_max"] == 0.04 and s["wall_s_max"] == 130.0
+        assert s["min_clearance_m_min"] == 0.0
+        assert s["per_seed"]["seed"] == [1, 2, 3, 4]
+        assert s["per_seed"]["ok"] == [True, False, False, False]
+        assert s["per_seed"]["final_pos_error_m"] == [0.01, None, 0.05, 0.012]
+        assert s["per_seed"]["error"][1] == "no report.json, demo exit 1"
+        assert s["per_seed"]["error"][2] == "2 collision(s), demo exit 1"
+        assert s["per_seed"]["error"][3] == "demo exit 1"
+        for goal in GOALS:
+            assert s[goal] is False, goal
+        assert "[parking 2/4] seed 2: FAILED (no report.json, demo exit 1)\n" in err, err
 
-    good = pathlib.Path(tmp) / "good"
-    for seed in range(5, 15):
-        put(good, seed, report(0.005 + 0.001 * seed, 1.5, 0.02, 9.0), exit_code=0)
-    s, _ = sweep(good, 10, first=5)
-    assert s["runs"] == 10 and s["successes"] == 10 and s["collisions_total"] == 0, s
-    assert s["final_pos_error_m_max"] == 0.019 and s["final_pos_error_m_median"] == 0.0145
-    for goal in GOALS:
-        assert s[goal] is True, goal
-    s, _ = sweep(good, 2, first=5)  # the first two of them: every goal but the ten runs
-    assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
+        good = pathlib.Path(tmp) / "good"
+        for seed in range(5, 15):
+            put(good, seed, report(0.005 + 0.001 * seed, 1.5, 0.02, 9.0), exit_code=0)
+        s, _ = sweep(good, 10, first=5)
+        assert s["runs"] == 10 and s["successes"] == 10 and s["collisions_total"] == 0, s
+        assert s["final_pos_error_m_max"] == 0.019 and s["final_pos_error_m_median"] == 0.0145
+        for goal in GOALS:
+            assert s[goal] is True, goal
+        s, _ = sweep(good, 2, first=5)  # the first two of them: every goal but the ten runs
+        assert s["goal_final_pose"] is True and s["goals_met"] is False, "2 runs cannot meet 10/10"
 
-    bad = subprocess.run(
-        [sys.executable, "-m", "autodrive.learn.sweep.parking", "--seeds", "0"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert bad.returncode == 2 and "--seeds 0" in bad.stderr, bad.stderr
-print("parking sweep aggregate ok")
+        bad = subprocess.run(
+            [sys.executable, "-m", "autodrive.learn.sweep.parking", "--seeds", "0"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert bad.returncode == 2 and "--seeds 0" in bad.stderr, bad.stderr
+    print("parking sweep aggregate ok")

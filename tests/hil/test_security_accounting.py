@@ -7,7 +7,7 @@ import pathlib
 import random
 import sys
 
-sys.path.insert(0, str(pathlib.Path(sys.argv[1]) / "python"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
 from autodrive.bench.security import applied_beyond_sent  # noqa: E402
 
 S = 1_000_000  # [us]
@@ -38,19 +38,20 @@ def statuses(read_lag_us: int, extra: int = 0, every_us: int = S // 5) -> list[t
     return out
 
 
-rng = random.Random(7)
-# An honest gate, in time or 3 s behind, with the logger losing 40 % and a burst: 0.
-for lag_us in (0, 3 * S):
-    for lost in (0.0, 0.4):
-        got = applied_beyond_sent(bus(10, lost, rng), statuses(lag_us))
-        assert got == 0, f"lag {lag_us} us, lost {lost}: {got}"
-# A gate that applied commands beyond those sent (replays, or foreign ones) is caught (a gate
-# reading the bus seconds late hides as many as were sent in its lag) ...
-for lag_us in (0, S // 5):
-    for lost in (0.0, 0.4):
-        got = applied_beyond_sent(bus(10, lost, rng), statuses(lag_us, extra=20))
-        assert got >= 20 - lag_us * 25 // S, f"lag {lag_us} us, lost {lost}: {got}"
-# ... and one that applies every replay is caught however late it reads.
-twice = [(t, 2 * a) for t, a in statuses(3 * S)]
-assert applied_beyond_sent(bus(10, 0.4, rng), twice) > 50
-print("security accounting ok")
+def test_replays_applied_counted_honestly() -> None:
+    rng = random.Random(7)
+    # An honest gate, in time or 3 s behind, with the logger losing 40 % and a burst: 0.
+    for lag_us in (0, 3 * S):
+        for lost in (0.0, 0.4):
+            got = applied_beyond_sent(bus(10, lost, rng), statuses(lag_us))
+            assert got == 0, f"lag {lag_us} us, lost {lost}: {got}"
+    # A gate that applied commands beyond those sent (replays, or foreign ones) is caught (a gate
+    # reading the bus seconds late hides as many as were sent in its lag) ...
+    for lag_us in (0, S // 5):
+        for lost in (0.0, 0.4):
+            got = applied_beyond_sent(bus(10, lost, rng), statuses(lag_us, extra=20))
+            assert got >= 20 - lag_us * 25 // S, f"lag {lag_us} us, lost {lost}: {got}"
+    # ... and one that applies every replay is caught however late it reads.
+    twice = [(t, 2 * a) for t, a in statuses(3 * S)]
+    assert applied_beyond_sent(bus(10, 0.4, rng), twice) > 50
+    print("security accounting ok")

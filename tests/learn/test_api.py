@@ -153,13 +153,3 @@ def test_bad_input() -> None:
     w.reset(1)  # the world still works after the refusals
     w.step(10)
     print("bad inputs refused with messages naming them")
-
-
-if __name__ == "__main__":
-    test_repeatable()
-    test_batch_equals_single()
-    test_firmware_path()
-    test_lane_flag()
-    test_bad_input()
-    test_camera()
-    print("learn.api: all passed")

@@ -93,12 +93,3 @@ def test_pettingzoo() -> None:
     assert np.array_equal(a, b), "same seed, another multi-agent episode"
     env.close()
     print(f"IntersectionEnv on {env.map_name}: parallel_api_test passed, seeded episodes repeat")
-
-
-if __name__ == "__main__":
-    test_gym()
-    test_taken_slot_refused()
-    test_render()
-    test_lane_keeper()
-    test_pettingzoo()
-    print("learn.envs: all passed")

@@ -42,9 +42,3 @@ def test_unknown_id_named() -> None:
     else:
         raise AssertionError("an unknown id was made")
 
-
-if __name__ == "__main__":
-    test_gymnasium_ids()
-    test_pettingzoo_ids()
-    test_unknown_id_named()
-    print("learn.registered: all passed")

@@ -15,17 +15,16 @@ from autodrive.core import lcmtypes
 from autodrive.gym import World
 from autodrive.gym import step_worlds
 
-BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 THROTTLE, STEERING, SEED, DURATION_S = 0.7, 0.4, 7, 10
 TOLERANCE_M = 1e-3
 
 
-def hil_truth() -> list[tuple[int, np.ndarray]]:
-    types = lcmtypes.load(BUILD)
+def hil_truth(build: Path) -> list[tuple[int, np.ndarray]]:
+    types = lcmtypes.load(build)
     with tempfile.TemporaryDirectory(prefix="learn-truth-") as d:
         log = os.path.join(d, "truth.bin")
         argv = [
-            str(BUILD / "bin" / "autodrive-sim"),
+            str(build / "bin" / "autodrive-sim"),
             "--quiet",
             "--lockstep",
             "--lcm-url",
@@ -52,8 +51,8 @@ def hil_truth() -> list[tuple[int, np.ndarray]]:
     return out
 
 
-def main() -> None:
-    truth = hil_truth()
+def test_world_matches_hil_truth(build_dir: Path) -> None:
+    truth = hil_truth(build_dir)
     assert len(truth) >= 100 * DURATION_S - 1, f"only {len(truth)} truth messages"
     w = World("parking_school", cars=1, seed=SEED, lidar_rays=360)
     w.command(0, THROTTLE, STEERING)
@@ -68,7 +67,3 @@ def main() -> None:
         f"learn.truth: {len(truth)} messages over {DURATION_S} s, car {travel:.2f} m from its "
         f"start, largest difference {worst * 1e3:.6f} mm"
     )
-
-
-if __name__ == "__main__":
-    main()

@@ -3,10 +3,10 @@ bad_*.yaml (good_town with one mistake, one per class of error) exits 1 with a m
 the file, the element (dotted key) and what is wrong; the shipped maps pass."""
 import pathlib
 import subprocess
-import sys
-import unittest
 
-ROOT = pathlib.Path(sys.argv[1])
+from pyhelpers import REPO_ROOT
+
+ROOT = REPO_ROOT
 FIX = ROOT / "tests" / "maps" / "fixtures" / "town"
 TOOL = ROOT / "tools" / "map"
 
@@ -39,34 +39,31 @@ def check(*files: str) -> subprocess.CompletedProcess:
     return subprocess.run([str(TOOL), "check", *files], capture_output=True, text=True, timeout=120)
 
 
-class MapCheck(unittest.TestCase):
-    def test_every_bad_fixture_is_covered(self) -> None:
-        self.assertEqual(sorted(p.name for p in FIX.glob("bad_*.yaml")), sorted(EXPECTED))
-
-    def test_good_fixture_and_shipped_maps_pass(self) -> None:
-        r = check(str(FIX / "good_town.yaml"), "parking_school", "driving_school",
-                  "intersection_school", "tiny_town")  # fmt: skip
-        self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertEqual(r.stdout.count(": ok ("), 5)
-
-    def test_each_bad_fixture_names_file_element_and_problem(self) -> None:
-        r = check(*(str(FIX / name) for name in EXPECTED))  # one run checks them all
-        self.assertEqual(r.returncode, 1, r.stdout)
-        self.assertEqual(r.stdout, "")
-        lines = r.stderr.splitlines()
-        self.assertEqual(len(lines), len(EXPECTED), r.stderr)
-        for name, (key, words) in EXPECTED.items():
-            with self.subTest(name):
-                line = next(l for l in lines if l.startswith(f"map check: {FIX / name}: "))
-                self.assertIn(f"map check: {FIX / name}: {key}: ", line)
-                self.assertIn(words, line)
-
-    def test_one_bad_file_among_good_ones_fails_the_run(self) -> None:
-        r = check(str(FIX / "good_town.yaml"), str(FIX / "bad_tile_gap.yaml"))
-        self.assertEqual(r.returncode, 1)
-        self.assertIn("good_town.yaml: ok", r.stdout)
-        self.assertIn("bad_tile_gap.yaml: tiles[0]", r.stderr)
+def test_every_bad_fixture_is_covered() -> None:
+    assert sorted(p.name for p in FIX.glob("bad_*.yaml")) == sorted(EXPECTED)
 
 
-if __name__ == "__main__":
-    unittest.main(argv=sys.argv[:1], verbosity=2)
+def test_good_fixture_and_shipped_maps_pass() -> None:
+    r = check(str(FIX / "good_town.yaml"), "parking_school", "driving_school",
+              "intersection_school", "tiny_town")  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count(": ok (") == 5
+
+
+def test_each_bad_fixture_names_file_element_and_problem() -> None:
+    r = check(*(str(FIX / name) for name in EXPECTED))  # one run checks them all
+    assert r.returncode == 1, r.stdout
+    assert r.stdout == ""
+    lines = r.stderr.splitlines()
+    assert len(lines) == len(EXPECTED), r.stderr
+    for name, (key, words) in EXPECTED.items():
+        line = next(l for l in lines if l.startswith(f"map check: {FIX / name}: "))
+        assert f"map check: {FIX / name}: {key}: " in line
+        assert words in line
+
+
+def test_one_bad_file_among_good_ones_fails_the_run() -> None:
+    r = check(str(FIX / "good_town.yaml"), str(FIX / "bad_tile_gap.yaml"))
+    assert r.returncode == 1
+    assert "good_town.yaml: ok" in r.stdout
+    assert "bad_tile_gap.yaml: tiles[0]" in r.stderr

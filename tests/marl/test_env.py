@@ -141,12 +141,3 @@ def test_shield_and_baseline() -> None:
         f"shield: all at goal ({with_shield['shield_interventions']} interventions); without: "
         f"{without['outcome']}; baseline: all at goal"
     )
-
-
-if __name__ == "__main__":
-    test_api()
-    test_seeded_and_reward()
-    test_progress_shaping()
-    test_steer_rate_penalty()
-    test_shield_and_baseline()
-    print("marl.env: all passed")

@@ -18,7 +18,7 @@ from autodrive.learn.marl.cli import HELD_OUT_SEED
 from autodrive.learn.marl.train import VALIDATION_SEED, TrainConfig, train
 
 
-def main() -> None:
+def test_train_export_evaluate() -> None:
     cfg = TrainConfig(stages=[(1, 128), (2, 128)], copies=2, workers=2, seed=3, buffer=128)
     model, curve, info = train(cfg, print)
     assert info["agent_steps_done"] >= 256
@@ -45,11 +45,9 @@ def main() -> None:
             if mode == "baseline":
                 assert r["success_rate"] == 1.0 and r["collisions"] == 0, r
         print("evaluation ran with the shield and the baseline")
-    checkpoint_selection()
-    print("marl.policy: all passed")
 
 
-def checkpoint_selection() -> None:
+def test_checkpoint_selection() -> None:
     cfg = TrainConfig(
         stages=[(1, 384)],
         copies=1,
@@ -83,7 +81,3 @@ def checkpoint_selection() -> None:
     t, kept_t = round(r["mean_traverse_s"], 3), v["kept"]["mean_traverse_s"]
     assert t == kept_t or (math.isnan(t) and math.isnan(kept_t)), (t, kept_t)
     print(f"checkpoint selection kept {v['kept']['agent_steps']} of {len(rows)} checkpoints")
-
-
-if __name__ == "__main__":
-    main()

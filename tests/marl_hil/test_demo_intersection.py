@@ -14,59 +14,63 @@ import tempfile
 import time
 from pathlib import Path
 
-build, port = Path(sys.argv[2]), int(sys.argv[3])
-keys = tempfile.TemporaryDirectory(prefix="marl-demo-keys-")
-os.environ["AUTODRIVE_KEY_DIR"] = keys.name  # the mission makes the four cars' keys here
 
+def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) -> None:
+    build, port = build_dir, lcm_port
+    keys = tempfile.TemporaryDirectory(prefix="marl-demo-keys-")
+    os.environ["AUTODRIVE_KEY_DIR"] = keys.name  # the mission makes the four cars' keys here
 
-def demo(out: Path, *extra: str) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection"]
-        + ["--build", str(build), "--out", str(out), "--headless", "--policy", "baseline"]
-        + ["--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0", *extra],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        start_new_session=True,
-    )
+    def demo(out: Path, *extra: str) -> subprocess.Popen[str]:
+        return subprocess.Popen(
+            [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection"]
+            + ["--build", str(build), "--out", str(out), "--headless", "--policy", "baseline"]
+            + ["--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0", *extra],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,
+        )
 
+    with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
+        # Ctrl-C mid-episode: everything stops, exit 130.
+        out = Path(tmp) / "interrupted"
+        p = demo(out, "--episodes", "2", "--seed", "4")
+        head = ""
+        assert p.stdout is not None
+        while "episode 1/2" not in head:  # the first episode has started (imports are slow here)
+            line = p.stdout.readline()
+            assert line, head
+            head += line
+        time.sleep(5.0)
+        os.killpg(p.pid, signal.SIGINT)
+        log, _ = p.communicate(timeout=60)
+        log = head + log
+        assert p.returncode == 130, (p.returncode, log)
+        rep = json.loads((out / "report.json").read_text())
+        assert rep["interrupted"] is True, rep
+        left = subprocess.run(["pgrep", "-f", str(out)], capture_output=True, text=True).stdout
+        assert not left.strip(), f"processes of the interrupted run still running: {left}"
+        print("Ctrl-C: exit 130, every process stopped, report kept")
 
-with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
-    # Ctrl-C mid-episode: everything stops, exit 130.
-    out = Path(tmp) / "interrupted"
-    p = demo(out, "--episodes", "2", "--seed", "4")
-    head = ""
-    assert p.stdout is not None
-    while "episode 1/2" not in head:  # the first episode has started (imports are slow here)
-        line = p.stdout.readline()
-        assert line, head
-        head += line
-    time.sleep(5.0)
-    os.killpg(p.pid, signal.SIGINT)
-    log, _ = p.communicate(timeout=60)
-    log = head + log
-    assert p.returncode == 130, (p.returncode, log)
-    rep = json.loads((out / "report.json").read_text())
-    assert rep["interrupted"] is True, rep
-    left = subprocess.run(["pgrep", "-f", str(out)], capture_output=True, text=True).stdout
-    assert not left.strip(), f"processes of the interrupted run still running: {left}"
-    print("Ctrl-C: exit 130, every process stopped, report kept")
+        out = Path(tmp) / "episode"
+        p = demo(out, "--episodes", "1", "--seed", "1")
+        log, _ = p.communicate(timeout=400)
+        print(log[-1500:])
+        rep = json.loads((out / "report.json").read_text())
+        for key in ("episodes", "success_rate", "collisions", "shield_interventions"):
+            assert key in rep, key
+        for key in ("mean_traverse_s", "steering_rate_rms"):
+            assert isinstance(rep[key], float) and rep[key] > 0, (key, rep[key])
+        assert rep["episodes"] == 1 and rep["success_rate"] == 1.0 and rep["collisions"] == 0, rep
+        assert rep["v2v_lost"] == 0 and p.returncode == 0, rep
+        assert (out / "trajectories.png").stat().st_size > 10000
+        from autodrive.hil.city.eye_standin import PERIOD_US
 
-    out = Path(tmp) / "episode"
-    p = demo(out, "--episodes", "1", "--seed", "1")
-    log, _ = p.communicate(timeout=400)
-    print(log[-1500:])
-    rep = json.loads((out / "report.json").read_text())
-    for key in ("episodes", "success_rate", "collisions", "shield_interventions"):
-        assert key in rep, key
-    for key in ("mean_traverse_s", "steering_rate_rms"):
-        assert isinstance(rep[key], float) and rep[key] > 0, (key, rep[key])
-    assert rep["episodes"] == 1 and rep["success_rate"] == 1.0 and rep["collisions"] == 0, rep
-    assert rep["v2v_lost"] == 0 and p.returncode == 0, rep
-    assert (out / "trajectories.png").stat().st_size > 10000
-    from autodrive.hil.city.eye_standin import PERIOD_US
-
-    # every car's <VEH>_POSE_EYE at the stand-in's rate over most of the episode's sim time
-    want = 0.5 * 4 * rep["per_episode"][0]["sim_s"] / (PERIOD_US * 1e-6)
-    assert rep["eye"].startswith("stand-in") and rep["eye_poses"] >= want, (rep["eye"], want, rep)
-print("ok")
+        # every car's <VEH>_POSE_EYE at the stand-in's rate over most of the episode's sim time
+        want = 0.5 * 4 * rep["per_episode"][0]["sim_s"] / (PERIOD_US * 1e-6)
+        assert rep["eye"].startswith("stand-in") and rep["eye_poses"] >= want, (
+            rep["eye"],
+            want,
+            rep,
+        )
+    print("ok")

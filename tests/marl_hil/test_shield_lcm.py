@@ -13,6 +13,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Callable
 
 from autodrive.core import channels
 from autodrive.core import command_auth
@@ -22,106 +23,108 @@ from autodrive.core.settings import REPO_ROOT
 sys.path.insert(0, str(Path(__file__).parent))
 from marl_test_policy import LOOKAHEAD_M, make_policy  # noqa: E402
 
-exe, build, port = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3])
-url = f"udpm://239.255.76.67:{port}?ttl=0"
-types = lcmtypes.load(build)
-MAP_JSON = REPO_ROOT / "maps" / "intersection_school.json"
-THROTTLE = 1.0  # the trained policies' (autodrive.learn.marl.export)
-keys = tempfile.TemporaryDirectory(prefix="marl-keys-")
-os.environ["AUTODRIVE_KEY_DIR"] = keys.name
-command_auth.create_key(command_auth.default_key_path("NIGEL1"))
 
+def test_shield_and_stale_v2v(
+    program: Callable[[str], str], build_dir: Path, lcm_port: int, lcm_url: str
+) -> None:
+    exe, build, port = program("autodrive-marl"), build_dir, lcm_port
+    url = lcm_url
+    types = lcmtypes.load(build)
+    MAP_JSON = REPO_ROOT / "maps" / "intersection_school.json"
+    THROTTLE = 1.0  # the trained policies' (autodrive.learn.marl.export)
+    keys = tempfile.TemporaryDirectory(prefix="marl-keys-")
+    os.environ["AUTODRIVE_KEY_DIR"] = keys.name
+    command_auth.create_key(command_auth.default_key_path("NIGEL1"))
 
-def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
-    """Runs autodrive-marl with the scripted inputs for >= 2.5 s and 40 engaged commands; returns
-    (commands, last status)."""
-    proc = subprocess.Popen(
-        [exe, "--vehicle", "NIGEL1", "--lcm-url", url, "--policy", str(policy)]
-        + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall"]
-        + ["--waypoint-lookahead-m", str(LOOKAHEAD_M), *extra],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-    lc = lcmtypes.bus(url)
-    commands, status = [], []
-    engaged = 0  # engaged commands so far, counted as they arrive
+    def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
+        """Runs autodrive-marl with the scripted inputs for >= 2.5 s and 40 engaged commands; returns
+        (commands, last status)."""
+        proc = subprocess.Popen(
+            [exe, "--vehicle", "NIGEL1", "--lcm-url", url, "--policy", str(policy)]
+            + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall"]
+            + ["--waypoint-lookahead-m", str(LOOKAHEAD_M), *extra],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        lc = lcmtypes.bus(url)
+        commands, status = [], []
+        engaged = 0  # engaged commands so far, counted as they arrive
 
-    def on_command(_c: str, d: bytes) -> None:
-        nonlocal engaged
-        commands.append(d)
-        engaged += types.vehicle_command_t.decode(d).engaged
+        def on_command(_c: str, d: bytes) -> None:
+            nonlocal engaged
+            commands.append(d)
+            engaged += types.vehicle_command_t.decode(d).engaged
 
-    lc.subscribe(channels.channel("COMMAND", "NIGEL1"), on_command)
-    lc.subscribe(channels.channel("MISSION", "NIGEL1"), lambda _c, d: status.append(d))
-    t0 = time.time()
-    seq = 0
+        lc.subscribe(channels.channel("COMMAND", "NIGEL1"), on_command)
+        lc.subscribe(channels.channel("MISSION", "NIGEL1"), lambda _c, d: status.append(d))
+        t0 = time.time()
+        seq = 0
 
-    # At least 2.5 s and 40 engaged commands: the count, not the wall time, is what the asserts
-    # need (a loaded machine starts the program late); 60 s caps a program that never drives.
-    while time.time() - t0 < 60.0 and (time.time() - t0 < 2.5 or engaged < 40):
-        now_us = int(time.time() * 1e6)
-        pose = types.odometry_t()
-        pose.utime, pose.vehicle, pose.frame_id = now_us, "NIGEL1", "map"
-        pose.x_m, pose.y_m, pose.yaw_rad, pose.vx_m_s = -1.0, -0.14, 0.0, 0.15
-        lc.publish(channels.channel("POSE_MAP", "NIGEL1"), pose.encode())
-        v = types.v2v_state_t()
-        v.utime = now_us - int(peer_age_s * 1e6)
-        v.seq, v.vehicle = seq, "NIGEL2"
-        v.x_m, v.y_m, v.yaw_rad = peer_xy_yaw
-        v.speed_m_s, v.route, v.route_s_m = 0.2, "east_to_west", -1.0
-        lc.publish(channels.channel("V2V"), v.encode())
-        seq += 1
-        end = time.time() + 0.05  # 20 Hz, as the runtimes broadcast
-        while (left := end - time.time()) > 0:
-            if select.select([lc.fileno()], [], [], left)[0]:
-                lc.handle()
-    proc.send_signal(2)
-    out, _ = proc.communicate(timeout=20)
-    assert proc.returncode == 0, out
-    cmds = [types.vehicle_command_t.decode(d) for d in commands]
-    cmds = [c for c in cmds if c.engaged]
-    assert len(cmds) >= 20, (len(cmds), out)
-    st = types.mission_status_t.decode(status[-1]) if status else None
-    return cmds[5:], st, out
+        # At least 2.5 s and 40 engaged commands: the count, not the wall time, is what the asserts
+        # need (a loaded machine starts the program late); 60 s caps a program that never drives.
+        while time.time() - t0 < 60.0 and (time.time() - t0 < 2.5 or engaged < 40):
+            now_us = int(time.time() * 1e6)
+            pose = types.odometry_t()
+            pose.utime, pose.vehicle, pose.frame_id = now_us, "NIGEL1", "map"
+            pose.x_m, pose.y_m, pose.yaw_rad, pose.vx_m_s = -1.0, -0.14, 0.0, 0.15
+            lc.publish(channels.channel("POSE_MAP", "NIGEL1"), pose.encode())
+            v = types.v2v_state_t()
+            v.utime = now_us - int(peer_age_s * 1e6)
+            v.seq, v.vehicle = seq, "NIGEL2"
+            v.x_m, v.y_m, v.yaw_rad = peer_xy_yaw
+            v.speed_m_s, v.route, v.route_s_m = 0.2, "east_to_west", -1.0
+            lc.publish(channels.channel("V2V"), v.encode())
+            seq += 1
+            end = time.time() + 0.05  # 20 Hz, as the runtimes broadcast
+            while (left := end - time.time()) > 0:
+                if select.select([lc.fileno()], [], [], left)[0]:
+                    lc.handle()
+        proc.send_signal(2)
+        out, _ = proc.communicate(timeout=20)
+        assert proc.returncode == 0, out
+        cmds = [types.vehicle_command_t.decode(d) for d in commands]
+        cmds = [c for c in cmds if c.engaged]
+        assert len(cmds) >= 20, (len(cmds), out)
+        st = types.mission_status_t.decode(status[-1]) if status else None
+        return cmds[5:], st, out
 
+    with tempfile.TemporaryDirectory(prefix="marl-shield-") as tmp:
+        policy, _net = make_policy(Path(tmp), throttle=THROTTLE)
+        head_on = (-0.55, -0.14, 3.14159)  # NIGEL2 0.45 m ahead in the same lane, coming at it
 
-with tempfile.TemporaryDirectory(prefix="marl-shield-") as tmp:
-    policy, _net = make_policy(Path(tmp), throttle=THROTTLE)
-    head_on = (-0.55, -0.14, 3.14159)  # NIGEL2 0.45 m ahead in the same lane, coming at it
+        cmds, st, out = run_case(policy, head_on, 0.0)
+        assert all(c.throttle == 0.0 for c in cmds), [c.throttle for c in cmds]
+        assert all(c.source == "marl" and any(c.mac) for c in cmds)
+        assert st is not None and "shield_interventions" in st.detail, st
+        n = int(st.detail.split("shield_interventions ")[1].split()[0])
+        assert n >= 20, (n, st.detail)  # the status lags the commands by up to 0.5 s
+        print(f"head-on: {len(cmds)} commands all braked (throttle 0); status: {st.detail}")
 
-    cmds, st, out = run_case(policy, head_on, 0.0)
-    assert all(c.throttle == 0.0 for c in cmds), [c.throttle for c in cmds]
-    assert all(c.source == "marl" and any(c.mac) for c in cmds)
-    assert st is not None and "shield_interventions" in st.detail, st
-    n = int(st.detail.split("shield_interventions ")[1].split()[0])
-    assert n >= 20, (n, st.detail)  # the status lags the commands by up to 0.5 s
-    print(f"head-on: {len(cmds)} commands all braked (throttle 0); status: {st.detail}")
+        cmds, st, out = run_case(policy, head_on, 0.0, "--no-shield")
+        assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), [c.throttle for c in cmds]
+        print(f"head-on, --no-shield: {len(cmds)} commands at throttle {THROTTLE}")
 
-    cmds, st, out = run_case(policy, head_on, 0.0, "--no-shield")
-    assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), [c.throttle for c in cmds]
-    print(f"head-on, --no-shield: {len(cmds)} commands at throttle {THROTTLE}")
+        cmds, st, out = run_case(policy, head_on, 0.5)
+        assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), [c.throttle for c in cmds]
+        stale = int(st.detail.split("v2v_dropped_stale ")[1].split()[0])
+        peers = int(st.detail.split("peers ")[1].split()[0])
+        assert stale >= 10 and peers == 0, st.detail
+        print(f"head-on peer 500 ms old: dropped as stale ({stale}), no brake; status: {st.detail}")
 
-    cmds, st, out = run_case(policy, head_on, 0.5)
-    assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), [c.throttle for c in cmds]
-    stale = int(st.detail.split("v2v_dropped_stale ")[1].split()[0])
-    peers = int(st.detail.split("peers ")[1].split()[0])
-    assert stale >= 10 and peers == 0, st.detail
-    print(f"head-on peer 500 ms old: dropped as stale ({stale}), no brake; status: {st.detail}")
+        cmds, st, out = run_case(policy, (2.5, 2.5, 0.0), 0.0)
+        assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds)
+        assert int(st.detail.split("peers ")[1].split()[0]) == 1, st.detail
+        print(f"peer far away: fresh (1 peer), no brake: {len(cmds)} commands at {THROTTLE}")
+        cmds, st, out = run_case(policy, head_on, 0.0, "--v2v-loss", "1", "--seed", "5")
+        lost = int(st.detail.split("v2v_lost ")[1].split()[0])
+        got = int(st.detail.split("v2v_received ")[1].split()[0])
+        assert lost == got > 0 and all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), st.detail
+        print(f"--v2v-loss 1: every state lost ({lost}/{got}), so nothing to brake for")
 
-    cmds, st, out = run_case(policy, (2.5, 2.5, 0.0), 0.0)
-    assert all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds)
-    assert int(st.detail.split("peers ")[1].split()[0]) == 1, st.detail
-    print(f"peer far away: fresh (1 peer), no brake: {len(cmds)} commands at {THROTTLE}")
-    cmds, st, out = run_case(policy, head_on, 0.0, "--v2v-loss", "1", "--seed", "5")
-    lost = int(st.detail.split("v2v_lost ")[1].split()[0])
-    got = int(st.detail.split("v2v_received ")[1].split()[0])
-    assert lost == got > 0 and all(abs(c.throttle - THROTTLE) < 1e-6 for c in cmds), st.detail
-    print(f"--v2v-loss 1: every state lost ({lost}/{got}), so nothing to brake for")
-
-    cmds, st, out = run_case(policy, head_on, 0.0, "--v2v-delay-ms", "100")
-    assert all(c.throttle == 0.0 for c in cmds), [c.throttle for c in cmds]
-    print(
-        "--v2v-delay-ms 100 (the demo's degraded link; under the 200 ms stale limit): still brakes"
-    )
-print("ok")
+        cmds, st, out = run_case(policy, head_on, 0.0, "--v2v-delay-ms", "100")
+        assert all(c.throttle == 0.0 for c in cmds), [c.throttle for c in cmds]
+        print(
+            "--v2v-delay-ms 100 (the demo's degraded link; under the 200 ms stale limit): still brakes"
+        )
+    print("ok")

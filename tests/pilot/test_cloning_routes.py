@@ -29,7 +29,7 @@ def drive(watch: lane_watch.LaneWatch, pts: list[tuple[float, float]], start: in
         watch.update((x0, y0, math.atan2(y1 - y0, x1 - x0)))
 
 
-def main() -> None:
+def test_cloning_routes_from_map() -> None:
     normal, n_start = cloning.condition_route("normal")
     rev, r_start = cloning.condition_route("reverse")
     # the recorded route is the normal one; reverse drives its very points the other way
@@ -85,7 +85,3 @@ def main() -> None:
     print(f"reverse: {rev.name}, {rev.length_m:.2f} m, start ({r_start.x_m:+.3f}, "
           f"{r_start.y_m:+.3f}, {math.degrees(r_start.yaw_rad):+.1f} deg); other-lane: "
           f"{other.name}, {gap:.3f} m from the recorded lane")  # fmt: skip
-
-
-if __name__ == "__main__":
-    main()

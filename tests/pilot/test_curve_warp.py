@@ -63,7 +63,7 @@ def centre(row: np.ndarray) -> float:
     return float((w * np.arange(len(w))).sum() / w.sum())
 
 
-def main() -> None:
+def test_curve_warp_geometry() -> None:
     manifest = {"camera": {"fx_px": FX, "fy_px": FX}}
     warp = train.curve_warp(manifest, SPEC, train.TrainConfig(curve_max_dk=0.75))
     assert warp is not None and warp.max_dk == 0.75
@@ -105,7 +105,3 @@ def main() -> None:
         assert moved and math.copysign(1.0, -float(np.mean(moved))) == math.copysign(1.0, dk)
         print(f"dk {dk:+.2f} 1/m: line on the arc within {max(errs):.2f} px over {len(errs)} rows, "
               f"moved {np.mean(moved):+.1f} px on average")  # fmt: skip
-
-
-if __name__ == "__main__":
-    main()

@@ -21,7 +21,7 @@ def heading(line: np.ndarray, i: int) -> float:
     return math.atan2(d[1], d[0])
 
 
-def main() -> None:
+def test_pure_pursuit_labels() -> None:
     route = maps.load("driving_school").route("loop_ccw")
     line, loop = labels.lane_polyline("driving_school", "loop_ccw", 0)
     assert loop and np.allclose(line, np.asarray(route.polyline_m))
@@ -72,7 +72,3 @@ def main() -> None:
     print(
         f"straight 0, left 0.03 m: {near:.3f} (0.2 m) {far:.3f} (0.45 m); arc r {radius:.2f} m ok"
     )
-
-
-if __name__ == "__main__":
-    main()

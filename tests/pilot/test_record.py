@@ -11,7 +11,6 @@ from __future__ import annotations
 import bisect
 import csv
 import json
-import os
 import subprocess
 import sys
 import tempfile
@@ -30,16 +29,15 @@ from autodrive.learn.pilot.make_model import expert_runs  # noqa: E402
 from autodrive.learn.pilot.dataset import record  # noqa: E402
 from autodrive.learn.pilot.expert import ExpertRun, record_expert  # noqa: E402
 
-BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 SEED = 3
 
 
-def check_real_run(d: Path) -> None:
+def check_real_run(d: Path, build: Path) -> None:
     log = d / "expert.lcmlog"
     run = ExpertRun(laps=1, seed=SEED, perturb=0.5, camera_fps=10.0, duration_s=4.0)
-    record_expert(run, log, BUILD)
-    manifest = record([log], d / "ds", build=BUILD, progress=False)
-    t = lcmtypes.load(BUILD)
+    record_expert(run, log, build)
+    manifest = record([log], d / "ds", build=build, progress=False)
+    t = lcmtypes.load(build)
     cam, gt = channels.channel("CAM_FRONT", "NIGEL1"), channels.channel("GROUND_TRUTH", "NIGEL1")
     frames, truth = [], []
     for e in lcmtypes.events(log):
@@ -77,7 +75,7 @@ def check_real_run(d: Path) -> None:
     print(f"real run: {len(rows)} frames, {perturbed} perturbed, manifest ok")
 
 
-def check_other_lane(d: Path) -> None:
+def check_other_lane(d: Path, build: Path) -> None:
     assert {r.lane_shift for r in expert_runs(5, SEED)} == {0}  # the shipped recipe: one lane
     runs = expert_runs(5, SEED, other_lane_laps=2)
     assert sum(r.laps for r in runs) == 5 and runs[0].laps == 2, runs
@@ -86,8 +84,8 @@ def check_other_lane(d: Path) -> None:
     log = d / "other_lane.lcmlog"
     run = ExpertRun(laps=1, seed=SEED, perturb=0.0, camera_fps=5.0, duration_s=4.0,
                     lane_shift=max(r.lane_shift for r in runs))  # fmt: skip
-    record_expert(run, log, BUILD)
-    record([log], d / "ds_other", build=BUILD, progress=False)
+    record_expert(run, log, build)
+    record([log], d / "ds_other", build=build, progress=False)
     route = maps.load(run.map).route(run.route)
     watch = LaneWatch(route, [])
     with open(d / "ds_other" / "frames.csv", newline="") as fh:
@@ -103,9 +101,9 @@ def check_other_lane(d: Path) -> None:
     )
 
 
-def check_refusal(d: Path) -> None:
+def check_refusal(d: Path, build: Path) -> None:
     log = d / "no_camera.lcmlog"
-    assert gen_log.write(log, BUILD, laps=1, frames_per_lap=20, cameras=False) == 0
+    assert gen_log.write(log, build, laps=1, frames_per_lap=20, cameras=False) == 0
     out = d / "refused"
     r = subprocess.run(
         [sys.executable, "-m", "autodrive.learn.pilot", "record", str(log), "--out", str(out),
@@ -118,12 +116,9 @@ def check_refusal(d: Path) -> None:
     print(f"refused: {r.stderr.strip()}")
 
 
-def main() -> None:
+def test_record_real_run_and_refusal(build_dir: Path) -> None:
+    build = build_dir
     with tempfile.TemporaryDirectory(prefix="pilot-record-") as tmp:
-        check_refusal(Path(tmp))
-        check_real_run(Path(tmp))
-        check_other_lane(Path(tmp))
-
-
-if __name__ == "__main__":
-    main()
+        check_refusal(Path(tmp), build)
+        check_real_run(Path(tmp), build)
+        check_other_lane(Path(tmp), build)

@@ -9,7 +9,6 @@ of the light gives nearly the same steering, and the chroma channels change noth
 from __future__ import annotations
 
 import json
-import os
 import sys
 import tempfile
 from pathlib import Path
@@ -28,10 +27,8 @@ from autodrive.learn.pilot.spec import InputSpec, preprocess, read_sidecar  # no
 from autodrive.learn.pilot.spec import sha256_file  # noqa: E402
 from autodrive.learn.pilot.train import TrainConfig, train  # noqa: E402
 
-BUILD = Path(os.environ["AUTODRIVE_BUILD"])
 
-
-def check_balance() -> None:
+def test_balance_weights() -> None:
     """A rare steering is drawn at most max_ratio times as often as a common one; 1: uniform."""
     steer = np.array([0.0] * 90 + [0.4] * 10)
     for ratio, want in ((20.0, 9.0), (3.0, 3.0), (1.0, 1.0)):
@@ -61,12 +58,12 @@ def check_in_graph_preprocessing(net: cv2.dnn.Net, x: np.ndarray, spec: InputSpe
     assert np.max(np.abs(outs[2] - outs[0])) < 1e-6, np.max(np.abs(outs[2] - outs[0]))
 
 
-def main() -> None:
-    check_balance()
+def test_train_one_epoch_and_export(build_dir: Path) -> None:
+    build = build_dir
     with tempfile.TemporaryDirectory(prefix="pilot-train-") as tmp:
         d = Path(tmp)
-        n = gen_log.write(d / "tiny.lcmlog", BUILD, laps=2, frames_per_lap=60)
-        m = record([d / "tiny.lcmlog"], d / "ds", map_name="driving_school", seed=0, build=BUILD)
+        n = gen_log.write(d / "tiny.lcmlog", build, laps=2, frames_per_lap=60)
+        m = record([d / "tiny.lcmlog"], d / "ds", map_name="driving_school", seed=0, build=build)
         assert m["frame_count"] == n and m["laps"] == 2, m
         assert m["frames_per_lap"] == {"0": 60, "1": 60}, m["frames_per_lap"]
         cfg = TrainConfig(epochs=1, batch=16, samples_per_epoch=64, seed=0, name="tiny")
@@ -111,7 +108,3 @@ def main() -> None:
         for f in res["figures"]:
             assert (d / "analysis" / f).stat().st_size > 1000, f
         print(f"one epoch: val loss {report['val_loss'][0]:.4f}, DNN vs torch {diff:.1e}, ok")
-
-
-if __name__ == "__main__":
-    main()

@@ -9,7 +9,6 @@ import math
 import pathlib
 import select
 import subprocess
-import sys
 import tempfile
 import time
 
@@ -21,127 +20,129 @@ from autodrive.core import lcmtypes
 from autodrive import maps
 from autodrive.core.settings import RUNTIME_HIL_CONFIG
 
-root, build, port = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), int(sys.argv[3])
-url = f"udpm://239.255.76.67:{port}?ttl=0"
-types = lcmtypes.load(build)
-veh = channels.vehicle_name(1)
-lc = lcmtypes.bus(url)
-truth: dict[str, float] = {}
-commands: list[tuple[float, bool, str]] = []  # (wall time, engaged, source)
 
+def test_frames_stop_stop_the_car(
+    root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
+) -> None:
+    build, port = build_dir, lcm_port
+    url = lcm_url
+    types = lcmtypes.load(build)
+    veh = channels.vehicle_name(1)
+    lc = lcmtypes.bus(url)
+    truth: dict[str, float] = {}
+    commands: list[tuple[float, bool, str]] = []  # (wall time, engaged, source)
 
-def on_truth(_c: str, d: bytes) -> None:
-    m = types.ground_truth_t.decode(d)
-    truth.update(x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=m.linear_velocity_m_s[0])
-
-
-def on_command(_c: str, d: bytes) -> None:
-    m = types.vehicle_command_t.decode(d)
-    commands.append((time.time(), bool(m.engaged), m.source))
-
-
-lc.subscribe(channels.channel("GROUND_TRUTH", veh), on_truth)
-lc.subscribe(channels.channel("COMMAND", veh), on_command)
-
-
-def pump(wall_s: float, frames: list[bytes] | None = None, fps: float = 30.0) -> None:
-    """Handles the bus for wall_s; publishes frames (cycled) at fps meanwhile when given."""
-    end, next_frame, i = time.time() + wall_s, time.time(), 0
-    while time.time() < end:
-        if frames is not None and time.time() >= next_frame:
-            img = types.compressed_image_t()
-            img.utime, img.frame_id, img.format = int(time.time() * 1e6), "camera_front", "jpeg"
-            img.width_px, img.height_px = fixture.SOURCE_W, fixture.SOURCE_H
-            img.data = frames[i % len(frames)]
-            img.size_bytes = len(img.data)
-            lc.publish(channels.channel("CAM_FRONT", veh), img.encode())
-            i += 1
-            next_frame += 1.0 / fps
-        if select.select([lc.fileno()], [], [], 0.005)[0]:
-            lc.handle()
-
-
-def teleport(x: float, y: float, yaw: float) -> None:
-    m = types.pose2d_t()
-    m.vehicle, m.frame_id, m.x_m, m.y_m, m.yaw_rad = veh, "map", x, y, yaw
-    m.covariance = [0.0] * 9
-    lc.publish(channels.channel("SIM_TELEPORT"), m.encode())
-
-
-with tempfile.TemporaryDirectory(prefix="pilot-stop-") as tmp:
-    out = pathlib.Path(tmp)
-    model, _ = fixture.export(out)
-    jpegs = [p.read_bytes() for p in fixture.frames(out, 10)]
-    route = maps.load("driving_school").route("loop_ccw")
-    start = route.pose_at(0.6)
-    run_dir = out / "run"
-    rcfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
-    rcfg.update(lcm_url=url, clock="sim")
-    rcfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
-    (out / "runtime.yaml").write_text(yaml.safe_dump(rcfg))
-    pcfg = yaml.safe_load((root / "runtime/jetson/config/pilot_hil.yaml").read_text())
-    pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300)
-    (out / "pilot.yaml").write_text(yaml.safe_dump(pcfg))
-    bin_ = build / "bin"
-    sim_log, pilot_log = open(out / "sim.log", "w"), open(out / "pilot.log", "w")
-    procs = [
-        subprocess.Popen(
-            [bin_ / "autodrive-sim", "--map", "driving_school", "--run-dir", run_dir, "--lcm-url",
-             url, "--no-lidar", "--quiet", "--lockstep-client", "--allow-teleport", "--duration",
-             "300", "--start", f"{start.x_m},{start.y_m},{math.degrees(start.yaw_rad)}"],
-            stdout=sim_log, stderr=subprocess.STDOUT)  # fmt: skip
-    ]
-    try:
-        t0 = time.time()
-        while not (run_dir / "nigel1-nano").exists():
-            assert time.time() - t0 < 30 and procs[0].poll() is None, "the sim did not start"
-            time.sleep(0.05)
-        procs.append(subprocess.Popen(
-            [bin_ / "autodrive-runtime", "--config", out / "runtime.yaml", "--only",
-             "bridge,estimator"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))  # fmt: skip
-        procs.append(subprocess.Popen(
-            [bin_ / "autodrive-pilot", "--config", out / "pilot.yaml"], stdout=pilot_log,
-            stderr=subprocess.STDOUT))  # fmt: skip
-        pump(3.0)
-        assert truth, "no ground truth"
-        assert not commands, "the pilot commanded before any frame"
-        # frames: the pilot drives
-        pump(5.0, jpegs)
-        driving = [c for c in commands if c[2] == "pilot"]
-        assert driving and all(e for _, e, _ in driving[-20:]), "the pilot did not engage"
-        assert truth["v"] > 0.05, f"the car does not move ({truth['v']:.3f} m/s)"
-        print(f"driving: {len(driving)} commands, {truth['v']:.3f} m/s")
-        # no frames: within the timeout, the pilot stops the car
-        t_stop = time.time()
-        pump(3.0)
-        after = [c for c in commands if c[0] > t_stop + 0.5]
-        assert after and not any(e for _, e, _ in after), "commands still engaged without frames"
-        first_off = next(c[0] for c in commands if c[0] > t_stop and not c[1])
-        assert abs(truth["v"]) < 0.01, f"the car still moves ({truth['v']:.3f} m/s)"
-        log = (out / "pilot.log").read_text()
-        assert "STOPPING the car" in log and "CAM_FRONT" in log, log
-        print(
-            f"frames stopped: disengaged after {first_off - t_stop:.2f} s, car at {truth['v']:.4f} m/s"
+    def on_truth(_c: str, d: bytes) -> None:
+        m = types.ground_truth_t.decode(d)
+        truth.update(
+            x=m.position_m[0], y=m.position_m[1], yaw=m.yaw_rad, v=m.linear_velocity_m_s[0]
         )
-        # frames again: it drives again
-        pump(3.0, jpegs)
-        assert commands[-1][1], "the pilot did not drive again"
-        assert "frames again" in (out / "pilot.log").read_text()
-        # SIM_TELEPORT: back to the start, standing; off the floor: refused and logged
-        pump(1.0)
-        teleport(start.x_m, start.y_m, start.yaw_rad)
-        pump(1.0)
-        assert math.hypot(truth["x"] - start.x_m, truth["y"] - start.y_m) < 0.02, truth
-        teleport(40.0, 0.0, 0.0)
-        pump(0.5)
-        sim_log.flush()
-        assert "SIM_TELEPORT refused" in (out / "sim.log").read_text()
-        print("teleport ok")
-    finally:
-        for p in reversed(procs):
-            p.send_signal(2)
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
-print("OK")
+
+    def on_command(_c: str, d: bytes) -> None:
+        m = types.vehicle_command_t.decode(d)
+        commands.append((time.time(), bool(m.engaged), m.source))
+
+    lc.subscribe(channels.channel("GROUND_TRUTH", veh), on_truth)
+    lc.subscribe(channels.channel("COMMAND", veh), on_command)
+
+    def pump(wall_s: float, frames: list[bytes] | None = None, fps: float = 30.0) -> None:
+        """Handles the bus for wall_s; publishes frames (cycled) at fps meanwhile when given."""
+        end, next_frame, i = time.time() + wall_s, time.time(), 0
+        while time.time() < end:
+            if frames is not None and time.time() >= next_frame:
+                img = types.compressed_image_t()
+                img.utime, img.frame_id, img.format = int(time.time() * 1e6), "camera_front", "jpeg"
+                img.width_px, img.height_px = fixture.SOURCE_W, fixture.SOURCE_H
+                img.data = frames[i % len(frames)]
+                img.size_bytes = len(img.data)
+                lc.publish(channels.channel("CAM_FRONT", veh), img.encode())
+                i += 1
+                next_frame += 1.0 / fps
+            if select.select([lc.fileno()], [], [], 0.005)[0]:
+                lc.handle()
+
+    def teleport(x: float, y: float, yaw: float) -> None:
+        m = types.pose2d_t()
+        m.vehicle, m.frame_id, m.x_m, m.y_m, m.yaw_rad = veh, "map", x, y, yaw
+        m.covariance = [0.0] * 9
+        lc.publish(channels.channel("SIM_TELEPORT"), m.encode())
+
+    with tempfile.TemporaryDirectory(prefix="pilot-stop-") as tmp:
+        out = pathlib.Path(tmp)
+        model, _ = fixture.export(out)
+        jpegs = [p.read_bytes() for p in fixture.frames(out, 10)]
+        route = maps.load("driving_school").route("loop_ccw")
+        start = route.pose_at(0.6)
+        run_dir = out / "run"
+        rcfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
+        rcfg.update(lcm_url=url, clock="sim")
+        rcfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
+        (out / "runtime.yaml").write_text(yaml.safe_dump(rcfg))
+        pcfg = yaml.safe_load((root / "runtime/jetson/pilot/config/pilot_hil.yaml").read_text())
+        pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300)
+        (out / "pilot.yaml").write_text(yaml.safe_dump(pcfg))
+        bin_ = build / "bin"
+        sim_log, pilot_log = open(out / "sim.log", "w"), open(out / "pilot.log", "w")
+        procs = [
+            subprocess.Popen(
+                [bin_ / "autodrive-sim", "--map", "driving_school", "--run-dir", run_dir, "--lcm-url",
+                 url, "--no-lidar", "--quiet", "--lockstep-client", "--allow-teleport", "--duration",
+                 "300", "--start", f"{start.x_m},{start.y_m},{math.degrees(start.yaw_rad)}"],
+                stdout=sim_log, stderr=subprocess.STDOUT)  # fmt: skip
+        ]
+        try:
+            t0 = time.time()
+            while not (run_dir / "nigel1-nano").exists():
+                assert time.time() - t0 < 30 and procs[0].poll() is None, "the sim did not start"
+                time.sleep(0.05)
+            procs.append(subprocess.Popen(
+                [bin_ / "autodrive-runtime", "--config", out / "runtime.yaml", "--only",
+                 "bridge,estimator"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))  # fmt: skip
+            procs.append(subprocess.Popen(
+                [bin_ / "autodrive-pilot", "--config", out / "pilot.yaml"], stdout=pilot_log,
+                stderr=subprocess.STDOUT))  # fmt: skip
+            pump(3.0)
+            assert truth, "no ground truth"
+            assert not commands, "the pilot commanded before any frame"
+            # frames: the pilot drives
+            pump(5.0, jpegs)
+            driving = [c for c in commands if c[2] == "pilot"]
+            assert driving and all(e for _, e, _ in driving[-20:]), "the pilot did not engage"
+            assert truth["v"] > 0.05, f"the car does not move ({truth['v']:.3f} m/s)"
+            print(f"driving: {len(driving)} commands, {truth['v']:.3f} m/s")
+            # no frames: within the timeout, the pilot stops the car
+            t_stop = time.time()
+            pump(3.0)
+            after = [c for c in commands if c[0] > t_stop + 0.5]
+            assert after and not any(
+                e for _, e, _ in after
+            ), "commands still engaged without frames"
+            first_off = next(c[0] for c in commands if c[0] > t_stop and not c[1])
+            assert abs(truth["v"]) < 0.01, f"the car still moves ({truth['v']:.3f} m/s)"
+            log = (out / "pilot.log").read_text()
+            assert "STOPPING the car" in log and "CAM_FRONT" in log, log
+            print(
+                f"frames stopped: disengaged after {first_off - t_stop:.2f} s, car at {truth['v']:.4f} m/s"
+            )
+            # frames again: it drives again
+            pump(3.0, jpegs)
+            assert commands[-1][1], "the pilot did not drive again"
+            assert "frames again" in (out / "pilot.log").read_text()
+            # SIM_TELEPORT: back to the start, standing; off the floor: refused and logged
+            pump(1.0)
+            teleport(start.x_m, start.y_m, start.yaw_rad)
+            pump(1.0)
+            assert math.hypot(truth["x"] - start.x_m, truth["y"] - start.y_m) < 0.02, truth
+            teleport(40.0, 0.0, 0.0)
+            pump(0.5)
+            sim_log.flush()
+            assert "SIM_TELEPORT refused" in (out / "sim.log").read_text()
+            print("teleport ok")
+        finally:
+            for p in reversed(procs):
+                p.send_signal(2)
+                try:
+                    p.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+    print("OK")

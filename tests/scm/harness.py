@@ -32,9 +32,7 @@ PY = str(ROOT / ".venv" / "bin" / "python")
 
 
 def check(cond: bool, what: str) -> None:
-    if not cond:
-        print(f"FAIL: {what}", flush=True)
-        sys.exit(1)
+    assert cond, f"FAIL: {what}"
     print(f"ok: {what}", flush=True)
 
 

@@ -9,10 +9,10 @@ viewer may read but not command (403 naming the role). Args: ROOT BUILD PORT."""
 from __future__ import annotations
 
 import math
-import sys
 import tempfile
 import threading
 import time
+from pathlib import Path
 
 from harness import Client, Server, add_user, check, wait_for
 
@@ -20,162 +20,168 @@ from autodrive.core import lcmtypes
 from autodrive import maps
 from autodrive.core.channels import channel
 
-root, build, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
-url = f"udpm://239.255.76.67:{port}?ttl=0"
-T = lcmtypes.load(build)
-lc = lcmtypes.bus(url)
-advisories: list[tuple[float, object]] = []
-commands: list[object] = []
-lc.subscribe(
-    channel("V2I", "NIGEL1"),
-    lambda _c, d: advisories.append((time.time(), T.v2i_advisory_t.decode(d))),
-)
-lc.subscribe(
-    channel("TRAFFIC_LIGHT_COMMAND"),
-    lambda _c, d: commands.append(T.traffic_light_command_t.decode(d)),
-)
-stop = threading.Event()
 
-
-def pump() -> None:
-    while not stop.is_set():
-        lc.handle_timeout(50)
-
-
-threading.Thread(target=pump, daemon=True).start()
-
-m = maps.load("tiny_town")
-route = m.route("north_to_lot")
-light1 = next(t for t in m.lights() if t.id == 1)
-stop_c = m.stop_line(light1.stop_line).centre_m
-pts = route.polyline_m
-acc = [0.0]
-for a, b in zip(pts, pts[1:]):
-    acc.append(acc[-1] + math.dist(a, b))
-s_stop = acc[min(range(len(pts)), key=lambda i: math.dist(pts[i], stop_c))]
-
-
-def odom(vehicle: str, x: float, y: float, yaw: float, v: float) -> bytes:
-    o = T.odometry_t()
-    o.utime, o.vehicle, o.frame_id, o.child_frame_id = (
-        int(time.time() * 1e6),
-        vehicle,
-        "map",
-        "base_link",
+def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: str) -> None:
+    root, build, port = str(root), str(build_dir), lcm_port
+    url = lcm_url
+    T = lcmtypes.load(build)
+    lc = lcmtypes.bus(url)
+    advisories: list[tuple[float, object]] = []
+    commands: list[object] = []
+    lc.subscribe(
+        channel("V2I", "NIGEL1"),
+        lambda _c, d: advisories.append((time.time(), T.v2i_advisory_t.decode(d))),
     )
-    o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = x, y, yaw, v
-    return bytes(o.encode())
-
-
-def eye(vehicle: str, x: float, y: float, yaw: float) -> bytes:
-    p = T.pose2d_t()
-    p.utime, p.vehicle, p.frame_id, p.source = (
-        int(time.time() * 1e6),
-        vehicle,
-        "map",
-        T.pose2d_t.SOURCE_EYE,
+    lc.subscribe(
+        channel("TRAFFIC_LIGHT_COMMAND"),
+        lambda _c, d: commands.append(T.traffic_light_command_t.decode(d)),
     )
-    p.x_m, p.y_m, p.yaw_rad = x, y, yaw
-    return bytes(p.encode())
+    stop = threading.Event()
 
+    def pump() -> None:
+        while not stop.is_set():
+            lc.handle_timeout(50)
 
-with tempfile.TemporaryDirectory(prefix="scm-lcm-") as tmp:
-    db = f"sqlite:///{tmp}/scm.sqlite"
-    add_user(db, "viewer1", "viewer", "viewer-pass")
-    add_user(db, "op1", "operator", "operator-pass")
-    srv = Server(db, url, build, "NIGEL1,NIGEL2")
-    try:
-        speed, s0 = 0.5, 0.3
-        truth: list[tuple[float, float]] = []  # (wall time, route s)
-        t0 = time.time()
-        sent = 0
-        while time.time() - t0 < 4.0:
-            s = s0 + speed * (time.time() - t0)
-            p = route.pose_at(s)
-            truth.append((time.time(), s))
-            lc.publish(
-                channel("POSE_MAP", "NIGEL1"), odom("NIGEL1", p.x_m, p.y_m, p.yaw_rad, speed)
-            )
-            lc.publish(channel("POSE_EYE", "NIGEL2"), eye("NIGEL2", -3.0, -3.14, 0.0))
-            lc.publish(channel("POSE_MAP", "NIGEL2"), odom("NIGEL2", -2.0, -3.14, 0.0, 0.0))
-            if sent % 10 == 0:
-                v = T.v2v_state_t()
-                v.utime, v.vehicle, v.route, v.route_s_m = (
-                    int(time.time() * 1e6),
-                    "NIGEL1",
-                    "north_to_lot",
-                    s,
+    threading.Thread(target=pump, daemon=True).start()
+
+    m = maps.load("tiny_town")
+    route = m.route("north_to_lot")
+    light1 = next(t for t in m.lights() if t.id == 1)
+    stop_c = m.stop_line(light1.stop_line).centre_m
+    pts = route.polyline_m
+    acc = [0.0]
+    for a, b in zip(pts, pts[1:]):
+        acc.append(acc[-1] + math.dist(a, b))
+    s_stop = acc[min(range(len(pts)), key=lambda i: math.dist(pts[i], stop_c))]
+
+    def odom(vehicle: str, x: float, y: float, yaw: float, v: float) -> bytes:
+        o = T.odometry_t()
+        o.utime, o.vehicle, o.frame_id, o.child_frame_id = (
+            int(time.time() * 1e6),
+            vehicle,
+            "map",
+            "base_link",
+        )
+        o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = x, y, yaw, v
+        return bytes(o.encode())
+
+    def eye(vehicle: str, x: float, y: float, yaw: float) -> bytes:
+        p = T.pose2d_t()
+        p.utime, p.vehicle, p.frame_id, p.source = (
+            int(time.time() * 1e6),
+            vehicle,
+            "map",
+            T.pose2d_t.SOURCE_EYE,
+        )
+        p.x_m, p.y_m, p.yaw_rad = x, y, yaw
+        return bytes(p.encode())
+
+    with tempfile.TemporaryDirectory(prefix="scm-lcm-") as tmp:
+        db = f"sqlite:///{tmp}/scm.sqlite"
+        add_user(db, "viewer1", "viewer", "viewer-pass")
+        add_user(db, "op1", "operator", "operator-pass")
+        srv = Server(db, url, build, "NIGEL1,NIGEL2")
+        try:
+            speed, s0 = 0.5, 0.3
+            truth: list[tuple[float, float]] = []  # (wall time, route s)
+            t0 = time.time()
+            sent = 0
+            while time.time() - t0 < 4.0:
+                s = s0 + speed * (time.time() - t0)
+                p = route.pose_at(s)
+                truth.append((time.time(), s))
+                lc.publish(
+                    channel("POSE_MAP", "NIGEL1"), odom("NIGEL1", p.x_m, p.y_m, p.yaw_rad, speed)
                 )
-                v.x_m, v.y_m, v.yaw_rad, v.speed_m_s = p.x_m, p.y_m, p.yaw_rad, speed
-                lc.publish(channel("V2V"), v.encode())
-            sent += 1
-            time.sleep(0.02)
-        time.sleep(0.5)
-        adv = [(t, a) for t, a in advisories if t > t0 + 1.0]
-        span = adv[-1][0] - adv[0][0]
-        rate = (len(adv) - 1) / span
-        check(abs(rate - 10.0) < 2.0, f"NIGEL1_V2I at {rate:.1f} Hz (10 Hz)")
-        check(all(a.vehicle == "NIGEL1" for _, a in adv), "advisories are addressed to NIGEL1")
-        check(all(a.light_id == 1 for _, a in adv), "the next light on north_to_lot is light 1")
-        errs = []
-        for t, a in adv:
-            s = min(truth, key=lambda x: abs(x[0] - t))[1]
-            errs.append(abs(a.stop_line_distance_m - (s_stop - s)))
-        # the advisory is computed from the newest pose (<= 20 ms old at 0.5 m/s: 1 cm)
-        check(
-            max(errs) < 0.03,
-            f"stop-line distance along the route within 3 cm (max {max(errs)*100:.1f} cm)",
-        )
-        seqs = [a.seq for _, a in advisories]
-        check(seqs == list(range(seqs[0], seqs[0] + len(seqs))), "advisory seq counts up by one")
-        early = [a for t, a in advisories if t < t0 + 1.0]
-        check(
-            any(abs(a.speed_limit_m_s - 0.15) < 1e-6 for a in early),
-            "speed limit 0.15 m/s of sign 3 on n2_e_w",
-        )
-        check(
-            {c.light_id for c in commands} == {1, 2, 3, 4}, "TRAFFIC_LIGHT_COMMAND for lights 1..4"
-        )
-        viewer = Client(srv.url)
-        viewer.login("viewer1", "viewer-pass")
-        code, state = viewer.call("GET", "/api/state")
-        cars = {c["name"]: c for c in state["vehicles"]}
-        check(
-            cars["NIGEL2"]["source"] == "eye" and abs(cars["NIGEL2"]["x_m"] + 3.0) < 1e-6,
-            "NIGEL2: the Eye pose wins over the EKF's",
-        )
-        check(cars["NIGEL1"]["route"] == "north_to_lot", "NIGEL1's route taken from V2V")
-        wait_for(
-            lambda: viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"] >= 38,
-            5,
-            "pose history rows written",
-        )
-        rows = viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"]
-        check(38 <= rows <= 42, f"NIGEL1 history thinned to 10 Hz: {rows} rows for 4 s at 50 Hz")
-        code, body = viewer.call("PUT", "/api/lights/1/state", {"state": "RED"})
-        check(
-            code == 403 and "operator role required" in body["detail"],
-            f"viewer refused: {code} {body}",
-        )
-        anon = Client(srv.url)
-        code, body = anon.call("GET", "/api/state")
-        check(code == 401 and "login required" in body["detail"], f"no session: {code} {body}")
-        op = Client(srv.url)
-        op.login("op1", "operator-pass")
-        code, body = op.call("PUT", "/api/lights/1/state", {"state": "RED"}, csrf=False)
-        check(
-            code == 403 and "CSRF" in body["detail"], f"operator without CSRF token: {code} {body}"
-        )
-        code, body = op.call("PUT", "/api/lights/9/state", {"state": "RED"})
-        check(
-            code == 404 and "no traffic light 9" in body["detail"], f"unknown light: {code} {body}"
-        )
-        code, body = op.call("PUT", "/api/lights/1/state", {"colour": "RED"})
-        check(code == 422 and body["detail"][0]["loc"][-1] == "state", f"malformed body: {code}")
-        code, body = op.call("PUT", "/api/lights/1/state", {"state": "RED"})
-        check(code == 200, f"operator sets light 1 RED: {body}")
-    finally:
-        stop.set()
-        rc = srv.stop()
-    check(rc == 0, f"autodrive-scm stopped cleanly on SIGTERM (rc {rc})")
-print("OK")
+                lc.publish(channel("POSE_EYE", "NIGEL2"), eye("NIGEL2", -3.0, -3.14, 0.0))
+                lc.publish(channel("POSE_MAP", "NIGEL2"), odom("NIGEL2", -2.0, -3.14, 0.0, 0.0))
+                if sent % 10 == 0:
+                    v = T.v2v_state_t()
+                    v.utime, v.vehicle, v.route, v.route_s_m = (
+                        int(time.time() * 1e6),
+                        "NIGEL1",
+                        "north_to_lot",
+                        s,
+                    )
+                    v.x_m, v.y_m, v.yaw_rad, v.speed_m_s = p.x_m, p.y_m, p.yaw_rad, speed
+                    lc.publish(channel("V2V"), v.encode())
+                sent += 1
+                time.sleep(0.02)
+            time.sleep(0.5)
+            adv = [(t, a) for t, a in advisories if t > t0 + 1.0]
+            span = adv[-1][0] - adv[0][0]
+            rate = (len(adv) - 1) / span
+            check(abs(rate - 10.0) < 2.0, f"NIGEL1_V2I at {rate:.1f} Hz (10 Hz)")
+            check(all(a.vehicle == "NIGEL1" for _, a in adv), "advisories are addressed to NIGEL1")
+            check(all(a.light_id == 1 for _, a in adv), "the next light on north_to_lot is light 1")
+            errs = []
+            for t, a in adv:
+                s = min(truth, key=lambda x: abs(x[0] - t))[1]
+                errs.append(abs(a.stop_line_distance_m - (s_stop - s)))
+            # the advisory is computed from the newest pose (<= 20 ms old at 0.5 m/s: 1 cm)
+            check(
+                max(errs) < 0.03,
+                f"stop-line distance along the route within 3 cm (max {max(errs)*100:.1f} cm)",
+            )
+            seqs = [a.seq for _, a in advisories]
+            check(
+                seqs == list(range(seqs[0], seqs[0] + len(seqs))), "advisory seq counts up by one"
+            )
+            early = [a for t, a in advisories if t < t0 + 1.0]
+            check(
+                any(abs(a.speed_limit_m_s - 0.15) < 1e-6 for a in early),
+                "speed limit 0.15 m/s of sign 3 on n2_e_w",
+            )
+            check(
+                {c.light_id for c in commands} == {1, 2, 3, 4},
+                "TRAFFIC_LIGHT_COMMAND for lights 1..4",
+            )
+            viewer = Client(srv.url)
+            viewer.login("viewer1", "viewer-pass")
+            code, state = viewer.call("GET", "/api/state")
+            cars = {c["name"]: c for c in state["vehicles"]}
+            check(
+                cars["NIGEL2"]["source"] == "eye" and abs(cars["NIGEL2"]["x_m"] + 3.0) < 1e-6,
+                "NIGEL2: the Eye pose wins over the EKF's",
+            )
+            check(cars["NIGEL1"]["route"] == "north_to_lot", "NIGEL1's route taken from V2V")
+            wait_for(
+                lambda: viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"] >= 38,
+                5,
+                "pose history rows written",
+            )
+            rows = viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"]
+            check(
+                38 <= rows <= 42, f"NIGEL1 history thinned to 10 Hz: {rows} rows for 4 s at 50 Hz"
+            )
+            code, body = viewer.call("PUT", "/api/lights/1/state", {"state": "RED"})
+            check(
+                code == 403 and "operator role required" in body["detail"],
+                f"viewer refused: {code} {body}",
+            )
+            anon = Client(srv.url)
+            code, body = anon.call("GET", "/api/state")
+            check(code == 401 and "login required" in body["detail"], f"no session: {code} {body}")
+            op = Client(srv.url)
+            op.login("op1", "operator-pass")
+            code, body = op.call("PUT", "/api/lights/1/state", {"state": "RED"}, csrf=False)
+            check(
+                code == 403 and "CSRF" in body["detail"],
+                f"operator without CSRF token: {code} {body}",
+            )
+            code, body = op.call("PUT", "/api/lights/9/state", {"state": "RED"})
+            check(
+                code == 404 and "no traffic light 9" in body["detail"],
+                f"unknown light: {code} {body}",
+            )
+            code, body = op.call("PUT", "/api/lights/1/state", {"colour": "RED"})
+            check(
+                code == 422 and body["detail"][0]["loc"][-1] == "state", f"malformed body: {code}"
+            )
+            code, body = op.call("PUT", "/api/lights/1/state", {"state": "RED"})
+            check(code == 200, f"operator sets light 1 RED: {body}")
+        finally:
+            stop.set()
+            rc = srv.stop()
+        check(rc == 0, f"autodrive-scm stopped cleanly on SIGTERM (rc {rc})")
+    print("OK")

@@ -1,4 +1,4 @@
-"""A real Ray cluster on loopback for tests: `ray start --head` plus nodes joining it, each with
+"""A real Ray cluster on loopback for tests (pyhelpers.ray_cluster): `ray start --head` plus nodes joining it, each with
 its CPUs, in one temp dir; stopped bounded in time, its processes found by that temp dir so that
 nothing else on the machine that runs Ray is touched. Used by sweep.ray_cluster_parking and
 marl.ray_train."""
