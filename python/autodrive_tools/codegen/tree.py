@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import channels, vehicle
-from . import channels_doc, firmware_header, protocol_doc, vehicle_doc
+from . import channels_doc, firmware_header, maps_doc, protocol_doc, vehicle_doc
 
 PARAMS = "vehicle/nigel.params"
 CHANNELS = "lcm_types/channels.yaml"
@@ -21,4 +21,5 @@ def render_all(root: Path) -> dict[str, str]:
         vehicle_doc.PATH: vehicle_doc.render(car, PARAMS),
         firmware_header.PATH: firmware_header.render(car, PARAMS),
         protocol_doc.PATH: protocol_doc.render(root),
+        maps_doc.PATH: maps_doc.render(root),
     }
