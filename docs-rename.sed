@@ -6,7 +6,7 @@
 # ---- generated pages, now site pages -------------------------------------------------------
 s#lcm_types/CHANNELS\.md#docs/reference/channels.md#g
 s#docs/VEHICLE\.md#docs/reference/vehicle.md#g
-s#(^|[^/A-Za-z_])CHANNELS\.md#\1docs/reference/channels.md#g
+s#CHANNELS\.md#docs/reference/channels.md#g
 # ---- README sections cited in comments and help texts ---------------------------------------
 s#\(README, Behavioural cloning\)#(docs/guides/training.md)#g
 s#; README, "Behavioural cloning":#; docs/guides/training.md:#g
