@@ -69,13 +69,12 @@ def main() -> int:
         print("FAIL: mkdocs build --strict")
         return 1
     problems = broken_anchors(root / "docs", site)
-    for p in problems:
-        print(p)
     if problems:
-        print(f"FAIL: {len(problems)} link(s) to a heading that does not exist")
-        return 1
-    print("ok: the site builds with --strict and every heading link resolves")
-    return 0
+        problems.append(f"FAIL: {len(problems)} link(s) to a heading that does not exist")
+    print(
+        "\n".join(problems) or "ok: the site builds with --strict and every heading link resolves"
+    )
+    return 1 if problems else 0
 
 
 if __name__ == "__main__":
