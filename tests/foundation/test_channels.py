@@ -1,6 +1,6 @@
 """Checks the channel table lcm_types/channels.yaml against lcm_types/autodrive/*.lcm: every
 channel has an existing type, a unique name and id, and every type starts with int64_t utime.
-(CHANNELS.md is generated from the table; foundation.single_source checks it is fresh.)"""
+(docs/reference/channels.md is generated from the table; foundation.single_source checks it is fresh.)"""
 import pathlib
 import re
 import sys

@@ -90,6 +90,8 @@ def check_tree(root: pathlib.Path) -> list[str]:
                 if "<" in cited or "*" in cited:
                     continue
                 candidates = [root / cited, f.parent / cited]
+                if f.name == "mkdocs.yml":  # its nav names pages inside docs_dir
+                    candidates.append(root / "docs" / cited)
                 if not any(inside(root, c) and c.exists() for c in candidates):
                     problems.append(f"{where}: cites {cited}, which is not in the tree")
             for m in MD_NAME_RE.finditer(line):

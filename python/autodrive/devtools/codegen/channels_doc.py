@@ -1,10 +1,10 @@
-"""lcm_types/channels.yaml -> lcm_types/CHANNELS.md: the channel table as a person reads it."""
+"""lcm_types/channels.yaml -> docs/reference/channels.md: the channel table as a person reads it."""
 
 from __future__ import annotations
 
 from autodrive.core import channels
 
-PATH = "lcm_types/CHANNELS.md"
+PATH = "docs/reference/channels.md"
 
 
 def _programs(names: tuple[str, ...]) -> str:

@@ -33,6 +33,6 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         GUARD,
         source_name,
         "autodrive.devtools.codegen.channels_header",
-        "LCM channel names; CHANNELS.md describes each.",
+        "LCM channel names; docs/reference/channels.md describes each.",
         lines,
     )

@@ -6,7 +6,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from autodrive.core import channels, vehicle
-from autodrive.devtools.codegen import channels_doc, firmware_header, vehicle_doc
+from autodrive.devtools.codegen import (
+    channels_doc,
+    firmware_header,
+    maps_doc,
+    protocol_doc,
+    vehicle_doc,
+)
 
 PARAMS = "vehicle/nigel.params"
 CHANNELS = "lcm_types/channels.yaml"
@@ -20,4 +26,6 @@ def render_all(root: Path) -> dict[str, str]:
         channels_doc.PATH: channels_doc.render(table, CHANNELS),
         vehicle_doc.PATH: vehicle_doc.render(car, PARAMS),
         firmware_header.PATH: firmware_header.render(car, PARAMS),
+        protocol_doc.PATH: protocol_doc.render(root),
+        maps_doc.PATH: maps_doc.render(root),
     }

@@ -1,4 +1,4 @@
-"""vehicle/nigel.params -> docs/VEHICLE.md: the car's figures as a table a person reads, with the
+"""vehicle/nigel.params -> docs/reference/vehicle.md: the car's figures as a table a person reads, with the
 description's own section headings and comments, so that no document restates a figure by hand."""
 
 from __future__ import annotations
@@ -6,8 +6,9 @@ from __future__ import annotations
 import re
 
 from autodrive.core import vehicle
+from autodrive.devtools.codegen import firmware_header
 
-PATH = "docs/VEHICLE.md"
+PATH = "docs/reference/vehicle.md"
 _SECTION = re.compile(r"^#\s*-+\s*(.*?)\s*-+\s*$")
 
 
@@ -26,8 +27,8 @@ def render(car: vehicle.Vehicle, source_name: str) -> str:
         "",
         f"Every figure of the car is written once, in `{source_name}`; C and C++ code include the",
         "generated `<autodrive_vehicle.h>` (macros `AUTODRIVE_VEHICLE_<KEY>`), Python reads it",
-        "through `autodrive.core.vehicle`, the firmware's servo figures are generated into",
-        "`firmware/nano/core/actuation/actuation_vehicle.h`, and the simulator builds the car's MJCF from it.",
+from autodrive.core import vehicle
+from autodrive.devtools.codegen import firmware_header
         "Units are in each key. Frame: `base_link` is the rear-axle centre on the ground, x",
         "forward, y left, z up.",
         "",
