@@ -154,7 +154,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         choices=("cameras", "standin"),
         default="standin",
         help="smart-city: car poses from the ground-truth stand-in (truth + noise; default: the "
-        "real Eye's rendering does not leave 2 shared cores enough for 3 laps, README) or from "
+        "real Eye's rendering does not leave 2 shared cores enough for 3 laps, docs/results/smart-city.md) or from "
         "autodrive-eye on the simulator's rendered overhead cameras (--cameras FPS sets their "
         "rate, 0: the mission's default)",
     )

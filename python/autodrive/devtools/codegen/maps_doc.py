@@ -10,16 +10,15 @@ from pathlib import Path
 from typing import Any
 
 PATH = "docs/reference/maps.md"
-# Where the map descriptions live: maps/ at the root (the sim's maps/ folder before the move).
-MAP_DIRS = ("maps", "sim/mujoco_hil/maps")
 FIGURES = "docs/maps"  # tools/map show NAME -o docs/maps/NAME.png
 
 
 def maps_dir(root: Path) -> Path:
-    for rel in MAP_DIRS:
-        if sorted((root / rel).glob("*.json")):
-            return root / rel
-    raise FileNotFoundError(f"no map sidecars (*.json) in any of {', '.join(MAP_DIRS)}")
+    """The map descriptions and their sidecars, at the root's maps/."""
+    found = root / "maps"
+    if not sorted(found.glob("*.json")):
+        raise FileNotFoundError(f"no map sidecars (*.json) in {found}")
+    return found
 
 
 def _title(name: str) -> str:

@@ -9,12 +9,15 @@ from pathlib import Path
 PATH = "docs/reference/protocol.md"
 
 
+SOURCE = "firmware/nano/core/protocol/PROTOCOL.md"
+
+
 def source(root: Path) -> Path:
-    """The protocol's description wherever the firmware core keeps its codec."""
-    found = sorted((root / "firmware" / "nano").glob("**/PROTOCOL.md"))
-    if len(found) != 1:
-        raise FileNotFoundError(f"expected one PROTOCOL.md under firmware/nano, found {found}")
-    return found[0]
+    """The protocol's description, beside its codec."""
+    src = root / SOURCE
+    if not src.is_file():
+        raise FileNotFoundError(f"the serial protocol's description {src} is missing")
+    return src
 
 
 def render(root: Path) -> str:

@@ -53,7 +53,7 @@ BLOCKED_S = 30.0  # a car standing this long [s sim] away from any stop line is 
 # The overhead cameras' frame rate [Hz of sim time]. The cars drive at most 0.27 m/s, so 5 Hz
 # is <= 54 mm between poses, which the EKF bridges with odometry and gyro; each frame time is
 # four 1280x960 renders (~160 ms of CPU with software OpenGL), which is what 2 shared cores can
-# give beside three runtimes (README, smart-city section: the figures were measured at 5 Hz).
+# give beside three runtimes (docs/results/smart-city.md: the figures were measured at 5 Hz).
 EYE_FPS_DEFAULT = 5.0
 # Starting up is bounded by each program's own CPU time, not by wall time (on a loaded machine
 # the wall time of a start is anyone's guess: at load 48 the SCM was not up in 90 s). Measured

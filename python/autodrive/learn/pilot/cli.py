@@ -20,7 +20,7 @@ DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front c
   make-model  expert 5 laps + record + train + analyse: the shipped models/pilot/driving_school
 A person can drive instead of the expert: autodrive-sim --map driving_school --cameras
 --lockstep-client, the runtime on its pty, autodrive-teleop, and tools/record LOG; then
-`tools/pilot record LOG --map driving_school` (README, Behavioural cloning)."""
+`tools/pilot record LOG --map driving_school` (docs/guides/training.md)."""
 
 
 def _build() -> Path:
@@ -91,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument(
         "--label-lookahead", type=float, default=0.0, metavar="M",
         help="label each frame with pure pursuit's steering at this lookahead [m] from its "
-        "ground-truth pose (a label the picture determines; README) instead of the recorded "
+        "ground-truth pose (a label the picture determines; docs/guides/training.md) instead of the recorded "
         "steering (0, the default)",
     )  # fmt: skip
     t.add_argument(
@@ -117,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument(
         "--other-lane-laps", type=int, default=0,
         help="an experiment (the shipped model: 0): this many of the laps in the road's other "
-        "lane, still counter-clockwise (README: the reverse direction)",
+        "lane, still counter-clockwise (docs/guides/demo-cloning.md: the reverse direction)",
     )  # fmt: skip
     m.add_argument("--epochs", type=int, default=4)
     m.add_argument(

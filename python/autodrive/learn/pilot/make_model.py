@@ -38,7 +38,7 @@ STRIDE = 1
 SAMPLES_PER_EPOCH = 2560
 
 
-# --other-lane-laps N (an experiment, not the shipped recipe; README, "Behavioural cloning":
+# --other-lane-laps N (an experiment, not the shipped recipe; docs/guides/training.md:
 # the reverse direction): N of the laps in the lane left of loop_ccw's, still driven
 # counter-clockwise. The clockwise direction (loop_cw) is never recorded: it is an unseen test
 # condition. Seen in a mirror, that lane's left-hand curves with the centre line on the car's

@@ -10,7 +10,7 @@ C++ `autodrive-pilot` share one definition of them (the input stays the sidecar'
   dashes. The aim: the network should not take "the yellow line is on the inside of the curve"
   (true on every curve of the recorded loop_ccw, false on every curve of loop_cw) for the
   curve's direction. It did not make loop_cw drivable: the inner lane's tighter curves still
-  read as "heading into the centre line" (README, issue 16).
+  read as "heading into the centre line" (docs/guides/training.md).
 - per-image normalisation (ONNX InstanceNormalization: each channel of each frame to mean 0,
   standard deviation 1, no learned parameters): a darker scene (night) gives the convolutions
   the same input as the day. A tanh keeps the output in [-1, 1] (not a

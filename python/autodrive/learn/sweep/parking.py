@@ -45,7 +45,7 @@ from autodrive.core.runfiles import read_columns
 DEFAULT_LCM_URL = "udpm://239.255.76.67:7846?ttl=0"
 # The files a job sends back (the LCM log and its MCAP only with --keep-logs: megabytes).
 BULKY_FILES = ("run.lcmlog", "run.mcap")
-# Goals of issue 7 (runtime/jetson/modules/autonomy/README.md).
+# The parking goals (docs/results/parking.md).
 GOAL_RUNS = 10
 GOAL_POS_ERROR_M = 0.02
 GOAL_HEADING_ERROR_DEG = 2.0
@@ -67,7 +67,7 @@ PER_SEED_FACTS = ("start_world", "goal_world")
 # Two sweeps of the same seeds agree when the scenario and each run's success are the same
 # and the closed-loop figures are within these. Not exact: in the demo's --lockstep-client the
 # runtime's and the autonomy's commands land at sim steps that depend on wall-clock scheduling
-# (docs/ARCHITECTURE.md, Clocks), so two runs of one seed on one machine differ this much too.
+# (docs/design/clocks.md), so two runs of one seed on one machine differ this much too.
 AGREE_TOLERANCE = {
     "final_pos_error_m": 0.01,
     "final_heading_error_deg": 2.0,
@@ -101,7 +101,7 @@ def parse_args(argv: list[str], prog: str = "tools/sweep parking") -> argparse.N
         "line. Exit code 0 when the sweep ran (whether or not the goals are met), 2 bad input, "
         "130 interrupted.",
         epilog="examples: tools/sweep parking --seeds 4 --workers 2; tools/sweep parking "
-        "--seeds 20 --address 192.168.1.10:6379 (a Ray cluster of lab machines: README, "
+        "--seeds 20 --address 192.168.1.10:6379 (a Ray cluster of lab machines: docs/guides/sweeps.md, "
         "'Sweeps on Ray'); tools/sweep parking --seeds 2 --serial --extra --realtime",
     )
     p.add_argument("--seeds", type=int, default=10, help="number of seeds to run (default 10)")
