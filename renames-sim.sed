@@ -36,3 +36,4 @@ s/\bmg_(write_scene|write_physics_map|tag_id|car|geom_named|late_box|rel_from)\b
 s/\bcl_prism_t\b/clearance_prism_t/g
 s/\bstruct cl_prism\b/struct clearance_prism/g
 s/\bcl_(check_on_map|corners|geom_prism|name|on_plane|prisms_overlap|radius)\b/clearance_\1/g
+s/\bCL_(UPRIGHT_COS|VERTICAL_NZ|EPS_M)\b/CLEARANCE_\1/g

@@ -40,7 +40,13 @@
  * obstacles, when checking a start pose or a late box [m] */
 #define SIM_GROUND_CLEARANCE_M 0.005
 
-enum { W_FL = 0, W_FR, W_RL, W_RR, W_N }; /* wheels: front left, front right, rear left, rear right */
+enum {
+  W_FL = 0,
+  W_FR,
+  W_RL,
+  W_RR,
+  W_N
+}; /* wheels: front left, front right, rear left, rear right */
 
 #define SIM_LAMPS 9 /* lamp geoms per car (car_lamps.c) */
 /* 115200 baud moves 11.5 bytes/ms: 100 ms of Nano output fits, so a batch never drops */
