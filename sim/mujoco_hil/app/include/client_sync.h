@@ -12,8 +12,8 @@
  * every 20 ms of its clock, which is SIM_CLOCK: so the sim goes as fast as the runtime keeps
  * up, and the emulated Nano never sees a gap the runtime did not make (its failsafe is 100 ms). */
 #define CLIENT_SYNC_HORIZON_US 40000
-#define CLIENT_SYNC_LOST_S 2.0 /* [s] wall without bytes: the client is gone; stop waiting for it \
-                                */
+/* [s] wall without bytes: the client is gone; stop waiting for it */
+#define CLIENT_SYNC_LOST_S 2.0
 typedef struct {
   int started;                          /* a client has written at least once */
   int64_t lost_rx_us[SIM_MAX_CARS + 1]; /* host_rx of a client given up on (0: none) */

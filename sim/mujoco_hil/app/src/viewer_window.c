@@ -28,9 +28,9 @@ int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s) {
     if (sim_viewer_frame(w->v, sim_render_model(s), sim_render_data(s), &in) != 0) return 1;
     if (in.quit || app_stop_requested()) return 1;
     if (in.reset_requested) {
-      /* back to the start poses (qpos0, core/src/car_placement.c); late boxes that appeared come back on the next
-       * step; encoder counts restart with the wheel angles, as when a car
-       * is picked up and put back */
+      /* back to the start poses (qpos0, core/src/car_placement.c); late boxes that appeared come
+       * back on the next step; encoder counts restart with the wheel angles, as when a car is
+       * picked up and put back */
       mj_resetData(sim_model(s), sim_data(s));
       mj_forward(sim_model(s), sim_data(s));
     }

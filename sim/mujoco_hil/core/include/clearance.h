@@ -32,8 +32,8 @@ int clearance_prisms_overlap(const clearance_prism_t *a, const clearance_prism_t
 /* 0 when p fits (see above), or -1 with what is in the way in err ("overlaps geom 'box_a'",
  * "is outside the floor 'floor' ...", "is behind the wall plane 'wall_n'"). d needs the
  * kinematics of the model (mj_forward or mj_kinematics). */
-int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p, int contype,
-                    int conaffinity, char *err, size_t err_sz);
+int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p,
+                           int contype, int conaffinity, char *err, size_t err_sz);
 
 #ifdef __cplusplus
 }

@@ -41,14 +41,14 @@ typedef struct mjcf_gen_options {
  * MuJoCo 2.2 narrow-phase time each step against every car geom. Returns the number of geoms
  * left out, or -1 with a message. */
 int mjcf_gen_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
-                         char *err, size_t err_sz);
+                               char *err, size_t err_sz);
 
 /* Roof tag id of car i (1-based): tag36h11 id i. */
 int mjcf_gen_tag_id(int car);
 
 /* Writes the scene to out_path. Returns 0, or -1 with a message in err. */
-int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p, const mjcf_gen_options_t *o,
-                   char *err, size_t err_sz);
+int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p,
+                         const mjcf_gen_options_t *o, char *err, size_t err_sz);
 
 #ifdef __cplusplus
 }

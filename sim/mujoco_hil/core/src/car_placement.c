@@ -192,7 +192,7 @@ int sim_teleport(sim_t *s, int car, double x_m, double y_m, double yaw_rad, char
   char why[512];
   sim_car_prism(s, car - 1, &pr);
   if (clearance_check_on_map(s->m, s->d, &pr, s->m->geom_contype[c->chassis_geom],
-                      s->m->geom_conaffinity[c->chassis_geom], why, sizeof why) != 0) {
+                             s->m->geom_conaffinity[c->chassis_geom], why, sizeof why) != 0) {
     mju_copy(qp, saved, 7);
     snprintf(err, err_sz, "(x %.3f, y %.3f m, yaw %.3f rad): %s", x_m, y_m, yaw_rad, why);
     return -1;

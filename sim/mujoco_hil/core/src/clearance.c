@@ -4,9 +4,10 @@
 #include <math.h>
 #include <stdio.h>
 
-#define CL_UPRIGHT_COS 0.999 /* |cos| between a geom's z axis and the world's: upright [-] */
-#define CL_VERTICAL_NZ 0.1   /* |normal z| below this: a wall plane [-] */
-#define CL_EPS_M 1e-9        /* overlaps smaller than this are touching [m] */
+/* |cos| between a geom's z axis and the world's above which it is upright [-] */
+#define CLEARANCE_UPRIGHT_COS 0.999
+#define CLEARANCE_VERTICAL_NZ 0.1 /* |normal z| below this: a wall plane [-] */
+#define CLEARANCE_EPS_M 1e-9      /* overlaps smaller than this are touching [m] */
 
 /* Projection radius of prism p on the unit direction n [m]. */
 static double clearance_radius(const clearance_prism_t *p, const double n[2]) {
@@ -15,13 +16,16 @@ static double clearance_radius(const clearance_prism_t *p, const double n[2]) {
 }
 
 int clearance_prisms_overlap(const clearance_prism_t *a, const clearance_prism_t *b) {
-  if (a->z_hi_m <= b->z_lo_m + CL_EPS_M || b->z_hi_m <= a->z_lo_m + CL_EPS_M) return 0;
+  if (a->z_hi_m <= b->z_lo_m + CLEARANCE_EPS_M || b->z_hi_m <= a->z_lo_m + CLEARANCE_EPS_M)
+    return 0;
   const double d[2] = {b->centre_m[0] - a->centre_m[0], b->centre_m[1] - a->centre_m[1]};
   const double yaw[2] = {a->yaw_rad, b->yaw_rad};
   for (int k = 0; k < 4; k++) { /* separating axes: both rectangles' x and y */
     const double t = yaw[k / 2] + (k % 2) * 0.5 * M_PI;
     const double n[2] = {cos(t), sin(t)};
-    if (fabs(d[0] * n[0] + d[1] * n[1]) >= clearance_radius(a, n) + clearance_radius(b, n) - CL_EPS_M) return 0;
+    if (fabs(d[0] * n[0] + d[1] * n[1]) >=
+        clearance_radius(a, n) + clearance_radius(b, n) - CLEARANCE_EPS_M)
+      return 0;
   }
   return 1;
 }
@@ -50,7 +54,7 @@ static void clearance_geom_prism(const mjModel *m, const mjData *d, int g, clear
   p->yaw_rad = 0.0;
   switch (m->geom_type[g]) {
     case mjGEOM_BOX:
-      if (fabs(R[8]) > CL_UPRIGHT_COS) { /* upright: its own x-y rectangle */
+      if (fabs(R[8]) > CLEARANCE_UPRIGHT_COS) { /* upright: its own x-y rectangle */
         p->yaw_rad = atan2(R[3], R[0]);
         ext[0] = sz[0], ext[1] = sz[1], ext[2] = sz[2];
       } else {
@@ -88,11 +92,11 @@ static int clearance_on_plane(const mjModel *m, const mjData *d, int g, const do
   const mjtNum *R = d->geom_xmat + 9 * g, *pos = d->geom_xpos + 3 * g, *sz = m->geom_size + 3 * g;
   const double r[2] = {c[0] - pos[0], c[1] - pos[1]};
   const double lx = r[0] * R[0] + r[1] * R[3], ly = r[0] * R[1] + r[1] * R[4];
-  return fabs(lx) <= sz[0] + CL_EPS_M && fabs(ly) <= sz[1] + CL_EPS_M;
+  return fabs(lx) <= sz[0] + CLEARANCE_EPS_M && fabs(ly) <= sz[1] + CLEARANCE_EPS_M;
 }
 
-int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p, int contype,
-                    int conaffinity, char *err, size_t err_sz) {
+int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_prism_t *p,
+                           int contype, int conaffinity, char *err, size_t err_sz) {
   double corner[4][2];
   clearance_corners(p, corner);
   char name[96];
@@ -104,13 +108,13 @@ int clearance_check_on_map(const mjModel *m, const mjData *d, const clearance_pr
     const int touches = (contype & m->geom_conaffinity[g]) || (m->geom_contype[g] & conaffinity);
     if (m->geom_type[g] == mjGEOM_PLANE) {
       const double n[3] = {R[2], R[5], R[8]}; /* plane normal: its z axis */
-      if (n[2] > CL_UPRIGHT_COS && m->geom_size[3 * g] > 0 && m->geom_size[3 * g + 1] > 0) {
+      if (n[2] > CLEARANCE_UPRIGHT_COS && m->geom_size[3 * g] > 0 && m->geom_size[3 * g + 1] > 0) {
         floors++;
         if (first_floor < 0) first_floor = g;
         for (int k = 0; k < 4; k++) corner_on[k] |= clearance_on_plane(m, d, g, corner[k]);
-      } else if (fabs(n[2]) < CL_VERTICAL_NZ && touches) {
+      } else if (fabs(n[2]) < CLEARANCE_VERTICAL_NZ && touches) {
         for (int k = 0; k < 4; k++)
-          if ((corner[k][0] - pos[0]) * n[0] + (corner[k][1] - pos[1]) * n[1] < -CL_EPS_M) {
+          if ((corner[k][0] - pos[0]) * n[0] + (corner[k][1] - pos[1]) * n[1] < -CLEARANCE_EPS_M) {
             clearance_name(m, g, name, sizeof name);
             snprintf(err, err_sz, "is behind the wall plane %s (corner at %.3f, %.3f m)", name,
                      corner[k][0], corner[k][1]);

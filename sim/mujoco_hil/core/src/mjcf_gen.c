@@ -34,7 +34,7 @@ static void mjcf_gen_rel_from(const char *scene_path, const char *abs_path, char
 /* physics_only: leave out the car's visual-only lamps and wheel discs (drawn in the render
  * model; in the physics model they would only cost collision tests) */
 static void mjcf_gen_car(FILE *f, const vehicle_params_t *p, int i, const char *tag_geom,
-                   int physics_only) {
+                         int physics_only) {
   const double L = p->wheelbase_m, hw = 0.5 * p->track_m, r = p->wheel_radius_m;
   const double mw = p->wheel_mass_kg, mk = MG_KNUCKLE_KG, M = p->mass_kg;
   const double mc = M - 4.0 * mw - 2.0 * mk;
@@ -178,7 +178,7 @@ static int mjcf_gen_geom_named(const char *line, const char *names) {
 }
 
 int mjcf_gen_write_physics_map(const char *map_path, const char *out_path, const char *drop_names,
-                         char *err, size_t err_sz) {
+                               char *err, size_t err_sz) {
   FILE *in = fopen(map_path, "r");
   if (!in) {
     snprintf(err, err_sz, "map file '%s': %s", map_path, strerror(errno));
@@ -210,8 +210,8 @@ int mjcf_gen_write_physics_map(const char *map_path, const char *out_path, const
   return dropped;
 }
 
-int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p, const mjcf_gen_options_t *o,
-                   char *err, size_t err_sz) {
+int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p,
+                         const mjcf_gen_options_t *o, char *err, size_t err_sz) {
   FILE *f = fopen(out_path, "w");
   if (!f) {
     snprintf(err, err_sz, "cannot write scene '%s': %s", out_path, strerror(errno));

@@ -10,7 +10,8 @@
 
 /* prefix followed by car's decimal digits (car >= 0), into dst of dst_sz >= 16 bytes: 100 ground
  * truths a car every sim second, where two snprintf calls were ~0.6 % of a 1-car step */
-static void publish_join_name(char *dst, size_t dst_sz, const char *prefix, int car, const char *suffix) {
+static void publish_join_name(char *dst, size_t dst_sz, const char *prefix, int car,
+                              const char *suffix) {
   char digits[12];
   int n = 0;
   do {
@@ -30,7 +31,7 @@ int publish_ground_truth(publish_queue_t *q, const sim_t *s, int car, FILE *log)
   char vehicle[16], channel[48];
   publish_join_name(vehicle, sizeof vehicle, AUTODRIVE_VEHICLE_PREFIX, car, "");
   publish_join_name(channel, sizeof channel, AUTODRIVE_VEHICLE_PREFIX, car,
-              AUTODRIVE_CH_GROUND_TRUTH_SUFFIX);
+                    AUTODRIVE_CH_GROUND_TRUTH_SUFFIX);
   autodrive_ground_truth_t msg;
   memset(&msg, 0, sizeof msg);
   msg.utime = sim_time_us(s);

@@ -55,7 +55,8 @@ int lcm_receive_filter_keep_only(lcm_t *lcm, const char *url, const char *channe
   if (port == 0) return 0;
   const size_t n = strlen(channel) + 1; /* with its NUL */
   if (n - 1 > RECEIVE_FILTER_MAX_CHANNEL) {
-    snprintf(err, err_sz, "LCM filter: channel '%s' longer than %d", channel, RECEIVE_FILTER_MAX_CHANNEL);
+    snprintf(err, err_sz, "LCM filter: channel '%s' longer than %d", channel,
+             RECEIVE_FILTER_MAX_CHANNEL);
     return -1;
   }
   (void)lcm_get_fileno(lcm); /* the receive socket exists once this returns */
