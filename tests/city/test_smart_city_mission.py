@@ -1,5 +1,5 @@
 """tools/demo --mission smart-city, short (a smoke test of the whole mission; the laps and the
-goals are measured by full runs, see README): Tiny Town, three cars, three runtimes (LIDAR on),
+goals are measured by full runs, see docs/results/smart-city.md): Tiny Town, three cars, three runtimes (LIDAR on),
 three city drivers and the advisory stand-in, for SIM_SECONDS of sim time (--sim-seconds: the machine's load changes only how long that takes).
 The report must have every key, no violation, no collision, every car driven; the PNG and the
 LCM log (with V2V, the cars' V2I advisories and LIDAR scans in it) written. Args: ROOT BUILD

@@ -32,8 +32,8 @@ def test_platformio_ini_through_platformio(root: Path, monkeypatch: pytest.Monke
         assert cfg.get(f"env:{env}", "framework") == ["arduino"], f"{env}: framework"
     src = cfg.get("platformio", "src_dir")
     lib = cfg.get("platformio", "lib_dir")
-    assert os.path.samefile(src, os.path.join(root, "firmware/nano/src")), f"src_dir {src}"
-    assert os.path.samefile(lib, os.path.join(root, "firmware/nano/lib")), f"lib_dir {lib}"
+    assert os.path.samefile(src, os.path.join(root, "firmware/nano/hal_avr")), f"src_dir {src}"
+    assert os.path.samefile(lib, os.path.join(root, "firmware/nano/core")), f"lib_dir {lib}"
     main_cpp = open(os.path.join(src, "main.cpp")).read()
     assert "void setup()" in main_cpp and "void loop()" in main_cpp, "src has no Arduino sketch"
     for module in ("nigel", "proto", "enc"):

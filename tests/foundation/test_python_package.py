@@ -49,4 +49,3 @@ def test_root_from_editable_install() -> None:
         r = settings_root(env, tmp)
     assert r.returncode == 0 and Path(r.stdout.strip()) == ROOT, r.stdout + r.stderr
     print(f"editable install's repository: {r.stdout.strip()}")
-

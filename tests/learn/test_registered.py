@@ -41,4 +41,3 @@ def test_unknown_id_named() -> None:
         assert "autodrive/NoSuch-v0" in str(e) and "Intersection" in str(e), e
     else:
         raise AssertionError("an unknown id was made")
-

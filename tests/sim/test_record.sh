@@ -15,7 +15,7 @@ if ! "$sim" --quiet --rtf 4 --duration 2 --cars 2 --no-pty --no-lidar --lcm-url 
   --script constant:throttle=0.5,steering=0 >/dev/null 2>"$dir/sim.err"; then
   cat "$dir/sim.err"
   kill -INT "$rec" 2>/dev/null || true
-  # no multicast route on this machine (tools/setup adds one; README.md, "Tests"): skip
+  # no multicast route on this machine (tools/setup adds one; docs/guides/tests.md): skip
   grep -q "multicast route" "$dir/sim.err" && { echo "SKIP: no multicast route"; exit 77; }
   exit 1
 fi

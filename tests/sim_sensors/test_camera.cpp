@@ -208,7 +208,7 @@ TEST(SimCamera, OverheadRoofTagsDecodeAtTrueIdsAndHeadings) {
       // camera looks down with image right = world +x, image up = world +y
       const double u = k[2] + k[0] * (wx - cp[0]) / depth;
       const double v = k[5] - k[4] * (wy - cp[1]) / depth;
-      // libapriltag's pixel centres are 0.5 px off OpenCV's (eye/README.md)
+      // libapriltag's pixel centres are 0.5 px off OpenCV's (docs/reference/eye.md)
       EXPECT_NEAR(dd->c[0] - 0.5, u, 1.0) << "tag " << t.id;
       EXPECT_NEAR(dd->c[1] - 0.5, v, 1.0) << "tag " << t.id;
       // heading: from the bottom edge's middle (p0, p1) to the top edge's middle (p3, p2)

@@ -28,7 +28,9 @@ ON_LANE_TOLERANCE_M = 0.01  # a stop line's centre must be this close to its lan
 MAX_LATE_OBSTACLES = 8  # the simulator's SCN_MAX_MAP_LATE_BOXES (scenario.h)
 MAX_EYE_CAMERAS = 8  # the simulator's CAMERAS_MAX_EYES (app/include/cameras.h)
 TAG36H11_CODES = 587  # ids 0..586
-MIN_REFERENCE_TAG_ID = 100  # below: the cars' roof tags (mjcf_gen.c mjcf_gen_tag_id: car i has id i)
+MIN_REFERENCE_TAG_ID = (
+    100  # below: the cars' roof tags (mjcf_gen.c mjcf_gen_tag_id: car i has id i)
+)
 
 
 def names(maps_dir: Path = MAPS_DIR) -> list[str]:

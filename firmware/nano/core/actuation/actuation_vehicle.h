@@ -1,5 +1,5 @@
-/* Generated from vehicle/nigel.params by autodrive.devtools.codegen.firmware_header (tools/gen-docs):
- * do not edit. The steering servo's figures as the firmware's integers. */
+/* Generated from vehicle/nigel.params by autodrive.devtools.codegen.firmware_header
+ * (tools/gen-docs): do not edit. The steering servo's figures as the firmware's integers. */
 #ifndef AUTODRIVE_ACTUATION_VEHICLE_H
 #define AUTODRIVE_ACTUATION_VEHICLE_H
 

@@ -27,8 +27,8 @@ def render(car: vehicle.Vehicle, source_name: str) -> str:
         "",
         f"Every figure of the car is written once, in `{source_name}`; C and C++ code include the",
         "generated `<autodrive_vehicle.h>` (macros `AUTODRIVE_VEHICLE_<KEY>`), Python reads it",
-from autodrive.core import vehicle
-from autodrive.devtools.codegen import firmware_header
+        "through `autodrive.core.vehicle`, the firmware's servo figures are generated into",
+        f"`{firmware_header.PATH}`, and the simulator builds the car's MJCF from it.",
         "Units are in each key. Frame: `base_link` is the rear-axle centre on the ground, x",
         "forward, y left, z up.",
         "",
