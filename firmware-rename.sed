@@ -49,8 +49,15 @@ s#\bAUTODRIVE_FS_H\b#AUTODRIVE_FAILSAFE_H#g
 s#\bFS_DEFAULT_TIMEOUT_MS\b#FAILSAFE_DEFAULT_TIMEOUT_MS#g
 s#\bfs_(t|init|set_timeout_ms|on_command|update|may_drive)\b#failsafe_\1#g
 s#\bstruct fs\b#struct failsafe#g
-# the core's member (nano_core_t.failsafe)
+# the core's members (nano_core_t.failsafe, .actuation, .battery, .wheel_speed), by their fields
+# where the short name is common (->act is MuJoCo's mjData.act)
 s#->fs\b#->failsafe#g
+s#(&[A-Za-z_][A-Za-z0-9_]*)\.fs\b#\1.failsafe#g
+s#\.fs\.(last_cmd_us|timeout_us|mode|fresh|prev_disengaged|link_lost)\b#.failsafe.\1#g
+s#(\.|->)act\.(throttle_u|steering_u|last_us|trim_us|servo_us|duty|reverse|brake|decelerating)\b#\1actuation.\2#g
+s#(\.|->)batt\.(mv_x256|have|low|cutoff)\b#\1battery.\2#g
+s#(\.|->)wspd\.(prev_counts|speed_x16|last_us|have)\b#\1wheel_speed.\2#g
+s#\bbatt_next_us\b#battery_next_us#g
 
 # ---- wheel_speed (was wspd) ---------------------------------------------------------------
 s#\bAUTODRIVE_WSPD_H\b#AUTODRIVE_WHEEL_SPEED_H#g

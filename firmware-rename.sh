@@ -9,7 +9,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 script="$PWD/firmware-rename.sed"
 
 # Any old name or path the sed rewrites (a superset is fine: sed leaves other files as they are).
-old='firmware/nano/(lib|src)\b|\b(fs|wspd|act|enc|batt|proto|nigel|nigel_core|nigel_hal|fw)_[A-Za-z0-9_]|\b(FS|WSPD|ACT|ENC|BATT|PROTO|NIGEL|FW)_[A-Z0-9_]|\b(fs|wspd|act|enc|batt|proto|nigel_core|nigel_hal)\.[ch]\b|\bnano_(proto|enc)\b|->fs\b|\bstruct (fs|wspd|act|enc|batt|nigel)\b|\b(fs|wspd|act|enc|batt|proto|nigel)/'
+old='firmware/nano/(lib|src)\b|\b(fs|wspd|act|enc|batt|proto|nigel|nigel_core|nigel_hal|fw)_[A-Za-z0-9_]|\b(FS|WSPD|ACT|ENC|BATT|PROTO|NIGEL|FW)_[A-Z0-9_]|\b(fs|wspd|act|enc|batt|proto|nigel_core|nigel_hal)\.[ch]\b|\bnano_(proto|enc)\b|(\.|->)(fs|act|batt|wspd)\b|\bstruct (fs|wspd|act|enc|batt|nigel)\b|\b(fs|wspd|act|enc|batt|proto|nigel)/'
 
 files=$(git grep -lIE "$old" -- . ':!firmware-rename.sed' ':!firmware-rename.sh' || true)
 if [ "${1:-}" = "--list" ]; then
