@@ -163,8 +163,8 @@ MUTANTS = [
     ),
     (
         "battery/battery.c",
-        "  else if (mv > BATTERY_CUTOFF_CLEAR_MV) b->cutoff = 0;",
-        "  else b->cutoff = 0;",
+        "  else if (mv > BATTERY_CUTOFF_CLEAR_MV)\n    b->cutoff = 0;",
+        "  else\n    b->cutoff = 0;",
         "no cut-off hysteresis",
     ),
     ("lights/lights.c", "  if (braking) lamps |= NANO_CORE_LAMP_TAIL;", "", "no taillights"),
@@ -240,7 +240,7 @@ def main():
                 return 2
             continue
         results.append((f, what, status))
-        print("[mutant %2d] %-18s %-36s %s" % (i, f, what, status), flush=True)
+        print("[mutant %2d] %-26s %-36s %s" % (i, f, what, status), flush=True)
         if "--keep" not in sys.argv:
             shutil.rmtree(lib)
     killed = sum(1 for r in results if r[2].startswith("killed"))
