@@ -36,6 +36,6 @@ def test_platformio_ini_through_platformio(root: Path, monkeypatch: pytest.Monke
     assert os.path.samefile(lib, os.path.join(root, "firmware/nano/core")), f"lib_dir {lib}"
     main_cpp = open(os.path.join(src, "main.cpp")).read()
     assert "void setup()" in main_cpp and "void loop()" in main_cpp, "src has no Arduino sketch"
-    for module in ("nigel", "proto", "enc"):
+    for module in ("nano_core", "protocol", "encoder"):
         assert os.path.isdir(os.path.join(lib, module)), f"lib module {module} missing"
     print("platformio.ini ok:", ", ".join(envs))

@@ -78,7 +78,7 @@ def test_frames_stop_stop_the_car(
         rcfg.update(lcm_url=url, clock="sim")
         rcfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
         (out / "runtime.yaml").write_text(yaml.safe_dump(rcfg))
-        pcfg = yaml.safe_load((root / "runtime/jetson/pilot/config/pilot_hil.yaml").read_text())
+        pcfg = yaml.safe_load((root / "runtime/jetson/config/pilot_hil.yaml").read_text())
         pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300)
         (out / "pilot.yaml").write_text(yaml.safe_dump(pcfg))
         bin_ = build / "bin"
