@@ -176,6 +176,31 @@ struct Accuracy {
   int misses = 0;
 };
 
+// Sums an estimate's errors against the truth; finish() turns them into an Accuracy's figures.
+struct ErrorSum {
+  std::vector<double> pos_mm;
+  double ss_pos = 0, ss_heading = 0;
+  void add(double x_m, double y_m, double yaw_rad, double true_x_m, double true_y_m,
+           double true_yaw_rad) {
+    const double ep = 1000 * std::hypot(x_m - true_x_m, y_m - true_y_m);
+    const double eh = autodrive::angle_wrap_rad(yaw_rad - true_yaw_rad) * 180 / M_PI;
+    ss_pos += ep * ep;
+    ss_heading += eh * eh;
+    pos_mm.push_back(ep);
+  }
+  // total: the poses that should have been detected.
+  void finish(Accuracy &a, double total) const {
+    const double n = static_cast<double>(pos_mm.size());
+    a.detect_rate = n / total;
+    if (n > 0) {
+      a.pos_rms_mm = std::sqrt(ss_pos / n);
+      a.heading_rms_deg = std::sqrt(ss_heading / n);
+      a.pos_median_mm = median(pos_mm);
+      a.pos_max_mm = *std::max_element(pos_mm.begin(), pos_mm.end());
+    }
+  }
+};
+
 // Pixel of a car's roof tag centre.
 cv::Point2d eye_tag_centre_px(const eye::SynthScene &s, const eye::SynthCar &car) {
   const double c = std::cos(car.yaw_rad), sn = std::sin(car.yaw_rad);
@@ -187,25 +212,13 @@ cv::Point2d eye_tag_centre_px(const eye::SynthScene &s, const eye::SynthCar &car
 
 Accuracy accuracy(const Scene &sc, const RunResult &r) {
   Accuracy a;
-  std::vector<double> e;
-  double ss_p = 0, ss_h = 0;
+  ErrorSum e;
   for (size_t i = 0; i < sc.path.size(); ++i) {
     if (!r.est[i]) continue;
     const auto &t = sc.path[i];
-    const double ep = 1000 * std::hypot(r.est[i]->x_m - t.x_m, r.est[i]->y_m - t.y_m);
-    const double eh = autodrive::angle_wrap_rad(r.est[i]->yaw_rad - t.yaw_rad) * 180 / M_PI;
-    ss_p += ep * ep;
-    ss_h += eh * eh;
-    e.push_back(ep);
+    e.add(r.est[i]->x_m, r.est[i]->y_m, r.est[i]->yaw_rad, t.x_m, t.y_m, t.yaw_rad);
   }
-  const double n = static_cast<double>(e.size());
-  a.detect_rate = n / static_cast<double>(sc.path.size());
-  if (n > 0) {
-    a.pos_rms_mm = std::sqrt(ss_p / n);
-    a.heading_rms_deg = std::sqrt(ss_h / n);
-    a.pos_median_mm = median(e);
-    a.pos_max_mm = *std::max_element(e.begin(), e.end());
-  }
+  e.finish(a, static_cast<double>(sc.path.size()));
   return a;
 }
 
@@ -377,8 +390,8 @@ WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::
 
 Accuracy wide_accuracy(const WideScene &sc, const WideResult &r) {
   Accuracy a;
-  std::vector<double> e;
-  double ss_p = 0, ss_h = 0, total = 0;
+  ErrorSum e;
+  double total = 0;
   for (size_t i = 0; i < sc.cars.size(); ++i)
     for (const auto &t : sc.cars[i]) {
       total += 1;
@@ -392,21 +405,10 @@ Accuracy wide_accuracy(const WideScene &sc, const WideResult &r) {
       }
       for (const auto &p : r.est[i]) {
         if (p.tag_id != t.tag_id) continue;
-        const double ep = 1000 * std::hypot(p.x_m - t.x_m, p.y_m - t.y_m);
-        const double eh = autodrive::angle_wrap_rad(p.yaw_rad - t.yaw_rad) * 180 / M_PI;
-        ss_p += ep * ep;
-        ss_h += eh * eh;
-        e.push_back(ep);
+        e.add(p.x_m, p.y_m, p.yaw_rad, t.x_m, t.y_m, t.yaw_rad);
       }
     }
-  const double n = static_cast<double>(e.size());
-  a.detect_rate = n / total;
-  if (n > 0) {
-    a.pos_rms_mm = std::sqrt(ss_p / n);
-    a.heading_rms_deg = std::sqrt(ss_h / n);
-    a.pos_median_mm = median(e);
-    a.pos_max_mm = *std::max_element(e.begin(), e.end());
-  }
+  e.finish(a, total);
   return a;
 }
 

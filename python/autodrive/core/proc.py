@@ -3,9 +3,11 @@ runner that starts named programs with their own log files and stops them in rev
 
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -16,7 +18,32 @@ from typing import IO, Any
 SIGINT_GRACE_S = 5.0
 SIGTERM_GRACE_S = 3.0
 
+# What a child gets when the process that started it dies (SIGKILL, SIGHUP, a crash: no
+# `finally` of ours runs then, and a child in its own session hears no terminal signal).
+PARENT_DEATH_SIGNAL = signal.SIGTERM
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
 Log = Callable[[str], None]
+
+
+def die_with_parent() -> Callable[[], None] | None:
+    """A preexec_fn that has the kernel send PARENT_DEATH_SIGNAL to the child when the thread
+    that started it ends (Linux prctl PR_SET_PDEATHSIG). Everything it calls is bound here, in
+    the parent: between fork and exec the child only makes the system calls. None (no such
+    call) on other systems."""
+    if not sys.platform.startswith("linux"):
+        return None
+    prctl = ctypes.CDLL(None, use_errno=True).prctl
+    parent = os.getpid()
+    sig = int(PARENT_DEATH_SIGNAL)
+
+    def preexec() -> None:
+        if prctl(_PR_SET_PDEATHSIG, sig, 0, 0, 0) != 0:
+            raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG)")
+        if os.getppid() != parent:  # the parent died before prctl: nobody would stop us
+            os.kill(os.getpid(), sig)
+
+    return preexec
 
 
 def stop(
@@ -42,7 +69,10 @@ def stop(
 
 class ProcessGroup:
     """Named child processes, each in its own session (a Ctrl-C on the terminal reaches only
-    us, and we stop them in order), stdout and stderr into one log file each."""
+    us, and we stop them in order), stdout and stderr into one log file each. On Linux each
+    child also gets PARENT_DEATH_SIGNAL when the thread that started it ends, so that no child
+    outlives a parent that died without stopping it (start them from a thread that lives as
+    long as they should)."""
 
     def __init__(self, log: Log) -> None:
         self.log = log
@@ -52,7 +82,11 @@ class ProcessGroup:
         self.log(f"starting {name}: {' '.join(map(str, argv))}")
         f = open(logfile, "w")
         proc = subprocess.Popen(
-            [str(a) for a in argv], stdout=f, stderr=subprocess.STDOUT, start_new_session=True
+            [str(a) for a in argv],
+            stdout=f,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+            preexec_fn=die_with_parent(),
         )
         self.items.append((name, proc, f))
         return proc

@@ -68,29 +68,42 @@ autodrive::vehicle_command_t make_cmd(int32_t seq, float throttle, float steerin
   return c;
 }
 
+// A fake Nano on the pty that keeps the link up once the bridge said hello (100 Hz telemetry).
+struct LinkedNano {
+  autodrive::devtools::FakeNano nano;
+  protocol_state_t st{};
+  int64_t next_state_us = 0;
+  explicit LinkedNano(const std::string &pty) : nano(pty) {
+    nano.open();
+    st.quat_q14[0] = PROTOCOL_QUAT_ONE;
+  }
+  void service() {
+    nano.pump(1);
+    const int64_t now = autodrive::clock::monotonic_us();
+    if (nano.hellos_sent > 0 && now >= next_state_us) {
+      st.nano_time_us += 10000;
+      nano.send_state(st);
+      next_state_us = now + 10000;
+    }
+  }
+  // Serves until the bridge has sent 5 commands (linked), 30 s at most; false, said on stderr
+  // for mode, when it never did.
+  bool wait_linked(const char *mode, const std::string &pty) {
+    const int64_t give_up = autodrive::clock::monotonic_us() + 30000000;
+    while (nano.commands.size() < 5 && autodrive::clock::monotonic_us() < give_up) service();
+    if (nano.commands.size() >= 5) return true;
+    std::fprintf(stderr, "%s: the bridge never linked on %s\n", mode, pty.c_str());
+    return false;
+  }
+};
+
 // ---- flood ---------------------------------------------------------------------------
 int run_flood(const std::string &url, const std::string &vehicle, const std::string &pty,
               double seconds, double flood_hz) {
-  autodrive::devtools::FakeNano nano(pty);
-  nano.open();
-  protocol_state_t st{};
-  st.quat_q14[0] = PROTOCOL_QUAT_ONE;
-  int64_t next_state = 0;
-  auto service = [&] {
-    nano.pump(1);
-    const int64_t now = autodrive::clock::monotonic_us();
-    if (nano.hellos_sent > 0 && now >= next_state) {
-      st.nano_time_us += 10000;
-      nano.send_state(st);
-      next_state = now + 10000;
-    }
-  };
-  const int64_t give_up = autodrive::clock::monotonic_us() + 30000000;
-  while (nano.commands.size() < 5 && autodrive::clock::monotonic_us() < give_up) service();
-  if (nano.commands.size() < 5) {
-    std::fprintf(stderr, "flood: the bridge never linked on %s\n", pty.c_str());
-    return 1;
-  }
+  LinkedNano link(pty);
+  auto &nano = link.nano;
+  auto service = [&] { link.service(); };
+  if (!link.wait_linked("flood", pty)) return 1;
   std::atomic<bool> done{false};
   std::atomic<long> sent{0};
   std::thread flooder([&] {
@@ -148,26 +161,10 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
 int run_serial(const std::string &url, const std::string &vehicle, const std::string &pty,
                int samples) {
   lcm::LCM lcm(url);
-  autodrive::devtools::FakeNano nano(pty);
-  nano.open();
-  protocol_state_t st{};
-  st.quat_q14[0] = PROTOCOL_QUAT_ONE;
-  int64_t next_state = 0;
-  auto service = [&] {
-    nano.pump(1);
-    const int64_t now = autodrive::clock::monotonic_us();
-    if (nano.hellos_sent > 0 && now >= next_state) {  // 100 Hz telemetry keeps the link up
-      st.nano_time_us += 10000;
-      nano.send_state(st);
-      next_state = now + 10000;
-    }
-  };
-  const int64_t give_up = autodrive::clock::monotonic_us() + 30000000;
-  while (nano.commands.size() < 5 && autodrive::clock::monotonic_us() < give_up) service();
-  if (nano.commands.size() < 5) {
-    std::fprintf(stderr, "serial: the bridge never linked on %s\n", pty.c_str());
-    return 1;
-  }
+  LinkedNano link(pty);
+  auto &nano = link.nano;
+  auto service = [&] { link.service(); };
+  if (!link.wait_linked("serial", pty)) return 1;
   std::vector<double> lat_us;
   std::mt19937 rng(3);
   int32_t seq = 0;

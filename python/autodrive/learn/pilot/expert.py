@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from autodrive.core.settings import RELEASE_BUILD
-from autodrive.core.proc import stop
+from autodrive.core.proc import die_with_parent, stop
 
 META_SUFFIX = ".meta.json"
 
@@ -95,6 +95,7 @@ def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: s
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
+            preexec_fn=die_with_parent(),
         )
         try:
             time.sleep(0.5)  # the logger subscribed before the first frame
