@@ -91,6 +91,10 @@ class Settings:
         return self.root / "common" / "path_tracking" / "include" / "autodrive" / "pure_pursuit.h"
 
     @property
+    def road_rules_header(self) -> Path:
+        return self.root / "common" / "road_rules" / "include" / "autodrive" / "road_rules.h"
+
+    @property
     def lcm_type_dir(self) -> Path:
         """The message types (lcm_types/autodrive/*_t.lcm)."""
         return self.root / "lcm_types" / "autodrive"

@@ -28,7 +28,7 @@ from autodrive.scm.lights import STATES, Change, ControlError, Controller, Light
 from autodrive.scm.models import Light as LightRow
 from autodrive.scm.models import Sign as SignRow
 from autodrive.scm.receiver import Receiver
-from autodrive.scm.roadnet import Ahead, Place, RoadNet
+from autodrive.scm.roadnet import Ahead, Place, for_map
 from autodrive.scm.store import Writer
 
 STALE_S = 0.5  # a car's pose older than this [s] gets no advisory (the car then goes stale)
@@ -90,7 +90,7 @@ class Scm:
         self.vehicles = vehicles
         self.history_us = 0 if history_hz <= 0 else int(0.9e6 / history_hz)
         self.advisory_period_s = 1.0 / advisory_hz
-        self.roadnet = RoadNet(m)
+        self.roadnet = for_map(m)
         self.lock = threading.RLock()
         self.cars: dict[str, Car] = {v: Car(v) for v in vehicles}
         self.sim_states: dict[int, tuple[str, float, float]] = {}  # id -> state, left, seen
@@ -396,9 +396,9 @@ class Scm:
                 continue
             if self.vehicles and car.name not in self.vehicles:
                 continue  # placed and advised: the listed cars only (others are only stored)
-            last = car.place.lane if car.place else ""
-            car.place = self.roadnet.place(car.x_m, car.y_m, car.yaw_rad, car.route, last)
-            car.ahead = self.roadnet.ahead(car.place, car.route) if car.place else Ahead()
+            car.place, car.ahead = self.roadnet.follow(
+                car.x_m, car.y_m, car.yaw_rad, car.route, car.place
+            )
             msg = self.types.v2i_advisory_t()
             msg.utime, msg.seq, msg.vehicle = int(t * 1e6), car.seq, car.name
             car.seq += 1

@@ -1,101 +1,55 @@
 """A small V2I advisory publisher, the stand-in for the Smart City Manager's in tests and in the
 smart-city mission until `autodrive-scm` runs: for each car, at 10 Hz (wall time), the next light
-ahead of it on its lane (from the map's sidecar JSON and the car's EKF pose, <VEH>_POSE_MAP) with
-the state the simulator publishes on TRAFFIC_LIGHT_STATE, the distance to its stop line, and the
-next sign. "Ahead on its lane": the stop line lies ahead of the car along the lane's heading
-(which matches the car's within 45 deg) and within the lane's half width plus a margin of its
-centre line's straight approach; distances are straight-line along that heading.
+ahead of it along its route with the state the simulator publishes on TRAFFIC_LIGHT_STATE, the
+distance to its stop line, the next sign and the speed limit in force. "Ahead" is the SCM's own
+rule, from the same code (autodrive.core.road_rules on the map's sidecar JSON): the car placed
+on a lane from its EKF pose (<VEH>_POSE_MAP), its route's lanes first, then walked along its
+route (--routes; without one it stops at a fork); distances are along the lanes.
 
-CLI: python -m autodrive.hil.city.advisory --map tiny_town --vehicles NIGEL1,NIGEL2 [--lcm-url]
+CLI: python -m autodrive.hil.city.advisory --map tiny_town --vehicles NIGEL1,NIGEL2
+     [--routes city_east,city_west] [--lcm-url URL]
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import select
 import signal
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
 
 from autodrive.core import channels, lcmtypes
 from autodrive.core.channels import channel
-from autodrive.maps.loader import MAPS_DIR
+from autodrive.core.road_rules import Ahead, Place, RoadNet, SidecarError
 from autodrive.core.settings import RELEASE_BUILD
-from autodrive.core.geometry import wrap
+from autodrive.maps.loader import MAPS_DIR
 
 PERIOD_S = 0.1  # 10 Hz per car
-HEADING_TOL_RAD = math.radians(45.0)
-LATERAL_TOL_M = 0.2  # half a lane width plus margin
-BEHIND_TOL_M = 0.05  # a stop line this far behind the car's base_link still counts
 
 
-@dataclass(frozen=True)
-class Target:
-    """A light's stop line or a sign: where it is and which way its lane runs."""
+class Advisor:
+    """Each car's place and what lies ahead of it, from its poses (its last lane kept)."""
 
-    ident: int
-    kind: str  # "light" or the sign's kind
-    x_m: float
-    y_m: float
-    heading_rad: float
-    speed_limit_m_s: float
+    def __init__(self, net: RoadNet, routes: dict[str, str]) -> None:
+        self.net = net
+        self.routes = routes
+        self.places: dict[str, Place | None] = {}
 
-
-def _lane_heading_at(lane: dict[str, Any], x: float, y: float) -> float:
-    pts = lane["centre_line"]
-    best = min(pts, key=lambda p: (p["x_m"] - x) ** 2 + (p["y_m"] - y) ** 2)
-    return float(best["heading_rad"])
+    def ahead(self, vehicle: str, x_m: float, y_m: float, yaw_rad: float) -> Ahead:
+        route = self.routes.get(vehicle, "")
+        place, ahead = self.net.follow(x_m, y_m, yaw_rad, route, self.places.get(vehicle))
+        self.places[vehicle] = place
+        return ahead
 
 
-def targets(map_json: Path) -> tuple[list[Target], list[Target]]:
-    """(lights at their stop lines, signs) of a map's sidecar JSON."""
-    d = json.loads(map_json.read_text())
-    lanes = {lane["name"]: lane for lane in d["lanes"]}
-    stops = {s["name"]: s for s in d["stop_lines"]}
-    lights = []
-    for t in d["traffic_lights"]:
-        sl = stops[t["stop_line"]]
-        x, y = sl["centre_m"]
-        lights.append(Target(t["id"], "light", x, y, _lane_heading_at(lanes[t["lane"]], x, y), -1))
-    signs = []
-    for s in d["signs"]:
-        x, y = s["position_m"]
-        limit = s.get("speed_limit_m_s")
-        heading = _lane_heading_at(lanes[s["lane"]], x, y)
-        signs.append(Target(s["id"], s["kind"], x, y, heading, -1 if limit is None else limit))
-    return lights, signs
-
-
-def ahead(pose: tuple[float, float, float], t: Target) -> float | None:
-    """Distance [m] along the lane from the car to t when t is ahead on the car's lane, else None."""
-    x, y, yaw = pose
-    if abs(wrap(yaw - t.heading_rad)) > HEADING_TOL_RAD:
-        return None
-    c, s = math.cos(t.heading_rad), math.sin(t.heading_rad)
-    along = (t.x_m - x) * c + (t.y_m - y) * s
-    lateral = -(t.x_m - x) * s + (t.y_m - y) * c
-    if along < -BEHIND_TOL_M:
-        return None
-    # Signs stand beside the road: the lateral check is for stop lines only.
-    if t.kind == "light" and abs(lateral) > LATERAL_TOL_M:
-        return None
-    return along
-
-
-def nearest(pose: tuple[float, float, float], items: list[Target]) -> tuple[Target, float] | None:
-    found = [(t, d) for t in items if (d := ahead(pose, t)) is not None]
-    return min(found, key=lambda td: td[1]) if found else None
-
-
-def run(map_name: str, vehicles: list[str], url: str, build: Path, stop: list[bool]) -> int:
+def run(
+    map_name: str, vehicles: list[str], routes: dict[str, str], url: str, build: Path,
+    stop: list[bool],
+) -> int:  # fmt: skip
     types = lcmtypes.load(build)
-    lights, signs = targets(MAPS_DIR / f"{map_name}.json")
+    advisor = Advisor(RoadNet.from_file(MAPS_DIR / f"{map_name}.json"), routes)
     lc = lcmtypes.bus(url)
     poses: dict[str, tuple[float, float, float]] = {}
     states: dict[int, tuple[int, float]] = {}
@@ -113,7 +67,8 @@ def run(map_name: str, vehicles: list[str], url: str, build: Path, stop: list[bo
     lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
     seq = 0
     next_t = time.monotonic()
-    print(f"[advisory] {', '.join(vehicles)} on {map_name}: {len(lights)} lights", flush=True)
+    on = ", ".join(f"{v} ({routes.get(v) or 'no route'})" for v in vehicles)
+    print(f"[advisory] {on} on {map_name}", flush=True)
     while not stop[0]:
         wait = next_t - time.monotonic()
         if wait > 0:
@@ -124,20 +79,17 @@ def run(map_name: str, vehicles: list[str], url: str, build: Path, stop: list[bo
         for v in vehicles:
             if v not in poses:
                 continue
+            ahead = advisor.ahead(v, *poses[v])
             a = types.v2i_advisory_t()
             a.utime, a.seq, a.vehicle = int(time.time() * 1e6), seq, v
             a.light_id, a.light_state, a.light_time_remaining_s = -1, 0, -1.0
-            a.stop_line_distance_m, a.sign_id, a.sign_kind = -1.0, -1, ""
-            a.sign_distance_m, a.speed_limit_m_s = -1.0, -1.0
-            light = nearest(poses[v], lights)
-            if light is not None and light[0].ident in states:
-                a.light_id = light[0].ident
-                a.light_state, remaining = states[light[0].ident]
-                a.light_time_remaining_s = remaining
-                a.stop_line_distance_m = max(0.0, light[1])
-            sign = nearest(poses[v], signs)
-            if sign is not None:
-                a.sign_id, a.sign_kind, a.sign_distance_m = sign[0].ident, sign[0].kind, sign[1]
+            a.stop_line_distance_m = -1.0
+            if ahead.light_id in states:
+                a.light_id = ahead.light_id
+                a.light_state, a.light_time_remaining_s = states[ahead.light_id]
+                a.stop_line_distance_m = ahead.stop_line_distance_m
+            a.sign_id, a.sign_kind = ahead.sign_id, ahead.sign_kind
+            a.sign_distance_m, a.speed_limit_m_s = ahead.sign_distance_m, ahead.speed_limit_m_s
             lc.publish(channel("V2I", v), a.encode())
         seq += 1
     return 0
@@ -149,11 +101,30 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--map", default="tiny_town", help="map name (maps/NAME.json)")
     p.add_argument("--vehicles", default=channels.vehicle_name(1), help="comma-separated cars")
+    p.add_argument(
+        "--routes",
+        default="",
+        help="each car's named route, comma-separated in the order of --vehicles (empty: none; "
+        "the walk ahead then stops at a fork)",
+    )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir (LCM types)")
     args = p.parse_args(argv)
-    if not (MAPS_DIR / f"{args.map}.json").is_file():
-        p.error(f"--map {args.map}: no {MAPS_DIR / (args.map + '.json')}")
+    sidecar = MAPS_DIR / f"{args.map}.json"
+    if not sidecar.is_file():
+        p.error(f"--map {args.map}: no {sidecar}")
+    vehicles = args.vehicles.split(",")
+    names = [r.strip() for r in args.routes.split(",")] if args.routes else []
+    if names and len(names) != len(vehicles):
+        p.error(f"--routes: {len(names)} routes for {len(vehicles)} vehicles")
+    try:
+        known = RoadNet.from_file(sidecar).routes
+    except SidecarError as err:
+        p.error(f"--map {args.map}: {err}")
+    for r in names:
+        if r and r not in known:
+            p.error(f"--routes: no route '{r}' on {args.map} (has {', '.join(known)})")
+    routes = dict(zip(vehicles, names))
     stop = [False]
 
     def on_signal(_s: int, _f: FrameType | None) -> None:
@@ -161,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
-    return run(args.map, args.vehicles.split(","), args.lcm_url, Path(args.build), stop)
+    return run(args.map, vehicles, routes, args.lcm_url, Path(args.build), stop)
 
 
 if __name__ == "__main__":

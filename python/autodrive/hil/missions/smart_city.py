@@ -296,6 +296,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             say(f"Smart City Manager web app: {scm_url} (ready after {cpu_s:.1f} s of its CPU)")
         else:
             adv = [py, "-m", "autodrive.hil.city.advisory", "--map", MAP, "--vehicles", vehicles]
+            adv += ["--routes", ",".join(ROUTES[i - 1] for i in range(1, cars + 1))]
             procs.start(
                 "advisory", [*adv, "--lcm-url", url, "--build", build], out / "advisory.log"
             )

@@ -58,6 +58,52 @@ double lane_length(const Lane &l) {
   return s;
 }
 
+int lane_index(const CityMap &m, const std::string &lane, const std::string &where) {
+  const auto it = m.lanes.find(lane);
+  if (it == m.lanes.end()) throw Error(m.file + ": " + where + ": lane '" + lane + "' is not on the map");
+  return it->second.index;
+}
+
+// The one "next light and sign ahead" on this map: lights at their stop lines, signs beside
+// their lanes, the named routes.
+std::shared_ptr<const autodrive::road::Network> road_network(const CityMap &m) {
+  std::vector<autodrive::road::LaneInput> lanes;
+  for (const std::string &name : m.lane_order) {
+    const Lane &l = m.lanes.at(name);
+    autodrive::road::LaneInput in;
+    for (const Point &p : l.centre_line) in.centre_line.push_back({p.x_m, p.y_m, p.heading_rad});
+    in.half_width_m = l.half_width_m;
+    lanes.push_back(in);
+  }
+  std::vector<road_light_t> lights;
+  for (const Light &l : m.lights) {
+    const std::string where = "traffic light " + std::to_string(l.id);
+    const auto sl = std::find_if(m.stop_lines.begin(), m.stop_lines.end(),
+                                 [&](const StopLine &x) { return x.name == l.stop_line; });
+    if (sl == m.stop_lines.end())
+      throw Error(m.file + ": " + where + ": stop line '" + l.stop_line + "' is not on the map");
+    lights.push_back({l.id, lane_index(m, sl->lane, where), sl->x_m, sl->y_m});
+  }
+  std::vector<road_sign_t> signs;
+  for (const Sign &g : m.signs)
+    signs.push_back({g.id,
+                     g.lane.empty() ? -1 : lane_index(m, g.lane, "sign " + std::to_string(g.id)),
+                     g.x_m, g.y_m, g.yaw_rad, g.speed_limit_m_s});
+  std::vector<autodrive::road::RouteInput> routes;
+  for (const std::string &name : m.route_order) {
+    autodrive::road::RouteInput r;
+    for (const std::string &l : m.routes.at(name).lanes)
+      r.lanes.push_back(lane_index(m, l, "route " + name));
+    r.loop = m.routes.at(name).loop;
+    routes.push_back(r);
+  }
+  try {
+    return std::make_shared<const autodrive::road::Network>(lanes, lights, signs, routes);
+  } catch (const std::invalid_argument &e) {
+    throw Error(m.file + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 CityMap load_city_map(const std::string &path) {
@@ -80,6 +126,10 @@ CityMap load_city_map(const std::string &path) {
       lane.centre_line.push_back(
           {num(p, "x_m", where), num(p, "y_m", where), num(p, "heading_rad", where)});
     if (lane.centre_line.size() < 2) throw Error(where + ": fewer than 2 centre-line points");
+    lane.half_width_m = num(l, "half_width_m", where);
+    lane.index = static_cast<int>(m.lane_order.size());
+    if (m.lanes.count(lane.name)) throw Error(where + ": appears twice");
+    m.lane_order.push_back(lane.name);
     m.lanes[lane.name] = lane;
   }
   for (const json &s : need(j, "stop_lines", path)) {
@@ -108,11 +158,12 @@ CityMap load_city_map(const std::string &path) {
     const std::string where = path + ": sign " + std::to_string(g.id);
     g.name = str(s, "name", where);
     g.kind = str(s, "kind", where);
-    g.lane = str(s, "lane", where);
+    g.lane = need(s, "lane", where).is_null() ? "" : str(s, "lane", where);
     const json &p = need(s, "position_m", where);
     if (!p.is_array() || p.size() != 2) throw Error(where + ": position_m is not [x, y]");
     g.x_m = p[0].get<double>();
     g.y_m = p[1].get<double>();
+    g.yaw_rad = num(s, "yaw_rad", where);
     if (g.kind == "speed_limit") g.speed_limit_m_s = num(s, "speed_limit_m_s", where);
     m.signs.push_back(g);
   }
@@ -122,8 +173,10 @@ CityMap load_city_map(const std::string &path) {
     const std::string where = path + ": route " + nr.name;
     for (const json &l : need(r, "lanes", where)) nr.lanes.push_back(l.get<std::string>());
     nr.loop = need(r, "loop", where).get<bool>();
+    m.route_order.push_back(nr.name);
     m.routes[nr.name] = nr;
   }
+  m.roads = road_network(m);
   return m;
 }
 
@@ -170,46 +223,42 @@ Track build_track(const CityMap &m, const std::string &name, const std::vector<s
     t.points.pop_back();  // the start point closes the loop
   }
   t.length_m = s;
-  // Stops: each light's stop line on a lane of the track; each stop sign at its lane's stop line
-  // (or at the sign itself when the lane has none).
-  for (const Light &l : m.lights) {
-    if (!lane_s0.count(l.lane)) continue;
-    const auto sl = std::find_if(m.stop_lines.begin(), m.stop_lines.end(),
-                                 [&](const StopLine &x) { return x.name == l.stop_line; });
-    if (sl == m.stop_lines.end())
-      throw Error(m.file + ": traffic light " + std::to_string(l.id) + ": stop line '" +
-                  l.stop_line + "' is not on the map");
-    t.stops.push_back({Stop::Kind::light,
-                       lane_s0[l.lane] + s_on_lane(m.lanes.at(l.lane), sl->x_m, sl->y_m), l.id,
-                       sl->name});
-  }
-  for (const Sign &g : m.signs) {
-    if (!lane_s0.count(g.lane)) continue;
-    const Lane &lane = m.lanes.at(g.lane);
-    const double s_sign = lane_s0[g.lane] + s_on_lane(lane, g.x_m, g.y_m);
-    if (g.kind == "stop") {
-      const auto sl = std::find_if(m.stop_lines.begin(), m.stop_lines.end(),
-                                   [&](const StopLine &x) { return x.lane == g.lane; });
-      const double s_stop =
-          sl == m.stop_lines.end() ? s_sign : lane_s0[g.lane] + s_on_lane(lane, sl->x_m, sl->y_m);
-      t.stops.push_back(
-          {Stop::Kind::stop_sign, s_stop, -1, sl == m.stop_lines.end() ? g.name : sl->name});
-    } else if (g.kind == "speed_limit") {
-      // Holds from the sign to the end of its lane (the rest of its road tile).
-      t.zones.push_back({s_sign, lane_s0[g.lane] + lane_length(lane), g.speed_limit_m_s,
-                         g.name + " speed_limit"});
-    } else if (g.kind == "curve_left" || g.kind == "curve_right") {
-      // From the sign through the end of the first curved lane after it.
-      double s1 = -1;
-      for (size_t k = 0; k < placed.size() * 2 && s1 < 0; ++k) {
-        const auto &[s0, l] = placed[k % placed.size()];
-        const double base = s0 + (k >= placed.size() ? t.length_m : 0.0);
-        const double turn = std::abs(autodrive::angle_wrap_rad(l->centre_line.back().heading_rad -
-                                                               l->centre_line.front().heading_rad));
-        if (base + 1e-6 >= s_sign && turn > kCurveRad) s1 = base + lane_length(*l);
-        if (!loop && k + 1 >= placed.size()) break;
+  // Stops and zones where the road network puts the lights and signs on the track's lanes:
+  // each light at its stop line; each stop sign at its lane's stop line (or at the sign itself
+  // when the lane has none).
+  for (const auto &[s0, lane] : placed) {
+    for (const road_anchor_t &a : m.roads->anchors(lane->index)) {
+      const double s_at = s0 + a.s_m;
+      if (a.kind == ROAD_LIGHT) {
+        const Light &l = m.lights[static_cast<size_t>(a.index)];
+        t.stops.push_back({Stop::Kind::light, s_at, l.id, l.stop_line});
+        continue;
       }
-      if (s1 > 0) t.zones.push_back({s_sign, s1, -1.0, g.name + " " + g.kind});
+      const Sign &g = m.signs[static_cast<size_t>(a.index)];
+      if (g.kind == "stop") {
+        const auto sl = std::find_if(m.stop_lines.begin(), m.stop_lines.end(),
+                                     [&](const StopLine &x) { return x.lane == g.lane; });
+        const double s_stop =
+            sl == m.stop_lines.end() ? s_at : s0 + s_on_lane(*lane, sl->x_m, sl->y_m);
+        t.stops.push_back(
+            {Stop::Kind::stop_sign, s_stop, -1, sl == m.stop_lines.end() ? g.name : sl->name});
+      } else if (g.kind == "speed_limit") {
+        // Holds from the sign to the end of its lane (the rest of its road tile).
+        t.zones.push_back({s_at, s0 + lane_length(*lane), g.speed_limit_m_s,
+                           g.name + " speed_limit"});
+      } else if (g.kind == "curve_left" || g.kind == "curve_right") {
+        // From the sign through the end of the first curved lane after it.
+        double s1 = -1;
+        for (size_t k = 0; k < placed.size() * 2 && s1 < 0; ++k) {
+          const auto &[c0, l] = placed[k % placed.size()];
+          const double base = c0 + (k >= placed.size() ? t.length_m : 0.0);
+          const double turn = std::abs(autodrive::angle_wrap_rad(
+              l->centre_line.back().heading_rad - l->centre_line.front().heading_rad));
+          if (base + 1e-6 >= s_at && turn > kCurveRad) s1 = base + lane_length(*l);
+          if (!loop && k + 1 >= placed.size()) break;
+        }
+        if (s1 > 0) t.zones.push_back({s_at, s1, -1.0, g.name + " " + g.kind});
+      }
     }
   }
   std::sort(t.stops.begin(), t.stops.end(),
@@ -237,8 +286,10 @@ Track track_for(const CityMap &m, const std::string &route) {
 }
 
 TrackPoint point_at(const Track &t, double s) {
-  if (t.loop) s = std::fmod(std::fmod(s, t.length_m) + t.length_m, t.length_m);
-  s = std::clamp(s, 0.0, t.points.back().s_m);
+  if (t.loop)  // on into the closing segment (the last point back to the first)
+    s = std::fmod(std::fmod(s, t.length_m) + t.length_m, t.length_m);
+  else
+    s = std::clamp(s, 0.0, t.points.back().s_m);
   auto it = std::upper_bound(t.points.begin(), t.points.end(), s,
                              [](double v, const TrackPoint &p) { return v < p.s_m; });
   const size_t i = it == t.points.begin() ? 0 : static_cast<size_t>(it - t.points.begin()) - 1;

@@ -1,13 +1,17 @@
 // The city as the behaviour layer sees it, read from a map's sidecar JSON (written by
 // tools/gen-maps from maps/<map>.yaml; never typed here): lane centre lines,
-// named routes, stop lines, traffic lights and signs. A route (a named one, or a chain of lanes)
-// becomes a Track: one polyline with arc length, the stops on it (each light's stop line, each
-// stop sign's stop line) and its speed zones (speed-limit and curve signs).
+// named routes, stop lines, traffic lights and signs. Lights and signs stand on the lanes where the
+// one "next light and sign ahead" (<autodrive/road_rules.hpp>, the SCM's too) puts them. A route
+// (a named one, or a chain of lanes) becomes a Track: one polyline with arc length, the stops on
+// it (each light's stop line, each stop sign's stop line) and its speed zones (speed-limit and
+// curve signs).
 #pragma once
 
+#include <autodrive/road_rules.hpp>
 #include <autodrive/strict_yaml.hpp>
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +26,8 @@ struct Point {
 struct Lane {
   std::string name;
   std::vector<Point> centre_line;
+  double half_width_m = 0;
+  int index = 0;  // its place in the sidecar's list (the road network's lane index)
 };
 
 struct StopLine {
@@ -36,8 +42,8 @@ struct Light {
 
 struct Sign {
   int id = 0;
-  std::string name, kind, lane;
-  double x_m = 0, y_m = 0;
+  std::string name, kind, lane;  // lane empty: a sign at a pose
+  double x_m = 0, y_m = 0, yaw_rad = 0;
   double speed_limit_m_s = -1;  // speed_limit signs only
 };
 
@@ -54,6 +60,10 @@ struct CityMap {
   std::vector<Light> lights;
   std::vector<Sign> signs;
   std::map<std::string, NamedRoute> routes;
+  std::vector<std::string> lane_order;  // lane names in the sidecar's order
+  std::vector<std::string> route_order;  // route names in the sidecar's order
+  // where the lights and signs stand, and the walk ahead (shared: a CityMap copies cheaply)
+  std::shared_ptr<const autodrive::road::Network> roads;
 };
 
 // Reads a sidecar JSON; Error naming the file and the element when something is missing.
