@@ -119,6 +119,6 @@ TEST(RoadRules, NoLaneNoPlaceAndAForkStopsTheWalk) {
   EXPECT_EQ(a.light_id, 5);
   EXPECT_NEAR(a.stop_line_distance_m, 0.3, 1e-9);
   EXPECT_EQ(a.sign_id, -1);  // beyond the fork: unknown without a route
-  a = n.ahead(p, 0);  // along route 0 (the left branch)
+  a = n.ahead(p, 0);         // along route 0 (the left branch)
   EXPECT_EQ(a.sign_id, 9);
 }

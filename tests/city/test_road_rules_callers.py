@@ -52,7 +52,9 @@ def test_scm_and_standin_agree_on_every_pose() -> None:
                 where = f"{name} at ({x2:.3f}, {y2:.3f}) on {place.lane}"
                 assert (got.light_id, got.sign_id, got.sign_kind) == (
                     want.light_id, want.sign_id, want.sign_kind), where  # fmt: skip
-                assert got.stop_line_distance_m == pytest.approx(want.stop_line_distance_m, abs=1e-6)
+                assert got.stop_line_distance_m == pytest.approx(
+                    want.stop_line_distance_m, abs=1e-6
+                )
                 assert got.sign_distance_m == pytest.approx(want.sign_distance_m, abs=1e-6)
                 assert got.speed_limit_m_s == want.speed_limit_m_s, where
                 lights_seen.add(want.light_id)

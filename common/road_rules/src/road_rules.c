@@ -48,9 +48,8 @@ static projection_t project_segment(const lane_geom_t *g, int i, double x, doubl
   projection_t p;
   p.s_m = g->s_m[i] + u * (g->s_m[i + 1] - g->s_m[i]);
   p.dist_m = hypot(a->x_m + u * dx - x, a->y_m + u * dy - y);
-  p.heading_rad =
-      autodrive_angle_wrap_rad(a->heading_rad + u * autodrive_angle_wrap_rad(b->heading_rad -
-                                                                             a->heading_rad));
+  p.heading_rad = autodrive_angle_wrap_rad(
+      a->heading_rad + u * autodrive_angle_wrap_rad(b->heading_rad - a->heading_rad));
   return p;
 }
 
@@ -61,7 +60,8 @@ static projection_t project_lane(const lane_geom_t *g, double x, double y, doubl
   projection_t best = {0.0, INFINITY, 0.0};
   for (int i = 0; i + 1 < g->n; ++i) {
     const projection_t p = project_segment(g, i, x, y);
-    if (isfinite(yaw_rad) && fabs(autodrive_angle_wrap_rad(p.heading_rad - yaw_rad)) >= max_dyaw_rad)
+    if (isfinite(yaw_rad) &&
+        fabs(autodrive_angle_wrap_rad(p.heading_rad - yaw_rad)) >= max_dyaw_rad)
       continue;
     if (p.dist_m < best.dist_m) best = p;
   }
@@ -126,8 +126,8 @@ static int copy_lane(lane_geom_t *g, const road_lane_t *in) {
     g->max_y_m = fmax(g->max_y_m, g->pts[i].y_m);
   }
   for (int i = 1; i < g->n; ++i)
-    g->s_m[i] = g->s_m[i - 1] + hypot(g->pts[i].x_m - g->pts[i - 1].x_m,
-                                      g->pts[i].y_m - g->pts[i - 1].y_m);
+    g->s_m[i] =
+        g->s_m[i - 1] + hypot(g->pts[i].x_m - g->pts[i - 1].x_m, g->pts[i].y_m - g->pts[i - 1].y_m);
   return 0;
 }
 
@@ -152,8 +152,7 @@ static int join_lanes(road_net_t *net) {
  * nearest such lane and its twins (within ROAD_JOIN_M more). */
 static int attach(road_net_t *net, road_anchor_t anchor, double x, double y, double heading_rad,
                   int own_lane, double reach_m) {
-  if (own_lane >= 0)
-    heading_rad = project_lane(&net->lanes[own_lane], x, y, NAN, 0.0).heading_rad;
+  if (own_lane >= 0) heading_rad = project_lane(&net->lanes[own_lane], x, y, NAN, 0.0).heading_rad;
   double dmin = INFINITY;
   for (int pass = 0; pass < 2; ++pass)
     for (int k = 0; k < net->n_lanes; ++k) {
@@ -189,7 +188,8 @@ static int place_anchors(road_net_t *net, const road_light_t *lights, int n_ligh
       point_at(g, project_lane(g, sg->x_m, sg->y_m, NAN, 0.0).s_m, &x, &y);
       rc = attach(net, a, x, y, 0.0, sg->lane, ROAD_JOIN_M);
     } else { /* at a pose: its face points against its traffic */
-      rc = attach(net, a, sg->x_m, sg->y_m, autodrive_angle_wrap_rad(sg->yaw_rad + 3.14159265358979323846), -1,
+      rc = attach(net, a, sg->x_m, sg->y_m,
+                  autodrive_angle_wrap_rad(sg->yaw_rad + 3.14159265358979323846), -1,
                   ROAD_POSE_SIGN_REACH_M);
     }
     if (rc) return -1;
@@ -220,8 +220,8 @@ static int check_input(const road_lane_t *lanes, int n_lanes, const road_light_t
   for (int r = 0; r < n_routes; ++r)
     for (int k = 0; k < routes[r].n_lanes; ++k)
       if (routes[r].lanes[k] < 0 || routes[r].lanes[k] >= n_lanes) {
-        fail(err, err_sz, "route %d: lane index %d out of range (%d lanes)", r,
-             routes[r].lanes[k], n_lanes);
+        fail(err, err_sz, "route %d: lane index %d out of range (%d lanes)", r, routes[r].lanes[k],
+             n_lanes);
         return -1;
       }
   return 0;
@@ -230,8 +230,7 @@ static int check_input(const road_lane_t *lanes, int n_lanes, const road_light_t
 road_net_t *road_net_create(const road_lane_t *lanes, int n_lanes, const road_light_t *lights,
                             int n_lights, const road_sign_t *signs, int n_signs,
                             const road_route_t *routes, int n_routes, char *err, size_t err_sz) {
-  if (check_input(lanes, n_lanes, lights, n_lights, signs, n_signs, routes, n_routes, err,
-                  err_sz))
+  if (check_input(lanes, n_lanes, lights, n_lights, signs, n_signs, routes, n_routes, err, err_sz))
     return NULL;
   road_net_t *net = calloc(1, sizeof *net);
   if (!net) goto no_memory;
@@ -310,8 +309,8 @@ static int follows(const road_net_t *net, int last_lane, int lane) {
   return 0;
 }
 
-int road_place(const road_net_t *net, double x_m, double y_m, double yaw_rad, int route,
-               int last_lane, road_place_t *out) {
+int road_place_car(const road_net_t *net, double x_m, double y_m, double yaw_rad, int route,
+                   int last_lane, road_place_t *out) {
   long best_rank = -1;
   for (int k = 0; k < net->n_lanes; ++k) {
     const lane_geom_t *g = &net->lanes[k];
@@ -346,8 +345,8 @@ int road_next_lane(const road_net_t *net, int lane, int route) {
   return g->n_succ == 1 ? g->succ[0] : -1;
 }
 
-road_ahead_t road_ahead(const road_net_t *net, const road_place_t *place, int route,
-                        double horizon_m) {
+road_ahead_t road_walk_ahead(const road_net_t *net, const road_place_t *place, int route,
+                             double horizon_m) {
   road_ahead_t out = {-1, -1, -1.0, -1, -1, -1.0, road_speed_limit_m_s(net, place)};
   int lane = place->lane;
   double s0 = place->s_m, travelled = 0.0;

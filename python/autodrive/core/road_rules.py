@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -23,17 +22,24 @@ LIB_NAME = "libautodrive_road_rules.so"
 HORIZON_M = 12.0  # how far ahead the walk looks [m] (ROAD_HORIZON_M)
 
 
-def library_path() -> Path:
-    """The road rules library (see gym._lib.find_library)."""
+def library_path(build: Path | None = None) -> Path:
+    """The road rules library: in build/lib when a build is named (the one whose LCM types the
+    caller uses), else see gym._lib.find_library."""
+    if build is not None and (Path(build) / "lib" / LIB_NAME).is_file():
+        return Path(build) / "lib" / LIB_NAME
     return find_library(LIB_NAME, "autodrive_road_rules_shared")
 
 
-@lru_cache(maxsize=1)
-def load() -> tuple[Any, Any]:
-    """(ffi, lib) of the library."""
-    ffi = cffi.FFI()
-    ffi.cdef(declarations(settings().road_rules_header))
-    return ffi, ffi.dlopen(str(library_path()))
+_loaded: list[tuple[Any, Any]] = []
+
+
+def load(build: Path | None = None) -> tuple[Any, Any]:
+    """(ffi, lib) of the library (the first load decides which library file serves)."""
+    if not _loaded:
+        ffi = cffi.FFI()
+        ffi.cdef(declarations(settings().road_rules_header))
+        _loaded.append((ffi, ffi.dlopen(str(library_path(build)))))
+    return _loaded[0]
 
 
 @dataclass(frozen=True)
@@ -90,8 +96,10 @@ def _need(d: dict[str, Any], key: str, where: str) -> Any:
 class RoadNet:
     """The road network of a map's sidecar document (dict, as maps/<map>.json holds it)."""
 
-    def __init__(self, doc: dict[str, Any], source: str = "sidecar") -> None:
-        ffi, lib = load()
+    def __init__(
+        self, doc: dict[str, Any], source: str = "sidecar", build: Path | None = None
+    ) -> None:
+        ffi, lib = load(build)
         self.source = source
         lanes = _need(doc, "lanes", source)
         self._names = [str(_need(lane, "name", f"{source}: lanes[]")) for lane in lanes]
@@ -112,7 +120,9 @@ class RoadNet:
                  float(_need(p, "heading_rad", where)))
                 for p in _need(lane, "centre_line", where)
             ]  # fmt: skip
-            c_pts = ffi.new("road_point_t[]", [{"x_m": x, "y_m": y, "heading_rad": h} for x, y, h in pts])
+            c_pts = ffi.new(
+                "road_point_t[]", [{"x_m": x, "y_m": y, "heading_rad": h} for x, y, h in pts]
+            )
             keep.append(c_pts)
             half = float(_need(lane, "half_width_m", where))
             c_lanes[i] = {"points": c_pts, "n_points": len(pts), "half_width_m": half}
@@ -125,9 +135,16 @@ class RoadNet:
             where = f"traffic light {t.get('id')}"
             stop = stops.get(_need(t, "stop_line", f"{source}: {where}"))
             if stop is None:
-                raise SidecarError(f"{source}: {where}: stop line '{t['stop_line']}' is not on the map")
+                raise SidecarError(
+                    f"{source}: {where}: stop line '{t['stop_line']}' is not on the map"
+                )
             x, y = stop["centre_m"]
-            c_lights[i] = {"id": int(t["id"]), "lane": lane_index(stop["lane"], where), "x_m": x, "y_m": y}
+            c_lights[i] = {
+                "id": int(t["id"]),
+                "lane": lane_index(stop["lane"], where),
+                "x_m": x,
+                "y_m": y,
+            }
         self._signs = _need(doc, "signs", source)
         c_signs = ffi.new("road_sign_t[]", max(1, len(self._signs)))
         for i, s in enumerate(self._signs):
@@ -152,7 +169,11 @@ class RoadNet:
             names = list(_need(route, "lanes", f"{source}: route {name}"))
             c_ids = ffi.new("int[]", [lane_index(n, f"route {name}") for n in names] or [0])
             keep.append(c_ids)
-            c_routes[r] = {"lanes": c_ids, "n_lanes": len(names), "loop": int(bool(route.get("loop")))}
+            c_routes[r] = {
+                "lanes": c_ids,
+                "n_lanes": len(names),
+                "loop": int(bool(route.get("loop"))),
+            }
             self.routes[name] = names
             self._route_index[name] = r
         err = ffi.new("char[]", 256)
@@ -165,16 +186,18 @@ class RoadNet:
             g = self.lanes[name]
             g.length_m = float(lib.road_lane_length_m(self._net, i))
             out = ffi.new("int **")
-            g.successors = [self._names[out[0][k]] for k in range(lib.road_lane_successors(self._net, i, out))]
+            g.successors = [
+                self._names[out[0][k]] for k in range(lib.road_lane_successors(self._net, i, out))
+            ]
 
     @classmethod
-    def from_file(cls, path: Path) -> RoadNet:
+    def from_file(cls, path: Path, build: Path | None = None) -> RoadNet:
         """The network of a sidecar JSON file (maps/<map>.json)."""
         try:
             doc = json.loads(Path(path).read_text())
         except (OSError, json.JSONDecodeError) as err:
             raise SidecarError(f"{path}: {err}") from err
-        return cls(doc, str(path))
+        return cls(doc, str(path), build)
 
     def _route(self, route: str) -> int:
         return self._route_index.get(route, -1)
@@ -202,7 +225,7 @@ class RoadNet:
         ffi, lib = load()
         out = ffi.new("road_place_t *")
         last = self._names.index(last_lane) if last_lane in self.lanes else -1
-        if not lib.road_place(self._net, x_m, y_m, yaw_rad, self._route(route), last, out):
+        if not lib.road_place_car(self._net, x_m, y_m, yaw_rad, self._route(route), last, out):
             return None
         return Place(self._names[out.lane], float(out.s_m), float(out.offset_m))
 
@@ -211,7 +234,7 @@ class RoadNet:
         ffi, lib = load()
         p = ffi.new("road_place_t *", {"lane": self._names.index(place.lane), "s_m": place.s_m,
                                        "offset_m": place.offset_m})  # fmt: skip
-        a = lib.road_ahead(self._net, p, self._route(route), horizon_m)
+        a = lib.road_walk_ahead(self._net, p, self._route(route), horizon_m)
         limit = float(a.speed_limit_m_s)
         return Ahead(
             light_id=int(a.light_id),

@@ -6,6 +6,8 @@ from the car's pose point (base_link, the rear-axle centre)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from autodrive.core.road_rules import HORIZON_M, Ahead, Anchor, Lane, Place, RoadNet
 from autodrive.maps import MapDescription
 from autodrive.maps.sidecar import document
@@ -13,6 +15,7 @@ from autodrive.maps.sidecar import document
 __all__ = ["HORIZON_M", "Ahead", "Anchor", "Lane", "Place", "RoadNet", "for_map"]
 
 
-def for_map(m: MapDescription) -> RoadNet:
-    """The network of a map description (its sidecar document, as maps/<map>.json holds it)."""
-    return RoadNet(document(m), str(m.source))
+def for_map(m: MapDescription, build: Path | None = None) -> RoadNet:
+    """The network of a map description (its sidecar document, as maps/<map>.json holds it),
+    with the road rules library of build (when it has one)."""
+    return RoadNet(document(m), str(m.source), build)

@@ -90,7 +90,7 @@ class Scm:
         self.vehicles = vehicles
         self.history_us = 0 if history_hz <= 0 else int(0.9e6 / history_hz)
         self.advisory_period_s = 1.0 / advisory_hz
-        self.roadnet = for_map(m)
+        self.roadnet = for_map(m, build)
         self.lock = threading.RLock()
         self.cars: dict[str, Car] = {v: Car(v) for v in vehicles}
         self.sim_states: dict[int, tuple[str, float, float]] = {}  # id -> state, left, seen

@@ -27,12 +27,13 @@
 extern "C" {
 #endif
 
-#define ROAD_JOIN_M 0.03             /* lane ends this close join; an anchor this close is on a lane [m] */
-#define ROAD_JOIN_RAD 0.35           /* and their headings differ by less than this [rad] */
-#define ROAD_MAX_HEADING_RAD 1.0471975511965976 /* a car further off a lane's heading is not on it (60 deg) */
-#define ROAD_LANE_MARGIN_M 0.05      /* a car this far beyond a lane's half width is not on it [m] */
-#define ROAD_POSE_SIGN_REACH_M 0.6   /* a sign at a pose belongs to a lane this close [m] */
-#define ROAD_HORIZON_M 12.0          /* how far ahead a walk looks by default [m] */
+#define ROAD_JOIN_M 0.03   /* lane ends this close join; an anchor this close is on a lane [m] */
+#define ROAD_JOIN_RAD 0.35 /* and their headings differ by less than this [rad] */
+#define ROAD_MAX_HEADING_RAD \
+  1.0471975511965976               /* a car further off a lane's heading is not on it (60 deg) */
+#define ROAD_LANE_MARGIN_M 0.05    /* a car this far beyond a lane's half width is not on it [m] */
+#define ROAD_POSE_SIGN_REACH_M 0.6 /* a sign at a pose belongs to a lane this close [m] */
+#define ROAD_HORIZON_M 12.0        /* how far ahead a walk looks by default [m] */
 
 /* CFFI-BEGIN */
 typedef struct road_point {
@@ -47,8 +48,8 @@ typedef struct road_lane {
 
 typedef struct road_light {
   int id;
-  int lane;         /* index of its stop line's lane */
-  double x_m, y_m;  /* its stop line's centre */
+  int lane;        /* index of its stop line's lane */
+  double x_m, y_m; /* its stop line's centre */
 } road_light_t;
 
 typedef struct road_sign {
@@ -114,13 +115,13 @@ int road_lane_anchors(const road_net_t *net, int lane, const road_anchor_t **out
 
 /* Places a car at (x, y, yaw) [m, m, rad]. route: index of its named route or -1; last_lane:
  * the lane it was on or -1. Returns 1 and fills *out, or 0 when it is on no lane. */
-int road_place(const road_net_t *net, double x_m, double y_m, double yaw_rad, int route,
-               int last_lane, road_place_t *out);
+int road_place_car(const road_net_t *net, double x_m, double y_m, double yaw_rad, int route,
+                   int last_lane, road_place_t *out);
 /* The lane after lane on route (-1: none), else the lane's one successor, else -1. */
 int road_next_lane(const road_net_t *net, int lane, int route);
 /* The next light and sign within horizon_m [m] ahead of place, walking along route (or -1). */
-road_ahead_t road_ahead(const road_net_t *net, const road_place_t *place, int route,
-                        double horizon_m);
+road_ahead_t road_walk_ahead(const road_net_t *net, const road_place_t *place, int route,
+                             double horizon_m);
 /* The speed limit in force at place [m/s], < 0 when none. */
 double road_speed_limit_m_s(const road_net_t *net, const road_place_t *place);
 /* CFFI-END */

@@ -28,8 +28,8 @@ class Network {
           const std::vector<road_sign_t> &signs, const std::vector<RouteInput> &routes) {
     std::vector<road_lane_t> c_lanes;
     for (const LaneInput &l : lanes)
-      c_lanes.push_back({l.centre_line.data(), static_cast<int>(l.centre_line.size()),
-                         l.half_width_m});
+      c_lanes.push_back(
+          {l.centre_line.data(), static_cast<int>(l.centre_line.size()), l.half_width_m});
     std::vector<road_route_t> c_routes;
     for (const RouteInput &r : routes)
       c_routes.push_back({r.lanes.data(), static_cast<int>(r.lanes.size()), r.loop ? 1 : 0});
@@ -52,11 +52,11 @@ class Network {
   // false when the car is on no lane.
   bool place(double x_m, double y_m, double yaw_rad, int route, int last_lane,
              road_place_t &out) const {
-    return road_place(net_.get(), x_m, y_m, yaw_rad, route, last_lane, &out) != 0;
+    return road_place_car(net_.get(), x_m, y_m, yaw_rad, route, last_lane, &out) != 0;
   }
   road_ahead_t ahead(const road_place_t &place, int route,
                      double horizon_m = ROAD_HORIZON_M) const {
-    return road_ahead(net_.get(), &place, route, horizon_m);
+    return road_walk_ahead(net_.get(), &place, route, horizon_m);
   }
 
  private:

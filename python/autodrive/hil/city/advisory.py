@@ -49,7 +49,7 @@ def run(
     stop: list[bool],
 ) -> int:  # fmt: skip
     types = lcmtypes.load(build)
-    advisor = Advisor(RoadNet.from_file(MAPS_DIR / f"{map_name}.json"), routes)
+    advisor = Advisor(RoadNet.from_file(MAPS_DIR / f"{map_name}.json", build), routes)
     lc = lcmtypes.bus(url)
     poses: dict[str, tuple[float, float, float]] = {}
     states: dict[int, tuple[int, float]] = {}
@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
     if names and len(names) != len(vehicles):
         p.error(f"--routes: {len(names)} routes for {len(vehicles)} vehicles")
     try:
-        known = RoadNet.from_file(sidecar).routes
+        known = RoadNet.from_file(sidecar, Path(args.build)).routes
     except SidecarError as err:
         p.error(f"--map {args.map}: {err}")
     for r in names:

@@ -35,6 +35,15 @@ std::string str(const json &j, const char *key, const std::string &where) {
   return v.get<std::string>();
 }
 
+// A point given as [x, y] [m].
+void xy(const json &j, const char *key, const std::string &where, double &x_m, double &y_m) {
+  const json &v = need(j, key, where);
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+    throw Error(where + ": " + key + " is not [x, y]");
+  x_m = v[0].get<double>();
+  y_m = v[1].get<double>();
+}
+
 // Arc length along the lane's centre line of the point nearest to (x, y).
 double s_on_lane(const Lane &l, double x, double y) {
   double best = 1e18, best_s = 0, s = 0;
@@ -60,7 +69,8 @@ double lane_length(const Lane &l) {
 
 int lane_index(const CityMap &m, const std::string &lane, const std::string &where) {
   const auto it = m.lanes.find(lane);
-  if (it == m.lanes.end()) throw Error(m.file + ": " + where + ": lane '" + lane + "' is not on the map");
+  if (it == m.lanes.end())
+    throw Error(m.file + ": " + where + ": lane '" + lane + "' is not on the map");
   return it->second.index;
 }
 
@@ -137,10 +147,7 @@ CityMap load_city_map(const std::string &path) {
     sl.name = str(s, "name", path + ": stop_lines[]");
     const std::string where = path + ": stop line " + sl.name;
     sl.lane = str(s, "lane", where);
-    const json &c = need(s, "centre_m", where);
-    if (!c.is_array() || c.size() != 2) throw Error(where + ": centre_m is not [x, y]");
-    sl.x_m = c[0].get<double>();
-    sl.y_m = c[1].get<double>();
+    xy(s, "centre_m", where, sl.x_m, sl.y_m);
     m.stop_lines.push_back(sl);
   }
   for (const json &t : need(j, "traffic_lights", path)) {
@@ -159,10 +166,7 @@ CityMap load_city_map(const std::string &path) {
     g.name = str(s, "name", where);
     g.kind = str(s, "kind", where);
     g.lane = need(s, "lane", where).is_null() ? "" : str(s, "lane", where);
-    const json &p = need(s, "position_m", where);
-    if (!p.is_array() || p.size() != 2) throw Error(where + ": position_m is not [x, y]");
-    g.x_m = p[0].get<double>();
-    g.y_m = p[1].get<double>();
+    xy(s, "position_m", where, g.x_m, g.y_m);
     g.yaw_rad = num(s, "yaw_rad", where);
     if (g.kind == "speed_limit") g.speed_limit_m_s = num(s, "speed_limit_m_s", where);
     m.signs.push_back(g);
@@ -244,8 +248,8 @@ Track build_track(const CityMap &m, const std::string &name, const std::vector<s
             {Stop::Kind::stop_sign, s_stop, -1, sl == m.stop_lines.end() ? g.name : sl->name});
       } else if (g.kind == "speed_limit") {
         // Holds from the sign to the end of its lane (the rest of its road tile).
-        t.zones.push_back({s_at, s0 + lane_length(*lane), g.speed_limit_m_s,
-                           g.name + " speed_limit"});
+        t.zones.push_back(
+            {s_at, s0 + lane_length(*lane), g.speed_limit_m_s, g.name + " speed_limit"});
       } else if (g.kind == "curve_left" || g.kind == "curve_right") {
         // From the sign through the end of the first curved lane after it.
         double s1 = -1;

@@ -60,7 +60,7 @@ struct CityMap {
   std::vector<Light> lights;
   std::vector<Sign> signs;
   std::map<std::string, NamedRoute> routes;
-  std::vector<std::string> lane_order;  // lane names in the sidecar's order
+  std::vector<std::string> lane_order;   // lane names in the sidecar's order
   std::vector<std::string> route_order;  // route names in the sidecar's order
   // where the lights and signs stand, and the walk ahead (shared: a CityMap copies cheaply)
   std::shared_ptr<const autodrive::road::Network> roads;
