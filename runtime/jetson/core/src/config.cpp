@@ -51,6 +51,12 @@ Bridge parse_bridge(const Section &s) {
                std::to_string(b.failsafe_timeout_ms) +
                ": must be >= " + std::to_string(2000.0 / b.failsafe_timeout_ms) +
                " (two frames per failsafe period)");
+  b.command_burst_frames = s.in_range("command_burst_frames", 1, 8, b.command_burst_frames);
+  b.command_rate_hz = s.in_range("command_rate_hz", 1.0, 500.0, b.command_rate_hz);
+  if (b.command_rate_hz < b.heartbeat_hz)
+    s.fail(s.key("command_rate_hz"), "must be >= heartbeat_hz (" +
+                                         std::to_string(b.heartbeat_hz) +
+                                         "): a heartbeat takes a token too");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
   b.command_key_file = s.get<std::string>("command_key_file", "");
