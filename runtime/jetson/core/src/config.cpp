@@ -115,6 +115,7 @@ Camera parse_camera(const Section &s) {
   c.height_px = s.in_range("height_px", 16, 8192, c.height_px);
   c.jpeg_quality = s.in_range("jpeg_quality", 1, 100, c.jpeg_quality);
   c.loop_file = s.get<bool>("loop_file", c.loop_file);
+  c.open_timeout_ms = s.in_range("open_timeout_ms", 100, 60000, c.open_timeout_ms);
   // Intrinsics: from the pinhole figures of the Nigel camera unless given.
   const double fx = c.width_px / (2.0 * std::tan(0.5 * 62.2 * M_PI / 180.0));
   c.k = {fx, 0, c.width_px / 2.0, 0, fx, c.height_px / 2.0, 0, 0, 1};

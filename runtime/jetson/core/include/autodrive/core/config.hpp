@@ -84,6 +84,9 @@ struct Camera {
   std::array<double, 9> k{};  // camera matrix [px]
   std::vector<double> d;      // plumb_bob k1 k2 p1 p2 k3
   bool loop_file = true;      // restart a video file at its end
+  // Optional: how long opening the source may take [ms] before it is reported and retried (a
+  // GStreamer pipeline whose element is missing or whose camera is unplugged never opens).
+  int open_timeout_ms = 5000;
 };
 
 struct Estimator {
