@@ -589,18 +589,22 @@ TEST(BridgePty, AFreshCommandGoesOutInThePassThatReceivedIt) {
   h.nano.open();
   h.start();
   ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
-  // Commands one at a time, each after the previous one's frame: every one is written in the
+  // Commands one at a time, each two heartbeats after the previous one's frame (so the bucket
+  // has refilled: 2 tokens per heartbeat period at 100 Hz vs 50 Hz): every one is written in the
   // LCM callback that received it (commands_at_once), none waits for a heartbeat or a token.
   const uint64_t at_once = h.status().commands_at_once;
   for (int k = 0; k < 10; ++k) {
     const int16_t milli = static_cast<int16_t>(100 + 10 * k);
     const std::size_t mark = h.nano.commands.size();
     h.publish_command(milli / 1000.0f, 0.0f, true);
+    std::size_t at = 0;
     ASSERT_TRUE(h.wait_for([&] {
       for (std::size_t i = mark; i < h.nano.commands.size(); ++i)
-        if (h.nano.commands[i].throttle_milli == milli) return true;
+        if (h.nano.commands[i].throttle_milli == milli) return (at = i) > 0;
       return false;
-    })) << "command " << k << " never reached the Nano";
+    })) << "command "
+        << k << " never reached the Nano";
+    ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= at + 3; }));
   }
   EXPECT_EQ(h.status().commands_at_once, at_once + 10);
   EXPECT_EQ(h.status().commands_held, 0u);
@@ -616,10 +620,9 @@ TEST(BridgePty, OnTheSimClockASilentSourceDisengagesAtItsTimeout) {
     h.publish_sim_clock(sim_us);
     return h.status().state == autodrive::bridge::LinkState::linked;
   }));
-  ASSERT_TRUE(h.wait_for([&] {
-    h.publish_command(0.4f, 0.0f, true);
-    return count_engaged(h.nano.commands) >= 1;
-  }));
+  // One command (more, still on their way, would be frames of their own later on).
+  h.publish_command(0.4f, 0.0f, true);
+  ASSERT_TRUE(h.wait_for([&] { return count_engaged(h.nano.commands) >= 1; }));
   // The source falls silent at sim time 1.0 s (command_timeout_ms 200). The next frame after a
   // SIM_CLOCK step is the heartbeat of that sim time.
   auto frame_after_step = [&](int64_t t_us) {

@@ -186,9 +186,10 @@ TEST(Config, TokenBucketKeysChecked) {
   EXPECT_NE(error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 50, command_rate_hz: 20"))
                 .find("bridge.command_rate_hz: must be >= heartbeat_hz"),
             std::string::npos);
-  EXPECT_NE(error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 50, command_burst_frames: 0"))
-                .find("bridge.command_burst_frames"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 50, command_burst_frames: 0"))
+          .find("bridge.command_burst_frames"),
+      std::string::npos);
 }
 
 TEST(Config, TheCarsSerialDevicesAreTheShippedUdevSymlinks) {

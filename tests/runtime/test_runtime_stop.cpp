@@ -37,8 +37,8 @@ bool wait_until(const std::function<bool()> &pred, double max_s) {
 }
 
 void stops_on(int signal_number) {
-  const std::string base = "/tmp/adr-rt-stop-" + std::to_string(getpid()) + "-" +
-                           std::to_string(signal_number);
+  const std::string base =
+      "/tmp/adr-rt-stop-" + std::to_string(getpid()) + "-" + std::to_string(signal_number);
   const std::string config = base + ".yaml", log = base + ".log";
   {
     std::ofstream f(config);
@@ -59,7 +59,8 @@ void stops_on(int signal_number) {
   ASSERT_TRUE(runtime.running()) << text;
   ASSERT_EQ(::kill(runtime.pid(), signal_number), 0);
   EXPECT_TRUE(wait_until([&] { return !runtime.running(); }, 60.0))
-      << "still running after the signal:\n" << read_file(log);
+      << "still running after the signal:\n"
+      << read_file(log);
   ::unlink(config.c_str());
   ::unlink(log.c_str());
 }

@@ -54,8 +54,7 @@ Bridge parse_bridge(const Section &s) {
   b.command_burst_frames = s.in_range("command_burst_frames", 1, 8, b.command_burst_frames);
   b.command_rate_hz = s.in_range("command_rate_hz", 1.0, 500.0, b.command_rate_hz);
   if (b.command_rate_hz < b.heartbeat_hz)
-    s.fail(s.key("command_rate_hz"), "must be >= heartbeat_hz (" +
-                                         std::to_string(b.heartbeat_hz) +
+    s.fail(s.key("command_rate_hz"), "must be >= heartbeat_hz (" + std::to_string(b.heartbeat_hz) +
                                          "): a heartbeat takes a token too");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);

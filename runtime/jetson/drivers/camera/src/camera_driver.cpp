@@ -103,8 +103,8 @@ struct CameraDriver::Impl {
         o->cv.notify_all();
       }).detach();
     }
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::milliseconds(cam.open_timeout_ms);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(cam.open_timeout_ms);
     std::unique_lock<std::mutex> lk(opener->mu);
     while (!opener->done && !stop && std::chrono::steady_clock::now() < deadline)
       opener->cv.wait_for(lk, std::chrono::milliseconds(20));

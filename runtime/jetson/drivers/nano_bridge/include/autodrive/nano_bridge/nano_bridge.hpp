@@ -2,9 +2,9 @@
 // Handshake (HELLO_REQUEST until a HELLO with our schema hash), telemetry -> <VEH>_STATE and
 // <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames: a fresh command at once, a flood capped by a token
 // bucket, a heartbeat when no command went out for a period (command_pacer.hpp); engaged only
-// while the LCM command stream is fresh (on the sim clock with clock: sim). Only commands the command gate admits (signed, not replayed, from the lease holder) count;
-// the holder and the gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device
-// disappears.
+// while the LCM command stream is fresh (on the sim clock with clock: sim). Only commands the
+// command gate admits (signed, not replayed, from the lease holder) count; the holder and the
+// gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device disappears.
 #pragma once
 
 #include <atomic>

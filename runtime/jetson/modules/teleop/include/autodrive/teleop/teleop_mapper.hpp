@@ -3,8 +3,9 @@
 //  - Keyboard (a terminal sends no key-release events): w/s drive forward/back and a/d steer
 //    while their key auto-repeats; no repeat for `key_hold_us` = released -> throttle 0,
 //    steering centred, disengaged. A fresh press is held for `key_first_hold_us` instead: the
-//    first repeat only comes after the platform's autorepeat delay (X11: 660 ms by default). Space stops at once. +/- change the drive level.
-//    h cycles headlights (off/low/high); z left, c right, x hazard indicators (again = off).
+//    first repeat only comes after the platform's autorepeat delay (X11: 660 ms by default). Space
+//    stops at once. +/- change the drive level. h cycles headlights (off/low/high); z left, c
+//    right, x hazard indicators (again = off).
 //  - Gamepad (Linux joystick API): the dead-man button must be held; left stick Y = throttle,
 //    right stick X = steering. Buttons cycle headlights and toggle indicators.
 #pragma once
@@ -24,7 +25,7 @@ struct Params {
   // A fresh press, before its first repeat: the autorepeat delay (X11's default 660 ms) plus
   // kKeyRepeatMarginUs. autodrive-teleop sets it from the platform's delay where it can.
   int64_t key_first_hold_us = 660000 + kKeyRepeatMarginUs;
-  int deadman_button = 4;        // gamepad button (LB on most pads)
+  int deadman_button = 4;  // gamepad button (LB on most pads)
   int headlight_button = 0;
   int left_button = 2, right_button = 1, hazard_button = 3;
   int throttle_axis = 1;        // left stick Y (up is negative)
