@@ -8,6 +8,7 @@
 #include <autodrive/command_auth.hpp>
 #include <autodrive/control_status_t.hpp>
 #include <autodrive/imu_t.hpp>
+#include <autodrive/sim_clock_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 
@@ -45,10 +46,13 @@ struct TestKey {
   autodrive::auth::Key key{};
 };
 
-std::string config_yaml(int port, const std::string &device, const std::string &key_file) {
+std::string config_yaml(int port, const std::string &device, const std::string &key_file,
+                        const std::string &clock) {
   return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
          "?ttl=0\"\n"
-         "clock: wall\n"
+         "clock: " +
+         clock +
+         "\n"
          "vehicle: {name: TESTCAR}\n"
          "bridge: {device: " +
          device +
@@ -63,11 +67,11 @@ std::string config_yaml(int port, const std::string &device, const std::string &
 
 class BridgeHarness {
  public:
-  BridgeHarness(int port, uint32_t hash = protocol_schema_hash())
+  BridgeHarness(int port, uint32_t hash = protocol_schema_hash(), const std::string &clock = "wall")
       : link_("/tmp/adr-rt-test-" + std::to_string(getpid()) + "-" + std::to_string(port)),
         nano(link_, hash),
         key(link_ + ".key"),
-        config(autodrive::config::parse(config_yaml(port, link_, key.path), "test config")),
+        config(autodrive::config::parse(config_yaml(port, link_, key.path, clock), "test config")),
         lcm(config.lcm_url),
         signer(key.key, "TESTCAR", "test-autonomy", autodrive::auth::kAuthorityMachine) {
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, BridgeHarness, &BridgeHarness::on_state>(
@@ -133,6 +137,12 @@ class BridgeHarness {
     autodrive::vehicle_command_t c = command(throttle, steering, engaged, headlights, indicators);
     signer.sign(c);
     lcm.publish("TESTCAR_COMMAND", &c);
+  }
+  void publish_sim_clock(int64_t t_us) {
+    autodrive::sim_clock_t m{};
+    m.utime = t_us;
+    m.real_time_factor = 1.0;
+    lcm.publish("SIM_CLOCK", &m);
   }
 
   std::string link_;
@@ -490,7 +500,7 @@ TEST(BridgeAuth, LeaseTeleopTakesFromAutonomyAutonomyNeverFromTeleop) {
   EXPECT_GE(h.status().control.holder_changes, 4);  // autonomy, teleop, none, autonomy
 }
 
-TEST(BridgeAuth, FloodDoesNotRaiseTheSerialRate) {
+TEST(BridgeAuth, FloodIsCappedAtTheBucketRate) {
   BridgeHarness h(7778);
   h.nano.open();
   h.start();
@@ -510,11 +520,14 @@ TEST(BridgeAuth, FloodDoesNotRaiseTheSerialRate) {
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t frames = h.nano.commands.size() - mark;
-  // At most the heartbeat rate (50 Hz) over the time it took, with slack for the edges: a slow
-  // machine makes fewer frames, never more.
-  EXPECT_LE(static_cast<double>(frames), 50.0 * elapsed_s * 1.1 + 3)
+  // At most the bucket's arithmetic over the time it took (burst + rate x time), with 3 frames
+  // for the edges (written before the mark, read after it): a slow machine makes fewer
+  // frames, never more.
+  const auto &b = h.config.bridge;
+  EXPECT_LE(static_cast<double>(frames), b.command_burst_frames + b.command_rate_hz * elapsed_s + 3)
       << frames << " COMMAND frames in " << elapsed_s << " s";
   EXPECT_GE(h.status().control.applied, 100);
+  EXPECT_GT(h.status().commands_held, 0u) << "the flood never found the bucket empty";
 }
 
 TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
@@ -523,14 +536,14 @@ TEST(BridgeAuth, StaleCommandNeverResentBeyondTheTimeout) {
   h.start();
   ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= 3; }));
-  // One burst of a few commands, then silence: the bridge may repeat the command only while it
-  // is younger than command_timeout_ms (200 ms at 50 Hz: about 10 frames), then disengages and
-  // stays so, and the Nano's own failsafe timer runs out as designed.
+  // One burst of a few commands, then silence: the bridge sends the 3 at once, then repeats the
+  // last only while it is younger than command_timeout_ms (200 ms at 50 Hz: 10 heartbeats),
+  // then disengages and stays so, and the Nano's own failsafe timer runs out as designed.
   const std::size_t mark = h.nano.commands.size();
   for (int i = 0; i < 3; ++i) h.publish_command(1.0f, 0.0f, true);
   ASSERT_TRUE(h.wait_for([&] { return count_engaged(h.nano.commands, mark) >= 1; }));
   ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= mark + 40; }));
-  EXPECT_LE(count_engaged(h.nano.commands, mark), 200 / 20 + 2);
+  EXPECT_LE(count_engaged(h.nano.commands, mark), 3 + 200 / 20 + 1);
   EXPECT_FALSE(h.nano.commands.back().flags & PROTOCOL_CMD_ENGAGED);
 }
 
@@ -569,4 +582,58 @@ TEST(BridgeAuth, UnicastUdpToTheLcmPortDoesNotDrive) {
   EXPECT_EQ(count_engaged(h.nano.commands), 0);
   EXPECT_EQ(h.status().control.applied, 0);
   EXPECT_EQ(h.status().control.last_dropped_source, "unicast");
+}
+
+TEST(BridgePty, AFreshCommandGoesOutInThePassThatReceivedIt) {
+  BridgeHarness h(7788);
+  h.nano.open();
+  h.start();
+  ASSERT_TRUE(h.wait_for([&] { return h.status().state == autodrive::bridge::LinkState::linked; }));
+  // Commands one at a time, each two heartbeats after the previous one's frame (so the bucket
+  // has refilled: 2 tokens per heartbeat period at 100 Hz vs 50 Hz): every one is written in the
+  // LCM callback that received it (commands_at_once), none waits for a heartbeat or a token.
+  const uint64_t at_once = h.status().commands_at_once;
+  for (int k = 0; k < 10; ++k) {
+    const int16_t milli = static_cast<int16_t>(100 + 10 * k);
+    const std::size_t mark = h.nano.commands.size();
+    h.publish_command(milli / 1000.0f, 0.0f, true);
+    std::size_t at = 0;
+    ASSERT_TRUE(h.wait_for([&] {
+      for (std::size_t i = mark; i < h.nano.commands.size(); ++i)
+        if (h.nano.commands[i].throttle_milli == milli) return (at = i) > 0;
+      return false;
+    })) << "command "
+        << k << " never reached the Nano";
+    ASSERT_TRUE(h.wait_for([&] { return h.nano.commands.size() >= at + 3; }));
+  }
+  EXPECT_EQ(h.status().commands_at_once, at_once + 10);
+  EXPECT_EQ(h.status().commands_held, 0u);
+}
+
+TEST(BridgePty, OnTheSimClockASilentSourceDisengagesAtItsTimeout) {
+  // clock: sim: freshness and heartbeat follow SIM_CLOCK, which this test moves by hand.
+  BridgeHarness h(7789, protocol_schema_hash(), "sim");
+  h.nano.open();
+  h.start();
+  int64_t sim_us = 1000000;
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_sim_clock(sim_us);
+    return h.status().state == autodrive::bridge::LinkState::linked;
+  }));
+  // One command (more, still on their way, would be frames of their own later on).
+  h.publish_command(0.4f, 0.0f, true);
+  ASSERT_TRUE(h.wait_for([&] { return count_engaged(h.nano.commands) >= 1; }));
+  // The source falls silent at sim time 1.0 s (command_timeout_ms 200). The next frame after a
+  // SIM_CLOCK step is the heartbeat of that sim time.
+  auto frame_after_step = [&](int64_t t_us) {
+    const std::size_t mark = h.nano.commands.size();
+    h.publish_sim_clock(t_us);
+    EXPECT_TRUE(h.wait_for([&] { return h.nano.commands.size() > mark; }));
+    return h.nano.commands.back();
+  };
+  const protocol_command_t young = frame_after_step(sim_us + 150000);
+  EXPECT_TRUE(young.flags & PROTOCOL_CMD_ENGAGED) << "150 ms of sim time: still fresh";
+  const protocol_command_t stale = frame_after_step(sim_us + 250000);
+  EXPECT_FALSE(stale.flags & PROTOCOL_CMD_ENGAGED) << "250 ms of sim time: past the timeout";
+  EXPECT_EQ(stale.throttle_milli, 0);
 }

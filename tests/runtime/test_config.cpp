@@ -1,6 +1,8 @@
 // Config loading: the shipped configs parse; a missing or bad key names the file and key.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <autodrive_channels.h>
@@ -167,4 +169,40 @@ TEST(ConfigRanges, EveryRuntimeNumberHasABound) {
   EXPECT_NE(
       error_of(replace(kGood, "baud: 500000", "baud: 0")).find("bridge.baud: 0 is out of range"),
       std::string::npos);
+}
+
+TEST(Config, ATypoOfARequiredKeyIsAnUnknownKey) {
+  // As the Jetson guide says: `devcie` for `device` is reported as the unknown key it is.
+  const std::string e = error_of(replace(kGood, "device: /dev/ttyUSB0", "devcie: /dev/ttyUSB0"));
+  EXPECT_EQ(e, "test.yaml: bridge.devcie: unknown key (a typo of bridge.device?)");
+  const std::string far = error_of(replace(kGood, "device: /dev/ttyUSB0", "port: /dev/ttyUSB0"));
+  EXPECT_EQ(far, "test.yaml: bridge.device: missing key");
+}
+
+TEST(Config, TokenBucketKeysChecked) {
+  const autodrive::config::Config c = autodrive::config::parse(kGood, "test.yaml");
+  EXPECT_EQ(c.bridge.command_burst_frames, 4);
+  EXPECT_DOUBLE_EQ(c.bridge.command_rate_hz, 100.0);
+  EXPECT_NE(error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 50, command_rate_hz: 20"))
+                .find("bridge.command_rate_hz: must be >= heartbeat_hz"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(replace(kGood, "heartbeat_hz: 50", "heartbeat_hz: 50, command_burst_frames: 0"))
+          .find("bridge.command_burst_frames"),
+      std::string::npos);
+}
+
+TEST(Config, TheCarsSerialDevicesAreTheShippedUdevSymlinks) {
+  // nigel_car.yaml names /dev/nigel-* links; tools/udev's rules make exactly those.
+  const std::string root = AUTODRIVE_ROOT;
+  const autodrive::config::Config c =
+      autodrive::config::load(root + "/runtime/jetson/config/nigel_car.yaml");
+  std::ifstream f(root + "/tools/udev/99-autodrive-nigel.rules");
+  ASSERT_TRUE(f) << "tools/udev/99-autodrive-nigel.rules missing";
+  const std::string rules((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  for (const std::string &dev : {c.bridge.device, c.lidar.device}) {
+    ASSERT_EQ(dev.rfind("/dev/nigel-", 0), 0u) << dev << ": not a udev symlink of tools/udev";
+    EXPECT_NE(rules.find("SYMLINK+=\"" + dev.substr(5) + "\""), std::string::npos)
+        << "no rule makes " << dev;
+  }
 }

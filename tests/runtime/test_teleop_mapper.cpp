@@ -26,6 +26,28 @@ TEST(Teleop, KeyHeldDrivesReleaseStops) {
   EXPECT_EQ(c.throttle, 0.0f);
 }
 
+TEST(Teleop, AFreshPressIsHeldThroughTheAutorepeatDelay) {
+  // X11's default: the first repeat 660 ms after the press, then every 40 ms (25 Hz).
+  autodrive::teleop::Params p;
+  ASSERT_GT(p.key_first_hold_us, 660000) << "the default must outlast X11's autorepeat delay";
+  autodrive::teleop::Mapper m(p);
+  m.key('w', 0);
+  for (int64_t t = 0; t < 660000; t += 20000)  // 50 Hz publishing before the first repeat
+    EXPECT_TRUE(m.command(t).engaged) << "stuttered at " << t << " us";
+  m.key('w', 660000);                                   // the first repeat
+  for (int64_t t = 680000; t <= 1000000; t += 40000) {  // then every 40 ms, the last at 1 s
+    m.key('w', t);
+    EXPECT_TRUE(m.command(t + 20000).engaged);
+  }
+  // Once repeating, the release is seen after key_hold_us as before.
+  EXPECT_TRUE(m.command(1000000 + p.key_hold_us).engaged);
+  EXPECT_FALSE(m.command(1000000 + p.key_hold_us + 1).engaged);
+  // A fresh press with no repeat at all (a tap) ends after key_first_hold_us.
+  m.key('s', 5000000);
+  EXPECT_TRUE(m.command(5000000 + p.key_first_hold_us).engaged);
+  EXPECT_FALSE(m.command(5000000 + p.key_first_hold_us + 1).engaged);
+}
+
 TEST(Teleop, SpaceStopsAtOnce) {
   autodrive::teleop::Mapper m;
   m.key('s', 0);

@@ -17,8 +17,8 @@ Figures:
   serial_cmd_hz_under_flood  COMMAND frames per second on the serial link (autodrive-runtime
       --only bridge, fake Nano on a pty) while 40000 commands a second go to <VEH>_COMMAND
       (1 in 8 valid, signed by the lease holder, the rest unsigned; lcm_flood_msgs_per_s is the
-      rate the publisher reached), against the configured rate (bridge.heartbeat_hz of the
-      car's config)
+      rate the publisher reached), against the configured cap (bridge.command_rate_hz of the
+      car's config: the bridge's token bucket)
 The input-checking figures of security_inputs.py are merged in when that module exists.
 Progress on stderr; the last line is one JSON object. Usage: tools/bench security [--help]"""
 
@@ -31,7 +31,6 @@ import os
 import random
 import select
 import socket
-import subprocess
 import sys
 import tempfile
 import threading
@@ -40,13 +39,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import yaml
 
 from autodrive.core import channels, command_auth, lcm_wire, lcmtypes
 from autodrive.hil import demo
-from autodrive.core.settings import RUNTIME_CAR_CONFIG
-from autodrive.core.proc import ProcessGroup
-from autodrive.bench import Progress, build_dir, last_json, out_dir, print_figures
+from autodrive.bench import Progress, build_dir, link, out_dir, print_figures
 
 PORT_DEMO, PORT_FLOOD = 7848, 7849
 VEHICLE = channels.vehicle_name(1)
@@ -274,39 +270,7 @@ def demo_under_attack(build: Path, out: Path, timeout_s: float, key: bytes) -> d
 
 
 def flood(build: Path, work: Path) -> dict[str, Any]:
-    cfg = yaml.safe_load(RUNTIME_CAR_CONFIG.read_text())
-    rate_hz = float(cfg["bridge"]["heartbeat_hz"])
-    pty = work / "fake-nano"
-    cfg["lcm_url"] = url(PORT_FLOOD)
-    cfg["bridge"]["device"] = str(pty)
-    cfg.pop("lidar", None)
-    cfg.pop("cameras", None)
-    cfg_path = work / "flood.yaml"
-    cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
-    log(
-        f"flood: 40000 commands/s on LCM, the bridge against a fake Nano (heartbeat {rate_hz:g} Hz)"
-    )
-    procs = ProcessGroup(log)
-    try:
-        procs.start(
-            "autodrive-runtime",
-            [build / "bin" / "autodrive-runtime", "--config", cfg_path, "--only", "bridge"]
-            + ["--log-level", "warn"],
-            work / "flood-runtime.log",
-        )
-        out = subprocess.run(
-            [str(build / "bin" / "runtime-link-bench"), "flood", "--lcm-url", url(PORT_FLOOD)]
-            + ["--pty", str(pty), "--seconds", "10", "--flood-hz", "40000"],
-            check=True,
-            stdout=subprocess.PIPE,
-            text=True,
-        ).stdout
-        res = last_json(out, "runtime-link-bench flood")
-    finally:
-        procs.stop_all()
-    res["serial_cmd_hz_configured"] = rate_hz
-    res["serial_cmd_rate_ratio"] = round(res["serial_cmd_hz_under_flood"] / rate_hz, 3)
-    return res
+    return link.flood(build, work, PORT_FLOOD, log)
 
 
 def input_figures() -> dict[str, Any]:

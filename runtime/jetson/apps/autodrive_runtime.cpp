@@ -5,7 +5,10 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <set>
 #include <sstream>
@@ -23,6 +26,49 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) {
   g_stop = true;
+}
+
+// After SIGINT/SIGTERM every component has this long to return from run() [ms]; one that does
+// not (blocked in a driver call) is named and the process exits anyway, so a stop takes at
+// most about a second whatever a component is doing (systemd's TimeoutStopSec is 5 s).
+constexpr int kStopGraceMs = 800;
+
+struct Component {
+  std::string name;
+  std::function<void()> run;
+  std::thread thread;
+  std::atomic<bool> done{false};
+};
+
+// Runs the components until a signal, then waits for them; the process's exit code.
+int run_until_signal(std::vector<std::unique_ptr<Component>> &components) {
+  for (auto &c : components)
+    c->thread = std::thread([p = c.get()] {
+      p->run();
+      p->done = true;
+    });
+  while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(kStopGraceMs);
+  std::string stuck;
+  for (auto &c : components) {
+    while (!c->done && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (c->done)
+      c->thread.join();
+    else
+      stuck += (stuck.empty() ? "" : ", ") + c->name;
+  }
+  if (stuck.empty() && autodrive::camera::stuck_openers() == 0) {
+    spdlog::info("autodrive-runtime: stopped");
+    return 0;
+  }
+  // A thread blocked in a driver call cannot be joined, nor may static destructors run under
+  // it: say which, and leave at once.
+  spdlog::error("autodrive-runtime: {} did not stop within {} ms of the signal; exiting anyway",
+                stuck.empty() ? "a camera open" : stuck, kStopGraceMs);
+  spdlog::shutdown();
+  std::fflush(nullptr);
+  std::_Exit(1);
 }
 }  // namespace
 
@@ -80,7 +126,12 @@ int main(int argc, char **argv) {
   }
 
   // Build every component first so that a bad section fails before anything starts.
-  std::vector<std::function<void()>> runners;
+  std::vector<std::unique_ptr<Component>> runners;
+  auto add = [&runners](const std::string &name, std::function<void()> run) {
+    runners.push_back(std::make_unique<Component>());
+    runners.back()->name = name;
+    runners.back()->run = std::move(run);
+  };
   std::unique_ptr<autodrive::bridge::NanoBridge> br;
   std::unique_ptr<autodrive::rplidar::Driver> lidar;
   std::unique_ptr<autodrive::estimator::EstimatorNode> estimator;
@@ -94,22 +145,22 @@ int main(int argc, char **argv) {
   if (want.count("bridge")) {
     br = std::make_unique<autodrive::bridge::NanoBridge>(config);
     if (!check("bridge", br->init_error())) return 2;
-    runners.push_back([&] { br->run(g_stop); });
+    add("bridge", [&] { br->run(g_stop); });
   }
   if (want.count("lidar")) {
     lidar = std::make_unique<autodrive::rplidar::Driver>(config);
     if (!check("lidar", lidar->init_error())) return 2;
-    runners.push_back([&] { lidar->run(g_stop); });
+    add("lidar", [&] { lidar->run(g_stop); });
   }
   if (want.count("estimator")) {
     estimator = std::make_unique<autodrive::estimator::EstimatorNode>(config);
     if (!check("estimator", estimator->init_error())) return 2;
-    runners.push_back([&] { estimator->run(g_stop); });
+    add("estimator", [&] { estimator->run(g_stop); });
   }
   if (want.count("v2v")) {
     v2v_node = std::make_unique<autodrive::v2v::V2vNode>(config);
     if (!check("v2v", v2v_node->init_error())) return 2;
-    runners.push_back([&] { v2v_node->run(g_stop); });
+    add("v2v", [&] { v2v_node->run(g_stop); });
   }
   if (want.count("camera")) {
     if (config.cameras.empty()) {
@@ -120,7 +171,7 @@ int main(int argc, char **argv) {
       cameras.push_back(std::make_unique<autodrive::camera::CameraDriver>(config, i));
       if (!check("camera", cameras.back()->init_error())) return 2;
       autodrive::camera::CameraDriver *c = cameras.back().get();
-      runners.push_back([c] { c->run(g_stop); });
+      add("camera " + config.cameras[i].channel.substr(1), [c] { c->run(g_stop); });
     }
   }
   std::signal(SIGINT, on_signal);
@@ -129,9 +180,5 @@ int main(int argc, char **argv) {
   for (const auto &w : want) names += (names.empty() ? "" : ",") + w;
   spdlog::info("autodrive-runtime {}: running {} on {}", config.vehicle.name, names,
                config.lcm_url);
-  std::vector<std::thread> threads;
-  for (auto &r : runners) threads.emplace_back(r);
-  for (auto &t : threads) t.join();
-  spdlog::info("autodrive-runtime: stopped");
-  return 0;
+  return run_until_signal(runners);
 }

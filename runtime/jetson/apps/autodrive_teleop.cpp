@@ -6,13 +6,17 @@
 #include <fcntl.h>
 #include <lcm/lcm-cpp.hpp>
 #include <linux/joystick.h>
+#include <linux/kd.h>
+#include <sys/ioctl.h>
 #include <poll.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <csignal>
-#include <optional>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <string>
 
 #include <autodrive/core/clock.hpp>
@@ -22,6 +26,27 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) {
   g_stop = 1;
+}
+
+// The platform's keyboard autorepeat delay [ms] and where it came from: the Linux console's
+// (KDGKBREP on the terminal), else X11's (`xset q`, when DISPLAY is set); 0 when unknown.
+int platform_autorepeat_delay_ms(int tty_fd, std::string *from) {
+  kbd_repeat rep{-1, -1};
+  if (::ioctl(tty_fd, KDKBDREP, &rep) == 0 && rep.delay > 0) {
+    *from = "the Linux console";
+    return rep.delay;
+  }
+  if (std::getenv("DISPLAY") == nullptr) return 0;
+  FILE *xset = ::popen("xset q 2>/dev/null", "r");
+  if (xset == nullptr) return 0;
+  char line[256];
+  int delay_ms = 0;
+  while (std::fgets(line, sizeof line, xset))
+    if (const char *at = std::strstr(line, "auto repeat delay:"))
+      delay_ms = std::atoi(at + std::strlen("auto repeat delay:"));
+  ::pclose(xset);
+  if (delay_ms > 0) *from = "X11 (xset q)";
+  return delay_ms;
 }
 
 // Puts the terminal in raw mode for single key presses; restores it on destruction.
@@ -59,6 +84,7 @@ int main(int argc, char **argv) {
               key_file, source = "teleop";
   double rate_hz = 50.0;
   bool no_keyboard = false;
+  int repeat_delay_ms = 0;
   autodrive::teleop::Params p;
   app.add_option("--vehicle", vehicle, "vehicle name, channel prefix")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
@@ -72,6 +98,11 @@ int main(int argc, char **argv) {
   app.add_option("--deadman-button", p.deadman_button, "gamepad dead-man button number")
       ->capture_default_str();
   app.add_flag("--no-keyboard", no_keyboard, "do not read the terminal");
+  app.add_option("--key-repeat-delay-ms", repeat_delay_ms,
+                 "the keyboard's autorepeat delay [ms]: a fresh key press counts as held this "
+                 "long + 150 ms before its first repeat (default: read from the Linux console or "
+                 "X11, else 660, X11's default)")
+      ->check(CLI::Range(50, 5000));
   app.add_option("--key-file", key_file,
                  "the car's command key (default: $AUTODRIVE_KEY_DIR/<VEH>.key, else "
                  "~/.config/autodrive/keys/<VEH>.key; tools/keys creates it)");
@@ -112,6 +143,16 @@ int main(int argc, char **argv) {
   RawTerminal term(STDIN_FILENO);
   if (!no_keyboard && !term.active())
     std::fprintf(stderr, "autodrive-teleop: stdin is not a terminal; keyboard disabled\n");
+  if (repeat_delay_ms == 0) {
+    std::string from;
+    repeat_delay_ms = platform_autorepeat_delay_ms(STDIN_FILENO, &from);
+    if (repeat_delay_ms > 0)
+      std::fprintf(stderr, "autodrive-teleop: key autorepeat delay %d ms (from %s)\n",
+                   repeat_delay_ms, from.c_str());
+    else
+      repeat_delay_ms = 660;  // X11's default; --key-repeat-delay-ms to change
+  }
+  p.key_first_hold_us = (repeat_delay_ms * 1000LL) + autodrive::teleop::kKeyRepeatMarginUs;
   autodrive::teleop::Mapper mapper(p);
   const std::string channel = vehicle + AUTODRIVE_CH_COMMAND_SUFFIX;
   const int64_t period_us = static_cast<int64_t>(1e6 / rate_hz);

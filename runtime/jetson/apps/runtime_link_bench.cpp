@@ -10,7 +10,9 @@
 //               ground truth (ekf_*_rms)
 //   flood     : a fake Nano on a pty (--pty) while --flood-hz commands a second go to
 //               <VEH>_COMMAND (1 in 8 signed by the lease holder, the rest unsigned); COMMAND
-//               frames per second on the serial link (serial_cmd_hz_under_flood)
+//               frames per second on the serial link (serial_cmd_hz_under_flood), and with
+//               --cpu-pid the CPU that process spent per wall second meanwhile
+//               (flood_cpu_percent: 100 = one core)
 // Commands are signed with the car's key (--key-file, default as autodrive-teleop's).
 #include <autodrive/angles.hpp>
 #include <autodrive/command_auth.hpp>
@@ -33,13 +35,21 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <iterator>
 #include <thread>
+#include <unistd.h>
 
 #include <autodrive/core/clock.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <autodrive/devtools/fake_nano.hpp>
 
 namespace {
+
+std::string fmt_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return NAN;
@@ -98,8 +108,24 @@ struct LinkedNano {
 };
 
 // ---- flood ---------------------------------------------------------------------------
+// User + system CPU time of a process [s], from /proc/<pid>/stat; NAN when unreadable.
+double process_cpu_s(int pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');  // the command name may hold spaces
+  if (close == std::string::npos) return NAN;
+  std::istringstream rest(text.substr(close + 2));
+  std::string field;
+  double utime = NAN, stime = NAN;
+  for (int i = 3; i <= 15 && rest >> field; ++i) {  // fields 14, 15: utime, stime [ticks]
+    if (i == 14) utime = std::stod(field);
+    if (i == 15) stime = std::stod(field);
+  }
+  return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
 int run_flood(const std::string &url, const std::string &vehicle, const std::string &pty,
-              double seconds, double flood_hz) {
+              double seconds, double flood_hz, int cpu_pid) {
   LinkedNano link(pty);
   auto &nano = link.nano;
   auto service = [&] { link.service(); };
@@ -136,6 +162,7 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
   while (autodrive::clock::monotonic_us() < t_settle) service();
   const std::size_t n0 = nano.commands.size();
   const long s0 = sent;
+  const double cpu0 = cpu_pid > 0 ? process_cpu_s(cpu_pid) : NAN;
   const int64_t t0 = autodrive::clock::monotonic_us();
   int64_t next_print = t0 + 1000000;
   while (autodrive::clock::monotonic_us() < t0 + static_cast<int64_t>(seconds * 1e6)) {
@@ -150,10 +177,13 @@ int run_flood(const std::string &url, const std::string &vehicle, const std::str
   const double dt = (autodrive::clock::monotonic_us() - t0) * 1e-6;
   const double frames_hz = static_cast<double>(nano.commands.size() - n0) / dt;
   const double lcm_hz = static_cast<double>(sent - s0) / dt;
+  const double cpu_percent = cpu_pid > 0 ? (process_cpu_s(cpu_pid) - cpu0) / dt * 100.0 : NAN;
   done = true;
   flooder.join();
-  std::printf("{\"serial_cmd_hz_under_flood\": %.2f, \"lcm_flood_msgs_per_s\": %.0f}\n", frames_hz,
-              lcm_hz);
+  std::printf(
+      "{\"serial_cmd_hz_under_flood\": %.2f, \"lcm_flood_msgs_per_s\": %.0f, "
+      "\"flood_cpu_percent\": %s}\n",
+      frames_hz, lcm_hz, std::isnan(cpu_percent) ? "null" : fmt_number(cpu_percent).c_str());
   return 0;
 }
 
@@ -529,6 +559,7 @@ int main(int argc, char **argv) {
   std::string mode, url = "udpm://239.255.76.67:7786?ttl=0", vehicle = AUTODRIVE_VEHICLE_DEFAULT,
                     pty, pwm_log, suffix;
   int samples = 500;
+  int cpu_pid = 0;
   double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50, flood_hz = 40000;
   std::string key_file;
   app.add_option("mode", mode, "serial | pwm | telemetry | ekf | flood")
@@ -540,6 +571,7 @@ int main(int argc, char **argv) {
   app.add_option("--flood-hz", flood_hz, "flood: commands per second on LCM")
       ->check(CLI::Range(1.0, 1e6))
       ->capture_default_str();
+  app.add_option("--cpu-pid", cpu_pid, "flood: the process whose CPU time to report (the bridge)");
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
   app.add_option("--vehicle", vehicle, "vehicle name")->capture_default_str();
   app.add_option("--pty", pty, "serial: symlink for the fake Nano's pty");
@@ -563,7 +595,7 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (mode == "flood") return run_flood(url, vehicle, pty, seconds, flood_hz);
+  if (mode == "flood") return run_flood(url, vehicle, pty, seconds, flood_hz, cpu_pid);
   if (mode == "serial") return run_serial(url, vehicle, pty, samples);
   if (mode == "pwm") return run_pwm(url, vehicle, pwm_log, samples);
   if (mode == "telemetry") return run_telemetry(url, vehicle, seconds, suffix);

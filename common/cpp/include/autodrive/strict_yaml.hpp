@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -81,8 +82,19 @@ class Section {
   template <typename T>
   T get(const std::string &k) const {
     used_->insert(k);
-    if (!has(k)) fail_key(k, "missing key");
+    if (!has(k)) fail_missing(k);
     return convert<T>(k);
+  }
+  // A required key is missing: a present key one or two letters off it (`devcie` for
+  // `device`) is its typo, reported as the unknown key it is; else "missing key".
+  [[noreturn]] void fail_missing(const std::string &k) const {
+    if (node_)
+      for (const auto &kv : node_) {
+        const std::string other = kv.first.as<std::string>();
+        if (!used_->count(other) && edit_distance(other, k) <= 2)
+          fail_key(other, "unknown key (a typo of " + key(k) + "?)");
+      }
+    fail_key(k, "missing key");
   }
   template <typename T>
   T get(const std::string &k, T fallback) const {
@@ -175,6 +187,22 @@ class Section {
   const YAML::Node &node() const { return node_; }
 
  private:
+  // Levenshtein distance of two short keys [edits].
+  static size_t edit_distance(const std::string &a, const std::string &b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diagonal = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t above = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+        diagonal = above;
+      }
+    }
+    return row[b.size()];
+  }
+
   template <typename T>
   static std::string text(T v) {
     std::ostringstream s;

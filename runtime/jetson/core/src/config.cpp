@@ -51,6 +51,11 @@ Bridge parse_bridge(const Section &s) {
                std::to_string(b.failsafe_timeout_ms) +
                ": must be >= " + std::to_string(2000.0 / b.failsafe_timeout_ms) +
                " (two frames per failsafe period)");
+  b.command_burst_frames = s.in_range("command_burst_frames", 1, 8, b.command_burst_frames);
+  b.command_rate_hz = s.in_range("command_rate_hz", 1.0, 500.0, b.command_rate_hz);
+  if (b.command_rate_hz < b.heartbeat_hz)
+    s.fail(s.key("command_rate_hz"), "must be >= heartbeat_hz (" + std::to_string(b.heartbeat_hz) +
+                                         "): a heartbeat takes a token too");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
   b.command_key_file = s.get<std::string>("command_key_file", "");
@@ -109,6 +114,7 @@ Camera parse_camera(const Section &s) {
   c.height_px = s.in_range("height_px", 16, 8192, c.height_px);
   c.jpeg_quality = s.in_range("jpeg_quality", 1, 100, c.jpeg_quality);
   c.loop_file = s.get<bool>("loop_file", c.loop_file);
+  c.open_timeout_ms = s.in_range("open_timeout_ms", 100, 60000, c.open_timeout_ms);
   // Intrinsics: from the pinhole figures of the Nigel camera unless given.
   const double fx = c.width_px / (2.0 * std::tan(0.5 * 62.2 * M_PI / 180.0));
   c.k = {fx, 0, c.width_px / 2.0, 0, fx, c.height_px / 2.0, 0, 0, 1};

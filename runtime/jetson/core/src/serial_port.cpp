@@ -14,6 +14,10 @@ std::string SerialPort::open(const std::string &path, int baud) {
   close();
   path_ = path;
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0 && errno == ENOENT && path.rfind("/dev/nigel-", 0) == 0)
+    return path +
+           ": no such device: unplugged, or the udev rules that make this name are not "
+           "installed (tools/udev/99-autodrive-nigel.rules, docs/guides/jetson.md)";
   if (fd < 0) return path + ": " + std::strerror(errno);
   struct termios2 tio {};
   if (ioctl(fd, TCGETS2, &tio) != 0) {

@@ -8,6 +8,8 @@
 #include <opencv2/videoio.hpp>
 #include <spdlog/spdlog.h>
 
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include <autodrive/core/clock.hpp>
@@ -30,6 +32,26 @@ std::vector<uint8_t> encode_jpeg(const void *bgr, int w, int h, int out_w, int o
   return out;
 }
 
+namespace {
+// Openers still blocked inside cv::VideoCapture::open (their threads are detached).
+std::atomic<int> g_stuck_openers{0};
+
+// One cv::VideoCapture::open on a thread of its own: OpenCV's GStreamer backend waits for the
+// pipeline to start without any timeout, so a pipeline that never starts would hold the
+// driver (and its stop) for good. The state is shared, so a stuck opener may outlive the
+// driver and end whenever open returns.
+struct Opener {
+  std::mutex mu;
+  std::condition_variable cv;
+  bool done = false, ok = false;
+  cv::VideoCapture cap;
+};
+}  // namespace
+
+int stuck_openers() {
+  return g_stuck_openers.load();
+}
+
 struct CameraDriver::Impl {
   autodrive::config::Config config;
   autodrive::config::Camera cam;
@@ -38,6 +60,7 @@ struct CameraDriver::Impl {
   autodrive::clock::Clock clock;
   std::atomic<uint64_t> published{0};
   std::string error;
+  std::shared_ptr<Opener> opener;  // the open in progress (or stuck), if any
 
   Impl(const autodrive::config::Config &c, std::size_t i)
       : config(c), lcm(c.lcm_url), clock(c.clock) {
@@ -50,7 +73,7 @@ struct CameraDriver::Impl {
     if (lcm.good()) clock.attach(lcm);
   }
 
-  bool open(cv::VideoCapture &cap) {
+  static bool open_source(const autodrive::config::Camera &cam, cv::VideoCapture &cap) {
     switch (classify_source(cam.source)) {
       case SourceKind::gstreamer: return cap.open(cam.source, cv::CAP_GSTREAMER);
       case SourceKind::v4l2:
@@ -62,6 +85,41 @@ struct CameraDriver::Impl {
       case SourceKind::file: return cap.open(cam.source, cv::CAP_ANY);
     }
     return false;
+  }
+
+  // Opens the source within cam.open_timeout_ms (returning early on stop). False when it failed
+  // or timed out (logged once per outage by the caller via `why`); a timed-out open keeps
+  // running detached, and the next call waits for it rather than starting another.
+  bool open(cv::VideoCapture &cap, const std::atomic<bool> &stop, std::string *why) {
+    if (!opener) {
+      opener = std::make_shared<Opener>();
+      ++g_stuck_openers;
+      std::thread([o = opener, c = cam] {
+        const bool ok = open_source(c, o->cap);
+        std::lock_guard<std::mutex> g(o->mu);
+        o->ok = ok;
+        o->done = true;
+        --g_stuck_openers;
+        o->cv.notify_all();
+      }).detach();
+    }
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(cam.open_timeout_ms);
+    std::unique_lock<std::mutex> lk(opener->mu);
+    while (!opener->done && !stop && std::chrono::steady_clock::now() < deadline)
+      opener->cv.wait_for(lk, std::chrono::milliseconds(20));
+    if (!opener->done) {
+      *why = "opening it did not finish within " + std::to_string(cam.open_timeout_ms) +
+             " ms (camera.open_timeout_ms): is every element of the pipeline installed (e.g. "
+             "nvarguscamerasrc on a Jetson) and the camera plugged in?";
+      return false;  // still running: the next attempt waits for this one
+    }
+    const bool ok = opener->ok;
+    if (ok) cap = std::move(opener->cap);
+    lk.unlock();
+    opener.reset();
+    *why = "it does not open (no such device or file, or a pipeline that fails to start)";
+    return ok;
   }
 
   void publish_info() {
@@ -85,9 +143,12 @@ struct CameraDriver::Impl {
     int64_t next_frame_us = autodrive::clock::monotonic_us(), next_info_us = next_frame_us;
     while (!stop) {
       if (!cap.isOpened()) {
-        if (!open(cap)) {
+        if (!failure_logged) spdlog::info("{}opening '{}'", tag, cam.source);
+        std::string why;
+        if (!open(cap, stop, &why)) {
+          if (stop) break;
           if (!failure_logged)
-            spdlog::warn("{}cannot open '{}'; retrying every 1 s", tag, cam.source);
+            spdlog::error("{}cannot open '{}': {}; retrying every 1 s", tag, cam.source, why);
           failure_logged = true;
           for (int i = 0; i < 50 && !stop; ++i)
             std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -9,7 +9,6 @@
 #include <lcm/lcm-cpp.hpp>
 #include <poll.h>
 #include <spdlog/spdlog.h>
-#include <autodrive/log_limiter.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -19,6 +18,7 @@
 
 #include <autodrive/nano_bridge/bridge_convert.hpp>
 #include <autodrive/nano_bridge/command_gate.hpp>
+#include <autodrive/nano_bridge/command_pacer.hpp>
 #include <autodrive/core/clock.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <autodrive/core/serial_port.hpp>
@@ -58,10 +58,11 @@ struct NanoBridge::Impl {
   // sync_to_sim_clock: a command stamped later than the sim clock waits here for its tick
   std::optional<autodrive::vehicle_command_t> scheduled_cmd;
   int64_t scheduled_rx_us = 0;
-  int64_t latest_cmd_rx_us = 0;  // monotonic
+  int64_t latest_cmd_rx_us = 0;  // command time (command_now_us)
   uint16_t cmd_seq = 0;
   uint8_t frame_seq = 0;
-  int64_t next_tx_us = 0;       // next heartbeat / hello [monotonic us]
+  int64_t next_tx_us = 0;       // next hello; sync_to_sim_clock: next frame [monotonic us]
+  CommandPacer pacer;           // COMMAND frames: at once, capped, heartbeat when idle
   int64_t last_tick = -1;       // sync_to_sim_clock: the SIM_CLOCK tick last answered
   bool config_pending = false;  // sync_to_sim_clock: CONFIG goes out as the next tick's frame
   int64_t next_open_us = 0;
@@ -82,7 +83,12 @@ struct NanoBridge::Impl {
       autodrive::LogLimits{1, std::chrono::milliseconds(1000), spdlog::level::warn}};
 
   explicit Impl(const autodrive::config::Config &c)
-      : config(c), tag("[bridge " + c.vehicle.name + "] "), lcm(c.lcm_url), clock(c.clock) {
+      : config(c),
+        tag("[bridge " + c.vehicle.name + "] "),
+        lcm(c.lcm_url),
+        clock(c.clock),
+        pacer(c.bridge.command_burst_frames, c.bridge.command_rate_hz,
+              static_cast<int64_t>(1e6 / c.bridge.heartbeat_hz)) {
     protocol_parser_init(&parser);
     key_file = c.bridge.command_key_file.empty() ? autodrive::auth::default_key_path(c.vehicle.name)
                                                  : c.bridge.command_key_file;
@@ -118,6 +124,17 @@ struct NanoBridge::Impl {
     return static_cast<int64_t>(1e6 / config.bridge.heartbeat_hz);
   }
 
+  // The clock of the command path [us]: the control lease, command freshness, the token bucket
+  // and the heartbeat. With clock: sim it is the simulator's SIM_CLOCK, so a HIL run behaves
+  // the same at any real-time factor (the emulated Nano's failsafe runs on sim time too); else
+  // the monotonic clock. sync_to_sim_clock keeps the monotonic clock here (frames go on ticks,
+  // and a frozen sim still goes stale). The serial link's own timers (hello, reconnect, link
+  // timeout) stay monotonic: the pty is real whatever the clock.
+  int64_t command_now_us() const {
+    if (clock.sim() && !config.bridge.sync_to_sim_clock) return clock.now_us();
+    return autodrive::clock::monotonic_us();
+  }
+
   void log_drop(const autodrive::vehicle_command_t &m, Drop d) {
     // The source is what the sender claims: printable, bounded, and only for the log. Sources
     // a signature vouches for are few; unsigned ones all share one entry.
@@ -131,7 +148,7 @@ struct NanoBridge::Impl {
     drop_log.event(key, "dropped a command from source '" + source + "'");
   }
 
-  void publish_control(int64_t now_mono) {
+  void publish_control() {
     const GateCounters &n = gate->counters();
     autodrive::control_status_t m{};
     m.utime = clock.now_us();
@@ -149,25 +166,25 @@ struct NanoBridge::Impl {
       s.control = n;
       s.holder = gate->holder();
     });
-    next_control_us = now_mono + 200000;  // 5 Hz
+    next_control_us = autodrive::clock::monotonic_us() + 200000;  // 5 Hz
   }
 
-  void holder_changed(int64_t now_mono) {
+  void holder_changed() {
     if (gate->holder().empty())
       spdlog::warn("{}control lease lapsed: no source holds control", tag);
     else
       spdlog::warn(
           "{}control now held by '{}' ({})", tag, gate->holder(),
           gate->holder_authority() == autodrive::auth::kAuthorityPerson ? "person" : "machine");
-    publish_control(now_mono);
+    publish_control();
   }
 
   void on_command(const autodrive::vehicle_command_t *m) {
     if (!gate) return;
-    const int64_t now_mono = autodrive::clock::monotonic_us();
-    if (gate->expire(now_mono)) holder_changed(now_mono);  // a lapse is published on its own
-    const CommandGate::Verdict v = gate->admit(*m, now_mono, autodrive::clock::wall_us());
-    if (v.holder_changed) holder_changed(now_mono);
+    const int64_t now_cmd = command_now_us();
+    if (gate->expire(now_cmd)) holder_changed();  // a lapse is published on its own
+    const CommandGate::Verdict v = gate->admit(*m, now_cmd, autodrive::clock::wall_us());
+    if (v.holder_changed) holder_changed();
     if (v.drop != Drop::none) {
       if (v.drop != Drop::idle) log_drop(*m, v.drop);
       return;
@@ -185,19 +202,20 @@ struct NanoBridge::Impl {
       // In step with SIM_CLOCK a command stamped in the future applies from that sim time, so
       // a scripted sender acts at the same tick in every run.
       scheduled_cmd = *m;
-      scheduled_rx_us = autodrive::clock::monotonic_us();
+      scheduled_rx_us = now_cmd;
       return;
     }
     latest_cmd = *m;
-    latest_cmd_rx_us = autodrive::clock::monotonic_us();
-    // The serial link carries at most one COMMAND frame per heartbeat period, whatever rate
-    // commands arrive at (a flood on LCM cannot flood the Nano): a fresh command goes out at
-    // once only when a whole period has passed since the last frame (latency), else with the
-    // next heartbeat. In step with SIM_CLOCK every frame waits for its tick instead.
-    if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock &&
-        latest_cmd_rx_us >= next_tx_us) {
-      send_command(latest_cmd_rx_us);
-      next_tx_us = latest_cmd_rx_us + heartbeat_period_us();
+    latest_cmd_rx_us = now_cmd;
+    // A fresh command goes to the Nano at once while the token bucket has a token; under a
+    // flood the newest one waits for the next token (CommandPacer). In step with SIM_CLOCK
+    // every frame waits for its tick instead.
+    if (state() != LinkState::linked || config.bridge.sync_to_sim_clock) return;
+    if (pacer.command(now_cmd)) {
+      send_command(now_cmd);
+      count([](Status &s) { ++s.commands_at_once; });
+    } else {
+      count([](Status &s) { ++s.commands_held; });
     }
   }
 
@@ -352,6 +370,7 @@ struct NanoBridge::Impl {
     else
       send_config();
     next_tx_us = now_us;
+    pacer.restart(command_now_us());
   }
 
   void on_state(const protocol_frame_t &f) {
@@ -437,8 +456,13 @@ struct NanoBridge::Impl {
     fds[nfds++] = {lcm.getFileno(), POLLIN, 0};
     if (port.is_open()) fds[nfds++] = {port.fd(), POLLIN, 0};
     int64_t wait_us = 20000;
-    if (port.is_open())
-      wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, next_tx_us - now));
+    if (port.is_open()) {
+      // On the sim clock the next frame comes with a SIM_CLOCK message: the LCM wake-up.
+      int64_t due_us = next_tx_us - now;
+      if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock)
+        due_us = clock.sim() ? wait_us : pacer.next_due_us() - now;
+      wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, due_us));
+    }
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
     if (stop) return;
     // Drain what LCM has (bounded, so the serial side is served even under a flood).
@@ -447,9 +471,8 @@ struct NanoBridge::Impl {
       }
     if (gate) {
       drop_log.flush();
-      const int64_t tm = autodrive::clock::monotonic_us();
-      if (gate->expire(tm)) holder_changed(tm);
-      if (tm >= next_control_us) publish_control(tm);
+      if (gate->expire(command_now_us())) holder_changed();
+      if (autodrive::clock::monotonic_us() >= next_control_us) publish_control();
     }
     if (r > 0 && nfds == 2 && port.is_open()) {
       if (fds[1].revents & POLLIN) {
@@ -477,12 +500,15 @@ struct NanoBridge::Impl {
       send_on_tick(t);
       return;
     }
+    if (state() == LinkState::linked) {
+      // A held command once a token is back, else the heartbeat after a quiet period.
+      const int64_t tc = command_now_us();
+      if (pacer.due(tc)) send_command(tc);
+      return;
+    }
     if (t < next_tx_us) return;
     switch (state()) {
-      case LinkState::linked:
-        send_command(t);
-        next_tx_us = t + heartbeat_period_us();
-        break;
+      case LinkState::linked: break;
       case LinkState::handshaking:
         send_hello_request();
         next_tx_us = t + config.bridge.hello_retry_ms * 1000LL;

@@ -9,28 +9,27 @@ void Mapper::toggle_indicator(int8_t which) {
   indicators_ = indicators_ == which ? 0 : which;
 }
 
+bool Mapper::held(int64_t since_us, bool repeating, int64_t t_us) const {
+  return since_us >= 0 && t_us - since_us <= (repeating ? p_.key_hold_us : p_.key_first_hold_us);
+}
+
+// The same key again while it is held is its autorepeat; anything else is a fresh press.
+void Mapper::press(int *axis, int value, int64_t *since_us, bool *repeating, int64_t t_us) {
+  *repeating = *axis == value && held(*since_us, *repeating, t_us);
+  *axis = value;
+  *since_us = t_us;
+}
+
 bool Mapper::key(char c, int64_t t) {
   switch (c) {
     case 'w':
-    case 'W':
-      key_drive_ = 1;
-      drive_t_us_ = t;
-      break;
+    case 'W': press(&key_drive_, 1, &drive_t_us_, &drive_repeating_, t); break;
     case 's':
-    case 'S':
-      key_drive_ = -1;
-      drive_t_us_ = t;
-      break;
+    case 'S': press(&key_drive_, -1, &drive_t_us_, &drive_repeating_, t); break;
     case 'a':
-    case 'A':
-      key_steer_ = 1;
-      steer_t_us_ = t;
-      break;  // + left
+    case 'A': press(&key_steer_, 1, &steer_t_us_, &steer_repeating_, t); break;  // + left
     case 'd':
-    case 'D':
-      key_steer_ = -1;
-      steer_t_us_ = t;
-      break;
+    case 'D': press(&key_steer_, -1, &steer_t_us_, &steer_repeating_, t); break;
     case ' ':
       key_drive_ = 0;
       key_steer_ = 0;
@@ -84,8 +83,8 @@ autodrive::vehicle_command_t Mapper::command(int64_t t) {
   c.seq = seq_++;
   c.headlights = headlights_;
   c.indicators = indicators_;
-  const bool drive_held = drive_t_us_ >= 0 && t - drive_t_us_ <= p_.key_hold_us;
-  const bool steer_held = steer_t_us_ >= 0 && t - steer_t_us_ <= p_.key_hold_us;
+  const bool drive_held = held(drive_t_us_, drive_repeating_, t);
+  const bool steer_held = held(steer_t_us_, steer_repeating_, t);
   if (deadman_) {
     c.throttle = static_cast<float>(js_throttle_ * p_.max_throttle);
     c.steering = static_cast<float>(js_steer_);

@@ -31,17 +31,23 @@ struct Vehicle {
 };
 
 struct Bridge {
-  std::string device;             // serial device or pty symlink
-  int baud = 500000;              // [bit/s]
-  double heartbeat_hz = 50.0;     // COMMAND frames per second
-  int command_timeout_ms = 200;   // older LCM command -> disengage
-  int hello_retry_ms = 200;       // HELLO_REQUEST period while handshaking
-  int refused_retry_ms = 5000;    // HELLO_REQUEST period after a schema mismatch
-  int reconnect_ms = 500;         // reopen period while the device is missing
-  int link_timeout_ms = 500;      // no frame for this long -> handshake again
-  int telemetry_period_ms = 10;   // sent to the Nano in CONFIG; 0 = do not send CONFIG
-  int failsafe_timeout_ms = 100;  // sent in CONFIG
-  int servo_trim_us = 0;          // sent in CONFIG
+  std::string device;          // serial device or pty symlink
+  int baud = 500000;           // [bit/s]
+  double heartbeat_hz = 50.0;  // COMMAND frames per second while no command arrives
+  // The token bucket of COMMAND frames (nano_bridge/command_pacer.hpp): a fresh command goes
+  // at once while a token is left; a flood is capped at command_rate_hz. Optional keys. A
+  // 16-byte COMMAND frame is 320 us of line at 500 kBd: 100 Hz is 3.2 % of the line, and a
+  // burst of 4 frames (64 bytes) half the Nano's 128-byte receive ring.
+  int command_burst_frames = 4;    // bucket depth [frames], 1..8
+  double command_rate_hz = 100.0;  // refill [frames/s], heartbeat_hz..500
+  int command_timeout_ms = 200;    // older LCM command -> disengage
+  int hello_retry_ms = 200;        // HELLO_REQUEST period while handshaking
+  int refused_retry_ms = 5000;     // HELLO_REQUEST period after a schema mismatch
+  int reconnect_ms = 500;          // reopen period while the device is missing
+  int link_timeout_ms = 500;       // no frame for this long -> handshake again
+  int telemetry_period_ms = 10;    // sent to the Nano in CONFIG; 0 = do not send CONFIG
+  int failsafe_timeout_ms = 100;   // sent in CONFIG
+  int servo_trim_us = 0;           // sent in CONFIG
   // clock sim: one frame per SIM_CLOCK tick, and a command stamped later than the sim clock
   // applies from that sim time (repeatable HIL with autodrive-sim --lockstep-frames)
   bool sync_to_sim_clock = false;
@@ -78,6 +84,9 @@ struct Camera {
   std::array<double, 9> k{};  // camera matrix [px]
   std::vector<double> d;      // plumb_bob k1 k2 p1 p2 k3
   bool loop_file = true;      // restart a video file at its end
+  // Optional: how long opening the source may take [ms] before it is reported and retried (a
+  // GStreamer pipeline whose element is missing or whose camera is unplugged never opens).
+  int open_timeout_ms = 5000;
 };
 
 struct Estimator {

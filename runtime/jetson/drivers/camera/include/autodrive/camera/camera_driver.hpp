@@ -21,6 +21,10 @@ SourceKind classify_source(const std::string &source);
 std::vector<uint8_t> encode_jpeg(const void *bgr, int width_px, int height_px, int out_w, int out_h,
                                  int quality);
 
+// Camera opens still blocked in OpenCV after their driver gave up waiting (a program exits
+// with std::_Exit rather than run static destructors under them).
+int stuck_openers();
+
 class CameraDriver {
  public:
   CameraDriver(const autodrive::config::Config &config, std::size_t camera_index);

@@ -1,10 +1,10 @@
 // Nano bridge: the serial link to the Arduino Nano (or the simulator's / simavr's pty).
 // Handshake (HELLO_REQUEST until a HELLO with our schema hash), telemetry -> <VEH>_STATE and
-// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames at a steady heartbeat (at most one frame per
-// heartbeat period, whatever rate commands arrive at), engaged only while the LCM command stream is
-// fresh. Only commands the command gate admits (signed, not replayed, from the lease holder) count;
-// the holder and the gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device
-// disappears.
+// <VEH>_IMU, <VEH>_COMMAND -> COMMAND frames: a fresh command at once, a flood capped by a token
+// bucket, a heartbeat when no command went out for a period (command_pacer.hpp); engaged only
+// while the LCM command stream is fresh (on the sim clock with clock: sim). Only commands the
+// command gate admits (signed, not replayed, from the lease holder) count; the holder and the
+// gate's counters go out on <VEH>_CONTROL. Reconnects by itself when the device disappears.
 #pragma once
 
 #include <atomic>
@@ -31,6 +31,8 @@ struct Status {
   uint64_t refusals = 0;           // HELLOs refused (schema or version mismatch)
   uint64_t commands_sent = 0;      // COMMAND frames written
   uint64_t engaged_sent = 0;       // ... of which with the engaged flag
+  uint64_t commands_at_once = 0;   // admitted commands written in the call that received them
+  uint64_t commands_held = 0;      // admitted commands that found the token bucket empty
   uint64_t commands_rejected = 0;  // LCM commands with out-of-range fields
   uint64_t states_published = 0;
   uint64_t imu_published = 0;
