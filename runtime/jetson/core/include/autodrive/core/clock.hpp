@@ -14,13 +14,16 @@
 #include <optional>
 #include <string>
 
-#include <autodrive/core/config.hpp>
 
 namespace lcm {
 class LCM;
 }
 namespace autodrive {
 class sim_clock_t;
+}
+
+namespace autodrive::config {
+enum class ClockMode { wall, sim };  // a program's clock: `clock: wall|sim` in its config
 }
 
 namespace autodrive::clock {
