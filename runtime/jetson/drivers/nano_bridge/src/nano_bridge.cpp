@@ -58,7 +58,8 @@ struct NanoBridge::Impl {
   // sync_to_sim_clock: a command stamped later than the sim clock waits here for its tick
   std::optional<autodrive::vehicle_command_t> scheduled_cmd;
   int64_t scheduled_rx_us = 0;
-  int64_t latest_cmd_rx_us = 0;  // monotonic
+  int64_t latest_cmd_rx_us = 0;     // monotonic
+  int64_t latest_cmd_clock_us = 0;  // the same arrival on `clock` (clock sim: its freshness)
   uint16_t cmd_seq = 0;
   uint8_t frame_seq = 0;
   int64_t next_tx_us = 0;       // next heartbeat / hello [monotonic us]
@@ -190,6 +191,7 @@ struct NanoBridge::Impl {
     }
     latest_cmd = *m;
     latest_cmd_rx_us = autodrive::clock::monotonic_us();
+    latest_cmd_clock_us = clock.now_us();
     // The serial link carries at most one COMMAND frame per heartbeat period, whatever rate
     // commands arrive at (a flood on LCM cannot flood the Nano): a fresh command goes out at
     // once only when a whole period has passed since the last frame (latency), else with the
@@ -212,8 +214,12 @@ struct NanoBridge::Impl {
   }
 
   void send_command(int64_t now_us) {
+    // clock sim: command_timeout_ms of sim time (right at any real-time factor), and stale on a
+    // frozen SIM_CLOCK (Clock::kFrozenAfterUs of wall time); else of the monotonic clock.
+    const int64_t timeout_us = config.bridge.command_timeout_ms * 1000LL;
     const bool fresh = latest_cmd.has_value() &&
-                       now_us - latest_cmd_rx_us <= config.bridge.command_timeout_ms * 1000LL;
+                       (clock.sim() ? clock.fresh(latest_cmd_clock_us, timeout_us)
+                                    : now_us - latest_cmd_rx_us <= timeout_us);
     const protocol_command_t c =
         make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
     uint8_t payload[PROTOCOL_LEN_COMMAND];
@@ -257,6 +263,7 @@ struct NanoBridge::Impl {
     if (scheduled_cmd && scheduled_cmd->utime <= clock.now_us()) {
       latest_cmd = scheduled_cmd;
       latest_cmd_rx_us = scheduled_rx_us;
+      latest_cmd_clock_us = clock.now_us();
       scheduled_cmd.reset();
     }
     switch (state()) {
