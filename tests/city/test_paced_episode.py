@@ -74,9 +74,7 @@ def episode(build: Path, out: Path, url: str, rtf: float | None) -> dict[str, ob
         while demo.poll() is None and time.time() - t_wall0 < WALL_GUARD_S:
             if select.select([lc.fileno()], [], [], 0.1)[0]:
                 lc.handle()
-            done = len(first) == CARS and all(
-                last[c][0] > first[c] + WINDOW_S for c in first
-            )
+            done = len(first) == CARS and all(last[c][0] > first[c] + WINDOW_S for c in first)
             if done or (sim_t[0] > SIM_GUARD_S and len(first) < CARS):
                 break
         assert demo.poll() is None, f"the mission ended early (exit {demo.returncode})"

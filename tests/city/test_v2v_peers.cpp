@@ -123,8 +123,8 @@ TEST(PeerTable, FrozenSimClockDropsEveryPeer) {
   Clock clock(autodrive::config::ClockMode::sim);
   autodrive::v2v::PeerTable t("NIGEL1", 200000);
   // The last tick came kFrozenAfterUs + 1 us of monotonic time ago: the simulator froze.
-  ASSERT_TRUE(clock.set_sim_us(
-      1000000, autodrive::clock::monotonic_us() - Clock::kFrozenAfterUs - 1000000));
+  ASSERT_TRUE(clock.set_sim_us(1000000,
+                               autodrive::clock::monotonic_us() - Clock::kFrozenAfterUs - 1000000));
   t.on_state(state("NIGEL2", 1000000), clock.now_us());
   EXPECT_TRUE(clock.frozen());
   EXPECT_TRUE(t.fresh(clock).empty());  // age 0 in sim time, yet not believed

@@ -19,7 +19,7 @@ TEST(FrameWatchdog, TimesOutInSimTimeAndOnAFrozenSimClock) {
   using autodrive::clock::Clock;
   Clock clock(autodrive::config::ClockMode::sim);
   autodrive::pilot::FrameWatchdog w(clock, 500);
-  int64_t mono = 10000000;  // the backstop's monotonic time [us], moved by hand
+  int64_t mono = 10000000;       // the backstop's monotonic time [us], moved by hand
   EXPECT_FALSE(w.silent(mono));  // no frame yet: not driving, nothing to time out
   ASSERT_TRUE(clock.set_sim_us(3000000, mono));
   w.frame();

@@ -255,8 +255,7 @@ class App {
   double last_steering_ = 0;
   double steering_now_ = 0;  // <VEH>_STATE's steering_applied, normalised
   bool have_steering_ = false;
-  int64_t start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000,
-          goal_us_ = -1;
+  int64_t start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000, goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
   uint64_t steps_ = 0, shield_interventions_ = 0, lane_steers_ = 0;

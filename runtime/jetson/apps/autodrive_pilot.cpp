@@ -124,8 +124,8 @@ class PilotNode {
     if (!stopped_ && watchdog_.silent(now)) {
       stopped_ = true;
       ++timeouts_;
-      spdlog::error("no frame on {} for {} ms (frame_timeout_ms {}{}): STOPPING the car",
-                    ch_cam_, watchdog_.silent_ms(), cfg_.frame_timeout_ms,
+      spdlog::error("no frame on {} for {} ms (frame_timeout_ms {}{}): STOPPING the car", ch_cam_,
+                    watchdog_.silent_ms(), cfg_.frame_timeout_ms,
                     clock_.frozen(now) ? ", the sim clock is frozen" : "");
       rule_.reset();
     }
@@ -190,8 +190,7 @@ class PilotNode {
   std::vector<double> infer_ms_, infer_cpu_ms_, decode_ms_;
   float steering_ = 0.0f;
   double speed_m_s_ = 0.0;
-  int64_t last_frame_utime_ = 0, state_utime_ = 0, last_pub_us_ = 0,
-          last_report_us_ = 0;
+  int64_t last_frame_utime_ = 0, state_utime_ = 0, last_pub_us_ = 0, last_report_us_ = 0;
   size_t reported_frames_ = 0;
   int timeouts_ = 0;
   int32_t seq_ = 0;

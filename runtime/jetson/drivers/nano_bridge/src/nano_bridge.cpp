@@ -217,9 +217,9 @@ struct NanoBridge::Impl {
     // clock sim: command_timeout_ms of sim time (right at any real-time factor), and stale on a
     // frozen SIM_CLOCK (Clock::kFrozenAfterUs of wall time); else of the monotonic clock.
     const int64_t timeout_us = config.bridge.command_timeout_ms * 1000LL;
-    const bool fresh = latest_cmd.has_value() &&
-                       (clock.sim() ? clock.fresh(latest_cmd_clock_us, timeout_us)
-                                    : now_us - latest_cmd_rx_us <= timeout_us);
+    const bool fresh =
+        latest_cmd.has_value() && (clock.sim() ? clock.fresh(latest_cmd_clock_us, timeout_us)
+                                               : now_us - latest_cmd_rx_us <= timeout_us);
     const protocol_command_t c =
         make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
     uint8_t payload[PROTOCOL_LEN_COMMAND];

@@ -13,7 +13,7 @@ namespace autodrive::pilot {
 struct PilotConfig {
   std::string lcm_url;
   std::string vehicle;
-  std::string model;            // NAME.onnx; relative paths are relative to the config file
+  std::string model;  // NAME.onnx; relative paths are relative to the config file
   // Optional key `clock: wall|sim` (default wall): the frame timeout's clock and SIM_CLOCK's use.
   autodrive::config::ClockMode clock = autodrive::config::ClockMode::wall;
   int frame_timeout_ms = 500;   // no front-camera frame for this long [ms, clock] -> stop
