@@ -97,3 +97,36 @@ TEST(RuntimeConfigV2v, BadValuesNameTheKey) {
         << e.what();
   }
 }
+
+// The stale limit on a sim clock the test advances (event order, no wall time): age in sim
+// time, and no peer at all while the clock has no SIM_CLOCK yet or is frozen.
+TEST(PeerTable, StaleLimitOnTheSimClock) {
+  using autodrive::clock::Clock;
+  Clock clock(autodrive::config::ClockMode::sim);
+  autodrive::v2v::PeerTable t("NIGEL1", 200000);
+  t.on_state(state("NIGEL2", 1000000), 0);
+  EXPECT_TRUE(t.fresh(clock).empty());  // no SIM_CLOCK yet: nothing believed
+  EXPECT_EQ(t.dropped_stale(), 1u);
+  const int64_t mono = autodrive::clock::monotonic_us();  // the backstop's time, held still
+  ASSERT_TRUE(clock.set_sim_us(1100000, mono));
+  t.on_state(state("NIGEL2", 1000000), clock.now_us());
+  EXPECT_EQ(t.fresh(clock).size(), 1u);  // 100 ms of sim time old
+  ASSERT_TRUE(clock.set_sim_us(1200000, mono));
+  EXPECT_EQ(t.fresh(clock).size(), 1u);  // 200 ms: the limit itself is fresh
+  ASSERT_TRUE(clock.set_sim_us(1200001, mono));
+  EXPECT_TRUE(t.fresh(clock).empty());
+  EXPECT_EQ(t.dropped_stale(), 2u);
+}
+
+TEST(PeerTable, FrozenSimClockDropsEveryPeer) {
+  using autodrive::clock::Clock;
+  Clock clock(autodrive::config::ClockMode::sim);
+  autodrive::v2v::PeerTable t("NIGEL1", 200000);
+  // The last tick came kFrozenAfterUs + 1 us of monotonic time ago: the simulator froze.
+  ASSERT_TRUE(clock.set_sim_us(1000000,
+                               autodrive::clock::monotonic_us() - Clock::kFrozenAfterUs - 1000000));
+  t.on_state(state("NIGEL2", 1000000), clock.now_us());
+  EXPECT_TRUE(clock.frozen());
+  EXPECT_TRUE(t.fresh(clock).empty());  // age 0 in sim time, yet not believed
+  EXPECT_EQ(t.dropped_stale(), 1u);
+}

@@ -79,7 +79,8 @@ def test_frames_stop_stop_the_car(
         rcfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
         (out / "runtime.yaml").write_text(yaml.safe_dump(rcfg))
         pcfg = yaml.safe_load((root / "runtime/jetson/config/pilot_hil.yaml").read_text())
-        pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300)
+        # the test's frames are paced on the wall clock: so is the pilot's timeout here
+        pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300, clock="wall")
         (out / "pilot.yaml").write_text(yaml.safe_dump(pcfg))
         bin_ = build / "bin"
         sim_log, pilot_log = open(out / "sim.log", "w"), open(out / "pilot.log", "w")

@@ -7,10 +7,32 @@
 #include <fstream>
 #include <string>
 
+#include <autodrive/pilot/frame_watchdog.hpp>
 #include <autodrive/pilot/pilot_model.hpp>
 #include <autodrive/pilot/speed_rule.hpp>
 
 namespace {
+
+// The frame timeout on a sim clock the test advances (event order, no wall time): silence is
+// counted in sim time, and a frozen sim clock is silence whatever the sim age.
+TEST(FrameWatchdog, TimesOutInSimTimeAndOnAFrozenSimClock) {
+  using autodrive::clock::Clock;
+  Clock clock(autodrive::config::ClockMode::sim);
+  autodrive::pilot::FrameWatchdog w(clock, 500);
+  int64_t mono = 10000000;       // the backstop's monotonic time [us], moved by hand
+  EXPECT_FALSE(w.silent(mono));  // no frame yet: not driving, nothing to time out
+  ASSERT_TRUE(clock.set_sim_us(3000000, mono));
+  w.frame();
+  ASSERT_TRUE(clock.set_sim_us(3500000, mono));
+  EXPECT_FALSE(w.silent(mono));  // 500 ms of sim time: still within
+  ASSERT_TRUE(clock.set_sim_us(3500001, mono));
+  EXPECT_TRUE(w.silent(mono));
+  EXPECT_EQ(w.silent_ms(), 500);
+  w.frame();
+  EXPECT_FALSE(w.silent(mono));
+  mono += Clock::kFrozenAfterUs + 1;  // no SIM_CLOCK since: the simulator froze
+  EXPECT_TRUE(w.silent(mono));
+}
 
 TEST(SpeedRule, SlowsForSteeringAndHoldsTheSetSpeed) {
   autodrive::pilot::SpeedRuleConfig c;

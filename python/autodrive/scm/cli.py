@@ -61,8 +61,10 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
         "--clock",
         choices=("wall", "sim"),
         default="wall",
-        help="the lights' clock (yellow, all-red, programs, actuated holds): this machine's "
-        "(a real town), or the simulator's SIM_CLOCK (a simulated one, whatever its speed)",
+        help="the SCM's clock (the lights' yellow, all-red, programs and actuated holds, the "
+        "advisories' rate, the poses' freshness): this machine's (a real town), or the "
+        "simulator's SIM_CLOCK (a simulated one, whatever its speed; a SIM_CLOCK still for 5 s "
+        "of wall time makes every car stale)",
     )
     p.add_argument("--build", default=None, help="build dir with the LCM types")
     p.add_argument("--log-level", default="warning", help="uvicorn's log level")

@@ -3,7 +3,13 @@ the event log, talks LCM (poses, V2V routes and TRAFFIC_LIGHT_STATE in; TRAFFIC_
 and each car's V2I advisory out) and writes everything through one database writer.
 
 Threads: LCM receive, the control loop (lights at 20 Hz, advisories at 10 Hz per car) and the
-writer. The web API (api.py) calls the methods below; one lock guards the shared state."""
+writer. The web API (api.py) calls the methods below; one lock guards the shared state.
+
+Its clock (--clock wall|sim, autodrive.core.clock.Clock) times the lights, the advisories' rate
+and every freshness (poses, the Eye's preference, light states). With --clock sim that is
+SIM_CLOCK, so a simulated town paced at 0.1x real time is served as one at full speed; a frozen
+SIM_CLOCK (still for clock.FROZEN_AFTER_S of wall time) makes every car stale (no advisory:
+the cars' drivers then see every light red) and every light unknown."""
 
 from __future__ import annotations
 
@@ -22,6 +28,8 @@ from typing import Any
 from sqlalchemy import Engine, select as sql_select
 
 from autodrive.core import channels, lcmtypes
+from autodrive.core.clock import MODES as clock_modes
+from autodrive.core.clock import Clock
 from autodrive.maps import MapDescription
 from autodrive.scm.core.db import sessions
 from autodrive.scm.lights import STATES, Change, ControlError, Controller, Light, Program
@@ -31,16 +39,16 @@ from autodrive.scm.receiver import Receiver
 from autodrive.scm.roadnet import Ahead, Place, for_map
 from autodrive.scm.store import Writer
 
-STALE_S = 0.5  # a car's pose older than this [s] gets no advisory (the car then goes stale)
-EYE_PREFERRED_S = 0.5  # an Eye pose this recent [s] wins over the EKF's
+STALE_S = 0.5  # a car's pose older than this [s, clock] gets no advisory (the car goes stale)
+EYE_PREFERRED_S = 0.5  # an Eye pose this recent [s, clock] wins over the EKF's
 QUEUE_M = 1.2  # a car this close to a red light's stop line [m] is queued on its approach
 COMMAND_HOLD_S = 2.0  # each light command holds this long [s]; refreshed every REFRESH_S
 REFRESH_S = 0.5
 # The simulator publishes every light at 10 Hz of sim time and each change at once; a light
-# not heard of for this long [s, wall] (the simulator gone, not merely slowed) is unknown.
+# not heard of for this long [s, clock] is unknown (with --clock sim, a frozen simulator too).
 LIGHT_UNKNOWN_S = 5.0
 VEHICLE_PATTERN = "[A-Z][A-Z0-9]*"  # a vehicle name: capitals and digits
-CLOCKS = ("wall", "sim")  # the lights' clock: this machine's, or the simulator's SIM_CLOCK
+CLOCKS = clock_modes  # the SCM's clock: this machine's, or the simulator's SIM_CLOCK
 
 
 def now_us() -> int:
@@ -56,8 +64,9 @@ class Car:
     speed_m_s: float = 0.0
     source: str = ""
     utime: int = 0  # the pose's stamp [us]
-    seen_s: float = 0.0  # wall time of the last pose [s]
-    eye_seen_s: float = -1e9
+    seen_s: float = 0.0  # wall time of the last pose [s] (shown, stored)
+    seen_c: float | None = None  # the last pose's arrival [s, the SCM's clock] (its freshness)
+    eye_seen_c: float | None = None  # the last Eye pose's arrival [s, the SCM's clock]
     kept_utime: int = -(10**18)  # stamp of the last pose kept in the history [us]
     route: str = ""
     place: Place | None = None
@@ -82,7 +91,7 @@ class Scm:
             raise ValueError(f"clock must be one of {CLOCKS}, got {clock!r}")
         self.map = m
         self.clock = clock
-        self.sim_now_s: float | None = None  # the latest SIM_CLOCK [s of sim time]
+        self.time = Clock(clock)  # the lights', the advisories' and the freshness' clock
         self.engine = engine
         self.sessions = sessions(engine)
         self.types = lcmtypes.load(build)
@@ -93,7 +102,8 @@ class Scm:
         self.roadnet = for_map(m, build)
         self.lock = threading.RLock()
         self.cars: dict[str, Car] = {v: Car(v) for v in vehicles}
-        self.sim_states: dict[int, tuple[str, float, float]] = {}  # id -> state, left, seen
+        # id -> state, time left [s], seen [s, wall], seen [s, clock]
+        self.sim_states: dict[int, tuple[str, float, float, float | None]] = {}
         self.recent: collections.deque[dict[str, Any]] = collections.deque(maxlen=200)
         self._event_seq = 0
         self.stats = {"poses_in": 0, "advisories_out": 0, "commands_out": 0, "bad_messages": 0}
@@ -231,9 +241,8 @@ class Scm:
 
     def _on_sim_clock(self, _chan: str, data: bytes) -> None:
         msg = self._decode(self.types.sim_clock_t, data)
-        if msg is not None:
-            with self.lock:  # forward only: a late message never turns the lights' clock back
-                self.sim_now_s = max(self.sim_now_s or 0.0, msg.utime * 1e-6)
+        if msg is not None:  # forward only: a late message never turns the clock back
+            self.time.on_sim_clock(msg.utime)
 
     def city_now(self) -> float | None:
         """The lights' clock [s]: wall time, or with clock 'sim' the simulator's SIM_CLOCK, so
@@ -241,7 +250,7 @@ class Scm:
         however fast or slowly the simulator runs (in lockstep on a loaded machine it may run at
         half real time, or several times faster on a quiet one); None before the first
         SIM_CLOCK (the lights are then neither commanded nor timed)."""
-        return time.time() if self.clock == "wall" else self.sim_now_s
+        return self.time.now_s()
 
     def _on_light_state(self, _chan: str, data: bytes) -> None:
         msg = self._decode(self.types.traffic_light_state_t, data)
@@ -250,8 +259,8 @@ class Scm:
         state, t = STATES[msg.state], time.time()
         with self.lock:
             before = self.sim_states.get(msg.light_id)
-            self.sim_states[msg.light_id] = (state, float(msg.time_remaining_s), t)
             tc = self.city_now()
+            self.sim_states[msg.light_id] = (state, float(msg.time_remaining_s), t, tc)
             if tc is not None:
                 self.controller.observed(msg.light_id, state, tc)
             if (before is None or before[0] != state) and msg.light_id in self.controller.lights:
@@ -276,13 +285,14 @@ class Scm:
             return
         t = time.time()
         with self.lock:
+            tc = self.city_now()
             self.stats["poses_in"] += 1
             car = self.cars.get(vehicle)
             if car is None:
                 car = self.cars[vehicle] = Car(vehicle)
             if source == "eye":
-                car.eye_seen_s = t
-            elif source == "ekf" and t - car.eye_seen_s < EYE_PREFERRED_S:
+                car.eye_seen_c = tc
+            elif source == "ekf" and self.time.fresh(car.eye_seen_c, EYE_PREFERRED_S):
                 return  # the Eye is running: its poses are the ones kept
             if speed_m_s is None:  # the Eye gives no speed: from the last pose
                 dt = (utime - car.utime) * 1e-6
@@ -292,7 +302,7 @@ class Scm:
                 else:
                     speed_m_s = 0.0
             car.x_m, car.y_m, car.yaw_rad, car.speed_m_s = x_m, y_m, yaw_rad, speed_m_s
-            car.source, car.utime, car.seen_s = source, utime, t
+            car.source, car.utime, car.seen_s, car.seen_c = source, utime, t, tc
             if car.status != "ok":
                 car.status = "ok"
                 self.event("server", "vehicle_ok", vehicle, {"source": source})
@@ -315,18 +325,16 @@ class Scm:
     # --- control loop -------------------------------------------------------------------------
 
     def _control_loop(self) -> None:
-        next_adv = next_refresh = time.monotonic()
-        next_vehicles = next_adv
+        next_refresh = next_vehicles = time.monotonic()
+        next_adv_c = -math.inf  # the next advisories are due at this time [s, the SCM's clock]
         refreshed_c = -math.inf  # the lights' clock at the last refresh [s]
         while not self._stop.wait(0.05):
             t = time.time()
             mono = time.monotonic()
             with self.lock:
                 tc = self.city_now()
-                if mono >= next_adv:
-                    next_adv += self.advisory_period_s
-                    if mono > next_adv:
-                        next_adv = mono + self.advisory_period_s
+                if tc is not None and tc >= next_adv_c:  # the advisories' rate on the clock
+                    next_adv_c = max(next_adv_c + self.advisory_period_s, tc)
                     self._advise(t, tc)
                 if tc is not None:
                     self._apply(self.controller.tick(tc, self._demand()))
@@ -374,9 +382,10 @@ class Scm:
         late; a GREEN announced from the command let a car drive off at a red light). The time
         left is the SCM's (it decides the next change) while the light shows the SCM's state,
         else unknown (the light is about to follow a command). No state yet, or none for
-        LIGHT_UNKNOWN_S: unknown, advised as RED. t: wall time, tc: the lights' clock [s]."""
+        LIGHT_UNKNOWN_S of the clock (or a frozen sim clock): unknown, advised as RED. t: wall
+        time, tc: the lights' clock [s]."""
         sim = self.sim_states.get(light_id)
-        if sim is None or t - sim[2] > LIGHT_UNKNOWN_S:
+        if sim is None or not self.time.fresh(sim[3], LIGHT_UNKNOWN_S):
             return "RED", -1.0
         shown = sim[0]
         light = self.controller.lights[light_id]
@@ -386,8 +395,7 @@ class Scm:
 
     def _advise(self, t: float, tc: float | None) -> None:
         for car in self.cars.values():
-            fresh = t - car.seen_s < STALE_S
-            if not fresh:
+            if not self.time.fresh(car.seen_c, STALE_S):
                 if car.status == "ok":
                     car.status = "stale"
                     self.event(
@@ -400,7 +408,8 @@ class Scm:
                 car.x_m, car.y_m, car.yaw_rad, car.route, car.place
             )
             msg = self.types.v2i_advisory_t()
-            msg.utime, msg.seq, msg.vehicle = int(t * 1e6), car.seq, car.name
+            stamp_s = t if tc is None else tc  # on the SCM's clock
+            msg.utime, msg.seq, msg.vehicle = int(stamp_s * 1e6), car.seq, car.name
             car.seq += 1
             a = car.ahead
             msg.light_id = a.light_id

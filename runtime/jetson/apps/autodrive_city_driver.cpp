@@ -4,6 +4,10 @@
 // map's sidecar JSON), keeps a gap behind cars ahead (V2V peers), stops for obstacles on its
 // path (the runtime's <VEH>_LIDAR scan; no fresh scan = blocked), and drives through the
 // runtime's guarded path: signed <VEH>_COMMAND (autodrive::auth::Signer), 50 Hz of car time.
+// Its clock (--clock wall|sim, autodrive::clock::Clock) judges the advisory's and the peers'
+// age; with --clock sim a frozen SIM_CLOCK (no tick for Clock::kFrozenAfterUs of monotonic
+// time) makes the driver send disengaged stops only.
+#include <autodrive/core/clock.hpp>
 #include <CLI/CLI.hpp>
 #include <autodrive/command_auth.hpp>
 #include <autodrive/lidar_scan_t.hpp>
@@ -39,10 +43,9 @@ void on_signal(int) {
   g_stop = true;
 }
 
-using Clock = std::chrono::steady_clock;
-
 struct Options {
   std::string map, route, vehicle = "NIGEL1", lcm_url, key_file;
+  autodrive::config::ClockMode clock = autodrive::config::ClockMode::wall;
   double lookahead_m = 0.2, speed_kp = 1.5, advisory_stale_ms = 500;
   double status_period_s = 2.0;
   double scan_stale_ms = 500;  // a scan older than this [ms, car time]: no fresh scan
@@ -60,7 +63,10 @@ class Driver {
         rules_(track_, o.rules),
         lcm_(lcm),
         signer_(std::move(signer)),
-        peers_(o.vehicle) {}
+        clock_(o.clock),
+        peers_(o.vehicle) {
+    clock_.attach(lcm_);
+  }
 
   void on_pose(const autodrive::odometry_t *m) {
     now_us_ = m->utime;
@@ -76,6 +82,10 @@ class Driver {
     pose_ = {m->x_m, m->y_m, m->yaw_rad, s_local_};
     if (last_cmd_us_ != 0 && m->utime - last_cmd_us_ < 19000) return;  // 50 Hz
     last_cmd_us_ = m->utime;
+    if (clock_.frozen()) {  // no time to judge anything by (no or a stopped SIM_CLOCK): stop
+      send(false, 0.0, 0.0);
+      return;
+    }
     const double s = s_local_ + lap_ * track_.length_m;
     autodrive::behaviour::RulesInput in;
     in.s_m = s;
@@ -86,7 +96,7 @@ class Driver {
       in.scan_fresh = scan_us_ > 0 && m->utime - scan_us_ <= o_.scan_stale_ms * 1e3;
       in.obstacle_ahead_m = obstacle_.ahead_m(track_, s_local_);
     }
-    for (const auto &peer : peers_.fresh(m->utime)) {
+    for (const auto &peer : peers_.fresh(clock_)) {
       const auto q = autodrive::behaviour::project(track_, peer.x_m, peer.y_m, s_local_, 0.0,
                                                    o_.rules.peer_horizon_m);
       double ahead = q.s_m - s_local_;
@@ -118,11 +128,11 @@ class Driver {
   void on_advisory(const autodrive::v2i_advisory_t *m) {
     if (m->vehicle != o_.vehicle) return;
     adv_ = *m;
-    adv_wall_ = Clock::now();
+    adv_at_us_ = clock_.now_us();
     have_adv_ = true;
   }
 
-  void on_peer(const autodrive::v2v_state_t *m) { peers_.on_state(*m, now_us_); }
+  void on_peer(const autodrive::v2v_state_t *m) { peers_.on_state(*m, clock_.now_us()); }
 
   // Judged at once with the latest pose (the scan is ~1/7 s long; the margin covers that).
   void on_scan(const autodrive::lidar_scan_t *m) {
@@ -150,14 +160,12 @@ class Driver {
   }
 
  private:
-  // The advisory is judged fresh by its arrival on this machine's steady clock: its stamp is
-  // the server's wall clock, which the car's (sim) clock cannot be compared with.
+  // The advisory is judged fresh by its arrival on this program's clock (wall, or SIM_CLOCK):
+  // its stamp is the server's clock, which need not be this one.
   autodrive::behaviour::Advisory advisory() const {
     autodrive::behaviour::Advisory a;
     if (!have_adv_) return a;
-    const double age_ms =
-        std::chrono::duration<double, std::milli>(Clock::now() - adv_wall_).count();
-    a.fresh = age_ms <= o_.advisory_stale_ms;
+    a.fresh = clock_.fresh(adv_at_us_, static_cast<int64_t>(o_.advisory_stale_ms * 1e3));
     a.light_id = adv_.light_id;
     a.light = static_cast<autodrive::behaviour::LightState>(adv_.light_state);
     a.speed_limit_m_s = adv_.speed_limit_m_s;
@@ -169,9 +177,10 @@ class Driver {
   autodrive::behaviour::CityRules rules_;
   lcm::LCM &lcm_;
   autodrive::auth::Signer signer_;
+  autodrive::clock::Clock clock_;
   autodrive::v2v::PeerTable peers_;
   autodrive::v2i_advisory_t adv_{};
-  Clock::time_point adv_wall_{};
+  int64_t adv_at_us_ = 0;  // the advisory's arrival [us, clock_]
   bool have_adv_ = false, have_s_ = false;
   double s_local_ = 0;
   autodrive::behaviour::CarPose pose_;
@@ -213,8 +222,14 @@ int main(int argc, char **argv) {
       ->check(CLI::Range(0.05, 2.0))
       ->capture_default_str();
   cli.add_option("--advisory-stale-ms", o.advisory_stale_ms,
-                 "an advisory older than this [ms, wall] is stale: every light is red")
+                 "an advisory older than this [ms, --clock] is stale: every light is red")
       ->check(CLI::Range(50.0, 10000.0))
+      ->capture_default_str();
+  std::string clock = "wall";
+  cli.add_option("--clock", clock,
+                 "the clock of staleness: wall (a car) or sim (SIM_CLOCK: HIL, correct at any "
+                 "real-time factor; a SIM_CLOCK still for 5 s of wall time stops the car)")
+      ->check(CLI::IsMember({"wall", "sim"}))
       ->capture_default_str();
   cli.add_option("--obstacle-margin", o.rules.obstacle_margin_m,
                  "the front stops this far before an obstacle on the path (LIDAR) [m]")
@@ -224,6 +239,7 @@ int main(int argc, char **argv) {
                "do not stop for obstacles: no <VEH>_LIDAR (the car then drives into what is "
                "not on the map)");
   CLI11_PARSE(cli, argc, argv);
+  o.clock = *autodrive::clock::clock_mode_named(clock);
 
   autodrive::behaviour::Track track;
   try {

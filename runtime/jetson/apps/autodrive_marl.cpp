@@ -11,7 +11,6 @@
 #include <autodrive/command_auth.hpp>
 #include <autodrive/mission_status_t.hpp>
 #include <autodrive/odometry_t.hpp>
-#include <autodrive/sim_clock_t.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
@@ -20,7 +19,6 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -29,6 +27,7 @@
 #include <optional>
 #include <sstream>
 
+#include <autodrive/core/clock.hpp>
 #include <autodrive/marl/core_adapter.hpp>
 #include <autodrive/marl/fcfs_baseline.hpp>
 #include <autodrive/marl/link_degrade.hpp>
@@ -40,12 +39,6 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) {
   g_stop = 1;
-}
-
-int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 struct Options {
@@ -73,6 +66,7 @@ class App {
         route_(std::move(route)),
         baseline_(std::move(baseline)),
         origin_(origin),
+        clock_(*autodrive::clock::clock_mode_named(o.clock)),
         core_(route_, o.waypoint_lookahead_m),
         peers_(o.vehicle, static_cast<int64_t>(o.stale_ms * 1000)),
         link_(o.v2v_loss, static_cast<int64_t>(o.v2v_delay_ms * 1000), o.seed) {
@@ -86,9 +80,6 @@ class App {
         static_cast<int64_t>(1e6 * (policy_ ? policy_->spec().control_period_s : 1.0 / o.rate_hz));
   }
 
-  void on_clock(const lcm::ReceiveBuffer *, const std::string &, const autodrive::sim_clock_t *m) {
-    sim_now_us_ = std::max(sim_now_us_, m->utime);
-  }
   void on_v2v(const lcm::ReceiveBuffer *, const std::string &, const autodrive::v2v_state_t *m) {
     if (m->vehicle == o_.vehicle) return;
     link_.on_receive(*m, now_us());
@@ -108,12 +99,14 @@ class App {
     have_steering_ = true;
   }
 
-  int64_t now_us() const { return o_.clock == "sim" ? sim_now_us_ : wall_us(); }
-  bool clock_ready() const { return o_.clock != "sim" || sim_now_us_ > 0; }
+  int64_t now_us() const { return clock_.now_us(); }
+  void attach_clock() { clock_.attach(lcm_); }
 
   // One pass of the loop: deliver due V2V states, command when a control period has passed.
+  // Nothing while the clock has no time or a frozen one (no SIM_CLOCK tick for
+  // Clock::kFrozenAfterUs of monotonic time): the bridge's command timeout then stops the car.
   void tick() {
-    if (!clock_ready()) return;
+    if (clock_.frozen()) return;
     const int64_t now = now_us();
     for (const auto &s : link_.due(now)) peers_.on_state(s, now);
     if (now < static_cast<int64_t>(o_.start_delay_s * 1e6)) return;  // not yet: stays parked
@@ -251,6 +244,7 @@ class App {
   autodrive::marl::Route route_;
   std::unique_ptr<autodrive::marl::FcfsBaseline> baseline_;
   std::optional<autodrive::autonomy::Pose2> origin_;
+  autodrive::clock::Clock clock_;  // --clock: control period, V2V delay and staleness
   autodrive::marl::Core core_;
   autodrive::autonomy::PurePursuit after_goal_;
   double goal_[2] = {0, 0};
@@ -261,8 +255,7 @@ class App {
   double last_steering_ = 0;
   double steering_now_ = 0;  // <VEH>_STATE's steering_applied, normalised
   bool have_steering_ = false;
-  int64_t sim_now_us_ = 0, start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000,
-          goal_us_ = -1;
+  int64_t start_us_ = -1, last_cmd_us_ = -1, last_status_us_ = -1000000000, goal_us_ = -1;
   int64_t period_us_ = 50000;
   int32_t seq_ = 0;
   uint64_t steps_ = 0, shield_interventions_ = 0, lane_steers_ = 0;
@@ -447,8 +440,7 @@ int main(int argc, char **argv) {
   std::signal(SIGTERM, on_signal);
   App app(o, lcm, std::move(*signer), std::move(policy), std::move(route), std::move(baseline),
           origin);
-  autodrive_lcm::subscribe<autodrive::sim_clock_t, App, &App::on_clock>(lcm, AUTODRIVE_CH_SIM_CLOCK,
-                                                                        &app);
+  app.attach_clock();
   autodrive_lcm::subscribe<autodrive::v2v_state_t, App, &App::on_v2v>(lcm, AUTODRIVE_CH_V2V, &app)
       ->setQueueCapacity(200);
   const std::string pose_ch =

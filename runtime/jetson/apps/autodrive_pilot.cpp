@@ -3,8 +3,9 @@
 // HIL) and <VEH>_ODOM (speed, the runtime's estimator), runs the ONNX model with OpenCV's DNN
 // module on one thread, and publishes signed <VEH>_COMMAND (the project's Signer; the bridge's
 // lease) with the network's steering and a throttle that holds a set speed and slows for large
-// steering. When frames stop arriving for frame_timeout_ms (monotonic clock) it stops the car
-// (disengaged commands) and says so; it drives again when frames return. --predict runs the model
+// steering. When frames stop arriving for frame_timeout_ms of its clock (`clock: wall|sim`; a
+// frozen SIM_CLOCK counts as no frames) it stops the car (disengaged commands) and says so; it
+// drives again when frames return. --predict runs the model
 // on image files instead.
 #include <autodrive/command_auth.hpp>
 #include <autodrive/compressed_image_t.hpp>
@@ -32,6 +33,7 @@
 #include <vector>
 
 #include <autodrive/core/clock.hpp>
+#include <autodrive/pilot/frame_watchdog.hpp>
 #include <autodrive/pilot/pilot_config.hpp>
 #include <autodrive/pilot/pilot_model.hpp>
 #include <autodrive/pilot/speed_rule.hpp>
@@ -70,8 +72,12 @@ class PilotNode {
         model_(model),
         signer_(std::move(signer)),
         rule_(cfg.speed),
+        clock_(cfg.clock),
+        watchdog_(clock_, cfg.frame_timeout_ms),
         ch_cam_(cfg.vehicle + AUTODRIVE_CH_CAM_FRONT_SUFFIX),
-        ch_cmd_(cfg.vehicle + AUTODRIVE_CH_COMMAND_SUFFIX) {}
+        ch_cmd_(cfg.vehicle + AUTODRIVE_CH_COMMAND_SUFFIX) {
+    clock_.attach(lcm_);
+  }
 
   void on_frame(const autodrive::compressed_image_t *m) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -94,11 +100,10 @@ class PilotNode {
     decode_ms_.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     infer_ms_.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     infer_cpu_ms_.push_back(thread_cpu_ms() - cpu0);
-    const int64_t now = autodrive::clock::monotonic_us();
     if (stopped_) spdlog::info("{}: frames again: driving", ch_cam_);
-    if (last_frame_mono_us_ < 0) spdlog::info("{}: first frame: driving", ch_cam_);
+    if (!watchdog_.seen()) spdlog::info("{}: first frame: driving", ch_cam_);
     stopped_ = false;
-    last_frame_mono_us_ = now;
+    watchdog_.frame();
     const double dt_s = last_frame_utime_ > 0 ? (m->utime - last_frame_utime_) * 1e-6 : 0.0;
     last_frame_utime_ = m->utime;
     steering_ = steering;
@@ -115,13 +120,13 @@ class PilotNode {
   void tick() {
     const int64_t now = autodrive::clock::monotonic_us();
     if (now - last_report_us_ >= kReportPeriodUs) report(now);
-    if (last_frame_mono_us_ < 0) return;  // not driving yet: nothing to hold
-    const int64_t silent_ms = (now - last_frame_mono_us_) / 1000;
-    if (!stopped_ && silent_ms > cfg_.frame_timeout_ms) {
+    if (!watchdog_.seen()) return;  // not driving yet: nothing to hold
+    if (!stopped_ && watchdog_.silent(now)) {
       stopped_ = true;
       ++timeouts_;
-      spdlog::error("no frame on {} for {} ms (frame_timeout_ms {}): STOPPING the car", ch_cam_,
-                    silent_ms, cfg_.frame_timeout_ms);
+      spdlog::error("no frame on {} for {} ms (frame_timeout_ms {}{}): STOPPING the car", ch_cam_,
+                    watchdog_.silent_ms(), cfg_.frame_timeout_ms,
+                    clock_.frozen(now) ? ", the sim clock is frozen" : "");
       rule_.reset();
     }
     if (now - last_pub_us_ >= static_cast<int64_t>(1e6 / cfg_.command_rate_hz))
@@ -179,12 +184,13 @@ class PilotNode {
   autodrive::pilot::PilotModel &model_;
   autodrive::auth::Signer signer_;
   autodrive::pilot::SpeedRule rule_;
+  autodrive::clock::Clock clock_;
+  autodrive::pilot::FrameWatchdog watchdog_;
   std::string ch_cam_, ch_cmd_;
   std::vector<double> infer_ms_, infer_cpu_ms_, decode_ms_;
   float steering_ = 0.0f;
   double speed_m_s_ = 0.0;
-  int64_t last_frame_mono_us_ = -1, last_frame_utime_ = 0, state_utime_ = 0, last_pub_us_ = 0,
-          last_report_us_ = 0;
+  int64_t last_frame_utime_ = 0, state_utime_ = 0, last_pub_us_ = 0, last_report_us_ = 0;
   size_t reported_frames_ = 0;
   int timeouts_ = 0;
   int32_t seq_ = 0;

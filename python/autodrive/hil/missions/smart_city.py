@@ -211,7 +211,9 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         if args.late_obstacles == "none":
             sim += ["--no-late-obstacles"]
         sim += ["--seed", args.seed, "--run-dir", run_dir, "--lcm-url", url]
-        sim += ["--lockstep-client", "--duration", 3600]
+        # --rtf X (tools/demo): paced at X real time; else in lockstep with the runtimes
+        pacing = ["--rtf", args.rtf] if args.rtf else ["--lockstep-client"]
+        sim += [*pacing, "--duration", 3600]
         eye_fps = args.cameras or EYE_FPS_DEFAULT
         if args.city_eye == "cameras":
             sim += ["--eye", "--camera-fps", eye_fps]
@@ -303,6 +305,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         for i in range(1, cars + 1):
             drv = [build / "bin" / "autodrive-city-driver", "--map", MAPS_DIR / f"{MAP}.json"]
             drv += ["--route", ROUTES[i - 1], "--vehicle", vehicle_name(i), "--lcm-url", url]
+            drv += ["--clock", "sim"]  # advisories' and peers' age in sim time, at any speed
             procs.start(f"city-driver{i}", drv, out / f"city-driver{i}.log")
         say(f"driving {args.laps} laps each (timeout {args.timeout:g} s wall) ...")
         last = time.monotonic()

@@ -1,5 +1,7 @@
 #include <autodrive/core/config.hpp>
 
+#include <autodrive/core/clock.hpp>
+
 #include <autodrive_channels.h>
 
 #include <cmath>
@@ -158,10 +160,8 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   c.file = file;
   c.lcm_url = top.get<std::string>("lcm_url");
   const auto clock = top.get<std::string>("clock");
-  if (clock == "wall")
-    c.clock = ClockMode::wall;
-  else if (clock == "sim")
-    c.clock = ClockMode::sim;
+  if (const auto mode = autodrive::clock::clock_mode_named(clock))
+    c.clock = *mode;
   else
     top.fail("clock", "must be 'wall' or 'sim', got '" + clock + "'");
   c.vehicle = parse_vehicle(top.child("vehicle"));

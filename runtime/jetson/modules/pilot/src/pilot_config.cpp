@@ -14,6 +14,11 @@ PilotConfig load_config(const std::string &path) {
   c.model = top.get<std::string>("model");
   if (!c.model.empty() && std::filesystem::path(c.model).is_relative())
     c.model = (std::filesystem::path(path).parent_path() / c.model).lexically_normal().string();
+  const auto clock = top.get<std::string>("clock", "wall");
+  if (const auto mode = autodrive::clock::clock_mode_named(clock))
+    c.clock = *mode;
+  else
+    top.fail("clock", "must be 'wall' or 'sim', got '" + clock + "'");
   c.frame_timeout_ms = top.in_range<int>("frame_timeout_ms", 50, 5000);
   c.command_rate_hz = top.in_range<double>("command_rate_hz", 20.0, 200.0);
   const auto s = top.child("speed");

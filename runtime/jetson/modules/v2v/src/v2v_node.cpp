@@ -21,19 +21,22 @@ constexpr int64_t kStatusPeriodUs = 5000000;  // status log period [us of messag
 struct V2vNode::Impl {
   autodrive::config::Config config;
   lcm::LCM lcm;
+  autodrive::clock::Clock clock;  // peers' age: SIM_CLOCK with clock sim, else wall time
   autodrive::v2v::PeerTable peers;
   autodrive::vehicle_state_t state{};
   bool have_state = false;
   int64_t period_us;
-  int64_t next_pub_us = 0, next_status_us = 0, now_us = 0;
+  int64_t next_pub_us = 0, next_status_us = 0;  // [us, pose stamps]
   int32_t seq = 0;
 
   explicit Impl(const autodrive::config::Config &c)
       : config(c),
         lcm(c.lcm_url),
+        clock(c.clock),
         peers(c.vehicle.name, static_cast<int64_t>(c.v2v_stale_ms) * 1000),
         period_us(c.v2v_hz > 0 ? static_cast<int64_t>(1e6 / c.v2v_hz) : 0) {
     if (!lcm.good()) return;
+    clock.attach(lcm);
     const std::string v = c.vehicle.name;
     autodrive_lcm::subscribe<autodrive::odometry_t, Impl, &Impl::on_pose>(
         lcm, v + AUTODRIVE_CH_POSE_MAP_SUFFIX, this);
@@ -48,10 +51,9 @@ struct V2vNode::Impl {
     have_state = true;
   }
 
-  void on_peer(const autodrive::v2v_state_t *m) { peers.on_state(*m, now_us); }
+  void on_peer(const autodrive::v2v_state_t *m) { peers.on_state(*m, clock.now_us()); }
 
   void on_pose(const autodrive::odometry_t *m) {
-    now_us = m->utime;
     // A quarter period of slack so that the 100 Hz pose stream's jitter skips no broadcast.
     if (next_pub_us == 0 || m->utime >= next_pub_us - period_us / 4) {
       next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
@@ -60,7 +62,7 @@ struct V2vNode::Impl {
     }
     if (m->utime >= next_status_us) {
       if (next_status_us != 0) {
-        const auto fresh = peers.fresh(m->utime);
+        const auto fresh = peers.fresh(clock);
         spdlog::info("{} V2V: {} broadcasts, {}", config.vehicle.name, seq,
                      autodrive::v2v::status_line(fresh, peers.dropped_stale()));
       }

@@ -30,6 +30,13 @@ std::vector<autodrive::v2v_state_t> PeerTable::fresh(int64_t now_us) {
   return out;
 }
 
+std::vector<autodrive::v2v_state_t> PeerTable::fresh(const autodrive::clock::Clock &clock) {
+  if (clock.ready() && !clock.frozen()) return fresh(clock.now_us());
+  dropped_stale_ += latest_.size();
+  latest_.clear();
+  return {};
+}
+
 std::string status_line(const std::vector<autodrive::v2v_state_t> &fresh, uint64_t dropped) {
   std::string names;
   for (const auto &s : fresh) names += (names.empty() ? "" : ", ") + s.vehicle;

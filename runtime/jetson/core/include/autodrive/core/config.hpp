@@ -2,6 +2,7 @@
 // missing or malformed key throws autodrive::config::Error naming the file and the dotted key.
 #pragma once
 
+#include <autodrive/core/clock.hpp>
 #include <autodrive/strict_yaml.hpp>
 #include <autodrive_vehicle.h>
 #include <yaml-cpp/yaml.h>
@@ -16,8 +17,6 @@
 namespace autodrive::config {
 
 using Error = autodrive::yaml::Error;
-
-enum class ClockMode { wall, sim };
 
 // The car: its name from the config, its figures from vehicle/nigel.params (generated
 // <autodrive_vehicle.h>) and the firmware's encoder resolution; a config cannot change them.

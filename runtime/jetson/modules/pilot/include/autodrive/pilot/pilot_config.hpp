@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <autodrive/core/clock.hpp>
+
 #include <autodrive/pilot/speed_rule.hpp>
 
 namespace autodrive::pilot {
@@ -11,8 +13,10 @@ namespace autodrive::pilot {
 struct PilotConfig {
   std::string lcm_url;
   std::string vehicle;
-  std::string model;            // NAME.onnx; relative paths are relative to the config file
-  int frame_timeout_ms = 500;   // no front-camera frame for this long (monotonic) -> stop
+  std::string model;  // NAME.onnx; relative paths are relative to the config file
+  // Optional key `clock: wall|sim` (default wall): the frame timeout's clock and SIM_CLOCK's use.
+  autodrive::config::ClockMode clock = autodrive::config::ClockMode::wall;
+  int frame_timeout_ms = 500;   // no front-camera frame for this long [ms, clock] -> stop
   double command_rate_hz = 50;  // commands at least this often while driving or stopped
   SpeedRuleConfig speed;
 };

@@ -1,8 +1,11 @@
 // V2V peer table: the latest v2v_state_t of every other car, as heard on the V2V channel.
 // A state older than the stale limit [us] is dropped (and counted) when the fresh peers are
 // asked for, so a car that went silent, or a link that lost it, is never believed for long.
-// The time base is the receiver's clock: sim time (SIM_CLOCK) in HIL, else wall time.
+// The time base is the receiver's clock (autodrive::clock::Clock): sim time (SIM_CLOCK) in
+// HIL, else wall time; on a frozen sim clock every peer is stale.
 #pragma once
+
+#include <autodrive/core/clock.hpp>
 
 #include <autodrive/v2v_state_t.hpp>
 
@@ -24,6 +27,8 @@ class PeerTable {
   // Every peer whose latest state is at most stale_us old at now_us [us], in name order; the
   // others are removed and counted in dropped_stale().
   std::vector<autodrive::v2v_state_t> fresh(int64_t now_us);
+  // The same at the clock's now; none (every peer dropped) while the clock is not ready or frozen.
+  std::vector<autodrive::v2v_state_t> fresh(const autodrive::clock::Clock &clock);
   uint64_t dropped_stale() const { return dropped_stale_; }
   // States received from peers (own broadcasts and reordered ones not counted) [count].
   uint64_t received() const { return received_; }
