@@ -19,12 +19,15 @@ struct eye_sync {
   int heard;          /* an Eye answered and was not given up since */
   int64_t latency_us; /* its latency (sim time) */
   int64_t done_us;    /* capture time of the newest frame it is done with; -1: none */
-  int64_t lost_at_us; /* done_us when it was given up (it is heard again after it); -1: never */
+  int64_t lost_at_us; /* done_us when it was given up (heard again after it); INT64_MIN: never */
+  int first_sent;     /* the first frame went out (the sim waited for an Eye before it) */
   int64_t pending[EYE_SYNC_MAX_PENDING]; /* capture times sent, oldest first from head */
   int head, n;
   long waits, given_up, refused;
   double waited_s;
 };
+
+static void eye_sync_handle(eye_sync_t *e, int timeout_ms);
 
 /* Frames the Eye is done with leave the queue. */
 static void eye_sync_drop_done(eye_sync_t *e) {
@@ -38,16 +41,20 @@ static void eye_sync_on_done(const lcm_recv_buf_t *rbuf, const char *channel,
                              const autodrive_eye_frame_done_t *msg, void *user) {
   (void)rbuf;
   eye_sync_t *e = user;
-  if (msg->latency_us < 0 || msg->latency_us > EYE_SYNC_MAX_LATENCY_US || msg->utime < 0) {
+  if (msg->latency_us < 0 || msg->latency_us > EYE_SYNC_MAX_LATENCY_US || msg->utime < -1) {
     if (e->refused++ == 0)
       fprintf(stderr,
               "[autodrive-sim] %s: frame %lld us with latency %lld us refused (want a capture "
-              "time >= 0 and a latency of 0..%d us); further ones are counted only\n",
+              "time >= 0, or -1, and a latency of 0..%d us); further ones are counted only\n",
               channel, (long long)msg->utime, (long long)msg->latency_us, EYE_SYNC_MAX_LATENCY_US);
     return;
   }
-  if (msg->utime > e->done_us) e->done_us = msg->utime;
   e->latency_us = msg->latency_us;
+  if (msg->utime < 0) { /* an Eye that is ready and has had no frame yet */
+    e->heard = 1;
+    return;
+  }
+  if (msg->utime > e->done_us) e->done_us = msg->utime;
   if (!e->heard && msg->utime > e->lost_at_us) e->heard = 1;
   eye_sync_drop_done(e);
 }
@@ -59,7 +66,8 @@ eye_sync_t *eye_sync_create(lcm_t *lcm, char *err, size_t err_sz) {
     return NULL;
   }
   e->lcm = lcm;
-  e->done_us = e->lost_at_us = -1;
+  e->done_us = -1;
+  e->lost_at_us = INT64_MIN;
   e->sub =
       autodrive_eye_frame_done_t_subscribe(lcm, AUTODRIVE_CH_EYE_FRAME_DONE, eye_sync_on_done, e);
   if (!e->sub) {
@@ -74,6 +82,22 @@ void eye_sync_destroy(eye_sync_t *e) {
   if (!e) return;
   autodrive_eye_frame_done_t_unsubscribe(e->lcm, e->sub);
   free(e);
+}
+
+void eye_sync_before_frame(eye_sync_t *e) {
+  if (e->first_sent) return;
+  e->first_sent = 1;
+  const double t_give_up = app_wall_s() + EYE_SYNC_FIRST_S;
+  while (!e->heard && !app_stop_requested()) {
+    eye_sync_handle(e, 50);
+    if (!e->heard && app_wall_s() > t_give_up) {
+      fprintf(stderr,
+              "[autodrive-sim] --eye-sync: no Eye announced itself on " AUTODRIVE_CH_EYE_FRAME_DONE
+              " in %.0f s (wall): running on; it is waited for once it answers\n",
+              EYE_SYNC_FIRST_S);
+      return;
+    }
+  }
 }
 
 void eye_sync_frame_sent(eye_sync_t *e, int64_t capture_us) {

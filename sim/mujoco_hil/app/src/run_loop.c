@@ -94,6 +94,7 @@ static int loop_cameras(app_t *a, int64_t now_us, char *err, size_t err_sz) {
   sim_t *s = a->sim;
   if (now_us % a->cam_period_us < SIM_STEP_US) {
     int sent = 0;
+    if (a->eye_sync) eye_sync_before_frame(a->eye_sync);
     if (a->cams.n > 0) {
       if (cameras_publish(&a->cams, sim_render_model(s), sim_render_data(s), a->lcm, now_us, err,
                           err_sz) != 0)
