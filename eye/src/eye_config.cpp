@@ -47,6 +47,7 @@ RunConfig runconfig_load(const std::string &path) {
   c.camera_name = c.cameras[0].name;
   n.read("lcm_url", c.lcm_url);
   n.read_in_range("realtime_priority", c.realtime_priority, 0, 98);
+  if (n.has("sim_latency_ms")) n.read_in_range("sim_latency_ms", c.sim_latency_ms, 0.0, 10000.0);
   // Default: the simulated Nigel's tag (vehicle/nigel.params); a lab gives its printed size.
   c.locate.tag_size_m = n.positive_up_to("tag_size_m", 2.0, AUTODRIVE_VEHICLE_TAG_SIZE_M);
   // Nigel's roof tag offset comes from vehicle/nigel.params (tag_pos_m); a config gives it only

@@ -44,6 +44,9 @@ struct RunConfig {
   std::string map_path;
   std::string lcm_url = AUTODRIVE_LCM_URL_DEFAULT;
   int realtime_priority = 0;  // SCHED_FIFO priority of `run`'s threads (0: ordinary)
+  // lockstep with the simulator: poses out at capture + this, in sim time (eye_lockstep.hpp);
+  // < 0: not in lockstep (run --sim-latency-ms overrides)
+  double sim_latency_ms = -1.0;
   Intrinsics in;
   CameraPose pose;
   LocateParams locate;

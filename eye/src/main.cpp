@@ -15,6 +15,7 @@
 #include "eye_error.hpp"
 #include "eye_fuse.hpp"
 #include "eye_intrinsics.hpp"
+#include "eye_lockstep.hpp"
 #include "eye_mapcal.hpp"
 #include "eye_publish.hpp"
 #include "eye_realtime.hpp"
@@ -143,7 +144,7 @@ int main(int argc, char **argv) {
   // run
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
   std::string rn_config, rn_source = std::string("lcm:") + AUTODRIVE_CH_EYE_IMAGE, rn_debug, rn_url;
-  double rn_fps = 30.0, rn_idle_s = 0.0;
+  double rn_fps = 30.0, rn_idle_s = 0.0, rn_sim_latency_ms = -1.0, rn_cpu_delay_ms = 0.0;
   int rn_max_frames = 0, rn_debug_every = 1, rn_realtime = -1;
   bool rn_quiet = false;
   rn->add_option("-c,--config", rn_config, "run config YAML (see eye/config/eye.yaml)")->required();
@@ -165,6 +166,15 @@ int main(int argc, char **argv) {
                  "lcm source: stop after this long without a frame (0: never)")
       ->capture_default_str();
   rn->add_flag("-q,--quiet", rn_quiet, "no per-frame line on stdout");
+  rn->add_option("--sim-latency-ms", rn_sim_latency_ms,
+                 "lockstep with the simulator (lcm: sources, autodrive-sim --eye-sync): publish "
+                 "a frame's poses (stamped with its capture time) when SIM_CLOCK reaches capture "
+                 "time + this [ms of sim time], then EYE_FRAME_DONE; overrides the config's "
+                 "sim_latency_ms (e.g. tools/bench eye's capture_to_pose_ms_p99)")
+      ->check(CLI::Range(0.0, 10000.0));
+  rn->add_option("--cpu-delay-ms", rn_cpu_delay_ms,
+                 "test double, a slower Eye: spend this much more CPU time on each frame [ms]")
+      ->check(CLI::Range(0.0, 10000.0));
 
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, on_signal);
@@ -263,6 +273,7 @@ int main(int argc, char **argv) {
                      rn_config.c_str(), cfg.realtime_priority, rt_why.c_str());
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
+      if (rn_sim_latency_ms >= 0) cfg.sim_latency_ms = rn_sim_latency_ms;
       // One source per camera: the config's `source`, else --source (one camera only).
       std::vector<std::unique_ptr<eye::Source>> srcs;
       std::vector<eye::RunConfig> cams;
@@ -272,11 +283,19 @@ int main(int argc, char **argv) {
         if (cfg.cameras.size() > 1 && cfg.cameras[i].source.empty())
           throw eye::Error(rn_config + ": cameras[" + std::to_string(i) +
                            "].source: missing key (each of several cameras needs its source)");
+        if (cfg.sim_latency_ms >= 0 && spec.rfind("lcm:", 0) != 0)
+          throw eye::Error("source '" + spec +
+                           "': sim_latency_ms / --sim-latency-ms needs lcm: sources (the "
+                           "simulator's frames, stamped in sim time)");
         cams.push_back(eye::runconfig_camera(cfg, i));
         srcs.push_back(eye::source_open(spec, rn_fps, cfg.lcm_url, rn_idle_s,
                                         cams.back().in.width_px, cams.back().in.height_px));
         refs.push_back(cfg.reference_tags);
       }
+      // After the sources: the simulator may send its first frame as soon as it is told
+      std::unique_ptr<eye::SimLockstep> lockstep;
+      if (cfg.sim_latency_ms >= 0)
+        lockstep = std::make_unique<eye::SimLockstep>(cfg.lcm_url, cfg.sim_latency_ms);
       eye::MultiEye multi(cams, refs, cfg.health);
       std::vector<eye::Frame> fs(srcs.size());
       long frames = 0, published = 0;
@@ -318,7 +337,13 @@ int main(int argc, char **argv) {
                                        std::to_string(in.width_px) + "x" +
                                        std::to_string(in.height_px) + " (frame skipped)");
         }
-        if (!sizes_ok) continue;
+        if (!sizes_ok) {
+          if (lockstep) {  // the sim waits for every frame it sent: this one is done, empty
+            lockstep->hold(fs[0].utime, &g_stop);
+            lockstep->done(lcm, fs[0].utime, 0);
+          }
+          continue;
+        }
         // Cameras of one Eye are triggered together (the simulator renders them at one sim
         // time): the frame time is the first camera's capture time.
         std::vector<eye::TrackInput> grays;
@@ -327,12 +352,22 @@ int main(int argc, char **argv) {
         // The tracked cars' poses go out first; the staggered band (new cars, reference tags
         // for health) finishes after them.
         auto poses = multi.track(grays, utime);
-        published += eye::publish_poses(lcm, poses, utime);
-        if (fs[0].wall_clock)
-          latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
+        if (rn_cpu_delay_ms > 0) eye::burn_cpu_ms(rn_cpu_delay_ms);
+        if (!lockstep) {
+          published += eye::publish_poses(lcm, poses, utime);
+          if (fs[0].wall_clock)
+            latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
+        }
         const auto late = multi.finish();
-        published += eye::publish_poses(lcm, late, utime);
-        poses.insert(poses.end(), late.begin(), late.end());
+        if (lockstep) {  // every pose of the frame at capture + latency of sim time
+          poses.insert(poses.end(), late.begin(), late.end());
+          lockstep->hold(utime, &g_stop);
+          published += eye::publish_poses(lcm, poses, utime);
+          lockstep->done(lcm, utime, static_cast<int>(poses.size()));
+        } else {
+          published += eye::publish_poses(lcm, late, utime);
+          poses.insert(poses.end(), late.begin(), late.end());
+        }
         for (size_t i : multi.newly_moved()) {
           const auto &st = multi.health(i).status();
           std::fprintf(stderr,
@@ -359,6 +394,12 @@ int main(int argc, char **argv) {
         ++frames;
       }
       std::fprintf(stderr, "autodrive-eye: %ld frames, %ld poses published\n", frames, published);
+      if (lockstep)
+        std::fprintf(stderr,
+                     "autodrive-eye: in lockstep with the simulator: poses out at capture + "
+                     "%.3f ms of sim time; %ld frame(s) released without " AUTODRIVE_CH_SIM_CLOCK
+                     " getting there\n",
+                     1e-3 * static_cast<double>(lockstep->latency_us()), lockstep->given_up());
       if (unpaired > 0)
         std::fprintf(stderr,
                      "autodrive-eye: %ld camera frames dropped: another camera had no frame of "

@@ -18,8 +18,15 @@ rtf_1_two_cameras_30fps: one car with its front and rear cameras rendered and JP
 at 30 Hz. turn_radius_error_pct: circle fitted to the ground truth at steering 0.6 vs
 L/tan(delta); *_mujoco_friction: the same with plain MuJoCo contact friction instead of the
 paper tyre model. goals_met: each goal by wall time and by CPU time. lidar_scan_us,
-camera_fps_640x480: from the sensors library's sim-sensors-bench. Options: SIM_BENCH_REPEATS
-(3).
+camera_fps_640x480: from the sensors library's sim-sensors-bench.
+eye_render_ms_per_frame_1280x960: median process CPU time (llvmpipe's threads included) of one
+overhead-camera frame of Tiny Town (4 cameras, one car driving in the view of each) with the
+static world cached (sim_render_cache.h), and eye_render_full_ms_per_frame_1280x960 the full
+render of the same frames in the same run (`autodrive-sim --eye-render compare`: each frame
+rendered both ways), their ratio, the wall-clock medians (*_wall_*, load-dependent), how many
+pixels differ (eye_render_differing_fraction, eye_render_max_abs_diff) and the load average
+when it ran (eye_render_load_avg). Goals: <= 10 ms, and at most 1e-4 of the pixels differing.
+Options: SIM_BENCH_REPEATS (3).
 """
 
 from __future__ import annotations
@@ -45,6 +52,11 @@ DRIVE_SCRIPT = "constant:throttle=0.5,steering=0.3"
 TURN_STEERINGS = (0.3, 0.6, 1.0)
 TURN_SETTLE_US = 3e6  # skip the start of the circle
 TOP_SPEED_SETTLE_US = 2e6
+# one car in the view of each of Tiny Town's four overhead cameras (eye1..eye4)
+EYE_RENDER_STARTS = ("1,-3.0,-3.14,0", "2,3.0,-3.14,180", "3,-3.0,2.86,0", "4,3.0,2.86,180")
+EYE_RENDER_DURATION_S = 2.0  # 60 frame times x 4 cameras, each rendered cached and in full
+EYE_RENDER_GOAL_MS = 10.0
+EYE_RENDER_MAX_DIFFERING = 1e-4  # fraction of the pixels (tests/sim: sim.EyeRenderCache.*)
 log = Progress("sim")
 
 
@@ -155,6 +167,38 @@ def speed(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
         log(f"cameras unavailable: {e.stderr.strip() if e.stderr else e}")
 
 
+def eye_render(bench: SimBench, url: str, res: dict[str, Any]) -> None:
+    """The overhead cameras: cached and full render of the same frames, in one run."""
+    args = ["--lockstep", "--no-pty", "--map", "tiny_town", "--cars", "4", "--eye"]
+    for start in EYE_RENDER_STARTS:
+        args += ["--car-start", start]
+    args += ["--eye-render", "compare", "--script", DRIVE_SCRIPT]
+    args += ["--duration", str(EYE_RENDER_DURATION_S)]
+    load = os.getloadavg()[0]
+    try:
+        r = bench.run(args, url)
+    except subprocess.CalledProcessError as e:
+        log(f"overhead cameras unavailable: {e.stderr.strip() if e.stderr else e}")
+        return
+    cached, full = r["eye_render_cpu_ms_median"], r["eye_render_full_cpu_ms_median"]
+    res["eye_render_ms_per_frame_1280x960"] = round(cached, 3)
+    res["eye_render_full_ms_per_frame_1280x960"] = round(full, 3)
+    res["eye_render_ratio"] = round(cached / full, 4) if full > 0 else None
+    res["eye_render_wall_ms_per_frame_1280x960"] = round(r["eye_render_wall_ms_median"], 3)
+    res["eye_render_full_wall_ms_per_frame_1280x960"] = round(
+        r["eye_render_full_wall_ms_median"], 3
+    )
+    res["eye_render_frames"] = r["eye_render_frames"]
+    res["eye_render_differing_fraction"] = r["eye_render_differing_fraction"]
+    res["eye_render_max_abs_diff"] = r["eye_render_max_abs_diff"]
+    res["eye_render_load_avg"] = round(load, 1)
+    log(
+        f"overhead cameras (Tiny Town, {r['eye_render_frames']} frames, load {load:.1f}): "
+        f"cached {cached:.2f} ms, full {full:.2f} ms of CPU per frame (median); "
+        f"{r['eye_render_differing_fraction']:.2g} of the pixels differ"
+    )
+
+
 def instructions(bench: SimBench, res: dict[str, Any]) -> None:
     if not sim_instructions.available():
         log("valgrind not installed: no instruction counts")
@@ -212,6 +256,13 @@ def goals_met(res: dict[str, Any]) -> dict[str, bool]:
     if "rtf_16" in res:
         out["rtf_16"] = res["rtf_16"] >= 3.0
         out["rtf_cpu_16"] = res["rtf_cpu_16"] >= 3.0
+    # a missing figure fails its goal
+    eye_ms = res.get("eye_render_ms_per_frame_1280x960")
+    out["eye_render_ms_per_frame_1280x960"] = eye_ms is not None and eye_ms <= EYE_RENDER_GOAL_MS
+    differing = res.get("eye_render_differing_fraction")
+    out["eye_render_equals_full_render"] = (
+        differing is not None and differing <= EYE_RENDER_MAX_DIFFERING
+    )
     return out
 
 
@@ -225,6 +276,7 @@ def main(argv: list[str]) -> int:
     res: dict[str, Any] = {}
     url = bench.pick_url()
     speed(bench, url, repeats, res)
+    eye_render(bench, url, res)
     instructions(bench, res)
     fidelity(bench, res)
     sensors(build, res)

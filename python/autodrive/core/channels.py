@@ -19,7 +19,10 @@ CAM = "<CAM>"  # an overhead camera of the map (EYE1, EYE2, ...: the map's eye_c
 # when someone acts (a command), only when a runtime knows its map pose (v2v: an Eye or
 # estimator.initial_pose_map), or only while the Smart City Manager runs. "" = every run.
 # eye_cameras: only when the simulator renders a map's several overhead cameras.
-WHEN = frozenset({"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras"})
+# eye_lockstep: only while an Eye runs in lockstep with the simulator (--sim-latency-ms).
+WHEN = frozenset(
+    {"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras", "eye_lockstep"}
+)
 
 
 class ChannelTableError(ValueError):

@@ -11,6 +11,7 @@
 
 #include "bench_pairs.h"
 #include "cameras.h"
+#include "eye_sync.h"
 #include "options.h"
 #include "publish_queue.h"
 #include "render_thread.h"
@@ -29,6 +30,7 @@ typedef struct app {
   int64_t cam_period_us;
   traffic_lights_lcm_t *lights; /* the map's traffic lights on LCM, or NULL */
   teleport_lcm_t *teleport;     /* --allow-teleport, or NULL */
+  eye_sync_t *eye_sync;         /* --eye-sync, or NULL */
   viewer_window_t viewer;
   publish_queue_t *pubq; /* ground truth and SIM_CLOCK leave through its worker thread */
 } app_t;

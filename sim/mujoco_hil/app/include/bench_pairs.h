@@ -25,6 +25,9 @@ typedef struct bench_pairs {
   double *ratio_wall, *ratio_cpu; /* sim block / bare block, per pair */
 } bench_pairs_t;
 
+/* The median of v[0..n) (0 when n <= 0); v is not changed. */
+double bench_median(const double *v, int n);
+
 /* Starts pairing on s (the cars at their start poses). Returns 0, or -1 when out of memory. */
 int bench_pairs_start(bench_pairs_t *bp, const sim_t *s);
 /* Call after the sim's step number `step` (1-based). At the end of a block it runs the bare

@@ -19,6 +19,8 @@ typedef struct app_options {
   double rtf, duration_s;
   int bench, quiet, lidar_lcm, view;
   int cameras, eye; /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */
+  int eye_sync;     /* --eye-sync: wait for the Eye's EYE_FRAME_DONE (eye_sync.h) */
+  int eye_render;   /* --eye-render: CAMERAS_RENDER_CACHED, _FULL or _COMPARE (cameras.h) */
   double camera_fps, light_level, camera_noise, camera_blur;
   scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
   int nstarts;

@@ -31,9 +31,9 @@ typedef struct render_thread {
   lcm_t *lcm;
   mjData *snap[RENDER_THREAD_QUEUE]; /* a ring of states at frame times */
   int64_t frame_us[RENDER_THREAD_QUEUE];
-  int head, queued;         /* next to render; queued (the one in hand included) */
-  int stop, opened, failed; /* opened: 1 ok, -1 failed */
-  int cameras, eye;         /* cameras_open's arguments */
+  int head, queued;             /* next to render; queued (the one in hand included) */
+  int stop, opened, failed;     /* opened: 1 ok, -1 failed */
+  int cameras, eye, eye_render; /* cameras_open's arguments */
   double noise, blur_px;
   uint64_t seed;
   long rendered, skipped;
@@ -43,7 +43,8 @@ typedef struct render_thread {
 /* Starts the thread, which opens the cameras (t->cameras, t->eye, effects from t->noise,
  * t->blur_px, t->seed) and waits for snapshots. */
 int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err, size_t err_sz);
-/* The state at frame time now_us to the render thread's queue, unless it is full. */
+/* The state at frame time now_us to the render thread's queue, unless it is full. Returns 1
+ * when queued, 0 when skipped (the queue was full), -1 when the thread failed (err). */
 int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, char *err,
                          size_t err_sz);
 /* Frames waiting behind the one being rendered: the stepping thread's pause this step [us]. */

@@ -8,7 +8,7 @@ static int bp_cmp(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-static double bp_median(const double *v, int n) {
+double bench_median(const double *v, int n) {
   if (n <= 0) return 0.0;
   double *w = malloc(sizeof *w * (size_t)n);
   if (!w) return 0.0;
@@ -69,7 +69,7 @@ void bench_pairs_print_json(const bench_pairs_t *bp, FILE *out) {
           "\"overhead_ratio_paired_cpu\": %.4f",
           bp->bare_wall_s > 0 ? sim_s / bp->bare_wall_s : 0.0,
           bp->bare_cpu_s > 0 ? sim_s / bp->bare_cpu_s : 0.0, bp->bare_steps, bp->n,
-          bp_median(bp->ratio_wall, bp->n), bp_median(bp->ratio_cpu, bp->n));
+          bench_median(bp->ratio_wall, bp->n), bench_median(bp->ratio_cpu, bp->n));
 }
 
 void bench_pairs_free(bench_pairs_t *bp) {

@@ -2,6 +2,7 @@
  * bare mj_step loop on the same model, the route driver's cross-track error, the lights. */
 #include <math.h>
 #include <stdio.h>
+#include <time.h>
 
 #include "app.h"
 #include "route_driver.h"
@@ -19,6 +20,28 @@ static void bench_print_bare(const app_t *a, double sim_s, const bench_pairs_t *
   printf(", \"bare_mj_step_rtf\": %.3f, \"bare_mj_step_rtf_cpu\": %.3f, \"bare_steps\": %d",
          bare_s > 0 ? bare_steps * 1e-3 / bare_s : 0.0,
          bare_cpu_s > 0 ? bare_steps * 1e-3 / bare_cpu_s : 0.0, bare_steps);
+}
+
+/* The overhead cameras' render times (and the cached-vs-full check), --eye-sync's waits. */
+static void bench_print_cameras(const app_t *a) {
+  if (a->render) { /* the render thread idle: it touches its statistics only with a frame */
+    pthread_mutex_lock(&a->render->mu);
+    while (a->render->queued > 0 && !a->render->failed) {
+      pthread_mutex_unlock(&a->render->mu);
+      const struct timespec ts = {0, 1000000};
+      nanosleep(&ts, NULL);
+      pthread_mutex_lock(&a->render->mu);
+    }
+  }
+  render_stats_print_json(a->render ? &a->render->cams.stats : &a->cams.stats, stdout);
+  if (a->render) pthread_mutex_unlock(&a->render->mu);
+  if (a->eye_sync) {
+    double waited_s = 0.0;
+    long given_up = 0;
+    const long waits = eye_sync_stats(a->eye_sync, &waited_s, &given_up);
+    printf(", \"eye_sync_waits\": %ld, \"eye_sync_waited_s\": %.3f, \"eye_sync_given_up\": %ld",
+           waits, waited_s, given_up);
+  }
 }
 
 void app_print_bench(const app_t *a, const app_run_stats_t *st, const bench_pairs_t *pairs) {
@@ -43,6 +66,8 @@ void app_print_bench(const app_t *a, const app_run_stats_t *st, const bench_pair
   }
   long refused = 0;
   const long commands = traffic_lights_lcm_commands(a->lights, &refused);
-  printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld}\n",
+  printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld",
          sim_traffic_lights(s)->n, commands, refused);
+  bench_print_cameras(a);
+  printf("}\n");
 }

@@ -3,6 +3,7 @@
 
 #include <ctype.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <autodrive_channels.h>
@@ -49,6 +50,7 @@ static int cameras_open_eyes(cameras_t *k, const mjModel *m, char *err, size_t e
     k->cam[k->n] = sim_camera_create(k->render, m, name, name, w, h, 90, err, err_sz);
     if (!k->cam[k->n]) return -1;
     k->cam_id[k->n] = id;
+    k->eye[k->n] = 1;
     snprintf(k->channel[k->n], sizeof k->channel[0], "%s" AUTODRIVE_CH_IMAGE_SUFFIX, cam);
     snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "%s" AUTODRIVE_CH_CAMERA_INFO_SUFFIX,
              cam);
@@ -57,7 +59,22 @@ static int cameras_open_eyes(cameras_t *k, const mjModel *m, char *err, size_t e
   return 0;
 }
 
-int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, char *err, size_t err_sz) {
+/* The overhead cameras' render mode and its buffers (--eye-render). */
+static int cameras_eye_render(cameras_t *k, int eye_render, int w, int h, char *err,
+                              size_t err_sz) {
+  k->eye_render = eye_render;
+  if (render_stats_init(&k->stats) != 0 ||
+      (eye_render == CAMERAS_RENDER_COMPARE && !(k->full_rgb = malloc((size_t)w * h * 3)))) {
+    snprintf(err, err_sz, "--eye: out of memory for the render statistics");
+    return -1;
+  }
+  for (int i = 0; i < k->n; i++)
+    if (k->eye[i]) sim_camera_set_full_render(k->cam[i], eye_render == CAMERAS_RENDER_FULL);
+  return 0;
+}
+
+int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, int eye_render, char *err,
+                 size_t err_sz) {
   memset(k, 0, sizeof *k);
   if (!cameras && !eye) return 0;
   const mjModel *m = sim_render_model(s);
@@ -91,10 +108,33 @@ int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, char *err, 
     }
     k->cam[k->n] = sim_camera_create(k->render, m, "eye", "eye", 1280, 960, 90, err, err_sz);
     if (!k->cam[k->n]) return -1;
+    k->eye[k->n] = 1;
     snprintf(k->channel[k->n], sizeof k->channel[0], "%s", AUTODRIVE_CH_EYE_IMAGE);
     snprintf(k->info_channel[k->n], sizeof k->info_channel[0], "%s", AUTODRIVE_CH_EYE_CAMERA_INFO);
     k->n++;
   }
+  return eye ? cameras_eye_render(k, eye_render, rw, rh, err, err_sz) : 0;
+}
+
+/* An overhead camera's frame, timed; compare: its full render first, then the cached one. */
+static int cameras_render_eye(cameras_t *k, int i, const mjModel *mv, mjData *dv) {
+  sim_camera_t *c = k->cam[i];
+  const size_t n = (size_t)sim_camera_width(c) * (size_t)sim_camera_height(c) * 3;
+  double t0[2];
+  if (k->eye_render == CAMERAS_RENDER_COMPARE) {
+    sim_camera_set_full_render(c, 1);
+    render_stats_clock(t0);
+    if (sim_camera_render(c, mv, dv) != 0) return -1;
+    render_stats_add(&k->stats, RENDER_STATS_FULL, t0);
+    memcpy(k->full_rgb, sim_camera_rgb(c), n);
+    sim_camera_set_full_render(c, 0);
+  }
+  render_stats_clock(t0);
+  if (sim_camera_render(c, mv, dv) != 0) return -1;
+  render_stats_add(&k->stats, sim_camera_render_cache(c) ? RENDER_STATS_CACHED : RENDER_STATS_FULL,
+                   t0);
+  if (k->eye_render == CAMERAS_RENDER_COMPARE)
+    render_stats_compare(&k->stats, k->full_rgb, sim_camera_rgb(c), n);
   return 0;
 }
 
@@ -103,7 +143,9 @@ int cameras_publish(cameras_t *k, const mjModel *mv, mjData *dv, lcm_t *lcm, int
   const int info = now_us >= k->next_info_us;
   if (info) k->next_info_us = now_us + 1000000; /* camera_info at 1 Hz */
   for (int i = 0; i < k->n; i++) {
-    if (sim_camera_capture(k->cam[i], mv, dv, now_us) != 0) {
+    const int rendered =
+        k->eye[i] ? cameras_render_eye(k, i, mv, dv) : sim_camera_render(k->cam[i], mv, dv);
+    if (rendered != 0 || sim_camera_encode(k->cam[i], now_us) != 0) {
       snprintf(err, err_sz, "rendering %s failed", k->channel[i]);
       return -1;
     }
@@ -119,5 +161,8 @@ void cameras_close(cameras_t *k) {
     cfx_free(&k->fx[i]);
   }
   if (k->render) sim_render_destroy(k->render);
+  render_stats_free(&k->stats);
+  free(k->full_rgb);
+  k->full_rgb = NULL;
   k->n = 0;
 }

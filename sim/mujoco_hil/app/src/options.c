@@ -84,6 +84,17 @@ static void options_usage(FILE *f) {
       "  --eye               render the map's overhead camera 'eye' (1280x960) on EYE_IMAGE,\n"
       "                      or, on a map with eye_cameras (Tiny Town), each of those on\n"
       "                      <CAM>_IMAGE (EYE1_IMAGE, ...) and <CAM>_CAMERA_INFO\n"
+      "  --eye-sync          (lockstep modes, with --eye) lockstep with the Eye: after a\n"
+      "                      frame captured at t the sim does not step past t + L until\n"
+      "                      autodrive-eye run --sim-latency-ms L has published its poses\n"
+      "                      (EYE_FRAME_DONE); it publishes SIM_CLOCK at t + L, when the Eye\n"
+      "                      releases them. Before the first frame it waits up to 60 s\n"
+      "                      (wall) for the Eye to say it is ready; an Eye silent for 2 s\n"
+      "                      (wall) while waited for is given up until it answers again\n"
+      "  --eye-render MODE   cached (default): an overhead camera renders the static world\n"
+      "                      once and draws only what moves over it; full: every frame in\n"
+      "                      full; compare: both, the cached one published (--bench reports\n"
+      "                      their times and how their pixels differ)\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
       "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
@@ -299,6 +310,18 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     o->cameras = CAMERAS_FRONT;
   } else if (!strcmp(a, "--eye")) {
     o->eye = 1;
+  } else if (!strcmp(a, "--eye-sync")) {
+    o->eye_sync = 1;
+  } else if (!strcmp(a, "--eye-render") && v) {
+    o->eye_render = !strcmp(v, "cached")    ? CAMERAS_RENDER_CACHED
+                    : !strcmp(v, "full")    ? CAMERAS_RENDER_FULL
+                    : !strcmp(v, "compare") ? CAMERAS_RENDER_COMPARE
+                                            : -1;
+    if (o->eye_render < 0) {
+      fprintf(stderr, "autodrive-sim: --eye-render '%s': expected cached, full or compare\n", v);
+      return OPTIONS_BAD;
+    }
+    return 1;
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
   } else if (!strcmp(a, "--camera-fps")) {
@@ -326,6 +349,12 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
             "--lockstep-frames (a car never jumps in a real-time run)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->eye_sync && (!o->lockstep || !o->eye)) {
+    fprintf(stderr,
+            "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
+            "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
     return OPTIONS_BAD;
   }
   if (o->client_sync && !o->cfg.open_ptys) {

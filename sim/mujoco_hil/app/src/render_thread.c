@@ -6,7 +6,7 @@
 static void *render_thread_run(void *arg) {
   render_thread_t *t = arg;
   char err[256] = "";
-  int rc = cameras_open(&t->cams, t->s, t->cameras, t->eye, err, sizeof err);
+  int rc = cameras_open(&t->cams, t->s, t->cameras, t->eye, t->eye_render, err, sizeof err);
   if (rc == 0) cameras_set_effects(&t->cams, t->noise, t->blur_px, t->seed);
   pthread_mutex_lock(&t->mu);
   t->opened = rc == 0 ? 1 : -1;
@@ -60,11 +60,13 @@ int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, cha
                          size_t err_sz) {
   pthread_mutex_lock(&t->mu);
   const int failed = t->failed;
+  int queued = 0;
   if (failed) {
     snprintf(err, err_sz, "%s", t->err);
   } else if (t->queued == RENDER_THREAD_QUEUE) {
     t->skipped++;
   } else {
+    queued = 1;
     const int tail = (t->head + t->queued) % RENDER_THREAD_QUEUE;
     sim_render_snapshot(s, t->snap[tail]);
     t->frame_us[tail] = now_us;
@@ -72,7 +74,7 @@ int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, cha
     pthread_cond_signal(&t->cv);
   }
   pthread_mutex_unlock(&t->mu);
-  return failed ? -1 : 0;
+  return failed ? -1 : queued;
 }
 
 long render_thread_backlog_us(render_thread_t *t) {

@@ -88,14 +88,23 @@ static void loop_publish_sensors(app_t *a, const loop_t *l) {
 }
 
 /* The cameras at their frame times: rendered here, or queued for the render thread (which
- * slows the stepping down while frames wait). Returns 0, or -1 with the message in err. */
+ * slows the stepping down while frames wait); --eye-sync learns of each frame sent. Returns 0,
+ * or -1 with the message in err. */
 static int loop_cameras(app_t *a, int64_t now_us, char *err, size_t err_sz) {
   sim_t *s = a->sim;
-  if (now_us % a->cam_period_us < SIM_STEP_US &&
-      ((a->cams.n > 0 && cameras_publish(&a->cams, sim_render_model(s), sim_render_data(s), a->lcm,
-                                         now_us, err, err_sz) != 0) ||
-       (a->render && render_thread_submit(a->render, s, now_us, err, err_sz) != 0)))
-    return -1;
+  if (now_us % a->cam_period_us < SIM_STEP_US) {
+    int sent = 0;
+    if (a->eye_sync) eye_sync_before_frame(a->eye_sync);
+    if (a->cams.n > 0) {
+      if (cameras_publish(&a->cams, sim_render_model(s), sim_render_data(s), a->lcm, now_us, err,
+                          err_sz) != 0)
+        return -1;
+      sent = 1;
+    }
+    if (a->render && (sent = render_thread_submit(a->render, s, now_us, err, err_sz)) < 0)
+      return -1;
+    if (sent && a->eye_sync) eye_sync_frame_sent(a->eye_sync, now_us);
+  }
   if (a->render) { /* slow down while frames wait to be rendered */
     const long backlog_us = render_thread_backlog_us(a->render);
     if (backlog_us > 0) {
@@ -141,6 +150,26 @@ static void loop_pace(app_t *a, loop_t *l, int64_t now_us) {
   }
 }
 
+/* SIM_CLOCK (lockstep modes and --rtf) with the run's average rtf so far. */
+static void loop_publish_clock(app_t *a, const loop_t *l, int64_t now_us) {
+  const double since = app_wall_s() - l->t0;
+  publish_sim_clock(a->pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
+}
+
+/* --eye-sync: at the step that reaches a frame's capture time + the Eye's latency, SIM_CLOCK
+ * goes out (the Eye releases the frame's poses on it) and the sim waits for EYE_FRAME_DONE.
+ * --lockstep-frames sends no extra SIM_CLOCK (its clients answer each one with a frame): there
+ * the sim waits at the next regular one. clock_sent: this step's SIM_CLOCK is out already. */
+static void loop_wait_for_eye(app_t *a, const loop_t *l, int64_t now_us, int clock_sent) {
+  eye_sync_t *e = a->eye_sync;
+  if (!e) return;
+  if (clock_sent) eye_sync_poll(e); /* an Eye's first answer, and those that came early */
+  if (!eye_sync_due(e, now_us) || (!clock_sent && a->opt->frame_sync)) return;
+  if (!clock_sent) loop_publish_clock(a, l, now_us);
+  publish_queue_flush(a->pubq);
+  eye_sync_wait(e, now_us);
+}
+
 /* One pass of the loop. Returns 1 to go on, 0 when the run is over, -1 on an error (message on
  * stderr). */
 static int loop_once(app_t *a, loop_t *l) {
@@ -170,10 +199,9 @@ static int loop_once(app_t *a, loop_t *l) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return -1;
   }
-  if ((o->lockstep || o->rtf_given) && l->step % LOOP_CLOCK_EVERY == 0) {
-    const double since = app_wall_s() - l->t0; /* average rtf of the run so far */
-    publish_sim_clock(a->pubq, now_us, since > 0 ? now_us * 1e-6 / since : 0.0, 0);
-  }
+  const int clock_now = (o->lockstep || o->rtf_given) && l->step % LOOP_CLOCK_EVERY == 0;
+  if (clock_now) loop_publish_clock(a, l, now_us);
+  loop_wait_for_eye(a, l, now_us, clock_now);
   if (a->viewer.v && viewer_window_frame(&a->viewer, s, &l->t0) != 0) return 0;
   if (l->paired) { /* the bare block is not part of the run: its time moves the start on */
     const double bare_wall_s = bench_pairs_after_step(&l->pairs, l->step);
@@ -217,6 +245,14 @@ int app_run(app_t *a, app_run_stats_t *st) {
   st->wall_s = app_wall_s() - l.t0;
   st->cpu_s = app_cpu_s() - cpu0 - bench_pairs_bare_cpu_s(&l.pairs);
   st->steps = l.step;
+  double eye_waited_s = 0.0;
+  long eye_given_up = 0;
+  const long eye_waits = eye_sync_stats(a->eye_sync, &eye_waited_s, &eye_given_up);
+  if (a->eye_sync && !o->quiet)
+    fprintf(stderr,
+            "autodrive-sim: --eye-sync: waited for the Eye at %ld frame(s), %.1f s of wall time "
+            "in all, gave it up %ld time(s)\n",
+            eye_waits, eye_waited_s, eye_given_up);
   if (lcm_failures)
     fprintf(stderr, "autodrive-sim: LCM refused %llu ground-truth/clock message(s) on '%s'\n",
             (unsigned long long)lcm_failures, o->url);

@@ -103,11 +103,13 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
       (o->cameras || o->eye) && !(o->lockstep && (o->frame_sync || !o->client_sync));
   render.cameras = o->cameras;
   render.eye = o->eye;
+  render.eye_render = o->eye_render;
   render.noise = o->camera_noise;
   render.blur_px = o->camera_blur;
   render.seed = o->cfg.seed;
-  if (threaded ? render_thread_start(&render, a->sim, a->lcm, err, err_sz) != 0
-               : cameras_open(&a->cams, a->sim, o->cameras, o->eye, err, err_sz) != 0) {
+  if (threaded
+          ? render_thread_start(&render, a->sim, a->lcm, err, err_sz) != 0
+          : cameras_open(&a->cams, a->sim, o->cameras, o->eye, o->eye_render, err, err_sz) != 0) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;
   }
@@ -132,6 +134,10 @@ static int app_build_links(app_t *a, char *err, size_t err_sz) {
     return 1;
   }
   if (a->teleport) printf("teleport: obeying " AUTODRIVE_CH_SIM_TELEPORT " (--allow-teleport)\n");
+  if (o->eye_sync && !(a->eye_sync = eye_sync_create(a->lcm, err, err_sz))) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    return 1;
+  }
   if (viewer_window_open(&a->viewer, a->sim, o->view, err, err_sz) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
     return 1;
@@ -186,6 +192,7 @@ void app_close(app_t *a) {
   if (a->pubq) publish_queue_destroy(a->pubq);
   traffic_lights_lcm_destroy(a->lights);
   teleport_lcm_destroy(a->teleport);
+  eye_sync_destroy(a->eye_sync);
   viewer_window_close(&a->viewer);
   if (a->render) render_thread_stop(a->render);
   cameras_close(&a->cams);

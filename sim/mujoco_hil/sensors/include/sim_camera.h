@@ -47,6 +47,17 @@ void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx);
 
 /* Renders the current state d and JPEG-encodes it. Returns 0, or -1 on failure. */
 int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime);
+/* The two halves of sim_camera_capture: render (the filter applied) into the RGB frame, then
+ * JPEG-encode that frame stamped utime. Each returns 0, or -1 on failure. */
+int sim_camera_render(sim_camera_t *c, const mjModel *m, mjData *d);
+int sim_camera_encode(sim_camera_t *c, int64_t utime);
+
+/* A camera fixed in the world (an overhead Eye camera) renders its static world once and
+ * draws only what moves over it (sim_render_cache.h): on by default for such a camera.
+ * full = 1 renders every frame in full instead. Returns the cache, or NULL when it has none
+ * (a camera on a car, or full). Borrowed. */
+struct sim_render_cache *sim_camera_render_cache(const sim_camera_t *c);
+void sim_camera_set_full_render(sim_camera_t *c, int full);
 
 /* The last frame: RGB rows top-down (width*height*3) and its JPEG. Borrowed, valid until the
  * next capture. */

@@ -10,6 +10,7 @@
 #include <autodrive_compressed_image_t.h>
 
 #include "sim_jpeg.h"
+#include "sim_render_cache.h"
 
 struct sim_camera {
   sim_render_t *render;
@@ -18,11 +19,14 @@ struct sim_camera {
   int w, h;
   char frame_id[64];
   uint8_t *rgb;
+  const uint8_t *frame; /* the last frame: rgb, or the cache's own image (no copy) */
   const uint8_t *jpg;
   size_t jpg_len;
   int64_t utime;
   sim_camera_filter_fn filter;
   void *filter_ctx;
+  sim_render_cache_t *cache; /* a camera fixed in the world: its static world, or NULL */
+  int full_render;           /* 1: render in full even with a cache */
 };
 
 void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx) {
@@ -59,8 +63,11 @@ sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *c
   c->h = height_px;
   snprintf(c->frame_id, sizeof c->frame_id, "%s", frame_id);
   c->rgb = calloc((size_t)width_px * (size_t)height_px, 3);
+  c->frame = c->rgb;
   c->jpeg = sim_jpeg_create(jpeg_quality);
-  if (!c->rgb || !c->jpeg) {
+  if (sim_render_cache_applies(m, id))
+    c->cache = sim_render_cache_create(m, id, width_px, height_px, NULL, 0);
+  if (!c->rgb || !c->jpeg || (sim_render_cache_applies(m, id) && !c->cache)) {
     sim_camera_destroy(c);
     if (err && err_len) snprintf(err, err_len, "sim_camera: out of memory for '%s'", cam_name);
     return NULL;
@@ -71,20 +78,43 @@ sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *c
 void sim_camera_destroy(sim_camera_t *c) {
   if (!c) return;
   sim_jpeg_destroy(c->jpeg);
+  sim_render_cache_destroy(c->cache);
   free(c->rgb);
   free(c);
 }
 
-int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime) {
-  if (sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb) != 0) return -1;
+struct sim_render_cache *sim_camera_render_cache(const sim_camera_t *c) {
+  return c->full_render ? NULL : c->cache;
+}
+
+void sim_camera_set_full_render(sim_camera_t *c, int full) {
+  c->full_render = full != 0;
+}
+
+int sim_camera_render(sim_camera_t *c, const mjModel *m, mjData *d) {
+  const int cached = c->cache && !c->full_render;
+  /* a filter changes the frame: it works on our copy, never on the cache's own image */
+  uint8_t *into = cached && !c->filter ? NULL : c->rgb;
+  const int rc = cached ? sim_render_camera_cached(c->render, c->cache, m, d, into)
+                        : sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb);
+  if (rc != 0) return -1;
+  c->frame = into ? c->rgb : sim_render_cache_image(c->cache);
   if (c->filter) c->filter(c->rgb, c->w, c->h, c->filter_ctx);
-  if (sim_jpeg_encode(c->jpeg, c->rgb, c->w, c->h, &c->jpg, &c->jpg_len) != 0) return -1;
+  return 0;
+}
+
+int sim_camera_encode(sim_camera_t *c, int64_t utime) {
+  if (sim_jpeg_encode(c->jpeg, c->frame, c->w, c->h, &c->jpg, &c->jpg_len) != 0) return -1;
   c->utime = utime;
   return 0;
 }
 
+int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime) {
+  return sim_camera_render(c, m, d) == 0 ? sim_camera_encode(c, utime) : -1;
+}
+
 const uint8_t *sim_camera_rgb(const sim_camera_t *c) {
-  return c->rgb;
+  return c->frame;
 }
 const uint8_t *sim_camera_jpeg(const sim_camera_t *c, size_t *size_bytes) {
   if (size_bytes) *size_bytes = c->jpg_len;

@@ -1,62 +1,10 @@
 /* sim_render: see sim_render.h. */
-#include "sim_render.h"
+#include "sim_render_internal.h"
 
 #include <dlfcn.h>
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
-#include <GL/gl.h>
-#include <GL/glext.h>
-#include <GL/osmesa.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* EGL and OSMesa are loaded at run time (dlopen, RTLD_GLOBAL), only the one in use: MuJoCo's
- * GL loader looks for eglGetProcAddress before OSMesaGetProcAddress, so an OSMesa context
- * only works when libEGL was never loaded into the process. */
-typedef struct egl_api {
-  void *lib;
-  __eglMustCastToProperFunctionPointerType (*GetProcAddress)(const char *);
-  EGLBoolean (*Initialize)(EGLDisplay, EGLint *, EGLint *);
-  EGLBoolean (*Terminate)(EGLDisplay);
-  EGLBoolean (*ChooseConfig)(EGLDisplay, const EGLint *, EGLConfig *, EGLint, EGLint *);
-  EGLBoolean (*BindAPI)(EGLenum);
-  EGLContext (*CreateContext)(EGLDisplay, EGLConfig, EGLContext, const EGLint *);
-  EGLBoolean (*DestroyContext)(EGLDisplay, EGLContext);
-  EGLBoolean (*MakeCurrent)(EGLDisplay, EGLSurface, EGLSurface, EGLContext);
-  EGLContext (*GetCurrentContext)(void);
-} egl_api_t;
-
-typedef struct osmesa_api {
-  void *lib;
-  void *(*GetProcAddress)(const char *);
-  OSMesaContext (*CreateContextExt)(GLenum, GLint, GLint, GLint, OSMesaContext);
-  GLboolean (*MakeCurrent)(OSMesaContext, void *, GLenum, GLsizei, GLsizei);
-  OSMesaContext (*GetCurrentContext)(void);
-  void (*DestroyContext)(OSMesaContext);
-} osmesa_api_t;
-
-struct sim_render {
-  sim_render_backend_t backend;
-  egl_api_t egl;
-  osmesa_api_t osm;
-  EGLDisplay egl_dpy;
-  EGLContext egl_ctx;
-  OSMesaContext osm_ctx;
-  void *osm_buf;  /* OSMesa's default framebuffer (unused by MuJoCo's offscreen) */
-  mjModel *mcopy; /* shallow copy of the model with our render settings */
-  mjrContext con;
-  mjvScene scn;
-  mjvOption opt;
-  mjvCamera cam;
-  int maxw, maxh;
-  uint8_t *rgba; /* RGBA readback: Mesa's fast glReadPixels path (RGB is ~30 % slower) */
-  void (*ReadPixels)(GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, void *);
-  void (*BindFramebuffer)(GLenum, GLuint);
-  float light_k; /* day 1, night < 1: scales every scene light */
-};
-
-static int render_make_current(sim_render_t *r);
 
 static void err_set(char *err, size_t n, const char *msg) {
   if (err && n) snprintf(err, n, "sim_render: %s", msg);
@@ -196,10 +144,11 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
     err_set(err, err_len, "MuJoCo could not make an offscreen buffer of the requested size");
     return NULL;
   }
-  /* glReadPixels / glBindFramebuffer from the backend in use (MuJoCo does not export its own) */
-  const char *names[2] = {"glReadPixels", "glBindFramebuffer"};
-  void *fp[2] = {NULL, NULL};
-  for (int i = 0; i < 2; i++) {
+  /* glReadPixels, glBindFramebuffer, glGetFloatv from the backend in use (MuJoCo does not
+   * export its own) */
+  const char *names[3] = {"glReadPixels", "glBindFramebuffer", "glGetFloatv"};
+  void *fp[3] = {NULL, NULL, NULL};
+  for (int i = 0; i < 3; i++) {
     if (r->backend == SIM_RENDER_EGL) {
       __eglMustCastToProperFunctionPointerType f = r->egl.GetProcAddress(names[i]);
       memcpy(&fp[i], &f, sizeof f);
@@ -209,9 +158,10 @@ sim_render_t *sim_render_create(const mjModel *m, int max_width_px, int max_heig
   }
   memcpy(&r->ReadPixels, &fp[0], sizeof fp[0]);
   memcpy(&r->BindFramebuffer, &fp[1], sizeof fp[1]);
-  if (!r->ReadPixels || !r->BindFramebuffer) {
+  memcpy(&r->GetFloatv, &fp[2], sizeof fp[2]);
+  if (!r->ReadPixels || !r->BindFramebuffer || !r->GetFloatv) {
     sim_render_destroy(r);
-    err_set(err, err_len, "the GL context has no glReadPixels/glBindFramebuffer");
+    err_set(err, err_len, "the GL context has no glReadPixels/glBindFramebuffer/glGetFloatv");
     return NULL;
   }
   mjv_defaultScene(&r->scn);
@@ -229,7 +179,7 @@ void sim_render_destroy(sim_render_t *r) {
   if (!r) return;
   mjv_freeScene(&r->scn);
   /* GL objects are freed in the context that made them */
-  if (r->egl_ctx != EGL_NO_CONTEXT || r->osm_ctx) render_make_current(r);
+  if (r->egl_ctx != EGL_NO_CONTEXT || r->osm_ctx) sim_render_make_current(r);
   mjr_freeContext(&r->con);
   if (r->egl_dpy != EGL_NO_DISPLAY) {
     r->egl.MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -263,7 +213,7 @@ mjvOption *sim_render_options(sim_render_t *r) {
 
 /* Makes the renderer's context current again if something else (a viewer window) took the
  * thread's current context since the last frame. */
-static int render_make_current(sim_render_t *r) {
+int sim_render_make_current(sim_render_t *r) {
   if (r->backend == SIM_RENDER_EGL) {
     if (r->egl.GetCurrentContext() == r->egl_ctx) return 0;
     return r->egl.MakeCurrent(r->egl_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->egl_ctx) ? 0 : -1;
@@ -272,12 +222,7 @@ static int render_make_current(sim_render_t *r) {
   return r->osm.MakeCurrent(r->osm_ctx, r->osm_buf, GL_UNSIGNED_BYTE, 4, 4) ? 0 : -1;
 }
 
-int sim_render_camera(sim_render_t *r, const mjModel *m, mjData *d, int cam_id, int width_px,
-                      int height_px, uint8_t *rgb) {
-  if (cam_id < 0 || cam_id >= m->ncam || width_px < 1 || height_px < 1 || width_px > r->maxw ||
-      height_px > r->maxh || !rgb)
-    return -1;
-  if (render_make_current(r) != 0) return -1;
+void sim_render_update_scene(sim_render_t *r, const mjModel *m, mjData *d, int cam_id) {
   r->cam.fixedcamid = cam_id;
   mjv_updateScene(m, d, &r->opt, NULL, &r->cam, mjCAT_ALL, &r->scn);
   if (r->light_k != 1.0f)
@@ -287,8 +232,9 @@ int sim_render_camera(sim_render_t *r, const mjModel *m, mjData *d, int cam_id, 
         r->scn.lights[i].ambient[c] *= r->light_k;
         r->scn.lights[i].specular[c] *= r->light_k;
       }
-  mjrRect vp = {0, 0, width_px, height_px};
-  mjr_render(vp, &r->scn, &r->con);
+}
+
+void sim_render_read_rgb(sim_render_t *r, int width_px, int height_px, uint8_t *rgb) {
   /* read RGBA from MuJoCo's offscreen FBO (no MSAA: no resolve step), then drop alpha and
    * flip: OpenGL rows are bottom-up, images top-down */
   r->BindFramebuffer(GL_READ_FRAMEBUFFER, r->con.offFBO);
@@ -302,15 +248,29 @@ int sim_render_camera(sim_render_t *r, const mjModel *m, mjData *d, int cam_id, 
       dst[2] = src[2];
     }
   }
+}
+
+int sim_render_camera(sim_render_t *r, const mjModel *m, mjData *d, int cam_id, int width_px,
+                      int height_px, uint8_t *rgb) {
+  if (cam_id < 0 || cam_id >= m->ncam || !sim_render_fits(r, width_px, height_px) || !rgb)
+    return -1;
+  if (sim_render_make_current(r) != 0) return -1;
+  sim_render_update_scene(r, m, d, cam_id);
+  mjrRect vp = {0, 0, width_px, height_px};
+  mjr_render(vp, &r->scn, &r->con);
+  sim_render_read_rgb(r, width_px, height_px, rgb);
   mjr_restoreBuffer(&r->con);
   return 0;
 }
 
 void sim_render_set_daylight(sim_render_t *r, const mjModel *m, int day) {
   (void)m;
-  r->light_k = day ? 1.0f : 0.15f; /* night keeps 15 % of every light, headlight included */
+  const float k = day ? 1.0f : 0.15f; /* night keeps 15 % of every light, headlight included */
+  if (k != r->light_k) r->epoch++;
+  r->light_k = k;
 }
 
 void sim_render_upload_texture(sim_render_t *r, const mjModel *m, int tex_id) {
   mjr_uploadTexture(m, &r->con, tex_id);
+  r->epoch++;
 }
