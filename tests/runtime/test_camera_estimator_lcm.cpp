@@ -227,3 +227,64 @@ TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
   EXPECT_EQ(st.gyro_dropped, 1u);
   EXPECT_EQ(st.reacquired, 0u);
 }
+
+// A car knows its map pose only from the Eye (or a pose given with its uncertainty): before
+// the first Eye pose no POSE_MAP at all (never the filter's origin), then one from that fix on.
+TEST(EstimatorLcm, NoMapPoseBeforeTheFirstEyeFix) {
+  const autodrive::config::Config c =
+      autodrive::config::parse(base_yaml(7788) + "estimator: {rate_hz: 100}\n", "test config");
+  lcm::LCM lcm(c.lcm_url);
+  Sink sink;
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_odom>(lcm, "TESTCAR_ODOM", &sink);
+  autodrive_lcm::subscribe<autodrive::odometry_t, Sink, &Sink::on_map>(lcm, "TESTCAR_POSE_MAP",
+                                                                       &sink);
+  autodrive::estimator::EstimatorNode node(c);
+  ASSERT_EQ(node.init_error(), "");
+  std::atomic<bool> stop{false};
+  std::thread th([&] { node.run(stop); });
+  const int64_t first_fix_us = 1000000 + 150 * 10000LL;  // after 1.5 s of telemetry
+  int k = 0;
+  auto feed = [&] {
+    autodrive::vehicle_state_t s{};
+    s.utime = 1000000 + k * 10000LL;
+    s.nano_time_us = k * 10000LL;
+    lcm.publish("TESTCAR_STATE", &s);
+    if (s.utime >= first_fix_us && k % 10 == 0) {
+      autodrive::pose2d_t e{};
+      e.utime = s.utime;
+      e.vehicle = "TESTCAR";
+      e.x_m = 2.0;
+      e.y_m = -1.0;
+      e.yaw_rad = 1.0;
+      lcm.publish("TESTCAR_POSE_EYE", &e);
+    }
+    ++k;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  };
+  const bool got = pump_until(
+      lcm, [&] { return k >= 250 && sink.odom.size() > 200 && sink.map.size() > 20; }, 60, feed);
+  stop = true;
+  th.join();
+  ASSERT_TRUE(got);
+  for (const auto &m : sink.map) EXPECT_GE(m.utime, first_fix_us) << "a map pose before a fix";
+  EXPECT_NEAR(sink.map.front().x_m, 2.0, 0.01);  // the first is the fix, not the origin
+  EXPECT_NEAR(sink.map.front().y_m, -1.0, 0.01);
+  EXPECT_NEAR(sink.map.front().yaw_rad, 1.0, 0.01);
+}
+
+// A start pose given with its uncertainty: the map filter starts there, as sure as it says.
+TEST(EstimatorConfig, InitialPoseWithItsUncertainty) {
+  const auto c = autodrive::config::parse(
+      base_yaml(7788) +
+          "estimator: {rate_hz: 100, initial_pose_map: [1, 2, 0.5], initial_pos_std_m: 0.02, "
+          "initial_yaw_std_rad: 0.035}\n",
+      "test config");
+  ASSERT_TRUE(c.estimator.has_initial_pose_map);
+  EXPECT_DOUBLE_EQ(c.estimator.initial_pos_std_m, 0.02);
+  EXPECT_DOUBLE_EQ(c.estimator.initial_yaw_std_rad, 0.035);
+  const auto d = autodrive::config::parse(base_yaml(7788) + "estimator: {rate_hz: 100}\n", "t");
+  EXPECT_DOUBLE_EQ(d.estimator.initial_pos_std_m, d.estimator.eye_pos_std_m);  // the default
+  EXPECT_THROW(autodrive::config::parse(
+                   base_yaml(7788) + "estimator: {rate_hz: 100, initial_pos_std_m: -1}\n", "t"),
+               autodrive::config::Error);
+}

@@ -1,6 +1,7 @@
 """HIL demo orchestration: starts the simulator (Parking School), the unchanged Jetson runtime
-on the simulator's ptys, a mission (parking or loop) and lcm-logger; stops everything cleanly
-(also on Ctrl-C); then writes OUT: report.json, PNG plots and the LCM log of the run.
+on the simulator's ptys, the car's pose source (--eye: by default autodrive-eye on the rendered
+overhead camera), a mission (parking or loop) and lcm-logger; stops everything cleanly (also on
+Ctrl-C); then writes OUT: report.json, PNG plots and the LCM log of the run.
 
 CLI: tools/demo --help (python -m autodrive.hil.demo). In-process: run(parse_args(argv))."""
 
@@ -22,7 +23,7 @@ from typing import Any, TextIO
 import yaml
 
 from autodrive.core import channels, command_auth
-from autodrive.hil import report
+from autodrive.hil import pose_source, report
 from autodrive.devtools.inspect import export_mcap
 from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
@@ -36,6 +37,7 @@ from autodrive.core.settings import EYE_SIM_CONFIG, OUT_DIR, RELEASE_BUILD, RUNT
 from autodrive.core.proc import ProcessGroup, wait_for_path
 
 VEHICLE = channels.vehicle_name(1)
+MAP = "parking_school"
 PROGRAMS = ("autodrive-sim", "autodrive-runtime", "autodrive-autonomy")
 # The default scenario's unmapped box (x, y [m], T [s], half sizes [m], R [m]), on the direct
 # way from the spawn to slot 2. After a mapping route it steps out once the car comes back
@@ -138,9 +140,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         type=float,
         default=0.0,
         metavar="FPS",
-        help="render every camera (front, rear, the overhead Eye) at FPS [Hz of sim time] and run "
-        "autodrive-eye on the overhead one, whose poses the runtime fuses (default 0: off)",
+        help="render every camera (front, rear, the overhead Eye) at FPS [Hz of sim time] "
+        "(default 0: only the overhead ones, for --eye cameras, at "
+        f"{pose_source.EYE_FPS_DEFAULT:g} Hz)",
     )
+    pose_source.add_eye_option(p, default=None)
     p.add_argument("--laps", type=int, default=3, help="smart-city: laps every car drives")
     p.add_argument(
         "--advisory",
@@ -152,11 +156,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument(
         "--city-eye",
         choices=("cameras", "standin"),
-        default="standin",
-        help="smart-city: car poses from the ground-truth stand-in (truth + noise; default: the "
-        "real Eye's rendering does not leave 2 shared cores enough for 3 laps, docs/results/smart-city.md) or from "
-        "autodrive-eye on the simulator's rendered overhead cameras (--cameras FPS sets their "
-        "rate, 0: the mission's default)",
+        help="deprecated: the old name of --eye (smart-city); says so and does what --eye does",
     )
     p.add_argument("--scm-port", type=int, default=8765, help="smart-city: the SCM's web port")
     p.add_argument(
@@ -175,6 +175,17 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
+    if args.city_eye is not None:
+        if args.eye is not None and args.eye != args.city_eye:
+            p.error(f"--city-eye {args.city_eye} contradicts --eye {args.eye}: give --eye only")
+        print(
+            f"tools/demo: --city-eye is deprecated, use --eye {args.city_eye} (the one pose-source "
+            "flag of every mission)",
+            file=sys.stderr,
+        )
+        args.eye = args.city_eye
+    if args.eye is None:
+        args.eye = "cameras"
     if args.timeout is None:
         args.timeout = smart_city.TIMEOUT_S if args.mission == "smart-city" else PARKING_TIMEOUT_S
     if args.timeout <= 0:
@@ -210,7 +221,9 @@ def sim_argv(
     argv += ["--run-dir", run_dir, "--seed", args.seed, "--lcm-url", args.lcm_url]
     argv += ["--duration", duration_s]
     if args.cameras > 0:
-        argv += ["--cameras", "--eye", "--camera-fps", args.cameras]
+        argv += ["--cameras"]  # front and rear, at the overhead camera's rate
+    if args.cameras > 0 or args.eye == "cameras":
+        argv += ["--eye", "--camera-fps", args.cameras or pose_source.EYE_FPS_DEFAULT]
     if plan is not None:
         argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
         s = plan.start
@@ -222,6 +235,20 @@ def sim_argv(
     if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
         argv += ["--view"]  # a window when a display exists; headless otherwise
     return argv
+
+
+def start_pose_source(args: argparse.Namespace, build: Path, out: Path, procs: ProcessGroup) -> str:
+    """The car's pose source of --eye on Parking School (its one overhead camera 'eye', the
+    config eye/config/sim/eye.yaml); returns what runs."""
+    fps = args.cameras or pose_source.EYE_FPS_DEFAULT
+    if args.eye == "cameras":
+        eye_argv = [build / "bin" / "autodrive-eye", "run", "-c", EYE_SIM_CONFIG, "-q"]
+        eye_argv += ["--source", f"lcm:{channels.channel('EYE_IMAGE')}"]
+        procs.start("autodrive-eye", [*eye_argv, "--lcm-url", args.lcm_url], out / "eye.log")
+        return pose_source.describe("cameras", MAP, fps)
+    return pose_source.start(
+        procs, args.eye, build, MAP, out, args.lcm_url, [VEHICLE], args.seed, fps
+    )
 
 
 def parking_plan(args: argparse.Namespace) -> parking.ParkingPlan:
@@ -314,20 +341,19 @@ def run(
     lcm_log = out / "run.lcmlog"
     t_wall0 = time.time()
     result: dict[str, Any] = {}
+    eye_what = "not started"
     ctx = MissionContext(build, out, args.lcm_url, VEHICLE, procs, stop_requested, say, echo)
     try:
         logger_argv = ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f", "--flush-interval=100"]
         procs.start("lcm-logger", [*logger_argv, lcm_log], out / "lcm-logger.log")
         procs.start("autodrive-sim", sim_argv(args, build, run_dir, rtf, plan), out / "sim.log")
         wait_for_path(run_dir / "nigel1-nano", PTY_TIMEOUT_S, procs)
-        if args.cameras > 0:
-            eye_argv = [build / "bin" / "autodrive-eye", "run", "-c", EYE_SIM_CONFIG, "-q"]
-            eye_argv += ["--source", f"lcm:{channels.channel('EYE_IMAGE')}"]
-            procs.start("autodrive-eye", [*eye_argv, "--lcm-url", args.lcm_url], out / "eye.log")
+        eye_what = start_pose_source(args, build, out, procs)
         runtime = build / "bin" / "autodrive-runtime"
         procs.start("autodrive-runtime", [runtime, "--config", cfg_path], out / "runtime.log")
-        if plan is None:
-            result = loop.drive(ctx, args.duration, rtf)
+        if plan is None:  # on the map filter; without an Eye (no map fix) on the odometry
+            pose_channel = "ODOM" if args.eye == "none" else "POSE_MAP"
+            result = loop.drive(ctx, args.duration, rtf, pose_channel)
         else:
             result = parking.run(ctx, plan)
     except RuntimeError as e:
@@ -342,7 +368,7 @@ def run(
     stop_requested()
     if interrupted:
         say("interrupted: everything stopped; analysing what was recorded")
-    rep = report.analyse(lcm_log, out, VEHICLE, build)
+    rep = report.analyse(lcm_log, out, VEHICLE, build, args.eye, eye_what)
     rep.update(result)
     if plan is not None and "goal_world" in result:
         rep.update(parking.score(lcm_log, out, VEHICLE, build, result))
@@ -364,6 +390,7 @@ def run(
     (out / "report.json.tmp").write_text(json.dumps(rep, indent=2))
     os.replace(out / "report.json.tmp", out / "report.json")
     say(f"report: {json.dumps(rep)}")
+    say(pose_source.summary_line(rep))
     pngs = ", ".join(p.name for p in sorted(out.glob("*.png")))
     say(f"wrote {out}/report.json, plots {pngs}, log {lcm_log}")
     write_mcap(lcm_log, out, build, say)

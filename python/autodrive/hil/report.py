@@ -1,5 +1,6 @@
 """The demo's report of a recorded run: the runtime's EKF against the simulator's ground truth,
-collisions, telemetry rate, path length; trajectory.png and ekf_error.png.
+collisions, telemetry rate, path length, Eye poses; trajectory.png and ekf_error.png. The EKF
+is its map filter (<VEH>_POSE_MAP), or its odometry (<VEH>_ODOM) in a run without an Eye.
 
 Also runnable on any recorded log:
     python -m autodrive.hil.report <run.lcmlog> <out-dir> [VEHICLE] [--build DIR]"""
@@ -19,18 +20,25 @@ from autodrive.core import channels
 from autodrive.core.channels import channel
 from autodrive.core.geometry import Alignment, wrap
 from autodrive.core.settings import RELEASE_BUILD
+from autodrive.hil import pose_source
 from autodrive.hil.scoring import nearest_index, rms
 
 Report = dict[str, Any]
 
 
-def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
+def analyse(
+    log_path: Path, out: Path, veh: str, build: Path, eye: str = "none", eye_what: str = ""
+) -> Report:
+    """eye: the run's --eye (its pose_source); eye_what: what ran (for the report)."""
     if not Path(log_path).exists():
         return {"ok": False, "error": f"no LCM log at {log_path}"}
     types = lcmtypes.load(build)
-    ch_truth, ch_pose, ch_state, ch_control = (
-        channel(c, veh) for c in ("GROUND_TRUTH", "POSE_MAP", "STATE", "CONTROL")
+    ch_truth, ch_pose, ch_state, ch_control, ch_odom, ch_eye = (
+        channel(c, veh)
+        for c in ("GROUND_TRUTH", "POSE_MAP", "STATE", "CONTROL", "ODOM", "POSE_EYE")
     )
+    poses = pose_source.PoseRecord()
+    odom: list[tuple[int, float, float, float]] = []  # (receive time [us], x, y, yaw)
     control: Any = None  # the bridge's last control_status_t
     holders: set[str] = set()
     # (sim time [us], x, y, yaw); gt_rx: the log's receive time of each
@@ -45,12 +53,19 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
             m = types.ground_truth_t.decode(ev.data)
             gt.append((m.utime, m.position_m[0], m.position_m[1], m.yaw_rad))
             gt_rx.append(ev.timestamp)
+            poses.on_truth(veh, m.utime * 1e-6, m.position_m[0], m.position_m[1])
             if m.in_collision and not in_collision:
                 collisions += 1
             in_collision = m.in_collision
         elif ev.channel == ch_pose:
             m = types.odometry_t.decode(ev.data)
             ekf.append((ev.timestamp, m.x_m, m.y_m, m.yaw_rad))
+            poses.on_ekf(veh, m.utime * 1e-6, m.x_m, m.y_m)
+        elif ev.channel == ch_odom:
+            m = types.odometry_t.decode(ev.data)
+            odom.append((ev.timestamp, m.x_m, m.y_m, m.yaw_rad))
+        elif ev.channel == ch_eye:
+            poses.on_eye(veh, types.pose2d_t.decode(ev.data).utime * 1e-6)
         elif ev.channel == ch_state:
             m = types.vehicle_state_t.decode(ev.data)
             state_t.append(m.nano_time_us)  # the Nano's clock: sim time in HIL
@@ -59,8 +74,13 @@ def analyse(log_path: Path, out: Path, veh: str, build: Path) -> Report:
             control = types.control_status_t.decode(ev.data)
             if control.holder:
                 holders.add(control.holder)
+    # No map pose without an Eye fix: then the EKF's odometry, aligned below as the map was.
+    ekf_channel = ch_pose if len(ekf) >= 10 or len(odom) < 10 else ch_odom
+    ekf = ekf if ekf_channel == ch_pose else odom
     rep: Report = {
         "ok": False,
+        **pose_source.report(eye, eye_what or eye, [poses], [veh]),
+        "ekf_channel": ekf_channel,
         "gt_samples": len(gt),
         "ekf_samples": len(ekf),
         "state_samples": len(state_t),

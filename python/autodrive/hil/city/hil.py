@@ -1,6 +1,7 @@
-"""Several cars on one simulator: a runtime config per car (its ptys, the run's bus, its start
-pose as the EKF's initial map pose, its route intent) and the start poses read once from the
-simulator's ground truth (where it placed each car)."""
+"""Several cars on one simulator: a runtime config per car (its ptys, the run's bus, the EKF's
+start: its first Eye fix, or a given start pose with its placement uncertainty; its route
+intent) and the start poses read once from the simulator's ground truth (where it placed each
+car, for tests that place cars by hand)."""
 
 from __future__ import annotations
 
@@ -14,15 +15,23 @@ import yaml
 from autodrive.core import lcmtypes
 from autodrive.core.channels import channel, vehicle_name
 from autodrive.core.settings import RUNTIME_HIL_CONFIG
+from autodrive.hil import pose_source
 
 Pose = tuple[float, float, float]  # x [m], y [m], yaw [rad]
 
 
 def runtime_config(
-    out: Path, run_dir: Path, url: str, car: int, start: Pose, route: str, lidar: bool = False
+    out: Path,
+    run_dir: Path,
+    url: str,
+    car: int,
+    start: Pose | None,
+    route: str,
+    lidar: bool = False,
 ) -> Path:
-    """The HIL runtime config of car `car` (1-based) on the sim's ptys, clock sim, its map pose
-    at start, its route; without the LIDAR unless asked (the city cars do not use it)."""
+    """The HIL runtime config of car `car` (1-based) on the sim's ptys, clock sim, its route;
+    its EKF placed at start with the placement uncertainty (pose_source.PLACEMENT_STD_M, _RAD),
+    or, start None, by its first Eye fix; without the LIDAR unless asked."""
     cfg: dict[str, Any] = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
     name = vehicle_name(car)
     cfg["lcm_url"] = url
@@ -33,7 +42,7 @@ def runtime_config(
         cfg["lidar"]["device"] = str(run_dir / f"{name.lower()}-lidar")
     else:
         del cfg["lidar"]
-    cfg["estimator"]["initial_pose_map"] = [float(v) for v in start]
+    pose_source.estimator_start(cfg, "cameras" if start is None else "none", start or (0, 0, 0))
     cfg["route"] = route
     path = out / f"runtime-{name.lower()}.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=False))

@@ -8,10 +8,12 @@ that is the reset. Routes and spawns are drawn from the seed as in training (aut
 per approach, each turning left, going straight or right, a later spawn further back. The simulator runs in lockstep with the runtimes (--lockstep-client),
 so a loaded machine slows the run down and does not change it much.
 
-Localisation: in the lab the overhead Eye localises every car; here, by default (--eye
-standin), autodrive.hil.city.eye_standin publishes each car's <VEH>_POSE_EYE from the
-simulator's ground truth with the Eye's noise, which the unchanged runtimes' EKFs fuse, as in the
-smart-city mission. --eye none leaves the EKFs on dead reckoning from the start pose.
+Localisation: in the lab the overhead Eye localises every car; here too, by default (--eye
+cameras): the simulator renders Intersection School's two overhead cameras (the map's
+eye_cameras) and autodrive-eye publishes each car's <VEH>_POSE_EYE from them, which the unchanged
+runtimes' EKFs fuse; each EKF starts from its car's first Eye fix and the car waits still until
+then. --eye standin is the test double (ground truth + the Eye's noise); --eye none leaves the
+EKFs on dead reckoning from the marked start pose (autodrive.hil.pose_source).
 
 CLI: tools/demo --mission intersection --help."""
 
@@ -39,6 +41,7 @@ from autodrive.gym import tasks
 from autodrive.learn.marl import env as marl_env
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
 from autodrive.core.proc import ProcessGroup, wait_for_path
+from autodrive.hil import pose_source
 from autodrive.hil.missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options
 
 MAP = tasks.INTERSECTION_MAP
@@ -47,11 +50,6 @@ DEFAULT_POLICY = settings().models_dir / "marl" / "intersection.onnx"
 CARS = 4
 EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
 PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
-EYE_WHAT = {  # --eye: what gives the EKFs their absolute poses (said in the report)
-    "standin": "stand-in: ground truth + the Eye's noise (city.eye_standin)",
-    "none": "none: dead reckoning from the start pose",
-}
-EYES = tuple(EYE_WHAT)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -81,14 +79,18 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         default=0.0,
         help="how far each car's EKF pose may be off [m]: the shield grows every footprint by it",
     )
+    pose_source.add_eye_option(p)
     p.add_argument(
-        "--eye",
-        choices=EYES,
-        default="standin",
-        help="the cars' absolute poses: standin (default): ground truth + the Eye's noise on "
-        "<VEH>_POSE_EYE (city.eye_standin); none: the EKFs dead-reckon from the start pose",
+        "--cameras",
+        type=float,
+        default=0.0,
+        metavar="FPS",
+        help="--eye cameras: the overhead cameras' frame rate [Hz of sim time] (default 0: "
+        f"{pose_source.EYE_FPS_DEFAULT:g})",
     )
     args = p.parse_args(argv)
+    if args.cameras < 0:
+        p.error(f"--cameras {args.cameras}: the frame rate must be >= 0 Hz")
     if args.episodes < 1:
         p.error(f"--episodes {args.episodes}: at least 1")
     if not 0.0 <= args.v2v_loss <= 1.0:
@@ -123,17 +125,19 @@ def plan_episode(seed: int) -> list[CarPlan]:
     return plans
 
 
-def write_runtime_config(path: Path, run_dir: Path, url: str, car: int, plan: CarPlan) -> Path:
+def write_runtime_config(
+    path: Path, run_dir: Path, url: str, car: int, plan: CarPlan, eye: str
+) -> Path:
     """The HIL runtime config of car `car` (1-based): its name and pty, SIM_CLOCK, no LIDAR,
-    its EKF's map filter started at the car's start pose (V2V needs a map pose before the
-    first Eye pose, and with --eye none there is none)."""
+    its EKF's map filter started by its first Eye fix, or (--eye none) at the car's marked start
+    with the placement uncertainty (pose_source.estimator_start)."""
     cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
     cfg["lcm_url"] = url
     cfg["clock"] = "sim"
     cfg["vehicle"]["name"] = channels.vehicle_name(car)
     cfg["bridge"]["device"] = str(run_dir / f"nigel{car}-nano")
     cfg.pop("lidar", None)  # the sim runs --no-lidar: nothing here needs it
-    cfg["estimator"]["initial_pose_map"] = [float(v) for v in plan.start]
+    pose_source.estimator_start(cfg, eye, plan.start)
     path.write_text(yaml.safe_dump(cfg, sort_keys=False))
     return path
 
@@ -146,8 +150,7 @@ class EpisodeRecord:
     at_goal: set[str] = field(default_factory=set)
     goal_t: dict[str, float] = field(default_factory=dict)  # sim time at the goal [s]
     sim_s: float = 0.0
-    eye_poses: int = 0  # <VEH>_POSE_EYE messages seen, every car
-    ekf: dict[str, list[tuple[float, float, float]]] = field(default_factory=dict)  # t, x, y
+    poses: pose_source.PoseRecord = field(default_factory=pose_source.PoseRecord)
 
 
 def ensure_keys(say: Any) -> None:
@@ -176,11 +179,13 @@ def run_episode(
     run_dir.mkdir(parents=True, exist_ok=True)
     rec = EpisodeRecord()
     lc = lcmtypes.bus(args.lcm_url)
+    fps = args.cameras or pose_source.EYE_FPS_DEFAULT
 
     def on_truth(ch: str, data: bytes) -> None:
         m = types.ground_truth_t.decode(data)
         v = ch.split("_")[0]
         rec.truth.setdefault(v, []).append((m.utime * 1e-6, m.position_m[0], m.position_m[1]))
+        rec.poses.on_truth(v, m.utime * 1e-6, m.position_m[0], m.position_m[1])
         rec.sim_s = max(rec.sim_s, m.utime * 1e-6)
         if m.in_collision:
             rec.collided.add(v)
@@ -196,12 +201,13 @@ def run_episode(
             rec.at_goal.add(m.vehicle)
             rec.goal_t[m.vehicle] = m.utime * 1e-6
 
-    def on_eye(_ch: str, _data: bytes) -> None:
-        rec.eye_poses += 1
+    def on_eye(_ch: str, data: bytes) -> None:
+        m = types.pose2d_t.decode(data)
+        rec.poses.on_eye(m.vehicle, m.utime * 1e-6)
 
     def on_pose_map(ch: str, data: bytes) -> None:
         m = types.odometry_t.decode(data)
-        rec.ekf.setdefault(ch.split("_")[0], []).append((m.utime * 1e-6, m.x_m, m.y_m))
+        rec.poses.on_ekf(ch.split("_")[0], m.utime * 1e-6, m.x_m, m.y_m)
 
     subs = []
     for p in plans:
@@ -218,24 +224,21 @@ def run_episode(
         sim = [build / "bin" / "autodrive-sim", "--map", MAP, "--cars", CARS]
         sim += ["--run-dir", run_dir, "--seed", args.seed * 1000 + ep, "--lcm-url", args.lcm_url]
         sim += ["--no-lidar", "--lockstep-client", "--duration", EPISODE_SIM_S + 5, "--quiet"]
-        for i, p in enumerate(plans):
-            sim += [
-                "--car-start",
-                f"{i + 1},{p.start[0]:.4f},{p.start[1]:.4f}," f"{math.degrees(p.start[2]):.3f}",
-            ]
+        seed = args.seed * 1000 + ep
+        marked = [p.start for p in plans]
+        for i, (x, y, yaw) in enumerate(pose_source.placed(marked, args.eye, seed)):
+            sim += ["--car-start", f"{i + 1},{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
+        sim += pose_source.sim_argv(args.eye, fps)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         procs.start("autodrive-sim", sim, ep_dir / "sim.log")
         for i in range(CARS):
             wait_for_path(run_dir / f"nigel{i + 1}-nano", PTY_TIMEOUT_S, procs)
-        if args.eye == "standin":
-            eye: list[object] = [sys.executable, "-m", "autodrive.hil.city.eye_standin"]
-            eye += ["--vehicles", ",".join(p.vehicle for p in plans)]
-            eye += ["--seed", args.seed * 1000 + ep, "--lcm-url", args.lcm_url, "--build", build]
-            procs.start("eye-standin", eye, ep_dir / "eye-standin.log")
+        names = [p.vehicle for p in plans]
+        pose_source.start(procs, args.eye, build, MAP, ep_dir, args.lcm_url, names, seed, fps)
         for i, p in enumerate(plans):
             cfg = write_runtime_config(
-                ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1, p
+                ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1, p, args.eye
             )
             procs.start(
                 f"autodrive-runtime {p.vehicle}",
@@ -308,19 +311,9 @@ def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
 
 
 def ekf_errors_m(rec: EpisodeRecord) -> list[float]:
-    """Every car's EKF map pose against the ground truth at the same sim time (interpolated
-    between the truth's samples, inside their span only) [m]: what the shield works on."""
-    out: list[float] = []
-    for v, poses in rec.ekf.items():
-        truth = np.array(rec.truth.get(v, []))
-        if len(truth) < 2 or not poses:
-            continue
-        est = np.array(poses)
-        est = est[(est[:, 0] >= truth[0, 0]) & (est[:, 0] <= truth[-1, 0])]
-        x = np.interp(est[:, 0], truth[:, 0], truth[:, 1])
-        y = np.interp(est[:, 0], truth[:, 0], truth[:, 2])
-        out += np.hypot(est[:, 1] - x, est[:, 2] - y).tolist()
-    return out
+    """Every car's EKF map pose against the ground truth at the same sim time [m]: what the
+    shield works on."""
+    return [e for car in sorted(rec.poses.ekf) for e in rec.poses.errors_m(car)]
 
 
 def steering_rates(rec: EpisodeRecord) -> list[float]:
@@ -442,8 +435,13 @@ def run(args: argparse.Namespace) -> int:
         "v2v_loss": args.v2v_loss,
         "v2v_delay_ms": args.v2v_delay_ms,
         "shield_pose_error_m": args.shield_pose_error_m,
-        "eye": EYE_WHAT[args.eye],
-        "eye_poses": sum(r.eye_poses for _p, r, _e in done),
+        **pose_source.report(
+            args.eye,
+            pose_source.describe(args.eye, MAP, args.cameras or pose_source.EYE_FPS_DEFAULT),
+            [r.poses for _p, r, _e in done],
+            [channels.vehicle_name(i + 1) for i in range(CARS)],
+        ),
+        "eye_poses": sum(sum(r.poses.eye_poses.values()) for _p, r, _e in done),
         "episodes": n,
         "episodes_requested": args.episodes,
         "successes": sum(1 for _p, _r, e in done if e == "goal"),
@@ -480,6 +478,7 @@ def run(args: argparse.Namespace) -> int:
     if done:
         plot(out / "trajectories.png", done)
     say(f"report: {json.dumps({k: v for k, v in rep.items() if k != 'per_episode'})}")
+    say(pose_source.summary_line(rep))
     say(f"wrote {out / 'report.json'} and {out / 'trajectories.png'}")
     if interrupted:
         say("interrupted: every process stopped")

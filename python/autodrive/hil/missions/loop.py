@@ -1,6 +1,7 @@
 """The loop mission: closes the loop through the whole HIL chain. It follows a stadium-shaped
 track (two 1.0 m straights, 0.4 m radius ends, laid out from the car's start pose) with pure
-pursuit on the runtime's EKF estimate (<VEH>_POSE_MAP), publishing <VEH>_COMMAND at 50 Hz.
+pursuit on the runtime's EKF estimate (<VEH>_POSE_MAP; <VEH>_ODOM in a run without an Eye, whose
+map filter has no fix), publishing <VEH>_COMMAND at 50 Hz.
 Ground truth is never used to drive; the report compares with it afterwards."""
 
 from __future__ import annotations
@@ -42,7 +43,10 @@ def stadium_track(step_m: float = 0.02) -> tuple[list[Point], list[Point]]:
     return lead, lap
 
 
-def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str, Any]:
+def drive(
+    ctx: MissionContext, duration_s: float, rtf: float | None, pose_channel: str = "POSE_MAP"
+) -> dict[str, Any]:
+    """Drives the stadium track on the EKF's pose_channel (POSE_MAP or ODOM)."""
     types = lcmtypes.load(ctx.build)
     car = pure_pursuit.default_vehicle()
     lc = lcmtypes.bus(ctx.lcm_url)
@@ -53,7 +57,7 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
     pose: dict[str, float] = {}
     state: dict[str, int] = {}
     ch_pose, ch_state, ch_command = (
-        channel(c, ctx.vehicle) for c in ("POSE_MAP", "STATE", "COMMAND")
+        channel(c, ctx.vehicle) for c in (pose_channel, "STATE", "COMMAND")
     )
 
     def on_pose(_ch: str, data: bytes) -> None:
@@ -137,7 +141,7 @@ def drive(ctx: MissionContext, duration_s: float, rtf: float | None) -> dict[str
         lc.publish(ch_command, signer.sign(command(False)).encode())
         time.sleep(COMMAND_PERIOD_S)
     return {
-        "driver": "pure pursuit on the runtime EKF (stadium track)",
+        "driver": f"pure pursuit on the runtime EKF's {ch_pose} (stadium track)",
         "laps": laps,
         "track_start_map": [start["x"], start["y"], start["yaw"]],
     }

@@ -1,14 +1,15 @@
 """The smart-city mission (tools/demo --mission smart-city): Tiny Town with three cars on looping
 routes through its lights and signs. Starts autodrive-sim (3 cars, lockstep with the runtimes),
-three unchanged autodrive-runtime processes on its ptys (EKF placed at each car's start pose,
-V2V on), the car poses (by default the Eye stand-in: ground truth with noise, as rendering
-leaves 2 shared cores too little; --city-eye cameras: autodrive-eye on the map's four overhead
-cameras, which the simulator renders at --cameras FPS, EYE_FPS_DEFAULT unless given), each
-car's <VEH>_POSE_EYE fused by its runtime's EKF, the Smart City Manager
+three unchanged autodrive-runtime processes on its ptys (V2V on), the car poses (--eye, see
+autodrive.hil.pose_source: by default autodrive-eye on the map's four overhead cameras, which
+the simulator renders at --cameras FPS, EYE_FPS_DEFAULT unless given; each EKF starts from its
+car's first Eye fix, and the car waits still until then), each car's <VEH>_POSE_EYE fused by its
+runtime's EKF, the Smart City Manager
 (autodrive-scm: web app, database, V2I advisories; --advisory standin uses the small advisory
 publisher instead), three autodrive-city-driver processes and lcm-logger. The run is scored
 from the simulator's ground truth and light states (autodrive.hil.city.scoring) while it
-runs: report.json, trajectories.png (paths and light phases) and run.lcmlog in --out."""
+runs, with each EKF's error against the truth: report.json, trajectories.png (paths and light
+phases) and run.lcmlog in --out."""
 
 from __future__ import annotations
 
@@ -28,8 +29,8 @@ from types import FrameType
 from typing import Any, TextIO
 
 from autodrive.core import command_auth, lcmtypes
-from autodrive.maps import eye_cameras
 from autodrive.core.channels import channel, vehicle_name
+from autodrive.hil import pose_source
 from autodrive.hil.city import hil
 from autodrive.hil.city.scoring import MapFacts, Scorer
 from autodrive.maps.loader import MAPS_DIR
@@ -54,7 +55,7 @@ BLOCKED_S = 30.0  # a car standing this long [s sim] away from any stop line is 
 # is <= 54 mm between poses, which the EKF bridges with odometry and gyro; each frame time is
 # four 1280x960 renders (~160 ms of CPU with software OpenGL), which is what 2 shared cores can
 # give beside three runtimes (docs/results/smart-city.md: the figures were measured at 5 Hz).
-EYE_FPS_DEFAULT = 5.0
+EYE_FPS_DEFAULT = pose_source.EYE_FPS_DEFAULT
 # Starting up is bounded by each program's own CPU time, not by wall time (on a loaded machine
 # the wall time of a start is anyone's guess: at load 48 the SCM was not up in 90 s). Measured
 # here (2026-11-27, load ~10): the SCM is ready after 1.2-1.3 s of its CPU (Python, FastAPI,
@@ -77,7 +78,8 @@ def scm_ready(base_url: str) -> str | None:
 
 
 def start_poses(seed: int) -> list[tuple[float, float, float]]:
-    """Each car's start on its route (the route's polyline), moved along it by the seed."""
+    """Each car's marked start on its route (the route's polyline), moved along it by the
+    seed."""
     routes = {r["name"]: r for r in json.loads((MAPS_DIR / f"{MAP}.json").read_text())["routes"]}
     rng = random.Random(seed)
     poses = []
@@ -167,8 +169,8 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
     tracks: dict[str, list[tuple[float, float, float]]] = {}
     phases: dict[int, list[tuple[float, int]]] = {}
     sim_t = [0.0]
-    eye_poses: dict[str, int] = {}  # <VEH>_POSE_EYE messages per car
-    eye_what = "none"
+    poses = pose_source.PoseRecord()
+    eye_what = "not started"
     result: dict[str, Any] = {}
     t_wall0 = time.time()
     scm_url = ""
@@ -181,6 +183,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             t = m.utime * 1e-6
             sim_t[0] = max(sim_t[0], t)
             x, y = m.position_m[0], m.position_m[1]
+            poses.on_truth(m.vehicle, t, x, y)
             scorer.truth(m.vehicle, t, x, y, m.yaw_rad, m.linear_velocity_m_s[0], m.in_collision)
             tr = tracks.setdefault(m.vehicle, [])
             if not tr or t - tr[-1][0] >= 0.1:
@@ -197,16 +200,21 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             lc.subscribe(channel("GROUND_TRUTH", vehicle_name(i)), on_truth)
         lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
 
+        def on_eye(_ch: str, data: bytes) -> None:
+            m = types.pose2d_t.decode(data)
+            poses.on_eye(m.vehicle, m.utime * 1e-6)
+
+        def on_ekf(_ch: str, data: bytes) -> None:
+            m = types.odometry_t.decode(data)
+            poses.on_ekf(m.vehicle, m.utime * 1e-6, m.x_m, m.y_m)
+
         for i in range(1, cars + 1):
-            eye_poses[vehicle_name(i)] = 0
-            lc.subscribe(
-                channel("POSE_EYE", vehicle_name(i)),
-                lambda _c, _d, car=vehicle_name(i): eye_poses.update({car: eye_poses[car] + 1}),
-            )
+            lc.subscribe(channel("POSE_EYE", vehicle_name(i)), on_eye)
+            lc.subscribe(channel("POSE_MAP", vehicle_name(i)), on_ekf)
         logger = ["lcm-logger", f"--lcm-url={url}", "-f", "--flush-interval=100"]
         procs.start("lcm-logger", [*logger, out / "run.lcmlog"], out / "lcm-logger.log")
         sim: list[object] = [build / "bin" / "autodrive-sim", "--map", MAP, "--cars", cars]
-        for x, y, yaw in starts:
+        for x, y, yaw in pose_source.placed(starts, args.eye, args.seed):
             sim += ["--start", f"{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
         if args.late_obstacles == "none":
             sim += ["--no-late-obstacles"]
@@ -215,8 +223,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         pacing = ["--rtf", args.rtf] if args.rtf else ["--lockstep-client"]
         sim += [*pacing, "--duration", 3600]
         eye_fps = args.cameras or EYE_FPS_DEFAULT
-        if args.city_eye == "cameras":
-            sim += ["--eye", "--camera-fps", eye_fps]
+        sim += pose_source.sim_argv(args.eye, eye_fps)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         sim_proc = procs.start("autodrive-sim", sim, out / "sim.log")
@@ -233,28 +240,15 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         )
         say(f"autodrive-sim has its ptys (after {sim_cpu_s:.1f} s of its CPU)")
         py = sys.executable
-        vehicles = ",".join(vehicle_name(i) for i in range(1, cars + 1))
-        if args.city_eye == "cameras":
-            cams = eye_cameras.load(MAP)
-            cars_tags = [(vehicle_name(i), eye_cameras.sim_tag_id(i)) for i in range(1, cars + 1)]
-            (out / "eye").mkdir(exist_ok=True)
-            eye_cfg = eye_cameras.write_eye_config(cams, out / "eye", url, cars_tags)
-            procs.start(
-                "autodrive-eye",
-                [build / "bin" / "autodrive-eye", "run", "-c", eye_cfg, "-q"],
-                out / "eye.log",
-            )
-            eye_what = f"autodrive-eye on {len(cams)} rendered overhead cameras at {eye_fps:g} Hz"
-        else:
-            eye = [py, "-m", "autodrive.hil.city.eye_standin", "--vehicles", vehicles]
-            procs.start(
-                "eye-standin",
-                [*eye, "--seed", args.seed, "--lcm-url", url, "--build", build],
-                out / "eye-standin.log",
-            )
-            eye_what = "stand-in: ground truth + noise (city.eye_standin)"
+        names = [vehicle_name(i) for i in range(1, cars + 1)]
+        vehicles = ",".join(names)
+        eye_what = pose_source.start(
+            procs, args.eye, build, MAP, out, url, names, args.seed, eye_fps
+        )
         for i in range(1, cars + 1):
-            cfg = hil.runtime_config(out, run_dir, url, i, starts[i - 1], ROUTES[i - 1], lidar=True)
+            # the EKF's start: its first Eye fix, or (--eye none) the marked start pose
+            given = starts[i - 1] if args.eye == "none" else None
+            cfg = hil.runtime_config(out, run_dir, url, i, given, ROUTES[i - 1], lidar=True)
             procs.start(
                 f"runtime{i}",
                 [build / "bin" / "autodrive-runtime", "--config", cfg],
@@ -361,11 +355,12 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         wall_s=round(time.time() - t_wall0, 1),
         advisory=args.advisory,
         scm_url=scm_url,
-        eye=eye_what,
-        eye_poses_per_car_hz={
-            car: round(n / max(sim_t[0], 1e-9), 2) for car, n in sorted(eye_poses.items())
-        },
         late_obstacles=args.late_obstacles,
+    )
+    rep.update(
+        pose_source.report(
+            args.eye, eye_what, [poses], [vehicle_name(i) for i in range(1, cars + 1)]
+        )
     )
     rep["ok"] = (
         "error" not in rep
@@ -379,6 +374,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
     if tracks:
         plot(out, tracks, phases, facts)
     say(f"report: {json.dumps({k: v for k, v in rep.items() if k != 'violations'})}")
+    say(pose_source.summary_line(rep))
     say(f"wrote {out}/report.json, trajectories.png, run.lcmlog")
     if interrupted:
         return EXIT_INTERRUPTED

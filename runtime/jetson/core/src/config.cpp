@@ -149,6 +149,8 @@ Estimator parse_estimator(const Section &s) {
     const auto v = s.numbers("initial_pose_map", 3);
     for (int i = 0; i < 3; ++i) e.initial_pose_map[i] = v[i];
   }
+  e.initial_pos_std_m = s.positive_up_to("initial_pos_std_m", 10.0, e.eye_pos_std_m);
+  e.initial_yaw_std_rad = s.positive_up_to("initial_yaw_std_rad", M_PI, e.eye_yaw_std_rad);
   s.reject_unknown();
   return e;
 }

@@ -46,6 +46,7 @@ struct EstimatorNode::Impl {
   lcm::LCM lcm;                   // inputs (and outputs, unless a separate output bus is given)
   std::unique_ptr<lcm::LCM> out;  // replay: the outputs go to their own bus (e.g. a log file)
   Ekf odom, map;
+  bool map_fixed = false;  // the map filter has a first Eye fix or its initial pose
   bool have_prev = false;
   autodrive::vehicle_state_t prev{};
   int64_t next_pub_us = 0;  // next ODOM/POSE_MAP due [us, message time]
@@ -69,11 +70,12 @@ struct EstimatorNode::Impl {
 
   void on_state(const autodrive::vehicle_state_t *m) {
     if (!odom.initialised()) odom.reset(m->utime, 0, 0, 0, 1e-9, 1e-9);
-    if (!map.initialised() && config.estimator.has_initial_pose_map) {
-      // Placed at a known pose: the map filter starts there, as sure as one Eye pose.
+    if (!map_fixed && config.estimator.has_initial_pose_map) {
+      // Placed at a known pose: the map filter starts there, as sure as its placer says.
       const auto &p = config.estimator.initial_pose_map;
-      map.reset(m->utime, p[0], p[1], p[2], std::pow(config.estimator.eye_pos_std_m, 2),
-                std::pow(config.estimator.eye_yaw_std_rad, 2));
+      map.reset(m->utime, p[0], p[1], p[2], std::pow(config.estimator.initial_pos_std_m, 2),
+                std::pow(config.estimator.initial_yaw_std_rad, 2));
+      map_fixed = true;
     }
     if (have_prev) {
       double v = 0;
@@ -104,7 +106,7 @@ struct EstimatorNode::Impl {
       next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
       if (next_pub_us < m->utime) next_pub_us = m->utime + period_us;  // fell behind
       publish(odom.estimate_at(m->utime), "odom", AUTODRIVE_CH_ODOM_SUFFIX);
-      if (map.initialised())
+      if (map_fixed)  // never a map pose the car has no fix for (the origin, say)
         publish(map.estimate_at(m->utime), "map", AUTODRIVE_CH_POSE_MAP_SUFFIX);
     }
   }
@@ -142,8 +144,9 @@ struct EstimatorNode::Impl {
                                              (m->utime - prev.utime) * 1e-6));
       return;
     }
-    const uint64_t reacquired = map.stats().reacquired;
+    const uint64_t reacquired = map.stats().reacquired, fused = map.stats().fused;
     map.add_pose(m->utime, m->x_m, m->y_m, m->yaw_rad, cov);
+    map_fixed = map_fixed || map.stats().fused > fused;
     if (map.stats().gated > gated_logged) {
       gated_logged = map.stats().gated;
       implausible.event(channel, fmt::format("pose ({:.3f}, {:.3f}) m far from the estimate "

@@ -107,11 +107,15 @@ struct Estimator {
   double max_speed_m_s = 10.0;        // encoder speed above this is a glitch: dropped
   double max_yaw_rate_rad_s = 17.45;  // gyro z above this (1000 deg/s, the IMU's range): dropped
   bool use_imu = true;
-  // Optional: the car's map pose (x [m], y [m], yaw [rad]) at start, where it was placed. The
-  // map filter starts there instead of waiting for the Eye, so POSE_MAP (and V2V) exist without
-  // an Eye; Eye poses, when they come, correct it.
+  // Optional: the car's map pose (x [m], y [m], yaw [rad]) at start, where it was placed, and
+  // how sure of it the one who placed it is (1 sigma; default: the Eye's noise). The map filter
+  // starts there instead of waiting for the Eye's first fix, so POSE_MAP (and V2V) exist
+  // without an Eye; Eye poses, when they come, correct it. Without it the map filter publishes
+  // nothing until its first Eye pose.
   bool has_initial_pose_map = false;
   std::array<double, 3> initial_pose_map{};
+  double initial_pos_std_m = 0.0;    // 0: eye_pos_std_m
+  double initial_yaw_std_rad = 0.0;  // 0: eye_yaw_std_rad
 };
 
 struct Config {

@@ -1,0 +1,68 @@
+"""The missions' pose source and its report (autodrive.hil.pose_source), on synthetic poses (no
+simulator: seconds): a planted EKF offset shows as the EKF error of that car only; Eye poses per
+second of sim time; no EKF is given a start pose with an Eye; --eye none puts the car down off
+its marked start; --city-eye is a deprecated alias of --eye; every mission defaults to the real
+Eye."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from autodrive.hil import demo, pose_source
+from autodrive.hil.missions import intersection
+
+
+def _drive(rec: pose_source.PoseRecord, car: str, offset_m: float, eye_hz: float) -> None:
+    """10 s of sim time along x at 0.2 m/s: truth at 100 Hz, the EKF offset_m off in y at
+    100 Hz, Eye poses at eye_hz."""
+    for k in range(1001):
+        t = k * 0.01
+        rec.on_truth(car, t, 0.2 * t, 0.0)
+        rec.on_ekf(car, t + 0.005, 0.2 * (t + 0.005), offset_m)
+        if eye_hz and k % round(100 / eye_hz) == 0:
+            rec.on_eye(car, t)
+
+
+def test_planted_ekf_error_and_eye_rate() -> None:
+    rec = pose_source.PoseRecord()
+    _drive(rec, "NIGEL1", 0.004, 5.0)
+    _drive(rec, "NIGEL2", 0.05, 0.0)  # planted: 5 cm off, no Eye
+    rep = pose_source.report("cameras", "test", [rec], ["NIGEL1", "NIGEL2", "NIGEL3"])
+    assert rep["pose_source"] == "eye"
+    assert rep["ekf_error_m"]["NIGEL1"]["p95"] == pytest.approx(0.004, abs=1e-4)
+    assert rep["ekf_error_m"]["NIGEL2"]["max"] == pytest.approx(0.05, abs=1e-4)
+    assert rep["ekf_error_m"]["NIGEL3"] is None  # never seen: said, not hidden
+    assert rep["ekf_error_p95_worst_m"] == pytest.approx(0.05, abs=1e-4)
+    assert rep["eye_poses_per_car_hz"]["NIGEL1"] == pytest.approx(5.0, abs=0.15)
+    assert rep["eye_poses_per_car_hz"]["NIGEL2"] == 0.0
+    assert rep["first_eye_fix_s"] == {"NIGEL1": 0.0}
+    line = pose_source.summary_line(rep)
+    assert "NIGEL2 p50 5.0" in line and "NIGEL3 no EKF map pose" in line, line
+
+
+def test_ekf_never_starts_on_truth() -> None:
+    start = (1.0, -2.0, 0.5)
+    cfg: dict[str, dict[str, object]] = {"estimator": {"initial_pose_map": [9, 9, 9]}}
+    pose_source.estimator_start(cfg, "cameras", start)
+    assert "initial_pose_map" not in cfg["estimator"], "with an Eye: its first fix, nothing else"
+    pose_source.estimator_start(cfg, "none", start)
+    assert cfg["estimator"]["initial_pose_map"] == list(start)
+    assert cfg["estimator"]["initial_pos_std_m"] == pose_source.PLACEMENT_STD_M
+    placed = pose_source.placed([start], "none", 3)[0]
+    off_m = math.hypot(placed[0] - start[0], placed[1] - start[1])
+    assert 0 < off_m < 5 * pose_source.PLACEMENT_STD_M, placed
+    assert pose_source.placed([start], "none", 3) == [placed], "seeded"
+    assert pose_source.placed([start], "cameras", 3) == [start]
+
+
+def test_one_eye_flag_default_cameras(capsys: pytest.CaptureFixture[str]) -> None:
+    assert demo.parse_args(["--mission", "smart-city"]).eye == "cameras"
+    assert demo.parse_args([]).eye == "cameras"
+    assert intersection.parse_args([]).eye == "cameras"
+    assert demo.parse_args(["--mission", "smart-city", "--city-eye", "standin"]).eye == "standin"
+    assert "--city-eye is deprecated" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        demo.parse_args(["--city-eye", "standin", "--eye", "cameras"])
+    assert "contradicts" in capsys.readouterr().err
