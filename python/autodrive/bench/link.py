@@ -23,6 +23,16 @@ import yaml
 from autodrive.core.settings import RUNTIME_CAR_CONFIG
 from autodrive.core.proc import ProcessGroup
 from autodrive.bench import Progress, build_dir, last_json, print_figures
+from autodrive.bench.goals import at_least, at_most, judge
+
+# Issue 5's goals (the EKF's with the Eye's poses on)
+GOALS = {
+    "cmd_to_serial": at_most("cmd_to_serial_us_p50", 500),
+    "cmd_to_pwm": at_most("cmd_to_pwm_ms_p50", 5),
+    "telemetry_rate": at_least("telemetry_hz", 100),
+    "ekf_pos_rms": at_most("ekf_pos_rms_m", 0.03),
+    "ekf_heading_rms": at_most("ekf_heading_rms_deg", 2),
+}
 
 PORT_SERIAL, PORT_SIMAVR, PORT_SIM = 7784, 7785, 7786
 PTY_WAIT_S = 10.0
@@ -160,5 +170,5 @@ def main(argv: list[str]) -> int:
     for part in parts:
         print_figures(part)
         figures.update(part)
-    print_figures(figures)
+    print_figures(judge(figures, GOALS))
     return 0

@@ -13,6 +13,8 @@ import sys
 from autodrive.learn.sweep import parking as sweep
 from autodrive.bench import build_dir, out_dir
 
+GOALS = sweep.GOALS  # judged by the sweep's aggregate (autodrive.bench.goals.judge)
+
 DEFAULT_SEEDS = "10"
 
 
