@@ -10,7 +10,7 @@ import lcm
 
 from autodrive.bench import goals
 from autodrive.bench import security
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, seeds
 
 
 def write_log(path: pathlib.Path, types, applied: list[tuple[float, float]]) -> pathlib.Path:
@@ -58,6 +58,6 @@ def test_an_applied_unsigned_command_fails_the_security_goals(tmp_path, build_di
     unsigned, wrong = counts(path, types)
     figures = {g.figure: g.bound for g in security.GOALS.values()}
     figures.update(unsigned_cmd_applied=unsigned, wrong_key_cmd_applied=wrong)
-    res = goals.judge(figures, security.GOALS)
+    res = goals.judge(figures, security.GOALS, seeds.unseeded("a constructed log"))
     assert unsigned == 6 and res["goals_met"] is False
     assert res["goals"]["unsigned_cmd_applied"] is False

@@ -31,6 +31,7 @@ from typing import Any
 
 from autodrive.hil.missions import cloning
 from autodrive.bench import Progress, build_dir, out_dir, print_figures
+from autodrive.core import seeds
 from autodrive.bench.goals import Goal, at_least, at_most, equals, judge
 
 SUITE = "cloning"
@@ -45,7 +46,15 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--laps", type=int, default=5, help="expert laps recorded and laps evaluated")
     p.add_argument("--unseen-laps", type=int, default=1, help="laps in each unseen condition")
     p.add_argument("--model", help="evaluate this NAME.onnx instead of recording and training")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=seeds.EVALUATION.start,
+        help="the evaluation runs' seed (default the first evaluation seed, autodrive.core.seeds)",
+    )
+    p.add_argument(
+        "--train-seed", type=int, default=1, help="the recording's seed (a training seed, default 1)"
+    )
     p.add_argument(
         "--curve-max", type=float, default=0.0, metavar="DK",
         help="train with the curvature augmentation up to DK [1/m] (make-model --curve-max; an "
@@ -170,7 +179,7 @@ def main(argv: list[str]) -> int:
         if args.model:
             model, train_s = Path(args.model), None
         else:
-            model, train_s = make_model(out, args.laps, args.seed, say, args.curve_max)
+            model, train_s = make_model(out, args.laps, args.train_seed, say, args.curve_max)
             step("record_train", t0, cpu0)
     except (RuntimeError, subprocess.CalledProcessError) as e:
         say(f"ERROR: {e}")
@@ -201,7 +210,7 @@ def main(argv: list[str]) -> int:
         step(f"evaluate_{cond}", tc, cpuc)
     figures["steps"] = steps
 
-    judge(figures, goal_table(args.laps, args.unseen_laps))
+    judge(figures, goal_table(args.laps, args.unseen_laps), seeds.span(args.seed, 1))
     for c in ("normal", *UNSEEN, *EXTRA):
         r = figures[c]
         print(f"{c}: laps {r.get('laps')}  interventions {r.get('interventions')}  autonomy "

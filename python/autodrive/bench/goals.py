@@ -2,8 +2,9 @@
 
 A goal is one figure against one bound (`at_most`, `at_least`, `equals`). A suite keeps its goals
 in one table (name -> Goal, every goal of its issue, whichever parts of the suite ran) and
-calls judge(figures, GOALS) once, at the end: figures then carry "goals" (name -> bool),
-"goals_missing" (the goals whose figure is absent) and "goals_met" (every goal met). A figure
+calls judge(figures, GOALS, seeds) once, at the end: figures then carry "goals" (name -> bool),
+"goals_missing" (the goals whose figure is absent), "goals_met" (every goal met) and the seeds
+the figures came from (autodrive.core.seeds.span, or seeds.unseeded for a figure no seed moves). A figure
 that is absent, None, not a number (a string such as "not present", NaN) or of the wrong kind
 fails its goal: a part of a suite that was skipped or crashed can never say goals_met true.
 A figure inside a nested object is named by a dotted path ("normal.autonomy_pct")."""
@@ -71,11 +72,17 @@ def met(goal: Goal, figures: Mapping[str, Any]) -> bool | None:
     return bool(value <= goal.bound) if goal.op == "<=" else bool(value >= goal.bound)
 
 
-def judge(figures: dict[str, Any], goals: Mapping[str, Goal]) -> dict[str, Any]:
-    """Adds goals / goals_missing / goals_met to figures (and returns them). An empty table is
-    refused: a suite without goals has nothing to say goals_met about."""
+def judge(
+    figures: dict[str, Any], goals: Mapping[str, Goal], seeds: Mapping[str, Any]
+) -> dict[str, Any]:
+    """Adds goals / goals_missing / goals_met and the seed range to figures (and returns them).
+    An empty table is refused (a suite without goals has nothing to say goals_met about), and
+    so are seeds without their range."""
     if not goals:
         raise ValueError("a bench suite's goal table is empty")
+    if "seed_range" not in seeds:
+        raise ValueError("a bench suite's figures must say their seed range (core.seeds)")
+    figures.update(seeds)
     verdicts = {name: met(goal, figures) for name, goal in goals.items()}
     figures["goals"] = {name: bool(v) for name, v in verdicts.items()}
     figures["goals_missing"] = sorted(

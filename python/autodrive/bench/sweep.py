@@ -18,6 +18,7 @@ from typing import Any
 
 from autodrive.learn.sweep import parking as sweep
 from autodrive.bench import Progress, build_dir, out_dir, print_figures
+from autodrive.core import seeds as seed_ranges
 from autodrive.bench.goals import at_least, equals, judge
 
 # The scale-out's goals: two workers give the same results as one, and a real speed-up on two
@@ -74,5 +75,6 @@ def main(argv: list[str]) -> int:
         "cpus": os.cpu_count(),
         "load_average_1min": round(os.getloadavg()[0], 2),
     }
-    print_figures(judge(figures, GOALS), key_value_lines=True)
+    span = seed_ranges.span(seed_ranges.DEVELOPMENT_MISSION_SEED, int(seeds))
+    print_figures(judge(figures, GOALS, span), key_value_lines=True)
     return 0

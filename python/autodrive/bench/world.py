@@ -43,8 +43,10 @@ from autodrive.core import lcmtypes
 from autodrive.core.channels import channel
 from autodrive.core.settings import settings
 from autodrive.bench import Progress, build_dir, last_json, print_figures, sim_instructions
+from autodrive.core import seeds
 from autodrive.bench.goals import at_least, at_most, equals, judge
 
+UNSEEDED = seeds.unseeded("the maps' routes driven by the route driver: deterministic")
 # The world's goals; the Tiny Town speed ratio by the stepping thread's CPU time (LCM's receive
 # thread reads the whole bus on a map with lights: see the docstring) and in instructions.
 GOALS = {
@@ -285,5 +287,5 @@ def main(argv: list[str] | None = None) -> int:
             f"{name}: RMS {r['rms_m'] * 1e3:.2f} mm, max {r['max_m'] * 1e3:.2f} mm"
             + ("" if r["done"] else " (NOT done)")
         )
-    print_figures(judge(figures, GOALS), key_value_lines=True)
+    print_figures(judge(figures, GOALS, UNSEEDED), key_value_lines=True)
     return 0

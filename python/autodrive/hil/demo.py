@@ -21,7 +21,7 @@ from typing import Any, TextIO
 
 import yaml
 
-from autodrive.core import channels, command_auth
+from autodrive.core import channels, command_auth, seeds
 from autodrive.hil import report
 from autodrive.devtools.inspect import export_mcap
 from autodrive.hil.missions import (
@@ -65,8 +65,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument(
         "--seed",
         type=int,
-        default=1,
-        help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start)",
+        default=seeds.DEVELOPMENT_MISSION_SEED,
+        help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start); "
+        f"default {seeds.DEVELOPMENT_MISSION_SEED}, a development seed (autodrive.core.seeds)",
     )
     p.add_argument(
         "--mission",

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from autodrive.core import channels
+from autodrive.core import channels, seeds
 from autodrive.core.settings import OUT_DIR, RELEASE_BUILD
 from autodrive.core.proc import Log, ProcessGroup
 
@@ -24,7 +24,7 @@ def add_run_options(
     p.add_argument("--mission", choices=(mission,), default=mission, help="this mission")
     p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
     p.add_argument("--out", default=str(OUT_DIR / f"demo-{mission}"), help="output folder")
-    p.add_argument("--seed", type=int, default=1, help=seed_help)
+    p.add_argument("--seed", type=int, default=seeds.DEVELOPMENT_MISSION_SEED, help=seed_help)
     p.add_argument("--headless", action="store_true", help="never open the simulator's window")
     p.add_argument("--timeout", type=float, default=timeout_s, help="give up after this [s wall]")
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")

@@ -31,6 +31,7 @@ from types import FrameType
 from typing import Any
 
 from autodrive.bench.goals import at_least, equals, judge
+from autodrive.core import seeds
 from autodrive.hil import demo
 from autodrive.core import plots
 from autodrive.learn.sweep import jobs as sweep_ray
@@ -115,7 +116,13 @@ def parse_args(argv: list[str], prog: str = "tools/sweep parking") -> argparse.N
         "'Sweeps on Ray'); tools/sweep parking --seeds 2 --serial --extra --realtime",
     )
     p.add_argument("--seeds", type=int, default=10, help="number of seeds to run (default 10)")
-    p.add_argument("--first-seed", type=int, default=1, help="first seed (default 1)")
+    p.add_argument(
+        "--first-seed",
+        type=int,
+        default=seeds.DEVELOPMENT_MISSION_SEED,
+        help=f"first seed (default {seeds.DEVELOPMENT_MISSION_SEED}, a development seed: "
+        "autodrive.core.seeds; tools/bench parking runs evaluation seeds)",
+    )
     p.add_argument(
         "--slot",
         type=int,
@@ -432,7 +439,13 @@ def aggregate(runs: list[Run]) -> dict[str, Any]:
     )
     s["goal_localization_rms"] = _all_within(per["localization_rms_m"], GOAL_LOCALIZATION_RMS_M)
     s["goal_wall_s"] = _all_within(per["wall_s"], GOAL_WALL_S)
-    judge(s, GOALS)
+    run_seeds = [r["seed"] for r in runs]
+    span = (
+        seeds.span(min(run_seeds), max(run_seeds) - min(run_seeds) + 1)
+        if run_seeds
+        else seeds.unseeded("no runs")
+    )
+    judge(s, GOALS, span)
     s["goal_bounds"] = {
         "runs": GOAL_RUNS,
         "final_pos_error_m": GOAL_POS_ERROR_M,
