@@ -14,7 +14,10 @@ STEP_S = 0.02  # ground truth at 50 Hz [s]
 
 def facts():
     lane = [{"x_m": x * 0.5 - 5.0, "y_m": 0.0, "heading_rad": 0.0} for x in range(31)]
-    stops = [StopPoint("light_line", 0.0, 0.0, 0.0, LIGHT), StopPoint("sign_line", 5.0, 0.0, 0.0, -1)]
+    stops = [
+        StopPoint("light_line", 0.0, 0.0, 0.0, LIGHT),
+        StopPoint("sign_line", 5.0, 0.0, 0.0, -1),
+    ]
     return MapFacts({"east": lane}, stops)
 
 

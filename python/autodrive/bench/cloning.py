@@ -53,7 +53,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         help="the evaluation runs' seed (default the first evaluation seed, autodrive.core.seeds)",
     )
     p.add_argument(
-        "--train-seed", type=int, default=1, help="the recording's seed (a training seed, default 1)"
+        "--train-seed",
+        type=int,
+        default=1,
+        help="the recording's seed (a training seed, default 1)",
     )
     p.add_argument(
         "--curve-max", type=float, default=0.0, metavar="DK",

@@ -153,8 +153,7 @@ def main(argv: list[str]) -> int:
     except ValueError as e:
         log(f"plot failed: {e}")
     typed: dict[str, Any] = {
-        k: int(v) if k in INT_KEYS else bool(v) if k in BOOL_KEYS else v
-        for k, v in figures.items()
+        k: int(v) if k in INT_KEYS else bool(v) if k in BOOL_KEYS else v for k, v in figures.items()
     }
     print_figures(judge(typed, GOALS, UNSEEDED))
     return 0

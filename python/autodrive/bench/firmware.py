@@ -66,5 +66,7 @@ def main(argv: list[str]) -> int:
     except ValueError as e:
         log(f"ERROR: {e}")
         return 1
-    print_figures(judge({"flash_bytes": flash, "ram_static_bytes": ram, **figures}, GOALS, UNSEEDED))
+    print_figures(
+        judge({"flash_bytes": flash, "ram_static_bytes": ram, **figures}, GOALS, UNSEEDED)
+    )
     return 0

@@ -340,7 +340,11 @@ def main(argv: list[str]) -> int:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--timeout", type=float, default=240.0, help="demo timeout [s] (default 240)")
-    p.add_argument("--skip-demo", action="store_true", help="only the flood figure (goals_met is then false: the demo's figures are missing)")
+    p.add_argument(
+        "--skip-demo",
+        action="store_true",
+        help="only the flood figure (goals_met is then false: the demo's figures are missing)",
+    )
     a = p.parse_args(argv)
     build = build_dir("security")
     needed = ("autodrive-runtime", "runtime-link-bench") + (() if a.skip_demo else demo.PROGRAMS)

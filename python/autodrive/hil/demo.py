@@ -28,6 +28,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     MissionContext,
+    record_children,
     loop,
     parking,
     smart_city,
@@ -335,7 +336,7 @@ def run(
         say(f"ERROR: {e}")
         result = {"error": str(e)}
     finally:
-        procs.stop_all()
+        exits = procs.stop_all()
         shutil.rmtree(run_dir, ignore_errors=True)
         for s, h in old_handlers:
             signal.signal(s, h)
@@ -358,6 +359,7 @@ def run(
             f"{rep.get('foreign_bad_signature')}, replayed {rep.get('foreign_replayed')}): "
             "not a success"
         )
+    record_children(rep, exits, say)
     rep["wall_s"] = round(wall_s, 2)
     rep["rtf_requested"] = rtf if rtf is not None else "lockstep"
     if rep.get("sim_s") and wall_s > 0:

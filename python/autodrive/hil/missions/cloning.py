@@ -36,7 +36,13 @@ from autodrive import maps
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
 from autodrive.learn.pilot.expert import ExpertRun
 from autodrive.core.proc import ProcessGroup, wait_for_path
-from autodrive.hil.missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
+from autodrive.hil.missions import (
+    EXIT_INTERRUPTED,
+    PTY_TIMEOUT_S,
+    add_run_options,
+    lane_watch,
+    record_children,
+)
 
 MAP = "driving_school"
 TRAINED_ROUTE = ExpertRun.route  # the route tools/pilot make-model records (loop_ccw)
@@ -361,7 +367,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         error = str(e)
         say(f"ERROR: {e}")
     finally:
-        procs.stop_all()  # the pilot stops the car and writes its stats on SIGINT
+        exits = procs.stop_all()  # the pilot stops the car and writes its stats on SIGINT
         shutil.rmtree(run_dir, ignore_errors=True)
         for s, h in old:
             signal.signal(s, h)
@@ -388,6 +394,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
     if error:
         rep["error"] = error
     rep["ok"] = not error and not interrupted and rep["laps"] >= args.laps
+    record_children(rep, exits, say)
     if referee.path:
         title = (f"cloning, {args.condition}: {rep['laps']:.2f} laps, {rep['interventions']} "
                  f"interventions, autonomy {rep['autonomy_pct']} %, cross-track rms "

@@ -38,8 +38,13 @@ from autodrive.core import channels, command_auth, lcmtypes
 from autodrive.gym import tasks
 from autodrive.learn.marl import env as marl_env
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
-from autodrive.core.proc import ProcessGroup, wait_for_path
-from autodrive.hil.missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options
+from autodrive.core.proc import ChildExit, ProcessGroup, wait_for_path
+from autodrive.hil.missions import (
+    EXIT_INTERRUPTED,
+    PTY_TIMEOUT_S,
+    add_run_options,
+    record_children,
+)
 
 MAP = tasks.INTERSECTION_MAP
 MAP_JSON = tasks.MAPS_DIR / f"{MAP}.json"
@@ -151,6 +156,7 @@ class EpisodeRecord:
     sim_s: float = 0.0
     eye_poses: int = 0  # <VEH>_POSE_EYE messages seen, every car
     ekf: dict[str, list[tuple[float, float, float]]] = field(default_factory=dict)  # t, x, y
+    children: list[ChildExit] = field(default_factory=list)  # how the episode's processes ended
 
 
 def ensure_keys(say: Any) -> None:
@@ -284,7 +290,7 @@ def run_episode(
             if rec.sim_s > EPISODE_SIM_S:
                 break
     finally:
-        procs.stop_all()
+        rec.children = procs.stop_all()
         for s in subs:
             lc.unsubscribe(s)
         shutil.rmtree(run_dir, ignore_errors=True)
@@ -527,6 +533,7 @@ def run(args: argparse.Namespace) -> int:
         "wall_s": round(time.time() - t0, 1),
         "interrupted": interrupted,
     }
+    record_children(rep, [c for _p, r, _e in done for c in r.children], say)
     (out / "report.json").write_text(json.dumps(rep, indent=2))
     if done:
         plot(out / "trajectories.png", done)
@@ -535,7 +542,8 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         say("interrupted: every process stopped")
         return EXIT_INTERRUPTED
-    return 0 if rep["success_rate"] == 1.0 and rep["collisions"] == 0 else 1
+    ok = rep["success_rate"] == 1.0 and rep["collisions"] == 0 and not rep["sanitizer_reports"]
+    return 0 if ok else 1
 
 
 def main(argv: list[str] | None = None) -> int:
