@@ -1,7 +1,8 @@
 """marl.env: the paper's intersection environment passes PettingZoo's own checker
 (parallel_api_test) in its discrete and continuous forms, the same seed gives the same
 episode, the reward follows the paper's terms (and the progress shaping is the distance gained), and the shield and the rule-based baseline
-bring four cars across without a collision on a held-out seed."""
+bring four cars across without a collision on one development seed on which the lane follower
+without the shield collides."""
 
 import math
 import warnings
@@ -19,8 +20,9 @@ from autodrive.learn.marl.env import (
     follow_steering,
 )
 
-HELD_OUT_SEED = 1_000_000_000
-COLLIDING_SEED = 1  # without the shield, the lane follower collides on this one
+# a development seed (autodrive.core.seeds): without the shield the lane follower collides on
+# it, with the shield every car arrives
+SHIELD_SEED = 1_000_000_000
 
 
 def test_api() -> None:
@@ -124,16 +126,16 @@ def run(env: MarlIntersectionEnv, seed: int) -> dict:
 
 
 def test_shield_and_baseline() -> None:
-    # a lane follower on discrete steering: with the shield, every car arrives, none collides;
-    # without it, cars collide (on a seed known to need it)
-    with_shield = run(MarlIntersectionEnv(cars=4, shield=True, max_steps=500), HELD_OUT_SEED)
+    # a lane follower on discrete steering, one seed: without the shield, cars collide; with
+    # it, every car arrives and none collides
+    without = run(MarlIntersectionEnv(cars=4, shield=False, max_steps=500), SHIELD_SEED)
+    assert "collision" in without["outcome"], without["outcome"]
+    with_shield = run(MarlIntersectionEnv(cars=4, shield=True, max_steps=500), SHIELD_SEED)
     assert with_shield["outcome"] == ["goal"] * 4, with_shield["outcome"]
     assert with_shield["shield_interventions"] > 0
-    without = run(MarlIntersectionEnv(cars=4, shield=False, max_steps=500), COLLIDING_SEED)
-    assert "collision" in without["outcome"], without["outcome"]
     env = MarlIntersectionEnv(cars=4, max_steps=500)
     env.baseline = FcfsBaseline()
-    env.reset(seed=HELD_OUT_SEED)
+    env.reset(seed=SHIELD_SEED)
     while env.agents:
         env.step({})
     assert env.stats["outcome"] == ["goal"] * 4, env.stats["outcome"]

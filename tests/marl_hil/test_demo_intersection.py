@@ -1,10 +1,11 @@
 """tools/demo --mission intersection in HIL (the simulator with four cars, four unchanged
 autodrive-runtime processes on their ptys, four autodrive-marl, V2V over real LCM): one episode
-of the rule-based baseline crosses with every car at its goal and no collision, and writes the
-report's fields and the trajectory plot, with the real Eye (the default: autodrive-eye on the
-two rendered overhead cameras) feeding every car's EKF at its rate from its first fix, each EKF
-within EKF_P95_M of the truth; Ctrl-C mid-episode stops every process (exit 130, the report
-kept, marked interrupted). argv: autodrive-marl, build dir, LCM port."""
+of the shipped policy (models/marl/intersection.onnx, behind the shield) crosses with every car
+truly at its goal and no collision, and writes the report's fields and the trajectory plot, with
+the real Eye (the default: autodrive-eye on the two rendered overhead cameras) feeding every car's
+EKF at its rate from its first fix, each EKF within EKF_P95_M of the truth; Ctrl-C mid-episode of
+the rule-based baseline stops every process (exit 130, the report kept, marked interrupted).
+argv: autodrive-marl, build dir, LCM port."""
 
 EYE_HZ_MIN = 3.0  # of the cameras' 5 Hz of sim time
 EKF_P95_M = 0.03  # each car's EKF map pose against the truth, p95 [m]
@@ -24,10 +25,10 @@ def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) ->
     keys = tempfile.TemporaryDirectory(prefix="marl-demo-keys-")
     os.environ["AUTODRIVE_KEY_DIR"] = keys.name  # the mission makes the four cars' keys here
 
-    def demo(out: Path, *extra: str) -> subprocess.Popen[str]:
+    def demo(out: Path, policy: str, *extra: str) -> subprocess.Popen[str]:
         return subprocess.Popen(
             [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection"]
-            + ["--build", str(build), "--out", str(out), "--headless", "--policy", "baseline"]
+            + ["--build", str(build), "--out", str(out), "--headless", "--policy", policy]
             + ["--lcm-url", f"udpm://239.255.76.67:{port}?ttl=0", *extra],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -38,7 +39,7 @@ def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) ->
     with tempfile.TemporaryDirectory(prefix="marl-demo-") as tmp:
         # Ctrl-C mid-episode: everything stops, exit 130.
         out = Path(tmp) / "interrupted"
-        p = demo(out, "--episodes", "2", "--seed", "4")
+        p = demo(out, "baseline", "--episodes", "2", "--seed", "4")
         head = ""
         assert p.stdout is not None
         while "episode 1/2" not in head:  # the first episode has started (imports are slow here)
@@ -57,7 +58,7 @@ def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) ->
         print("Ctrl-C: exit 130, every process stopped, report kept")
 
         out = Path(tmp) / "episode"
-        p = demo(out, "--episodes", "1", "--seed", "1")
+        p = demo(out, "rl", "--episodes", "1", "--seed", "1")  # the shipped policy
         log, _ = p.communicate(timeout=400)
         print(log[-1500:])
         rep = json.loads((out / "report.json").read_text())
@@ -66,6 +67,10 @@ def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) ->
         for key in ("mean_traverse_s", "steering_rate_rms"):
             assert isinstance(rep[key], float) and rep[key] > 0, (key, rep[key])
         assert rep["episodes"] == 1 and rep["success_rate"] == 1.0 and rep["collisions"] == 0, rep
+        assert rep["policy"] == "rl" and rep["policy_file"].endswith("intersection.onnx"), rep
+        # judged from ground truth: every car truly within the tolerance of its goal
+        assert rep["goal_error_true_max_m"] <= rep["goal_true_tolerance_m"], rep
+        assert rep["cars_arrived"] == 4 and not rep["sanitizer_reports"], rep
         assert rep["v2v_lost"] == 0 and p.returncode == 0, rep
         assert (out / "trajectories.png").stat().st_size > 10000
         # every car's <VEH>_POSE_EYE from the real Eye at its rate, every EKF close to the truth

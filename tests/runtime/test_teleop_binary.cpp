@@ -87,9 +87,12 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   ASSERT_TRUE(pump_until(lcm, [&] { return !cmds.got.back().engaged; }));
   EXPECT_EQ(cmds.got.back().throttle, 0.0f);
   EXPECT_EQ(cmds.got.back().headlights, 1);  // lights stay as set
-  // Quit: the last command it sends is disengaged.
+  // Quit while engaged (the dead-man held again): the last command it sends is disengaged.
+  send_js(w, JS_EVENT_BUTTON, 4, 1);
+  ASSERT_TRUE(pump_until(lcm, [&] { return cmds.got.back().engaged; }));
   teleop.stop();
-  lcm.handleTimeout(100);
+  while (lcm.handleTimeout(300) > 0) {
+  }  // every command it sent before it ended
   EXPECT_FALSE(cmds.got.back().engaged);
   ::close(w);
   ::unlink(fifo.c_str());

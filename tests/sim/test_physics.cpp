@@ -107,8 +107,12 @@ TEST(Physics, SteeringRateIs0805RadPerS) {
   }
   ASSERT_GT(t20, 0);
   ASSERT_GT(t80, 0);
+  // Against the published figure itself, not the parameter the rate limiter is given (that
+  // would pass with any value in vehicle/nigel.params): Nigel's system identification measured
+  // 0.805 rad/s at the knuckles.
+  const double published_rate_rad_s = 0.805;
   const double rate = 0.6 * kSteerLimit_rad / (t80 - t20);
-  EXPECT_NEAR(rate, AUTODRIVE_VEHICLE_STEER_RATE_RAD_S, 0.03 * AUTODRIVE_VEHICLE_STEER_RATE_RAD_S);
+  EXPECT_NEAR(rate, published_rate_rad_s, 0.03 * published_rate_rad_s);
   ASSERT_TRUE(s.run_to(1.5)) << s.err;
   EXPECT_NEAR(s.truth().steering_rad, kSteerLimit_rad, 0.01 * kSteerLimit_rad);
 }

@@ -28,6 +28,7 @@ import math
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 from autodrive.core import plots
 from autodrive.core.runfiles import read_columns
@@ -40,7 +41,24 @@ from autodrive.bench import (
     out_dir,
     print_figures,
 )
+from autodrive.core import seeds
+from autodrive.bench.goals import at_least, at_most, equals, judge
 
+UNSEEDED = seeds.unseeded("fixed synthesised scenes and simulator runs: speeds and pose errors")
+# The Eye's goals (every part of the suite: a part skipped by its option fails its goals)
+GOALS = {
+    "fps_720p": at_least("fps_1280x720_1t", 60),
+    "fps_1080p": at_least("fps_1920x1080_1t", 25),
+    "pos_rms": at_most("pos_rms_mm", 5),
+    "heading_rms": at_most("heading_rms_deg", 0.5),
+    "detect_rate": at_least("detect_rate", 0.99),
+    "detect_rate_wide_angle": at_least("detect_rate_wide_angle", 0.995),
+    "pos_rms_wide_angle": at_most("pos_rms_mm_wide_angle", 1.0),
+    "heading_rms_wide_angle": at_most("heading_rms_deg_wide_angle", 0.3),
+    "fps_720p_wide_angle": at_least("fps_1280x720_1t_wide_angle", 60),
+    "bumped_camera_detected": equals("bumped_camera_detected", True),
+    "capture_to_pose_p99": at_most("capture_to_pose_ms_p99", 15),
+}
 INT_KEYS = ("frames", "repeats")
 BOOL_KEYS = (  # measured as 0 / 1
     "bumped_camera_detected",
@@ -134,10 +152,8 @@ def main(argv: list[str]) -> int:
         log(f"plot {png}")
     except ValueError as e:
         log(f"plot failed: {e}")
-    print_figures(
-        {
-            k: int(v) if k in INT_KEYS else bool(v) if k in BOOL_KEYS else v
-            for k, v in figures.items()
-        }
-    )
+    typed: dict[str, Any] = {
+        k: int(v) if k in INT_KEYS else bool(v) if k in BOOL_KEYS else v for k, v in figures.items()
+    }
+    print_figures(judge(typed, GOALS, UNSEEDED))
     return 0

@@ -9,6 +9,20 @@ from __future__ import annotations
 import subprocess
 
 from autodrive.bench import Progress, build_dir, last_json, print_figures
+from autodrive.core import seeds
+from autodrive.bench.goals import at_least, at_most, judge
+
+UNSEEDED = seeds.unseeded("the real ELF in simavr, simulated time: no random input")
+# The firmware's goals (sizes on the ATmega328P with its bootloader; timings in simulated time)
+GOALS = {
+    "flash_fits": at_most("flash_bytes", 23040),
+    "ram_fits": at_most("ram_static_bytes", 1200),
+    "encoder_isr_cycles": at_most("encoder_isr_cycles_max", 150),
+    "cmd_to_pwm": at_most("cmd_to_pwm_us", 2000),
+    "failsafe_stop": at_most("failsafe_stop_ms", 150),
+    "telemetry_rate": at_least("telemetry_hz", 100),
+    "edge_rate": at_least("max_edge_rate_hz", 16640),
+}
 
 # ATmega328P with its 2 KiB bootloader: what the firmware may use.
 FLASH_USABLE_BYTES = 30720
@@ -52,5 +66,7 @@ def main(argv: list[str]) -> int:
     except ValueError as e:
         log(f"ERROR: {e}")
         return 1
-    print_figures({"flash_bytes": flash, "ram_static_bytes": ram, **figures})
+    print_figures(
+        judge({"flash_bytes": flash, "ram_static_bytes": ram, **figures}, GOALS, UNSEEDED)
+    )
     return 0

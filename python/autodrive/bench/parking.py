@@ -12,6 +12,9 @@ import sys
 
 from autodrive.learn.sweep import parking as sweep
 from autodrive.bench import build_dir, out_dir
+from autodrive.core import seeds as seed_ranges
+
+GOALS = sweep.GOALS  # judged by the sweep's aggregate (autodrive.bench.goals.judge)
 
 DEFAULT_SEEDS = "10"
 
@@ -30,4 +33,5 @@ def main(argv: list[str]) -> int:
     # --seeds/--out first: options given to the suite come later and win (argparse keeps
     # the last).
     base = ["--build", str(build_dir("parking")), "--seeds", seeds]
+    base += ["--first-seed", str(seed_ranges.EVALUATION.start)]  # figures: evaluation seeds
     return sweep.main(base + ["--out", str(out_dir() / "parking")] + argv, "tools/bench parking")

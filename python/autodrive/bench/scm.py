@@ -40,6 +40,15 @@ from autodrive.core.channels import channel
 from autodrive.scm import testkit
 from autodrive.scm.light_watch import LightWatch
 from autodrive.bench import Progress, build_dir, out_dir, print_figures
+from autodrive.core import seeds
+from autodrive.bench.goals import at_least, at_most, equals, judge
+
+UNSEEDED = seeds.unseeded("web latencies, ingest rates and restart losses")
+GOALS = {
+    "click_to_light_state": at_most("click_to_light_state_ms_p50", 100),
+    "pose_ingest": at_least("pose_ingest_hz_max", 100),
+    "restart_loss": equals("restart_loss", 0),
+}
 
 URL = "udpm://239.255.76.67:7796?ttl=0"
 log = Progress("scm")
@@ -265,12 +274,8 @@ def main(argv: list[str]) -> int:
             if pg:
                 pg.stop()
     ingest_keys = [k for k in fig if k.startswith("pose_ingest_hz_max_")]
-    fig["pose_ingest_hz_max"] = min(fig[k] for k in ingest_keys)
-    fig["restart_loss"] = sum(v for k, v in fig.items() if k.startswith("restart_loss_"))
-    fig["goals_met"] = (
-        fig.get("click_to_light_state_ms_p50", 1e9) <= 100
-        and fig["pose_ingest_hz_max"] >= 100
-        and fig["restart_loss"] == 0
-    )
-    print_figures(fig, key_value_lines=True)
+    fig["pose_ingest_hz_max"] = min((fig[k] for k in ingest_keys), default=None)
+    losses = [v for k, v in fig.items() if k.startswith("restart_loss_")]
+    fig["restart_loss"] = sum(losses) if losses else None
+    print_figures(judge(fig, GOALS, UNSEEDED), key_value_lines=True)
     return 0

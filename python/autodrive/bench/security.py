@@ -43,6 +43,19 @@ from typing import Any
 from autodrive.core import channels, command_auth, lcm_wire, lcmtypes
 from autodrive.hil import demo
 from autodrive.bench import Progress, build_dir, link, out_dir, print_figures
+from autodrive.core import seeds
+from autodrive.bench.goals import at_most, equals, judge
+
+# Every goal, the demo's included: with --skip-demo its figures are missing and fail their goals.
+GOALS = {
+    "unsigned_cmd_applied": equals("unsigned_cmd_applied", 0),
+    "replayed_cmd_applied": equals("replayed_cmd_applied", 0),
+    "wrong_key_cmd_applied": equals("wrong_key_cmd_applied", 0),
+    "foreign_source_takeover": equals("foreign_source_takeover", 0),
+    "demo_success_under_attack": equals("demo_success_under_attack", True),
+    "demo_exit_0": equals("demo_exit_code", 0),
+    "serial_cmd_rate_under_flood": at_most("serial_cmd_rate_ratio", 1.1),
+}
 
 PORT_DEMO, PORT_FLOOD = 7848, 7849
 VEHICLE = channels.vehicle_name(1)
@@ -291,7 +304,11 @@ def main(argv: list[str]) -> int:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--timeout", type=float, default=240.0, help="demo timeout [s] (default 240)")
-    p.add_argument("--skip-demo", action="store_true", help="only the flood figure")
+    p.add_argument(
+        "--skip-demo",
+        action="store_true",
+        help="only the flood figure (goals_met is then false: the demo's figures are missing)",
+    )
     a = p.parse_args(argv)
     build = build_dir("security")
     needed = ("autodrive-runtime", "runtime-link-bench") + (() if a.skip_demo else demo.PROGRAMS)
@@ -309,12 +326,6 @@ def main(argv: list[str]) -> int:
             figures.update(demo_under_attack(build, out_dir() / "security", a.timeout, key))
         figures.update(flood(build, Path(work)))
     figures.update(input_figures())
-    figures["goals_met"] = (
-        figures.get("unsigned_cmd_applied", 0) == 0
-        and figures.get("replayed_cmd_applied", 0) == 0
-        and figures.get("foreign_source_takeover", 0) == 0
-        and (a.skip_demo or figures.get("demo_success_under_attack") is True)
-        and figures["serial_cmd_hz_under_flood"] <= 1.1 * figures["serial_cmd_hz_configured"]
-    )
-    print_figures(figures, key_value_lines=True)
+    span = seeds.span(seeds.DEVELOPMENT_MISSION_SEED, 1)  # the demo's default seed
+    print_figures(judge(figures, GOALS, span), key_value_lines=True)
     return 0

@@ -18,6 +18,15 @@ from typing import Any
 
 from autodrive.learn.sweep import parking as sweep
 from autodrive.bench import Progress, build_dir, out_dir, print_figures
+from autodrive.core import seeds as seed_ranges
+from autodrive.bench.goals import at_least, equals, judge
+
+# The scale-out's goals: two workers give the same results as one, and a real speed-up on two
+# cores (the start-up of Ray apart).
+GOALS = {
+    "agree_1_vs_2": equals("agree_1_vs_2", True),
+    "speedup_2_workers": at_least("speedup_2_workers", 1.5),
+}
 
 DEFAULT_SEEDS = "4"
 LCM_URL = "udpm://239.255.76.67:7860?ttl=0"  # jobs take 7860.. (the parking bench: 7846..)
@@ -66,5 +75,6 @@ def main(argv: list[str]) -> int:
         "cpus": os.cpu_count(),
         "load_average_1min": round(os.getloadavg()[0], 2),
     }
-    print_figures(figures, key_value_lines=True)
+    span = seed_ranges.span(seed_ranges.DEVELOPMENT_MISSION_SEED, int(seeds))
+    print_figures(judge(figures, GOALS, span), key_value_lines=True)
     return 0

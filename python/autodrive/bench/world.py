@@ -43,6 +43,21 @@ from autodrive.core import lcmtypes
 from autodrive.core.channels import channel
 from autodrive.core.settings import settings
 from autodrive.bench import Progress, build_dir, last_json, print_figures, sim_instructions
+from autodrive.core import seeds
+from autodrive.bench.goals import at_least, at_most, equals, judge
+
+UNSEEDED = seeds.unseeded("the maps' routes driven by the route driver: deterministic")
+# The world's goals; the Tiny Town speed ratio by the stepping thread's CPU time (LCM's receive
+# thread reads the whole bus on a map with lights: see the docstring) and in instructions.
+GOALS = {
+    "maps_loaded": at_least("maps_loaded", 4),
+    "route_cross_track_rms": at_most("route_cross_track_rms_m", 0.02),
+    "route_cross_track_max": at_most("route_cross_track_max_m", 0.03),
+    "every_route_done": equals("routes_not_done", 0),  # a blocked route is left out of the RMS
+    "rtf_1_tiny_town_ratio": at_least("rtf_1_tiny_town_ratio_step_thread_cpu", 0.9),
+    "rtf_1_tiny_town_ratio_instructions": at_least("rtf_1_tiny_town_ratio_instructions", 0.9),
+    "light_cmd_to_state": at_most("light_cmd_to_state_ms_p50", 20),
+}
 
 URL = "udpm://239.255.76.67:7758?ttl=0"  # sim's test/bench port range 7730-7759
 MAPS = ("parking_school", "driving_school", "intersection_school", "tiny_town")
@@ -129,6 +144,7 @@ class WorldBench:
             "route_cross_track_max_m": round(worst, 5),
             "routes": total,
             "routes_done": done,
+            "routes_not_done": total - done,
             "routes_blocked": blocked,
             "per_route": per_route,
         }
@@ -271,5 +287,5 @@ def main(argv: list[str] | None = None) -> int:
             f"{name}: RMS {r['rms_m'] * 1e3:.2f} mm, max {r['max_m'] * 1e3:.2f} mm"
             + ("" if r["done"] else " (NOT done)")
         )
-    print_figures(figures, key_value_lines=True)
+    print_figures(judge(figures, GOALS, UNSEEDED), key_value_lines=True)
     return 0

@@ -1,5 +1,7 @@
 """Child processes: the one process stopper (SIGINT, then SIGTERM, then SIGKILL) and a group
-runner that starts named programs with their own log files and stops them in reverse order."""
+runner that starts named programs with their own log files and stops them in reverse order,
+handing back each child's exit code and any sanitizer report (ASan, UBSan, LSan) in its log, so
+that a report at shutdown fails the test or mission that ran it."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
@@ -24,6 +27,47 @@ PARENT_DEATH_SIGNAL = signal.SIGTERM
 _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 Log = Callable[[str], None]
+# The first line of a sanitizer's report (gcc's ASan/LSan/UBSan runtimes)
+SANITIZER_MARKS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:",
+                   "SUMMARY: UndefinedBehaviorSanitizer")  # fmt: skip
+REPORT_LINES = 12  # of a report kept in the result
+
+
+def sanitizer_report(logfile: Path) -> str | None:
+    """The first sanitizer report in a child's log (its first REPORT_LINES lines), or None."""
+    try:
+        lines = logfile.read_text(errors="replace").splitlines()
+    except OSError:
+        return None
+    for k, line in enumerate(lines):
+        if any(m in line for m in SANITIZER_MARKS):
+            return "\n".join(lines[k : k + REPORT_LINES])
+    return None
+
+
+@dataclass(frozen=True)
+class ChildExit:
+    """How a child of a ProcessGroup ended: its exit code (< 0: the signal that ended it),
+    whether it had to be killed, and the sanitizer report in its log (None: none)."""
+
+    name: str
+    exit_code: int
+    killed: bool
+    log: str
+    sanitizer_report: str | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "exit_code": self.exit_code, "killed": self.killed,
+                "log": self.log, "sanitizer_report": self.sanitizer_report}  # fmt: skip
+
+
+def sanitizer_failures(exits: Sequence[ChildExit]) -> list[str]:
+    """One line per child whose log holds a sanitizer report ([] = clean)."""
+    return [
+        f"{e.name}: sanitizer report in {e.log}: {(e.sanitizer_report or '').splitlines()[0]}"
+        for e in exits
+        if e.sanitizer_report
+    ]
 
 
 def die_with_parent() -> Callable[[], None] | None:
@@ -101,11 +145,34 @@ class ProcessGroup:
             if code is not None and (code != 0 or clean_exit_fails):
                 raise RuntimeError(f"{name} exited with code {code} (log: {f.name})")
 
-    def stop_all(self) -> None:
+    def stop_all(self) -> list[ChildExit]:
+        """Stops every child, the last started first; how each ended, in start order."""
+        exits = []
         for name, proc, f in reversed(self.items):
-            stop(proc, name, self.log)
+            notes: list[str] = []
+
+            def note(msg: str) -> None:
+                notes.append(msg)
+                self.log(msg)
+
+            code = stop(proc, name, note)
             f.close()
+            report = sanitizer_report(Path(f.name))
+            if report:
+                self.log(f"{name}: sanitizer report in {f.name}")
+            was_killed = any(m.startswith("killing") for m in notes)
+            exits.append(ChildExit(name, code, was_killed, f.name, report))
         self.items.clear()
+        return exits[::-1]
+
+    def stop_all_checked(self) -> list[ChildExit]:
+        """stop_all, raising RuntimeError when a child's log holds a sanitizer report (for
+        tests: a report at shutdown fails them)."""
+        exits = self.stop_all()
+        bad = sanitizer_failures(exits)
+        if bad:
+            raise RuntimeError("; ".join(bad))
+        return exits
 
 
 def wait_for_path(path: Path, timeout_s: float, procs: ProcessGroup) -> None:

@@ -22,13 +22,14 @@ from typing import Any, TextIO
 
 import yaml
 
-from autodrive.core import channels, command_auth
+from autodrive.core import channels, command_auth, seeds
 from autodrive.hil import pose_source, report
 from autodrive.devtools.inspect import export_mcap
 from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     MissionContext,
+    record_children,
     loop,
     parking,
     smart_city,
@@ -67,8 +68,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument(
         "--seed",
         type=int,
-        default=1,
-        help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start)",
+        default=seeds.DEVELOPMENT_MISSION_SEED,
+        help="scenario seed: sensor noise, IMU biases, AMCL, and the start pose (see --start); "
+        f"default {seeds.DEVELOPMENT_MISSION_SEED}, a development seed (autodrive.core.seeds)",
     )
     p.add_argument(
         "--mission",
@@ -360,7 +362,7 @@ def run(
         say(f"ERROR: {e}")
         result = {"error": str(e)}
     finally:
-        procs.stop_all()
+        exits = procs.stop_all()
         shutil.rmtree(run_dir, ignore_errors=True)
         for s, h in old_handlers:
             signal.signal(s, h)
@@ -383,6 +385,7 @@ def run(
             f"{rep.get('foreign_bad_signature')}, replayed {rep.get('foreign_replayed')}): "
             "not a success"
         )
+    record_children(rep, exits, say)
     rep["wall_s"] = round(wall_s, 2)
     rep["rtf_requested"] = rtf if rtf is not None else "lockstep"
     if rep.get("sim_s") and wall_s > 0:

@@ -8,9 +8,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from autodrive.core import channels
+from autodrive.core import channels, seeds
 from autodrive.core.settings import OUT_DIR, RELEASE_BUILD
-from autodrive.core.proc import Log, ProcessGroup
+from typing import Any
+
+from autodrive.core.proc import ChildExit, Log, ProcessGroup, sanitizer_failures
 
 PTY_TIMEOUT_S = 30.0  # a started simulator's Nano pty appears within this [s wall]
 EXIT_INTERRUPTED = 130  # a mission stopped by Ctrl-C exits as a shell's SIGINT does
@@ -24,10 +26,21 @@ def add_run_options(
     p.add_argument("--mission", choices=(mission,), default=mission, help="this mission")
     p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir")
     p.add_argument("--out", default=str(OUT_DIR / f"demo-{mission}"), help="output folder")
-    p.add_argument("--seed", type=int, default=1, help=seed_help)
+    p.add_argument("--seed", type=int, default=seeds.DEVELOPMENT_MISSION_SEED, help=seed_help)
     p.add_argument("--headless", action="store_true", help="never open the simulator's window")
     p.add_argument("--timeout", type=float, default=timeout_s, help="give up after this [s wall]")
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
+
+
+def record_children(rep: dict[str, Any], exits: list[ChildExit], say: Log) -> None:
+    """Every child's exit code and sanitizer report into a mission's report; a sanitizer report
+    (at shutdown too) fails the run: rep["ok"] becomes False."""
+    rep["children"] = [e.as_dict() for e in exits]
+    rep["sanitizer_reports"] = sanitizer_failures(exits)
+    for line in rep["sanitizer_reports"]:
+        say(f"FAILED: {line}")
+    if rep["sanitizer_reports"]:
+        rep["ok"] = False
 
 
 @dataclass

@@ -4,7 +4,8 @@ obeys SIM_TELEPORT (--allow-teleport), the unchanged autodrive-runtime runs its 
 estimator on the sim's Nano pty, autodrive-pilot runs the model and commands the car. This
 module referees from ground truth and the map's lane data (lane_watch): each time a wheel
 crosses the lane bound it counts an intervention and puts the car back on the centre line.
-autonomy = 1 - interventions x 6 s / elapsed s (PilotNet). Writes OUT/report.json, laps.png (the
+autonomy = 1 - interventions x 6 s / elapsed s (PilotNet), a stall (6 s of sim time without
+progress along the route) counting as an intervention too (lane_watch.StallWatch). Writes OUT/report.json, laps.png (the
 driven path) and trace.png (steering and offset over time, interventions marked).
 
 Unseen conditions (--condition), issue 16's three: night (--light-level), noise2x (twice the
@@ -35,7 +36,13 @@ from autodrive import maps
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
 from autodrive.learn.pilot.expert import ExpertRun
 from autodrive.core.proc import ProcessGroup, wait_for_path
-from autodrive.hil.missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options, lane_watch
+from autodrive.hil.missions import (
+    EXIT_INTERRUPTED,
+    PTY_TIMEOUT_S,
+    add_run_options,
+    lane_watch,
+    record_children,
+)
 
 MAP = "driving_school"
 TRAINED_ROUTE = ExpertRun.route  # the route tools/pilot make-model records (loop_ccw)
@@ -52,7 +59,6 @@ UNSEEN = ("night", "noise2x", "reverse")  # issue 16's conditions not in the tra
 EXTRA = ("other-lane",)  # unseen too, but not one of the issue's
 DEFAULT_MODEL = settings().models_dir / "pilot" / "driving_school.onnx"
 PILOT_CONFIG = settings().pilot_hil_config
-INTERVENTION_COST_S = 6.0  # PilotNet: each intervention costs 6 s of autonomy
 NIGHT_LIGHT_LEVEL = 0.25  # the scene's light level at "night" (1 = day)
 # The camera noise [sigma, 8-bit levels] and frame rate [Hz of sim time] the model was trained
 # with when its sidecar's "trained" section does not say (camera_noise, camera_fps: tools/pilot
@@ -183,6 +189,7 @@ class Referee:
         self.args, self.lc, self.types, self.say = args, lc, types, say
         self.veh = channels.vehicle_name(1)
         self.watch = lane_watch.for_route(route)
+        self.stall = lane_watch.StallWatch()
         self.n = 0
         self.t_us = 0
         self.t0_us: int | None = None  # when the car first moved
@@ -225,6 +232,11 @@ class Referee:
         offset = self.watch.update((x, y, yaw))
         self.path.append((x, y))
         self.trace.append((self.elapsed_s(), float(m.command_steering), offset))
+        if self.stall.update(self.elapsed_s(), self.watch.progress_m):
+            self.interventions.append((self.elapsed_s(), x, y))
+            self.say(f"intervention {len(self.interventions)} at t = {self.elapsed_s():.1f} s: "
+                     f"stalled (under {lane_watch.STALL_PROGRESS_M} m along the route in "
+                     f"{lane_watch.STALL_S} s)")  # fmt: skip
         if m.utime < self.settle_until_us or not self.watch.wheels_out((x, y, yaw)):
             return
         _, _, back = self.watch.locate(x, y)
@@ -245,10 +257,11 @@ class Referee:
     def figures(self) -> dict[str, Any]:
         elapsed = self.elapsed_s()
         n = len(self.interventions)
-        autonomy = 100.0 * (1.0 - n * INTERVENTION_COST_S / elapsed) if elapsed > 0 else None
+        autonomy = lane_watch.autonomy_pct(n, elapsed)
         return {
             "laps": round(self.watch.laps, 3),
             "interventions": n,
+            "stalls": self.stall.stalls,  # of the interventions: time without progress
             "autonomy_pct": None if autonomy is None else round(autonomy, 2),
             "cross_track_rms_m": round(self.watch.cross_track_rms_m(), 4),
             "mean_speed_m_s": round(self.watch.progress_m / elapsed, 4) if elapsed > 0 else None,
@@ -354,7 +367,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         error = str(e)
         say(f"ERROR: {e}")
     finally:
-        procs.stop_all()  # the pilot stops the car and writes its stats on SIGINT
+        exits = procs.stop_all()  # the pilot stops the car and writes its stats on SIGINT
         shutil.rmtree(run_dir, ignore_errors=True)
         for s, h in old:
             signal.signal(s, h)
@@ -381,6 +394,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
     if error:
         rep["error"] = error
     rep["ok"] = not error and not interrupted and rep["laps"] >= args.laps
+    record_children(rep, exits, say)
     if referee.path:
         title = (f"cloning, {args.condition}: {rep['laps']:.2f} laps, {rep['interventions']} "
                  f"interventions, autonomy {rep['autonomy_pct']} %, cross-track rms "

@@ -40,15 +40,23 @@ from autodrive.core import channels, command_auth, lcmtypes
 from autodrive.gym import tasks
 from autodrive.learn.marl import env as marl_env
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
-from autodrive.core.proc import ProcessGroup, wait_for_path
+from autodrive.core.proc import ChildExit, ProcessGroup, wait_for_path
 from autodrive.hil import pose_source
-from autodrive.hil.missions import EXIT_INTERRUPTED, PTY_TIMEOUT_S, add_run_options
+from autodrive.hil.missions import (
+    EXIT_INTERRUPTED,
+    PTY_TIMEOUT_S,
+    add_run_options,
+    record_children,
+)
 
 MAP = tasks.INTERSECTION_MAP
 MAP_JSON = tasks.MAPS_DIR / f"{MAP}.json"
 DEFAULT_POLICY = settings().models_dir / "marl" / "intersection.onnx"
 CARS = 4
 EPISODE_SIM_S = 90.0  # an episode that has not ended by then is a failure [s of sim time]
+# A car is truly at its goal when its ground truth is within this of it when its EKF says so:
+# the policy's goal tolerance plus what the Eye-fused EKF may be off by [m].
+GOAL_TRUE_TOLERANCE_M = marl_env.GOAL_REACHED_M + 0.05
 PLOT_HALF_M = 3.6  # the plots show the map this far around the centre [m]
 
 
@@ -151,6 +159,7 @@ class EpisodeRecord:
     goal_t: dict[str, float] = field(default_factory=dict)  # sim time at the goal [s]
     sim_s: float = 0.0
     poses: pose_source.PoseRecord = field(default_factory=pose_source.PoseRecord)
+    children: list[ChildExit] = field(default_factory=list)  # how the episode's processes ended
 
 
 def ensure_keys(say: Any) -> None:
@@ -284,7 +293,7 @@ def run_episode(
             if rec.sim_s > EPISODE_SIM_S:
                 break
     finally:
-        procs.stop_all()
+        rec.children = procs.stop_all()
         for s in subs:
             lc.unsubscribe(s)
         shutil.rmtree(run_dir, ignore_errors=True)
@@ -299,15 +308,59 @@ def run_episode(
 
 def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
     """For each car its EKF put at the goal: its true distance from the goal then [m]."""
-    out = []
+    return [e for e in true_goal_errors_m(plans, rec).values() if e is not None]
+
+
+def true_goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> dict[str, float | None]:
+    """Each car's true distance from its goal [m] at the first ground truth after its EKF said
+    "at the goal"; None when it never said so (or no ground truth came after)."""
+    out: dict[str, float | None] = {}
     for p in plans:
+        out[p.vehicle] = None
         if p.vehicle in rec.at_goal and rec.truth.get(p.vehicle):
-            # the first ground truth after the EKF said "at the goal"
             t_goal = rec.goal_t.get(p.vehicle, math.inf)
             after = [(x, y) for t, x, y in rec.truth[p.vehicle] if t >= t_goal]
             if after:
-                out.append(float(math.hypot(after[0][0] - p.goal[0], after[0][1] - p.goal[1])))
+                out[p.vehicle] = float(math.hypot(after[0][0] - p.goal[0], after[0][1] - p.goal[1]))
     return out
+
+
+def episode_outcome(plans: list[CarPlan], rec: EpisodeRecord, ended: str) -> str:
+    """How the episode ended, judged from ground truth: 'goal' only when every car's EKF said
+    so and its ground truth was then within GOAL_TRUE_TOLERANCE_M of its goal ('goal_false'
+    when a car only believed it); otherwise how it ended (collision, timeout)."""
+    if ended != "goal":
+        return ended
+    errors = true_goal_errors_m(plans, rec).values()
+    ok = all(e is not None and e <= GOAL_TRUE_TOLERANCE_M for e in errors)
+    return "goal" if ok else "goal_false"
+
+
+def score_episodes(
+    requested: int, outcomes: list[str], traverse_s: list[list[float | None]]
+) -> dict[str, Any]:
+    """The mission's rates over every planned episode: an episode not run (a wall --timeout, an
+    interruption) is a failure. outcomes: episode_outcome of each episode run; traverse_s: each
+    run episode's cars' start-to-goal times [s of sim time] (None: did not arrive). The mean
+    traverse time counts every car of every planned episode, one that did not arrive (or whose
+    episode did not run) at the episode's whole EPISODE_SIM_S."""
+    n = len(outcomes)
+    successes = sum(o == "goal" for o in outcomes)
+    cars = [t if t is not None else EPISODE_SIM_S for ep in traverse_s for t in ep]
+    cars += [EPISODE_SIM_S] * (CARS * (requested - n))
+    arrived = [t for ep in traverse_s for t in ep if t is not None]
+    return {
+        "episodes": n,
+        "episodes_requested": requested,
+        "episodes_not_run": requested - n,
+        "successes": successes,
+        "success_rate": round(successes / requested, 4) if requested else 0.0,
+        "goal_believed_not_true": sum(o == "goal_false" for o in outcomes),
+        "timeouts": sum(o == "timeout" for o in outcomes),
+        "mean_traverse_s": round(float(np.mean(cars)), 3) if cars else None,
+        "mean_traverse_s_arrived": round(float(np.mean(arrived)), 3) if arrived else None,
+        "cars_arrived": len(arrived),
+    }
 
 
 def ekf_errors_m(rec: EpisodeRecord) -> list[float]:
@@ -389,7 +442,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.time()
     done: list[tuple[list[CarPlan], EpisodeRecord, str]] = []
     summaries_all: list[dict[str, Any]] = []
-    traverse_s: list[float] = []
+    traverse_s: list[list[float | None]] = []  # per episode run, per car [s] (None: not arrived)
+    outcomes: list[str] = []
     rates: list[float] = []
     goal_err: list[float] = []
     ekf_err: list[float] = []
@@ -405,11 +459,16 @@ def run(args: argparse.Namespace) -> int:
             )
             if ended == "interrupted":
                 break
+            ended = episode_outcome(plans, rec, ended)
             done.append((plans, rec, ended))
+            outcomes.append(ended)
             summaries_all += summaries
-            for s in summaries:
-                if s.get("goal_s", -1) >= 0 and s.get("start_s", -1) >= 0:
-                    traverse_s.append(s["goal_s"] - s["start_s"])
+            arrived = [
+                s["goal_s"] - s["start_s"]
+                for s in summaries
+                if s.get("goal_s", -1) >= 0 and s.get("start_s", -1) >= 0
+            ]
+            traverse_s.append([*arrived, *[None] * (CARS - len(arrived))])
             rates += steering_rates(rec)
             goal_err += goal_errors_m(plans, rec)
             errs = ekf_errors_m(rec)
@@ -425,7 +484,9 @@ def run(args: argparse.Namespace) -> int:
     finally:
         for sig, handler in old:
             signal.signal(sig, handler)
-    n = len(done)
+    if len(done) < args.episodes and not interrupted:
+        say(f"ERROR: --timeout {args.timeout:g} s of wall time ran out after {len(done)} of "
+            f"{args.episodes} episodes: the {args.episodes - len(done)} not run count as failures")  # fmt: skip
     rep: dict[str, Any] = {
         "mission": "intersection",
         "policy": args.policy,
@@ -442,20 +503,16 @@ def run(args: argparse.Namespace) -> int:
             [channels.vehicle_name(i + 1) for i in range(CARS)],
         ),
         "eye_poses": sum(sum(r.poses.eye_poses.values()) for _p, r, _e in done),
-        "episodes": n,
-        "episodes_requested": args.episodes,
-        "successes": sum(1 for _p, _r, e in done if e == "goal"),
-        "success_rate": round(sum(1 for _p, _r, e in done if e == "goal") / n, 4) if n else 0.0,
+        **score_episodes(args.episodes, outcomes, traverse_s),
         "collisions": sum(1 for _p, r, _e in done if r.collided),
-        "timeouts": sum(1 for _p, _r, e in done if e == "timeout"),
         "shield_interventions": sum(s.get("shield_interventions", 0) for s in summaries_all),
         # of them, steps where the shield's lane term replaced the policy's steering
         "shield_lane_steers": sum(s.get("shield_lane_steers", 0) for s in summaries_all),
-        "mean_traverse_s": round(float(np.mean(traverse_s)), 3) if traverse_s else None,
         "steering_rate_rms": round(float(np.sqrt(np.mean(np.square(rates)))), 4) if rates else None,
         "goal_error_true_max_m": (
             round(max(goal_err), 3) if goal_err else None
         ),  # how far from its goal a car really was when its EKF said it was there
+        "goal_true_tolerance_m": GOAL_TRUE_TOLERANCE_M,
         # every EKF map pose against the truth then [m] (the shield's input)
         "ekf_error_true_p95_m": round(float(np.percentile(ekf_err, 95)), 4) if ekf_err else None,
         "ekf_error_true_max_m": round(max(ekf_err), 4) if ekf_err else None,
@@ -474,6 +531,7 @@ def run(args: argparse.Namespace) -> int:
         "wall_s": round(time.time() - t0, 1),
         "interrupted": interrupted,
     }
+    record_children(rep, [c for _p, r, _e in done for c in r.children], say)
     (out / "report.json").write_text(json.dumps(rep, indent=2))
     if done:
         plot(out / "trajectories.png", done)
@@ -483,7 +541,8 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         say("interrupted: every process stopped")
         return EXIT_INTERRUPTED
-    return 0 if rep["success_rate"] == 1.0 and rep["collisions"] == 0 else 1
+    ok = rep["success_rate"] == 1.0 and rep["collisions"] == 0 and not rep["sanitizer_reports"]
+    return 0 if ok else 1
 
 
 def main(argv: list[str] | None = None) -> int:

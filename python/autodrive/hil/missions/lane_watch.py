@@ -1,7 +1,9 @@
 """The cloning evaluation's referee: where a car is on its route's lane, from ground truth and the
 map's lane data (autodrive.maps). Signed offsets of base_link and of the four wheels from
 the route's centre line, a crossing of the lane bound by any wheel (an intervention in the
-PilotNet sense), laps from the distance driven along the route."""
+PilotNet sense), laps from the distance driven along the route; a stall (sim time without
+progress along the route, which a safety driver would take over too: an intervention) and the
+autonomy figure they give."""
 
 from __future__ import annotations
 
@@ -15,6 +17,38 @@ from autodrive.core import vehicle
 from autodrive.maps.description import Route
 
 Pose3 = tuple[float, float, float]  # x [m], y [m], yaw [rad]
+INTERVENTION_COST_S = 6.0  # PilotNet: each intervention costs 6 s of autonomy
+STALL_S = 6.0  # this long of sim time with less than STALL_PROGRESS_M along the route: a stall
+STALL_PROGRESS_M = 0.05
+
+
+def autonomy_pct(interventions: int, elapsed_s: float) -> float | None:
+    """PilotNet's autonomy, 100 (1 - interventions x 6 s / elapsed) [%], never below 0; None
+    before any time has elapsed."""
+    if elapsed_s <= 0:
+        return None
+    return max(0.0, 100.0 * (1.0 - interventions * INTERVENTION_COST_S / elapsed_s))
+
+
+@dataclass
+class StallWatch:
+    """Counts a stall each STALL_S of sim time in which the car gained less than
+    STALL_PROGRESS_M along its route (standing, or driving the wrong way)."""
+
+    since_s: float | None = None  # start of the current window [s of sim time]
+    since_progress_m: float = 0.0
+    stalls: int = 0
+
+    def update(self, t_s: float, progress_m: float) -> bool:
+        """True when this sample ends a stalled window (one more intervention)."""
+        if self.since_s is None or progress_m - self.since_progress_m >= STALL_PROGRESS_M:
+            self.since_s, self.since_progress_m = t_s, progress_m
+            return False
+        if t_s - self.since_s < STALL_S:
+            return False
+        self.stalls += 1
+        self.since_s, self.since_progress_m = t_s, progress_m
+        return True
 
 
 @dataclass

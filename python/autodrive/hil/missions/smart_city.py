@@ -36,7 +36,7 @@ from autodrive.hil.city.scoring import MapFacts, Scorer
 from autodrive.maps.loader import MAPS_DIR
 from autodrive.core.settings import OUT_DIR
 from autodrive.core.proc import ProcessGroup, wait_ready
-from autodrive.hil.missions import EXIT_INTERRUPTED
+from autodrive.hil.missions import EXIT_INTERRUPTED, record_children
 
 MAP = "tiny_town"
 # One looping route of the map per car: north through light 3 and the stop sign; south through
@@ -342,7 +342,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         say(f"ERROR: {e}")
         result["error"] = str(e)
     finally:
-        procs.stop_all()
+        exits = procs.stop_all()
         shutil.rmtree(run_dir, ignore_errors=True)
         for s, h in old:
             signal.signal(s, h)
@@ -370,6 +370,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         and rep["collisions"] == 0
         and rep["laps_completed"] >= args.laps
     )
+    record_children(rep, exits, say)
     (out / "report.json").write_text(json.dumps(rep, indent=2))
     if tracks:
         plot(out, tracks, phases, facts)

@@ -40,7 +40,27 @@ def run_episodes(
     )
     if mode == "baseline":
         env.baseline = FcfsBaseline()
-    acc: dict[str, Any] = {
+    acc = new_tally()
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed)
+        while env.agents:
+            actions: dict[str, Any] = {}
+            if policy is not None:
+                live = list(env.agents)
+                batch = np.stack([obs[a] for a in live])
+                t0 = time.perf_counter()
+                act = policy.act(batch)
+                acc["inference_us"].append((time.perf_counter() - t0) * 1e6)
+                actions = {a: act[k] for k, a in enumerate(live)}
+            obs, _, _, _, _ = env.step(actions)
+        tally_episode(acc, seed, env.stats)
+    env.close()
+    return acc
+
+
+def new_tally() -> dict[str, Any]:
+    """The raw sums of no episode yet (tally_episode adds one)."""
+    return {
         "episodes": 0,
         "successes": 0,
         "collisions": 0,
@@ -55,37 +75,26 @@ def run_episodes(
         "failed_seeds": [],
         "failures": [],
     }
-    for seed in seeds:
-        obs, _ = env.reset(seed=seed)
-        while env.agents:
-            actions: dict[str, Any] = {}
-            if policy is not None:
-                live = list(env.agents)
-                batch = np.stack([obs[a] for a in live])
-                t0 = time.perf_counter()
-                act = policy.act(batch)
-                acc["inference_us"].append((time.perf_counter() - t0) * 1e6)
-                actions = {a: act[k] for k, a in enumerate(live)}
-            obs, _, _, _, _ = env.step(actions)
-        out = env.stats["outcome"]
-        acc["episodes"] += 1
-        ok = all(o == "goal" for o in out)
-        acc["successes"] += int(ok)
-        if not ok:
-            acc["failed_seeds"].append(seed)
-            acc["failures"].append(
-                {"seed": seed, "routes": env.stats["routes"], "outcome": list(out)}
-            )
-        acc["collisions"] += sum(o == "collision" for o in out)
-        acc["off_road"] += sum(o == "off_road" for o in out)
-        acc["timeouts"] += sum(o == "timeout" for o in out)
-        acc["shield_interventions"] += int(env.stats["shield_interventions"])
-        acc["shield_lane_steers"] += int(env.stats["shield_lane_steers"])
-        acc["traverse_s"] += [t for t in env.stats["traverse_s"] if not math.isnan(t)]
-        acc["rate_sq_sum"] += env.stats["steering_rate_sq_sum"]
-        acc["rate_n"] += env.stats["steering_rate_n"]
-    env.close()
-    return acc
+
+
+def tally_episode(acc: dict[str, Any], seed: int, stats: dict[str, Any]) -> None:
+    """Adds one finished episode (the env's stats) to acc: a success only when every car is
+    at its goal; each car's collision, off-road or timeout counted."""
+    out = stats["outcome"]
+    acc["episodes"] += 1
+    ok = all(o == "goal" for o in out)
+    acc["successes"] += int(ok)
+    if not ok:
+        acc["failed_seeds"].append(seed)
+        acc["failures"].append({"seed": seed, "routes": stats["routes"], "outcome": list(out)})
+    acc["collisions"] += sum(o == "collision" for o in out)
+    acc["off_road"] += sum(o == "off_road" for o in out)
+    acc["timeouts"] += sum(o == "timeout" for o in out)
+    acc["shield_interventions"] += int(stats["shield_interventions"])
+    acc["shield_lane_steers"] += int(stats["shield_lane_steers"])
+    acc["traverse_s"] += [t for t in stats["traverse_s"] if not math.isnan(t)]
+    acc["rate_sq_sum"] += stats["steering_rate_sq_sum"]
+    acc["rate_n"] += stats["steering_rate_n"]
 
 
 def _star(args: tuple[str, int, str, list[int]]) -> dict[str, Any]:

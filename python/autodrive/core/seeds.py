@@ -1,0 +1,47 @@
+"""The one place of the seed ranges (docs/reference/seeds.md): training, development and
+evaluation are disjoint, so a reported figure comes from seeds nothing was tuned on.
+
+- TRAINING: what learning draws its episodes from (MARL PPO rollouts, base + copy x 1 000 003,
+  and its checkpoint validation from 500 000 000; the cloning expert's recordings).
+- DEVELOPMENT: anything looked at while building or debugging: tests, demos, traced failures.
+  The old MARL "held-out" block 1 000 000 000-1 000 000 199 lies here: its seeds 01, 05, 10, 12,
+  13, 88, 106 and 187 were traced to write the shield's standing-car rules. HIL missions (which
+  train nothing) default to DEVELOPMENT_MISSION_SEED; their seeds 1-10 of earlier sessions
+  (HIL seed 1, smart-city 1-5, parking 1-10) were looked at too and are never reported again.
+- EVALUATION: benches only, for figures; a seed of it that anybody traces moves to development
+  for good (start the next measurement past it, and say so in docs/results)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+TRAINING = range(0, 1_000_000_000)
+DEVELOPMENT = range(1_000_000_000, 1_500_000_000)
+EVALUATION = range(1_500_000_000, 2_000_000_000)  # below 2^31: every seed type takes it
+RANGES = {"training": TRAINING, "development": DEVELOPMENT, "evaluation": EVALUATION}
+DEVELOPMENT_MISSION_SEED = DEVELOPMENT.start + 1  # tools/demo's default --seed
+
+
+def range_of(seed: int) -> str:
+    """The name of the range seed lies in; ValueError for a seed outside every range."""
+    for name, r in RANGES.items():
+        if seed in r:
+            return name
+    raise ValueError(f"seed {seed} lies outside every seed range (autodrive.core.seeds)")
+
+
+def span(first: int, count: int) -> dict[str, Any]:
+    """What a bench records in its JSON: its seeds first .. first + count - 1 and their range
+    (ValueError when they straddle two ranges)."""
+    if count < 1:
+        raise ValueError(f"seed span of {count} seeds")
+    name = range_of(first)
+    if range_of(first + count - 1) != name:
+        raise ValueError(f"seeds {first}..{first + count - 1} straddle two seed ranges")
+    return {"seed_range": name, "first_seed": first, "seeds": count}
+
+
+def unseeded(why: str) -> dict[str, Any]:
+    """What a bench without seeded episodes records instead (a throughput or latency figure,
+    the same whatever the seed): why."""
+    return {"seed_range": "none", "seed_note": why}

@@ -1,0 +1,56 @@
+"""The cloning referee's scoring (missions/lane_watch.py) is shown to catch what it scores, on
+constructed runs along a straight 10 m route (no simulator): a lane departure is a wheel out,
+a stalled car (standing, or creeping under 5 cm in 6 s of sim time) counts as interventions and
+scores no autonomy, and a car that keeps moving keeps its 100 %."""
+
+from __future__ import annotations
+
+from autodrive.hil.missions import lane_watch
+from autodrive.maps.description import Route
+
+STEP_S = 0.05  # the referee's 20 Hz of sim time [s]
+
+
+def straight() -> lane_watch.LaneWatch:
+    pts = [(0.05 * k, 0.0) for k in range(201)]
+    return lane_watch.for_route(Route("straight", ["east"], False, pts, 0.2))
+
+
+def score(xs: list[float], y_m: float = 0.0) -> tuple[int, float | None, int]:
+    """(interventions, autonomy %, wheels-out samples) of a car at xs, one per referee step."""
+    watch, stall = straight(), lane_watch.StallWatch()
+    out = 0
+    for k, x in enumerate(xs):
+        watch.update((x, y_m, 0.0))
+        stall.update(k * STEP_S, watch.progress_m)
+        out += watch.wheels_out((x, y_m, 0.0))
+    return stall.stalls, lane_watch.autonomy_pct(stall.stalls, (len(xs) - 1) * STEP_S), out
+
+
+def test_a_lane_departure_is_a_wheel_out() -> None:
+    watch = straight()
+    assert not watch.wheels_out((2.0, 0.0, 0.0))
+    assert watch.wheels_out((2.0, 0.15, 0.0))  # base_link inside, its left wheels over 0.2 m
+    assert watch.wheels_out((2.0, -0.3, 0.0))
+
+
+def test_a_moving_car_keeps_full_autonomy() -> None:
+    xs = [0.2 * STEP_S * k for k in range(600)]  # 0.2 m/s for 30 s
+    stalls, autonomy, out = score(xs)
+    assert (stalls, autonomy, out) == (0, 100.0, 0)
+
+
+def test_a_stalled_car_is_not_autonomous() -> None:
+    stalls, autonomy, _ = score([1.0] * 600)  # stands 30 s on the lane
+    assert stalls == 4 and autonomy is not None and autonomy <= 20.0
+    # creeping 1 cm per 6 s is a stall too
+    stalls, _, _ = score([1.0 + 0.01 / 6.0 * STEP_S * k for k in range(600)])
+    assert stalls == 4
+
+
+def test_a_stall_midway_costs_autonomy() -> None:
+    drive = [0.2 * STEP_S * k for k in range(200)]  # 10 s driving, then 20 s standing
+    stalls, autonomy, _ = score(drive + [drive[-1]] * 400)
+    assert stalls == 3 and autonomy is not None and autonomy < 50.0
+    assert lane_watch.autonomy_pct(0, 0.0) is None
+    assert lane_watch.autonomy_pct(10, 30.0) == 0.0  # never below 0
