@@ -1,4 +1,5 @@
 // autodrive-eye: overhead AprilTag localisation of every car, and its calibration tools.
+#include <autodrive/instance.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -261,6 +262,7 @@ int main(int argc, char **argv) {
                      "(setcap cap_sys_nice+ep on autodrive-eye, or an rtprio limit) or set "
                      "realtime_priority: 0\n",
                      rn_config.c_str(), cfg.realtime_priority, rt_why.c_str());
+      cfg.lcm_url = autodrive::instance_lcm_url(cfg.lcm_url);  // AUTODRIVE_INSTANCE
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
       // One source per camera: the config's `source`, else --source (one camera only).

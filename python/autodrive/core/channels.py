@@ -62,11 +62,23 @@ class Channel:
 
 
 @dataclass(frozen=True)
+class InstanceRule:
+    """How a session's instance number moves its ports (channels.yaml `instances`)."""
+
+    variable: str  # the environment variable holding the instance number
+    max: int  # the largest instance number
+    port_step: int  # instance N adds N * port_step to the LCM and the web port
+    web_port: int  # instance 0's web port (the Smart City Manager's)
+    sim_run_dir: str  # instance 0's simulator run dir; instance N's is <this>-N
+
+
+@dataclass(frozen=True)
 class ChannelTable:
     source: Path
     url_default: str
     vehicle_prefix: str
     channels: tuple[Channel, ...]
+    instances: InstanceRule
 
     def by_id(self, channel_id: str) -> Channel:
         for ch in self.channels:
@@ -142,7 +154,24 @@ def load(path: Path | str | None = None) -> ChannelTable:
         url_default=str(doc.get("url_default", "")),
         vehicle_prefix=str(doc.get("vehicle_prefix", "")),
         channels=tuple(out),
+        instances=_instance_rule(source, doc.get("instances")),
     )
+
+
+def _instance_rule(source: Path, entry: object) -> InstanceRule:
+    keys = ("variable", "max", "port_step", "web_port", "sim_run_dir")
+    if not isinstance(entry, dict) or any(k not in entry for k in keys):
+        raise ChannelTableError(f"{source}: 'instances' needs {', '.join(keys)}")
+    try:
+        return InstanceRule(
+            variable=str(entry["variable"]),
+            max=int(entry["max"]),
+            port_step=int(entry["port_step"]),
+            web_port=int(entry["web_port"]),
+            sim_run_dir=str(entry["sim_run_dir"]),
+        )
+    except (TypeError, ValueError) as err:
+        raise ChannelTableError(f"{source}: 'instances': {err}") from err
 
 
 def channel(channel_id: str, vehicle: str | None = None) -> str:

@@ -20,6 +20,13 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         "/* the simulator's cars are <prefix><i>; one-car programs default to car 1 */",
         f'#define AUTODRIVE_VEHICLE_PREFIX "{table.vehicle_prefix}"',
         f'#define AUTODRIVE_VEHICLE_DEFAULT "{table.vehicle_prefix}1"',
+        "/* sessions side by side: instance N moves the default LCM port and the web port by",
+        "   N * AUTODRIVE_INSTANCE_PORT_STEP and the simulator's run dir to <dir>-N */",
+        f'#define AUTODRIVE_INSTANCE_VARIABLE "{table.instances.variable}"',
+        f"#define AUTODRIVE_INSTANCE_MAX {table.instances.max}",
+        f"#define AUTODRIVE_INSTANCE_PORT_STEP {table.instances.port_step}",
+        f"#define AUTODRIVE_WEB_PORT_DEFAULT {table.instances.web_port}",
+        f'#define AUTODRIVE_SIM_RUN_DIR_DEFAULT "{table.instances.sim_run_dir}"',
         "",
     ]
     for ch in table.channels:
