@@ -10,6 +10,7 @@
 
 #include <autodrive/strict_yaml.hpp>
 #include <autodrive_channels.h>
+#include <autodrive_instance_rule.h>
 
 namespace autodrive {
 

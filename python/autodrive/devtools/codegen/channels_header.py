@@ -20,13 +20,6 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         "/* the simulator's cars are <prefix><i>; one-car programs default to car 1 */",
         f'#define AUTODRIVE_VEHICLE_PREFIX "{table.vehicle_prefix}"',
         f'#define AUTODRIVE_VEHICLE_DEFAULT "{table.vehicle_prefix}1"',
-        "/* sessions side by side: instance N moves the default LCM port and the web port by",
-        "   N * AUTODRIVE_INSTANCE_PORT_STEP and the simulator's run dir to <dir>-N */",
-        f'#define AUTODRIVE_INSTANCE_VARIABLE "{table.instances.variable}"',
-        f"#define AUTODRIVE_INSTANCE_MAX {table.instances.max}",
-        f"#define AUTODRIVE_INSTANCE_PORT_STEP {table.instances.port_step}",
-        f"#define AUTODRIVE_WEB_PORT_DEFAULT {table.instances.web_port}",
-        f'#define AUTODRIVE_SIM_RUN_DIR_DEFAULT "{table.instances.sim_run_dir}"',
         "",
     ]
     for ch in table.channels:
@@ -41,5 +34,30 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         source_name,
         "autodrive.devtools.codegen.channels_header",
         "LCM channel names; docs/reference/channels.md describes each.",
+        lines,
+    )
+
+
+INSTANCE_GUARD = "AUTODRIVE_INSTANCE_RULE_H"
+
+
+def render_instance(table: channels.ChannelTable, source_name: str) -> str:
+    """<autodrive_instance_rule.h>: the table's `instances` rule (its own header, so that a
+    change of it rebuilds only the code of sessions, not every user of a channel name)."""
+    rule = table.instances
+    lines = [
+        f'#define AUTODRIVE_INSTANCE_VARIABLE "{rule.variable}"',
+        f"#define AUTODRIVE_INSTANCE_MAX {rule.max}",
+        "/* instance N adds N * this to the default LCM port and to the web port */",
+        f"#define AUTODRIVE_INSTANCE_PORT_STEP {rule.port_step}",
+        f"#define AUTODRIVE_WEB_PORT_DEFAULT {rule.web_port}",
+        "/* instance N > 0 runs the simulator in <this>-N */",
+        f'#define AUTODRIVE_SIM_RUN_DIR_DEFAULT "{rule.sim_run_dir}"',
+    ]
+    return c_header.wrap(
+        INSTANCE_GUARD,
+        source_name,
+        "autodrive.devtools.codegen.channels_header",
+        "Sessions side by side (AUTODRIVE_INSTANCE); docs/reference/channels.md describes them.",
         lines,
     )

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include <autodrive_channels.h>
+#include <autodrive_instance_rule.h>
 
 #include "camera_fx.h"
 #include "cameras.h"
@@ -64,10 +65,10 @@ static void options_usage(FILE *f) {
       "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
       "  --lcm-url URL       LCM provider (default %s)\n"
       "  --run-dir DIR       ptys' symlinks and the generated scene (default %s)\n"
-      "  --instance N        this session's instance, 0..%d (default: $%s, else 0): instance\n"
-      "                      N > 0 moves the LCM URL on the default port to that port + %d N\n"
-      "                      and the default run dir to <run dir>-N, so two users' sims,\n"
-      "                      runtimes and SCMs on one machine never hear each other
+      "  --instance N        this session's instance 0..%d (default: $%s, else 0):\n"
+      "                      instance N > 0 moves the LCM URL on the default port to\n"
+      "                      that port + %d N and the default run dir to <run dir>-N,\n"
+      "                      so two users' sims, runtimes and SCMs never hear each other\n"
       "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
       "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
       "                      or route:NAME[,speed=F][,start=s][,lookahead=M][,laps=N]\n"

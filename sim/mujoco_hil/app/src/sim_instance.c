@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include <autodrive_channels.h>
+#include <autodrive_instance_rule.h>
 
 /* The port of AUTODRIVE_LCM_URL_DEFAULT ("udpm://239.255.76.67:7667?ttl=0" -> 7667). */
 static int instance_default_port(void) {
