@@ -117,10 +117,10 @@ def run(guide: Path, root: Path, env: dict[str, str]) -> int:
                     continue
                 if line == "":  # the shell exited: set -e on a failing command
                     break
-                if line.startswith(DONE):
-                    finished = True
-                else:
-                    print(f"  {line.rstrip()}", flush=True)
+                before, done, _ = line.partition(DONE)  # output without a last newline
+                if before.strip():
+                    print(f"  {before.rstrip()}", flush=True)
+                finished = bool(done)
             if not finished:
                 why = (
                     f"did not finish within its {step.timeout_s} s guard"
