@@ -42,7 +42,11 @@ def test_link_programs_prefers_release(root: Path, tmp_path: Path) -> None:
     )
     print(r.stdout)
     out = tmp_path / "build" / "bin"
-    assert sorted(p.name for p in out.iterdir()) == ["autodrive-eye", "autodrive-sim", "nano-simavr"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "autodrive-eye",
+        "autodrive-sim",
+        "nano-simavr",
+    ]
     assert os.readlink(out / "autodrive-sim") == "../release/bin/autodrive-sim"
     assert os.readlink(out / "autodrive-eye") == "../asan/bin/autodrive-eye"
     assert (out / "nano-simavr").resolve() == tmp_path / "build" / "asan" / "bin" / "nano-simavr"

@@ -138,8 +138,10 @@ def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm
             log = driver.find_element(By.ID, "events").text
             check("op1 light_request light 1" in log, "the event log names op1's request")
             check(
-                log.index("Operators' actions") < log.index("op1 light_request")
-                < log.index("Programmed changes") and "{" not in log.split("Programmed")[1],
+                log.index("Operators' actions")
+                < log.index("op1 light_request")
+                < log.index("Programmed changes")
+                and "{" not in log.split("Programmed")[1],
                 "operators' actions first, then the programmed changes, grouped, no raw JSON",
             )
 
