@@ -10,7 +10,7 @@ started is stopped (its process group: SIGTERM, then SIGKILL).
 
 The session is an instance of its own (AUTODRIVE_INSTANCE, from --instance), so the guide's
 default LCM bus, web port and simulator run dir are nobody else's; AUTODRIVE_BUILD is the build
-under test. Usage: run_guide.py GUIDE.md --root ROOT --build BUILD --instance N
+under test. Usage: run_guide.py GUIDE --root ROOT --build BUILD --instance N
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ RUNNER = Path(__file__).with_name("run_guide.py")
 
 
 def run(tmp: Path, text: str) -> subprocess.CompletedProcess[str]:
-    guide = tmp / "guide.md"
+    guide = tmp / "guide.markdown"
     guide.write_text(text)
     return subprocess.run(
         [sys.executable, str(RUNNER), str(guide), "--root", str(tmp), "--build", str(tmp),
@@ -36,7 +36,7 @@ def test_steps_share_one_shell_and_skip_unmarked(tmp_path: Path) -> None:
     assert (
         "instance 40" in r.stdout
         and "no-newline" in r.stdout
-        and "ok: guide.md: 2 steps" in r.stdout
+        and "ok: guide.markdown: 2 steps" in r.stdout
     )
     assert not (tmp_path / "never-run").exists(), "an unmarked block ran"
     pid = int((tmp_path / "bg.pid").read_text())
@@ -54,7 +54,7 @@ def test_failing_step_is_named(tmp_path: Path) -> None:
         "<!-- ci-run -->\n```sh\ntrue\n```\n<!-- ci-run -->\n```sh\nfalse\necho after\n```\n",
     )
     print(r.stdout, r.stderr)
-    assert r.returncode == 1 and "guide.md:6: step 2 failed" in r.stderr
+    assert r.returncode == 1 and "guide.markdown:6: step 2 failed" in r.stderr
     assert "  after" not in r.stdout
 
 
