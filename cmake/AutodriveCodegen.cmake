@@ -38,3 +38,10 @@ function(autodrive_channels_target)
   autodrive_codegen_header(autodrive_channels channels-header autodrive_channels.h
     "${AUTODRIVE_ROOT}/lcm_types/channels.yaml" --table core/channels.py)
 endfunction()
+
+# `autodrive_instance_rule`: <autodrive_instance_rule.h>, the sessions' instance rule
+# (AUTODRIVE_INSTANCE) from lcm_types/channels.yaml.
+function(autodrive_instance_rule_target)
+  autodrive_codegen_header(autodrive_instance_rule instance-header autodrive_instance_rule.h
+    "${AUTODRIVE_ROOT}/lcm_types/channels.yaml" --table core/channels.py)
+endfunction()

@@ -15,6 +15,21 @@ build_host() {
   log "building preset $preset"
   cmake --build "$ROOT/build/$preset" "$@" || die "build ($preset) failed"
 }
+# build/bin: the one place the programs a user runs come from, whichever of tools/demo (release)
+# and tools/test (asan) built them. Each autodrive-* program and nano-simavr is a relative link
+# into build/release/bin, or into build/asan/bin where the release build lacks it (ASan's build
+# runs the same code, slower). Test: foundation.programs_place.
+link_programs() {
+  local out="$ROOT/build/bin" preset program
+  mkdir -p "$out"
+  for preset in asan release; do
+    for program in "$ROOT/build/$preset/bin/"autodrive-* "$ROOT/build/$preset/bin/nano-simavr"; do
+      [ -f "$program" ] && [ -x "$program" ] || continue
+      ln -sfn "../$preset/bin/$(basename "$program")" "$out/$(basename "$program")"
+    done
+  done
+  log "the programs are in build/bin: $(cd "$out" && ls | tr '\n' ' ')"
+}
 # Builds the AVR firmware (.elf/.hex) if its CMake project exists.
 build_avr() {
   if [ -f "$ROOT/firmware/nano/avr/CMakeLists.txt" ]; then

@@ -3,14 +3,15 @@
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "eye_error.hpp"
 
 namespace eye {
 
-IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
-                                      const IntrinsicsParams &p) {
+IntrinsicsReport intrinsics_detect(const std::vector<cv::Mat> &views, const IntrinsicsParams &p) {
   IntrinsicsReport rep;
   rep.views_total = static_cast<int>(views.size());
   if (views.empty()) throw Error("calibrate-intrinsics: no images");
@@ -21,14 +22,15 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
     for (int c = 0; c < p.inner_cols; ++c)
       board.emplace_back(static_cast<float>(c * p.square_m), static_cast<float>(r * p.square_m),
                          0.f);
-  std::vector<std::vector<cv::Point3f>> obj;
-  std::vector<std::vector<cv::Point2f>> img;
-  bool cell[4][4] = {};
+  rep.image_size = size;
+  auto &obj = rep.points;
+  auto &img = rep.corners;
   const auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100);
   const auto charuco = cv::aruco::CharucoBoard::create(
       p.inner_cols + 1, p.inner_rows + 1, static_cast<float>(p.square_m),
       static_cast<float>(p.square_m * p.marker_ratio), dict);
-  for (const auto &v : views) {
+  for (size_t i = 0; i < views.size(); ++i) {
+    const cv::Mat &v = views[i];
     if (v.size() != size)
       throw Error("calibrate-intrinsics: images differ in size (" + std::to_string(v.cols) + "x" +
                   std::to_string(v.rows) + " vs " + std::to_string(size.width) + "x" +
@@ -54,16 +56,23 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
     for (const auto &c : corners) {
       const int cx = std::min(3, std::max(0, static_cast<int>(4 * c.x / size.width)));
       const int cy = std::min(3, std::max(0, static_cast<int>(4 * c.y / size.height)));
-      cell[cy][cx] = true;
+      rep.cells[static_cast<size_t>(cy * 4 + cx)] = true;
     }
     obj.push_back(points);
     img.push_back(corners);
+    rep.used.push_back(static_cast<int>(i));
   }
   rep.views_used = static_cast<int>(img.size());
   int cells = 0;
-  for (auto &row : cell)
-    for (bool b : row) cells += b;
+  for (bool b : rep.cells) cells += b;
   rep.coverage = cells / 16.0;
+  return rep;
+}
+
+void intrinsics_solve(IntrinsicsReport &rep, const IntrinsicsParams &p) {
+  const auto &obj = rep.points;
+  const auto &img = rep.corners;
+  const cv::Size size = rep.image_size;
   if (rep.views_used < p.min_views)
     throw Error("calibrate-intrinsics: too few views: the " +
                 std::string(p.charuco ? "ChArUco board" : "checkerboard") + " (" +
@@ -96,6 +105,23 @@ IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
   rep.in.dist.assign(dist.ptr<double>(), dist.ptr<double>() + dist.total());
   rep.in.rms_px = rms;
   rep.in.views = rep.views_used;
+  rep.view_rms_px.clear();
+  for (size_t i = 0; i < obj.size(); ++i) {
+    std::vector<cv::Point2f> back;
+    cv::projectPoints(obj[i], rv[i], tv[i], k, dist, back);
+    double sq = 0;
+    for (size_t j = 0; j < back.size(); ++j) {
+      const cv::Point2f d = back[j] - img[i][j];
+      sq += d.dot(d);
+    }
+    rep.view_rms_px.push_back(std::sqrt(sq / static_cast<double>(std::max<size_t>(1, back.size()))));
+  }
+}
+
+IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &views,
+                                      const IntrinsicsParams &p) {
+  IntrinsicsReport rep = intrinsics_detect(views, p);
+  intrinsics_solve(rep, p);
   return rep;
 }
 

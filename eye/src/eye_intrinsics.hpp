@@ -31,11 +31,23 @@ struct IntrinsicsReport {
   int views_total = 0;  // images offered
   int views_used = 0;   // images where the board was found
   double coverage = 0;  // fraction of the 4x4 grid cells holding a corner
+  cv::Size image_size;
+  std::vector<int> used;                            // index of each used image in the input
+  std::vector<std::vector<cv::Point2f>> corners;    // per used image: the corners found [px]
+  std::vector<std::vector<cv::Point3f>> points;     // their places on the board [m]
+  std::vector<bool> cells = std::vector<bool>(16);  // 4x4 grid cells (row-major) reached
+  std::vector<double> view_rms_px;                  // per used image, after the calibration
 };
 
-// Finds the board in each image (CV_8UC1; a ChArUco view counts if >= 6 corners are seen)
-// and calibrates. Throws eye::Error with a clear
-// reason on too few views, poor coverage or too high an RMS.
+// Finds the board in each image (CV_8UC1; a ChArUco view counts if >= 6 corners are seen):
+// the corners and the coverage, no refusal yet (the coverage picture is drawn from this).
+// Throws eye::Error on no images or images of different sizes.
+IntrinsicsReport intrinsics_detect(const std::vector<cv::Mat> &gray_views,
+                                   const IntrinsicsParams &p);
+// Calibrates from a detection: fills rep.in and rep.view_rms_px (each image's reprojection
+// RMS). Throws eye::Error with a clear reason on too few views, poor coverage or too high an RMS.
+void intrinsics_solve(IntrinsicsReport &rep, const IntrinsicsParams &p);
+// intrinsics_detect, then intrinsics_solve.
 IntrinsicsReport intrinsics_calibrate(const std::vector<cv::Mat> &gray_views,
                                       const IntrinsicsParams &p);
 

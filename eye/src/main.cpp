@@ -1,4 +1,5 @@
 // autodrive-eye: overhead AprilTag localisation of every car, and its calibration tools.
+#include <autodrive/instance.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "eye_boards.hpp"
 #include "eye_config.hpp"
 #include "eye_error.hpp"
 #include "eye_fuse.hpp"
@@ -73,6 +75,34 @@ std::vector<cv::Mat> grab_views(cv::VideoCapture &cap, const std::string &what, 
   return out;
 }
 
+// What a calibration tool shows its user: the coverage picture, then each image's corners and
+// reprojection error; the refusal (too few views, poor coverage, high RMS) comes after them.
+eye::IntrinsicsReport calibrate_and_report(const std::vector<cv::Mat> &views,
+                                           const std::vector<std::string> &names,
+                                           const eye::IntrinsicsParams &ip,
+                                           const std::string &coverage_png) {
+  eye::IntrinsicsReport rep = eye::intrinsics_detect(views, ip);
+  const auto write_picture = [&] {
+    if (!cv::imwrite(coverage_png, eye::intrinsics_coverage_image(rep)))
+      throw eye::Error(coverage_png + ": cannot write the coverage picture");
+    std::printf("coverage picture: %s\n", coverage_png.c_str());
+  };
+  try {
+    eye::intrinsics_solve(rep, ip);
+  } catch (const eye::Error &) {
+    write_picture();
+    throw;
+  }
+  write_picture();
+  for (size_t i = 0; i < rep.corners.size(); ++i) {
+    const auto k = static_cast<size_t>(rep.used[i]);
+    std::printf("image %s: %zu corners, reprojection RMS %.3f px\n",
+                k < names.size() ? names[k].c_str() : std::to_string(k).c_str(),
+                rep.corners[i].size(), rep.view_rms_px[i]);
+  }
+  return rep;
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -113,6 +143,35 @@ int main(int argc, char **argv) {
   ci->add_option("--marker-ratio", ip.marker_ratio, "ChArUco: marker edge / square edge")
       ->capture_default_str();
   ci->add_option("-o,--out", ci_out, "output YAML (camera matrix, distortion, RMS)")->required();
+  std::string ci_coverage;
+  ci->add_option("--coverage-png", ci_coverage,
+                 "the coverage picture: the 4x4 grid, reached cells green, every corner found "
+                 "(default: the output's name with .coverage.png)");
+
+  // make-board-images
+  auto *mb = app.add_subcommand(
+      "make-board-images",
+      "A calibration set without a camera: the checkerboard rendered through a camera model "
+      "from many poses, covering the image (calibrate-intrinsics --images DIR takes it)");
+  std::string mb_intr, mb_config, mb_out;
+  eye::BoardSetParams bp;
+  eye::IntrinsicsParams mp;
+  auto *mb_cam = mb->add_option_group("camera model", "one of");
+  mb_cam->add_option("--intrinsics", mb_intr, "the camera model: an intrinsics YAML");
+  mb_cam->add_option("-c,--config", mb_config, "a run config: its intrinsics are the model");
+  mb_cam->require_option(1);
+  mb->add_option("--views", bp.views, "images to render (16: each 4x4 grid cell once)")
+      ->check(CLI::Range(1, 200))
+      ->capture_default_str();
+  mb->add_option("--cols", mp.inner_cols, "inner corners along the board's width")
+      ->capture_default_str();
+  mb->add_option("--rows", mp.inner_rows, "inner corners along the board's height")
+      ->capture_default_str();
+  mb->add_option("--square-m", mp.square_m, "square edge [m]")->capture_default_str();
+  mb->add_option("--max-tilt-rad", bp.max_tilt_rad, "largest board tilt [rad]")
+      ->check(CLI::Range(0.0, 1.2))
+      ->capture_default_str();
+  mb->add_option("-o,--out", mb_out, "folder for board-NN.png (created)")->required();
 
   // calibrate-map
   auto *cm = app.add_subcommand("calibrate-map",
@@ -181,10 +240,30 @@ int main(int argc, char **argv) {
   std::signal(SIGTERM, on_signal);
 
   try {
+    if (*mb) {
+      const eye::Intrinsics in =
+          mb_intr.empty() ? eye::runconfig_load(mb_config).in : eye::intrinsics_load(mb_intr);
+      std::filesystem::create_directories(mb_out);
+      const auto boards = eye::boards_render(in, mp, bp);
+      for (size_t i = 0; i < boards.size(); ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "board-%02zu.png", i + 1);
+        const std::string path = (std::filesystem::path(mb_out) / name).string();
+        if (!cv::imwrite(path, boards[i].image)) throw eye::Error(path + ": cannot write");
+      }
+      std::printf("wrote %zu board images (%dx%d px, %dx%d inner corners, %.3f m squares) to %s\n",
+                  boards.size(), in.width_px, in.height_px, mp.inner_cols, mp.inner_rows,
+                  mp.square_m, mb_out.c_str());
+      return 0;
+    }
     if (*ci) {
       std::vector<cv::Mat> views;
+      std::vector<std::string> names;
       if (!ci_images.empty()) {
-        for (auto &[name, img] : load_images(ci_images)) views.push_back(img);
+        for (auto &[name, img] : load_images(ci_images)) {
+          names.push_back(std::filesystem::path(name).filename().string());
+          views.push_back(img);
+        }
       } else if (!ci_video.empty()) {
         if (!std::filesystem::exists(ci_video)) throw eye::Error(ci_video + ": no such file");
         cv::VideoCapture cap(ci_video, cv::CAP_FFMPEG);
@@ -194,7 +273,9 @@ int main(int argc, char **argv) {
         views =
             grab_views(cap, "camera " + std::to_string(ci_device), std::max(1, ci_every), ci_max);
       }
-      const auto rep = eye::intrinsics_calibrate(views, ip);
+      if (ci_coverage.empty())
+        ci_coverage = std::filesystem::path(ci_out).replace_extension(".coverage.png").string();
+      const auto rep = calibrate_and_report(views, names, ip, ci_coverage);
       eye::intrinsics_save(ci_out, rep.in);
       std::printf(
           "views %d/%d, coverage %.0f%%, rms %.4f px\nfx %.3f fy %.3f cx %.3f cy %.3f\n"
@@ -271,6 +352,7 @@ int main(int argc, char **argv) {
                      "(setcap cap_sys_nice+ep on autodrive-eye, or an rtprio limit) or set "
                      "realtime_priority: 0\n",
                      rn_config.c_str(), cfg.realtime_priority, rt_why.c_str());
+      cfg.lcm_url = autodrive::instance_lcm_url(cfg.lcm_url);  // AUTODRIVE_INSTANCE
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
       if (rn_sim_latency_ms >= 0) cfg.sim_latency_ms = rn_sim_latency_ms;

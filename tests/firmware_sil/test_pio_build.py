@@ -1,5 +1,5 @@
-"""PlatformIO builds the firmware here, offline (`pio run -e nano_offline`: the platform in
-firmware/nano/pio, Debian's avr-gcc and Arduino core, SCons from PyPI as tool-scons), and its
+"""PlatformIO builds the firmware here, offline (a plain `pio run`: default_envs is nano_offline,
+the platform in firmware/nano/pio, Debian's avr-gcc and Arduino core, SCons from PyPI as tool-scons), and its
 ELF matches the CMake AVR build's: the same .text, .data and .bss sizes and the same symbols
 with the same sizes (only where LTO places a few functions may differ; see firmware/nano/README).
 Then the upload command line: `pio run -e nano_offline[_new] -t upload --upload-port <pty>`
@@ -66,8 +66,10 @@ def pio_env(work: Path) -> dict[str, str]:
 
 
 def check_build(root: Path, cmake_elf: Path, work: Path, pio: Path) -> Path:
+    # A plain `pio run`, no -e: the reflex of every PlatformIO user builds the offline env
+    # (default_envs) and nothing else.
     r = subprocess.run(
-        [str(pio), "run", "-d", str(root), "-e", "nano_offline"],
+        [str(pio), "run", "-d", str(root)],
         env=pio_env(work),
         capture_output=True,
         text=True,
@@ -75,6 +77,8 @@ def check_build(root: Path, cmake_elf: Path, work: Path, pio: Path) -> Path:
     )
     assert r.returncode == 0, f"pio run failed:\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}"
     assert "HTTPClientError" not in r.stdout + r.stderr, "PlatformIO tried its registry"
+    built = sorted(p.name for p in (work / "build").iterdir() if p.is_dir())
+    assert built == ["nano_offline"], f"a plain pio run built {built}, not only nano_offline"
     pio_elf = work / "build" / "nano_offline" / "firmware.elf"
     assert pio_elf.is_file(), f"no {pio_elf}"
     assert (work / "build" / "nano_offline" / "firmware.hex").is_file(), "no firmware.hex"

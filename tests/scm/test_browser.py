@@ -62,14 +62,34 @@ def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm
         watch = LightWatch(lc, T)
         feeder = CarFeeder(feed_lc, T, {"NIGEL1": ("loop_ccw", 0.5), "NIGEL2": ("loop_ccw", 8.0),
                                         "NIGEL3": ("loop_cw", 3.0)}, 0.4)  # fmt: skip
-        srv = Server(db, url, build)
+        srv = Server(db, url, build, "NIGEL1,NIGEL2,NIGEL3,NIGEL4")  # NIGEL4 never drives
         driver = chromium()
         try:
             wait_for(
                 lambda: watch.latest(1) is not None, 30, "the simulator publishes light states"
             )
+            driver.get(srv.url + "/")
+            WebDriverWait(driver, 20).until(lambda d: d.find_element(By.ID, "login-name"))
+            check(
+                not driver.find_element(By.ID, "map").is_displayed()
+                and not driver.find_element(By.ID, "vehicles").is_displayed(),
+                "before login: the login form only, no map and no tables",
+            )
+            driver.save_screenshot(str(out / "browser_login.png"))
             login(driver, srv.url, "op1", "operator-pass")
             WebDriverWait(driver, 20).until(lambda d: len(table(d)) == 3)
+            ghost = driver.execute_script(
+                "const tr = document.querySelector('#vehicles tr[data-name=NIGEL4]');"
+                "return tr ? tr.textContent : null;"
+            )
+            check(ghost == "NIGEL4not seen yet", f"a car never seen is not put at 0, 0: {ghost}")
+            unlabelled = driver.execute_script(
+                "return [...document.querySelectorAll('input.prog')].filter(i => "
+                "!document.querySelector(`label[for='${i.id}']`)).map(i => i.id);"
+            )
+            check(not unlabelled, f"every program input has its label: {unlabelled}")
+            junction = driver.find_element(By.ID, "junctions").text
+            check("cross tile at" in junction, f"the junction named as the map has it: {junction}")
             first = table(driver)
             time.sleep(1.5)
             second = table(driver)
@@ -123,6 +143,13 @@ def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm
             driver.save_screenshot(str(out / "browser_operator.png"))
             log = driver.find_element(By.ID, "events").text
             check("op1 light_request light 1" in log, "the event log names op1's request")
+            check(
+                log.index("Operators' actions")
+                < log.index("op1 light_request")
+                < log.index("Programmed changes")
+                and "{" not in log.split("Programmed")[1],
+                "operators' actions first, then the programmed changes, grouped, no raw JSON",
+            )
 
             driver.delete_all_cookies()
             login(driver, srv.url, "viewer1", "viewer-pass")

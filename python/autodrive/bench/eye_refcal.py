@@ -41,18 +41,11 @@ log = Progress("eye refcal")
 
 def reference_tags(map_name: str) -> list[dict[str, Any]]:
     """The map's reference tags (sidecar: id, x_m, y_m, z_m, yaw_rad, size_m)."""
-    tags: list[dict[str, Any]] = json.loads((MAPS_DIR / f"{map_name}.json").read_text()).get(
-        "reference_tags", []
-    )
-    return tags
+    return eye_cameras.reference_tags(map_name, MAPS_DIR)
 
 
 def write_tags(tags: list[dict[str, Any]], path: Path) -> None:
-    lines = ["tags:"] + [
-        " - {" + ", ".join(f"{k}: {t[k]!r}" for k in ("id", "x_m", "y_m", "z_m", "yaw_rad", "size_m")) + "}"
-        for t in tags
-    ]  # fmt: skip
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(eye_cameras.tags_text(tags))
 
 
 def grab_frames(

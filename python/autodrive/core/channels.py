@@ -18,11 +18,16 @@ CAM = "<CAM>"  # an overhead camera of the map (EYE1, EYE2, ...: the map's eye_c
 # Conditions of a channel's optional "when": published only on maps with traffic lights, only
 # when someone acts (a command), only when a runtime knows its map pose (v2v: an Eye or
 # estimator.initial_pose_map), or only while the Smart City Manager runs. "" = every run.
-# eye_cameras: only when the simulator renders a map's several overhead cameras.
-# eye_lockstep: only while an Eye runs in lockstep with the simulator (--sim-latency-ms).
+# eye_cameras: only when the simulator renders a map's several overhead cameras. cameras: only
+# with the cars' cameras on; sim_eye: only with autodrive-sim --eye; paced: only when the
+# simulator publishes its clock (--lockstep*, --rtf). eye_lockstep: only while an Eye runs in
+# lockstep with the simulator (--sim-latency-ms).
 WHEN = frozenset(
-    {"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras", "eye_lockstep"}
-)
+    {"", "traffic_lights", "on_demand", "v2v", "smart_city", "eye_cameras", "cameras", "sim_eye",
+     "paced", "eye_lockstep"}
+)  # fmt: skip
+# What an audit without a named run assumes: a full run, cameras, the simulated Eye and a clock.
+FULL_RUN = frozenset({"cameras", "sim_eye", "paced"})
 
 
 class ChannelTableError(ValueError):
@@ -65,11 +70,45 @@ class Channel:
 
 
 @dataclass(frozen=True)
+class InstanceRule:
+    """How a session's instance number moves its ports (channels.yaml `instances`)."""
+
+    variable: str  # the environment variable holding the instance number
+    max: int  # the largest instance number
+    port_step: int  # instance N adds N * port_step to the LCM and the web port
+    web_port: int  # instance 0's web port (the Smart City Manager's)
+    sim_run_dir: str  # instance 0's simulator run dir; instance N's is <this>-N
+
+
+@dataclass(frozen=True)
+class RunKind:
+    """A kind of recorded run (channels.yaml `runs`): who publishes and what holds in it."""
+
+    name: str
+    programs: frozenset[str]  # the publishers (program names of the table) that run
+    when: frozenset[str]  # the conditions (WHEN) that hold
+
+    def expects(self, ch: Channel) -> bool:
+        """Whether this kind of run publishes the live channel ch."""
+        runs = any(p in self.programs for p in ch.publishers)
+        return ch.status == "live" and runs and (not ch.when or ch.when in self.when)
+
+
+@dataclass(frozen=True)
 class ChannelTable:
     source: Path
     url_default: str
     vehicle_prefix: str
     channels: tuple[Channel, ...]
+    instances: InstanceRule
+    runs: tuple[RunKind, ...] = ()
+
+    def run(self, name: str) -> RunKind:
+        for r in self.runs:
+            if r.name == name:
+                return r
+        known = ", ".join(r.name for r in self.runs)
+        raise ChannelTableError(f"{self.source}: no run kind '{name}' (runs: {known})")
 
     def by_id(self, channel_id: str) -> Channel:
         for ch in self.channels:
@@ -145,7 +184,39 @@ def load(path: Path | str | None = None) -> ChannelTable:
         url_default=str(doc.get("url_default", "")),
         vehicle_prefix=str(doc.get("vehicle_prefix", "")),
         channels=tuple(out),
+        instances=_instance_rule(source, doc.get("instances")),
+        runs=_runs(source, doc.get("runs", {})),
     )
+
+
+def _runs(source: Path, entry: object) -> tuple[RunKind, ...]:
+    if not isinstance(entry, dict):
+        raise ChannelTableError(f"{source}: 'runs' must map run names to programs and when")
+    out = []
+    for name, r in entry.items():
+        if not isinstance(r, dict) or not isinstance(r.get("programs"), list):
+            raise ChannelTableError(f"{source}: runs.{name}: needs a 'programs' list")
+        when = frozenset(str(w) for w in r.get("when", []))
+        if not when <= WHEN:
+            raise ChannelTableError(f"{source}: runs.{name}.when: unknown {sorted(when - WHEN)}")
+        out.append(RunKind(str(name), frozenset(str(p) for p in r["programs"]), when))
+    return tuple(out)
+
+
+def _instance_rule(source: Path, entry: object) -> InstanceRule:
+    keys = ("variable", "max", "port_step", "web_port", "sim_run_dir")
+    if not isinstance(entry, dict) or any(k not in entry for k in keys):
+        raise ChannelTableError(f"{source}: 'instances' needs {', '.join(keys)}")
+    try:
+        return InstanceRule(
+            variable=str(entry["variable"]),
+            max=int(entry["max"]),
+            port_step=int(entry["port_step"]),
+            web_port=int(entry["web_port"]),
+            sim_run_dir=str(entry["sim_run_dir"]),
+        )
+    except (TypeError, ValueError) as err:
+        raise ChannelTableError(f"{source}: 'instances': {err}") from err
 
 
 def channel(channel_id: str, vehicle: str | None = None) -> str:

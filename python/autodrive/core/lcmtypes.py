@@ -16,6 +16,8 @@ from typing import Any
 
 import lcm
 
+from autodrive.core.settings import instance
+
 PACKAGE = "autodrive_msg"
 
 
@@ -43,8 +45,8 @@ def load(build: Path | str) -> Any:
 
 
 def bus(url: str) -> Any:
-    """An LCM instance on url."""
-    return lcm.LCM(url)
+    """An LCM instance on url, moved to the session's instance (AUTODRIVE_INSTANCE)."""
+    return lcm.LCM(instance().lcm_url(url))
 
 
 def events(log_path: Path | str) -> Iterator[Any]:

@@ -9,6 +9,11 @@ The first that holds the markers (vehicle/nigel.params, lcm_types/channels.yaml)
 is an error naming what is missing. AUTODRIVE_BUILD names the host build (default
 <root>/build/release).
 
+A session's instance (two users on one machine): ``instance()`` reads AUTODRIVE_INSTANCE (the
+variable and the port rule are channels.yaml's `instances`), and ``instance().lcm_url(url)``,
+``.web_port(port)`` and ``.sim_run_dir`` give the session's own bus, web port and simulator
+run dir; every LCM bus of the distribution opens through it (autodrive.core.lcmtypes.bus).
+
 Usage: ``settings().maps_dir``; the old module constants (REPO_ROOT, RELEASE_BUILD, ...) are
 read from it on first use (``from autodrive.core.settings import RELEASE_BUILD``).
 """
@@ -115,6 +120,87 @@ class Settings:
     @property
     def out_dir(self) -> Path:
         return self.root / "out"
+
+
+class InstanceError(ValueError):
+    """AUTODRIVE_INSTANCE holds no instance number: names the variable, the value and the range."""
+
+
+@dataclass(frozen=True)
+class Instance:
+    """A session's instance N: instance 0 keeps the table's ports, N > 0 moves them."""
+
+    number: int
+    variable: str  # the environment variable it came from
+    port_step: int
+    default_lcm_port: int  # url_default's port
+    default_web_port: int
+    default_sim_run_dir: str
+
+    def lcm_url(self, url: str) -> str:
+        """url, moved to this instance when it is a udpm:// URL on the default port."""
+        parsed = urlparse(url)
+        if self.number == 0 or parsed.scheme != "udpm":
+            return url
+        port = parsed.port or self.default_lcm_port
+        if port != self.default_lcm_port:
+            return url  # an explicit other port is the caller's own choice
+        host = parsed.hostname or ""
+        return parsed._replace(netloc=f"{host}:{port + self.number * self.port_step}").geturl()
+
+    def web_port(self, port: int | None = None) -> int:
+        """The web port: the given one, or the default moved to this instance."""
+        if port is not None:
+            return port
+        return self.default_web_port + self.number * self.port_step
+
+    @property
+    def sim_run_dir(self) -> str:
+        base = self.default_sim_run_dir
+        return base if self.number == 0 else f"{base}-{self.number}"
+
+    def describe(self) -> str:
+        """One line for error messages: how to pick another instance."""
+        return (
+            f"this is instance {self.number} ({self.variable}={self.number}); "
+            f"run as another instance with {self.variable}=N (0..) or --instance N: "
+            f"instance N uses LCM port {self.default_lcm_port}+{self.port_step}*N and web port "
+            f"{self.default_web_port}+{self.port_step}*N"
+        )
+
+
+def instance(value: str | None = None) -> Instance:
+    """The session's instance, from AUTODRIVE_INSTANCE (or value); raises InstanceError."""
+    from autodrive.core import channels  # channels reads its table's path from this module
+
+    table = channels.load()
+    rule = table.instances
+    text = os.environ.get(rule.variable, "") if value is None else value
+    try:
+        number = int(text) if text.strip() else 0
+    except ValueError:
+        number = -1
+    if not 0 <= number <= rule.max:
+        raise InstanceError(
+            f"{rule.variable}='{text}': expected an instance number in 0..{rule.max} "
+            "(0, or unset, is the default instance)"
+        )
+    default_port = urlparse(table.url_default).port
+    if default_port is None:
+        raise InstanceError(f"{table.source}: url_default names no port: {table.url_default}")
+    return Instance(
+        number=number,
+        variable=rule.variable,
+        port_step=rule.port_step,
+        default_lcm_port=default_port,
+        default_web_port=rule.web_port,
+        default_sim_run_dir=rule.sim_run_dir,
+    )
+
+
+def use_instance(number: int) -> None:
+    """A program's --instance N: sets AUTODRIVE_INSTANCE for this process and its children."""
+    os.environ[instance(str(number)).variable] = str(number)
 
 
 def _is_repo(path: Path) -> bool:

@@ -13,6 +13,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from autodrive.core.channels import channel
 from autodrive.maps.loader import MAPS_DIR
@@ -60,24 +61,77 @@ class OverheadCamera:
             and margin_px <= v <= self.height_px - 1 - margin_px
         )
 
-    def write_calibration(self, folder: Path) -> tuple[Path, Path]:
+    def calibration_texts(self) -> dict[str, str]:
         """<name>_camera.yaml (intrinsics, no lens) and <name>_map.yaml (X_cam = R X_map + t:
         camera x = map x, camera y (image down) = map -y, optical axis = map -z)."""
         size = f"width_px: {self.width_px}\nheight_px: {self.height_px}\n"
-        intr = folder / f"{self.name}_camera.yaml"
-        intr.write_text(f"{size}k: {self.k()}\ndist: [0, 0, 0, 0, 0]\n")
-        pose = folder / f"{self.name}_map.yaml"
-        pose.write_text(
-            f"{size}r_cam_map: [1, 0, 0, 0, -1, 0, 0, 0, -1]\n"
-            f"t_cam_map_m: [{-self.x_m!r}, {self.y_m!r}, {self.z_m!r}]\n"
-        )
-        return intr, pose
+        return {
+            f"{self.name}_camera.yaml": f"{size}k: {self.k()}\ndist: [0, 0, 0, 0, 0]\n",
+            f"{self.name}_map.yaml": f"{size}r_cam_map: [1, 0, 0, 0, -1, 0, 0, 0, -1]\n"
+            f"t_cam_map_m: [{-self.x_m!r}, {self.y_m!r}, {self.z_m!r}]\n",
+        }
+
+    def write_calibration(self, folder: Path) -> tuple[Path, Path]:
+        """The files of calibration_texts in folder: (intrinsics, pose)."""
+        paths = []
+        for name, text in self.calibration_texts().items():
+            (folder / name).write_text(text)
+            paths.append(folder / name)
+        return paths[0], paths[1]
 
 
 def sim_tag_id(car: int) -> int:
     """The roof tag id the simulator gives its car number car (1, 2, ...: mjcf_gen.c
     mjcf_gen_tag_id)."""
     return car
+
+
+def kit_eye(map_name: str, maps_dir: Path = MAPS_DIR) -> OverheadCamera:
+    """The overhead camera every simulator map has, "eye" (autodrive-sim --eye on EYE_IMAGE):
+    the kit's, above the map's origin (mjcf.py)."""
+    from autodrive.maps.loader import load_kit
+
+    e = load_kit(maps_dir / "kit.yaml").eye_camera
+    return OverheadCamera("eye", 0.0, 0.0, e.height_m, e.fovy_deg, e.width_px, e.height_px)
+
+
+def config_text(
+    cams: list[OverheadCamera],
+    url: str,
+    vehicles: list[tuple[str, int]],
+    maps: dict[str, str] | None = None,
+    reference_tags: str | None = None,
+    extra: list[str] | None = None,
+) -> str:
+    """The text of an `autodrive-eye run` config serving cams as one Eye (the calibration
+    files of calibration_texts beside it; maps: a camera's own map calibration file instead)."""
+    lines = [f'lcm_url: "{url}"', "base_link_height_m: 0.0", *(extra or [])]
+    if reference_tags is not None:
+        lines.append(f"reference_tags: {reference_tags}")
+    lines.append("cameras:")
+    for c in cams:
+        pose = (maps or {}).get(c.name, f"{c.name}_map.yaml")
+        lines.append(
+            f"  - {{name: {c.name}, intrinsics: {c.name}_camera.yaml, map: {pose}, "
+            f"source: 'lcm:{c.image_channel()}'}}"
+        )
+    lines.append("vehicles:")
+    lines += [f"  - {{name: {name}, tag_id: {tag}}}" for name, tag in vehicles]
+    return "\n".join(lines) + "\n"
+
+
+def reference_tags(map_name: str, maps_dir: Path = MAPS_DIR) -> list[dict[str, Any]]:
+    """The map's reference tags (sidecar: id, x_m, y_m, z_m, yaw_rad, size_m)."""
+    side = json.loads((maps_dir / f"{map_name}.json").read_text())
+    tags: list[dict[str, Any]] = side.get("reference_tags", [])
+    return tags
+
+
+def tags_text(tags: list[dict[str, Any]]) -> str:
+    """The Eye's reference tag list (calibrate-map --tags, run config reference_tags)."""
+    keys = ("id", "x_m", "y_m", "z_m", "yaw_rad", "size_m")
+    lines = ["tags:"] + [" - {" + ", ".join(f"{k}: {t[k]!r}" for k in keys) + "}" for t in tags]
+    return "\n".join(lines) + "\n"
 
 
 def load(map_name: str, maps_dir: Path = MAPS_DIR) -> list[OverheadCamera]:
@@ -111,19 +165,10 @@ def write_eye_config(
     map calibration (calibrate-map's output, in folder) in place of the map's own pose;
     reference_tags (in folder): the tags the Eye watches for a moved camera; extra: more
     config lines."""
-    lines = [f'lcm_url: "{url}"', "base_link_height_m: 0.0", *(extra or [])]
-    if reference_tags is not None:
-        lines.append(f"reference_tags: {reference_tags.name}")
-    lines.append("cameras:")
     for c in cams:
-        intr, pose = c.write_calibration(folder)
-        pose = (maps or {}).get(c.name, pose)
-        lines.append(
-            f"  - {{name: {c.name}, intrinsics: {intr.name}, map: {pose.name}, "
-            f"source: 'lcm:{c.image_channel()}'}}"
-        )
-    lines.append("vehicles:")
-    lines += [f"  - {{name: {name}, tag_id: {tag}}}" for name, tag in vehicles]
+        c.write_calibration(folder)
+    names = {k: v.name for k, v in (maps or {}).items()}
+    tags = reference_tags.name if reference_tags is not None else None
     path = folder / "eye.yaml"
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(config_text(cams, url, vehicles, names, tags, extra))
     return path

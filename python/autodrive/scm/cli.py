@@ -1,9 +1,9 @@
 """autodrive-scm: the Smart City Manager server, and its user administration.
 
     autodrive-scm --map tiny_town [--db URL] [--host H] [--port N] [--lcm-url URL]
-                  [--vehicles NIGEL1,NIGEL2,NIGEL3] [--history-hz HZ] [--clock wall|sim]
-                  [--build DIR]
-    autodrive-scm user add NAME --role operator|viewer [--db URL] [--password-stdin]
+                  [--instance N] [--vehicles NIGEL1,NIGEL2,NIGEL3] [--history-hz HZ]
+                  [--clock wall|sim] [--build DIR]
+    autodrive-scm user add NAME --role operator|viewer [--db URL] [--password-stdin] [--reset]
 
 Prints "SCM ready http://HOST:PORT/" on stdout once it serves."""
 
@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import getpass
 import signal
+import socket
 import sys
 import threading
 import time
@@ -22,15 +24,26 @@ import uvicorn
 
 from autodrive.core import channels
 from autodrive import maps
+from autodrive.core.settings import Instance, InstanceError, instance, use_instance
 from autodrive.scm.core.config import (
     DEFAULT_HOST,
     DEFAULT_MAP,
-    DEFAULT_PORT,
     default_url,
     find_build,
 )
 from autodrive.scm.core.db import DatabaseError, migrate, open_engine, sessions
 from autodrive.scm.core.security import UserError, add_user
+from autodrive.scm.crud import user_exists
+
+
+class DefaultsHelp(argparse.ArgumentDefaultsHelpFormatter):
+    """--help with each option's default, unless the option's own text says it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if action.default is None or "default" in text or isinstance(action.default, bool):
+            return text
+        return super()._get_help_string(action)
 
 
 def parse_serve(argv: list[str]) -> argparse.Namespace:
@@ -39,16 +52,35 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
         description="Smart City Manager: vehicles, traffic lights, signs and an event log in a "
         "database; light control; V2I advisories on LCM; a REST/WebSocket API (/docs) and a web "
         "app. Users: 'autodrive-scm user add NAME --role operator'.",
+        formatter_class=DefaultsHelp,
     )
+    rule = channels.load().instances
     p.add_argument("--map", default=DEFAULT_MAP, help="map name or description YAML")
     p.add_argument("--db", default=default_url(), help="sqlite:///PATH or postgresql://...")
-    p.add_argument("--host", default=DEFAULT_HOST)
-    p.add_argument("--port", type=int, default=DEFAULT_PORT)
-    p.add_argument("--lcm-url", default=channels.load().url_default)
+    p.add_argument("--host", default=DEFAULT_HOST, help="address to serve on")
+    p.add_argument(
+        "--port",
+        type=int,
+        default=None,
+        help=f"web port (default: the instance's, {rule.web_port} + {rule.port_step} N)",
+    )
+    p.add_argument(
+        "--lcm-url",
+        default=channels.load().url_default,
+        help="LCM bus; one on the default port moves to the instance's (default: %(default)s)",
+    )
+    p.add_argument(
+        "--instance",
+        type=int,
+        default=None,
+        help="this session's instance N (default: $AUTODRIVE_INSTANCE, else 0): its own LCM "
+        "port and web port, so two users' SCMs and simulators on one machine never meet",
+    )
     p.add_argument(
         "--vehicles",
         default="",
-        help="cars to advise, e.g. NIGEL1,NIGEL2,NIGEL3 " "(empty: every car whose pose is seen)",
+        help="cars to advise, e.g. NIGEL1,NIGEL2,NIGEL3 (default: empty, every car whose pose is "
+        "seen)",
     )
     p.add_argument(
         "--history-hz",
@@ -66,9 +98,18 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
         "simulator's SIM_CLOCK (a simulated one, whatever its speed; a SIM_CLOCK still for 5 s "
         "of wall time makes every car stale)",
     )
-    p.add_argument("--build", default=None, help="build dir with the LCM types")
+    p.add_argument(
+        "--build", default=None, help="build dir with the LCM types (default: the first built)"
+    )
     p.add_argument("--log-level", default="warning", help="uvicorn's log level")
     a = p.parse_args(argv)
+    try:
+        if a.instance is not None:
+            use_instance(a.instance)  # for this process and the programs it starts
+        a.session = instance()
+    except InstanceError as err:
+        p.error(str(err))
+    a.port = a.session.web_port(a.port)
     if not 0 < a.port < 65536:
         p.error(f"--port {a.port}: expected 1..65535")
     if a.history_hz < 0 or not 0 < a.advisory_hz <= 100:
@@ -88,6 +129,24 @@ class _Server(uvicorn.Server):
     @contextlib.contextmanager
     def capture_signals(self) -> Iterator[None]:
         yield
+
+
+def bind_web_port(host: str, port: int, session: Instance) -> socket.socket | str:
+    """The listening socket of host:port, or the message that says why not and what to do."""
+    sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind((host, port))
+    except OSError as err:
+        sock.close()
+        if err.errno == errno.EADDRINUSE:
+            return (
+                f"web port {port} on {host} is already in use (another SCM, perhaps another "
+                f"user's session): pick another with --port P, or {session.describe()}"
+            )
+        return f"cannot serve on {host}:{port}: {err.strerror}"
+    sock.listen(128)
+    return sock
 
 
 def serve(argv: list[str]) -> int:
@@ -116,6 +175,10 @@ def serve(argv: list[str]) -> int:
         a.advisory_hz,
         a.clock,
     )
+    sock = bind_web_port(a.host, a.port, a.session)
+    if isinstance(sock, str):
+        print(f"autodrive-scm: {sock}", file=sys.stderr)
+        return 2
     app = create_app(scm)
     config = uvicorn.Config(
         app, host=a.host, port=a.port, log_level=a.log_level, ws="websockets-sansio"
@@ -133,25 +196,50 @@ def serve(argv: list[str]) -> int:
 
     threading.Thread(target=announce, daemon=True).start()
     try:
-        server.run()
+        server.run(sockets=[sock])
     finally:
         scm.stop()
+        sock.close()
     return 0
 
 
 def user_command(argv: list[str]) -> int:
     p = argparse.ArgumentParser(prog="autodrive-scm user", description="Manage SCM users.")
     sub = p.add_subparsers(dest="action", required=True)
-    add = sub.add_parser("add", help="add a user or reset one's role and password")
+    add = sub.add_parser(
+        "add",
+        help="add a user (--reset: set an existing one's role and password)",
+        formatter_class=DefaultsHelp,
+    )
     add.add_argument("name")
     add.add_argument("--role", required=True, choices=["operator", "viewer"])
-    add.add_argument("--db", default=default_url())
+    add.add_argument("--db", default=default_url(), help="the SCM's database")
+    add.add_argument(
+        "--reset",
+        action="store_true",
+        help="replace the role and password of a user who exists (without it: refused)",
+    )
     add.add_argument(
         "--password-stdin",
         action="store_true",
         help="read the password from the first line of stdin (scripts)",
     )
     a = p.parse_args(argv)
+    try:
+        engine = open_engine(a.db)
+        migrate(engine)
+        with sessions(engine)() as s:
+            exists = user_exists(s, a.name)
+    except DatabaseError as err:
+        print(f"autodrive-scm user add: {err}", file=sys.stderr)
+        return 2
+    if exists and not a.reset:
+        print(
+            f"autodrive-scm user add: user {a.name} exists already; --reset replaces its role "
+            "and password",
+            file=sys.stderr,
+        )
+        return 2
     if a.password_stdin:
         password = sys.stdin.readline().rstrip("\n")
     else:
@@ -160,8 +248,6 @@ def user_command(argv: list[str]) -> int:
             print("autodrive-scm user add: the passwords differ", file=sys.stderr)
             return 2
     try:
-        engine = open_engine(a.db)
-        migrate(engine)
         new = add_user(sessions(engine), a.name, a.role, password)
     except (DatabaseError, UserError) as err:
         print(f"autodrive-scm user add: {err}", file=sys.stderr)

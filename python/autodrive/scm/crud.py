@@ -8,10 +8,15 @@ from typing import Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from autodrive.scm.models import Event, Pose
+from autodrive.scm.models import Event, Pose, User
 
 MAX_HISTORY_ROWS = 100000
 MAX_EVENT_ROWS = 5000
+
+
+def user_exists(s: Session, name: str) -> bool:
+    """Whether the user name is taken (autodrive-scm user add refuses it without --reset)."""
+    return s.get(User, name) is not None
 
 
 def pose_history(s: Session, vehicle: str, limit: int) -> list[dict[str, Any]]:

@@ -4,6 +4,7 @@
 // tools/plot-parking. With --replay LOG it reads <VEH>_LIDAR and <VEH>_ODOM from a recorded LCM
 // log instead (file://, as fast as it goes) and writes what it publishes to --replay-out: its
 // only clock is the messages' stamps, so a replay computes what the run did.
+#include <autodrive/instance.hpp>
 #include <autodrive_channels.h>
 #include <cmath>
 #include <csignal>
@@ -250,6 +251,7 @@ int main(int argc, char **argv) {
     cfg.lcm_url = "file://" + std::filesystem::absolute(replay_in).string() + "?speed=0";
     replay_out = "file://" + std::filesystem::absolute(replay_out).string() + "?mode=w";
   }
+  cfg.lcm_url = autodrive::instance_lcm_url(cfg.lcm_url);  // AUTODRIVE_INSTANCE
   lcm::LCM lcm(cfg.lcm_url);
   std::unique_ptr<lcm::LCM> replay_lcm;  // replay: what the autonomy publishes goes here
   if (replay) replay_lcm = std::make_unique<lcm::LCM>(replay_out);

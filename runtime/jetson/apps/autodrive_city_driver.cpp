@@ -9,6 +9,7 @@
 // time) makes the driver send disengaged stops only.
 #include <autodrive/core/clock.hpp>
 #include <CLI/CLI.hpp>
+#include <autodrive/instance.hpp>
 #include <autodrive/command_auth.hpp>
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/odometry_t.hpp>
@@ -252,6 +253,7 @@ int main(int argc, char **argv) {
   auto signer = autodrive::auth::load_machine_signer("autodrive-city-driver", o.vehicle, o.key_file,
                                                      "city-driver");
   if (!signer) return 2;
+  o.lcm_url = autodrive::instance_lcm_url(o.lcm_url);  // AUTODRIVE_INSTANCE
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-city-driver: --lcm-url '%s' unusable\n", o.lcm_url.c_str());

@@ -5,6 +5,7 @@
 // command through the core's TTC shield and publishes signed <VEH>_COMMAND at the policy's
 // control rate, through the runtime's guarded bridge (signature + control lease). Status on
 // <VEH>_MISSION at 2 Hz; a JSON summary as the last stdout line at exit.
+#include <autodrive/instance.hpp>
 #include <autodrive_channels.h>
 
 #include <CLI/CLI.hpp>
@@ -42,7 +43,7 @@ void on_signal(int) {
 }
 
 struct Options {
-  std::string vehicle = "NIGEL1", lcm_url = "udpm://239.255.76.67:7667?ttl=0", mode = "rl";
+  std::string vehicle = "NIGEL1", lcm_url = AUTODRIVE_LCM_URL_DEFAULT, mode = "rl";
   std::string policy, map_json, route, clock = "wall", key_file, odom_origin, eval_obs, goal;
   double waypoint_lookahead_m = 0;
   std::string log_level = "info";
@@ -430,6 +431,7 @@ int main(int argc, char **argv) {
   auto signer =
       autodrive::auth::load_machine_signer("autodrive-marl", o.vehicle, o.key_file, "marl");
   if (!signer) return 2;
+  o.lcm_url = autodrive::instance_lcm_url(o.lcm_url);  // AUTODRIVE_INSTANCE
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-marl: cannot open LCM at '%s' (multicast route missing?)\n",

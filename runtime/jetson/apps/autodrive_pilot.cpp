@@ -7,6 +7,7 @@
 // frozen SIM_CLOCK counts as no frames) it stops the car (disengaged commands) and says so; it
 // drives again when frames return. --predict runs the model
 // on image files instead.
+#include <autodrive/instance.hpp>
 #include <autodrive/command_auth.hpp>
 #include <autodrive/compressed_image_t.hpp>
 #include <autodrive/vehicle_command_t.hpp>
@@ -303,6 +304,7 @@ int main(int argc, char **argv) {
   auto signer =
       autodrive::auth::load_machine_signer("autodrive-pilot", cfg.vehicle, key_file, "pilot");
   if (!signer) return 2;
+  cfg.lcm_url = autodrive::instance_lcm_url(cfg.lcm_url);  // AUTODRIVE_INSTANCE
   lcm::LCM lcm(cfg.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-pilot: cannot open LCM at '%s' (multicast route missing?)\n",

@@ -1,5 +1,6 @@
 // autodrive-teleop: drive a car from a terminal keyboard and/or a gamepad (Linux joystick
 // API), publishing <VEH>_COMMAND at a steady rate. Dead-man: release stops the car.
+#include <autodrive/instance.hpp>
 #include <autodrive/command_auth.hpp>
 #include <autodrive_channels.h>
 #include <CLI/CLI.hpp>
@@ -121,6 +122,7 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "autodrive-teleop: %s\n", e.what());
     return 2;
   }
+  url = autodrive::instance_lcm_url(url);  // AUTODRIVE_INSTANCE
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-teleop: LCM URL '%s' unusable\n", url.c_str());

@@ -2,6 +2,7 @@
 
   vehicle-header OUT   <autodrive_vehicle.h> for C and C++ (run by CMake at build time)
   channels-header OUT  <autodrive_channels.h> for C and C++ (run by CMake at build time)
+  instance-header OUT  <autodrive_instance_rule.h>: the sessions' instance rule (likewise)
   tree [--check]       the generated files kept in the tree (docs, the firmware's servo header):
                        write them, or with --check fail naming each one that is stale
 Files are written only when their content changes, so that builds do not redo work."""
@@ -46,6 +47,13 @@ def main(argv: list[str] | None = None) -> int:
     ch_header.add_argument(
         "--table", type=Path, help="channel table (default lcm_types/channels.yaml)"
     )
+    inst_header = sub.add_parser(
+        "instance-header", help="write <autodrive_instance_rule.h> (channels.yaml's instances)"
+    )
+    inst_header.add_argument("out", type=Path, help="the header to write")
+    inst_header.add_argument(
+        "--table", type=Path, help="channel table (default lcm_types/channels.yaml)"
+    )
     in_tree = sub.add_parser("tree", help="write (or --check) the generated files in the tree")
     in_tree.add_argument("--check", action="store_true", help="only check that they are fresh")
     in_tree.add_argument("--root", type=Path, default=REPO_ROOT, help="repository root")
@@ -58,6 +66,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.what == "channels-header":
             table = channels.load(args.table)
             write_if_changed(args.out, channels_header.render(table, tree.CHANNELS))
+            return 0
+        if args.what == "instance-header":
+            table = channels.load(args.table)
+            write_if_changed(args.out, channels_header.render_instance(table, tree.CHANNELS))
             return 0
         stale = []
         for rel, text in tree.render_all(args.root).items():

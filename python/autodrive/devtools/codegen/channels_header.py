@@ -36,3 +36,28 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
         "LCM channel names; docs/reference/channels.md describes each.",
         lines,
     )
+
+
+INSTANCE_GUARD = "AUTODRIVE_INSTANCE_RULE_H"
+
+
+def render_instance(table: channels.ChannelTable, source_name: str) -> str:
+    """<autodrive_instance_rule.h>: the table's `instances` rule (its own header, so that a
+    change of it rebuilds only the code of sessions, not every user of a channel name)."""
+    rule = table.instances
+    lines = [
+        f'#define AUTODRIVE_INSTANCE_VARIABLE "{rule.variable}"',
+        f"#define AUTODRIVE_INSTANCE_MAX {rule.max}",
+        "/* instance N adds N * this to the default LCM port and to the web port */",
+        f"#define AUTODRIVE_INSTANCE_PORT_STEP {rule.port_step}",
+        f"#define AUTODRIVE_WEB_PORT_DEFAULT {rule.web_port}",
+        "/* instance N > 0 runs the simulator in <this>-N */",
+        f'#define AUTODRIVE_SIM_RUN_DIR_DEFAULT "{rule.sim_run_dir}"',
+    ]
+    return c_header.wrap(
+        INSTANCE_GUARD,
+        source_name,
+        "autodrive.devtools.codegen.channels_header",
+        "Sessions side by side (AUTODRIVE_INSTANCE); docs/reference/channels.md describes them.",
+        lines,
+    )

@@ -8,6 +8,7 @@ from pathlib import Path
 from autodrive.core import channels, vehicle
 from autodrive.devtools.codegen import (
     channels_doc,
+    eye_configs,
     firmware_header,
     maps_doc,
     protocol_doc,
@@ -28,4 +29,5 @@ def render_all(root: Path) -> dict[str, str]:
         firmware_header.PATH: firmware_header.render(car, PARAMS),
         protocol_doc.PATH: protocol_doc.render(root),
         maps_doc.PATH: maps_doc.render(root),
+        **eye_configs.render(root),
     }

@@ -328,14 +328,21 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="tools/export-mcap",
         description=__doc__.split("\n\n")[0] if __doc__ else None,
-        epilog="example: tools/export-mcap out/demo/run.lcmlog out/demo/run.mcap "
-        "--map out/demo/map.yaml",
+        epilog="example: tools/export-mcap out/demo/run.lcmlog   (writes out/demo/run.mcap; "
+        "--map out/demo/map.yaml adds the saved map)",
     )
     p.add_argument("lcmlog", type=Path, help="the LCM log (lcm-logger output)")
-    p.add_argument("mcap", type=Path, help="the MCAP file to write")
+    p.add_argument(
+        "mcap",
+        type=Path,
+        nargs="?",
+        help="the MCAP file to write (default: the log's path with .mcap instead of .lcmlog)",
+    )
     p.add_argument("--map", type=Path, help="the autonomy's saved map (map.yaml) for /map")
     p.add_argument("--build", type=Path, default=RELEASE_BUILD, help="build dir with the LCM types")
     args = p.parse_args(argv)
+    if args.mcap is None:
+        args.mcap = args.lcmlog.with_suffix(".mcap")
     try:
         counts = export_mcap(args.lcmlog, args.mcap, args.build, args.map)
     except (ValueError, RuntimeError, OSError) as e:

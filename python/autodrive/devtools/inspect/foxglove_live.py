@@ -27,6 +27,7 @@ import foxglove.messages as fm
 import numpy as np
 
 from autodrive.core import channels, lcmtypes, vehicle
+from autodrive.core.settings import instance
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.core.runfiles import read_occupancy
 from autodrive.devtools.inspect import frames
@@ -238,7 +239,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"foxglove-live: {e}", file=sys.stderr)
         return 1
     bus.subscribe(".*", bridge.on_lcm)
-    server = foxglove.start_server(name="autodrive", host=args.host, port=args.port)
+    try:
+        server = foxglove.start_server(name="autodrive", host=args.host, port=args.port)
+    except Exception as e:  # the SDK raises its own error types for a taken or bad address
+        print(
+            f"foxglove-live: cannot serve on {args.host}:{args.port} ({e}): if the port is in use "
+            f"(another foxglove-live, an SCM, another user's session), pick another with --port "
+            f"P; {instance().describe()}",
+            file=sys.stderr,
+        )
+        return 1
     print(f"foxglove-live: serving ws://{args.host}:{server.port} from {args.lcm_url}", flush=True)
     stop = threading.Event()
 

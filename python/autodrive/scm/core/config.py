@@ -14,7 +14,6 @@ from autodrive.core.settings import settings
 
 DEFAULT_MAP = "tiny_town"
 DEFAULT_HOST = "127.0.0.1"
-DEFAULT_PORT = 8765
 BUILD_PRESETS = ("release", "asan", "dev")
 
 

@@ -93,8 +93,9 @@ function drawMap() {
   }
   if (!s) return;
   const f = m.footprint;
+  const labels = [];  // where names are written, so that the next one moves clear of them
   for (const car of s.vehicles) {
-    if (car.age_s === null) continue;
+    if (car.age_s === null) continue;  // never seen: no place to draw it
     const [u, v] = px(car.x_m, car.y_m);
     g.save(); g.translate(u, v); g.rotate(-car.yaw_rad);
     g.fillStyle = car.status === "ok" ? "#17c" : "#999"; g.strokeStyle = "#000";
@@ -104,7 +105,10 @@ function drawMap() {
     g.moveTo(cx + L / 2, 0); g.lineTo(cx + L / 2 - 0.06 * k, W / 3); g.lineTo(cx + L / 2 - 0.06 * k, -W / 3);
     g.fill(); g.restore();
     g.fillStyle = "#000"; g.font = "bold 12px sans-serif";
-    g.fillText(`${car.name} ${car.speed_m_s.toFixed(2)} m/s`, u + 10, v - 10);
+    let lv = v - 10;
+    while (labels.some(([a, b]) => Math.abs(a - (u + 10)) < 120 && Math.abs(b - lv) < 14)) lv -= 14;
+    labels.push([u + 10, lv]);
+    g.fillText(`${car.name} ${car.speed_m_s.toFixed(2)} m/s`, u + 10, lv);
   }
 }
 
@@ -116,6 +120,10 @@ function drawTables() {
   const vb = $("vehicles").tBodies[0]; vb.innerHTML = "";
   for (const c of s.vehicles) {
     const tr = vb.insertRow(); tr.dataset.name = c.name;
+    if (c.age_s === null) {  // a car the SCM was told of but has never seen: no made-up 0, 0
+      cell(tr, c.name); const td = cell(tr, "not seen yet", "unseen"); td.colSpan = 8;
+      continue;
+    }
     cell(tr, c.name); cell(tr, c.x_m.toFixed(3)); cell(tr, c.y_m.toFixed(3)); cell(tr, c.speed_m_s.toFixed(2));
     cell(tr, c.source); cell(tr, c.status); cell(tr, c.lane);
     cell(tr, c.next_light >= 0 ? `L${c.next_light}` : "-"); cell(tr, fmt(c.stop_line_m));
@@ -125,7 +133,10 @@ function drawTables() {
     jd.dataset.built = "1";
     for (const j of s.junctions) {
       const div = document.createElement("div");
-      div.innerHTML = `junction <b>${j.name}</b> (lights ${j.lights.join(", ")}): mode
+      const t = (scm.map.junctions || []).find((x) => x.name === j.name);
+      const where = t ? `, the map's ${t.type} tile at (${t.centre_m.map((x) => x.toFixed(1)).join(", ")}) m` : "";
+      div.innerHTML = `<label for="mode-${j.name}">junction <b>${j.name}</b>${where}, lights
+        ${j.lights.map((i) => `L${i}`).join(", ")}: mode</label>
         <select id="mode-${j.name}" ${op ? "" : "disabled"}><option>fixed</option><option>actuated</option><option>manual</option></select>`;
       jd.appendChild(div);
       div.querySelector("select").onchange = (ev) => act("PUT", `/api/junctions/${j.name}/mode`, { mode: ev.target.value });
@@ -143,7 +154,8 @@ function drawTables() {
         const b = document.createElement("button"); b.textContent = st; b.id = `light-${l.id}-${st.toLowerCase()}`;
         b.disabled = !op; b.onclick = () => setLight(l.id, st); tr.cells[4].appendChild(b);
       }
-      tr.cells[5].innerHTML = ["offset", "green", "yellow", "red"].map((n) => `<input class="prog" id="prog-${l.id}-${n}" ${op ? "" : "disabled"}>`).join(" ")
+      tr.cells[5].innerHTML = ["offset", "green", "yellow", "red"].map((n) =>
+        `<label class="prog" for="prog-${l.id}-${n}">${n}</label><input class="prog" id="prog-${l.id}-${n}" aria-label="L${l.id} ${n} [s]" ${op ? "" : "disabled"}>`).join(" ")
         + ` <button id="prog-${l.id}-save" ${op ? "" : "disabled"}>save</button>`;
       $(`prog-${l.id}-save`).onclick = () => saveProgram(l.id);
       fillProgram(l);
@@ -152,12 +164,32 @@ function drawTables() {
     tr.cells[2].textContent = l.sim_state; tr.cells[2].className = `st-${l.sim_state}`;
     tr.cells[3].textContent = fmt(l.time_left_s, 1);
   }
+  drawEvents(s.events);
+}
+
+// Programmed changes (a light's program, actuation, the server) are the background of a town:
+// one line per light with their count and the latest; what people did comes first, one each.
+const AUTOMATIC = new Set(["program", "actuated", "server"]);
+function detailText(d) {
+  return Object.entries(d || {}).map(([k, v]) => `${k} ${typeof v === "object" ? JSON.stringify(v) : v}`).join(", ");
+}
+function drawEvents(events) {
   const ev = $("events"); ev.innerHTML = "";
-  for (const e of s.events.slice().reverse()) {
-    const li = document.createElement("li");
-    li.textContent = `${new Date(e.utime / 1000).toLocaleTimeString()} ${e.actor} ${e.kind} ${e.subject} ${JSON.stringify(e.detail)}`;
-    ev.appendChild(li);
+  const when = (e) => new Date(e.utime / 1000).toLocaleTimeString();
+  const people = events.filter((e) => !AUTOMATIC.has(e.actor)).reverse();
+  const auto = {};
+  for (const e of events.filter((x) => AUTOMATIC.has(x.actor))) {
+    const k = `${e.actor} ${e.kind} ${e.subject}`;
+    auto[k] = { n: (auto[k] ? auto[k].n : 0) + 1, last: e };
   }
+  const list = (title, items) => {
+    const h = document.createElement("h3"); h.textContent = title; ev.appendChild(h);
+    const ol = document.createElement("ol"); ev.appendChild(ol);
+    for (const [text, cls] of items) { const li = document.createElement("li"); li.textContent = text; if (cls) li.className = cls; ol.appendChild(li); }
+  };
+  list("Operators' actions", people.map((e) => [`${when(e)} ${e.actor} ${e.kind} ${e.subject}: ${detailText(e.detail)}`, "operator"]));
+  list("Programmed changes", Object.entries(auto).sort((a, b) => b[1].last.utime - a[1].last.utime).map(([k, g]) =>
+    [`${k}: ${g.n} change${g.n > 1 ? "s" : ""}, last ${when(g.last)} (${detailText(g.last.detail)})`, ""]));
 }
 
 function fillProgram(l) {

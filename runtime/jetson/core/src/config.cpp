@@ -1,6 +1,7 @@
 #include <autodrive/core/config.hpp>
 
 #include <autodrive/core/clock.hpp>
+#include <autodrive/instance.hpp>
 
 #include <autodrive_channels.h>
 
@@ -161,6 +162,15 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   Config c;
   c.file = file;
   c.lcm_url = top.get<std::string>("lcm_url");
+  // Two sessions on one machine: AUTODRIVE_INSTANCE moves the default bus and the simulator's
+  // ptys (<autodrive/instance.hpp>).
+  autodrive::Instance session(0);
+  try {
+    session = autodrive::instance();
+  } catch (const autodrive::InstanceError &e) {
+    throw Error(file + ": " + e.what());
+  }
+  c.lcm_url = session.lcm_url(c.lcm_url);
   const auto clock = top.get<std::string>("clock");
   if (const auto mode = autodrive::clock::clock_mode_named(clock))
     c.clock = *mode;
@@ -169,9 +179,11 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   c.vehicle = parse_vehicle(top.child("vehicle"));
   if (!top.has("vehicle")) top.fail("vehicle", "missing key");
   if ((c.has_bridge = top.has("bridge"))) c.bridge = parse_bridge(top.child("bridge"));
+  c.bridge.device = session.sim_path(c.bridge.device);
   if (c.has_bridge && c.bridge.sync_to_sim_clock && c.clock != ClockMode::sim)
     top.fail("bridge.sync_to_sim_clock", "needs clock: sim (it sends on SIM_CLOCK ticks)");
   if ((c.has_lidar = top.has("lidar"))) c.lidar = parse_lidar(top.child("lidar"));
+  c.lidar.device = session.sim_path(c.lidar.device);
   if ((c.has_estimator = top.has("estimator")))
     c.estimator = parse_estimator(top.child("estimator"));
   if (top.has("cameras")) {

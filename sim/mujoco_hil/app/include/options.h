@@ -14,6 +14,9 @@ typedef struct app_options {
   sim_config_t cfg; /* its paths point into this struct: parse in place, never copy */
   char params[1024], map[1024];
   const char *url, *truth_log;
+  int instance;                          /* --instance or AUTODRIVE_INSTANCE (sim_instance.h) */
+  int run_dir_given;                     /* --run-dir: the instance leaves it alone */
+  char instance_url[512], run_dir[1024]; /* url and run dir moved to the instance */
   int lockstep, client_sync, frame_sync, allow_teleport, rtf_given;
   int host_io_ms; /* --host-io-ms; 0: the mode's default */
   double rtf, duration_s;

@@ -8,10 +8,12 @@
 #include <string.h>
 
 #include <autodrive_channels.h>
+#include <autodrive_instance_rule.h>
 
 #include "camera_fx.h"
 #include "cameras.h"
 #include "script.h"
+#include "sim_instance.h"
 
 #define OPTIONS_BAD 2      /* a bad option or value: the exit status */
 #define OPTIONS_UNKNOWN -2 /* not an option of this group */
@@ -62,7 +64,11 @@ static void options_usage(FILE *f) {
       "                      every step)\n"
       "  --duration S        stop after S sim seconds (default: until SIGINT/SIGTERM)\n"
       "  --lcm-url URL       LCM provider (default %s)\n"
-      "  --run-dir DIR       ptys' symlinks and the generated scene (default /tmp/autodrive-sim)\n"
+      "  --run-dir DIR       ptys' symlinks and the generated scene (default %s)\n"
+      "  --instance N        this session's instance 0..%d (default: $%s, else 0):\n"
+      "                      instance N > 0 moves the LCM URL on the default port to\n"
+      "                      that port + %d N and the default run dir to <run dir>-N,\n"
+      "                      so two users' sims, runtimes and SCMs never hear each other\n"
       "  --script SPEC       scripted driver instead of a client on the pty, for tests and\n"
       "                      benchmarks: constant:throttle=T,steering=S[,start=s][,stop_after=s]\n"
       "                      or route:NAME[,speed=F][,start=s][,lookahead=M][,laps=N]\n"
@@ -114,6 +120,8 @@ static void options_usage(FILE *f) {
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
       SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
       SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT,
+      AUTODRIVE_SIM_RUN_DIR_DEFAULT, AUTODRIVE_INSTANCE_MAX, AUTODRIVE_INSTANCE_VARIABLE,
+      AUTODRIVE_INSTANCE_PORT_STEP,
       SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M, CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
 }
 
@@ -136,7 +144,7 @@ static void options_defaults(app_options_t *o) {
   snprintf(o->map, sizeof o->map, "%s/parking_school.xml", AUTODRIVE_MAPS_DIR);
   o->cfg.params_path = o->params;
   o->cfg.map_path = o->map;
-  o->cfg.run_dir = "/tmp/autodrive-sim";
+  o->cfg.run_dir = AUTODRIVE_SIM_RUN_DIR_DEFAULT;
   o->cfg.cars = 1;
   o->cfg.seed = 1;
   o->cfg.open_ptys = 1;
@@ -282,6 +290,14 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--run-dir") && v) {
     o->cfg.run_dir = v;
+    o->run_dir_given = 1;
+    return 1;
+  } else if (!strcmp(a, "--instance")) {
+    if ((o->instance = sim_instance_parse(v)) < 0) {
+      fprintf(stderr, "autodrive-sim: --instance '%s': expected a number in 0..%d\n", v ? v : "",
+              AUTODRIVE_INSTANCE_MAX);
+      return OPTIONS_BAD;
+    }
     return 1;
   } else if (!strcmp(a, "--host-io-ms")) {
     if (options_number(a, v, 1, 100, &x)) return OPTIONS_BAD;
@@ -364,8 +380,16 @@ static int options_check(const app_options_t *o) {
   return -1;
 }
 
+/* Moves the URL and, unless given, the run dir to the session's instance. */
+static void options_instance(app_options_t *o) {
+  o->url = sim_instance_url(o->instance, o->url, o->instance_url, sizeof o->instance_url);
+  if (!o->run_dir_given)
+    o->cfg.run_dir = sim_instance_run_dir(o->instance, o->run_dir, sizeof o->run_dir);
+}
+
 int app_options_parse(app_options_t *o, int argc, char **argv) {
   options_defaults(o);
+  if ((o->instance = sim_instance_from_env()) < 0) return OPTIONS_BAD;
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *v = (i + 1 < argc) ? argv[i + 1] : NULL;
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -382,6 +406,7 @@ int app_options_parse(app_options_t *o, int argc, char **argv) {
     }
     i += took;
   }
+  options_instance(o);
   const int free_lockstep = app_options_free_lockstep(o);
   o->cfg.host_io_period_ms = o->host_io_ms   ? o->host_io_ms
                              : free_lockstep ? OPTIONS_FREE_LOCKSTEP_IO_MS

@@ -25,13 +25,17 @@
 #define LOOP_PROGRESS_S 5.0     /* [s] wall time between progress lines */
 /* Largest lag behind the real-time schedule [s] before the schedule slips (see pacing). */
 #define LOOP_MAX_LAG_S 0.02
+/* A progress line says the run lags only when the slips of its interval add up to more than
+ * this share of it: single 20 ms hiccups of a busy machine are normal, not news. */
+#define LOOP_LAG_NOTE_SHARE 0.1
 
 typedef struct loop {
   int64_t end_us; /* --duration in sim time, -1: none */
   double t0;      /* wall start, moved forward by pauses in the viewer and bare blocks */
   double next_progress, next_flush;
   int64_t last_progress_us;
-  long step, slips;
+  long step;
+  double slipped_s; /* [s] wall the schedule slipped since the last progress line */
   int free_lockstep;
   client_sync_t sync;
   bench_pairs_t pairs; /* --bench in free lockstep: sim blocks paired with bare mj_step blocks */
@@ -132,21 +136,25 @@ static void loop_pace(app_t *a, loop_t *l, int64_t now_us) {
        * through the backlog. A burst would advance sim time with no bytes arriving on the
        * pty, and the emulated Nano's failsafe would trip on a client that is fine. */
       l->t0 -= ahead;
-      l->slips++;
+      l->slipped_s -= ahead;
     } else if (ahead > 0.0005) {
       struct timespec ts = {(time_t)ahead, (long)((ahead - floor(ahead)) * 1e9)};
       nanosleep(&ts, NULL);
     }
   }
   if (wall >= l->next_progress) {
-    const double rtf_now =
-        (now_us - l->last_progress_us) * 1e-6 / (wall - l->next_progress + LOOP_PROGRESS_S);
+    const double interval_s = wall - l->next_progress + LOOP_PROGRESS_S;
+    const double rtf_now = (now_us - l->last_progress_us) * 1e-6 / interval_s;
     l->last_progress_us = now_us;
     l->next_progress = wall + LOOP_PROGRESS_S;
-    if (!o->quiet)
-      fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f%s\n", now_us * 1e-6, rtf_now,
-              l->slips ? " (fell behind: schedule slipped)" : "");
-    l->slips = 0;
+    if (!o->quiet && l->slipped_s > LOOP_LAG_NOTE_SHARE * interval_s && !o->lockstep)
+      fprintf(stderr,
+              "[autodrive-sim] t = %.1f s sim, rtf %.2f (asked %.2f: this machine is too busy; "
+              "%.1f s of the last %.1f s lost)\n",
+              now_us * 1e-6, rtf_now, o->rtf, l->slipped_s, interval_s);
+    else if (!o->quiet)
+      fprintf(stderr, "[autodrive-sim] t = %.1f s sim, rtf %.2f\n", now_us * 1e-6, rtf_now);
+    l->slipped_s = 0;
   }
 }
 

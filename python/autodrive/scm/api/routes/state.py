@@ -65,6 +65,12 @@ def map_payload(scm: Scm) -> dict[str, Any]:
             for s in m.placed_signs()
         ],
         "conflicts": m.light_conflicts(),
+        # the map's tiles that hold lights: a junction's name, kind and place, as the map says
+        "junctions": [
+            {"name": t.name, "type": t.type, "centre_m": list(t.centre_m)}
+            for t in m.tiles
+            if t.name in {j for j in scm.controller.junctions}
+        ],
         "footprint": {
             "length_m": v.envelope_length_m,
             "width_m": v.envelope_width_m,

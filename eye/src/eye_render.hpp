@@ -1,5 +1,5 @@
-// Synthetic overhead frames with exact geometry, for tests and benchmarks ("synthesised golden
-// frames"). Everything uses the Eye's pixel convention: the centre of pixel (col,row) is at
+// Synthetic frames with exact geometry: the calibration board set of autodrive-eye
+// make-board-images (eye_boards), and the golden frames of the tests and the benchmark. Everything uses the Eye's pixel convention: the centre of pixel (col,row) is at
 // (x,y) = (col,row) and the pixel covers the square [col-0.5,col+0.5] x [row-0.5,row+0.5].
 // Each output pixel is the box-filtered average of ss x ss point samples taken at the centres
 // of its sub-squares, so edges are anti-aliased without any half-pixel shift.
