@@ -58,7 +58,7 @@ def verdict(ca: v2x_ca.Authority, msg: Any, channel: str = "NIGEL1_V2I", channel
             name: str | None = None, now_us: int = NOW_US,
             verifier: v2x_auth.Verifier | None = None) -> v2x_auth.Verdict:  # fmt: skip
     v = verifier or v2x_auth.Verifier(ca.key_dir)
-    return v.verify(channel, msg, v2x_auth.ROLE_POLICY[channel_id], name, now_us)
+    return v.verify(channel, msg, v2x_auth.roles_for(channel_id), name, now_us)
 
 
 def test_accepts_a_signed_advisory_and_counts_it(ca: v2x_ca.Authority) -> None:

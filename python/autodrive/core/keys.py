@@ -14,7 +14,7 @@ from autodrive.core import channels
 from autodrive.core.command_auth import create_key, default_key_path, load_key
 
 
-CA_ACTIONS = ("ca", "issue", "revoke", "show")
+CA_ACTIONS = ("ca", "issue", "revoke", "show", "testbed")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -28,7 +28,7 @@ def main(argv: list[str] | None = None) -> int:
         description="Create or check a car's command key (signs <VEH>_COMMAND; the runtime's "
         "bridge drops commands without a valid signature). Default file: "
         "$AUTODRIVE_KEY_DIR/<VEH>.key, else ~/.config/autodrive/keys/<VEH>.key. The testbed "
-        "certificate authority: tools/keys ca init | issue | revoke | show (each with --help).",
+        "certificate authority: tools/keys ca init | issue | revoke | show | testbed (each with --help).",
     )
     p.add_argument("action", choices=("create", "check", "path"), help="what to do")
     p.add_argument("vehicles", nargs="*", help=f"car names (default: {channels.vehicle_name(1)})")

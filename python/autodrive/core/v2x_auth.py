@@ -8,7 +8,7 @@ and the LCM encoding of the message with an empty auth. Usage:
     signer = MessageSigner(v2x_ca.ensure_identity("SCM", "scm"))
     lc.publish(channel, signer.sign(channel, msg, sender_utime).encode())
     verifier = Verifier.from_key_dir()
-    result = verifier.verify(channel, msg, ROLE_POLICY["V2I"], None, now_us)
+    result = verifier.verify(channel, msg, roles_for("V2I"), None, now_us)
 """
 
 from __future__ import annotations
@@ -24,21 +24,19 @@ from typing import Any
 import nacl.exceptions
 import nacl.signing
 
+from autodrive.core import channels
 from autodrive.core.v2x_ca import Identity, default_key_dir, load_revocation_list, load_trust_anchor
 from autodrive.core.v2x_cert import CertificateError, decode_certificate
 
 ENVELOPE_MAGIC = b"ADSIG1"
 DEFAULT_WINDOW_US = 500_000  # a message's sender time within this of the receiver's clock [us]
-# Which roles may sign each channel (by channel id of lcm_types/channels.yaml), and whether the
-# certificate's name must equal the message's `vehicle` (V2V: only NIGELk sends as NIGELk).
-ROLE_POLICY: dict[str, frozenset[str]] = {
-    "V2V": frozenset({"car"}),
-    "V2I": frozenset({"scm"}),
-    "TRAFFIC_LIGHT_COMMAND": frozenset({"scm"}),
-    "TRAFFIC_LIGHT_STATE": frozenset({"light-controller"}),
-    "POSE_EYE": frozenset({"eye"}),
-}
-NAME_BOUND = frozenset({"V2V"})
+
+
+def roles_for(channel_id: str) -> frozenset[str]:
+    """The roles that may sign a channel (its signed_by in lcm_types/channels.yaml)."""
+    return frozenset(channels.load().by_id(channel_id).signed_by)
+
+
 # Reasons, worded as the C library's v2x_reason_name.
 ACCEPTED = "accepted"
 UNSIGNED = "unsigned"

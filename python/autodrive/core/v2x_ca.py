@@ -15,12 +15,14 @@ import base64
 import secrets
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import nacl.signing
 
-from autodrive.core.command_auth import default_key_path
+from autodrive.core import channels
+from autodrive.core.command_auth import create_key, default_key_path
 from autodrive.core.v2x_cert import (
     ROLES,
     Certificate,
@@ -155,19 +157,40 @@ def load_identity(name: str, key_dir: Path | None = None, now_s: float | None = 
     return Identity(cert, key)
 
 
-def ensure_identity(name: str, role: str, key_dir: Path | None = None) -> Identity:
-    """For missions and tests: the identity NAME, making the CA and the certificate (30 days)
-    when missing. A lab issues its certificates by hand instead (tools/keys issue)."""
+# The identities of a HIL run besides the cars: the Smart City Manager (and its stand-in), the
+# Eye (and its stand-in), the simulator as the lights' controller.
+TESTBED_IDENTITIES = (("SCM", "scm"), ("EYE", "eye"), ("SIM", "light-controller"))
+
+
+def ensure_testbed(cars: list[str], key_dir: Path | None = None) -> list[Path]:
+    """For setup, missions and tests: a CA and a certificate (30 days) for each car and each of
+    TESTBED_IDENTITIES, each made only when missing or no longer valid; returns what it made.
+    A lab issues its certificates by hand instead (tools/keys issue)."""
     ca = Authority(key_dir)
     if not (ca.ca_dir / "ca.key").exists() and not ca.public_path.exists():
         ca.init()
-    cert_path = ca.key_dir / f"{name}.cert"
-    if not cert_path.exists():
-        ca.issue(name, role, 30)
-    identity = load_identity(name, key_dir)
-    if identity.cert.role != role:
-        raise CertificateError(f"{cert_path}: role {identity.cert.role}, this program is {role}")
-    return identity
+    made = []
+    for name, role in [(c, "car") for c in cars] + list(TESTBED_IDENTITIES):
+        try:
+            if load_identity(name, ca.key_dir).cert.role == role:
+                continue
+        except CertificateError:
+            pass  # missing, expired or broken: issued anew
+        made.append(ca.issue(name, role, 30))
+    return made
+
+
+def ensure_run_keys(cars: list[str], say: Callable[[str], None]) -> None:
+    """For a mission: each car's command key and the testbed certificates, made where missing
+    in the key folder (say() tells what was made)."""
+    for car in cars:
+        path = default_key_path(car)
+        if not path.exists():
+            create_key(path)
+            say(f"created the command key of {car} at {path} (tools/keys)")
+    made = ensure_testbed(cars)
+    if made:
+        say(f"issued the testbed certificates {[p.name for p in made]} in {made[0].parent}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -188,6 +211,11 @@ def main(argv: list[str] | None = None) -> int:
     issue.add_argument("--days", type=float, default=30.0, help="validity [days] (default 30)")
     revoke = sub.add_parser("revoke", help="revoke certificates by name or serial (ca/ca.crl)")
     revoke.add_argument("items", nargs="+", help="names or serials")
+    testbed = sub.add_parser(
+        "testbed",
+        help="a CA (if none) and certificates for the cars, SCM, EYE and SIM (if missing)",
+    )
+    testbed.add_argument("--cars", type=int, default=4, help="NIGEL1..NIGELn (default 4)")
     show = sub.add_parser("show", help="print and check certificates")
     show.add_argument("names", nargs="+")
     args = p.parse_args(argv)
@@ -199,6 +227,12 @@ def main(argv: list[str] | None = None) -> int:
         elif args.action == "issue":
             path = authority.issue(args.name, args.role, args.days)
             print(f"[keys] issued {path} (role {args.role}, {args.days:g} days)")
+        elif args.action == "testbed":
+            cars = [channels.vehicle_name(i + 1) for i in range(args.cars)]
+            made = ensure_testbed(cars, args.dir)
+            print(
+                f"[keys] testbed in {authority.key_dir}: made {[p.name for p in made] or 'nothing'}"
+            )
         elif args.action == "revoke":
             serials = authority.revoke(args.items)
             print(f"[keys] revoked serials {serials}; {authority.crl_path} re-signed")

@@ -21,7 +21,7 @@ from typing import Any
 
 from sqlalchemy import Engine, select as sql_select
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
 from autodrive.maps import MapDescription
 from autodrive.scm.core.db import sessions
 from autodrive.scm.lights import STATES, Change, ControlError, Controller, Light, Program
@@ -77,6 +77,7 @@ class Scm:
         history_hz: float = 10.0,
         advisory_hz: float = 10.0,
         clock: str = "wall",
+        identity: str = "SCM",
     ) -> None:
         if clock not in CLOCKS:
             raise ValueError(f"clock must be one of {CLOCKS}, got {clock!r}")
@@ -105,6 +106,9 @@ class Scm:
         self.lc = lcmtypes.bus(lcm_url)
         self.lc_out = lcmtypes.bus(lcm_url)  # publishing from the control thread
         self.lcm_lock = threading.Lock()
+        # V2I advisories and light commands go out signed with the SCM's certificate
+        # (tools/keys issue --role scm); CertificateError naming the file when it is missing.
+        self.signer = v2x_auth.MessageSigner(v2x_ca.load_identity(identity))
 
     # --- set-up -------------------------------------------------------------------------------
 
@@ -359,8 +363,15 @@ class Scm:
         msg = self.types.traffic_light_command_t()
         msg.utime = now_us()
         msg.light_id, msg.state, msg.duration_s = light_id, STATES.index(state), COMMAND_HOLD_S
-        self._publish(channels.channel("TRAFFIC_LIGHT_COMMAND"), msg.encode())
+        self._publish_signed(channels.channel("TRAFFIC_LIGHT_COMMAND"), msg)
         self.stats["commands_out"] += 1
+
+    def _publish_signed(self, chan: str, msg: Any) -> None:
+        """Signs msg on the SCM's clock (the cars judge its freshness on theirs: in HIL both are
+        the simulator's; before the first SIM_CLOCK the wall's, which such a car refuses)."""
+        tc = self.city_now()
+        sender_utime = int((time.time() if tc is None else tc) * 1e6)
+        self._publish(chan, self.signer.sign(chan, msg, sender_utime).encode())
 
     def _publish(self, chan: str, data: bytes) -> None:
         with self.lcm_lock:
@@ -418,7 +429,7 @@ class Scm:
                 a.sign_distance_m,
             )
             msg.speed_limit_m_s = a.speed_limit_m_s
-            self._publish(channels.channel("V2I", car.name), msg.encode())
+            self._publish_signed(channels.channel("V2I", car.name), msg)
             self.stats["advisories_out"] += 1
 
     def _vehicle_rows(self, t: float) -> None:
