@@ -104,7 +104,10 @@ def test_https_server_under_brute_force(build_dir: Path, lcm_url: str) -> None:
             _, events = bob.call("GET", "/api/events?limit=5000")
             check(any(e["kind"] == "account_locked" and e["subject"] == "alice" for e in events),
                   "the lock is logged")  # fmt: skip
-            code, _ = Client(server.url, cafile=cert).call("GET", "/api/state")
+            anonymous = Client(server.url, cafile=cert)
+            code, _ = anonymous.call("GET", "/api/state")
             check(code == 401, "no session: refused")
+            code, crl = anonymous.call("GET", "/api/crl")
+            check(code == 200 and crl.startswith(b"QURDUkwx"), "the revocation list is served")
         finally:
             server.stop()

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import struct
 import sys
+import threading
 import time
 from collections import Counter
 from dataclasses import dataclass
@@ -221,6 +222,36 @@ class Verifier:
             return Verdict(REPLAYED, *sender)
         self._last_counter[cert.serial] = counter
         return Verdict(ACCEPTED, *sender)
+
+
+class BusClock:
+    """The clock a program without SIM_CLOCK of its own signs and checks with: the latest
+    simulator time it heard (SIM_CLOCK, or a signed TRAFFIC_LIGHT_STATE's sender time; only
+    forward), else this machine's wall clock (a real town, where every clock is the wall's).
+    [us]"""
+
+    def __init__(self) -> None:
+        self.sim_us: int | None = None
+        self._lock = threading.Lock()
+
+    def heard(self, sim_us: int) -> None:
+        with self._lock:
+            self.sim_us = sim_us if self.sim_us is None else max(self.sim_us, sim_us)
+
+    def now_us(self) -> int:
+        with self._lock:
+            return time.time_ns() // 1000 if self.sim_us is None else self.sim_us
+
+
+def sender_utime(auth: bytes) -> int | None:
+    """The sender time [us] an envelope claims (unchecked), None when malformed."""
+    head = len(ENVELOPE_MAGIC) + 2
+    if len(auth) < head:
+        return None
+    (cert_len,) = struct.unpack_from(">H", auth, len(ENVELOPE_MAGIC))
+    if len(auth) != head + cert_len + 16 + 64:
+        return None
+    return int(struct.unpack_from(">q", auth, head + cert_len + 8)[0])
 
 
 class DropLog:

@@ -11,6 +11,7 @@
 #include <autodrive/v2i_advisory_t.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
+#include <autodrive/v2x.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive_channels.h>
 #include <autodrive_vehicle.h>
@@ -54,12 +55,13 @@ struct Options {
 class Driver {
  public:
   Driver(const Options &o, const autodrive::behaviour::Track &track, lcm::LCM &lcm,
-         autodrive::auth::Signer signer)
+         autodrive::auth::Signer signer, autodrive::v2x::Verifier verifier)
       : o_(o),
         track_(track),
         rules_(track_, o.rules),
         lcm_(lcm),
         signer_(std::move(signer)),
+        verifier_(std::move(verifier)),
         peers_(o.vehicle) {}
 
   void on_pose(const autodrive::odometry_t *m) {
@@ -115,14 +117,25 @@ class Driver {
     }
   }
 
+  // Only the SCM's signed, fresh advisory (on the car's clock) counts: a forged GREEN is dropped.
   void on_advisory(const autodrive::v2i_advisory_t *m) {
     if (m->vehicle != o_.vehicle) return;
+    if (!verifier_.accept(o_.vehicle + AUTODRIVE_CH_V2I_SUFFIX, *m, AUTODRIVE_CH_V2I_SIGNED_BY,
+                          nullptr, now_us_))
+      return;
     adv_ = *m;
     adv_wall_ = Clock::now();
     have_adv_ = true;
   }
 
-  void on_peer(const autodrive::v2v_state_t *m) { peers_.on_state(*m, now_us_); }
+  // A peer counts only when signed by the car it names (no ghost cars, no borrowed names).
+  void on_peer(const autodrive::v2v_state_t *m) {
+    if (m->vehicle == o_.vehicle) return;  // our own broadcast: the peer table skips it
+    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(),
+                          now_us_))
+      return;
+    peers_.on_state(*m, now_us_);
+  }
 
   // Judged at once with the latest pose (the scan is ~1/7 s long; the margin covers that).
   void on_scan(const autodrive::lidar_scan_t *m) {
@@ -136,6 +149,8 @@ class Driver {
     obstacle_.on_scan(track_, pose_, scan, o_.obstacles, o_.rules.front_m);
     scan_us_ = m->utime;
   }
+
+  std::string refused_summary() const { return verifier_.summary(); }
 
   void send(bool engaged, double throttle, double steering) {
     autodrive::vehicle_command_t c{};
@@ -169,6 +184,7 @@ class Driver {
   autodrive::behaviour::CityRules rules_;
   lcm::LCM &lcm_;
   autodrive::auth::Signer signer_;
+  autodrive::v2x::Verifier verifier_;
   autodrive::v2v::PeerTable peers_;
   autodrive::v2i_advisory_t adv_{};
   Clock::time_point adv_wall_{};
@@ -236,12 +252,14 @@ int main(int argc, char **argv) {
   auto signer = autodrive::auth::load_machine_signer("autodrive-city-driver", o.vehicle, o.key_file,
                                                      "city-driver");
   if (!signer) return 2;
+  auto verifier = autodrive::v2x::Verifier::load("autodrive-city-driver");
+  if (!verifier) return 2;
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-city-driver: --lcm-url '%s' unusable\n", o.lcm_url.c_str());
     return 2;
   }
-  Driver d(o, track, lcm, std::move(*signer));
+  Driver d(o, track, lcm, std::move(*signer), std::move(*verifier));
   autodrive_lcm::subscribe<autodrive::odometry_t, Driver, &Driver::on_pose>(
       lcm, o.vehicle + AUTODRIVE_CH_POSE_MAP_SUFFIX, &d);
   autodrive_lcm::subscribe<autodrive::v2i_advisory_t, Driver, &Driver::on_advisory>(
@@ -275,6 +293,8 @@ int main(int argc, char **argv) {
     d.send(false, 0.0, 0.0);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::printf("[city-driver] %s: stopped\n", o.vehicle.c_str());
+  const std::string refused = d.refused_summary();
+  std::printf("[city-driver] %s: stopped; refused V2X messages: %s\n", o.vehicle.c_str(),
+              refused.empty() ? "none" : refused.c_str());
   return 0;
 }

@@ -23,7 +23,8 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
+from autodrive.core.v2x_cert import CertificateError
 from autodrive.core.channels import channel
 from autodrive.maps.loader import MAPS_DIR
 from autodrive.core.settings import RELEASE_BUILD
@@ -97,12 +98,17 @@ def run(map_name: str, vehicles: list[str], url: str, build: Path, stop: list[bo
     types = lcmtypes.load(build)
     lights, signs = targets(MAPS_DIR / f"{map_name}.json")
     lc = lcmtypes.bus(url)
+    # Signed as the SCM it stands in for (SCM.cert), stamped with each car's own clock (its
+    # latest pose's time: sim time in HIL), on which the car judges freshness.
+    signer = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM"))
     poses: dict[str, tuple[float, float, float]] = {}
+    pose_utime: dict[str, int] = {}
     states: dict[int, tuple[int, float]] = {}
 
     def on_pose(ch: str, data: bytes) -> None:
         m = types.odometry_t.decode(data)
         poses[m.vehicle] = (m.x_m, m.y_m, m.yaw_rad)
+        pose_utime[m.vehicle] = m.utime
 
     def on_light(_ch: str, data: bytes) -> None:
         m = types.traffic_light_state_t.decode(data)
@@ -138,6 +144,7 @@ def run(map_name: str, vehicles: list[str], url: str, build: Path, stop: list[bo
             sign = nearest(poses[v], signs)
             if sign is not None:
                 a.sign_id, a.sign_kind, a.sign_distance_m = sign[0].ident, sign[0].kind, sign[1]
+            signer.sign(channel("V2I", v), a, pose_utime[v])
             lc.publish(channel("V2I", v), a.encode())
         seq += 1
     return 0
@@ -161,7 +168,11 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
-    return run(args.map, args.vehicles.split(","), args.lcm_url, Path(args.build), stop)
+    try:
+        return run(args.map, args.vehicles.split(","), args.lcm_url, Path(args.build), stop)
+    except CertificateError as err:
+        print(f"[advisory] cannot sign as SCM: {err}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

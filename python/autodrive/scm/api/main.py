@@ -19,7 +19,7 @@ from fastapi.responses import FileResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.middleware.sessions import SessionMiddleware
 
-from autodrive.scm.api.routes import events, lights, live, session, state, vehicles
+from autodrive.scm.api.routes import crl, events, lights, live, session, state, vehicles
 from autodrive.scm.api.middleware import RefusalLog, SecurityHeaders, SessionExpiry
 from autodrive.scm.core.security import SESSION_MAX_S, LoginLimiter, session_secret
 from autodrive.scm.service import Scm
@@ -56,6 +56,6 @@ def create_app(scm: Scm, tls: bool = False) -> FastAPI:
         return FileResponse(STATIC / "index.html")
 
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
-    for r in (session, state, vehicles, lights, events, live):
+    for r in (session, state, vehicles, lights, events, live, crl):
         app.include_router(r.router)
     return app
