@@ -75,7 +75,8 @@ def test_shield_and_stale_v2v(
             v.seq, v.vehicle = seq, "NIGEL2"
             v.x_m, v.y_m, v.yaw_rad = peer_xy_yaw
             v.speed_m_s, v.route, v.route_s_m = 0.2, "east_to_west", -1.0
-            peer_signer.sign(channels.channel("V2V"), v, v.utime)  # as NIGEL2's runtime does
+            # signed when sent (now); the pose in it may be old: the peer table judges that
+            peer_signer.sign(channels.channel("V2V"), v, now_us)
             lc.publish(channels.channel("V2V"), v.encode())
             seq += 1
             end = time.time() + 0.05  # 20 Hz, as the runtimes broadcast

@@ -5,16 +5,17 @@
 - SecurityHeaders puts a Content-Security-Policy (only this server's own scripts, styles and
   connections; no inline script, no framing) and its companions on every page and answer.
 - RefusalLog writes every refused request (status 4xx) to the SCM's event log: who (user or
-  address), method, path and status."""
+  address), method, path and status; a refused login answers LOGIN_REFUSED_DELAY_S late."""
 
 from __future__ import annotations
 
+import asyncio
 import time
 from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from autodrive.scm.core.security import session_expired
+from autodrive.scm.core.security import LOGIN_REFUSED_DELAY_S, session_expired
 
 CONTENT_SECURITY_POLICY = (
     "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
@@ -94,6 +95,8 @@ class RefusalLog:
                     f"{scope['method']} {scope['path']}",
                     {"status": message["status"], "address": address},
                 )
+                if scope["path"] == "/api/login":
+                    await asyncio.sleep(LOGIN_REFUSED_DELAY_S)
             await send(message)
 
         await self.app(scope, receive, watch)

@@ -79,6 +79,9 @@ ACCOUNT_FAILURES = 10  # failed logins in a row that lock an account [count]
 ACCOUNT_LOCK_S = 900.0  # how long [s] (tries while locked are refused unchecked)
 ADDRESS_FAILURES = 30  # failed logins from one address within ADDRESS_WINDOW_S [count]
 ADDRESS_WINDOW_S = 60.0  # [s]
+# A refused login answers this late (without holding a worker): a scripted guesser on one
+# connection then costs the server a few percent, not the other users' response time.
+LOGIN_REFUSED_DELAY_S = 0.05
 SESSION_IDLE_S = 1800.0  # a session unused this long ends [s]
 SESSION_MAX_S = 8 * 3600.0  # and any session this long after its login [s]
 
