@@ -163,16 +163,20 @@ struct v2x_signer {
   uint64_t counter;
 };
 
-v2x_signer_t *v2x_signer_load(const char *key_dir, const char *name, char *err, size_t err_len) {
+/* libsodium initialised and `size` zeroed bytes; NULL with the reason in err. */
+static void *sodium_calloc_or_say(size_t size, char *err, size_t err_len) {
   if (sodium_init() < 0) {
     snprintf(err, err_len, "libsodium failed to initialise");
     return NULL;
   }
-  v2x_signer_t *s = calloc(1, sizeof *s);
-  if (!s) {
-    snprintf(err, err_len, "out of memory");
-    return NULL;
-  }
+  void *p = calloc(1, size);
+  if (!p) snprintf(err, err_len, "out of memory");
+  return p;
+}
+
+v2x_signer_t *v2x_signer_load(const char *key_dir, const char *name, char *err, size_t err_len) {
+  v2x_signer_t *s = sodium_calloc_or_say(sizeof *s, err, err_len);
+  if (!s) return NULL;
   char path[1024], file[64];
   snprintf(file, sizeof file, "%s.cert", name);
   key_dir_path(key_dir, file, path, sizeof path);
@@ -342,15 +346,8 @@ done:
 }
 
 v2x_verifier_t *v2x_verifier_create(const char *key_dir, char *err, size_t err_len) {
-  if (sodium_init() < 0) {
-    snprintf(err, err_len, "libsodium failed to initialise");
-    return NULL;
-  }
-  v2x_verifier_t *v = calloc(1, sizeof *v);
-  if (!v) {
-    snprintf(err, err_len, "out of memory");
-    return NULL;
-  }
+  v2x_verifier_t *v = sodium_calloc_or_say(sizeof *v, err, err_len);
+  if (!v) return NULL;
   if (key_dir) snprintf(v->key_dir, sizeof v->key_dir, "%s", key_dir);
   v->window_us = V2X_DEFAULT_WINDOW_US;
   char path[1100];

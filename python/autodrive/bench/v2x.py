@@ -19,9 +19,9 @@ Figures (goal in brackets):
       from the 15 others) [reported; <= 0.05]
   forged_green_red_violations  red-light violations of a real smart-city run (3 cars, the
       real SCM, 30 s of sim time) while forged GREEN advisories go to every car at 50 Hz [0]
-  ghost_car_extra_stop_s       the same run's stopped time of all cars (GROUND_TRUTH) over a
-      quiet run of the same seed, with ghost cars 0.3 m ahead of each on V2V [0; a run-to-run
-      difference shows here too]
+  ghost_car_extra_stop_s       the same run's stopped time of all cars (GROUND_TRUTH), with
+      ghost cars 0.3 m ahead of each on V2V, over the longer of two quiet runs of the same seed
+      (their spread: the run-to-run difference) [0]
   eye_walk_ekf_drift_m: the Eye poses are not signed yet: not measured, its goal fails.
 Progress on stderr; the last line is one JSON object. Usage: tools/bench v2x [--help]"""
 
@@ -427,17 +427,31 @@ def smart_city_run(build: Path, out: Path) -> dict[str, Any]:
     return report
 
 
+def refusals(out: Path) -> str:
+    """The city drivers' last words on what they refused (their logs in the run's folder)."""
+    lines = []
+    for f in sorted(out.glob("city-driver*.log")):
+        lines += [ln.split("refused V2X messages: ")[1] for ln in f.read_text().splitlines()
+                  if "refused V2X messages: " in ln]  # fmt: skip
+    return " | ".join(lines)
+
+
 def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dict[str, Any]:
-    log(f"smart-city run, quiet ({CITY_SIM_S} s of sim time, seed {CITY_SEED})")
-    quiet = smart_city_run(build, tmp / "quiet")
+    quiet_stops = []
+    for k in (1, 2):  # two quiet runs: their spread is the run-to-run difference
+        log(f"smart-city run, quiet #{k} ({CITY_SIM_S} s of sim time, seed {CITY_SEED})")
+        quiet = smart_city_run(build, tmp / f"quiet{k}")
+        quiet_stops.append(stopped_s(tmp / f"quiet{k}" / "run.lcmlog", types))
     attacker = CityAttacker(types, key_dir)
     log("smart-city run, under forged GREEN advisories and ghost cars")
     try:
         attacked = smart_city_run(build, tmp / "attacked")
     finally:
         attacker.close()
-    stop_quiet = stopped_s(tmp / "quiet" / "run.lcmlog", types)
+    stop_quiet = max(quiet_stops)
     stop_attacked = stopped_s(tmp / "attacked" / "run.lcmlog", types)
+    refused = refusals(tmp / "attacked")
+    log(f"the city drivers refused: {refused}")
     log(f"{attacker.sent} hostile messages; red-light violations {attacked['red_light_violations']}"
         f" (quiet {quiet['red_light_violations']}); stopped {stop_attacked:.1f} s "
         f"(quiet {stop_quiet:.1f} s, all cars)")  # fmt: skip
@@ -445,7 +459,8 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
         "city_hostile_messages": attacker.sent,
         "forged_green_red_violations": attacked["red_light_violations"],
         "city_collisions_under_attack": attacked["collisions"],
-        "city_stopped_s_quiet": round(stop_quiet, 1),
+        "city_stopped_s_quiet": [round(q, 1) for q in quiet_stops],
+        "city_drivers_refused": refused,
         "city_stopped_s_attacked": round(stop_attacked, 1),
         "ghost_car_extra_stop_s": round(max(0.0, stop_attacked - stop_quiet), 1),
     }
