@@ -23,7 +23,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
-from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import v2x_auth, v2x_ca  # noqa: E402
 from autodrive.core import lcmtypes  # noqa: E402
 from autodrive.core.channels import channel  # noqa: E402
 from autodrive.hil.city import hil, scoring  # noqa: E402
@@ -54,7 +54,7 @@ def test_city_driver_obeys(
         out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
         run_dir.mkdir()
         os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
-        command_auth.create_key(command_auth.default_key_path("NIGEL1"))
+        v2x_ca.ensure_run_keys(["NIGEL1"], log)  # and the V2I certificates
         facts = scoring.MapFacts.load(MAP)
         line = facts.stop_for_light(LIGHT)
         sign = facts.stop_sign_points()[0]
@@ -77,16 +77,24 @@ def test_city_driver_obeys(
             if m.in_collision:
                 truth["collisions"] = truth.get("collisions", 0) + 1
 
+        # light commands as the SCM would send them: signed, on the bus's (the sim's) clock
+        scm_signer, bus_clock = (
+            v2x_auth.MessageSigner(v2x_ca.load_identity("SCM")),
+            v2x_auth.BusClock(),
+        )
+
         def on_light(_ch, data):
             m = types.traffic_light_state_t.decode(data)
             lights[m.light_id] = m.state
+            bus_clock.heard(m.utime)
 
         lc.subscribe(channel("GROUND_TRUTH", "NIGEL1"), on_truth)
         lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
 
         def command_light(state):
             c = types.traffic_light_command_t()
-            c.utime, c.light_id, c.state, c.duration_s = int(time.time() * 1e6), LIGHT, state, 0.0
+            c.utime, c.light_id, c.state, c.duration_s = bus_clock.now_us(), LIGHT, state, 0.0
+            scm_signer.sign(channel("TRAFFIC_LIGHT_COMMAND"), c, bus_clock.now_us())
             lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), c.encode())
 
         def spin(seconds):

@@ -17,7 +17,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
-from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import v2x_auth, v2x_ca  # noqa: E402
 from autodrive.core import lcmtypes  # noqa: E402
 from autodrive.core import vehicle  # noqa: E402
 from autodrive.core.channels import channel  # noqa: E402
@@ -49,8 +49,7 @@ def test_gap_keeping(
         out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
         run_dir.mkdir()
         os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")
-        for car in CARS:
-            command_auth.create_key(command_auth.default_key_path(car))
+        v2x_ca.ensure_run_keys(list(CARS), log)  # and the V2V/V2I certificates
         facts = scoring.MapFacts.load(MAP)
         line, sign = facts.stop_for_light(LIGHT), facts.stop_sign_points()[0]
         # both on the straight before the turn to light 3, 0.65 m apart (base_link to base_link)
@@ -79,9 +78,16 @@ def test_gap_keeping(
                 if gap < stats["min_gap_m"]:
                     stats.update(min_gap_m=gap, t_min_gap_s=m.utime * 1e-6)
 
+        # light commands as the SCM would send them: signed, on the bus's (the sim's) clock
+        scm_signer, bus_clock = (
+            v2x_auth.MessageSigner(v2x_ca.load_identity("SCM")),
+            v2x_auth.BusClock(),
+        )
+
         def on_light(_ch, data):
             m = types.traffic_light_state_t.decode(data)
             lights[m.light_id] = m.state
+            bus_clock.heard(m.utime)
 
         for car in CARS:
             lc.subscribe(channel("GROUND_TRUTH", car), on_truth)
@@ -89,7 +95,8 @@ def test_gap_keeping(
 
         def command_light(state):
             c = types.traffic_light_command_t()
-            c.utime, c.light_id, c.state, c.duration_s = int(time.time() * 1e6), LIGHT, state, 0.0
+            c.utime, c.light_id, c.state, c.duration_s = bus_clock.now_us(), LIGHT, state, 0.0
+            scm_signer.sign(channel("TRAFFIC_LIGHT_COMMAND"), c, bus_clock.now_us())
             lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), c.encode())
 
         def wait_for(what, cond):

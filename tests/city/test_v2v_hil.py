@@ -12,7 +12,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "python"))
-from autodrive.core import command_auth  # noqa: E402
+from autodrive.core import v2x_ca  # noqa: E402
 from autodrive.core import lcmtypes  # noqa: E402
 from autodrive.core.channels import channel  # noqa: E402
 from autodrive.hil.city import hil  # noqa: E402
@@ -41,8 +41,7 @@ def test_v2v_between_two_runtimes(
         out, run_dir = pathlib.Path(tmp), pathlib.Path(tmp) / "run"
         run_dir.mkdir()
         os.environ["AUTODRIVE_KEY_DIR"] = str(out / "keys")  # the test's own car keys
-        for v in ("NIGEL1", "NIGEL2"):
-            command_auth.create_key(command_auth.default_key_path(v))
+        v2x_ca.ensure_run_keys(["NIGEL1", "NIGEL2"], log)  # and the V2V certificates
         procs = ProcessGroup(log)
         try:
             sim = [

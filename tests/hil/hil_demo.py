@@ -5,22 +5,20 @@ import sys
 import tempfile
 
 from autodrive.core import channels
-from autodrive.core import command_auth
+from autodrive.core import v2x_ca
 
 _KEY_DIR = None
 
 
 def use_test_keys(cars=1):
-    """A temporary key per car in $AUTODRIVE_KEY_DIR (inherited by the demo and its children),
+    """A temporary key and certificate per car (and the testbed's SCM, EYE, SIM) in
+    $AUTODRIVE_KEY_DIR (inherited by the demo and its children),
     so the tests never read or write the user's own keys."""
     global _KEY_DIR
     if _KEY_DIR is None:
         _KEY_DIR = tempfile.TemporaryDirectory(prefix="hil-keys-")
         os.environ["AUTODRIVE_KEY_DIR"] = _KEY_DIR.name
-    for i in range(1, cars + 1):
-        path = command_auth.default_key_path(channels.vehicle_name(i))
-        if not path.exists():
-            command_auth.create_key(path)
+    v2x_ca.ensure_run_keys([channels.vehicle_name(i) for i in range(1, cars + 1)], lambda _: None)
 
 
 def demo_command(build, out, port, *options):

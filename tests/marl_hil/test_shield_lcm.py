@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Callable
 
 from autodrive.core import channels
-from autodrive.core import command_auth
+from autodrive.core import v2x_auth, v2x_ca
 from autodrive.core import lcmtypes
 from autodrive.core.settings import REPO_ROOT
 
@@ -34,7 +34,8 @@ def test_shield_and_stale_v2v(
     THROTTLE = 1.0  # the trained policies' (autodrive.learn.marl.export)
     keys = tempfile.TemporaryDirectory(prefix="marl-keys-")
     os.environ["AUTODRIVE_KEY_DIR"] = keys.name
-    command_auth.create_key(command_auth.default_key_path("NIGEL1"))
+    v2x_ca.ensure_run_keys(["NIGEL1", "NIGEL2"], print)  # and NIGEL2's V2V certificate
+    peer_signer = v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL2"))
 
     def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
         """Runs autodrive-marl with the scripted inputs for >= 2.5 s and 40 engaged commands; returns
@@ -74,6 +75,8 @@ def test_shield_and_stale_v2v(
             v.seq, v.vehicle = seq, "NIGEL2"
             v.x_m, v.y_m, v.yaw_rad = peer_xy_yaw
             v.speed_m_s, v.route, v.route_s_m = 0.2, "east_to_west", -1.0
+            # signed when sent (now); the pose in it may be old: the peer table judges that
+            peer_signer.sign(channels.channel("V2V"), v, now_us)
             lc.publish(channels.channel("V2V"), v.encode())
             seq += 1
             end = time.time() + 0.05  # 20 Hz, as the runtimes broadcast

@@ -28,7 +28,7 @@ from harness import login_page as login
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 
 
@@ -59,6 +59,11 @@ def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm
         add_user(db, "op1", "operator", "operator-pass")
         add_user(db, "viewer1", "viewer", "viewer-pass")
         sim = start_sim(build, url, tmp)
+        bus_clock = v2x_auth.BusClock()  # the sim's time, for the probe's signature
+        lc.subscribe(
+            channel("TRAFFIC_LIGHT_STATE"),
+            lambda _c, d: bus_clock.heard(T.traffic_light_state_t.decode(d).utime),
+        )
         watch = LightWatch(lc, T)
         feeder = CarFeeder(feed_lc, T, {"NIGEL1": ("loop_ccw", 0.5), "NIGEL2": ("loop_ccw", 8.0),
                                         "NIGEL3": ("loop_cw", 3.0)}, 0.4)  # fmt: skip
@@ -116,9 +121,12 @@ def test_lights_from_the_browser(root: Path, build_dir: Path, lcm_port: int, lcm
                     "click on light 1: GREEN in the simulator",
                 )
             driver.save_screenshot(str(out / "browser_operator_green.png"))
-            # the simulator itself refuses a conflicting green sent past the SCM
+            # the simulator itself refuses a conflicting green sent past the SCM (signed as the
+            # SCM: an unsigned one it drops before its interlock sees it)
             probe = T.traffic_light_command_t()
             probe.utime, probe.light_id, probe.state, probe.duration_s = 0, 2, S.GREEN, 1.0
+            scm_signer = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM"))
+            scm_signer.sign(channel("TRAFFIC_LIGHT_COMMAND"), probe, bus_clock.now_us())
             t_probe = time.time()
             lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), probe.encode())
             # the light's next states (event order; the wait is a hang guard, not a deadline)

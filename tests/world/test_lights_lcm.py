@@ -10,7 +10,7 @@ import tempfile
 import time
 from collections import Counter
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 
 
@@ -38,10 +38,15 @@ def test_traffic_lights_on_lcm(
             if select.select([lc.fileno()], [], [], 0.01)[0]:
                 lc.handle()
 
-    def command(light_id: int, state: int, duration_s: float = 0.0) -> None:
+    # signed as the SCM (the only role the simulator obeys), on the sim clock
+    scm = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM"))
+
+    def command(light_id: int, state: int, duration_s: float = 0.0, signed: bool = True) -> None:
         msg = Command()
         msg.utime = clock["us"] or 0
         msg.light_id, msg.state, msg.duration_s = light_id, state, duration_s
+        if signed:
+            scm.sign(channel("TRAFFIC_LIGHT_COMMAND"), msg, msg.utime)
         lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), msg.encode())
 
     with tempfile.TemporaryDirectory(prefix="world-lights-") as run_dir:
@@ -99,6 +104,11 @@ def test_traffic_lights_on_lcm(
             print(f"light 1 RED on the bus {lag_ms:.1f} ms of sim time after the command was sent")
             assert lag_ms <= 100.0, f"{lag_ms:.1f} ms"
             assert red[0].time_remaining_s < 0  # held until the next command
+            # an unsigned GREEN for light 1 (no conflict now: all red but 3) is not obeyed
+            states.clear()
+            command(1, State.GREEN, signed=False)
+            pump(0.5)
+            assert all(m.state == State.RED for _, m in states if m.light_id == 1), "obeyed"
         finally:
             sim.terminate()
             _, err = sim.communicate(timeout=20)
@@ -106,5 +116,7 @@ def test_traffic_lights_on_lcm(
         refusal = [ln for ln in err.splitlines() if "refused" in ln]
         assert refusal, "the refusal was not logged"
         assert "light 2" in refusal[0] and "light 1" in refusal[0], refusal[0]
+        dropped = [ln for ln in err.splitlines() if "TRAFFIC_LIGHT_COMMAND dropped" in ln]
+        assert dropped and "unknown sender" in dropped[0] and "unsigned" in dropped[0], dropped
         assert sim.returncode == 0, sim.returncode
     print("OK")

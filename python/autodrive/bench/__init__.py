@@ -25,6 +25,7 @@ SUITES = (
     "security",
     "sim",
     "sweep",
+    "v2x",
     "world",
 )
 

@@ -39,7 +39,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 from autodrive.core.settings import settings
 from autodrive.bench import Progress, build_dir, last_json, print_figures, sim_instructions
@@ -200,9 +200,12 @@ class WorldBench:
         got: list[tuple[float, int, int]] = []  # wall time, light, state
         State, Command = self.types.traffic_light_state_t, self.types.traffic_light_command_t
 
+        scm, bus_clock = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM")), v2x_auth.BusClock()
+
         def on_state(_c: str, data: bytes) -> None:
             m = State.decode(data)
             got.append((time.monotonic(), m.light_id, m.state))
+            bus_clock.heard(m.utime)
 
         lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_state)
 
@@ -237,6 +240,8 @@ class WorldBench:
                     got.clear()
                     msg = Command()
                     msg.utime, msg.light_id, msg.state, msg.duration_s = 0, 1, want, 0.0
+                    # signed as the SCM, stamped with the sim time the states tell
+                    scm.sign(channel("TRAFFIC_LIGHT_COMMAND"), msg, bus_clock.now_us())
                     t0 = time.monotonic()
                     lc.publish(channel("TRAFFIC_LIGHT_COMMAND"), msg.encode())
                     end = t0 + 1.0

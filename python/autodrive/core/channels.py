@@ -45,6 +45,10 @@ class Channel:
     subscribers: tuple[str, ...]
     content: str
     when: str = ""  # "": every run; else the condition under which it is published
+    # Signed channels: the certificate roles that may send it (autodrive.core.v2x_auth), and
+    # whether the certificate's name must be the message's `vehicle` (V2V). () = not signed.
+    signed_by: tuple[str, ...] = ()
+    signer_is_vehicle: bool = False
 
     @property
     def per_vehicle(self) -> bool:
@@ -177,6 +181,8 @@ def load(path: Path | str | None = None) -> ChannelTable:
                 subscribers=tuple(entry["subscribers"]),
                 content=str(entry["content"]),
                 when=str(entry.get("when", "")),
+                signed_by=tuple(str(r) for r in entry.get("signed_by", ())),
+                signer_is_vehicle=bool(entry.get("signer_is_vehicle", False)),
             )
         )
     return ChannelTable(

@@ -1,7 +1,8 @@
 """tools/keys: creates and checks the per-car command keys (32 random bytes, 64 hex digits,
 mode 0600) that sign <VEH>_COMMAND. Default place: autodrive.core.command_auth.default_key_path.
 
-CLI: tools/keys --help (python -m autodrive.core.keys)."""
+Also the testbed certificate authority: tools/keys ca init | issue | revoke | show
+(autodrive.core.v2x_ca). CLI: tools/keys --help (python -m autodrive.core.keys)."""
 
 from __future__ import annotations
 
@@ -13,12 +14,21 @@ from autodrive.core import channels
 from autodrive.core.command_auth import create_key, default_key_path, load_key
 
 
+CA_ACTIONS = ("ca", "issue", "revoke", "show", "testbed")
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if any(a in CA_ACTIONS for a in argv[:3]):  # the testbed CA (autodrive.core.v2x_ca)
+        from autodrive.core import v2x_ca
+
+        return v2x_ca.main(argv)
     p = argparse.ArgumentParser(
         prog="tools/keys",
         description="Create or check a car's command key (signs <VEH>_COMMAND; the runtime's "
         "bridge drops commands without a valid signature). Default file: "
-        "$AUTODRIVE_KEY_DIR/<VEH>.key, else ~/.config/autodrive/keys/<VEH>.key.",
+        "$AUTODRIVE_KEY_DIR/<VEH>.key, else ~/.config/autodrive/keys/<VEH>.key. The testbed "
+        "certificate authority: tools/keys ca init | issue | revoke | show | testbed (each with --help).",
     )
     p.add_argument("action", choices=("create", "check", "path"), help="what to do")
     p.add_argument("vehicles", nargs="*", help=f"car names (default: {channels.vehicle_name(1)})")

@@ -19,10 +19,12 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import uvicorn
 
 from autodrive.core import channels
+from autodrive.core.v2x_cert import CertificateError
 from autodrive import maps
 from autodrive.core.settings import Instance, InstanceError, instance, use_instance
 from autodrive.scm.core.config import (
@@ -101,6 +103,19 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
     p.add_argument(
         "--build", default=None, help="build dir with the LCM types (default: the first built)"
     )
+    p.add_argument(
+        "--identity",
+        default="SCM",
+        help="the certificate that signs V2I and light commands: NAME.cert/.sk in "
+        "$AUTODRIVE_KEY_DIR (tools/keys issue --name NAME --role scm; default SCM)",
+    )
+    p.add_argument(
+        "--tls-cert",
+        type=Path,
+        help="serve HTTPS with this PEM certificate (with --tls-key); the session cookie is "
+        "then Secure",
+    )
+    p.add_argument("--tls-key", type=Path, help="the PEM private key of --tls-cert")
     p.add_argument("--log-level", default="warning", help="uvicorn's log level")
     a = p.parse_args(argv)
     try:
@@ -118,6 +133,11 @@ def parse_serve(argv: list[str]) -> argparse.Namespace:
     for v in names:
         if not (v.isalnum() and v.isupper()):
             p.error(f"--vehicles: '{v}' is not a vehicle name (capitals and digits, e.g. NIGEL1)")
+    if (a.tls_cert is None) != (a.tls_key is None):
+        p.error("--tls-cert and --tls-key go together")
+    for opt, path in (("--tls-cert", a.tls_cert), ("--tls-key", a.tls_key)):
+        if path is not None and not path.is_file():
+            p.error(f"{opt} {path}: no such file")
     a.vehicle_list = names
     return a
 
@@ -165,23 +185,35 @@ def serve(argv: list[str]) -> int:
     except DatabaseError as err:
         print(f"autodrive-scm: {err}", file=sys.stderr)
         return 2
-    scm = Scm(
-        m,
-        engine,
-        find_build(a.build),
-        a.lcm_url,
-        a.vehicle_list,
-        a.history_hz,
-        a.advisory_hz,
-        a.clock,
-    )
+    try:
+        scm = Scm(
+            m,
+            engine,
+            find_build(a.build),
+            a.lcm_url,
+            a.vehicle_list,
+            a.history_hz,
+            a.advisory_hz,
+            a.clock,
+            a.identity,
+        )
+    except CertificateError as err:
+        print(f"autodrive-scm: --identity {a.identity}: {err}", file=sys.stderr)
+        return 2
     sock = bind_web_port(a.host, a.port, a.session)
     if isinstance(sock, str):
         print(f"autodrive-scm: {sock}", file=sys.stderr)
         return 2
-    app = create_app(scm)
+    tls = a.tls_cert is not None
+    app = create_app(scm, tls=tls)
     config = uvicorn.Config(
-        app, host=a.host, port=a.port, log_level=a.log_level, ws="websockets-sansio"
+        app,
+        host=a.host,
+        port=a.port,
+        log_level=a.log_level,
+        ws="websockets-sansio",
+        ssl_certfile=str(a.tls_cert) if tls else None,
+        ssl_keyfile=str(a.tls_key) if tls else None,
     )
     server = _Server(config)
     for sig in (signal.SIGINT, signal.SIGTERM):  # stop serving, then stop the SCM: exit 0
@@ -192,7 +224,7 @@ def serve(argv: list[str]) -> int:
         while not server.started and not server.should_exit:
             time.sleep(0.02)
         if server.started:
-            print(f"SCM ready http://{a.host}:{a.port}/", flush=True)
+            print(f"SCM ready http{'s' if tls else ''}://{a.host}:{a.port}/", flush=True)
 
     threading.Thread(target=announce, daemon=True).start()
     try:

@@ -27,9 +27,10 @@ from typing import Any
 
 from sqlalchemy import Engine, select as sql_select
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.clock import MODES as clock_modes
 from autodrive.core.clock import Clock
+from autodrive.core.v2x_cert import CertificateError
 from autodrive.maps import MapDescription
 from autodrive.scm.core.db import sessions
 from autodrive.scm.lights import STATES, Change, ControlError, Controller, Light, Program
@@ -86,6 +87,7 @@ class Scm:
         history_hz: float = 10.0,
         advisory_hz: float = 10.0,
         clock: str = "wall",
+        identity: str = "SCM",
     ) -> None:
         if clock not in CLOCKS:
             raise ValueError(f"clock must be one of {CLOCKS}, got {clock!r}")
@@ -106,7 +108,13 @@ class Scm:
         self.sim_states: dict[int, tuple[str, float, float, float | None]] = {}
         self.recent: collections.deque[dict[str, Any]] = collections.deque(maxlen=200)
         self._event_seq = 0
-        self.stats = {"poses_in": 0, "advisories_out": 0, "commands_out": 0, "bad_messages": 0}
+        self.stats = {
+            "poses_in": 0,
+            "advisories_out": 0,
+            "commands_out": 0,
+            "bad_messages": 0,
+            "refused_messages": 0,  # signed channels whose envelope did not check out
+        }
         self.controller = self._make_controller()
         self.writer = Writer(self.sessions)
         self._stop = threading.Event()
@@ -115,6 +123,15 @@ class Scm:
         self.lc = lcmtypes.bus(lcm_url)
         self.lc_out = lcmtypes.bus(lcm_url)  # publishing from the control thread
         self.lcm_lock = threading.Lock()
+        # V2I advisories and light commands go out signed with the SCM's certificate
+        # (tools/keys issue --role scm); CertificateError naming the file when it is missing.
+        self.signer = v2x_auth.MessageSigner(v2x_ca.load_identity(identity))
+        # Light states count only when signed by a light controller (the simulator in HIL);
+        # what the SCM signs and checks is stamped with the bus's clock (sim time in HIL).
+        self.verifier = v2x_auth.Verifier()
+        self.bus_clock = v2x_auth.BusClock()
+        self.drop_log = v2x_auth.DropLog()
+        self._crl_checked_s = 0.0
 
     # --- set-up -------------------------------------------------------------------------------
 
@@ -174,8 +191,8 @@ class Scm:
         self.receiver.start()  # before the threads below: a process of its own for the poses
         self.lc.subscribe(channels.channel("TRAFFIC_LIGHT_STATE"), self._on_light_state)
         self.lc.subscribe(channels.channel("V2V"), self._on_v2v)
-        if self.clock == "sim":
-            self.lc.subscribe(channels.channel("SIM_CLOCK"), self._on_sim_clock)
+        # the lights' clock with --clock sim, and the bus clock of the signed messages always
+        self.lc.subscribe(channels.channel("SIM_CLOCK"), self._on_sim_clock)
         self.event("server", "start", "scm", {"map": self.map.name, "vehicles": self.vehicles})
         loops = ((self._lcm_loop, "scm-lcm"), (self._ingest_loop, "scm-ingest"),
                  (self._control_loop, "scm-control"))  # fmt: skip
@@ -243,6 +260,7 @@ class Scm:
         msg = self._decode(self.types.sim_clock_t, data)
         if msg is not None:  # forward only: a late message never turns the clock back
             self.time.on_sim_clock(msg.utime)
+            self.bus_clock.heard(msg.utime)
 
     def city_now(self) -> float | None:
         """The lights' clock [s]: wall time, or with clock 'sim' the simulator's SIM_CLOCK, so
@@ -252,10 +270,13 @@ class Scm:
         SIM_CLOCK (the lights are then neither commanded nor timed)."""
         return self.time.now_s()
 
-    def _on_light_state(self, _chan: str, data: bytes) -> None:
+    def _on_light_state(self, chan: str, data: bytes) -> None:
         msg = self._decode(self.types.traffic_light_state_t, data)
         if msg is None or not 0 <= msg.state < len(STATES):
             return
+        if not self._verified(chan, msg, "TRAFFIC_LIGHT_STATE"):
+            return
+        self.bus_clock.heard(v2x_auth.sender_utime(v2x_auth.auth_of(msg)) or 0)
         state, t = STATES[msg.state], time.time()
         with self.lock:
             before = self.sim_states.get(msg.light_id)
@@ -367,8 +388,36 @@ class Scm:
         msg = self.types.traffic_light_command_t()
         msg.utime = now_us()
         msg.light_id, msg.state, msg.duration_s = light_id, STATES.index(state), COMMAND_HOLD_S
-        self._publish(channels.channel("TRAFFIC_LIGHT_COMMAND"), msg.encode())
+        self._publish_signed(channels.channel("TRAFFIC_LIGHT_COMMAND"), msg)
         self.stats["commands_out"] += 1
+
+    def _publish_signed(self, chan: str, msg: Any) -> None:
+        """Signs msg on the bus's clock (the receivers judge its freshness on theirs: in HIL
+        the simulator's, which the SCM hears from SIM_CLOCK and the light states)."""
+        self._publish(chan, self.signer.sign(chan, msg, self.bus_clock.now_us()).encode())
+
+    def _verified(self, chan: str, msg: Any, channel_id: str) -> bool:
+        """True when msg's envelope checks out (v2x_auth); else counted and logged, bounded."""
+        now_s = time.time()
+        if now_s - self._crl_checked_s >= 0.25:  # the revocation list (a stat), 4 times a second
+            self._crl_checked_s = now_s
+            try:
+                self.verifier.reload()
+            except (OSError, CertificateError) as err:
+                self.drop_log.log(f"revocation list: {err} (the list held so far stays)", now_s)
+        if channel_id == "TRAFFIC_LIGHT_STATE":  # the simulator's time is heard from them too
+            claimed = v2x_auth.sender_utime(v2x_auth.auth_of(msg))
+            now_us = self.bus_clock.now_us()
+            if claimed is not None and self.bus_clock.sim_us is None:
+                now_us = claimed  # the first one sets the clock: its counter is still checked
+        else:
+            now_us = self.bus_clock.now_us()
+        verdict = self.verifier.verify(chan, msg, v2x_auth.roles_for(channel_id), None, now_us)
+        if verdict.ok:
+            return True
+        self.stats["refused_messages"] += 1
+        self.drop_log.log(verdict.describe(chan), now_s)
+        return False
 
     def _publish(self, chan: str, data: bytes) -> None:
         with self.lcm_lock:
@@ -427,7 +476,7 @@ class Scm:
                 a.sign_distance_m,
             )
             msg.speed_limit_m_s = a.speed_limit_m_s
-            self._publish(channels.channel("V2I", car.name), msg.encode())
+            self._publish_signed(channels.channel("V2I", car.name), msg)
             self.stats["advisories_out"] += 1
 
     def _vehicle_rows(self, t: float) -> None:

@@ -9,10 +9,13 @@ import os
 import pwd
 import shutil
 import socket
+import ssl
 import subprocess
 import sys
 import tempfile
+import http.client
 import urllib.error
+import urllib.parse
 import urllib.request
 from http.cookiejar import CookieJar
 from pathlib import Path
@@ -52,9 +55,12 @@ class Server:
         vehicles: str = "NIGEL1,NIGEL2,NIGEL3",
         extra: list[str] | None = None,
         port: int | None = None,
+        tls: tuple[Path, Path] | None = None,
     ) -> None:
         self.port = port or free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
+        self.url = f"{'https' if tls else 'http'}://127.0.0.1:{self.port}"
+        if tls:
+            extra = [*(extra or []), "--tls-cert", str(tls[0]), "--tls-key", str(tls[1])]
         self.log = open(f"/tmp/scm-{self.port}.log", "w")
         cmd = scm_command(
             "--map", "tiny_town", "--db", db, "--host", "127.0.0.1", "--port", str(self.port),
@@ -78,13 +84,32 @@ class Server:
         return rc
 
 
-class Client:
-    """An HTTP client with its own cookie jar and the CSRF token of its session."""
+def self_signed_cert(folder: Path, host: str = "127.0.0.1") -> tuple[Path, Path]:
+    """A throw-away self-signed certificate for host (openssl): (cert.pem, key.pem)."""
+    cert, key = folder / "cert.pem", folder / "key.pem"
+    subprocess.run(
+        ["openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:P-256",
+         "-nodes", "-days", "2", "-subj", f"/CN={host}", "-addext", f"subjectAltName=IP:{host}",
+         "-keyout", str(key), "-out", str(cert)],
+        check=True, capture_output=True,
+    )  # fmt: skip
+    return cert, key
 
-    def __init__(self, base: str) -> None:
+
+class Client:
+    """An HTTP client with its own cookie jar and the CSRF token of its session (cafile: the
+    certificate to trust for https)."""
+
+    def __init__(self, base: str, cafile: Path | None = None) -> None:
         self.base = base
-        self.opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor(CookieJar()))
+        self.cookies = CookieJar()
+        handlers: list[Any] = [urllib.request.HTTPCookieProcessor(self.cookies)]
+        if cafile is not None:
+            context = ssl.create_default_context(cafile=str(cafile))
+            handlers.append(urllib.request.HTTPSHandler(context=context))
+        self.opener = urllib.request.build_opener(*handlers)
         self.csrf = ""
+        self.last_headers: dict[str, str] = {}
 
     def call(self, method: str, path: str, body: Any = None, csrf: bool = True) -> tuple[int, Any]:
         data = json.dumps(body).encode() if body is not None else None
@@ -94,8 +119,12 @@ class Client:
             req.add_header("X-CSRF-Token", self.csrf)
         try:
             with self.opener.open(req, timeout=60) as r:
-                return int(r.status), json.loads(r.read() or b"null")
+                self.last_headers = {k.lower(): v for k, v in r.headers.items()}
+                body = r.read()
+                is_json = "json" in r.headers.get("content-type", "")
+                return int(r.status), json.loads(body or b"null") if is_json else body
         except urllib.error.HTTPError as err:
+            self.last_headers = {k.lower(): v for k, v in err.headers.items()}
             return int(err.code), json.loads(err.read() or b"null")
 
     def login(self, name: str, password: str) -> dict[str, str]:
@@ -183,3 +212,39 @@ def click_light(driver: Any, light_id: int) -> None:
     ActionChains(driver).move_to_element_with_offset(
         canvas, int(u - w / 2), int(v - h / 2)
     ).click().perform()
+
+
+class Attacker:
+    """A scripted login brute force from its own loopback address (source 127.0.0.2, so the
+    per-address limit it meets is its own): guesses passwords of one account over one kept-alive
+    connection, and counts the answers by status."""
+
+    def __init__(self, base: str, cafile: Path | None = None, source: str = "127.0.0.2") -> None:
+        parts = urllib.parse.urlsplit(base)
+        host, port = parts.hostname or "127.0.0.1", parts.port or 80
+        if parts.scheme == "https":
+            context = ssl.create_default_context(cafile=str(cafile) if cafile else None)
+            self.conn: http.client.HTTPConnection = http.client.HTTPSConnection(
+                host, port, context=context, source_address=(source, 0), timeout=60
+            )
+        else:
+            self.conn = http.client.HTTPConnection(
+                host, port, source_address=(source, 0), timeout=60
+            )
+
+    def guess(self, name: str, password: str) -> int:
+        body = json.dumps({"name": name, "password": password})
+        self.conn.request("POST", "/api/login", body, {"Content-Type": "application/json"})
+        r = self.conn.getresponse()
+        r.read()
+        return int(r.status)
+
+    def brute_force(self, name: str, passwords: list[str]) -> dict[int, int]:
+        counts: dict[int, int] = {}
+        for p in passwords:
+            status = self.guess(name, p)
+            counts[status] = counts.get(status, 0) + 1
+        return counts
+
+    def close(self) -> None:
+        self.conn.close()

@@ -16,6 +16,7 @@
 #include <autodrive/v2i_advisory_t.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
+#include <autodrive/v2x.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive_channels.h>
 #include <autodrive_vehicle.h>
@@ -58,13 +59,14 @@ struct Options {
 class Driver {
  public:
   Driver(const Options &o, const autodrive::behaviour::Track &track, lcm::LCM &lcm,
-         autodrive::auth::Signer signer)
+         autodrive::auth::Signer signer, autodrive::v2x::Verifier verifier)
       : o_(o),
         track_(track),
         rules_(track_, o.rules),
         lcm_(lcm),
         signer_(std::move(signer)),
         clock_(o.clock),
+        verifier_(std::move(verifier)),
         peers_(o.vehicle) {
     clock_.attach(lcm_);
   }
@@ -126,14 +128,25 @@ class Driver {
     }
   }
 
+  // Only the SCM's signed, fresh advisory (on the car's clock) counts: a forged GREEN is dropped.
   void on_advisory(const autodrive::v2i_advisory_t *m) {
     if (m->vehicle != o_.vehicle) return;
+    if (!verifier_.accept(o_.vehicle + AUTODRIVE_CH_V2I_SUFFIX, *m, AUTODRIVE_CH_V2I_SIGNED_BY,
+                          nullptr, clock_.now_us()))
+      return;
     adv_ = *m;
     adv_at_us_ = clock_.now_us();
     have_adv_ = true;
   }
 
-  void on_peer(const autodrive::v2v_state_t *m) { peers_.on_state(*m, clock_.now_us()); }
+  // A peer counts only when signed by the car it names (no ghost cars, no borrowed names).
+  void on_peer(const autodrive::v2v_state_t *m) {
+    if (m->vehicle == o_.vehicle) return;  // our own broadcast: the peer table skips it
+    const int64_t now = clock_.now_us();
+    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(), now))
+      return;
+    peers_.on_state(*m, now);
+  }
 
   // Judged at once with the latest pose (the scan is ~1/7 s long; the margin covers that).
   void on_scan(const autodrive::lidar_scan_t *m) {
@@ -147,6 +160,8 @@ class Driver {
     obstacle_.on_scan(track_, pose_, scan, o_.obstacles, o_.rules.front_m);
     scan_us_ = m->utime;
   }
+
+  std::string refused_summary() const { return verifier_.summary(); }
 
   void send(bool engaged, double throttle, double steering) {
     autodrive::vehicle_command_t c{};
@@ -179,6 +194,7 @@ class Driver {
   lcm::LCM &lcm_;
   autodrive::auth::Signer signer_;
   autodrive::clock::Clock clock_;
+  autodrive::v2x::Verifier verifier_;
   autodrive::v2v::PeerTable peers_;
   autodrive::v2i_advisory_t adv_{};
   int64_t adv_at_us_ = 0;  // the advisory's arrival [us, clock_]
@@ -254,12 +270,14 @@ int main(int argc, char **argv) {
                                                      "city-driver");
   if (!signer) return 2;
   o.lcm_url = autodrive::instance_lcm_url(o.lcm_url);  // AUTODRIVE_INSTANCE
+  auto verifier = autodrive::v2x::Verifier::load("autodrive-city-driver");
+  if (!verifier) return 2;
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-city-driver: --lcm-url '%s' unusable\n", o.lcm_url.c_str());
     return 2;
   }
-  Driver d(o, track, lcm, std::move(*signer));
+  Driver d(o, track, lcm, std::move(*signer), std::move(*verifier));
   autodrive_lcm::subscribe<autodrive::odometry_t, Driver, &Driver::on_pose>(
       lcm, o.vehicle + AUTODRIVE_CH_POSE_MAP_SUFFIX, &d);
   autodrive_lcm::subscribe<autodrive::v2i_advisory_t, Driver, &Driver::on_advisory>(
@@ -293,6 +311,8 @@ int main(int argc, char **argv) {
     d.send(false, 0.0, 0.0);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::printf("[city-driver] %s: stopped\n", o.vehicle.c_str());
+  const std::string refused = d.refused_summary();
+  std::printf("[city-driver] %s: stopped; refused V2X messages: %s\n", o.vehicle.c_str(),
+              refused.empty() ? "none" : refused.c_str());
   return 0;
 }

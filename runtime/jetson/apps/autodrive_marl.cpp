@@ -14,6 +14,7 @@
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
+#include <autodrive/v2x.hpp>
 #include <autodrive/vehicle_command_t.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 #include <autodrive_lcm/subscribe.hpp>
@@ -57,12 +58,13 @@ struct Options {
 class App {
  public:
   App(const Options &o, lcm::LCM &lcm, autodrive::auth::Signer signer,
-      std::unique_ptr<autodrive::marl::Policy> policy, autodrive::marl::Route route,
-      std::unique_ptr<autodrive::marl::FcfsBaseline> baseline,
+      autodrive::v2x::Verifier verifier, std::unique_ptr<autodrive::marl::Policy> policy,
+      autodrive::marl::Route route, std::unique_ptr<autodrive::marl::FcfsBaseline> baseline,
       std::optional<autodrive::autonomy::Pose2> origin)
       : o_(o),
         lcm_(lcm),
         signer_(std::move(signer)),
+        verifier_(std::move(verifier)),
         policy_(std::move(policy)),
         route_(std::move(route)),
         baseline_(std::move(baseline)),
@@ -83,6 +85,10 @@ class App {
 
   void on_v2v(const lcm::ReceiveBuffer *, const std::string &, const autodrive::v2v_state_t *m) {
     if (m->vehicle == o_.vehicle) return;
+    // Only a state signed by the car it names, fresh on this program's clock: no ghost cars.
+    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(),
+                          now_us()))
+      return;
     link_.on_receive(*m, now_us());
   }
   void on_pose(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
@@ -241,6 +247,7 @@ class App {
   const Options &o_;
   lcm::LCM &lcm_;
   autodrive::auth::Signer signer_;
+  autodrive::v2x::Verifier verifier_;
   std::unique_ptr<autodrive::marl::Policy> policy_;
   autodrive::marl::Route route_;
   std::unique_ptr<autodrive::marl::FcfsBaseline> baseline_;
@@ -432,6 +439,8 @@ int main(int argc, char **argv) {
       autodrive::auth::load_machine_signer("autodrive-marl", o.vehicle, o.key_file, "marl");
   if (!signer) return 2;
   o.lcm_url = autodrive::instance_lcm_url(o.lcm_url);  // AUTODRIVE_INSTANCE
+  auto verifier = autodrive::v2x::Verifier::load("autodrive-marl");
+  if (!verifier) return 2;
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "autodrive-marl: cannot open LCM at '%s' (multicast route missing?)\n",
@@ -440,8 +449,8 @@ int main(int argc, char **argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  App app(o, lcm, std::move(*signer), std::move(policy), std::move(route), std::move(baseline),
-          origin);
+  App app(o, lcm, std::move(*signer), std::move(*verifier), std::move(policy), std::move(route),
+          std::move(baseline), origin);
   app.attach_clock();
   autodrive_lcm::subscribe<autodrive::v2v_state_t, App, &App::on_v2v>(lcm, AUTODRIVE_CH_V2V, &app)
       ->setQueueCapacity(200);

@@ -29,6 +29,11 @@ def render(table: channels.ChannelTable, source_name: str) -> str:
             lines.append(f'#define AUTODRIVE_CH_{ch.id}_SUFFIX "{suffix}" {note}')
         else:
             lines.append(f'#define AUTODRIVE_CH_{ch.id} "{ch.name}" {note}')
+        if ch.signed_by:  # the roles v2x_role_mask takes; NAMED: the signer must be `vehicle`
+            lines.append(f'#define AUTODRIVE_CH_{ch.id}_SIGNED_BY "{",".join(ch.signed_by)}"')
+            lines.append(
+                f"#define AUTODRIVE_CH_{ch.id}_SIGNER_IS_VEHICLE {int(ch.signer_is_vehicle)}"
+            )
     return c_header.wrap(
         GUARD,
         source_name,

@@ -20,7 +20,8 @@ import time
 from pathlib import Path
 from types import FrameType
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
+from autodrive.core.v2x_cert import CertificateError
 from autodrive.core.channels import channel
 from autodrive.core.road_rules import Ahead, Place, RoadNet, SidecarError
 from autodrive.core.settings import RELEASE_BUILD
@@ -51,12 +52,17 @@ def run(
     types = lcmtypes.load(build)
     advisor = Advisor(RoadNet.from_file(MAPS_DIR / f"{map_name}.json", build), routes)
     lc = lcmtypes.bus(url)
+    # Signed as the SCM it stands in for (SCM.cert), stamped with each car's own clock (its
+    # latest pose's time: sim time in HIL), on which the car judges freshness.
+    signer = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM"))
     poses: dict[str, tuple[float, float, float]] = {}
+    pose_utime: dict[str, int] = {}
     states: dict[int, tuple[int, float]] = {}
 
     def on_pose(ch: str, data: bytes) -> None:
         m = types.odometry_t.decode(data)
         poses[m.vehicle] = (m.x_m, m.y_m, m.yaw_rad)
+        pose_utime[m.vehicle] = m.utime
 
     def on_light(_ch: str, data: bytes) -> None:
         m = types.traffic_light_state_t.decode(data)
@@ -90,6 +96,7 @@ def run(
                 a.stop_line_distance_m = ahead.stop_line_distance_m
             a.sign_id, a.sign_kind = ahead.sign_id, ahead.sign_kind
             a.sign_distance_m, a.speed_limit_m_s = ahead.sign_distance_m, ahead.speed_limit_m_s
+            signer.sign(channel("V2I", v), a, pose_utime[v])
             lc.publish(channel("V2I", v), a.encode())
         seq += 1
     return 0
@@ -132,7 +139,11 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
-    return run(args.map, vehicles, routes, args.lcm_url, Path(args.build), stop)
+    try:
+        return run(args.map, vehicles, routes, args.lcm_url, Path(args.build), stop)
+    except CertificateError as err:
+        print(f"[advisory] cannot sign as SCM: {err}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

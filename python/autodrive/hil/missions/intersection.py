@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from autodrive.core import channels, command_auth, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_ca
 from autodrive.gym import tasks
 from autodrive.learn.marl import env as marl_env
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
@@ -163,11 +163,8 @@ class EpisodeRecord:
 
 
 def ensure_keys(say: Any) -> None:
-    for i in range(1, CARS + 1):
-        path = command_auth.default_key_path(channels.vehicle_name(i))
-        if not path.exists():
-            command_auth.create_key(path)
-            say(f"created the command key of {channels.vehicle_name(i)} at {path} (tools/keys)")
+    """The cars' command keys and the testbed certificates (V2V, V2I, lights, Eye poses)."""
+    v2x_ca.ensure_run_keys([channels.vehicle_name(i) for i in range(1, CARS + 1)], say)
 
 
 def run_episode(

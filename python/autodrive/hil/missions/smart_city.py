@@ -28,7 +28,8 @@ from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
 
-from autodrive.core import command_auth, lcmtypes
+from autodrive.core import command_auth, lcmtypes, v2x_ca
+from autodrive.maps import eye_cameras
 from autodrive.core.channels import channel, vehicle_name
 from autodrive.hil import pose_source
 from autodrive.hil.city import hil
@@ -92,11 +93,8 @@ def start_poses(seed: int) -> list[tuple[float, float, float]]:
 
 
 def ensure_keys(cars: int, say: Any) -> None:
-    for i in range(1, cars + 1):
-        path = command_auth.default_key_path(vehicle_name(i))
-        if not path.exists():
-            command_auth.create_key(path)
-            say(f"created the command key of {vehicle_name(i)} at {path} (tools/keys)")
+    """The cars' command keys and the testbed certificates (V2V, V2I, lights, Eye poses)."""
+    v2x_ca.ensure_run_keys([vehicle_name(i) for i in range(1, cars + 1)], say)
 
 
 def plot(

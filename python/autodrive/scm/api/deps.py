@@ -26,7 +26,8 @@ def user_of(request: Request) -> dict[str, str]:
     """The logged-in user (any role); 401 without a session."""
     user = request.session.get("user")
     if not user:
-        raise HTTPException(401, "login required: no session (POST /api/login first)")
+        ended = request.scope.get("session_ended")  # set by api/middleware.SessionExpiry
+        raise HTTPException(401, f"login required: {ended or 'no session'} (POST /api/login)")
     return {"name": str(user), "role": str(request.session.get("role", ""))}
 
 

@@ -1,7 +1,9 @@
 /* The traffic lights on LCM (program side): TRAFFIC_LIGHT_COMMAND in, TRAFFIC_LIGHT_STATE out
  * for every light at 10 Hz of sim time and at once on each change (a command's effect is
  * published as soon as the command is handled). A refused command is logged on stderr
- * naming the light ids. Nothing is subscribed or published on a map without lights. */
+ * naming the light ids. Nothing is subscribed or published on a map without lights.
+ * Signed (<autodrive_v2x/v2x_auth.h>): the states with the simulator's certificate SIM.cert
+ * (role light-controller), and only commands signed by an scm and fresh on sim time count. */
 #ifndef SIM_TRAFFIC_LIGHTS_LCM_H
 #define SIM_TRAFFIC_LIGHTS_LCM_H
 
@@ -34,8 +36,10 @@ void traffic_lights_lcm_poll(traffic_lights_lcm_t *k, int64_t now_us);
  * when the 10 Hz period is due. */
 void traffic_lights_lcm_publish(traffic_lights_lcm_t *k, int64_t now_us);
 
-/* Commands handled so far, and how many were refused. */
+/* Commands handled so far (signed by an scm), and how many of those were refused. */
 long traffic_lights_lcm_commands(const traffic_lights_lcm_t *k, long *refused);
+/* Commands dropped before that: unsigned, forged, stale, replayed, wrong role, revoked. */
+long traffic_lights_lcm_unverified(const traffic_lights_lcm_t *k);
 
 #ifdef __cplusplus
 }

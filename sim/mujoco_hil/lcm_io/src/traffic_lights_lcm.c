@@ -6,9 +6,18 @@
 #include <autodrive_channels.h>
 #include <autodrive_traffic_light_command_t.h>
 #include <autodrive_traffic_light_state_t.h>
+#include <autodrive_v2x/v2x_auth.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* The simulator signs its light states as the lights' controller (SIM.cert) and obeys only
+ * commands signed by an scm, fresh on its own clock (sim time). */
+#define SIM_IDENTITY "SIM"
+#define MAX_MESSAGE_BYTES 512
+#define REFUSAL_LOG_LINES 5 /* per 10 s of sim time, then a count */
 
 struct traffic_lights_lcm {
   lcm_t *lcm;
@@ -17,6 +26,11 @@ struct traffic_lights_lcm {
   int64_t now_us;      /* sim time of the poll in progress */
   int64_t next_all_us; /* next 10 Hz publication of every light */
   long commands, refused;
+  v2x_signer_t *signer;
+  v2x_verifier_t *verifier;
+  long unverified;                       /* commands dropped by the envelope check */
+  int64_t log_window_us, next_reload_us; /* sim time */
+  int logged_in_window;
 };
 
 static void traffic_lights_lcm_send(traffic_lights_lcm_t *k, const tl_light_t *l, int64_t now_us) {
@@ -25,7 +39,58 @@ static void traffic_lights_lcm_send(traffic_lights_lcm_t *k, const tl_light_t *l
   msg.light_id = l->id;
   msg.state = (int8_t)l->state;
   msg.time_remaining_s = (float)l->remaining_s;
+  msg.auth_len = 0;
+  msg.auth = NULL;
+  uint8_t payload[MAX_MESSAGE_BYTES], envelope[V2X_MAX_ENVELOPE_BYTES];
+  const int n = autodrive_traffic_light_state_t_encode(payload, 0, sizeof payload, &msg);
+  if (n <= 0) return;
+  const size_t len = v2x_sign(k->signer, AUTODRIVE_CH_TRAFFIC_LIGHT_STATE, payload, (size_t)n,
+                              now_us, envelope, sizeof envelope);
+  msg.auth_len = (int16_t)len;
+  msg.auth = envelope;
   autodrive_traffic_light_state_t_publish(k->lcm, AUTODRIVE_CH_TRAFFIC_LIGHT_STATE, &msg);
+}
+
+/* 1 when msg carries a valid scm envelope fresh at k->now_us; else counts and logs (at most
+ * REFUSAL_LOG_LINES per 10 s of sim time) naming the sender and the reason. */
+static int traffic_lights_lcm_verified(traffic_lights_lcm_t *k,
+                                       const autodrive_traffic_light_command_t *msg) {
+  if (k->now_us >= k->next_reload_us) { /* the revocation list (a stat), 4 times a second */
+    char err[512];
+    if (v2x_verifier_reload(k->verifier, err, sizeof err) != 0)
+      fprintf(stderr, "[autodrive-sim] %s (the list held so far stays in force)\n", err);
+    k->next_reload_us = k->now_us + 250000;
+  }
+  autodrive_traffic_light_command_t bare = *msg;
+  bare.auth_len = 0;
+  bare.auth = NULL;
+  uint8_t payload[MAX_MESSAGE_BYTES];
+  const int n = autodrive_traffic_light_command_t_encode(payload, 0, sizeof payload, &bare);
+  v2x_sender_t sender;
+  const v2x_reason_t r =
+      n <= 0 ? V2X_MALFORMED_ENVELOPE
+             : v2x_verify(k->verifier, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, payload, (size_t)n,
+                          msg->auth, (size_t)(msg->auth_len > 0 ? msg->auth_len : 0),
+                          v2x_role_mask(AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND_SIGNED_BY), NULL,
+                          k->now_us, (int64_t)time(NULL), &sender);
+  if (r == V2X_OK) return 1;
+  k->unverified++;
+  if (k->now_us - k->log_window_us >= 10000000) {
+    if (k->logged_in_window >= REFUSAL_LOG_LINES)
+      fprintf(stderr,
+              "[autodrive-sim] " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND
+              ": %ld dropped in all (unsigned, forged, stale, wrong role...)\n",
+              k->unverified);
+    k->log_window_us = k->now_us;
+    k->logged_in_window = 0;
+  }
+  if (k->logged_in_window++ < REFUSAL_LOG_LINES)
+    fprintf(stderr,
+            "[autodrive-sim] " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND
+            " dropped at t = %.3f s: from %s%s (serial %llu): %s\n",
+            k->now_us * 1e-6, sender.name[0] ? "sender " : "an unknown sender", sender.name,
+            (unsigned long long)sender.serial, v2x_reason_name(r));
+  return 0;
 }
 
 static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char *channel,
@@ -35,6 +100,7 @@ static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char
   (void)channel;
   traffic_lights_lcm_t *k = user;
   char why[256];
+  if (!traffic_lights_lcm_verified(k, msg)) return;
   k->commands++;
   if (tl_command(k->t, msg->light_id, msg->state, msg->duration_s, k->now_us, why, sizeof why) !=
       0) {
@@ -59,11 +125,25 @@ traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, tra
   }
   k->lcm = lcm;
   k->t = t;
+  char why_key[512];
+  k->signer = v2x_signer_load(NULL, SIM_IDENTITY, why_key, sizeof why_key);
+  if (!k->signer) {
+    snprintf(err, err_sz, "cannot sign the light states as " SIM_IDENTITY ": %s", why_key);
+    free(k);
+    return NULL;
+  }
+  k->verifier = v2x_verifier_create(NULL, why_key, sizeof why_key);
+  if (!k->verifier) {
+    snprintf(err, err_sz, "cannot check light commands: %s", why_key);
+    v2x_signer_destroy(k->signer);
+    free(k);
+    return NULL;
+  }
   k->sub = autodrive_traffic_light_command_t_subscribe(lcm, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND,
                                                        traffic_lights_lcm_on_command, k);
   if (!k->sub) {
     snprintf(err, err_sz, "cannot subscribe to " AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND);
-    free(k);
+    traffic_lights_lcm_destroy(k);
     return NULL;
   }
   char why[256];
@@ -77,7 +157,9 @@ traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, tra
 
 void traffic_lights_lcm_destroy(traffic_lights_lcm_t *k) {
   if (!k) return;
-  autodrive_traffic_light_command_t_unsubscribe(k->lcm, k->sub);
+  if (k->sub) autodrive_traffic_light_command_t_unsubscribe(k->lcm, k->sub);
+  v2x_signer_destroy(k->signer);
+  v2x_verifier_destroy(k->verifier);
   free(k);
 }
 
@@ -100,4 +182,8 @@ void traffic_lights_lcm_publish(traffic_lights_lcm_t *k, int64_t now_us) {
 long traffic_lights_lcm_commands(const traffic_lights_lcm_t *k, long *refused) {
   if (refused) *refused = k ? k->refused : 0;
   return k ? k->commands : 0;
+}
+
+long traffic_lights_lcm_unverified(const traffic_lights_lcm_t *k) {
+  return k ? k->unverified : 0;
 }

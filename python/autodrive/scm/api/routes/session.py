@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import secrets
+import time
 
 from fastapi import APIRouter, HTTPException, Request
 
 from autodrive.scm.api.deps import ScmDep, Viewer
-from autodrive.scm.core.security import check_login
+from autodrive.scm.core.security import LoginLimiter, LoginRefused, check_login
 from autodrive.scm.schemas import LoginIn
 
 router = APIRouter(prefix="/api", tags=["session"])
@@ -15,11 +16,23 @@ router = APIRouter(prefix="/api", tags=["session"])
 
 @router.post("/login")
 def login(body: LoginIn, request: Request, scm: ScmDep) -> dict[str, str]:
+    limiter: LoginLimiter = request.app.state.login_limiter
+    address = request.client.host if request.client else "unknown"
+    try:
+        limiter.check(body.name, address)  # before any password hash is computed
+    except LoginRefused as refused:
+        raise HTTPException(429, str(refused)) from None
     user = check_login(scm.sessions, body.name, body.password)
     if user is None:
+        limiter.failed(body.name, address)
+        if limiter.locked(body.name):
+            scm.event(address, "account_locked", body.name, {"address": address})
         raise HTTPException(401, "wrong user name or password")
+    limiter.succeeded(user.name)
+    now = time.time()
     request.session.clear()
-    request.session.update(user=user.name, role=user.role, csrf=secrets.token_urlsafe(24))
+    request.session.update(user=user.name, role=user.role, csrf=secrets.token_urlsafe(24),
+                           login_s=now, seen_s=now)  # fmt: skip
     scm.event(user.name, "login", user.name, {"role": user.role})
     return {"user": user.name, "role": user.role, "csrf": request.session["csrf"]}
 

@@ -3,6 +3,7 @@
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
+#include <autodrive/v2x.hpp>
 #include <autodrive/vehicle_state_t.hpp>
 #include <autodrive_channels.h>
 #include <lcm/lcm-cpp.hpp>
@@ -28,6 +29,10 @@ struct V2vNode::Impl {
   int64_t period_us;
   int64_t next_pub_us = 0, next_status_us = 0;  // [us, pose stamps]
   int32_t seq = 0;
+  // The car signs its broadcast with its own certificate (NIGELk.cert) and takes a peer's only
+  // when signed by that peer's certificate.
+  std::optional<autodrive::v2x::Signer> signer;
+  std::optional<autodrive::v2x::Verifier> verifier;
 
   explicit Impl(const autodrive::config::Config &c)
       : config(c),
@@ -37,6 +42,16 @@ struct V2vNode::Impl {
         period_us(c.v2v_hz > 0 ? static_cast<int64_t>(1e6 / c.v2v_hz) : 0) {
     if (!lcm.good()) return;
     clock.attach(lcm);
+    if (period_us == 0) return;
+    // Without a certificate the car is not on V2V (nobody would take its unsigned states):
+    // said loudly at the start and in every status line, and the rest of the runtime runs.
+    signer = autodrive::v2x::Signer::load("autodrive-runtime V2V", c.vehicle.name);
+    verifier = autodrive::v2x::Verifier::load("autodrive-runtime V2V");
+    if (!signer || !verifier) {
+      spdlog::error("{} V2V: OFF, no usable certificate (tools/keys issue --name {} --role car)",
+                    c.vehicle.name, c.vehicle.name);
+      return;
+    }
     const std::string v = c.vehicle.name;
     autodrive_lcm::subscribe<autodrive::odometry_t, Impl, &Impl::on_pose>(
         lcm, v + AUTODRIVE_CH_POSE_MAP_SUFFIX, this);
@@ -51,9 +66,15 @@ struct V2vNode::Impl {
     have_state = true;
   }
 
-  void on_peer(const autodrive::v2v_state_t *m) { peers.on_state(*m, clock.now_us()); }
+  void on_peer(const autodrive::v2v_state_t *m) {
+    if (m->vehicle == config.vehicle.name) return;  // our own broadcast
+    const int64_t now = clock.now_us();
+    if (verifier->accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(), now))
+      peers.on_state(*m, now);
+  }
 
   void on_pose(const autodrive::odometry_t *m) {
+    if (!signer || !verifier) return;
     // A quarter period of slack so that the 100 Hz pose stream's jitter skips no broadcast.
     if (next_pub_us == 0 || m->utime >= next_pub_us - period_us / 4) {
       next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
@@ -63,8 +84,10 @@ struct V2vNode::Impl {
     if (m->utime >= next_status_us) {
       if (next_status_us != 0) {
         const auto fresh = peers.fresh(clock);
-        spdlog::info("{} V2V: {} broadcasts, {}", config.vehicle.name, seq,
-                     autodrive::v2v::status_line(fresh, peers.dropped_stale()));
+        const std::string refused = verifier->summary();
+        spdlog::info("{} V2V: {} broadcasts, {}; refused: {}", config.vehicle.name, seq,
+                     autodrive::v2v::status_line(fresh, peers.dropped_stale()),
+                     refused.empty() ? "none" : refused);
       }
       next_status_us = m->utime + kStatusPeriodUs;
     }
@@ -87,6 +110,7 @@ struct V2vNode::Impl {
     }
     s.route = config.route;
     s.route_s_m = -1.0f;  // the runtime does not follow the route itself
+    signer->sign(AUTODRIVE_CH_V2V, s, p.utime);
     lcm.publish(AUTODRIVE_CH_V2V, &s);
   }
 };
