@@ -143,7 +143,8 @@ class Driver {
   void on_peer(const autodrive::v2v_state_t *m) {
     if (m->vehicle == o_.vehicle) return;  // our own broadcast: the peer table skips it
     const int64_t now = clock_.now_us();
-    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(), now))
+    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(),
+                          now))
       return;
     peers_.on_state(*m, now);
   }

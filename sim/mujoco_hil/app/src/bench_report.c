@@ -66,9 +66,10 @@ void app_print_bench(const app_t *a, const app_run_stats_t *st, const bench_pair
   }
   long refused = 0;
   const long commands = traffic_lights_lcm_commands(a->lights, &refused);
-  printf(", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld, "
-         "\"light_commands_unverified\": %ld",
-         sim_traffic_lights(s)->n, commands, refused, traffic_lights_lcm_unverified(a->lights));
+  printf(
+      ", \"lights\": %d, \"light_commands\": %ld, \"light_commands_refused\": %ld, "
+      "\"light_commands_unverified\": %ld",
+      sim_traffic_lights(s)->n, commands, refused, traffic_lights_lcm_unverified(a->lights));
   bench_print_cameras(a);
   printf("}\n");
 }
