@@ -125,13 +125,12 @@ struct NanoBridge::Impl {
   }
 
   // The clock of the command path [us]: the control lease, command freshness, the token bucket
-  // and the heartbeat. With clock: sim it is the simulator's SIM_CLOCK, so a HIL run behaves
-  // the same at any real-time factor (the emulated Nano's failsafe runs on sim time too); else
-  // the monotonic clock. sync_to_sim_clock keeps the monotonic clock here (frames go on ticks,
-  // and a frozen sim still goes stale). The serial link's own timers (hello, reconnect, link
-  // timeout) stay monotonic: the pty is real whatever the clock.
+  // and the heartbeat. With bridge.sim_clock_commands (clock: sim) it is the simulator's
+  // SIM_CLOCK, so the path behaves the same at any real-time factor (the emulated Nano's
+  // failsafe runs on sim time too); else the monotonic clock. The serial link's own timers
+  // (hello, reconnect, link timeout) stay monotonic: the pty is real whatever the clock.
   int64_t command_now_us() const {
-    if (clock.sim() && !config.bridge.sync_to_sim_clock) return clock.now_us();
+    if (config.bridge.sim_clock_commands) return clock.now_us();
     return autodrive::clock::monotonic_us();
   }
 
@@ -460,7 +459,7 @@ struct NanoBridge::Impl {
       // On the sim clock the next frame comes with a SIM_CLOCK message: the LCM wake-up.
       int64_t due_us = next_tx_us - now;
       if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock)
-        due_us = clock.sim() ? wait_us : pacer.next_due_us() - now;
+        due_us = config.bridge.sim_clock_commands ? wait_us : pacer.next_due_us() - now;
       wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, due_us));
     }
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));
