@@ -48,6 +48,7 @@ struct TestKey {
 
 std::string config_yaml(int port, const std::string &device, const std::string &key_file,
                         const std::string &clock) {
+  const std::string sim_commands = clock == "sim" ? ", sim_clock_commands: true" : "";
   return "lcm_url: \"udpm://239.255.76.67:" + std::to_string(port) +
          "?ttl=0\"\n"
          "clock: " +
@@ -60,8 +61,8 @@ std::string config_yaml(int port, const std::string &device, const std::string &
          "         command_timeout_ms: 200, hello_retry_ms: 50, refused_retry_ms: 50,\n"
          "         reconnect_ms: 50, link_timeout_ms: 2000, telemetry_period_ms: 10,\n"
          "         command_key_file: " +
-         key_file +
-         ", command_lease_ms: 300,\n"
+         key_file + ", command_lease_ms: 300" + sim_commands +
+         ",\n"
          "         imu: {gyro_var_rad2_s2: 0.0004}}\n";
 }
 

@@ -206,3 +206,11 @@ TEST(Config, TheCarsSerialDevicesAreTheShippedUdevSymlinks) {
         << "no rule makes " << dev;
   }
 }
+
+TEST(Config, SimClockCommandsNeedTheSimClock) {
+  const std::string on = replace(kGood, "command_timeout_ms: 200",
+                                 "command_timeout_ms: 200, sim_clock_commands: true");
+  EXPECT_EQ(error_of(on), "test.yaml: bridge.sim_clock_commands: needs clock: sim");
+  EXPECT_TRUE(autodrive::config::parse(replace(on, "clock: wall", "clock: sim"), "test.yaml")
+                  .bridge.sim_clock_commands);
+}

@@ -61,6 +61,9 @@ Bridge parse_bridge(const Section &s) {
                                          "): a heartbeat takes a token too");
   b.servo_trim_us = s.get<int>("servo_trim_us", b.servo_trim_us);
   b.sync_to_sim_clock = s.get<bool>("sync_to_sim_clock", b.sync_to_sim_clock);
+  b.sim_clock_commands = s.get<bool>("sim_clock_commands", b.sim_clock_commands);
+  if (b.sim_clock_commands && b.sync_to_sim_clock)
+    s.fail(s.key("sim_clock_commands"), "and sync_to_sim_clock exclude each other");
   b.command_key_file = s.get<std::string>("command_key_file", "");
   b.replay_window_ms = s.positive_int("replay_window_ms", b.replay_window_ms);
   if (b.replay_window_ms > 10000)
@@ -182,6 +185,8 @@ Config from_node(const YAML::Node &root, const std::string &file) {
   c.bridge.device = session.sim_path(c.bridge.device);
   if (c.has_bridge && c.bridge.sync_to_sim_clock && c.clock != ClockMode::sim)
     top.fail("bridge.sync_to_sim_clock", "needs clock: sim (it sends on SIM_CLOCK ticks)");
+  if (c.has_bridge && c.bridge.sim_clock_commands && c.clock != ClockMode::sim)
+    top.fail("bridge.sim_clock_commands", "needs clock: sim");
   if ((c.has_lidar = top.has("lidar"))) c.lidar = parse_lidar(top.child("lidar"));
   c.lidar.device = session.sim_path(c.lidar.device);
   if ((c.has_estimator = top.has("estimator")))

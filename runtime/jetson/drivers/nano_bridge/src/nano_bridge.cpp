@@ -58,7 +58,8 @@ struct NanoBridge::Impl {
   // sync_to_sim_clock: a command stamped later than the sim clock waits here for its tick
   std::optional<autodrive::vehicle_command_t> scheduled_cmd;
   int64_t scheduled_rx_us = 0;
-  int64_t latest_cmd_rx_us = 0;  // command time (command_now_us)
+  int64_t latest_cmd_rx_us = 0;     // command time (command_now_us)
+  int64_t latest_cmd_clock_us = 0;  // the same arrival on `clock` (clock sim: its freshness)
   uint16_t cmd_seq = 0;
   uint8_t frame_seq = 0;
   int64_t next_tx_us = 0;       // next hello; sync_to_sim_clock: next frame [monotonic us]
@@ -125,13 +126,12 @@ struct NanoBridge::Impl {
   }
 
   // The clock of the command path [us]: the control lease, command freshness, the token bucket
-  // and the heartbeat. With clock: sim it is the simulator's SIM_CLOCK, so a HIL run behaves
-  // the same at any real-time factor (the emulated Nano's failsafe runs on sim time too); else
-  // the monotonic clock. sync_to_sim_clock keeps the monotonic clock here (frames go on ticks,
-  // and a frozen sim still goes stale). The serial link's own timers (hello, reconnect, link
-  // timeout) stay monotonic: the pty is real whatever the clock.
+  // and the heartbeat. With bridge.sim_clock_commands (clock: sim) it is the simulator's
+  // SIM_CLOCK, so the path behaves the same at any real-time factor (the emulated Nano's
+  // failsafe runs on sim time too); else the monotonic clock. The serial link's own timers
+  // (hello, reconnect, link timeout) stay monotonic: the pty is real whatever the clock.
   int64_t command_now_us() const {
-    if (clock.sim() && !config.bridge.sync_to_sim_clock) return clock.now_us();
+    if (config.bridge.sim_clock_commands) return clock.now_us();
     return autodrive::clock::monotonic_us();
   }
 
@@ -207,6 +207,7 @@ struct NanoBridge::Impl {
     }
     latest_cmd = *m;
     latest_cmd_rx_us = now_cmd;
+    latest_cmd_clock_us = clock.now_us();
     // A fresh command goes to the Nano at once while the token bucket has a token; under a
     // flood the newest one waits for the next token (CommandPacer). In step with SIM_CLOCK
     // every frame waits for its tick instead.
@@ -229,9 +230,20 @@ struct NanoBridge::Impl {
       spdlog::warn("{}{}", tag, port.error());
   }
 
+  // With clock: sim a command's freshness is judged in sim time (a run paced at 0.1x real time
+  // keeps its commands fresh), and every command is stale on a frozen SIM_CLOCK
+  // (Clock::kFrozenAfterUs of wall time). sim_clock_commands puts the whole command path on
+  // SIM_CLOCK already, and sync_to_sim_clock keeps it monotonic (repeatable frames).
+  bool command_fresh(int64_t now_us) const {
+    if (!latest_cmd) return false;
+    const int64_t timeout_us = config.bridge.command_timeout_ms * 1000LL;
+    if (clock.sim() && !config.bridge.sync_to_sim_clock && !config.bridge.sim_clock_commands)
+      return clock.fresh(latest_cmd_clock_us, timeout_us);
+    return now_us - latest_cmd_rx_us <= timeout_us;
+  }
+
   void send_command(int64_t now_us) {
-    const bool fresh = latest_cmd.has_value() &&
-                       now_us - latest_cmd_rx_us <= config.bridge.command_timeout_ms * 1000LL;
+    const bool fresh = command_fresh(now_us);
     const protocol_command_t c =
         make_command(latest_cmd ? &*latest_cmd : nullptr, fresh, cmd_seq++);
     uint8_t payload[PROTOCOL_LEN_COMMAND];
@@ -275,6 +287,7 @@ struct NanoBridge::Impl {
     if (scheduled_cmd && scheduled_cmd->utime <= clock.now_us()) {
       latest_cmd = scheduled_cmd;
       latest_cmd_rx_us = scheduled_rx_us;
+      latest_cmd_clock_us = clock.now_us();
       scheduled_cmd.reset();
     }
     switch (state()) {
@@ -460,7 +473,7 @@ struct NanoBridge::Impl {
       // On the sim clock the next frame comes with a SIM_CLOCK message: the LCM wake-up.
       int64_t due_us = next_tx_us - now;
       if (state() == LinkState::linked && !config.bridge.sync_to_sim_clock)
-        due_us = clock.sim() ? wait_us : pacer.next_due_us() - now;
+        due_us = config.bridge.sim_clock_commands ? wait_us : pacer.next_due_us() - now;
       wait_us = std::min<int64_t>(wait_us, std::max<int64_t>(0, due_us));
     }
     const int r = ::poll(fds, static_cast<nfds_t>(nfds), static_cast<int>(wait_us / 1000));

@@ -50,6 +50,11 @@ struct Bridge {
   // clock sim: one frame per SIM_CLOCK tick, and a command stamped later than the sim clock
   // applies from that sim time (repeatable HIL with autodrive-sim --lockstep-frames)
   bool sync_to_sim_clock = false;
+  // clock sim (optional, default false): the command path (lease, freshness, token bucket,
+  // heartbeat) on SIM_CLOCK instead of the monotonic clock. Off by default: autodrive-sim
+  // --lockstep-client paces itself on the bridge's bytes, and a sim-time heartbeat lets it run
+  // ahead of the other components.
+  bool sim_clock_commands = false;
   // Command authentication (bridge/command_gate.hpp). Optional keys: the key file (default
   // autodrive::auth::default_key_path(vehicle), created by tools/keys), how far a command's
   // counter may be from the wall clock, and how long the holder keeps control without commands.
