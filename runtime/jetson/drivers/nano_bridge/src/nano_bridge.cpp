@@ -135,6 +135,14 @@ struct NanoBridge::Impl {
     return autodrive::clock::monotonic_us();
   }
 
+  // The control lease's clock [us]: with clock: sim the simulator's, so a holder whose commands
+  // come at its rate of sim time keeps its lease at any real-time factor (a frozen sim stops the
+  // car through command_fresh instead); else the command path's.
+  int64_t lease_now_us() const {
+    if (clock.sim() && !config.bridge.sync_to_sim_clock) return clock.now_us();
+    return command_now_us();
+  }
+
   void log_drop(const autodrive::vehicle_command_t &m, Drop d) {
     // The source is what the sender claims: printable, bounded, and only for the log. Sources
     // a signature vouches for are few; unsigned ones all share one entry.
@@ -182,8 +190,9 @@ struct NanoBridge::Impl {
   void on_command(const autodrive::vehicle_command_t *m) {
     if (!gate) return;
     const int64_t now_cmd = command_now_us();
-    if (gate->expire(now_cmd)) holder_changed();  // a lapse is published on its own
-    const CommandGate::Verdict v = gate->admit(*m, now_cmd, autodrive::clock::wall_us());
+    const int64_t now_lease = lease_now_us();
+    if (gate->expire(now_lease)) holder_changed();  // a lapse is published on its own
+    const CommandGate::Verdict v = gate->admit(*m, now_lease, autodrive::clock::wall_us());
     if (v.holder_changed) holder_changed();
     if (v.drop != Drop::none) {
       if (v.drop != Drop::idle) log_drop(*m, v.drop);
@@ -484,7 +493,7 @@ struct NanoBridge::Impl {
       }
     if (gate) {
       drop_log.flush();
-      if (gate->expire(command_now_us())) holder_changed();
+      if (gate->expire(lease_now_us())) holder_changed();
       if (autodrive::clock::monotonic_us() >= next_control_us) publish_control();
     }
     if (r > 0 && nfds == 2 && port.is_open()) {
