@@ -188,6 +188,8 @@ def test_city_driver_obeys(
                 "tiny_town",
                 "--vehicles",
                 "NIGEL1",
+                "--routes",
+                ROUTE,
                 "--lcm-url",
                 URL,
                 "--build",

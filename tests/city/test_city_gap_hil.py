@@ -133,6 +133,7 @@ def test_gap_keeping(
                 "eye-standin", [*py, "autodrive.hil.city.eye_standin", *common], out / "eye.log"
             )
             adv = [*py, "autodrive.hil.city.advisory", "--map", "tiny_town", *common]
+            adv += ["--routes", ",".join(ROUTE for _ in CARS)]
             procs.start("advisory", adv, out / "advisory.log")
             for i, car in enumerate(CARS, 1):
                 cfg = hil.runtime_config(out, run_dir, URL, i, poses[i - 1], ROUTE, lidar=True)

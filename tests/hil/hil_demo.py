@@ -37,3 +37,22 @@ def demo_command(build, out, port, *options):
         f"udpm://239.255.76.67:{port}?ttl=0",
         *options,
     ]
+
+
+def start_demo_until(build, out, port, marker, *options):
+    """The demo started (demo_command) and read until a line with marker: (process, lines)."""
+    import subprocess
+
+    demo = subprocess.Popen(
+        demo_command(build, out, port, *options),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    seen = []
+    for line in demo.stdout:
+        seen.append(line)
+        sys.stdout.write(line)
+        if marker in line:
+            break
+    return demo, seen

@@ -7,10 +7,9 @@ import os
 import select
 import signal
 import subprocess
-import sys
 import tempfile
 
-from hil_demo import demo_command
+from hil_demo import start_demo_until
 
 
 def children_of_run(tmp: str) -> list[int]:
@@ -34,18 +33,9 @@ def wait_gone(pid: int) -> None:
 
 def test_killed_demo_leaves_no_child(build_dir, lcm_port) -> None:
     with tempfile.TemporaryDirectory(prefix="hil-dies-") as tmp:
-        demo = subprocess.Popen(
-            demo_command(build_dir, tmp, lcm_port, "--timeout", "200"),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        seen = []
-        for line in demo.stdout:
-            seen.append(line)
-            sys.stdout.write(line)
-            if "starting autodrive-sim" in line:  # lcm-logger runs, the simulator is starting
-                break
+        # "starting autodrive-sim": lcm-logger runs, the simulator is starting
+        marker = "starting autodrive-sim"
+        demo, seen = start_demo_until(build_dir, tmp, lcm_port, marker, "--timeout", "200")
         assert demo.poll() is None, "the demo ended before it started:\n" + "".join(seen)
         children = children_of_run(tmp)
         assert children, "lcm-logger is not running:\n" + "".join(seen)

@@ -9,7 +9,7 @@ import subprocess
 import sys
 import tempfile
 
-from hil_demo import demo_command
+from hil_demo import start_demo_until
 import time
 
 from autodrive.core import lcmtypes
@@ -25,18 +25,8 @@ def test_ctrl_c_mid_mission(root: pathlib.Path, build_dir: pathlib.Path, lcm_por
         return [p for p in r.stdout.split() if p and int(p) != 0]
 
     with tempfile.TemporaryDirectory(prefix="hil-int-") as tmp:
-        demo = subprocess.Popen(
-            demo_command(build, tmp, port, "--timeout", "200"),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        seen = []
-        for line in demo.stdout:
-            seen.append(line)
-            sys.stdout.write(line)
-            if "route leg 1/" in line:  # the car is engaged and moving
-                break
+        # "route leg 1/": the car is engaged and moving
+        demo, seen = start_demo_until(build, tmp, port, "route leg 1/", "--timeout", "200")
         assert demo.poll() is None, "the demo ended before the mapping route:\n" + "".join(seen)
         time.sleep(0.5)  # well into the leg
         children = alive(tmp) + alive(f"autodrive-demo-{demo.pid}")

@@ -19,13 +19,16 @@ import sys
 import time
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.v2x_cert import CertificateError
 from autodrive.core.channels import channel
-from autodrive.core.road_rules import Ahead, Place, RoadNet, SidecarError
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.maps.loader import MAPS_DIR
+
+if TYPE_CHECKING:  # imported in main, once the stop signals are handled (numpy, cffi: slow)
+    from autodrive.core.road_rules import Ahead, Place, RoadNet
 
 PERIOD_S = 0.1  # 10 Hz per car
 
@@ -36,9 +39,9 @@ class Advisor:
     def __init__(self, net: RoadNet, routes: dict[str, str]) -> None:
         self.net = net
         self.routes = routes
-        self.places: dict[str, Place | None] = {}
+        self.places: dict[str, "Place | None"] = {}
 
-    def ahead(self, vehicle: str, x_m: float, y_m: float, yaw_rad: float) -> Ahead:
+    def ahead(self, vehicle: str, x_m: float, y_m: float, yaw_rad: float) -> "Ahead":
         route = self.routes.get(vehicle, "")
         place, ahead = self.net.follow(x_m, y_m, yaw_rad, route, self.places.get(vehicle))
         self.places[vehicle] = place
@@ -46,11 +49,11 @@ class Advisor:
 
 
 def run(
-    map_name: str, vehicles: list[str], routes: dict[str, str], url: str, build: Path,
-    stop: list[bool],
+    map_name: str, net: RoadNet, vehicles: list[str], routes: dict[str, str], url: str,
+    build: Path, stop: list[bool],
 ) -> int:  # fmt: skip
     types = lcmtypes.load(build)
-    advisor = Advisor(RoadNet.from_file(MAPS_DIR / f"{map_name}.json", build), routes)
+    advisor = Advisor(net, routes)
     lc = lcmtypes.bus(url)
     # Signed as the SCM it stands in for (SCM.cert), stamped with each car's own clock (its
     # latest pose's time: sim time in HIL), on which the car judges freshness.
@@ -117,6 +120,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     p.add_argument("--build", default=str(RELEASE_BUILD), help="host build dir (LCM types)")
     args = p.parse_args(argv)
+    stop = [False]
+
+    def on_signal(_s: int, _f: FrameType | None) -> None:
+        stop[0] = True
+
+    # before the slow part: a stop that comes while the network is built still ends us cleanly
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    from autodrive.core.road_rules import RoadNet, SidecarError
+
     sidecar = MAPS_DIR / f"{args.map}.json"
     if not sidecar.is_file():
         p.error(f"--map {args.map}: no {sidecar}")
@@ -125,22 +138,15 @@ def main(argv: list[str] | None = None) -> int:
     if names and len(names) != len(vehicles):
         p.error(f"--routes: {len(names)} routes for {len(vehicles)} vehicles")
     try:
-        known = RoadNet.from_file(sidecar, Path(args.build)).routes
+        net = RoadNet.from_file(sidecar, Path(args.build))
     except SidecarError as err:
         p.error(f"--map {args.map}: {err}")
     for r in names:
-        if r and r not in known:
-            p.error(f"--routes: no route '{r}' on {args.map} (has {', '.join(known)})")
+        if r and r not in net.routes:
+            p.error(f"--routes: no route '{r}' on {args.map} (has {', '.join(net.routes)})")
     routes = dict(zip(vehicles, names))
-    stop = [False]
-
-    def on_signal(_s: int, _f: FrameType | None) -> None:
-        stop[0] = True
-
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
     try:
-        return run(args.map, vehicles, routes, args.lcm_url, Path(args.build), stop)
+        return run(args.map, net, vehicles, routes, args.lcm_url, Path(args.build), stop)
     except CertificateError as err:
         print(f"[advisory] cannot sign as SCM: {err}", file=sys.stderr)
         return 2
