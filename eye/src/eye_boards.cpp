@@ -21,8 +21,7 @@ constexpr double kSpin_rad = 0.2;  // the board also turns about the optical axi
 
 std::vector<BoardView> boards_render(const Intrinsics &in, const IntrinsicsParams &p,
                                      const BoardSetParams &b) {
-  if (p.charuco)
-    throw Error("make-board-images: renders checkerboards only (drop --charuco)");
+  if (p.charuco) throw Error("make-board-images: renders checkerboards only (drop --charuco)");
   if (in.width_px <= 0 || in.height_px <= 0)
     throw Error("make-board-images: the camera model has no image size");
   if (b.views < 1) throw Error("make-board-images: --views must be at least 1");
@@ -55,7 +54,8 @@ std::vector<BoardView> boards_render(const Intrinsics &in, const IntrinsicsParam
 
 cv::Mat intrinsics_coverage_image(const IntrinsicsReport &rep) {
   cv::Mat img(rep.image_size, CV_8UC3, cv::Scalar(40, 40, 40));
-  const double cw = rep.image_size.width / double(kGrid), ch = rep.image_size.height / double(kGrid);
+  const double cw = rep.image_size.width / double(kGrid),
+               ch = rep.image_size.height / double(kGrid);
   for (int r = 0; r < kGrid; ++r)
     for (int c = 0; c < kGrid; ++c) {
       const cv::Rect cell(int(c * cw), int(r * ch), int(cw), int(ch));
@@ -64,7 +64,8 @@ cv::Mat intrinsics_coverage_image(const IntrinsicsReport &rep) {
       cv::rectangle(img, cell, cv::Scalar(160, 160, 160), 1);
     }
   for (size_t v = 0; v < rep.corners.size(); ++v) {
-    cv::Mat hue(1, 1, CV_8UC3, cv::Scalar(static_cast<int>(180 * v / rep.corners.size()), 255, 255));
+    cv::Mat hue(1, 1, CV_8UC3,
+                cv::Scalar(static_cast<int>(180 * v / rep.corners.size()), 255, 255));
     cv::cvtColor(hue, hue, cv::COLOR_HSV2BGR);
     const cv::Vec3b bgr = hue.at<cv::Vec3b>(0, 0);
     for (const auto &c : rep.corners[v])

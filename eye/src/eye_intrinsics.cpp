@@ -114,7 +114,8 @@ void intrinsics_solve(IntrinsicsReport &rep, const IntrinsicsParams &p) {
       const cv::Point2f d = back[j] - img[i][j];
       sq += d.dot(d);
     }
-    rep.view_rms_px.push_back(std::sqrt(sq / static_cast<double>(std::max<size_t>(1, back.size()))));
+    rep.view_rms_px.push_back(
+        std::sqrt(sq / static_cast<double>(std::max<size_t>(1, back.size()))));
   }
 }
 

@@ -1,12 +1,12 @@
 // Synthetic frames with exact geometry: the calibration board set of autodrive-eye
-// make-board-images (eye_boards), and the golden frames of the tests and the benchmark. Everything uses the Eye's pixel convention: the centre of pixel (col,row) is at
-// (x,y) = (col,row) and the pixel covers the square [col-0.5,col+0.5] x [row-0.5,row+0.5].
-// Each output pixel is the box-filtered average of ss x ss point samples taken at the centres
-// of its sub-squares, so edges are anti-aliased without any half-pixel shift.
-// Lens distortion (the intrinsics' plumb_bob k1 k2 p1 p2 k3) is rendered exactly where it
-// matters: every sample point of the distorted image is taken back to its undistorted pixel
-// (cv::undistortPoints at the pixel corners, bilinear inside a pixel: < 0.001 px for k1 -0.3)
-// before the plane's homography is inverted.
+// make-board-images (eye_boards), and the golden frames of the tests and the benchmark. Everything
+// uses the Eye's pixel convention: the centre of pixel (col,row) is at (x,y) = (col,row) and the
+// pixel covers the square [col-0.5,col+0.5] x [row-0.5,row+0.5]. Each output pixel is the
+// box-filtered average of ss x ss point samples taken at the centres of its sub-squares, so edges
+// are anti-aliased without any half-pixel shift. Lens distortion (the intrinsics' plumb_bob k1 k2
+// p1 p2 k3) is rendered exactly where it matters: every sample point of the distorted image is
+// taken back to its undistorted pixel (cv::undistortPoints at the pixel corners, bilinear inside a
+// pixel: < 0.001 px for k1 -0.3) before the plane's homography is inverted.
 #pragma once
 #include <opencv2/core.hpp>
 

@@ -78,6 +78,8 @@ inline Instance instance() {
 }
 
 // url moved to the session's instance (the form every config reader and CLI uses).
-inline std::string instance_lcm_url(const std::string &url) { return instance().lcm_url(url); }
+inline std::string instance_lcm_url(const std::string &url) {
+  return instance().lcm_url(url);
+}
 
 }  // namespace autodrive

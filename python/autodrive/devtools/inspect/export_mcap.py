@@ -1,4 +1,4 @@
-"""tools/export-mcap RUN.lcmlog OUT.mcap: an LCM log as MCAP with ROS 2 message schemas, so that
+"""tools/export-mcap RUN.lcmlog [OUT.mcap]: an LCM log as MCAP with ROS 2 message schemas, so that
 a run opens in Foxglove and in `ros2 bag` (no ROS installation needed).
 
 Each channel of the log is looked up in the channel table (lcm_types/channels.yaml) and becomes
