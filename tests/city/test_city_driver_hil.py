@@ -206,6 +206,8 @@ def test_city_driver_obeys(
                 ROUTE,
                 "--lcm-url",
                 URL,
+                "--clock",  # the advisory's age in sim time, as the runtime's
+                "sim",
             ]
             procs.start("city-driver", drv, out / "driver.log")
             # 1. stale advisory: light 3 stays GREEN in the sim, the car stops at it anyway

@@ -151,7 +151,7 @@ def test_gap_keeping(
                     lc.handle()
             for i, car in enumerate(CARS, 1):
                 drv = [build / "bin" / "autodrive-city-driver", "--map", MAP, "--route", ROUTE]
-                drv += ["--vehicle", car, "--lcm-url", URL]
+                drv += ["--vehicle", car, "--lcm-url", URL, "--clock", "sim"]  # as the runtimes
                 procs.start(f"city-driver{i}", drv, out / f"driver{i}.log")
             # 1. red: the leader stands at the line, the follower closes up and stands behind it
             wait_for(
