@@ -63,7 +63,7 @@ def episode(build: Path, out: Path, url: str, rtf: float | None) -> dict[str, ob
         lc.subscribe(channel("GROUND_TRUTH", vehicle_name(i)), on_truth)
     cmd = [sys.executable, "-m", "autodrive.hil.demo", "--mission", "smart-city", "--headless",
            "--build", str(build), "--out", str(out), "--seed", str(SEED),
-           "--city-eye", "standin", "--advisory", "standin", "--lcm-url", url,
+           "--eye", "standin", "--advisory", "standin", "--lcm-url", url,
            "--timeout", str(WALL_GUARD_S)]  # fmt: skip
     if rtf is not None:
         cmd += ["--rtf", str(rtf)]
