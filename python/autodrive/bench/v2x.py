@@ -44,6 +44,8 @@ from pathlib import Path
 from typing import Any
 
 from autodrive.bench import Progress, build_dir, print_figures
+from autodrive.bench.goals import at_most, judge
+from autodrive.core import seeds
 from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 
@@ -52,18 +54,23 @@ PORT = 7873
 URL = f"udpm://239.255.76.67:{PORT}?ttl=0"
 CARS, BUS_HZ = 16, 20.0
 LIGHT = 1  # Intersection School's light 1: RED <-> OFF never conflicts
+# Issue 33's goals; every one a figure at or under its bound (a missing figure fails).
 GOALS = {
-    "forged_light_state_changes": 0,
-    "replayed_v2v_accepted": 0,
-    "replayed_light_cmd_accepted": 0,
-    "revoked_accepted_after_1s": 0,
-    "brute_force_accepted": 0,
-    "brute_force_user_latency_ratio": 2.0,
-    "bus16_cpu_share": 0.05,
-    "forged_green_red_violations": 0,
-    "ghost_car_extra_stop_s": 0.0,
-    "eye_walk_ekf_drift_m": 0.02,
+    name: at_most(name, bound)
+    for name, bound in {
+        "forged_light_state_changes": 0,
+        "replayed_v2v_accepted": 0,
+        "replayed_light_cmd_accepted": 0,
+        "revoked_accepted_after_1s": 0,
+        "brute_force_accepted": 0,
+        "brute_force_user_latency_ratio": 2.0,
+        "bus16_cpu_share": 0.05,
+        "forged_green_red_violations": 0,
+        "ghost_car_extra_stop_s": 0.0,
+        "eye_walk_ekf_drift_m": 0.02,
+    }.items()
 }
+UNSEEDED = seeds.unseeded("scripted attacks; the smart-city runs use the mission's default seed")
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -466,11 +473,6 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
     }
 
 
-def goals_met(fig: dict[str, Any]) -> dict[str, bool]:
-    """Each goal: a figure at or under its goal; a missing figure fails."""
-    return {k: isinstance(fig.get(k), (int, float)) and fig[k] <= goal for k, goal in GOALS.items()}
-
-
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="tools/bench v2x", description=__doc__.split("\n")[0])
     p.add_argument("--skip-web", action="store_true", help="no login brute force (goal fails)")
@@ -490,9 +492,6 @@ def main(argv: list[str] | None = None) -> int:
             fig.update(brute_force(build, Path(tmp)))
         if not a.skip_city:
             fig.update(smart_city_attacks(build, types, key_dir, Path(tmp)))
-    goals = goals_met(fig)
-    fig["goals"] = goals
-    fig["goals_met"] = all(goals.values())
     fig["load_1min"] = round(os.getloadavg()[0], 1)
-    print_figures(fig, key_value_lines=True)
+    print_figures(judge(fig, GOALS, UNSEEDED), key_value_lines=True)
     return 0
