@@ -50,11 +50,12 @@ def run_group(tmp_path, children):
     for name, argv, env_opts in children:
         logfile = tmp_path / f"{name}.log"
         procs.start(name, ["env", env_opts, *argv], logfile)
-    # every child prints one line when it is up: wait for it (event order, not a sleep)
+    # every child prints one line when it is up: wait for it (event order, not a sleep), or for
+    # its end (a child whose sanitizer halts it may end before the others are up)
+    running = {name: proc for name, proc, _f in procs.items}
     for name, _argv, _env in children:
         logfile = tmp_path / f"{name}.log"
-        while "ready" not in logfile.read_text():
-            procs.check()
+        while "ready" not in logfile.read_text() and running[name].poll() is None:
             time.sleep(0.01)
     return procs
 
