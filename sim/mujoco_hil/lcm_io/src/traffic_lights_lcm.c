@@ -39,9 +39,9 @@ static void traffic_lights_lcm_send(traffic_lights_lcm_t *k, const tl_light_t *l
   msg.light_id = l->id;
   msg.state = (int8_t)l->state;
   msg.time_remaining_s = (float)l->remaining_s;
-  msg.auth_len = 0;
-  msg.auth = NULL;
   uint8_t payload[MAX_MESSAGE_BYTES], envelope[V2X_MAX_ENVELOPE_BYTES];
+  msg.auth_len = 0;
+  msg.auth = envelope; /* empty, but never NULL: LCM memcpy's the array, even of 0 bytes */
   const int n = autodrive_traffic_light_state_t_encode(payload, 0, sizeof payload, &msg);
   if (n <= 0) return;
   const size_t len = v2x_sign(k->signer, AUTODRIVE_CH_TRAFFIC_LIGHT_STATE, payload, (size_t)n,
@@ -62,9 +62,9 @@ static int traffic_lights_lcm_verified(traffic_lights_lcm_t *k,
     k->next_reload_us = k->now_us + 250000;
   }
   autodrive_traffic_light_command_t bare = *msg;
-  bare.auth_len = 0;
-  bare.auth = NULL;
   uint8_t payload[MAX_MESSAGE_BYTES];
+  bare.auth_len = 0;
+  bare.auth = payload; /* empty, but never NULL: LCM memcpy's the array, even of 0 bytes */
   const int n = autodrive_traffic_light_command_t_encode(payload, 0, sizeof payload, &bare);
   v2x_sender_t sender;
   const v2x_reason_t r =
