@@ -62,9 +62,9 @@ static int traffic_lights_lcm_verified(traffic_lights_lcm_t *k,
     k->next_reload_us = k->now_us + 250000;
   }
   autodrive_traffic_light_command_t bare = *msg;
-  uint8_t payload[MAX_MESSAGE_BYTES];
+  uint8_t payload[MAX_MESSAGE_BYTES], no_auth[1] = {0};
   bare.auth_len = 0;
-  bare.auth = payload; /* empty, but never NULL: LCM memcpy's the array, even of 0 bytes */
+  bare.auth = no_auth; /* empty, but never NULL: LCM memcpy's the array, even of 0 bytes */
   const int n = autodrive_traffic_light_command_t_encode(payload, 0, sizeof payload, &bare);
   v2x_sender_t sender;
   const v2x_reason_t r =
