@@ -84,7 +84,8 @@ class Verifier {
   template <class Msg>
   bool accept(const std::string &channel, const Msg &m, const char *roles, const char *name,
               int64_t now_us) {
-    if (now_us - last_reload_us_ >= 250000 || now_us < last_reload_us_) {
+    // (now_us < last: a clock that went back, such as a new simulator run)
+    if (!last_reload_us_ || now_us < *last_reload_us_ || now_us - *last_reload_us_ >= 250000) {
       last_reload_us_ = now_us;
       char err[512] = "";
       if (v2x_verifier_reload(verifier_.get(), err, sizeof err) != 0)
@@ -131,7 +132,7 @@ class Verifier {
         limiter_(std::make_unique<autodrive::LogLimiter>(program + " refused messages")) {}
   std::unique_ptr<v2x_verifier_t, Free> verifier_;
   std::unique_ptr<autodrive::LogLimiter> limiter_;
-  int64_t last_reload_us_ = INT64_MIN;
+  std::optional<int64_t> last_reload_us_;  // [us, the receiver's clock]
 };
 
 }  // namespace autodrive::v2x
