@@ -75,7 +75,7 @@ build_aarch64() {
     cmake -G Ninja -S "$ROOT" -B "$dir" --toolchain "$ROOT/cmake/aarch64-linux-gnu.cmake" \
       -DCMAKE_BUILD_TYPE=Release "-DCMAKE_C_FLAGS_RELEASE=$AARCH64_OPT" \
       "-DCMAKE_CXX_FLAGS_RELEASE=$AARCH64_OPT" -DCMAKE_UNITY_BUILD=ON \
-      "-DAUTODRIVE_PARTS=vehicle;common/cpp;common/path_tracking;common/road_rules;common/marl_core;lcm_types;firmware/nano;runtime/jetson;eye;tests" \
+      "-DAUTODRIVE_PARTS=vehicle;common/cpp;common/path_tracking;common/road_rules;common/v2x_auth;common/marl_core;lcm_types;firmware/nano;runtime/jetson;eye;tests" \
       "-DAUTODRIVE_TEST_SUITES=firmware_host;runtime;autonomy;eye" >/dev/null \
       || die "aarch64 configure failed"
   fi
