@@ -32,7 +32,9 @@ std::vector<uint8_t> encode_jpeg(const void *bgr, int w, int h, int out_w, int o
   return out;
 }
 
-namespace {
+// Named, not anonymous: CameraDriver::Impl holds an Opener, and the aarch64 unity build
+// (-Wsubobject-linkage) refuses an anonymous type inside a class of an included file.
+namespace opener_detail {
 // Openers still blocked inside cv::VideoCapture::open (their threads are detached).
 std::atomic<int> g_stuck_openers{0};
 
@@ -46,7 +48,9 @@ struct Opener {
   bool done = false, ok = false;
   cv::VideoCapture cap;
 };
-}  // namespace
+}  // namespace opener_detail
+using opener_detail::g_stuck_openers;
+using opener_detail::Opener;
 
 int stuck_openers() {
   return g_stuck_openers.load();
