@@ -161,7 +161,9 @@ class Postgres:
         self.url = f"postgresql://scm@127.0.0.1:{self.port}/postgres"
 
     def _run(self, cmd: list[str]) -> None:
-        r = subprocess.run(self.prefix + cmd, capture_output=True, text=True)
+        # PostgreSQL is no part of the build under test: without the test's LD_PRELOAD of the
+        # sanitizer runtime (meant for the SCM's cffi libraries), under which it hangs.
+        r = subprocess.run(self.prefix + cmd, capture_output=True, text=True, env=no_preload())
         if r.returncode != 0:
             raise RuntimeError(f"{' '.join(cmd[:2])} failed: {r.stdout}{r.stderr}")
 
@@ -169,6 +171,11 @@ class Postgres:
         self._run([str(PG_BIN / "pg_ctl"), "-D", str(self.dir), "-m", "fast", "-w", "stop"])
         if self.own:
             shutil.rmtree(self.tmp, ignore_errors=True)
+
+
+def no_preload() -> dict[str, str]:
+    """This process's environment without LD_PRELOAD: for third-party programs a test starts."""
+    return {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
 
 
 def chromium() -> Any:
@@ -185,8 +192,9 @@ def chromium() -> Any:
         opts.add_argument(arg)
     # The browser is no part of the build under test: no sanitizer runtime preloaded into it (a
     # test's LD_PRELOAD for the SCM's cffi libraries makes chromedriver exit at start).
-    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
-    return webdriver.Chrome(options=opts, service=Service("/usr/bin/chromedriver", env=env))
+    return webdriver.Chrome(
+        options=opts, service=Service("/usr/bin/chromedriver", env=no_preload())
+    )
 
 
 def login_page(driver: Any, base: str, name: str, password: str) -> None:
