@@ -110,22 +110,24 @@ def run(guide: Path, root: Path, env: dict[str, str]) -> int:
             shell.stdin.write(f"{step.text}\necho {DONE} $?\n")
             shell.stdin.flush()
             end = time.monotonic() + step.timeout_s
-            finished = False
+            finished = eof = False
             while not finished and time.monotonic() < end:
                 line = reader.line(1.0)
                 if line is None:
                     continue
                 if line == "":  # the shell exited: set -e on a failing command
+                    eof = True
                     break
                 before, done, _ = line.partition(DONE)  # output without a last newline
                 if before.strip():
                     print(f"  {before.rstrip()}", flush=True)
                 finished = bool(done)
             if not finished:
+                # at the end of its output the shell may not be reaped yet: wait for it then
                 why = (
-                    f"did not finish within its {step.timeout_s} s guard"
-                    if shell.poll() is None
-                    else f"failed (exit status {shell.wait()})"
+                    f"failed (exit status {shell.wait(timeout=60)})"
+                    if eof or shell.poll() is not None
+                    else f"did not finish within its {step.timeout_s} s guard"
                 )
                 print(f"FAIL: {guide.name}:{step.line}: step {n} {why}", file=sys.stderr)
                 rc = 1
