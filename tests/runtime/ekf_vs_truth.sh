@@ -18,7 +18,7 @@ mkdir -m 700 "$AUTODRIVE_KEY_DIR"
 PIDS+=($!)
 for _ in $(seq 600); do [ -e "$W/sim/nigel1-nano" ] && break; sleep 0.1; done
 [ -e "$W/sim/nigel1-nano" ] || { echo "no sim pty"; cat "$W/sim.log"; exit 1; }
-sed -e "s#/dev/ttyUSB0#$W/sim/nigel1-nano#" -e "s#:7667#:$PORT#" -e '/^lidar:/,/^  range_max_m:/d' \
+sed -e "s#/dev/nigel-nano#$W/sim/nigel1-nano#" -e "s#:7667#:$PORT#" -e '/^lidar:/,/^  range_max_m:/d' \
     -e '/^cameras:/,/^    jpeg_quality:/d' "$ROOT/runtime/jetson/config/nigel_car.yaml" > "$W/rt.yaml"
 "$BIN/autodrive-runtime" --config "$W/rt.yaml" --only bridge,estimator --log-level warn >"$W/rt.log" 2>&1 &
 PIDS+=($!)
