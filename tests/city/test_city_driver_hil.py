@@ -103,52 +103,66 @@ def test_city_driver_obeys(
                 if select.select([lc.fileno()], [], [], 0.05)[0]:
                     lc.handle()
 
-        def wait_for(what, cond, wall_s=240):
-            t0 = time.monotonic()
-            while time.monotonic() - t0 < wall_s:
+        # Judged on sim time: the lockstep sim runs as fast as the slowest of the loop, so a busy
+        # host makes a run slower, never different. Only a sim clock that stops is an error.
+        STALL_WALL_S = 120.0  # a hang backstop, not a deadline: no sim time at all for this long
+
+        def wait_for(what, cond, sim_s=120.0):
+            t_start, seen_t, seen_wall = truth.get("t", 0.0), None, time.monotonic()
+            while True:
                 procs.check()
                 spin(0.1)
+                now = truth.get("t")
+                if now != seen_t:
+                    seen_t, seen_wall = now, time.monotonic()
+                elif time.monotonic() - seen_wall > STALL_WALL_S:
+                    raise AssertionError(
+                        f"{what}: the sim clock stopped for {STALL_WALL_S} s; {truth}"
+                    )
                 if truth and cond():
                     return
-                if truth and truth["t"] > SIM_LIMIT_S:
-                    break
-            raise AssertionError(
-                f"{what}: not within {wall_s} s wall / {SIM_LIMIT_S} s sim; {truth}"
-            )
+                if truth and (truth["t"] > t_start + sim_s or truth["t"] > SIM_LIMIT_S):
+                    raise AssertionError(f"{what}: not within {sim_s} s of sim time; {truth}")
 
         def set_light(state, what):
-            """Commands light 3 until it shows state: the simulator refuses a GREEN while a
-            conflicting light is green on its program, so one command may not do."""
-            sent = [0.0]
+            """Commands light 3 to hold state until it shows it: the simulator refuses a GREEN while
+            a conflicting light is green on its program, so one command may not do. The first
+            command goes out even when the program shows state already, or it would move on."""
+            sent_t = [None]  # sim time of the last command [s]
 
             def shown():
-                if lights.get(LIGHT) != state and time.monotonic() - sent[0] > 0.5:
+                resend = sent_t[0] is None or truth["t"] - sent_t[0] > 0.5
+                if resend and (sent_t[0] is None or lights.get(LIGHT) != state):
                     command_light(state)
-                    sent[0] = time.monotonic()
+                    sent_t[0] = truth["t"]
                 return lights.get(LIGHT) == state
 
-            wait_for(what, shown, 60)
+            wait_for(what, shown, 30.0)
 
         def past(stop_point):
             return scoring.front_past_m(truth["x"], truth["y"], truth["yaw"], stop_point)
 
+        STILL_M = 0.003  # a standing car's body moves less than this [m]
+
         def stopped_at(stop_point, hold_s):
-            """Waits until the car has stood within 0.25 m before stop_point for hold_s of sim time."""
-            since = None
-            t0 = time.monotonic()
-            while time.monotonic() - t0 < 240:
-                procs.check()
-                spin(0.1)
-                if not truth:
-                    continue
-                near = -0.25 < past(stop_point) < 0.1
-                if near and abs(truth["v"]) < 0.01:
-                    since = truth["t"] if since is None else since
-                    if truth["t"] - since >= hold_s:
-                        return past(stop_point)
-                else:
-                    since = None
-            raise AssertionError(f"never stood {hold_s} s at {stop_point.name}: {truth}")
+            """Waits until the car has stood within 0.25 m before stop_point for hold_s of sim time.
+            Standing is judged by where the car is, not by its body's speed: that speed wobbles
+            above 1 cm/s as the body settles after braking, and once hid a 1.3 s stop."""
+            anchor = [None]  # (t [s], x [m], y [m]) where the standstill began
+
+            def stood():
+                moved = (
+                    anchor[0] is None
+                    or math.dist(anchor[0][1:], (truth["x"], truth["y"])) > STILL_M
+                )
+                if not -0.25 < past(stop_point) < 0.1:
+                    anchor[0] = None
+                elif moved:
+                    anchor[0] = (truth["t"], truth["x"], truth["y"])
+                return anchor[0] is not None and truth["t"] - anchor[0][0] >= hold_s
+
+            wait_for(f"stood {hold_s} s at {stop_point.name}", stood)
+            return past(stop_point)
 
         try:
             sim = [build / "bin" / "autodrive-sim", "--map", "tiny_town", "--cars", "1"]
@@ -225,9 +239,13 @@ def test_city_driver_obeys(
             # 2. the advisory back, RED: the car stays; GREEN: it goes
             set_light(1, "light 3 RED")
             procs.start("advisory2", adv, out / "advisory2.log")
-            t_red = truth["t"]
-            wait_for("2 s of red", lambda: truth["t"] > t_red + 2.0 or abs(truth["v"]) > 0.01)
-            assert abs(truth["v"]) < 0.01 and past(line) < 0, f"the car moved on red: {truth}"
+            t_red, at_red = truth["t"], (truth["x"], truth["y"])
+
+            def moved_m():
+                return math.dist(at_red, (truth["x"], truth["y"]))
+
+            wait_for("2 s of red", lambda: truth["t"] > t_red + 2.0 or moved_m() > 0.01)
+            assert moved_m() <= 0.01 and past(line) < 0, f"the car moved on red: {truth}"
             set_light(3, "light 3 GREEN again")
             wait_for("across the line on green", lambda: past(line) > 0.3)
             log("2. red: stayed; green: crossed the stop line")
