@@ -28,18 +28,18 @@ class Drive:
         self.s, self.car, self.t = scorer, car, 0.0
         self.front = front_offset_m()
 
-    def at(self, front_x, v, hit=False, y=0.0):
-        self.s.truth(self.car, self.t, front_x - self.front, y, 0.0, v, hit)
+    def at(self, front_x, hit=False, y=0.0):
+        self.s.truth(self.car, self.t, front_x - self.front, y, 0.0, hit)
         self.t += STEP_S
 
     def drive(self, from_x, to_x, v):
         n = max(1, int(abs(to_x - from_x) / (v * STEP_S)))
         for k in range(n + 1):
-            self.at(from_x + (to_x - from_x) * k / n, v)
+            self.at(from_x + (to_x - from_x) * k / n)
 
     def stand(self, front_x, seconds):
         for _ in range(int(seconds / STEP_S)):
-            self.at(front_x, 0.0)
+            self.at(front_x)
 
 
 def scorer(light_state):
@@ -108,9 +108,9 @@ def test_a_stop_past_the_line_is_measured_as_overshoot():
 def test_a_collision_is_counted_once_per_contact():
     s = scorer(GREEN)
     d = Drive(s)
-    d.at(-2.0, 0.2)
-    d.at(-1.99, 0.2, hit=True)
-    d.at(-1.98, 0.0, hit=True)
-    d.at(-1.97, 0.2)
-    d.at(-1.96, 0.2, hit=True)
+    d.at(-2.0)
+    d.at(-1.99, hit=True)
+    d.at(-1.98, hit=True)
+    d.at(-1.97)
+    d.at(-1.96, hit=True)
     assert s.report()["collisions"] == 2

@@ -17,7 +17,9 @@ from autodrive.core.geometry import wrap
 
 HEADING_TOL_RAD = math.radians(45.0)
 LATERAL_TOL_M = 0.2  # a car within this of a stop line's centre is on its lane
-STOOD_M_S = 0.01  # slower than this: standing [m/s]
+# A car stands while its body stays within this of where it stopped [m]. Judged by position, not
+# by the body's speed: that wobbles above 1 cm/s as the body settles after braking.
+STILL_M = 0.003
 NEAR_BEFORE_M = 0.25  # a standstill this close before a stop point counts as stopping there
 STOP_SIGN_HOLD_S = 1.0
 RED = 1
@@ -119,6 +121,7 @@ class CarScore:
     lap_starts_s: list[float] = field(default_factory=list)
     prev_past: dict[str, float] = field(default_factory=dict)
     still_since_s: float | None = None
+    still_anchor: tuple[float, float] | None = None  # where the current standstill began [m]
     still_at: dict[str, float] = field(default_factory=dict)  # stop -> longest standstill [s]
     in_collision: bool = False
     driven_m: float = 0.0
@@ -157,9 +160,7 @@ class Scorer:
     def light(self, light_id: int, state: int) -> None:
         self.lights[light_id] = state
 
-    def truth(
-        self, car: str, t_s: float, x: float, y: float, yaw: float, v: float, hit: bool
-    ) -> None:
+    def truth(self, car: str, t_s: float, x: float, y: float, yaw: float, hit: bool) -> None:
         c = self.cars.setdefault(car, CarScore())
         if c.start is None:
             c.start = (x, y)
@@ -177,11 +178,10 @@ class Scorer:
         if hit and not c.in_collision:
             self.collisions += 1
         c.in_collision = hit
-        standing = abs(v) < STOOD_M_S
-        if standing:
-            c.still_since_s = t_s if c.still_since_s is None else c.still_since_s
-        else:
-            c.still_since_s = None
+        moved = c.still_anchor is None or math.dist(c.still_anchor, (x, y)) > STILL_M
+        if moved:  # a standstill can begin here
+            c.still_anchor, c.still_since_s = (x, y), t_s
+        standing = not moved
         c.t_s = t_s
         at_stop = False
         for p in self.facts.stops:

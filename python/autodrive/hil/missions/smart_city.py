@@ -182,7 +182,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             sim_t[0] = max(sim_t[0], t)
             x, y = m.position_m[0], m.position_m[1]
             poses.on_truth(m.vehicle, t, x, y)
-            scorer.truth(m.vehicle, t, x, y, m.yaw_rad, m.linear_velocity_m_s[0], m.in_collision)
+            scorer.truth(m.vehicle, t, x, y, m.yaw_rad, m.in_collision)
             tr = tracks.setdefault(m.vehicle, [])
             if not tr or t - tr[-1][0] >= 0.1:
                 tr.append((t, x, y))
