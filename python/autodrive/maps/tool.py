@@ -46,6 +46,31 @@ def _check(args: argparse.Namespace) -> int:
     return 1 if bad else 0
 
 
+def _import(args: argparse.Namespace) -> int:
+    from autodrive.maps.opendrive import importer  # OpenDRIVE only when importing
+
+    scale = importer.parse_scale(args.scale)
+    done = importer.write(args.file, scale, args.name, args.out, args.max_junctions)
+    for w in done.warnings:
+        print(f"map import: warning: {w}", file=sys.stderr)
+    d = done.description
+    print(
+        f"map import: wrote {args.out / args.name}.yaml, .xml, .json ({len(d['roads'])} lanes, "
+        f"{len(d['routes'])} routes, {len(d['traffic_lights'])} lights, {len(d['signs'])} signs; "
+        f"ours = {scale:g} * file + {d['imported_from']['offset_m']} m)"
+    )
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from autodrive.maps.opendrive import exporter
+
+    path, kit = _resolve(args.map)
+    exporter.write(load(path, kit), args.xodr)
+    print(f"map export: wrote {args.xodr}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="tools/map",
@@ -74,6 +99,36 @@ def main(argv: list[str] | None = None) -> int:
     )
     pc.add_argument("files", nargs="+", help="map names or description paths (.yaml)")
     pc.set_defaults(run=_check)
+    pi = sub.add_parser(
+        "import",
+        help="import an OpenDRIVE network as a kit map",
+        description="Import an OpenDRIVE (.xodr, 1.4-1.8) network: every driving lane becomes "
+        "a lane (its centre line in driving order, its narrowest half width), junction "
+        "connections and lane links become successors, routes are every lane-to-lane path "
+        "through up to --max-junctions junctions, traffic-light signals become lights at stop "
+        "lines, stop/give-way/speed-limit signals become signs (others are listed). Writes "
+        "OUT/NAME.yaml, .xml (MJCF), .json (sidecar, with imported_from: file, scale, offset_m: "
+        "ours = scale * file + offset_m) and OUT/textures; nothing when the file is refused.",
+    )
+    pi.add_argument("file", type=Path, help="the .xodr file")
+    pi.add_argument(
+        "--scale", default="1:14", help="1:14 (default) or a number (ours = scale * file)"
+    )
+    pi.add_argument("--name", required=True, help="the map's name (letters, digits, _)")
+    pi.add_argument("--out", type=Path, required=True, help="the folder to write the map to")
+    pi.add_argument("--max-junctions", type=int, default=1, help="junctions per route (default 1)")
+    pi.set_defaults(run=_import)
+    pe = sub.add_parser(
+        "export",
+        help="export a kit map as OpenDRIVE 1.7",
+        description="Write a kit map as OpenDRIVE 1.7: one road per lane (its centre line as "
+        "line and arc geometries, one right lane of the lane's width centred on it by a lane "
+        "offset), successors as road links or junctions. Importing it at --scale 1 gives the "
+        "same centre lines within 1 mm.",
+    )
+    pe.add_argument("map", help="a shipped map's name (tiny_town) or a description's path")
+    pe.add_argument("--xodr", type=Path, required=True, help="the .xodr file to write")
+    pe.set_defaults(run=_export)
     args = p.parse_args(argv)
     try:
         return int(args.run(args))
