@@ -9,6 +9,7 @@ is flattened with a warning naming the road, and imported_from maps the file's p
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 from pathlib import Path
 
@@ -70,3 +71,13 @@ def test_imported_from_maps_file_points_to_ours(
     assert p["y_m"] == pytest.approx(imp["scale"] * y + imp["offset_m"][1], abs=1e-4)
     assert len({ln["name"].split("_")[1] for ln in doc["lanes"]}) == 3  # three lane sections
     assert any("opens or closes" in w for w in imp["warnings"])
+
+
+def test_deviation_scorer_sees_a_planted_gap(imported: dict[str, tuple[Path, dict, str]]) -> None:
+    path, doc, _ = imported["crossing"]
+    bad = json.loads(json.dumps(doc))
+    p = bad["lanes"][3]["centre_line"][5]
+    shift = 0.02 * doc["imported_from"]["scale"]  # 20 mm at full scale, across the lane
+    p["x_m"] -= shift * math.sin(p["heading_rad"])
+    p["y_m"] += shift * math.cos(p["heading_rad"])
+    assert reference.max_centre_deviation_m(path, bad) * 1000 > 15.0

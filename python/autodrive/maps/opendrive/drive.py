@@ -32,8 +32,11 @@ class Drive:
     collisions: int
 
 
-def drive(map_xml: Path, route: str, points: list[tuple[float, float]]) -> Drive:
-    """Drives route (its polyline points [m], from the sidecar) on the map's MJCF."""
+def drive(
+    map_xml: Path, route: str, points: list[tuple[float, float]], max_sim_s: float = math.inf
+) -> Drive:
+    """Drives the map's route on its MJCF, steering along points [m] (the route's polyline from
+    the sidecar), for at most max_sim_s of sim time (else the route's length at 0.05 m/s)."""
     world = World(str(map_xml), cars=1)
     try:
         (x0, y0), (x1, y1) = points[0], points[1]
@@ -44,7 +47,7 @@ def drive(map_xml: Path, route: str, points: list[tuple[float, float]]) -> Drive
         off = collisions = 0
         worst = 0.0
         obs = world.observe(0)
-        budget_s = tracker.length_m / SPEED_FLOOR_M_S
+        budget_s = min(max_sim_s, tracker.length_m / SPEED_FLOOR_M_S)
         while obs.time_s < budget_s:
             steer = tracker.steer_nearest((obs.pos_m[0], obs.pos_m[1], obs.yaw_rad), LOOKAHEAD_M)
             world.command(0, THROTTLE, max(-1.0, min(1.0, steer / limit)))

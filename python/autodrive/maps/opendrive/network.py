@@ -224,7 +224,7 @@ def routes(
     seen: dict[str, int] = {}
     for path in out:
         a, b = path[0], path[-1]
-        base = f"{_tag(a)}_to_{_tag(b)}" if a[0] != b[0] or len(path) > 1 else _tag(a)
+        base = _tag(a) if _tag(a) == _tag(b) else f"{_tag(a)}_to_{_tag(b)}"
         seen[base] = seen.get(base, 0) + 1
         name = base if seen[base] == 1 else f"{base}_{seen[base]}"
         named.append((name, [lanes[k].name for k in path]))
