@@ -427,6 +427,7 @@ class ImportedFrom:
     opendrive_version: str
     warnings: list[str] = field(default_factory=list)
     unsupported_signals: list[str] = field(default_factory=list)
+    signal_lights: dict[str, list[int]] = field(default_factory=dict)  # signal id -> light ids
 
 
 @dataclass(frozen=True)

@@ -225,7 +225,8 @@ def document(m: MapDescription) -> dict[str, Any]:
         f = m.imported_from
         doc["imported_from"] = {"file": f.file, "scale": f.scale, "offset_m": _xy(f.offset_m),
                                 "opendrive_version": f.opendrive_version, "warnings": f.warnings,
-                                "unsupported_signals": f.unsupported_signals}  # fmt: skip
+                                "unsupported_signals": f.unsupported_signals,
+                                "signal_lights": f.signal_lights}  # fmt: skip
     return doc
 
 

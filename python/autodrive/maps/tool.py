@@ -71,6 +71,43 @@ def _export(args: argparse.Namespace) -> int:
     return 0
 
 
+def _scenario(args: argparse.Namespace) -> int:
+    import json
+    import os
+    import tempfile
+
+    from autodrive.maps.opendrive import scenario
+
+    sidecar = args.map.with_suffix(".json")
+    doc = json.loads(sidecar.read_text()) if sidecar.is_file() else {}
+    if "imported_from" not in doc:
+        raise MapDescriptionError(
+            f"{sidecar}: not the sidecar of an imported map (tools/map import)"
+        )
+    plan = scenario.read(args.file, doc["imported_from"])
+    for ent in plan.entities:
+        x, y, h = plan.starts[ent]
+        speed = plan.speeds_m_s.get(ent)
+        print(
+            f"map scenario: {ent}: start ({x:.3f}, {y:.3f}) m, yaw {h:.3f} rad, speed {speed} m/s"
+        )
+    for c in plan.changes:
+        when = (
+            f"at {c.at_s:g} s" if c.at_s is not None else f"when {c.entity} reaches {c.position_m}"
+        )
+        print(f"map scenario: event '{c.event}': lights {c.light_ids} -> state {c.state} {when}")
+    if args.dry_run:
+        return 0
+    build = Path(os.environ.get("AUTODRIVE_BUILD", "build/release"))
+    url = args.lcm_url
+    with tempfile.TemporaryDirectory(prefix="scenario-") as run_dir:
+        played = scenario.run(plan, args.map.with_suffix(".xml"), build, url, Path(run_dir),
+                              args.duration, lambda m: print(f"map scenario: {m}"))  # fmt: skip
+    for lid, states in sorted(played.light_states.items()):
+        print(f"map scenario: light {lid}: " + ", ".join(f"{s} from {t:.2f} s" for t, s in states))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="tools/map",
@@ -129,6 +166,21 @@ def main(argv: list[str] | None = None) -> int:
     pe.add_argument("map", help="a shipped map's name (tiny_town) or a description's path")
     pe.add_argument("--xodr", type=Path, required=True, help="the .xodr file to write")
     pe.set_defaults(run=_export)
+    psc = sub.add_parser(
+        "scenario",
+        help="play an OpenSCENARIO file on an imported map",
+        description="Read an OpenSCENARIO file (the subset: Init TeleportAction with "
+        "WorldPosition and AbsoluteSpeedAction; events of TrafficSignalStateAction started by "
+        "SimulationTimeCondition or ReachPositionCondition; anything else refused by name) on "
+        "a map imported by tools/map import, and play it in autodrive-sim: the entities' start "
+        "poses and the scripted light changes (signed light commands on the sim's clock).",
+    )
+    psc.add_argument("file", type=Path, help="the .xosc file")
+    psc.add_argument("--map", type=Path, required=True, help="the imported map (DIR/NAME)")
+    psc.add_argument("--duration", type=float, default=10.0, help="sim time to play [s]")
+    psc.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0", help="the LCM bus")
+    psc.add_argument("--dry-run", action="store_true", help="print the plan, start nothing")
+    psc.set_defaults(run=_scenario)
     args = p.parse_args(argv)
     try:
         return int(args.run(args))

@@ -118,3 +118,52 @@ FIXTURES: dict[str, Callable[[Path], Path]] = {"crossing": crossing, "sections":
 def write_all(folder: Path) -> dict[str, Path]:
     folder.mkdir(parents=True, exist_ok=True)
     return {n: f(folder / f"{n}.xodr") for n, f in FIXTURES.items()}
+
+
+def light_scenario(path: Path, road_network: str = "crossing.xodr") -> Path:
+    """An OpenSCENARIO file for crossing(): car1 starts on road 1's right lane (file frame
+    x 10 m, y -1.75 m, heading east) at 5 m/s; at 2 s of sim time signal 1 turns red; when
+    car1 is within 2 m of its start (at once), signal 2 turns green."""
+    from scenariogeneration import xosc
+
+    init = xosc.Init()
+    init.add_init_action("car1", xosc.TeleportAction(xosc.WorldPosition(10, -1.75, 0, 0)))
+    step = xosc.TransitionDynamics(xosc.DynamicsShapes.step, xosc.DynamicsDimension.time, 1)
+    init.add_init_action("car1", xosc.AbsoluteSpeedAction(5, step))
+    ent = xosc.Entities()
+    box = xosc.BoundingBox(1.8, 4.5, 1.5, 1.3, 0, 0.75)
+    front, rear = xosc.Axle(0.5, 0.6, 1.6, 2.9, 0.3), xosc.Axle(0, 0.6, 1.6, 0, 0.3)
+    ent.add_scenario_object(
+        "car1", xosc.Vehicle("car", xosc.VehicleCategory.car, box, front, rear, 40, 3, 5)
+    )
+    red = xosc.Event("signal_1_red", xosc.Priority.overwrite)
+    red.add_action("red", xosc.TrafficSignalStateAction("1", "red"))
+    at_2s = xosc.SimulationTimeCondition(2, xosc.Rule.greaterThan)
+    red.add_trigger(xosc.ValueTrigger("at_2s", 0, xosc.ConditionEdge.rising, at_2s))
+    green = xosc.Event("signal_2_green", xosc.Priority.overwrite)
+    green.add_action("green", xosc.TrafficSignalStateAction("2", "green"))
+    there = xosc.ReachPositionCondition(xosc.WorldPosition(10, -1.75, 0, 0), 2.0)
+    green.add_trigger(xosc.EntityTrigger("car1_there", 0, xosc.ConditionEdge.rising, there, "car1"))
+    man = xosc.Maneuver("lights")
+    man.add_event(red)
+    man.add_event(green)
+    group = xosc.ManeuverGroup("lights")
+    group.add_maneuver(man)
+    act = xosc.Act("lights")
+    act.add_maneuver_group(group)
+    story = xosc.Story("lights")
+    story.add_act(act)
+    board = xosc.StoryBoard(init)
+    board.add_story(story)
+    sc = xosc.Scenario(
+        "light change",
+        "autodrive",
+        xosc.ParameterDeclarations(),
+        ent,
+        board,
+        xosc.RoadNetwork(road_network),
+        xosc.Catalog(),
+        osc_minor_version=1,
+    )  # ReachPositionCondition: OpenSCENARIO 1.1
+    sc.write_xml(str(path))
+    return path

@@ -113,6 +113,7 @@ class _Signals:
         self.lights: list[dict[str, Any]] = []
         self.signs: list[dict[str, Any]] = []
         self.unsupported: list[str] = []
+        self.lights_of: dict[str, list[int]] = {}  # signal id -> our light ids
         group_of = {sid: c.id for c in net.controllers for sid in c.signal_ids}
         self.groups: list[str] = []
         for r in net.roads.values():
@@ -184,6 +185,7 @@ class _Signals:
                     "length_m": 2 * lane.half_width_m,
                 }
             )
+            self.lights_of.setdefault(sig.id, []).append(len(self.lights) + 1)
             self.lights.append(
                 {
                     "id": len(self.lights) + 1,
@@ -248,6 +250,7 @@ def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
             "opendrive_version": net.version,
             "warnings": warnings,
             "unsupported_signals": sig.unsupported,
+            "signal_lights": sig.lights_of,
         },
         "roads": [_road(ln) for ln in lanes.values()],
         "stop_lines": sig.stop_lines,
