@@ -41,13 +41,16 @@ def test_scripted_light_change_in_the_simulator(crossing: tuple[Path, dict], bui
     assert (x, y) == pytest.approx((imp["scale"] * 10 + imp["offset_m"][0],
                                     imp["scale"] * -1.75 + imp["offset_m"][1]))  # fmt: skip
     assert plan.speeds_m_s["car1"] == pytest.approx(5 / 14)
-    played = scenario.run(plan, folder / "crossing.xml", build_dir, lcm_url, tmp_path, 4.0, print)
+    # the simulator runs in real time: on a loaded machine the commands come late in sim time,
+    # so the test only asks for them before the programs would change the lights (8 s, 12 s)
+    played = scenario.run(plan, folder / "crossing.xml", build_dir, lcm_url, tmp_path, 7.0, print)
     print(played)
     light1, light2 = played.light_states[1], played.light_states[2]
     assert light1[0][1] == GREEN and light1[0][0] < 2.0  # its program's green first
-    red_at = next(t for t, s in light1 if s == RED)
-    assert 2.0 <= red_at < 2.5, light1
-    assert any(s == GREEN for _, s in light2), light2
+    assert light1[1][1] == RED and 2.0 <= light1[1][0] < 8.0, light1  # no yellow: commanded
+    assert light2[0][1] == RED and any(s == GREEN and t < 8.0 for t, s in light2), light2
+    fired = dict((e, t) for t, e in played.fired)
+    assert fired["signal_1_red"] >= 2.0
     px, py, pyaw = played.first_poses["car1"]
     assert math.dist((px, py), (x, y)) < 0.01 and abs(pyaw - yaw) < 0.01
 

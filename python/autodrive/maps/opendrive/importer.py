@@ -250,7 +250,6 @@ def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
             "opendrive_version": net.version,
             "warnings": warnings,
             "unsupported_signals": sig.unsupported,
-            "signal_lights": sig.lights_of,
         },
         "roads": [_road(ln) for ln in lanes.values()],
         "stop_lines": sig.stop_lines,
@@ -263,6 +262,8 @@ def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
         "cones": [],
         "parking_slots": [],
     }
+    if sig.lights_of:  # the schema takes no empty mapping
+        desc["imported_from"]["signal_lights"] = sig.lights_of
     return Imported(desc, warnings + [f"unsupported {u}" for u in sig.unsupported])
 
 

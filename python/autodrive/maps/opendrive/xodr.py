@@ -179,6 +179,10 @@ class _Reader:
             s_attr = "s"
         return Poly3(*(self.num(el, k, where) for k in (s_attr, "a", "b", "c", "d")))
 
+    def polys(self, parent: ET.Element, tag: str, where: str, s_attr: str) -> list[Poly3]:
+        """Every <tag> record of parent, the i-th named where[i]."""
+        return [self.poly(e, f"{where}[{i}]", s_attr) for i, e in enumerate(parent.findall(tag))]
+
     def network(self, root: ET.Element) -> Network:
         if root.tag != "OpenDRIVE":
             raise self.fail("root", f"is <{root.tag}>, not <OpenDRIVE>")
@@ -228,10 +232,7 @@ class _Reader:
         lanes_el = el.find("lanes")
         if lanes_el is None:
             raise self.fail(f"{where}: lanes", "missing")
-        offsets = [
-            self.poly(o, f"{where}: lanes.laneOffset[{i}]", "s")
-            for i, o in enumerate(lanes_el.findall("laneOffset"))
-        ]
+        offsets = self.polys(lanes_el, "laneOffset", f"{where}: lanes.laneOffset", "s")
         sections = [
             self.section(s, f"{where}: laneSection[{i}]")
             for i, s in enumerate(lanes_el.findall("laneSection"))
@@ -304,14 +305,8 @@ class _Reader:
             for ln in el.findall(f"{side}/lane"):
                 lid = int(self.num(ln, "id", f"{where}.{side}.lane"))
                 lw = f"{where}: lane {lid}"
-                widths = [
-                    self.poly(w, f"{lw}.width[{i}]", "sOffset")
-                    for i, w in enumerate(ln.findall("width"))
-                ]
-                borders = [
-                    self.poly(w, f"{lw}.border[{i}]", "sOffset")
-                    for i, w in enumerate(ln.findall("border"))
-                ]
+                widths = self.polys(ln, "width", f"{lw}.width", "sOffset")
+                borders = self.polys(ln, "border", f"{lw}.border", "sOffset")
                 for i, w in enumerate(widths):
                     if w.a < 0:
                         raise self.fail(f"{lw}.width[{i}].a", f"negative width {w.a:g} m")
