@@ -15,7 +15,7 @@ import pytest
 
 from autodrive.maps import geometry
 from autodrive.maps.loader import load, names
-from autodrive.maps.opendrive import reference
+from autodrive.maps.opendrive import exporter, importer, reference
 from pyhelpers import REPO_ROOT
 
 TOOL = REPO_ROOT / "tools" / "map"
@@ -45,9 +45,7 @@ def test_round_trip_within_1_mm(name: str, tmp_path: Path) -> None:
     root = ET.parse(xodr).getroot()
     assert (root.find("header").get("revMajor"), root.find("header").get("revMinor")) == ("1", "7")  # type: ignore[union-attr]
     road_of = {r.get("id"): r.get("name") for r in root.findall("road")}
-    run = subprocess.run([str(TOOL), "import", str(xodr), "--scale", "1", "--name", "rt",
-                          "--out", str(tmp_path / "rt")], capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
+    importer.write(xodr, 1.0, "rt", tmp_path / "rt")
     doc = json.loads((tmp_path / "rt" / "rt.json").read_text())
     ox, oy = doc["imported_from"]["offset_m"]
     m = load(name)
