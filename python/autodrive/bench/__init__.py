@@ -20,6 +20,7 @@ SUITES = (
     "learn",
     "link",
     "marl",
+    "opendrive",
     "parking",
     "scm",
     "security",

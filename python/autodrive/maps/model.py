@@ -417,6 +417,20 @@ class Options:
 
 
 @dataclass(frozen=True)
+class ImportedFrom:
+    """Where an imported map came from (tools/map import): a point of the file maps to ours as
+    ours = scale * file + offset_m [m]; what the import could not carry over is listed."""
+
+    file: str
+    scale: float
+    offset_m: Vec2
+    opendrive_version: str
+    warnings: list[str] = field(default_factory=list)
+    unsupported_signals: list[str] = field(default_factory=list)
+    signal_lights: dict[str, list[int]] = field(default_factory=dict)  # signal id -> light ids
+
+
+@dataclass(frozen=True)
 class MapFile:
     """Exactly the keys of a <map>.yaml."""
 
@@ -440,6 +454,7 @@ class MapFile:
     late_obstacles: list[LateObstacle] = field(default_factory=list)
     eye_cameras: list[EyeCameraSpec] = field(default_factory=list)
     reference_tags: list[ReferenceTagSpec] = field(default_factory=list)
+    imported_from: Optional[ImportedFrom] = None
 
 
 @dataclass(frozen=True)

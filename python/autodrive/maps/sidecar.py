@@ -221,6 +221,12 @@ def document(m: MapDescription) -> dict[str, Any]:
     }
     if m.reference_tags:  # only on maps that have them: the others' sidecars stay as they were
         doc["reference_tags"] = reftags.sidecar(m.reference_tags)
+    if m.imported_from is not None:  # only on imported maps (tools/map import)
+        f = m.imported_from
+        doc["imported_from"] = {"file": f.file, "scale": f.scale, "offset_m": _xy(f.offset_m),
+                                "opendrive_version": f.opendrive_version, "warnings": f.warnings,
+                                "unsupported_signals": f.unsupported_signals,
+                                "signal_lights": f.signal_lights}  # fmt: skip
     return doc
 
 
