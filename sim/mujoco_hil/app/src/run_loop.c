@@ -207,6 +207,10 @@ static int loop_once(app_t *a, loop_t *l) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return -1;
   }
+  if (run_recorder_step(&a->recorder, s, err, sizeof err) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    return -1;
+  }
   const int clock_now = (o->lockstep || o->rtf_given) && l->step % LOOP_CLOCK_EVERY == 0;
   if (clock_now) loop_publish_clock(a, l, now_us);
   loop_wait_for_eye(a, l, now_us, clock_now);
@@ -243,6 +247,17 @@ int app_run(app_t *a, app_run_stats_t *st) {
     const int r = loop_once(a, &l);
     if (r < 0) rc = 1;
     if (r <= 0) break;
+  }
+  if (run_recorder_active(&a->recorder)) {
+    char err[1024] = "";
+    const long frames = a->recorder.next_frame;
+    if (run_recorder_stop(&a->recorder, err, sizeof err) != 0) {
+      fprintf(stderr, "autodrive-sim: %s\n", err);
+      rc = 1;
+    } else if (!o->quiet) {
+      fprintf(stderr, "autodrive-sim: recorded %ld frame(s) to %s\n", frames,
+              a->recorder.video_path);
+    }
   }
   /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
   st->step_cpu_s =
