@@ -20,7 +20,9 @@ DURATION_S = 2.0
 GT_CHANNEL = "NIGEL1_GROUND_TRUTH"
 
 
-def _sim(build_dir: Path, tmp_path: Path, lcm_url: str, *extra: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+def _sim(
+    build_dir: Path, tmp_path: Path, lcm_url: str, *extra: str, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [str(build_dir / "bin" / "autodrive-sim"), "--no-pty", "--no-lidar", "--rtf", "4",
          "--duration", str(DURATION_S), "--run-dir", str(tmp_path), "--lcm-url", lcm_url,
@@ -41,7 +43,9 @@ def _frames(path: Path) -> list[np.ndarray]:
     return frames
 
 
-def test_record_writes_a_log_and_a_video_in_step(build_dir: Path, tmp_path: Path, lcm_url: str) -> None:
+def test_record_writes_a_log_and_a_video_in_step(
+    build_dir: Path, tmp_path: Path, lcm_url: str
+) -> None:
     out = tmp_path / "rec"
     r = _sim(build_dir, tmp_path, lcm_url, "--record", str(out))
     assert r.returncode == 0, r.stderr[-2000:]
@@ -68,7 +72,9 @@ def test_video_alone_and_bad_inputs(build_dir: Path, tmp_path: Path, lcm_url: st
     video = tmp_path / "eye.mp4"
     r = _sim(build_dir, tmp_path, lcm_url, "--video", str(video), "--video-camera", "eye")
     assert r.returncode == 0, r.stderr[-2000:]
-    assert len(_frames(video)) == len((tmp_path / "eye.mp4.frames.csv").read_text().splitlines()) - 1
+    assert (
+        len(_frames(video)) == len((tmp_path / "eye.mp4.frames.csv").read_text().splitlines()) - 1
+    )
     r = _sim(build_dir, tmp_path, lcm_url, "--video", str(video), "--video-camera", "nope")
     assert r.returncode == 1 and "--video-camera 'nope'" in r.stderr, r.stderr
     env = {"PATH": "/usr/bin:/bin", "AUTODRIVE_FFMPEG": "/nonexistent/ffmpeg"}
