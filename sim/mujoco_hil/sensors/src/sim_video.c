@@ -49,19 +49,38 @@ sim_video_t *sim_video_open(const char *path, int width_px, int height_px, doubl
   char size[32], rate[32];
   snprintf(size, sizeof size, "%dx%d", width_px, height_px);
   snprintf(rate, sizeof rate, "%.6g", fps);
+  /* ffmpeg's environment: ours without LD_PRELOAD (a sanitizer runtime a test preloaded is not
+   * for a foreign program), built before fork: the child only dups and execs */
+  extern char **environ;
+  size_t nenv = 0;
+  while (environ[nenv]) nenv++;
+  char **envp = calloc(nenv + 1, sizeof *envp);
+  if (!envp) {
+    snprintf(err, err_sz, "video '%s': out of memory", path);
+    close(sv[0]);
+    close(sv[1]);
+    close(ready[0]);
+    close(ready[1]);
+    return NULL;
+  }
+  for (size_t i = 0, k = 0; i < nenv; i++)
+    if (strncmp(environ[i], "LD_PRELOAD=", 11) != 0) envp[k++] = environ[i];
   const pid_t pid = fork();
   if (pid == 0) {
     dup2(sv[1], STDIN_FILENO);
     const int null = open("/dev/null", O_WRONLY);
     if (null >= 0) dup2(null, STDOUT_FILENO);
-    execlp(ffmpeg, ffmpeg, "-nostdin", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt",
-           "rgb24", "-video_size", size, "-framerate", rate, "-i", "pipe:0", "-c:v", "libx264",
-           "-preset", "veryfast", "-pix_fmt", "yuv420p", "-movflags", "+faststart", path,
-           (char *)NULL);
+    char *const argv[] = {(char *)ffmpeg, "-nostdin",   "-loglevel",  "error",      "-y",
+                          "-f",           "rawvideo",   "-pix_fmt",   "rgb24",      "-video_size",
+                          size,           "-framerate", rate,         "-i",         "pipe:0",
+                          "-c:v",         "libx264",    "-preset",    "veryfast",   "-pix_fmt",
+                          "yuv420p",      "-movflags",  "+faststart", (char *)path, NULL};
+    execvpe(ffmpeg, argv, envp);
     const int e = errno;
     if (write(ready[1], &e, sizeof e) < 0) _exit(127);
     _exit(127);
   }
+  free(envp);
   close(sv[1]);
   close(ready[1]);
   int exec_errno = 0;
