@@ -4,9 +4,9 @@
  * behind and above), god's eye (the map's "eye" camera, else an overview of the whole model),
  * free (an overview), and each overhead Eye camera of the map.
  * Keys: 1/2/3/4 views, Tab next car, N day/night, Space pause, R reset, M the Menu Panel,
- * H the HUD, Esc or closing quits; in manual mode the arrow keys (or W/A/S/D) drive.
+ * H the HUD, Esc or closing quits.
  * The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map, pause,
- * step, reset, quit), Car (ego car, autonomous or manual), View (camera, light level,
+ * step, reset, quit), Car (the ego car), View (camera, light level,
  * shadows, reflections, skybox, HUD), Sensors (LIDAR rays) and Record (start / stop). The HUD
  * is text the caller sets (sim_viewer_set_hud), drawn at the top right.
  * The viewer only reports what the user asked (sim_viewer_input_t); the sim's main loop acts.
@@ -43,12 +43,10 @@ typedef struct sim_viewer_input {
   int view;            /* sim_viewer_view_t: 1/2/3/4, the Camera radio */
   double light_level;  /* 0..1 scales the scene's lights (1 day) */
   int shadows, reflections, skybox; /* graphics quality (all 0: the fast default) */
-  int hud;        /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
-  int lidar_rays; /* 1: the caller's LIDAR rays are drawn */
-  int manual;     /* 0 autonomous, 1 manual: the keys below drive the ego car */
-  double manual_throttle, manual_steering; /* [-1, 1], held while an arrow / WASD key is down */
-  int step_requested;                      /* Step clicked (edge): one step while paused */
-  int record_toggled;                      /* the Record button (edge): start or stop recording */
+  int hud;            /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
+  int lidar_rays;     /* 1: the caller's LIDAR rays are drawn */
+  int step_requested; /* Step clicked (edge): one step while paused */
+  int record_toggled; /* the Record button (edge): start or stop recording */
 } sim_viewer_input_t;
 
 typedef struct sim_viewer sim_viewer_t;
@@ -81,13 +79,17 @@ void sim_viewer_set_map_name(sim_viewer_t *v, const char *name);
  * origin; replaces the previous set. NULL / 0 clears. */
 void sim_viewer_set_rays(sim_viewer_t *v, const double origin[3], const float *ends_xyz, int n);
 
+/* The MJCF camera id the current view shows (driver's, god's, an overhead Eye), or -1 for the
+ * views that follow no fixed camera (bird's, free). After the first frame. */
+int sim_viewer_camera_id(const sim_viewer_t *v);
+
 /* Scripted input for tests (the same paths as the window's callbacks): a left click at
  * window position (x_px, y_px; y down from the top), and the centre of the Menu Panel item
  * named name (its label, e.g. "Pause", "Reset"; radio elements by "Camera/Bird's") after the
  * first frame. sim_viewer_item_at returns 0, or -1 when no such item is shown. */
 void sim_viewer_click(sim_viewer_t *v, double x_px, double y_px);
 int sim_viewer_item_at(const sim_viewer_t *v, const char *name, double *x_px, double *y_px);
-/* A key held down (1) or released (0), as from the keyboard (GLFW_KEY_* code). */
+/* A key pressed (1) or released (0), as from the keyboard (GLFW_KEY_* code). */
 void sim_viewer_key_state(sim_viewer_t *v, int glfw_key, int down);
 
 /* With capture on, every frame is also read back (before the swap) so that

@@ -41,14 +41,7 @@ void sim_viewer_key(sim_viewer_t *v, int key) {
   }
 }
 
-/* Manual driving: while the mode is manual, the arrow keys or W/A/S/D held down give full
- * throttle / steering, released nothing (the car rolls to a stop on the firmware's ramp). */
 void sim_viewer_key_state(sim_viewer_t *v, int key, int down) {
-  const double d = down ? 1.0 : 0.0;
-  if (key == GLFW_KEY_UP || key == GLFW_KEY_W) v->in.manual_throttle = d;
-  if (key == GLFW_KEY_DOWN || key == GLFW_KEY_S) v->in.manual_throttle = -d;
-  if (key == GLFW_KEY_LEFT || key == GLFW_KEY_A) v->in.manual_steering = d; /* + left */
-  if (key == GLFW_KEY_RIGHT || key == GLFW_KEY_D) v->in.manual_steering = -d;
   if (down) sim_viewer_key(v, key);
 }
 
@@ -238,6 +231,10 @@ static void viewer_camera(sim_viewer_t *v, const mjModel *m) {
   }
 }
 
+int sim_viewer_camera_id(const sim_viewer_t *v) {
+  return v->cam.type == mjCAMERA_FIXED ? v->cam.fixedcamid : -1;
+}
+
 /* The scene of the chosen view with the light level, the graphics quality and the LIDAR rays. */
 static void viewer_scene(sim_viewer_t *v, const mjModel *m, mjData *d) {
   viewer_camera(v, m);
@@ -270,9 +267,8 @@ static void viewer_overlays(sim_viewer_t *v, mjrRect vp, double t_s) {
   static const char *names[4] = {"driver's", "bird's", "god's", "free"};
   char text[160];
   const char *view = v->in.view >= 0 && v->in.view < 4 ? names[v->in.view] : "overhead";
-  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s%s", v->in.car,
-           view, t_s, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night",
-           v->in.manual ? "  MANUAL (arrows / WASD)" : "");
+  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s", v->in.car,
+           view, t_s, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night");
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, vp, text,
               "1-4 view  Tab car  N night  Space pause  R reset  M menu  H HUD  Esc quit", &v->con);
   if (v->hud_titles[0])

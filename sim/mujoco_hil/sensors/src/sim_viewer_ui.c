@@ -53,7 +53,6 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   ui_add(v, mjITEM_BUTTON, UI_QUIT, NULL, "");
   ui_add(v, mjITEM_SECTION, "Car", NULL, "");
   ui_add(v, mjITEM_RADIO, "Ego car", &v->ui_car, cars);
-  ui_add(v, mjITEM_RADIO, "Driving", &v->in.manual, "Auto\nManual");
   ui_add(v, mjITEM_SECTION, "View", NULL, "");
   ui_add(v, mjITEM_RADIO, "Camera", &v->in.view, cams);
   ui_add(v, mjITEM_SLIDERNUM, "Light level", &v->in.light_level, "0 1");
