@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -40,7 +41,10 @@ static void viewer_rtf(viewer_window_t *w, const sim_t *s, double now_s) {
 
 int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s, const char *recording) {
   double now = app_wall_s();
-  if (now < w->next_frame_s) return 0;
+  /* ~30 Hz of wall time, but no more than one frame per 1/30 s of sim time: on a slow machine
+   * the window must not take the time the stepping needs */
+  if (now < w->next_frame_s || sim_time_us(s) < w->next_frame_us) return 0;
+  w->next_frame_us = sim_time_us(s) + (int64_t)(VIEWER_FRAME_S * 1e6);
   sim_viewer_input_t *in = &w->in;
   do {
     w->next_frame_s = now + VIEWER_FRAME_S;
@@ -48,7 +52,9 @@ int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s, const char *
     char titles[2048], values[2048];
     hud_text_build(s, w->rtf, recording, titles, sizeof titles, values, sizeof values);
     sim_viewer_set_hud(w->v, titles, values);
+    const double draw0_s = app_wall_s();
     if (sim_viewer_frame(w->v, sim_render_model(s), sim_render_data(s), in) != 0) return 1;
+    if (w->frames < VIEWER_WINDOW_TIMED_FRAMES) w->draw_s[w->frames] = app_wall_s() - draw0_s;
     w->frames++;
     w->record_toggles += in->record_toggled;
     if (in->quit || app_stop_requested()) return 1;
@@ -56,7 +62,9 @@ int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s, const char *
       /* back to the start poses (qpos0, core/src/car_placement.c); late boxes that appeared come
        * back on the next step; encoder counts restart with the wheel angles, as when a car is
        * picked up and put back */
+      const double t_s = sim_data(s)->time; /* the sim's clock runs on */
       mj_resetData(sim_model(s), sim_data(s));
+      sim_data(s)->time = t_s;
       mj_forward(sim_model(s), sim_data(s));
     }
     if (in->paused && !in->step_requested) {
@@ -89,6 +97,20 @@ void viewer_window_lidar(viewer_window_t *w, const sim_t *s, int car,
     n++;
   }
   sim_viewer_set_rays(w->v, o, ends, n);
+}
+
+static int viewer_cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+double viewer_window_median_draw_s(const viewer_window_t *w) {
+  const long n = w->frames < VIEWER_WINDOW_TIMED_FRAMES ? w->frames : VIEWER_WINDOW_TIMED_FRAMES;
+  if (n == 0) return 0.0;
+  static double sorted[VIEWER_WINDOW_TIMED_FRAMES];
+  memcpy(sorted, w->draw_s, (size_t)n * sizeof *sorted);
+  qsort(sorted, (size_t)n, sizeof *sorted, viewer_cmp_double);
+  return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
 }
 
 void viewer_window_close(viewer_window_t *w) {

@@ -77,6 +77,9 @@ void sim_viewer_set_hud(sim_viewer_t *v, const char *titles, const char *values)
 
 void sim_viewer_set_map_name(sim_viewer_t *v, const char *name) {
   snprintf(v->map_name, sizeof v->map_name, "%s", name ? name : "");
+  char *ext = strrchr(v->map_name, '.');
+  if (ext && !strcmp(ext, ".xml")) *ext = 0;
+  v->ui_dirty = 1;
   for (int s = 0; s < v->ui.nsect; s++) /* the Simulation section's Map line */
     for (int i = 0; i < v->ui.sect[s].nitem; i++)
       if (!strcmp(v->ui.sect[s].item[i].name, "Map")) {

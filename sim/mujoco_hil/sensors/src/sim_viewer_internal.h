@@ -33,8 +33,10 @@ struct sim_viewer {
   /* the Menu Panel */
   mjUI ui;
   mjuiState ui_state;
-  int panel;  /* 1: shown (M toggles) */
-  int ui_car; /* the Ego car radio: in.car - 1 */
+  int panel;                   /* 1: shown (M toggles) */
+  int ui_car;                  /* the Ego car radio: in.car - 1 */
+  int ui_dirty;                /* the panel's buffer needs a redraw (mjui_update) */
+  sim_viewer_input_t ui_shown; /* the state the buffer shows */
   const mjModel *model;
   double cursor_x, cursor_y; /* [px] window coordinates, y down (GLFW) */
   char map_name[128], rtf_text[64];

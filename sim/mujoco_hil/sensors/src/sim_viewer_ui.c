@@ -82,7 +82,13 @@ void sim_viewer_ui_render(sim_viewer_t *v) {
   if (!v->panel) return;
   ui_rects(v);
   v->ui_car = v->in.car - 1;
-  mjui_update(-1, -1, &v->ui, &v->ui_state, &v->con);
+  /* redrawn into its buffer only when what it shows changed: a software rasteriser pays for
+   * every item on every redraw */
+  if (v->ui_dirty || memcmp(&v->ui_shown, &v->in, sizeof v->in) != 0) {
+    mjui_update(-1, -1, &v->ui, &v->ui_state, &v->con);
+    v->ui_shown = v->in;
+    v->ui_dirty = 0;
+  }
   mjui_render(&v->ui, &v->ui_state, &v->con);
   mjr_setBuffer(mjFB_WINDOW, &v->con);
 }
@@ -114,6 +120,7 @@ int sim_viewer_ui_mouse(sim_viewer_t *v, double x_px, double y_px, int press) {
   const int owned = st->dragrect == 1;
   v->ui_car = v->in.car - 1;
   mjuiItem *it = mjui_event(&v->ui, st, &v->con);
+  v->ui_dirty = 1;
   if (it && it->type == mjITEM_BUTTON) ui_button(v, it->name); /* edges: once a frame */
   if (it && it->pdata == &v->ui_car) v->in.car = v->ui_car + 1;
   if (it && it->pdata == &v->in.light_level) v->in.day = v->in.light_level >= 0.5;
