@@ -25,7 +25,7 @@ import pytest
 from autodrive.core import lcmtypes
 from autodrive.core.channels import channel, vehicle_name
 
-WIN_W, WIN_H = 1024, 768  # viewer_window.c
+WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
 RECORD_BUTTON = (68, 551)  # [px] the Record button (tests/sim_sensors checks the layout)
 GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
@@ -53,7 +53,7 @@ class Window:
         self.lc.subscribe(channel("GROUND_TRUTH", vehicle_name(1)), self._on_truth)
         self.tmp = tmp
         self.sim = subprocess.Popen(
-            [str(build / "bin" / "autodrive-sim"), "--view", "--no-pty", "--no-lidar",
+            [str(build / "bin" / "autodrive-sim"), "--view", "--view-size", f"{WIN_W}x{WIN_H}", "--no-pty", "--no-lidar",
              "--rtf", "1", "--duration", "3600", "--run-dir", str(tmp), "--lcm-url", url,
              "--script", "constant:throttle=0.35,steering=0", "--quiet"],
             cwd=tmp, env=self.env, stdout=subprocess.PIPE, text=True,
@@ -103,12 +103,12 @@ class Window:
 
     def key(self, name: str) -> None:
         subprocess.run(["xdotool", "key", "--window", self.wid, name], env=self.env, check=True)
-        self.run_sim(0.3)  # a few frames drawn since
+        self.run_sim(0.15)  # a few frames drawn since
 
     def click(self, x: int, y: int) -> None:
         subprocess.run(["xdotool", "mousemove", "--window", self.wid, str(x), str(y), "click", "1"],
                        env=self.env, check=True)  # fmt: skip
-        self.run_sim(0.3)
+        self.run_sim(0.15)
 
     def shot(self, name: str) -> np.ndarray:
         path = self.tmp / f"{name}.png"
@@ -146,12 +146,12 @@ def window(build_dir: Path, tmp_path: Path, lcm_url: str) -> Iterator[Window]:
 
 def scene(img: np.ndarray) -> np.ndarray:
     """The scene right of the Menu Panel, below the HUD's top rows, above the status line."""
-    return img[120 : WIN_H - 60, PANEL_W + 10 : WIN_W - 330].astype(np.float64)
+    return img[270 : WIN_H - 40, PANEL_W + 10 : WIN_W].astype(np.float64)
 
 
 def test_window_as_a_person_uses_it(window: Window) -> None:
     w = window
-    w.run_sim(1.0)
+    w.run_sim(0.3)
     w.key("2")
     bird = w.shot("window-bird")
     w.key("3")
@@ -166,8 +166,8 @@ def test_window_as_a_person_uses_it(window: Window) -> None:
 
     # R puts the car back: it has driven off its start, then is back within 5 cm
     t0, x0, y0 = w.truth[0]
-    w._until(lambda: "ok" if abs(w.truth[-1][1] - x0) + abs(w.truth[-1][2] - y0) > 0.3 else None,
-             "the car to drive 0.3 m")  # fmt: skip
+    w._until(lambda: "ok" if abs(w.truth[-1][1] - x0) + abs(w.truth[-1][2] - y0) > 0.15 else None,
+             "the car to drive 0.15 m")  # fmt: skip
     t_key = w.sim_time()
     w.key("r")
     back = [s for s in w.truth if s[0] > t_key and abs(s[1] - x0) + abs(s[2] - y0) < 0.05]
@@ -178,7 +178,7 @@ def test_window_as_a_person_uses_it(window: Window) -> None:
     started = w._until(lambda: next((s for s in w.lines if s.startswith("recording ")), None),
                        "the recording to start")  # fmt: skip
     w.shot("window-recording")
-    w.run_sim(2.0)
+    w.run_sim(1.0)
     w.click(*RECORD_BUTTON)
     w._until(lambda: next((s for s in w.lines if s.startswith("recording stopped")), None),
              "the recording to stop")  # fmt: skip
@@ -190,7 +190,7 @@ def test_window_as_a_person_uses_it(window: Window) -> None:
     while cap.read()[0]:
         frames += 1
     print(f"recorded {frames} frames over {(sim_us[-1] - sim_us[0]) * 1e-6:.2f} s of sim time")
-    assert frames == len(rows) >= 2.0 * FPS
+    assert frames == len(rows) >= 1.0 * FPS
     assert frames / FPS == pytest.approx((sim_us[-1] - sim_us[0]) * 1e-6, abs=2 / FPS)
     assert (folder / "run.lcmlog").read_bytes().count(b"NIGEL1_GROUND_TRUTH") > 20
     subprocess.run(["xdotool", "key", "--window", w.wid, "Escape"], env=w.env, check=True)

@@ -18,16 +18,16 @@ typedef struct viewer_window {
   int64_t next_frame_us;  /* [us] sim time */
   double rtf, rtf_wall_s; /* the real-time factor over the last second of wall time */
   int64_t rtf_sim_us;
-  long frames; /* drawn so far */
+  long frames;                               /* drawn so far */
   double draw_s[VIEWER_WINDOW_TIMED_FRAMES]; /* [s] wall to draw each of the first frames */
   int record_toggles;    /* Record clicks not yet acted on (run_loop starts / stops) */
   sim_viewer_input_t in; /* the last frame's input */
 } viewer_window_t;
 
-/* Opens it when want (a display is needed); else leaves w->v NULL. map_name goes into the
- * Simulation section. */
-int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, const char *map_name,
-                       char *err, size_t err_sz);
+/* Opens a width_px x height_px window when want (a display is needed); else leaves w->v NULL.
+ * map_name goes into the Simulation section. */
+int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
+                       const char *map_name, char *err, size_t err_sz);
 /* Draws a frame when one is due; blocks while paused (shifting *t0_s so pacing resumes
  * smoothly) until Step or Pause is clicked. recording: shown in the HUD, or NULL. Returns 1
  * when the user quit. */

@@ -110,7 +110,9 @@ static void options_usage(FILE *f) {
       "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
       "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
-      "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
+      "                      eye, 4 free; Tab next car; N day/night; Space pause; R reset;\n"
+      "                      M the Menu Panel; H the HUD; Esc quit\n"
+      "  --view-size WxH     the window's size (default 1024x768 px)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
       "                      time stamped with it, and FILE.frames.csv (frame, sim_time_us);\n"
       "                      needs Debian's ffmpeg\n"
@@ -159,6 +161,8 @@ static void options_defaults(app_options_t *o) {
   o->url = AUTODRIVE_LCM_URL_DEFAULT;
   o->lidar_lcm = 1;
   o->video_camera = "nigel1/cam_front";
+  o->view_w = 1024;
+  o->view_h = 768;
   o->camera_fps = 30.0;
   o->light_level = -1.0;
   o->rtf = 1.0;
@@ -356,6 +360,15 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
+  } else if (!strcmp(a, "--view-size")) {
+    char tail = 0;
+    if (!v || sscanf(v, "%dx%d%c", &o->view_w, &o->view_h, &tail) != 2 || o->view_w < 640 ||
+        o->view_h < 600 || o->view_w > 7680 || o->view_h > 4320) {
+      fprintf(stderr, "autodrive-sim: --view-size '%s': expected WxH, 640x600 to 7680x4320 px\n",
+              v ? v : "");
+      return OPTIONS_BAD;
+    }
+    return 1;
   } else if (!strcmp(a, "--camera-fps")) {
     return options_number(a, v, 0.1, 1000, &o->camera_fps) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--light-level")) {

@@ -14,8 +14,8 @@
 #define VIEWER_RTF_WINDOW_S 1.0     /* [s] wall over which the HUD's rtf is measured */
 #define VIEWER_LIDAR_HEIGHT_M 0.12  /* rays drawn this far above base_link (the RPLIDAR's deck) */
 
-int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, const char *map_name,
-                       char *err, size_t err_sz) {
+int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
+                       const char *map_name, char *err, size_t err_sz) {
   memset(w, 0, sizeof *w);
   if (!want) return 0;
   if (!sim_viewer_display_available()) {
@@ -23,7 +23,7 @@ int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, const char 
     return -1;
   }
   w->v = sim_viewer_create(sim_render_model(s), sim_cars(s), "nigel%d/base_link",
-                           "nigel%d/cam_front", 1024, 768, err, err_sz);
+                           "nigel%d/cam_front", width_px, height_px, err, err_sz);
   if (!w->v) return -1;
   const char *slash = map_name ? strrchr(map_name, '/') : NULL;
   sim_viewer_set_map_name(w->v, slash ? slash + 1 : map_name);
