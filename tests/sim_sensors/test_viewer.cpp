@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <GLFW/glfw3.h>
+#include <png.h>
 
 #include <string>
 #include <vector>
@@ -81,6 +82,8 @@ TEST(SimViewer, RendersViewsAndReportsKeysNextToHeadlessCameras) {
   ASSERT_EQ(h, 480);
   std::vector<uint8_t> shot((size_t)w * h * 3);
   sim_viewer_input_t in;
+  sim_viewer_key(v, GLFW_KEY_M);  // the Menu Panel and the HUD off: this test reads whole frames
+  sim_viewer_key(v, GLFW_KEY_H);
 
   // driver's view = the front camera: blue pillar in the centre, green floor at the bottom
   sim_viewer_key(v, GLFW_KEY_1);
@@ -148,4 +151,110 @@ TEST(SimViewer, NoDisplayIsAClearError) {
             nullptr);
   EXPECT_NE(std::string(err).find("no display"), std::string::npos) << err;
   if (saved) setenv("DISPLAY", keep.c_str(), 1);
+}
+
+namespace {
+
+long frame_sum(const std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1) {
+  long sum = 0;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++)
+      for (int k = 0; k < 3; k++) sum += rgb[3 * ((size_t)y * w + x) + k];
+  return sum;
+}
+
+// The frame as a PNG in $AUTODRIVE_SCREENSHOT_DIR (the docs' screenshots), when it is set.
+void screenshot(const std::vector<uint8_t> &rgb, int w, int h, const char *name) {
+  const char *dir = getenv("AUTODRIVE_SCREENSHOT_DIR");
+  if (!dir || !*dir) return;
+  std::string path = std::string(dir) + "/" + name + ".png";
+  FILE *f = fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr) << path;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  png_init_io(png, f);
+  png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < h; y++) png_write_row(png, rgb.data() + (size_t)y * w * 3);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  fclose(f);
+}
+
+}  // namespace
+
+// The Menu Panel and the HUD, driven by scripted clicks at the panel's own item positions
+// (the same path as the window's mouse callback): each item changes the state it names.
+TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
+  if (access("/usr/bin/Xvfb", X_OK) != 0) GTEST_SKIP() << "Xvfb not installed";
+  Xvfb x;
+  ASSERT_TRUE(x.ready) << "Xvfb " << x.display << " did not start";
+  room::Room room;
+  ASSERT_NE(room.m, nullptr);
+  char err[256] = "";
+  // a headless renderer beside the window, as in the program: it keeps Mesa's EGL loaded past
+  // glfwTerminate, so that LeakSanitizer can name (and lsan.supp suppress) Mesa's own
+  // per-display allocations instead of reporting them from an unloaded "unknown module"
+  sim_render_t *r = sim_render_create(room.m, 64, 64, SIM_RENDER_EGL, err, sizeof err);
+  ASSERT_NE(r, nullptr) << err;
+  sim_viewer_t *v = sim_viewer_create(room.m, 1, "car", "car_cam_front", 800, 600, err, sizeof err);
+  ASSERT_NE(v, nullptr) << err;
+  sim_viewer_capture(v, 1);
+  sim_viewer_set_map_name(v, "test_room");
+  sim_viewer_set_hud(v, "sim time\nreal-time factor\nNIGEL1 speed", "12.34 s\n0.98\n0.50 m/s");
+  int w = 0, h = 0;
+  sim_viewer_size(v, &w, &h);
+  std::vector<uint8_t> shot((size_t)w * h * 3), other((size_t)w * h * 3);
+  sim_viewer_input_t in;
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
+  screenshot(shot, w, h, "window-panel-hud");
+  double cx = 0, cy = 0;
+  auto click = [&](const char *item) {
+    ASSERT_EQ(sim_viewer_item_at(v, item, &cx, &cy), 0) << item;
+    sim_viewer_click(v, cx, cy);
+    ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  };
+  EXPECT_EQ(sim_viewer_item_at(v, "No such item", &cx, &cy), -1);
+  click("Pause");
+  EXPECT_EQ(in.paused, 1);
+  click("Pause");
+  EXPECT_EQ(in.paused, 0);
+  click("Step");
+  EXPECT_EQ(in.step_requested, 1);
+  click("Reset");
+  EXPECT_EQ(in.reset_requested, 1);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.reset_requested, 0);  // an edge
+  click("Camera/God");
+  EXPECT_EQ(in.view, SIM_VIEW_GOD);
+  click("Camera/Driver");
+  EXPECT_EQ(in.view, SIM_VIEW_DRIVER);
+  click("Shadows");
+  EXPECT_EQ(in.shadows, 1);
+  ASSERT_EQ(sim_viewer_item_at(v, "Start or stop", &cx, &cy), 0);
+  // tests/sim/test_window.py clicks the real program's Record button here
+  EXPECT_NEAR(cx, 68, 2);
+  EXPECT_NEAR(cy, 551, 2);
+  printf("Record button at (%.0f, %.0f) px\n", cx, cy);
+  click("Start or stop");
+  EXPECT_EQ(in.record_toggled, 1);
+  // the HUD: its text at the top right, gone with H
+  ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
+  sim_viewer_key(v, GLFW_KEY_H);
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.hud, 0);
+  ASSERT_EQ(sim_viewer_read_rgb(v, other.data()), 0);
+  EXPECT_NE(frame_sum(shot, w, w - 200, 0, w, 60), frame_sum(other, w, w - 200, 0, w, 60));
+  // the light level slider: its middle halves the light, the scene right of the panel darkens
+  const long day = frame_sum(other, w, w / 2, h / 4, w, h);
+  click("Light level");
+  EXPECT_NEAR(in.light_level, 0.5, 0.15);
+  ASSERT_EQ(sim_viewer_read_rgb(v, other.data()), 0);
+  EXPECT_LT(frame_sum(other, w, w / 2, h / 4, w, h), day * 9 / 10);
+  click("Quit");
+  EXPECT_EQ(in.quit, 1);
+  sim_viewer_destroy(v);
+  sim_render_destroy(r);
 }

@@ -26,6 +26,8 @@ render of the same frames in the same run (`autodrive-sim --eye-render compare`:
 rendered both ways), their ratio, the wall-clock medians (*_wall_*, load-dependent), how many
 pixels differ (eye_render_differing_fraction, eye_render_max_abs_diff) and the load average
 when it ran (eye_render_load_avg). Goals: <= 10 ms, and at most 1e-4 of the pixels differing.
+viewer_fps, rtf_window_over_headless (goals >= 30, >= 0.8): the window with its HUD and Menu
+Panel, 1 car in Tiny Town, against the same run headless (viewer()).
 Options: SIM_BENCH_REPEATS (3).
 """
 
@@ -33,10 +35,12 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import statistics
 import struct
 import subprocess
 import tempfile
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -58,6 +62,7 @@ TOP_SPEED_SETTLE_US = 2e6
 EYE_RENDER_STARTS = ("1,-3.0,-3.14,0", "2,3.0,-3.14,180", "3,-3.0,2.86,0", "4,3.0,2.86,180")
 EYE_RENDER_DURATION_S = 2.0  # 60 frame times x 4 cameras, each rendered cached and in full
 EYE_RENDER_GOAL_MS = 10.0
+VIEWER_SIM_S = 3.0  # [s] sim time of each viewer run
 EYE_RENDER_MAX_DIFFERING = 1e-4  # fraction of the pixels (tests/sim: sim.EyeRenderCache.*)
 log = Progress("sim")
 
@@ -247,6 +252,47 @@ def sensors(build: Path, res: dict[str, Any]) -> None:
         log(f"sim-sensors-bench failed, no lidar/camera figures: {e}")
 
 
+def viewer(bench: SimBench, url: str, res: dict[str, Any]) -> None:
+    """The window (issue 36): 1 car in Tiny Town in lockstep, headless and then with --view
+    (HUD and Menu Panel on) on an Xvfb of its own, back to back. viewer_fps = 1 / the median
+    wall time to draw a frame (the rate the window can keep; it draws at most 30 Hz of wall
+    time); rtf_window_over_headless = rtf with the window / rtf headless. Xvfb renders with
+    Mesa's llvmpipe on the CPU: on a laptop's GPU the window costs far less."""
+    if not shutil.which("Xvfb"):
+        log("viewer: Xvfb missing (tools/debian-packages.txt): viewer figures left out")
+        return
+    display = f":{400 + os.getpid() % 500}"
+    xvfb = subprocess.Popen(
+        ["Xvfb", display, "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        sock = Path(f"/tmp/.X11-unix/X{display[1:]}")
+        for _ in range(300):  # readiness, not a timing figure
+            if sock.exists():
+                break
+            time.sleep(0.05)
+        args = ["--lockstep", "--map", "tiny_town", "--no-pty", "--duration", str(VIEWER_SIM_S)]
+        headless = bench.run(args, url)
+        log(f"viewer: headless rtf {headless['rtf']:.2f}")
+        os.environ["DISPLAY"] = display
+        try:
+            window = bench.run(args + ["--view"], url)
+        finally:
+            del os.environ["DISPLAY"]
+    finally:
+        xvfb.terminate()
+        xvfb.wait()
+    log(f"viewer: window rtf {window['rtf']:.2f}, {window['viewer_fps']:.1f} fps")
+    res["viewer_fps"] = window["viewer_fps"]
+    res["viewer_frame_ms_median"] = window["viewer_frame_ms_median"]
+    res["viewer_frames"] = window["viewer_frames"]
+    res["rtf_1_tiny_town_headless"] = headless["rtf"]
+    res["rtf_1_tiny_town_window"] = window["rtf"]
+    res["rtf_window_over_headless"] = round(window["rtf"] / headless["rtf"], 3)
+    res["viewer_load_avg"] = round(os.getloadavg()[0], 1)
+
+
 def goal_table() -> dict[str, Goal]:
     """The issue's speed goals, by wall time, by CPU time (a loaded machine) and in instructions
     (callgrind), and the sensor and fidelity goals."""
@@ -265,6 +311,8 @@ def goal_table() -> dict[str, Goal]:
         eye_render_ms_per_frame_1280x960=at_most(
             "eye_render_ms_per_frame_1280x960", EYE_RENDER_GOAL_MS
         ),
+        viewer_fps=at_least("viewer_fps", 30.0),
+        rtf_window_over_headless=at_least("rtf_window_over_headless", 0.8),
         eye_render_equals_full_render=at_most(
             "eye_render_differing_fraction", EYE_RENDER_MAX_DIFFERING
         ),
@@ -287,6 +335,7 @@ def main(argv: list[str]) -> int:
     url = bench.pick_url()
     speed(bench, url, repeats, res)
     eye_render(bench, url, res)
+    viewer(bench, url, res)
     instructions(bench, res)
     fidelity(bench, res)
     sensors(build, res)

@@ -114,6 +114,16 @@ int ad_world_set_route_points(ad_world_t *w, int car, const double *xy, int n, d
 /* Benchmark: wall time [s] of a bare mj_step loop of steps steps on a copy of the world's
  * model and state (MuJoCo alone, the baseline of api_overhead_ratio). */
 double ad_world_bare_mj_step_s(const ad_world_t *w, int steps);
+/* Videos of episodes (the simulator's own MP4 writer, sim/mujoco_hil/sensors/sim_video.h,
+ * through Debian's ffmpeg): frames of width x height x 3 RGB (rows top-down) at fps frames per
+ * second of sim time. ad_video_frame stamps each with t_s (sim time [s]) unless t_s < 0.
+ * NULL / -1 with the cause in err; ad_video_close finishes the file (0, or -1). */
+typedef struct ad_video ad_video_t;
+ad_video_t *ad_video_open(const char *path, int width_px, int height_px, double fps, char *err,
+                          size_t err_sz);
+int ad_video_frame(ad_video_t *v, const uint8_t *rgb, size_t n_bytes, double t_s, char *err,
+                   size_t err_sz);
+int ad_video_close(ad_video_t *v, char *err, size_t err_sz);
 /* CFFI-END */
 #pragma GCC visibility pop
 

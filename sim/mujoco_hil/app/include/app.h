@@ -15,6 +15,7 @@
 #include "options.h"
 #include "publish_queue.h"
 #include "render_thread.h"
+#include "run_recorder.h"
 #include "sim.h"
 #include "teleport_lcm.h"
 #include "traffic_lights_lcm.h"
@@ -32,7 +33,8 @@ typedef struct app {
   teleport_lcm_t *teleport;     /* --allow-teleport, or NULL */
   eye_sync_t *eye_sync;         /* --eye-sync, or NULL */
   viewer_window_t viewer;
-  publish_queue_t *pubq; /* ground truth and SIM_CLOCK leave through its worker thread */
+  run_recorder_t recorder; /* --video, --record, the window's Record button */
+  publish_queue_t *pubq;   /* ground truth and SIM_CLOCK leave through its worker thread */
 } app_t;
 
 /* What the loop measured, for --bench. */

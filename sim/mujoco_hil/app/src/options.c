@@ -110,7 +110,15 @@ static void options_usage(FILE *f) {
       "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
       "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
-      "                      eye; Tab next car; N day/night; Space pause; R reset; Esc quit\n"
+      "                      eye, 4 free; Tab next car; N day/night; Space pause; R reset;\n"
+      "                      M the Menu Panel; H the HUD; Esc quit\n"
+      "  --view-size WxH     the window's size (default 1024x768 px)\n"
+      "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
+      "                      time stamped with it, and FILE.frames.csv (frame, sim_time_us);\n"
+      "                      needs Debian's ffmpeg\n"
+      "  --record DIR        the same video as DIR/view.mp4 (+ view_frames.csv) and the LCM\n"
+      "                      log of every channel, DIR/run.lcmlog (lcm-logger)\n"
+      "  --video-camera NAME the camera recorded (default nigel1/cam_front; eye: the overhead)\n"
       "  --quiet             no progress lines\n"
       "  -h, --help          this text\n"
       "Publishes NIGEL<i>_GROUND_TRUTH (100 Hz), NIGEL<i>_LIDAR (when built with sensors),\n"
@@ -152,6 +160,9 @@ static void options_defaults(app_options_t *o) {
   o->cfg.tyre_model = -1;
   o->url = AUTODRIVE_LCM_URL_DEFAULT;
   o->lidar_lcm = 1;
+  o->video_camera = "nigel1/cam_front";
+  o->view_w = 1024;
+  o->view_h = 768;
   o->camera_fps = 30.0;
   o->light_level = -1.0;
   o->rtf = 1.0;
@@ -310,6 +321,15 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
     o->bench = 1;
   } else if (!strcmp(a, "--quiet")) {
     o->quiet = 1;
+  } else if (!strcmp(a, "--video") && v) {
+    o->video = v;
+    return 1;
+  } else if (!strcmp(a, "--record") && v) {
+    o->record_dir = v;
+    return 1;
+  } else if (!strcmp(a, "--video-camera") && v) {
+    o->video_camera = v;
+    return 1;
   } else {
     return OPTIONS_UNKNOWN;
   }
@@ -340,6 +360,15 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
+  } else if (!strcmp(a, "--view-size")) {
+    char tail = 0;
+    if (!v || sscanf(v, "%dx%d%c", &o->view_w, &o->view_h, &tail) != 2 || o->view_w < 640 ||
+        o->view_h < 600 || o->view_w > 7680 || o->view_h > 4320) {
+      fprintf(stderr, "autodrive-sim: --view-size '%s': expected WxH, 640x600 to 7680x4320 px\n",
+              v ? v : "");
+      return OPTIONS_BAD;
+    }
+    return 1;
   } else if (!strcmp(a, "--camera-fps")) {
     return options_number(a, v, 0.1, 1000, &o->camera_fps) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--light-level")) {
@@ -371,6 +400,12 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
             "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->video && o->record_dir) {
+    fprintf(stderr,
+            "autodrive-sim: --video and --record exclude each other (--record DIR "
+            "writes DIR/view.mp4)\n");
     return OPTIONS_BAD;
   }
   if (o->client_sync && !o->cfg.open_ptys) {

@@ -3,8 +3,11 @@
  * LIDAR, cameras, SIM_CLOCK), the window, and the pacing against the wall clock. */
 #include "app.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include <autodrive_channels.h>
@@ -83,6 +86,7 @@ static void loop_publish_sensors(app_t *a, const loop_t *l) {
     const sim_lidar_scan_t *scan = sim_lidar_new_scan(s, c);
     /* while the runtime's RPLIDAR driver scans on the pty it publishes <VEH>_LIDAR itself:
      * the sim then stays off the channel so that nobody sees every scan twice */
+    viewer_window_lidar(&a->viewer, s, c, scan);
     if (scan && a->opt->lidar_lcm && !sim_lidar_pty_scanning(s, c)) {
       char ch[32];
       snprintf(ch, sizeof ch, AUTODRIVE_VEHICLE_PREFIX "%d" AUTODRIVE_CH_LIDAR_SUFFIX, c);
@@ -178,6 +182,43 @@ static void loop_wait_for_eye(app_t *a, const loop_t *l, int64_t now_us, int clo
   eye_sync_wait(e, now_us);
 }
 
+/* The window's Record button: stops the recording, or starts one in recordings/<UTC time>/ of
+ * the camera the window shows (the ego car's front camera for the views that follow no fixed
+ * camera). Returns 0, or -1 with the message in err. */
+static int loop_record_button(app_t *a, char *err, size_t err_sz) {
+  const int toggles = a->viewer.record_toggles;
+  a->viewer.record_toggles = 0;
+  if (toggles % 2 == 0) return 0;
+  run_recorder_t *r = &a->recorder;
+  if (run_recorder_active(r)) {
+    const long frames = r->next_frame;
+    if (run_recorder_stop(r, err, err_sz) != 0) return -1;
+    printf("recording stopped at t = %.3f s: %ld frame(s) in %s\n", sim_time_us(a->sim) * 1e-6,
+           frames, r->dir[0] ? r->dir : r->video_path);
+    fflush(stdout);
+    return 0;
+  }
+  char dir[96], cam[64];
+  const time_t now = time(NULL);
+  struct tm utc;
+  gmtime_r(&now, &utc);
+  strftime(dir, sizeof dir, "recordings/%Y%m%d-%H%M%S", &utc);
+  if (mkdir("recordings", 0775) != 0 && errno != EEXIST) {
+    snprintf(err, err_sz, "Record: cannot make the folder 'recordings': %s", strerror(errno));
+    return -1;
+  }
+  const int id = sim_viewer_camera_id(a->viewer.v);
+  const char *name = id >= 0 ? mj_id2name(sim_render_model(a->sim), mjOBJ_CAMERA, id) : NULL;
+  if (name)
+    snprintf(cam, sizeof cam, "%s", name);
+  else
+    snprintf(cam, sizeof cam, "nigel%d/cam_front", a->viewer.in.car);
+  if (run_recorder_start(r, a->sim, cam, NULL, dir, a->opt->url, err, err_sz) != 0) return -1;
+  printf("recording %s from t = %.3f s into %s\n", cam, sim_time_us(a->sim) * 1e-6, dir);
+  fflush(stdout);
+  return 0;
+}
+
 /* One pass of the loop. Returns 1 to go on, 0 when the run is over, -1 on an error (message on
  * stderr). */
 static int loop_once(app_t *a, loop_t *l) {
@@ -207,10 +248,21 @@ static int loop_once(app_t *a, loop_t *l) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return -1;
   }
+  if (run_recorder_step(&a->recorder, s, err, sizeof err) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
+    return -1;
+  }
   const int clock_now = (o->lockstep || o->rtf_given) && l->step % LOOP_CLOCK_EVERY == 0;
   if (clock_now) loop_publish_clock(a, l, now_us);
   loop_wait_for_eye(a, l, now_us, clock_now);
-  if (a->viewer.v && viewer_window_frame(&a->viewer, s, &l->t0) != 0) return 0;
+  if (a->viewer.v) {
+    const char *rec = run_recorder_active(&a->recorder) ? a->recorder.video_path : NULL;
+    if (viewer_window_frame(&a->viewer, s, &l->t0, rec) != 0) return 0;
+    if (a->viewer.record_toggles && loop_record_button(a, err, sizeof err) != 0) {
+      fprintf(stderr, "autodrive-sim: %s\n", err);
+      return -1;
+    }
+  }
   if (l->paired) { /* the bare block is not part of the run: its time moves the start on */
     const double bare_wall_s = bench_pairs_after_step(&l->pairs, l->step);
     l->t0 += bare_wall_s;
@@ -243,6 +295,17 @@ int app_run(app_t *a, app_run_stats_t *st) {
     const int r = loop_once(a, &l);
     if (r < 0) rc = 1;
     if (r <= 0) break;
+  }
+  if (run_recorder_active(&a->recorder)) {
+    char err[1024] = "";
+    const long frames = a->recorder.next_frame;
+    if (run_recorder_stop(&a->recorder, err, sizeof err) != 0) {
+      fprintf(stderr, "autodrive-sim: %s\n", err);
+      rc = 1;
+    } else if (!o->quiet) {
+      fprintf(stderr, "autodrive-sim: recorded %ld frame(s) to %s\n", frames,
+              a->recorder.video_path);
+    }
   }
   /* the stepping thread alone: what bounds the rtf when the LCM worker has a core of its own */
   st->step_cpu_s =

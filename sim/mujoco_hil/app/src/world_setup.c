@@ -138,8 +138,15 @@ static int app_build_links(app_t *a, char *err, size_t err_sz) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;
   }
-  if (viewer_window_open(&a->viewer, a->sim, o->view, err, err_sz) != 0) {
+  if (viewer_window_open(&a->viewer, a->sim, o->view, o->view_w, o->view_h, o->cfg.map_path, err,
+                         err_sz) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
+    return 1;
+  }
+  if ((o->video || o->record_dir) &&
+      run_recorder_start(&a->recorder, a->sim, o->video_camera, o->video, o->record_dir, o->url,
+                         err, err_sz) != 0) {
+    fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;
   }
   if (!(a->pubq = publish_queue_create(a->lcm, err, err_sz))) {
@@ -193,6 +200,7 @@ void app_close(app_t *a) {
   traffic_lights_lcm_destroy(a->lights);
   teleport_lcm_destroy(a->teleport);
   eye_sync_destroy(a->eye_sync);
+  run_recorder_stop(&a->recorder, NULL, 0);
   viewer_window_close(&a->viewer);
   if (a->render) render_thread_stop(a->render);
   cameras_close(&a->cams);

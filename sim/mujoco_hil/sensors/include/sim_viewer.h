@@ -1,9 +1,15 @@
 /* sim_viewer: the optional GLFW window of the sim (only when a display exists).
  *
  * Views: driver's eye (the car's front camera), bird's eye (a camera tracking the car from
- * behind and above), god's eye (the map's "eye" camera, else an overview of the whole model).
- * Keys: 1/2/3 views, Tab next car, N day/night, Space pause, R reset, Esc or closing quits.
- * The viewer only reports pause/reset/quit; the sim's main loop acts on them.
+ * behind and above), god's eye (the map's "eye" camera, else an overview of the whole model),
+ * free (an overview), and each overhead Eye camera of the map.
+ * Keys: 1/2/3/4 views, Tab next car, N day/night, Space pause, R reset, M the Menu Panel,
+ * H the HUD, Esc or closing quits.
+ * The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map, pause,
+ * step, reset, quit), Car (the ego car), View (camera, light level,
+ * shadows, reflections, skybox, HUD), Sensors (LIDAR rays) and Record (start / stop). The HUD
+ * is text the caller sets (sim_viewer_set_hud), drawn at the top right.
+ * The viewer only reports what the user asked (sim_viewer_input_t); the sim's main loop acts.
  *
  * The window's OpenGL context is made with EGL (GLFW_EGL_CONTEXT_API) so that it coexists
  * with the headless sim_render EGL renderer in one process (MuJoCo binds its GL calls to one
@@ -24,15 +30,23 @@ typedef enum sim_viewer_view {
   SIM_VIEW_DRIVER = 0, /* the car's front camera */
   SIM_VIEW_BIRD,       /* tracking the car from behind and above */
   SIM_VIEW_GOD,        /* the map's "eye" camera, else a free overview */
+  SIM_VIEW_FREE,       /* an overview of the whole model */
+  SIM_VIEW_EYE0,       /* the map's first overhead camera; SIM_VIEW_EYE0 + k its k-th */
 } sim_viewer_view_t;
 
 typedef struct sim_viewer_input {
-  int quit;               /* 1 once Esc was pressed or the window closed */
-  int reset_requested;    /* R pressed since the previous frame (edge, cleared each frame) */
-  int paused;             /* Space toggles: while 1 the sim should not step */
-  int day;                /* N toggles: 1 day, 0 night */
-  int car;                /* shown car, 1-based (Tab cycles) */
-  sim_viewer_view_t view; /* 1/2/3 */
+  int quit;            /* 1 once Esc was pressed or the window closed */
+  int reset_requested; /* R pressed since the previous frame (edge, cleared each frame) */
+  int paused;          /* Space toggles: while 1 the sim should not step */
+  int day;             /* N toggles: 1 day, 0 night (the light level 1 or 0.15) */
+  int car;             /* shown (ego) car, 1-based (Tab cycles) */
+  int view;            /* sim_viewer_view_t: 1/2/3/4, the Camera radio */
+  double light_level;  /* 0..1 scales the scene's lights (1 day) */
+  int shadows, reflections, skybox; /* graphics quality (all 0: the fast default) */
+  int hud;            /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
+  int lidar_rays;     /* 1: the caller's LIDAR rays are drawn */
+  int step_requested; /* Step clicked (edge): one step while paused */
+  int record_toggled; /* the Record button (edge): start or stop recording */
 } sim_viewer_input_t;
 
 typedef struct sim_viewer sim_viewer_t;
@@ -55,6 +69,28 @@ int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_in
 
 /* Feeds one key as if pressed (GLFW_KEY_* code): the key handling, exposed for tests. */
 void sim_viewer_key(sim_viewer_t *v, int glfw_key);
+
+/* The HUD's text: titles (left column) and values (right column), lines split by '\n', drawn at
+ * the top right while in.hud is on. Copied (truncated at 4 kB). */
+void sim_viewer_set_hud(sim_viewer_t *v, const char *titles, const char *values);
+/* The map's name in the Simulation section (copied). */
+void sim_viewer_set_map_name(sim_viewer_t *v, const char *name);
+/* LIDAR rays to draw while in.lidar_rays is on: n end points (x, y, z [m], world) seen from
+ * origin; replaces the previous set. NULL / 0 clears. */
+void sim_viewer_set_rays(sim_viewer_t *v, const double origin[3], const float *ends_xyz, int n);
+
+/* The MJCF camera id the current view shows (driver's, god's, an overhead Eye), or -1 for the
+ * views that follow no fixed camera (bird's, free). After the first frame. */
+int sim_viewer_camera_id(const sim_viewer_t *v);
+
+/* Scripted input for tests (the same paths as the window's callbacks): a left click at
+ * window position (x_px, y_px; y down from the top), and the centre of the Menu Panel item
+ * named name (its label, e.g. "Pause", "Reset"; radio elements by "Camera/Bird's") after the
+ * first frame. sim_viewer_item_at returns 0, or -1 when no such item is shown. */
+void sim_viewer_click(sim_viewer_t *v, double x_px, double y_px);
+int sim_viewer_item_at(const sim_viewer_t *v, const char *name, double *x_px, double *y_px);
+/* A key pressed (1) or released (0), as from the keyboard (GLFW_KEY_* code). */
+void sim_viewer_key_state(sim_viewer_t *v, int glfw_key, int down);
 
 /* With capture on, every frame is also read back (before the swap) so that
  * sim_viewer_read_rgb can return it. Off by default (it costs a readback). For tests. */

@@ -1,0 +1,59 @@
+/* The viewer's own state, shared by sim_viewer.c (window, scene, frame) and sim_viewer_ui.c
+ * (the Menu Panel: mjui sections, mouse and keys). Not a public header. */
+#ifndef SIM_VIEWER_INTERNAL_H
+#define SIM_VIEWER_INTERNAL_H
+
+#include <mujoco/mujoco.h>
+
+#include "sim_viewer.h"
+
+#define SIM_VIEWER_HUD_CHARS 4096
+#define SIM_VIEWER_MAX_EYES 8
+#define SIM_VIEWER_NIGHT_LEVEL 0.15 /* N: the light level of night (day 1) */
+
+struct GLFWwindow;
+
+struct sim_viewer {
+  struct GLFWwindow *win;
+  mjrContext con;
+  mjvScene scn;
+  mjvOption opt;
+  mjvCamera cam;
+  int ncars;
+  int *car_body;                    /* base body id per car (index car-1), -1 if missing */
+  int *car_cam;                     /* front camera id per car, -1 if missing */
+  int eye_cam[SIM_VIEWER_MAX_EYES]; /* the map's overhead cameras ("eye", "eye_*") */
+  int neyes;
+  int w, h;
+  sim_viewer_input_t in;
+  int capture;
+  unsigned char *rgb; /* last captured frame, top-down */
+  size_t rgb_px;      /* its capacity [px] */
+  int have_rgb;
+  /* the Menu Panel */
+  mjUI ui;
+  mjuiState ui_state;
+  int panel;                   /* 1: shown (M toggles) */
+  int ui_car;                  /* the Ego car radio: in.car - 1 */
+  int ui_dirty;                /* the panel's buffer needs a redraw (mjui_update) */
+  sim_viewer_input_t ui_shown; /* the state the buffer shows */
+  const mjModel *model;
+  double cursor_x, cursor_y; /* [px] window coordinates, y down (GLFW) */
+  char map_name[128], rtf_text[64];
+  double ray_origin[3]; /* [m] world */
+  float *ray_end;       /* nrays x 3 [m] world */
+  int nrays;
+  char hud_titles[SIM_VIEWER_HUD_CHARS], hud_values[SIM_VIEWER_HUD_CHARS];
+};
+
+/* The Menu Panel: built once (sim_viewer_create), its figures refreshed and drawn each frame
+ * over the left of the scene, and the mouse events it owns. */
+void sim_viewer_ui_init(sim_viewer_t *v);
+void sim_viewer_ui_render(sim_viewer_t *v);
+/* A mouse button (press 1 / release 0) at window position (x_px, y_px, y down). Returns 1 when
+ * the panel took it. */
+int sim_viewer_ui_mouse(sim_viewer_t *v, double x_px, double y_px, int press);
+/* The names of the camera radio (driver, bird, god, free, then the overhead cameras). */
+void sim_viewer_ui_camera_names(const sim_viewer_t *v, const mjModel *m, char *out, size_t n);
+
+#endif
