@@ -83,6 +83,6 @@ def test_jetson_native_build_links_programs(root: Path) -> None:
     # The Jetson guide builds with plain cmake (no tools/setup there) and then runs build/bin.
     guide = (root / "docs" / "guides" / "jetson.md").read_text()
     build = guide.index("cmake --build build/release")
-    assert "tools/build --link-only" in guide[build : guide.index("```", build)], (
-        "docs/guides/jetson.md: the native build must link its programs into build/bin"
-    )
+    assert (
+        "tools/build --link-only" in guide[build : guide.index("```", build)]
+    ), "docs/guides/jetson.md: the native build must link its programs into build/bin"
