@@ -29,13 +29,21 @@ def make_program(path: Path) -> None:
     path.chmod(0o755)
 
 
-def test_link_programs_prefers_release(root: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "command",
+    [
+        "source {tree}/tools/lib.sh && link_programs",
+        # the Jetson guide's native build (plain cmake) links with this; nothing set up or built
+        "{tree}/tools/build --link-only",
+    ],
+)
+def test_link_programs_prefers_release(root: Path, tmp_path: Path, command: str) -> None:
     shutil.copytree(root / "tools", tmp_path / "tools", symlinks=True)
     for name in ("autodrive-sim", "autodrive-eye", "nano-simavr", "runtime_unit_tests"):
         make_program(tmp_path / "build" / "asan" / "bin" / name)
     make_program(tmp_path / "build" / "release" / "bin" / "autodrive-sim")
     r = subprocess.run(
-        ["bash", "-c", f"source {tmp_path}/tools/lib.sh && link_programs"],
+        ["bash", "-c", command.format(tree=tmp_path)],
         capture_output=True,
         text=True,
         check=True,
@@ -61,6 +69,7 @@ def test_every_build_command_links_programs(root: Path, tool: str) -> None:
 def test_guides_name_build_bin(root: Path) -> None:
     pages = [root / "README.md", root / "docs" / "getting-started.md"]
     pages += sorted((root / "docs" / "guides").glob("*.md"))
+    pages += sorted((root / "tools" / "systemd").glob("*.service"))  # what runs on the car
     bad = [
         f"{p.relative_to(root)}:{i}: {line.strip()}"
         for p in pages
@@ -68,3 +77,12 @@ def test_guides_name_build_bin(root: Path) -> None:
         if re.search(r"build/(release|asan|dev)/bin/", line)
     ]
     assert not bad, "user commands must run programs from build/bin:\n" + "\n".join(bad)
+
+
+def test_jetson_native_build_links_programs(root: Path) -> None:
+    # The Jetson guide builds with plain cmake (no tools/setup there) and then runs build/bin.
+    guide = (root / "docs" / "guides" / "jetson.md").read_text()
+    build = guide.index("cmake --build build/release")
+    assert (
+        "tools/build --link-only" in guide[build : guide.index("```", build)]
+    ), "docs/guides/jetson.md: the native build must link its programs into build/bin"

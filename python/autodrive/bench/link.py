@@ -1,16 +1,19 @@
 """tools/bench link: Nano link and estimator figures of the Jetson runtime (issues 5 and 40).
   cmd_to_serial_us_p50, _p99  LCM command -> COMMAND frame on the serial device (fake Nano on
                         a pty); goals <= 500 us and <= 20000 us (one heartbeat period)
-  cmd_to_pwm_ms_p50     LCM command -> motor PWM register change (real ELF in nano-simavr);
-                        cmd_to_pwm_ms_p50_at_real_time (scaled by simavr's speed) goal <= 5 ms
+  cmd_to_pwm_ms_p50     LCM command -> motor PWM register change (real ELF in nano-simavr),
+                        the commands a 50 Hz controller sends; cmd_to_pwm_ms_p50_at_real_time
+                        (scaled by simavr's speed) goal <= 5 ms
   serial_cmd_hz_under_flood  COMMAND frames per second on the serial link while 40000 commands a
                         second go to <VEH>_COMMAND (1 in 8 valid); goal <= 1.1 x the token
                         bucket's rate (bridge.command_rate_hz of the car's config)
   flood_cpu_percent     CPU of the bridge process (autodrive-runtime --only bridge) during that
                         flood, per wall second (100 = one core); goal <= FLOOD_CPU_GOAL_PERCENT
-  telemetry_hz, telemetry_jitter_ms   <VEH>_STATE on LCM from the real ELF in nano-simavr
-                        (jitter = median |inter-arrival - median inter-arrival|); *_sim: from
-                        autodrive-sim
+  telemetry_hz, telemetry_jitter_ms   <VEH>_STATE on LCM from the real ELF in nano-simavr:
+                        the rate in the Nano's clock (its nano_time_us: what the firmware sends
+                        and the bridge forwards, whatever speed simavr keeps on a loaded host;
+                        telemetry_hz_wall: per wall second); jitter = median |inter-arrival -
+                        median inter-arrival| on the host; *_sim: from autodrive-sim
   ekf_pos_rms_m, ekf_heading_rms_deg  <VEH>_POSE_MAP (EKF with Eye poses) vs the simulator's
                         ground truth over a 60 s driven loop; *_no_eye: <VEH>_ODOM (odometry only)
 goals_met: every goal above, a missing figure failing its goal. Progress on stderr; the last line

@@ -4,7 +4,8 @@
 //               readable on the pty master [us] (cmd_to_serial_us_*)
 //   pwm       : with nano-simavr --pwm-log; LCM command -> motor PWM register changed, from
 //               the log's monotonic stamps [ms] (cmd_to_pwm_ms_*)
-//   telemetry : <VEH>_STATE inter-arrival on LCM (telemetry_hz, telemetry_jitter_ms)
+//   telemetry : <VEH>_STATE on LCM: its rate in the sender's clock (nano_time_us:
+//               telemetry_hz) and on the host's (telemetry_hz_wall), inter-arrival jitter
 //   ekf       : drives a loop through <VEH>_COMMAND, publishes Eye poses made from the sim's
 //               ground truth (noise + latency), compares <VEH>_POSE_MAP and <VEH>_ODOM with
 //               ground truth (ekf_*_rms)
@@ -265,7 +266,8 @@ struct StateWatch {
 };
 
 int run_pwm(const std::string &url, const std::string &vehicle, const std::string &log_path,
-            int samples) {
+            int samples, double command_hz) {
+  const auto period_us = static_cast<int64_t>(std::llround(1e6 / command_hz));
   lcm::LCM lcm(url);
   StateWatch w;
   if (!w.attach(lcm, vehicle)) {
@@ -274,13 +276,24 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
   }
   int32_t seq = 0;
   // Engage at a base throttle and let the PWM settle, then alternate throttle steps; each
-  // step's first motor register change after its publish time is one sample.
+  // step's first motor register change after its publish time is one sample. Between steps
+  // the command stream a controller sends: one command per period, drift-free. (It used to
+  // publish after every LCM message received, at the STATE rate and above, faster than the
+  // bridge's token bucket (command_rate_hz): the bucket stayed empty and each step waited for
+  // a token, up to 10 ms, so the bench measured its own flood.)
   float throttle = 0.2f;
+  int64_t next_cmd_us = autodrive::clock::monotonic_us();
   auto hold = [&](int64_t until_us) {
-    while (autodrive::clock::monotonic_us() < until_us) {
-      const auto c = make_cmd(seq++, throttle, 0.0f, true);
-      lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
-      lcm.handleTimeout(20);
+    for (int64_t now = autodrive::clock::monotonic_us(); now < until_us;
+         now = autodrive::clock::monotonic_us()) {
+      if (now >= next_cmd_us) {
+        const auto c = make_cmd(seq++, throttle, 0.0f, true);
+        lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
+        next_cmd_us += period_us;
+        if (next_cmd_us <= now) next_cmd_us = now + period_us;  // resync after a stall
+      }
+      const int64_t wait_us = std::min(next_cmd_us, until_us) - now;
+      lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, (wait_us + 999) / 1000)));
     }
   };
   hold(autodrive::clock::monotonic_us() + 1500000);
@@ -290,6 +303,7 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
     const auto c = make_cmd(seq++, throttle, 0.0f, true);
     const int64_t t0 = autodrive::clock::monotonic_us();
     lcm.publish(vehicle + AUTODRIVE_CH_COMMAND_SUFFIX, &c);
+    next_cmd_us = t0 + period_us;  // the step is this period's command
     step_t0.push_back(t0);
     hold(t0 + 700000 + static_cast<int64_t>((k * 7919) % 20000));
     if (k % 5 == 0) progress("pwm: %.0f steps\n", k);
@@ -327,9 +341,10 @@ int run_pwm(const std::string &url, const std::string &vehicle, const std::strin
           double(lines.back().t_mono_us - first->t_mono_us);
   std::printf(
       "{\"cmd_to_pwm_ms_p50\": %.3f, \"cmd_to_pwm_ms_p90\": %.3f, \"cmd_to_pwm_samples\": %zu, "
-      "\"simavr_real_time_factor\": %.3f, \"cmd_to_pwm_ms_p50_at_real_time\": %.3f}\n",
+      "\"simavr_real_time_factor\": %.3f, \"cmd_to_pwm_ms_p50_at_real_time\": %.3f, "
+      "\"cmd_to_pwm_command_hz\": %.1f}\n",
       percentile(lat_ms, 50), percentile(lat_ms, 90), lat_ms.size(), rtf,
-      percentile(lat_ms, 50) * rtf);
+      percentile(lat_ms, 50) * rtf, command_hz);
   return lat_ms.empty() ? 1 : 0;
 }
 
@@ -348,18 +363,27 @@ int run_telemetry(const std::string &url, const std::string &vehicle, double sec
     return 1;
   }
   std::vector<double> dt_ms;
-  for (std::size_t i = 1; i < w.rx_mono_us.size(); ++i)
+  int64_t nano_span_us = 0;  // the Nano's clock over the messages received (it wraps at 2^32)
+  for (std::size_t i = 1; i < w.rx_mono_us.size(); ++i) {
     dt_ms.push_back((w.rx_mono_us[i] - w.rx_mono_us[i - 1]) / 1000.0);
+    nano_span_us += static_cast<int64_t>(static_cast<uint32_t>(w.states[i].nano_time_us) -
+                                         static_cast<uint32_t>(w.states[i - 1].nano_time_us));
+  }
+  const double n_intervals = static_cast<double>(w.rx_mono_us.size() - 1);
+  // The rate in the sender's own time: what the firmware (or the simulator) sends and the
+  // bridge forwards, whatever speed simavr keeps on a loaded host (a dropped STATE lowers it).
+  // Rounded to 0.1 Hz: the 1.024 ms tick's jitter at the two ends is 1e-4 of a 10 s span.
   const double hz =
-      (w.rx_mono_us.size() - 1) * 1e6 / double(w.rx_mono_us.back() - w.rx_mono_us.front());
+      nano_span_us > 0 ? std::round(n_intervals * 1e7 / double(nano_span_us)) / 10 : NAN;
+  const double hz_wall = n_intervals * 1e6 / double(w.rx_mono_us.back() - w.rx_mono_us.front());
   const double med = percentile(dt_ms, 50);
   std::vector<double> dev;
   for (double d : dt_ms) dev.push_back(std::fabs(d - med));
+  const char *k = key_suffix.c_str();
   std::printf(
-      "{\"telemetry_hz%s\": %.2f, \"telemetry_jitter_ms%s\": %.3f, "
+      "{\"telemetry_hz%s\": %.1f, \"telemetry_hz_wall%s\": %.2f, \"telemetry_jitter_ms%s\": %.3f, "
       "\"telemetry_jitter_ms_p99%s\": %.3f, \"telemetry_period_ms_p50%s\": %.3f}\n",
-      key_suffix.c_str(), hz, key_suffix.c_str(), percentile(dev, 50), key_suffix.c_str(),
-      percentile(dev, 99), key_suffix.c_str(), med);
+      k, hz, k, hz_wall, k, percentile(dev, 50), k, percentile(dev, 99), k, med);
   return 0;
 }
 
@@ -572,6 +596,7 @@ int main(int argc, char **argv) {
   int samples = 500;
   int cpu_pid = 0;
   double seconds = 10, throttle = 0.6, steering = 0.6, eye_delay_ms = 50, flood_hz = 40000;
+  double command_hz = 50;  // as the missions send (hil/missions/loop.py)
   std::string key_file;
   app.add_option("mode", mode, "serial | pwm | telemetry | ekf | flood")
       ->required()
@@ -581,6 +606,11 @@ int main(int argc, char **argv) {
                  "~/.config/autodrive/keys/<VEH>.key)");
   app.add_option("--flood-hz", flood_hz, "flood: commands per second on LCM")
       ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--command-hz", command_hz,
+                 "pwm: the controller's command rate between the steps [Hz]; above the "
+                 "bridge's command_rate_hz its token bucket runs dry")
+      ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();
   app.add_option("--cpu-pid", cpu_pid, "flood: the process whose CPU time to report (the bridge)");
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
@@ -609,7 +639,7 @@ int main(int argc, char **argv) {
   }
   if (mode == "flood") return run_flood(url, vehicle, pty, seconds, flood_hz, cpu_pid);
   if (mode == "serial") return run_serial(url, vehicle, pty, samples);
-  if (mode == "pwm") return run_pwm(url, vehicle, pwm_log, samples);
+  if (mode == "pwm") return run_pwm(url, vehicle, pwm_log, samples, command_hz);
   if (mode == "telemetry") return run_telemetry(url, vehicle, seconds, suffix);
   return run_ekf(url, vehicle, seconds, throttle, steering, eye_delay_ms);
 }
