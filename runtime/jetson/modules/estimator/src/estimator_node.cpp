@@ -70,6 +70,9 @@ struct EstimatorNode::Impl {
     if (!output_url.empty()) out = std::make_unique<lcm::LCM>(output_url);
     if (eye_auth == EyePoseAuth::verify) {
       eye_verifier = autodrive::v2x::Verifier::load("autodrive-runtime estimator");
+      // A pose is fresh while the filter can still fuse it (its history): the Eye's poses
+      // arrive up to a frame's processing after their capture stamp.
+      if (eye_verifier) eye_verifier->set_window_us(params_from_config(c).history_us);
       if (!eye_verifier)
         spdlog::error("{}{}: no trust anchor, so no Eye pose will be taken (tools/keys)",
                       c.vehicle.name, AUTODRIVE_CH_POSE_EYE_SUFFIX);
