@@ -110,6 +110,15 @@ Scene make_scene(int w, int h, int frames, double tag_size_m,
   return sc;
 }
 
+// The Eye's signer (the testbed's EYE certificate, tools/setup): the bench times signed poses,
+// as autodrive-eye publishes them. Exits when it cannot sign.
+autodrive::v2x::Signer &eye_signer() {
+  static std::optional<autodrive::v2x::Signer> signer =
+      autodrive::v2x::Signer::load("eye_bench", "EYE");
+  if (!signer) std::exit(2);
+  return *signer;
+}
+
 // Times `repeats` passes over the scene's frames: decode, detect (start_pass() gives a fresh
 // detector for each pass, a function of the grey frame to its car poses), publish.
 template <typename StartPass>
@@ -122,7 +131,7 @@ RunResult time_passes(const Scene &sc, lcm::LCM &lcm, int repeats, StartPass sta
     for (size_t i = 0; i < sc.jpeg.size(); ++i) {
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
       const std::vector<eye::CarPose> poses = detect(g);
-      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
+      eye::publish_poses(lcm, eye_signer(), poses, static_cast<int64_t>(i) * 33333);
       if (rep == 0)
         r.est.push_back(poses.empty() ? std::nullopt : std::optional<eye::CarPose>(poses[0]));
     }
@@ -369,11 +378,11 @@ WideResult run_wide(const WideScene &sc, lcm::LCM &lcm, int repeats, const eye::
       const cv::Mat g = eye::decode_gray(sc.jpeg[i].data(), sc.jpeg[i].size(), "bench frame");
       // As autodrive-eye: the tracked cars' poses out, then the band.
       auto poses = tr.track(g);
-      eye::publish_poses(lcm, poses, static_cast<int64_t>(i) * 33333);
+      eye::publish_poses(lcm, eye_signer(), poses, static_cast<int64_t>(i) * 33333);
       r.latency_ms.push_back(
           std::chrono::duration<double, std::milli>(clock_type::now() - f0).count());
       const auto late = tr.finish();
-      eye::publish_poses(lcm, late, static_cast<int64_t>(i) * 33333);
+      eye::publish_poses(lcm, eye_signer(), late, static_cast<int64_t>(i) * 33333);
       poses.insert(poses.end(), late.begin(), late.end());
       r.frame_cpu_ms.push_back(1e3 * (thread_cpu_s() - fc0));
       if (rep == 0) {

@@ -203,6 +203,7 @@ int main(int argc, char **argv) {
   // run
   auto *rn = app.add_subcommand("run", "Localise the cars and publish <VEH>_POSE_EYE (pose2d_t)");
   std::string rn_config, rn_source = std::string("lcm:") + AUTODRIVE_CH_EYE_IMAGE, rn_debug, rn_url;
+  std::string rn_sign_as = "EYE";
   double rn_fps = 30.0, rn_idle_s = 0.0, rn_sim_latency_ms = -1.0, rn_cpu_delay_ms = 0.0;
   int rn_max_frames = 0, rn_debug_every = 1, rn_realtime = -1;
   bool rn_quiet = false;
@@ -225,6 +226,10 @@ int main(int argc, char **argv) {
                  "lcm source: stop after this long without a frame (0: never)")
       ->capture_default_str();
   rn->add_flag("-q,--quiet", rn_quiet, "no per-frame line on stdout");
+  rn->add_option("--sign-as", rn_sign_as,
+                 "sign the poses with this eye-role certificate (NAME.cert, NAME.sk in "
+                 "$AUTODRIVE_KEY_DIR; tools/keys issue --role eye)")
+      ->capture_default_str();
   rn->add_option("--sim-latency-ms", rn_sim_latency_ms,
                  "lockstep with the simulator (lcm: sources, autodrive-sim --eye-sync): publish "
                  "a frame's poses (stamped with its capture time) when SIM_CLOCK reaches capture "
@@ -355,6 +360,11 @@ int main(int argc, char **argv) {
       cfg.lcm_url = autodrive::instance_lcm_url(cfg.lcm_url);  // AUTODRIVE_INSTANCE
       lcm::LCM lcm(cfg.lcm_url);
       if (!lcm.good()) throw eye::Error("lcm: cannot open " + cfg.lcm_url);
+      auto signer = autodrive::v2x::Signer::load("autodrive-eye", rn_sign_as);
+      if (!signer) return 2;  // the reason is printed: no car would take unsigned poses
+      if (signer->cert().role != V2X_ROLE_EYE)
+        throw eye::Error("--sign-as " + rn_sign_as + ": a " + v2x_role_name(signer->cert().role) +
+                         " certificate; Eye poses need an eye certificate");
       if (rn_sim_latency_ms >= 0) cfg.sim_latency_ms = rn_sim_latency_ms;
       // One source per camera: the config's `source`, else --source (one camera only).
       std::vector<std::unique_ptr<eye::Source>> srcs;
@@ -436,7 +446,7 @@ int main(int argc, char **argv) {
         auto poses = multi.track(grays, utime);
         if (rn_cpu_delay_ms > 0) eye::burn_cpu_ms(rn_cpu_delay_ms);
         if (!lockstep) {
-          published += eye::publish_poses(lcm, poses, utime);
+          published += eye::publish_poses(lcm, *signer, poses, utime);
           if (fs[0].wall_clock)
             latency_ms.push_back(1e-3 * static_cast<double>(eye::now_utime() - utime));
         }
@@ -444,10 +454,10 @@ int main(int argc, char **argv) {
         if (lockstep) {  // every pose of the frame at capture + latency of sim time
           poses.insert(poses.end(), late.begin(), late.end());
           lockstep->hold(utime, &g_stop);
-          published += eye::publish_poses(lcm, poses, utime);
+          published += eye::publish_poses(lcm, *signer, poses, utime);
           lockstep->done(lcm, utime, static_cast<int>(poses.size()));
         } else {
-          published += eye::publish_poses(lcm, late, utime);
+          published += eye::publish_poses(lcm, *signer, late, utime);
           poses.insert(poses.end(), late.begin(), late.end());
         }
         for (size_t i : multi.newly_moved()) {

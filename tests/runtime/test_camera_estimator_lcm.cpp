@@ -17,12 +17,14 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <thread>
 
 #include <autodrive/camera/camera_driver.hpp>
 #include <autodrive/core/config.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <autodrive/estimator/estimator_node.hpp>
+#include <autodrive/v2x.hpp>
 
 namespace {
 std::string base_yaml(int port) {
@@ -41,6 +43,17 @@ bool pump_until(lcm::LCM &lcm, const std::function<bool()> &pred, double max_s =
     if (pred()) return true;
   }
   return pred();
+}
+
+// Publishes e signed by `signer_name`'s certificate (the testbed's, tools/setup), stamped with
+// its own utime; the Eye's by default, as autodrive-eye does.
+void publish_pose(lcm::LCM &lcm, autodrive::pose2d_t &e, const std::string &signer_name = "EYE") {
+  static std::map<std::string, std::optional<autodrive::v2x::Signer>> signers;
+  auto &signer = signers[signer_name];
+  if (!signer) signer = autodrive::v2x::Signer::load("test", signer_name);
+  ASSERT_TRUE(signer.has_value()) << "tools/setup makes the testbed's certificates";
+  signer->sign("TESTCAR_POSE_EYE", e, e.utime);
+  lcm.publish("TESTCAR_POSE_EYE", &e);
 }
 
 struct Sink {
@@ -142,7 +155,7 @@ TEST(EstimatorLcm, TelemetryAndEyeToOdomAndMap) {
       e.x_m = 2.0;
       e.y_m = 1.0 + 0.204 * k * 0.01;
       e.yaw_rad = M_PI / 2;
-      lcm.publish("TESTCAR_POSE_EYE", &e);
+      publish_pose(lcm, e);
     }
     ++k;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -193,12 +206,19 @@ TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
     if (k % 10 == 0) {  // the real Eye at 10 Hz
       e.x_m = 2.0;
       e.y_m = 1.0 + 0.204 * k * 0.01;
-      lcm.publish("TESTCAR_POSE_EYE", &e);
+      publish_pose(lcm, e);
     }
-    if (k > 100) {  // a forger at 100 Hz, 1,000 m away
+    if (k > 100) {  // a forger with the Eye's own key at 100 Hz, 1,000 m away: the gate
       e.x_m = 1002.0;
       e.y_m = 1.0;
-      lcm.publish("TESTCAR_POSE_EYE", &e);
+      publish_pose(lcm, e);
+      // and forgers without it, 0.3 m off: unsigned, and signed by a car's certificate
+      e.x_m = 2.3;
+      autodrive::pose2d_t unsigned_pose = e;
+      unsigned_pose.auth.clear();
+      unsigned_pose.auth_len = 0;
+      lcm.publish("TESTCAR_POSE_EYE", &unsigned_pose);
+      publish_pose(lcm, e, "NIGEL1");
     }
     if (k == 200) {
       autodrive::imu_t imu{};
@@ -224,6 +244,11 @@ TEST(EstimatorLcm, ForgedPosesEncoderJumpsAndGyroSpikesAreRefused) {
   EXPECT_GE(st.wheel_dropped, 1u);
   EXPECT_LE(st.wheel_dropped, 2u);  // the jump and the step back
   EXPECT_GE(st.poses_gated, 150u);
+  EXPECT_GE(st.poses_unauthenticated, 300u);
+  EXPECT_NE(st.poses_refused_by_reason.find("unsigned="), std::string::npos)
+      << st.poses_refused_by_reason;
+  EXPECT_NE(st.poses_refused_by_reason.find("wrong role for this channel="), std::string::npos)
+      << st.poses_refused_by_reason;
   EXPECT_EQ(st.gyro_dropped, 1u);
   EXPECT_EQ(st.reacquired, 0u);
 }
@@ -256,7 +281,7 @@ TEST(EstimatorLcm, NoMapPoseBeforeTheFirstEyeFix) {
       e.x_m = 2.0;
       e.y_m = -1.0;
       e.yaw_rad = 1.0;
-      lcm.publish("TESTCAR_POSE_EYE", &e);
+      publish_pose(lcm, e);
     }
     ++k;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));

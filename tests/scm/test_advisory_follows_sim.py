@@ -20,7 +20,7 @@ from pathlib import Path
 
 from harness import Client, LightWatch, Server, add_user, check, start_sim, wait_for
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive import maps
 from autodrive.core.channels import channel
 
@@ -54,10 +54,23 @@ def test_advisory_never_ahead_of_sim_light(
     here = route.pose_at(s_stop - 0.5)  # the car stands 0.5 m before light 1's stop line
     feeding = threading.Event()
 
+    # NIGEL1's V2V signed by its certificate on the bus's clock (the sim's, from its light
+    # states), as its runtime signs it in HIL: the SCM takes a car's route from that car only
+    car_signer, bus_clock = (
+        v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL1")),
+        v2x_auth.BusClock(),
+    )
+    feed_lc.subscribe(
+        channel("TRAFFIC_LIGHT_STATE"),
+        lambda _c, d: bus_clock.heard(T.traffic_light_state_t.decode(d).utime),
+    )
+
     def feed() -> None:
         """NIGEL1's EKF pose at 20 Hz and its route on V2V at 2 Hz, on the wall clock."""
         n = 0
         while not feeding.is_set():
+            while feed_lc.handle_timeout(0) > 0:  # the light states heard so far: the clock
+                pass
             o = T.odometry_t()
             o.utime, o.vehicle, o.frame_id = int(time.time() * 1e6), "NIGEL1", "map"
             o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = here.x_m, here.y_m, here.yaw_rad, 0.0
@@ -66,6 +79,7 @@ def test_advisory_never_ahead_of_sim_light(
                 v = T.v2v_state_t()
                 v.utime, v.vehicle, v.route = o.utime, "NIGEL1", "north_to_lot"
                 v.x_m, v.y_m, v.yaw_rad = here.x_m, here.y_m, here.yaw_rad
+                car_signer.sign(channel("V2V"), v, bus_clock.now_us())
                 feed_lc.publish(channel("V2V"), v.encode())
             n += 1
             time.sleep(0.05)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from harness import Client, Server, add_user, check, wait_for
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive import maps
 from autodrive.core.channels import channel
 
@@ -65,6 +65,10 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
         o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = x, y, yaw, v
         return bytes(o.encode())
 
+    # the SCM takes Eye poses from the Eye's certificate and a car's V2V from that car's only
+    eye_signer = v2x_auth.MessageSigner(v2x_ca.load_identity("EYE"))
+    car_signer = v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL1"))
+
     def eye(vehicle: str, x: float, y: float, yaw: float) -> bytes:
         p = T.pose2d_t()
         p.utime, p.vehicle, p.frame_id, p.source = (
@@ -74,7 +78,7 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
             T.pose2d_t.SOURCE_EYE,
         )
         p.x_m, p.y_m, p.yaw_rad = x, y, yaw
-        return bytes(p.encode())
+        return bytes(eye_signer.sign(channel("POSE_EYE", vehicle), p, p.utime).encode())
 
     with tempfile.TemporaryDirectory(prefix="scm-lcm-") as tmp:
         db = f"sqlite:///{tmp}/scm.sqlite"
@@ -104,7 +108,7 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
                         s,
                     )
                     v.x_m, v.y_m, v.yaw_rad, v.speed_m_s = p.x_m, p.y_m, p.yaw_rad, speed
-                    lc.publish(channel("V2V"), v.encode())
+                    lc.publish(channel("V2V"), car_signer.sign(channel("V2V"), v, v.utime).encode())
                 sent += 1
                 time.sleep(0.02)
             time.sleep(0.5)

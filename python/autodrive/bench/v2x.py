@@ -18,16 +18,20 @@ Figures (goal in brackets):
   bus16_cpu_share              CPU share of one core to check a 16-car bus at 20 Hz (300 msg/s
       from the 15 others) [reported; <= 0.05]
   forged_green_red_violations  red-light violations of a real smart-city run (3 cars, the
-      real SCM, 30 s of sim time) while forged GREEN advisories go to every car at 50 Hz [0]
+      real SCM, 30 s of sim time, the Eye stand-in: CITY_EYE) while forged GREEN advisories go to every car at 50 Hz [0]
   ghost_car_extra_stop_s       the same run's stopped time of all cars (GROUND_TRUTH), with
       ghost cars 0.3 m ahead of each on V2V, over the longer of two quiet runs of the same seed
       (their spread: the run-to-run difference) [0]
-  eye_walk_ekf_drift_m: the Eye poses are not signed yet: not measured, its goal fails.
+  eye_walk_ekf_drift_m         the same run's EKF error (POSE_MAP against GROUND_TRUTH, median
+      over the last 10 s of sim time, the worst car) over the quiet runs', while forged Eye poses
+      walk each car away at 1 cm/s from its true pose (unsigned, signed by a car's certificate,
+      and the real Eye's signed pose with the walk written in) [<= 0.02 m]
 Progress on stderr; the last line is one JSON object. Usage: tools/bench v2x [--help]"""
 
 from __future__ import annotations
 
 import argparse
+import bisect
 import ctypes
 import json
 import math
@@ -334,13 +338,21 @@ def brute_force(build: Path, tmp: Path) -> dict[str, Any]:
 CITY_PORT, CITY_CARS, CITY_SIM_S, CITY_SEED = 7874, 3, 30, 2003  # seed: evaluation range
 CITY_URL = f"udpm://239.255.76.67:{CITY_PORT}?ttl=0"
 STOPPED_M_S = 0.01  # a car slower than this is stopped [m/s]
+# The Eye stand-in (a test double: poses from GROUND_TRUTH at 10 Hz of sim time, seeded noise,
+# signed with the testbed's EYE certificate), so that runs of one seed repeat: with the real
+# Eye, not yet in lockstep with the simulator, two quiet runs differed by 7.3 s of stop time,
+# which hid whatever an attack added.
+CITY_EYE = "standin"
+WALK_M_S = 0.01  # the forged Eye poses' walk away from the true pose [m/s of sim time]
 
 
 class CityAttacker:
     """Beside a real smart-city run: for each car, at 50 Hz of wall time, forged GREEN advisories
-    (unsigned; the real signed one with RED made GREEN; signed by a car's certificate) and a
+    (unsigned; the real signed one with RED made GREEN; signed by a car's certificate), a
     ghost car standing 0.3 m ahead of it on V2V (unsigned as NIGEL9, and under another real
-    car's name signed by this car's own certificate)."""
+    car's name signed by this car's own certificate) and Eye poses walking away from the car's
+    true pose at WALK_M_S of sim time (unsigned; signed by a car's certificate; the real Eye's
+    last signed pose with the walk written in)."""
 
     def __init__(self, types: Any, key_dir: Path) -> None:
         self.types = types
@@ -351,10 +363,16 @@ class CityAttacker:
         }
         self.advice: dict[str, Any] = {}
         self.states: dict[str, Any] = {}
+        self.truth: dict[str, Any] = {}  # each car's latest GROUND_TRUTH
+        self.eye: dict[str, Any] = {}  # each car's latest real (signed) Eye pose
+        self.walk_from_us: dict[str, int] = {}  # each car's walk start [us, sim]
+        self.forged_auth: set[bytes] = set()  # envelopes of this attacker's own Eye poses
         self.sent = 0
         self.stop = threading.Event()
         for car in self.car_signers:
             self.lc.subscribe(channel("V2I", car), self._on_advice)
+            self.lc.subscribe(channel("GROUND_TRUTH", car), self._on_truth)
+            self.lc.subscribe(channel("POSE_EYE", car), self._on_eye)
         self.lc.subscribe(channel("V2V"), self._on_v2v)
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
@@ -367,6 +385,42 @@ class CityAttacker:
         m = self.types.v2v_state_t.decode(data)
         if m.vehicle in self.car_signers:
             self.states[m.vehicle] = m
+
+    def _on_truth(self, _c: str, data: bytes) -> None:
+        m = self.types.ground_truth_t.decode(data)
+        self.truth[m.vehicle] = m
+        self.walk_from_us.setdefault(m.vehicle, m.utime)
+
+    def _on_eye(self, _c: str, data: bytes) -> None:
+        m = self.types.pose2d_t.decode(data)
+        auth = v2x_auth.auth_of(m)
+        if auth and auth not in self.forged_auth:  # the real Eye's (not this attacker's own)
+            self.eye[m.vehicle] = m
+
+    def _walk(self, car: str, signer: v2x_auth.MessageSigner) -> None:
+        """Eye poses of car WALK_M_S * (sim time since the walk began) off its true pose."""
+        truth = self.truth.get(car)
+        if truth is None:
+            return
+        off_m = WALK_M_S * (truth.utime - self.walk_from_us[car]) * 1e-6
+        chan = channel("POSE_EYE", car)
+        p = self.types.pose2d_t()
+        p.utime, p.vehicle, p.frame_id = truth.utime, car, "map"
+        p.source = self.types.pose2d_t.SOURCE_EYE
+        p.x_m = truth.position_m[0] + off_m * math.cos(truth.yaw_rad + math.pi / 2)
+        p.y_m = truth.position_m[1] + off_m * math.sin(truth.yaw_rad + math.pi / 2)
+        p.yaw_rad = truth.yaw_rad
+        self._publish(chan, p)  # unsigned
+        signed = signer.sign(chan, p, truth.utime)  # a car's certificate
+        if len(self.forged_auth) > 10_000:
+            self.forged_auth.clear()
+        self.forged_auth.add(v2x_auth.auth_of(signed))
+        self._publish(chan, signed)
+        real = self.eye.get(car)
+        if real is not None:  # the Eye's signature kept, the walk written in: a forgery
+            real.x_m, real.y_m = p.x_m, p.y_m
+            self.forged_auth.add(v2x_auth.auth_of(real))
+            self._publish(chan, real)
 
     def _publish(self, chan: str, msg: Any) -> None:
         self.lc.publish(chan, msg.encode())
@@ -381,6 +435,7 @@ class CityAttacker:
                 continue
             next_t += 0.02
             for car, signer in self.car_signers.items():
+                self._walk(car, signer)
                 real = self.advice.get(car)
                 if real is not None:
                     chan = channel("V2I", car)
@@ -409,6 +464,35 @@ class CityAttacker:
         self.thread.join(timeout=10)
 
 
+def ekf_error_m(log_path: Path, types: Any, last_s: float = 10.0) -> float:
+    """The worst car's median EKF map error [m]: each POSE_MAP against the car's
+    GROUND_TRUTH at its stamp (the latest at or before it), over the last `last_s` of the run's
+    sim time."""
+    truth: dict[str, list[tuple[int, float, float]]] = {}
+    maps: list[Any] = []
+    for e in lcmtypes.events(log_path):
+        if e.channel.endswith("_GROUND_TRUTH"):
+            g = types.ground_truth_t.decode(e.data)
+            truth.setdefault(g.vehicle, []).append((g.utime, g.position_m[0], g.position_m[1]))
+        elif e.channel.endswith("_POSE_MAP"):
+            maps.append(types.odometry_t.decode(e.data))
+    tracks = {v: sorted(t) for v, t in truth.items()}
+    errors: dict[str, list[tuple[int, float]]] = {}
+    for m in maps:
+        track = tracks.get(m.vehicle, [])
+        k = bisect.bisect_right(track, (m.utime, math.inf, math.inf)) - 1
+        if k >= 0:
+            _, tx, ty = track[k]
+            errors.setdefault(m.vehicle, []).append((m.utime, math.hypot(m.x_m - tx, m.y_m - ty)))
+    if not errors:
+        raise RuntimeError(f"{log_path}: no POSE_MAP beside GROUND_TRUTH")
+    worst = 0.0
+    for samples in errors.values():
+        end_us = samples[-1][0]
+        worst = max(worst, statistics.median(d for t, d in samples if t >= end_us - last_s * 1e6))
+    return worst
+
+
 def stopped_s(log_path: Path, types: Any) -> float:
     """Sim time the cars spent stopped, all cars [s], from the run's GROUND_TRUTH."""
     last: dict[str, tuple[int, float]] = {}
@@ -428,7 +512,8 @@ def stopped_s(log_path: Path, types: Any) -> float:
 def smart_city_run(build: Path, out: Path) -> dict[str, Any]:
     cmd = [sys.executable, "-m", "autodrive.hil.demo", "--mission", "smart-city", "--headless",
            "--build", str(build), "--out", str(out), "--seed", str(CITY_SEED), "--timeout", "900",
-           "--sim-seconds", str(CITY_SIM_S), "--advisory", "scm", "--lcm-url", CITY_URL]  # fmt: skip
+           "--sim-seconds", str(CITY_SIM_S), "--advisory", "scm", "--lcm-url", CITY_URL,
+           "--eye", CITY_EYE]  # fmt: skip
     subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=1100)
     report: dict[str, Any] = json.loads((out / "report.json").read_text())
     return report
@@ -444,11 +529,12 @@ def refusals(out: Path) -> str:
 
 
 def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dict[str, Any]:
-    quiet_stops = []
+    quiet_stops, quiet_ekf = [], []
     for k in (1, 2):  # two quiet runs: their spread is the run-to-run difference
         log(f"smart-city run, quiet #{k} ({CITY_SIM_S} s of sim time, seed {CITY_SEED})")
         quiet = smart_city_run(build, tmp / f"quiet{k}")
         quiet_stops.append(stopped_s(tmp / f"quiet{k}" / "run.lcmlog", types))
+        quiet_ekf.append(ekf_error_m(tmp / f"quiet{k}" / "run.lcmlog", types))
     attacker = CityAttacker(types, key_dir)
     log("smart-city run, under forged GREEN advisories and ghost cars")
     try:
@@ -457,12 +543,14 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
         attacker.close()
     stop_quiet = max(quiet_stops)
     stop_attacked = stopped_s(tmp / "attacked" / "run.lcmlog", types)
+    ekf_attacked = ekf_error_m(tmp / "attacked" / "run.lcmlog", types)
     refused = refusals(tmp / "attacked")
     log(f"the city drivers refused: {refused}")
     log(f"{attacker.sent} hostile messages; red-light violations {attacked['red_light_violations']}"
         f" (quiet {quiet['red_light_violations']}); stopped {stop_attacked:.1f} s "
         f"(quiet {stop_quiet:.1f} s, all cars)")  # fmt: skip
     return {
+        "city_pose_source": attacked.get("pose_source", CITY_EYE),
         "city_hostile_messages": attacker.sent,
         "forged_green_red_violations": attacked["red_light_violations"],
         "city_collisions_under_attack": attacked["collisions"],
@@ -470,6 +558,9 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
         "city_drivers_refused": refused,
         "city_stopped_s_attacked": round(stop_attacked, 1),
         "ghost_car_extra_stop_s": round(max(0.0, stop_attacked - stop_quiet), 1),
+        "city_ekf_error_m_quiet": [round(q, 4) for q in quiet_ekf],
+        "city_ekf_error_m_attacked": round(ekf_attacked, 4),
+        "eye_walk_ekf_drift_m": round(max(0.0, ekf_attacked - max(quiet_ekf)), 4),
     }
 
 

@@ -197,7 +197,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="tools/keys",
         description="The testbed certificate authority: certificates (Ed25519) that sign V2V, "
-        "V2I and light commands and states (Eye poses: planned). Folder: $AUTODRIVE_KEY_DIR, else "
+        "V2I, light commands and states, and Eye poses. Folder: $AUTODRIVE_KEY_DIR, else "
         "~/.config/autodrive/keys (the CA in its ca/). Format: docs/design/threat-model.md.",
     )
     p.add_argument("--dir", type=Path, help="the key folder (default: see above)")

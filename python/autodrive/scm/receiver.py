@@ -12,7 +12,8 @@ from multiprocessing.synchronize import Event as EventType
 from pathlib import Path
 from typing import Any
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth
+from autodrive.core.v2x_cert import CertificateError
 
 # (source "eye"/"ekf", vehicle, utime [us], x [m], y [m], yaw [rad], speed [m/s] or None)
 PoseTuple = tuple[str, str, int, float, float, float, float | None]
@@ -34,12 +35,25 @@ def run(build: str, url: str, pattern: str, out: "mp.Queue[list[PoseTuple]]",
     types = lcmtypes.load(Path(build))
     lc = lcmtypes.bus(with_receive_buffer(url))
     batch: list[PoseTuple] = []
+    # Eye poses only from an eye certificate (a slow forged walk would move a car's lane and its
+    # advisories): signature, role and a counter above that Eye's last. Their freshness is their
+    # arrival on the server's clock (Car.seen_c), so the window is not checked here.
+    verifier = v2x_auth.Verifier()
+    eye_roles = v2x_auth.roles_for("POSE_EYE")
+    drop_log = v2x_auth.DropLog()
+    reload_at = 0.0
 
     def on_eye(chan: str, data: bytes) -> None:
         try:
             m = types.pose2d_t.decode(data)
         except Exception:  # a message that does not decode is counted, never believed
             counters[1] += 1
+            return
+        claimed = v2x_auth.sender_utime(v2x_auth.auth_of(m))
+        verdict = verifier.verify(chan, m, eye_roles, None, m.utime if claimed is None else claimed)
+        if not verdict.ok:
+            counters[2] += 1
+            drop_log.log(f"scm: {verdict.describe(chan)}", time.monotonic())
             return
         batch.append(("eye", chan.split("_", 1)[0], m.utime, m.x_m, m.y_m, m.yaw_rad, None))
 
@@ -60,6 +74,13 @@ def run(build: str, url: str, pattern: str, out: "mp.Queue[list[PoseTuple]]",
     ready.set()
     flush_at = time.monotonic() + BATCH_S
     while not stop.is_set():
+        if time.monotonic() >= reload_at:  # the revocation list (a stat), 4 times a second
+            reload_at = time.monotonic() + 0.25
+            try:
+                verifier.reload()
+            except (OSError, CertificateError) as err:
+                drop_log.log(f"scm: revocation list: {err} (the list held so far stays)",
+                             time.monotonic())  # fmt: skip
         if select.select([fd], [], [], BATCH_S)[0]:
             lc.handle()
         if batch and time.monotonic() >= flush_at:
@@ -76,7 +97,8 @@ class Receiver:
         self.queue: "mp.Queue[list[PoseTuple]]" = ctx.Queue()
         self.stop_event = ctx.Event()
         self.ready = ctx.Event()
-        self.counters = ctx.Array("q", 2, lock=False)  # poses received, undecodable
+        # poses received, undecodable, Eye poses refused (v2x_auth)
+        self.counters = ctx.Array("q", 3, lock=False)
         self.proc = ctx.Process(
             target=run,
             args=(str(build), url, pattern, self.queue, self.stop_event, self.ready, self.counters),

@@ -1,5 +1,5 @@
 """The Smart City Manager's core: it keeps each car's latest pose, the lights' controller and
-the event log, talks LCM (poses, V2V routes and TRAFFIC_LIGHT_STATE in; TRAFFIC_LIGHT_COMMAND
+the event log, talks LCM (poses, V2V routes and TRAFFIC_LIGHT_STATE in, each signed; TRAFFIC_LIGHT_COMMAND
 and each car's V2I advisory out) and writes everything through one database writer.
 
 Threads: LCM receive, the control loop (lights at 20 Hz, advisories at 10 Hz per car) and the
@@ -250,6 +250,10 @@ class Scm:
         msg = self._decode(self.types.v2v_state_t, data)
         if msg is None or not re.fullmatch(VEHICLE_PATTERN, msg.vehicle):
             return
+        # A car's route only from that car's certificate: a ghost (or a real car under another's
+        # name) would move a real car onto another route and its advisories to another light.
+        if not self._verified(_chan, msg, "V2V", msg.vehicle):
+            return
         with self.lock:
             car = self.cars.setdefault(msg.vehicle, Car(msg.vehicle))
             if msg.route != car.route and (msg.route == "" or msg.route in self.roadnet.routes):
@@ -396,8 +400,9 @@ class Scm:
         the simulator's, which the SCM hears from SIM_CLOCK and the light states)."""
         self._publish(chan, self.signer.sign(chan, msg, self.bus_clock.now_us()).encode())
 
-    def _verified(self, chan: str, msg: Any, channel_id: str) -> bool:
-        """True when msg's envelope checks out (v2x_auth); else counted and logged, bounded."""
+    def _verified(self, chan: str, msg: Any, channel_id: str, name: str | None = None) -> bool:
+        """True when msg's envelope checks out (v2x_auth; name: the certificate's name it needs);
+        else counted and logged, bounded."""
         now_s = time.time()
         if now_s - self._crl_checked_s >= 0.25:  # the revocation list (a stat), 4 times a second
             self._crl_checked_s = now_s
@@ -412,7 +417,7 @@ class Scm:
                 now_us = claimed  # the first one sets the clock: its counter is still checked
         else:
             now_us = self.bus_clock.now_us()
-        verdict = self.verifier.verify(chan, msg, v2x_auth.roles_for(channel_id), None, now_us)
+        verdict = self.verifier.verify(chan, msg, v2x_auth.roles_for(channel_id), name, now_us)
         if verdict.ok:
             return True
         self.stats["refused_messages"] += 1
@@ -603,6 +608,7 @@ class Scm:
                     **self.stats,
                     "lcm_poses_received": int(self.receiver.counters[0]),
                     "lcm_poses_undecodable": int(self.receiver.counters[1]),
+                    "lcm_eye_poses_refused": int(self.receiver.counters[2]),
                     "db_rows_written": self.writer.rows_written,
                     "db_errors": self.writer.errors,
                     "db_pending": self.writer.pending,

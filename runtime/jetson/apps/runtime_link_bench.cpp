@@ -41,6 +41,7 @@
 #include <unistd.h>
 
 #include <autodrive/core/clock.hpp>
+#include <autodrive/v2x.hpp>
 #include <autodrive_lcm/subscribe.hpp>
 #include <autodrive/devtools/fake_nano.hpp>
 
@@ -408,6 +409,8 @@ bool truth_at(const std::vector<Pose> &gt, int64_t t_us, Pose *out) {
 struct EkfBench {
   std::string vehicle;
   lcm::LCM *lcm = nullptr;
+  std::optional<autodrive::v2x::Signer>
+      eye_signer;  // the Eye's certificate: the EKF takes no other
   std::vector<Pose> gt, map, odom;
   std::deque<Pose> eye_queue;
   bool eye = true;
@@ -450,6 +453,7 @@ struct EkfBench {
       e.yaw_rad = p.yaw;
       e.covariance[0] = e.covariance[4] = noise_m * noise_m;
       e.covariance[8] = noise_rad * noise_rad;
+      eye_signer->sign(vehicle + AUTODRIVE_CH_POSE_EYE_SUFFIX, e, p.t_us);
       lcm->publish(vehicle + AUTODRIVE_CH_POSE_EYE_SUFFIX, &e);
       eye_queue.pop_front();
     }
@@ -504,6 +508,8 @@ int run_ekf(const std::string &url, const std::string &vehicle, double seconds, 
   b.vehicle = vehicle;
   b.lcm = &lcm;
   b.eye_delay_us = eye_delay_ms * 1000.0;
+  b.eye_signer = autodrive::v2x::Signer::load("runtime-link-bench", "EYE");
+  if (!b.eye_signer) return 2;
   autodrive_lcm::subscribe<autodrive::ground_truth_t, EkfBench, &EkfBench::on_gt>(
       lcm, vehicle + AUTODRIVE_CH_GROUND_TRUTH_SUFFIX, &b);
   autodrive_lcm::subscribe<autodrive::odometry_t, EkfBench, &EkfBench::on_map>(

@@ -105,6 +105,9 @@ class Verifier {
     return false;
   }
 
+  // Freshness window around the receiver's clock [us] (default V2X_DEFAULT_WINDOW_US).
+  void set_window_us(int64_t window_us) { v2x_verifier_set_window_us(verifier_.get(), window_us); }
+
   uint64_t count(v2x_reason_t reason) const { return v2x_verifier_count(verifier_.get(), reason); }
   uint64_t refused() const {
     uint64_t n = 0;

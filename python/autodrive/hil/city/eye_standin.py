@@ -1,6 +1,7 @@
 """Eye stand-in for the HIL missions (smart-city, intersection): <VEH>_POSE_EYE for each car
 from the simulator's ground truth at 10 Hz of sim time, with Gaussian noise (5 mm, 0.5 deg;
-seeded), stamped at capture, as runtime-link-bench does for the EKF tests. It stands in for
+seeded), stamped at capture and signed with the Eye's certificate (EYE, role eye: the cars' EKFs
+take no other), as runtime-link-bench does for the EKF tests. It stands in for
 autodrive-eye on rendered overhead frames (tested on its own in eye/), which this 2-core machine
 cannot run for three or four cars beside everything else. Without any Eye the EKF's heading
 drifts with the gyro bias (~0.3 deg/s): the smart-city cars leave their lanes within a lap, and
@@ -19,19 +20,21 @@ import sys
 from pathlib import Path
 from types import FrameType
 
-from autodrive.core import channels, lcmtypes
+from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 from autodrive.core.settings import RELEASE_BUILD
 
 PERIOD_US = 100_000  # 10 Hz of sim time
 NOISE_M = 0.005
 NOISE_RAD = 0.0087
+EYE_IDENTITY = "EYE"  # the testbed's eye certificate (v2x_ca.TESTBED_IDENTITIES)
 
 
 def run(vehicles: list[str], url: str, build: Path, seed: int, stop: list[bool]) -> int:
     types = lcmtypes.load(build)
     lc = lcmtypes.bus(url)
     rng = random.Random(seed)
+    signer = v2x_auth.MessageSigner(v2x_ca.load_identity(EYE_IDENTITY))
     next_us: dict[str, int] = {}
 
     def on_truth(_ch: str, data: bytes) -> None:
@@ -49,7 +52,8 @@ def run(vehicles: list[str], url: str, build: Path, seed: int, stop: list[bool])
         cov[0] = cov[4] = NOISE_M**2
         cov[8] = NOISE_RAD**2
         p.covariance = cov
-        lc.publish(channel("POSE_EYE", m.vehicle), p.encode())
+        chan = channel("POSE_EYE", m.vehicle)
+        lc.publish(chan, signer.sign(chan, p, m.utime).encode())
 
     for v in vehicles:
         lc.subscribe(channel("GROUND_TRUTH", v), on_truth)
@@ -76,7 +80,11 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
-    return run(args.vehicles.split(","), args.lcm_url, Path(args.build), args.seed, stop)
+    try:
+        return run(args.vehicles.split(","), args.lcm_url, Path(args.build), args.seed, stop)
+    except v2x_ca.CertificateError as err:  # no car would take unsigned poses
+        print(f"[eye-standin] cannot sign as {EYE_IDENTITY}: {err}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 #include <autodrive/log_limiter.hpp>
+#include <autodrive/v2x.hpp>
 
 #include <cmath>
 
@@ -54,10 +55,28 @@ struct EstimatorNode::Impl {
   autodrive::LogLimiter implausible{"implausible inputs"};
   uint64_t wheel_dropped = 0, gyro_dropped = 0, poses_future = 0, gated_logged = 0;
   static constexpr int64_t kMaxPoseAheadUs = 1000000;  // a pose may be this far ahead [us]
+  // Eye poses: signed by an eye certificate (EyePoseAuth::verify); without a trust anchor
+  // (no CA in the key folder) every pose is refused, said once at start.
+  EyePoseAuth eye_auth;
+  std::optional<autodrive::v2x::Verifier> eye_verifier;
+  uint64_t poses_unauthenticated = 0;
 
-  Impl(const autodrive::config::Config &c, const std::string &output_url)
-      : config(c), lcm(c.lcm_url), odom(params_from_config(c)), map(params_from_config(c)) {
+  Impl(const autodrive::config::Config &c, const std::string &output_url, EyePoseAuth auth)
+      : config(c),
+        lcm(c.lcm_url),
+        odom(params_from_config(c)),
+        map(params_from_config(c)),
+        eye_auth(auth) {
     if (!output_url.empty()) out = std::make_unique<lcm::LCM>(output_url);
+    if (eye_auth == EyePoseAuth::verify) {
+      eye_verifier = autodrive::v2x::Verifier::load("autodrive-runtime estimator");
+      // A pose is fresh while the filter can still fuse it (its history): the Eye's poses
+      // arrive up to a frame's processing after their capture stamp.
+      if (eye_verifier) eye_verifier->set_window_us(params_from_config(c).history_us);
+      if (!eye_verifier)
+        spdlog::error("{}{}: no trust anchor, so no Eye pose will be taken (tools/keys)",
+                      c.vehicle.name, AUTODRIVE_CH_POSE_EYE_SUFFIX);
+    }
     if (!lcm.good()) return;
     const std::string v = c.vehicle.name;
     autodrive_lcm::subscribe<autodrive::vehicle_state_t, Impl, &Impl::on_state>(
@@ -135,6 +154,10 @@ struct EstimatorNode::Impl {
       cov(2, 2) = std::pow(config.estimator.eye_yaw_std_rad, 2);
     }
     const std::string channel = config.vehicle.name + AUTODRIVE_CH_POSE_EYE_SUFFIX;
+    if (!eye_pose_authentic(channel, *m)) {
+      ++poses_unauthenticated;
+      return;
+    }
     // A stamp far ahead of the car's own time would drag the filter's clock forward and make
     // every real measurement "too old": refused against the last STATE's stamp.
     if (have_prev && m->utime > prev.utime + kMaxPoseAheadUs) {
@@ -160,6 +183,14 @@ struct EstimatorNode::Impl {
           channel, config.estimator.pose_reacquire_s, m->x_m, m->y_m);
   }
 
+  // Signed by an Eye, fresh on the car's clock (the last STATE's stamp), not replayed.
+  // Before the first STATE the car has no clock to judge freshness by: refused.
+  bool eye_pose_authentic(const std::string &channel, const autodrive::pose2d_t &m) {
+    if (eye_auth == EyePoseAuth::trust_recorded_log) return true;
+    if (!eye_verifier || !have_prev) return false;
+    return eye_verifier->accept(channel, m, AUTODRIVE_CH_POSE_EYE_SIGNED_BY, nullptr, prev.utime);
+  }
+
   void publish(const Estimate &e, const char *frame, const char *suffix) {
     autodrive::odometry_t o{};
     o.utime = e.t_us;
@@ -181,8 +212,9 @@ struct EstimatorNode::Impl {
   }
 };
 
-EstimatorNode::EstimatorNode(const autodrive::config::Config &config, const std::string &output_url)
-    : impl_(std::make_unique<Impl>(config, output_url)) {}
+EstimatorNode::EstimatorNode(const autodrive::config::Config &config, const std::string &output_url,
+                             EyePoseAuth eye_auth)
+    : impl_(std::make_unique<Impl>(config, output_url, eye_auth)) {}
 EstimatorNode::~EstimatorNode() = default;
 
 std::string EstimatorNode::init_error() const {
@@ -198,11 +230,20 @@ void EstimatorNode::run(const std::atomic<bool> &stop) {
     impl_->implausible.flush();
     autodrive_lcm::malformed_log().flush();
   }
+  if (impl_->poses_unauthenticated)
+    spdlog::info("{}{}: refused {} Eye poses ({})", impl_->config.vehicle.name,
+                 AUTODRIVE_CH_POSE_EYE_SUFFIX, impl_->poses_unauthenticated,
+                 impl_->eye_verifier ? impl_->eye_verifier->summary() : "no trust anchor");
 }
 
 InputStats EstimatorNode::input_stats() const {
-  return {impl_->map.stats().gated, impl_->map.stats().reacquired, impl_->wheel_dropped,
-          impl_->gyro_dropped, impl_->poses_future};
+  return {impl_->map.stats().gated,
+          impl_->map.stats().reacquired,
+          impl_->wheel_dropped,
+          impl_->gyro_dropped,
+          impl_->poses_future,
+          impl_->poses_unauthenticated,
+          impl_->eye_verifier ? impl_->eye_verifier->summary() : std::string()};
 }
 
 long EstimatorNode::replay() {

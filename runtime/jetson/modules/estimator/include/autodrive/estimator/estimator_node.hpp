@@ -9,6 +9,7 @@
 #include <atomic>
 #include <memory>
 #include <string>
+#include <cstdint>
 
 #include <autodrive/core/config.hpp>
 #include <autodrive/estimator/ekf.hpp>
@@ -23,20 +24,29 @@ bool wheel_speed_from_encoders(int32_t prev_l, int32_t prev_r, int64_t prev_nano
 
 EkfParams params_from_config(const autodrive::config::Config &c);
 
+// Whose Eye poses the estimator takes: only those signed by an eye-role certificate, fresh on
+// the car's clock (the last STATE's stamp: SIM_CLOCK time in HIL) and with a counter above
+// that Eye's last (live); or every pose of a recorded log, checked when it was recorded
+// (replay: the stored logs predate signed poses).
+enum class EyePoseAuth { verify, trust_recorded_log };
+
 // Inputs the estimator refused (each also logged at a limited rate, naming the channel).
 struct InputStats {
-  uint64_t poses_gated = 0;    // <VEH>_POSE_EYE poses rejected by the Mahalanobis gate
-  uint64_t reacquired = 0;     // re-placements after a long gap (map filter)
-  uint64_t wheel_dropped = 0;  // <VEH>_STATE encoder speed or steering out of range
-  uint64_t gyro_dropped = 0;   // <VEH>_IMU gyro z out of range
-  uint64_t poses_future = 0;   // <VEH>_POSE_EYE stamped > 1 s ahead of the last STATE
+  uint64_t poses_gated = 0;             // <VEH>_POSE_EYE poses rejected by the Mahalanobis gate
+  uint64_t reacquired = 0;              // re-placements after a long gap (map filter)
+  uint64_t wheel_dropped = 0;           // <VEH>_STATE encoder speed or steering out of range
+  uint64_t gyro_dropped = 0;            // <VEH>_IMU gyro z out of range
+  uint64_t poses_future = 0;            // <VEH>_POSE_EYE stamped > 1 s ahead of the last STATE
+  uint64_t poses_unauthenticated = 0;   // <VEH>_POSE_EYE refused by the signature check
+  std::string poses_refused_by_reason;  // "unsigned=3, forged signature=1" ("" when none)
 };
 
 class EstimatorNode {
  public:
   // Inputs from config.lcm_url; outputs there too, or to output_url if given (replay).
   explicit EstimatorNode(const autodrive::config::Config &config,
-                         const std::string &output_url = "");
+                         const std::string &output_url = "",
+                         EyePoseAuth eye_auth = EyePoseAuth::verify);
   ~EstimatorNode();
   std::string init_error() const;
   void run(const std::atomic<bool> &stop);
