@@ -2,7 +2,7 @@
 simulator: seconds): a planted EKF offset shows as the EKF error of that car only; Eye poses per
 second of sim time; no EKF is given a start pose with an Eye; --eye none puts the car down off
 its marked start; --city-eye is a deprecated alias of --eye; every mission defaults to the real
-Eye."""
+Eye, in lockstep with the simulator in a lockstep run."""
 
 from __future__ import annotations
 
@@ -66,3 +66,27 @@ def test_one_eye_flag_default_cameras(capsys: pytest.CaptureFixture[str]) -> Non
     with pytest.raises(SystemExit):
         demo.parse_args(["--city-eye", "standin", "--eye", "cameras"])
     assert "contradicts" in capsys.readouterr().err
+
+
+def test_eye_lockstep_by_default_in_lockstep_runs(capsys: pytest.CaptureFixture[str]) -> None:
+    """The real Eye in a lockstep run is in lockstep too (the sim's --eye-sync, the Eye's
+    --sim-latency-ms L, L in the report); paced runs and the stand-in are not; a latency out of
+    what autodrive-eye accepts is refused naming the option."""
+    for args in (demo.parse_args(["--mission", "smart-city"]), intersection.parse_args([])):
+        latency = pose_source.lockstep_latency_ms(args, lockstep=True)
+        assert latency == pose_source.EYE_LATENCY_MS_DEFAULT
+        assert "--eye-sync" in pose_source.sim_argv(args.eye, 5.0, latency)
+        assert pose_source.eye_lockstep_argv(latency) == ["--sim-latency-ms", latency]
+        assert pose_source.lockstep_latency_ms(args, lockstep=False) is None
+    assert "--eye-sync" not in pose_source.sim_argv("cameras", 5.0, None)
+    assert pose_source.eye_lockstep_argv(None) == []
+    standin = demo.parse_args(["--eye", "standin"])
+    assert pose_source.lockstep_latency_ms(standin, lockstep=True) is None
+    given = intersection.parse_args(["--eye-latency-ms", "40"])
+    assert pose_source.lockstep_latency_ms(given, lockstep=True) == 40.0
+    rep = pose_source.report("cameras", "test", [pose_source.PoseRecord()], ["NIGEL1"], 40.0)
+    assert rep["eye_latency_ms"] == 40.0
+    for bad in ("-1", "20000", "fast"):
+        with pytest.raises(SystemExit):
+            demo.parse_args(["--eye-latency-ms", bad])
+        assert "--eye-latency-ms" in capsys.readouterr().err

@@ -212,7 +212,12 @@ def write_runtime_config(out: Path, run_dir: Path, url: str) -> Path:
 
 
 def sim_argv(
-    args: argparse.Namespace, build: Path, run_dir: Path, rtf: float | None, plan: Any
+    args: argparse.Namespace,
+    build: Path,
+    run_dir: Path,
+    rtf: float | None,
+    plan: Any,
+    eye_latency_ms: float | None,
 ) -> list[object]:
     if args.mission == "loop":
         duration_s = args.duration + LOOP_SIM_MARGIN_S
@@ -226,6 +231,8 @@ def sim_argv(
         argv += ["--cameras"]  # front and rear, at the overhead camera's rate
     if args.cameras > 0 or args.eye == "cameras":
         argv += ["--eye", "--camera-fps", args.cameras or pose_source.EYE_FPS_DEFAULT]
+    if eye_latency_ms is not None:  # the Eye in lockstep: its poses at capture + L, any load
+        argv += ["--eye-sync"]
     if plan is not None:
         argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
         s = plan.start
@@ -239,17 +246,25 @@ def sim_argv(
     return argv
 
 
-def start_pose_source(args: argparse.Namespace, build: Path, out: Path, procs: ProcessGroup) -> str:
+def start_pose_source(
+    args: argparse.Namespace,
+    build: Path,
+    out: Path,
+    procs: ProcessGroup,
+    latency_ms: float | None,
+) -> str:
     """The car's pose source of --eye on Parking School (its one overhead camera 'eye', the
-    config eye/config/sim/eye.yaml); returns what runs."""
+    config eye/config/sim/eye.yaml), in lockstep with latency_ms unless None; returns what
+    runs."""
     fps = args.cameras or pose_source.EYE_FPS_DEFAULT
     if args.eye == "cameras":
         eye_argv = [build / "bin" / "autodrive-eye", "run", "-c", EYE_SIM_CONFIG, "-q"]
         eye_argv += ["--source", f"lcm:{channels.channel('EYE_IMAGE')}"]
+        eye_argv += pose_source.eye_lockstep_argv(latency_ms)
         procs.start("autodrive-eye", [*eye_argv, "--lcm-url", args.lcm_url], out / "eye.log")
-        return pose_source.describe("cameras", MAP, fps)
+        return pose_source.describe("cameras", MAP, fps, latency_ms)
     return pose_source.start(
-        procs, args.eye, build, MAP, out, args.lcm_url, [VEHICLE], args.seed, fps
+        procs, args.eye, build, MAP, out, args.lcm_url, [VEHICLE], args.seed, fps, latency_ms
     )
 
 
@@ -344,13 +359,15 @@ def run(
     t_wall0 = time.time()
     result: dict[str, Any] = {}
     eye_what = "not started"
+    eye_latency = pose_source.lockstep_latency_ms(args, lockstep=rtf is None)
     ctx = MissionContext(build, out, args.lcm_url, VEHICLE, procs, stop_requested, say, echo)
     try:
         logger_argv = ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f", "--flush-interval=100"]
         procs.start("lcm-logger", [*logger_argv, lcm_log], out / "lcm-logger.log")
-        procs.start("autodrive-sim", sim_argv(args, build, run_dir, rtf, plan), out / "sim.log")
+        sim = sim_argv(args, build, run_dir, rtf, plan, eye_latency)
+        procs.start("autodrive-sim", sim, out / "sim.log")
         wait_for_path(run_dir / "nigel1-nano", PTY_TIMEOUT_S, procs)
-        eye_what = start_pose_source(args, build, out, procs)
+        eye_what = start_pose_source(args, build, out, procs, eye_latency)
         runtime = build / "bin" / "autodrive-runtime"
         procs.start("autodrive-runtime", [runtime, "--config", cfg_path], out / "runtime.log")
         if plan is None:  # on the map filter; without an Eye (no map fix) on the odometry
@@ -370,7 +387,7 @@ def run(
     stop_requested()
     if interrupted:
         say("interrupted: everything stopped; analysing what was recorded")
-    rep = report.analyse(lcm_log, out, VEHICLE, build, args.eye, eye_what)
+    rep = report.analyse(lcm_log, out, VEHICLE, build, args.eye, eye_what, eye_latency)
     rep.update(result)
     if plan is not None and "goal_world" in result:
         rep.update(parking.score(lcm_log, out, VEHICLE, build, result))

@@ -2,6 +2,9 @@
 
 - `cameras` (default): autodrive-eye on the simulator's rendered overhead cameras (the map's
   eye_cameras, or Parking School's one `eye` camera), as in the lab; report `pose_source` "eye".
+  In a lockstep run the Eye is in lockstep too (`autodrive-sim --eye-sync`, `autodrive-eye run
+  --sim-latency-ms L`, L from `--eye-latency-ms`): a frame captured at t has its poses on the
+  bus at t + L of sim time whatever the host's load; the report says L (`eye_latency_ms`).
 - `standin`: the test double autodrive.hil.city.eye_standin (ground truth + the Eye's noise, at
   once, never late, never missing); `pose_source` "standin".
 - `none`: no absolute poses; each EKF starts from the pose the car was put down at, given with
@@ -33,6 +36,11 @@ EYE_FPS_DEFAULT = 5.0  # the overhead cameras' frame rate [Hz of sim time] unles
 # its EKF is told with the pose (estimator.initial_pos_std_m, initial_yaw_std_rad).
 PLACEMENT_STD_M = 0.02
 PLACEMENT_STD_RAD = 0.035  # 2 deg
+# The Eye's capture-to-pose time in a lockstep run [ms of sim time]: `tools/bench eye`'s
+# capture_to_pose_ms_p99 at ordinary priority, 14.95 ms (docs/results/benchmarks.md,
+# 2026-11-28), which is also that bench's goal (<= 15 ms).
+EYE_LATENCY_MS_DEFAULT = 15.0
+EYE_LATENCY_FROM = "tools/bench eye capture_to_pose_ms_p99 (14.95 ms, docs/results/benchmarks.md)"
 
 
 def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") -> None:
@@ -49,6 +57,34 @@ def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") 
         f"({PLACEMENT_STD_M * 100:g} cm, {np.degrees(PLACEMENT_STD_RAD):.0f} deg) and "
         "dead-reckons",
     )
+    p.add_argument(
+        "--eye-latency-ms",
+        type=latency_ms_arg,
+        default=EYE_LATENCY_MS_DEFAULT,
+        metavar="L",
+        help="(--eye cameras, lockstep runs) the Eye's capture-to-pose time [ms of sim time]: "
+        "the simulator never runs past a frame's capture time + L before the Eye has published "
+        "its poses, so results do not depend on the host's load; default "
+        f"{EYE_LATENCY_MS_DEFAULT:g}, {EYE_LATENCY_FROM}",
+    )
+
+
+def latency_ms_arg(text: str) -> float:
+    """--eye-latency-ms's value: 0..10000 ms (what autodrive-eye accepts)."""
+    try:
+        latency = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: want a number of ms") from None
+    if not 0.0 <= latency <= 10000.0:
+        raise argparse.ArgumentTypeError(f"{text}: want 0..10000 ms")
+    return latency
+
+
+def lockstep_latency_ms(args: argparse.Namespace, lockstep: bool) -> float | None:
+    """The Eye's lockstep latency of a run [ms of sim time]: --eye-latency-ms when the real Eye
+    runs and the simulator is in a lockstep mode; None otherwise (paced runs: the Eye keeps up
+    or falls behind, as a real one)."""
+    return float(args.eye_latency_ms) if lockstep and args.eye == "cameras" else None
 
 
 def estimator_start(
@@ -132,10 +168,17 @@ class PoseRecord:
         return tr[-1][0] - tr[0][0] if len(tr) >= 2 else 0.0
 
 
-def report(eye: str, what: str, records: list[PoseRecord], cars: list[str]) -> dict[str, Any]:
-    """The report's pose fields over one or more runs (episodes): pose_source, what ran, Eye
-    poses per car per second of sim time, each car's EKF error against the truth (p50, p95,
-    max [m]) and the worst car's p95, and when each car's first Eye fix came [s sim]."""
+def report(
+    eye: str,
+    what: str,
+    records: list[PoseRecord],
+    cars: list[str],
+    latency_ms: float | None = None,
+) -> dict[str, Any]:
+    """The report's pose fields over one or more runs (episodes): pose_source, what ran, the
+    Eye's lockstep latency [ms of sim time] (None: not in lockstep), Eye poses per car per
+    second of sim time, each car's EKF error against the truth (p50, p95, max [m]) and the
+    worst car's p95, and when each car's first Eye fix came [s sim]."""
     rate: dict[str, float] = {}
     err: dict[str, dict[str, float] | None] = {}
     for car in cars:
@@ -148,6 +191,7 @@ def report(eye: str, what: str, records: list[PoseRecord], cars: list[str]) -> d
     return {
         "pose_source": POSE_SOURCE[eye],
         "eye": what,
+        "eye_latency_ms": latency_ms if eye == "cameras" else None,
         "eye_poses_per_car_hz": rate,
         "ekf_error_m": err,
         "ekf_error_p95_worst_m": max(p95) if p95 else None,
@@ -173,10 +217,17 @@ def summary_line(rep: dict[str, Any]) -> str:
     )
 
 
-def sim_argv(eye: str, fps: float) -> list[object]:
+def sim_argv(eye: str, fps: float, latency_ms: float | None) -> list[object]:
     """autodrive-sim's options for --eye: cameras renders the map's overhead cameras at fps
-    [Hz of sim time]."""
-    return ["--eye", "--camera-fps", fps] if eye == "cameras" else []
+    [Hz of sim time]; with latency_ms (a lockstep run) in lockstep with the Eye (--eye-sync)."""
+    if eye != "cameras":
+        return []
+    return ["--eye", "--camera-fps", fps, *(["--eye-sync"] if latency_ms is not None else [])]
+
+
+def eye_lockstep_argv(latency_ms: float | None) -> list[object]:
+    """autodrive-eye run's options for the lockstep of sim_argv (none when latency_ms is None)."""
+    return [] if latency_ms is None else ["--sim-latency-ms", latency_ms]
 
 
 def start(
@@ -189,9 +240,11 @@ def start(
     cars: list[str],
     seed: int,
     fps: float,
+    latency_ms: float | None,
 ) -> str:
     """Starts the pose source of --eye for cars (NIGEL1, ...; car i wears roof tag i) on the
-    map's overhead cameras, logs and configs in folder; returns what runs (for the report)."""
+    map's overhead cameras, logs and configs in folder, the Eye in lockstep with latency_ms
+    [ms of sim time] unless None; returns what runs (for the report)."""
     if eye == "cameras":
         cams = eye_cameras.load(map_name)
         if not cams:
@@ -200,6 +253,7 @@ def start(
         (folder / "eye").mkdir(exist_ok=True)
         cfg = eye_cameras.write_eye_config(cams, folder / "eye", url, tags)
         argv: list[object] = [build / "bin" / "autodrive-eye", "run", "-c", cfg, "-q"]
+        argv += eye_lockstep_argv(latency_ms)
         procs.start("autodrive-eye", argv, folder / "eye.log")
     elif eye == "standin":
         argv = [
@@ -211,14 +265,17 @@ def start(
         ]
         argv += ["--seed", seed, "--lcm-url", url, "--build", build]
         procs.start("eye-standin", argv, folder / "eye-standin.log")
-    return describe(eye, map_name, fps)
+    return describe(eye, map_name, fps, latency_ms)
 
 
-def describe(eye: str, map_name: str, fps: float) -> str:
+def describe(eye: str, map_name: str, fps: float, latency_ms: float | None = None) -> str:
     """What --eye runs on the map (for the report)."""
     if eye == "cameras":
         n = len(eye_cameras.load(map_name)) or 1  # none listed: the map's one camera 'eye'
-        return f"autodrive-eye on {n} rendered overhead camera(s) at {fps:g} Hz of sim time"
+        what = f"autodrive-eye on {n} rendered overhead camera(s) at {fps:g} Hz of sim time"
+        if latency_ms is None:
+            return what + ", not in lockstep with the simulator"
+        return what + f", in lockstep with the simulator: poses at capture + {latency_ms:g} ms"
     if eye == "standin":
         return "stand-in (test double): ground truth + the Eye's noise (city.eye_standin)"
     return "none: dead reckoning from the marked start pose"

@@ -27,9 +27,16 @@ Report = dict[str, Any]
 
 
 def analyse(
-    log_path: Path, out: Path, veh: str, build: Path, eye: str = "none", eye_what: str = ""
+    log_path: Path,
+    out: Path,
+    veh: str,
+    build: Path,
+    eye: str = "none",
+    eye_what: str = "",
+    eye_latency_ms: float | None = None,
 ) -> Report:
-    """eye: the run's --eye (its pose_source); eye_what: what ran (for the report)."""
+    """eye: the run's --eye (its pose_source); eye_what: what ran (for the report);
+    eye_latency_ms: the Eye's lockstep latency [ms of sim time], None when not in lockstep."""
     if not Path(log_path).exists():
         return {"ok": False, "error": f"no LCM log at {log_path}"}
     types = lcmtypes.load(build)
@@ -79,7 +86,7 @@ def analyse(
     ekf = ekf if ekf_channel == ch_pose else odom
     rep: Report = {
         "ok": False,
-        **pose_source.report(eye, eye_what or eye, [poses], [veh]),
+        **pose_source.report(eye, eye_what or eye, [poses], [veh], eye_latency_ms),
         "ekf_channel": ekf_channel,
         "gt_samples": len(gt),
         "ekf_samples": len(ekf),

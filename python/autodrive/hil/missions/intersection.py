@@ -186,6 +186,7 @@ def run_episode(
     rec = EpisodeRecord()
     lc = lcmtypes.bus(args.lcm_url)
     fps = args.cameras or pose_source.EYE_FPS_DEFAULT
+    latency = pose_source.lockstep_latency_ms(args, lockstep=True)  # the sim: --lockstep-client
 
     def on_truth(ch: str, data: bytes) -> None:
         m = types.ground_truth_t.decode(data)
@@ -234,14 +235,16 @@ def run_episode(
         marked = [p.start for p in plans]
         for i, (x, y, yaw) in enumerate(pose_source.placed(marked, args.eye, seed)):
             sim += ["--car-start", f"{i + 1},{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
-        sim += pose_source.sim_argv(args.eye, fps)
+        sim += pose_source.sim_argv(args.eye, fps, latency)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         procs.start("autodrive-sim", sim, ep_dir / "sim.log")
         for i in range(CARS):
             wait_for_path(run_dir / f"nigel{i + 1}-nano", PTY_TIMEOUT_S, procs)
         names = [p.vehicle for p in plans]
-        pose_source.start(procs, args.eye, build, MAP, ep_dir, args.lcm_url, names, seed, fps)
+        pose_source.start(
+            procs, args.eye, build, MAP, ep_dir, args.lcm_url, names, seed, fps, latency
+        )
         for i, p in enumerate(plans):
             cfg = write_runtime_config(
                 ep_dir / f"runtime{i + 1}.yaml", run_dir, args.lcm_url, i + 1, p, args.eye
@@ -484,6 +487,7 @@ def run(args: argparse.Namespace) -> int:
     if len(done) < args.episodes and not interrupted:
         say(f"ERROR: --timeout {args.timeout:g} s of wall time ran out after {len(done)} of "
             f"{args.episodes} episodes: the {args.episodes - len(done)} not run count as failures")  # fmt: skip
+    lat = pose_source.lockstep_latency_ms(args, lockstep=True)
     rep: dict[str, Any] = {
         "mission": "intersection",
         "policy": args.policy,
@@ -495,9 +499,10 @@ def run(args: argparse.Namespace) -> int:
         "shield_pose_error_m": args.shield_pose_error_m,
         **pose_source.report(
             args.eye,
-            pose_source.describe(args.eye, MAP, args.cameras or pose_source.EYE_FPS_DEFAULT),
+            pose_source.describe(args.eye, MAP, args.cameras or pose_source.EYE_FPS_DEFAULT, lat),
             [r.poses for _p, r, _e in done],
             [channels.vehicle_name(i + 1) for i in range(CARS)],
+            lat,
         ),
         "eye_poses": sum(sum(r.poses.eye_poses.values()) for _p, r, _e in done),
         **score_episodes(args.episodes, outcomes, traverse_s),

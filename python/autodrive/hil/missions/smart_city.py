@@ -169,6 +169,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
     sim_t = [0.0]
     poses = pose_source.PoseRecord()
     eye_what = "not started"
+    eye_latency: float | None = None
     result: dict[str, Any] = {}
     t_wall0 = time.time()
     scm_url = ""
@@ -221,7 +222,9 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         pacing = ["--rtf", args.rtf] if args.rtf else ["--lockstep-client"]
         sim += [*pacing, "--duration", 3600]
         eye_fps = args.cameras or EYE_FPS_DEFAULT
-        sim += pose_source.sim_argv(args.eye, eye_fps)
+        # in lockstep the Eye is too: its poses at capture + L of sim time, at any load
+        eye_latency = pose_source.lockstep_latency_ms(args, lockstep=not args.rtf)
+        sim += pose_source.sim_argv(args.eye, eye_fps, eye_latency)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         sim_proc = procs.start("autodrive-sim", sim, out / "sim.log")
@@ -241,7 +244,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         names = [vehicle_name(i) for i in range(1, cars + 1)]
         vehicles = ",".join(names)
         eye_what = pose_source.start(
-            procs, args.eye, build, MAP, out, url, names, args.seed, eye_fps
+            procs, args.eye, build, MAP, out, url, names, args.seed, eye_fps, eye_latency
         )
         for i in range(1, cars + 1):
             # the EKF's start: its first Eye fix, or (--eye none) the marked start pose
@@ -357,7 +360,11 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
     )
     rep.update(
         pose_source.report(
-            args.eye, eye_what, [poses], [vehicle_name(i) for i in range(1, cars + 1)]
+            args.eye,
+            eye_what,
+            [poses],
+            [vehicle_name(i) for i in range(1, cars + 1)],
+            eye_latency,
         )
     )
     rep["ok"] = (

@@ -10,7 +10,7 @@
  *
  * Before its first frame the sim waits up to EYE_SYNC_FIRST_S of wall time for an Eye to say it
  * is ready (so the Eye sees every frame, and a run repeats); an Eye silent for
- * CLIENT_SYNC_LOST_S of wall time while the sim waits is given up (a line on stderr) until it
+ * EYE_SYNC_LOST_S of wall time while the sim waits is given up (a line on stderr) until it
  * answers again, as --lockstep-client does with the runtime. */
 #ifndef SIM_APP_EYE_SYNC_H
 #define SIM_APP_EYE_SYNC_H
@@ -19,7 +19,11 @@
 
 #include <lcm/lcm.h>
 
-#define EYE_SYNC_FIRST_S 60.0   /* [s] wall, at most, for an Eye before the first frame */
+#define EYE_SYNC_FIRST_S 60.0 /* [s] wall, at most, for an Eye before the first frame */
+/* [s] wall: an Eye this long without finishing a frame waited for is given up. Longer than the
+ * runtime's CLIENT_SYNC_LOST_S: four 1280x960 frames took over 2 s at a load of 45 on 2 cores
+ * (Tiny Town, 2026-12-02), and an Eye given up for a slow frame makes the run depend on load. */
+#define EYE_SYNC_LOST_S 10.0
 #define EYE_SYNC_MAX_PENDING 64 /* frames sent and not yet done (an Eye far behind drops more) */
 
 typedef struct eye_sync eye_sync_t;

@@ -9,7 +9,6 @@
 #include <autodrive_eye_frame_done_t.h>
 
 #include "app_common.h"
-#include "client_sync.h"
 
 #define EYE_SYNC_MAX_LATENCY_US 10000000 /* a latency beyond 10 s of sim time is not believed */
 
@@ -128,7 +127,7 @@ int eye_sync_due(const eye_sync_t *e, int64_t now_us) {
 
 void eye_sync_wait(eye_sync_t *e, int64_t now_us) {
   const double t0 = app_wall_s();
-  const double t_give_up = t0 + CLIENT_SYNC_LOST_S;
+  const double t_give_up = t0 + EYE_SYNC_LOST_S;
   e->waits++;
   while (eye_sync_due(e, now_us) && !app_stop_requested()) {
     eye_sync_handle(e, 50);
@@ -136,7 +135,7 @@ void eye_sync_wait(eye_sync_t *e, int64_t now_us) {
       fprintf(stderr,
               "[autodrive-sim] the Eye has not finished the frame of t = %.3f s for %.1f s "
               "(wall; no " AUTODRIVE_CH_EYE_FRAME_DONE "): running on without it\n",
-              e->pending[e->head] * 1e-6, CLIENT_SYNC_LOST_S);
+              e->pending[e->head] * 1e-6, EYE_SYNC_LOST_S);
       e->heard = 0;
       e->lost_at_us = e->done_us;
       e->n = 0;

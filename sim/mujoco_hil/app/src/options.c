@@ -95,7 +95,7 @@ static void options_usage(FILE *f) {
       "                      autodrive-eye run --sim-latency-ms L has published its poses\n"
       "                      (EYE_FRAME_DONE); it publishes SIM_CLOCK at t + L, when the Eye\n"
       "                      releases them. Before the first frame it waits up to 60 s\n"
-      "                      (wall) for the Eye to say it is ready; an Eye silent for 2 s\n"
+      "                      (wall) for the Eye to say it is ready; an Eye silent for 10 s\n"
       "                      (wall) while waited for is given up until it answers again\n"
       "  --eye-render MODE   cached (default): an overhead camera renders the static world\n"
       "                      once and draws only what moves over it; full: every frame in\n"

@@ -122,9 +122,11 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
 /* The map's traffic lights and --allow-teleport on LCM, the window, the publish queue. */
 static int app_build_links(app_t *a, char *err, size_t err_sz) {
   const app_options_t *o = a->opt;
-  /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published) */
-  a->lights = traffic_lights_lcm_create(a->lcm, o->url, sim_traffic_lights(a->sim),
-                                        !o->allow_teleport, err, err_sz);
+  /* the map's traffic lights on LCM (none: NULL, nothing subscribed or published); the bus
+   * filtered to their commands and --eye-sync's EYE_FRAME_DONE (subscribed below) */
+  a->lights =
+      traffic_lights_lcm_create(a->lcm, o->url, sim_traffic_lights(a->sim), !o->allow_teleport,
+                                o->eye_sync ? AUTODRIVE_CH_EYE_FRAME_DONE : NULL, err, err_sz);
   if (!a->lights && err[0]) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;

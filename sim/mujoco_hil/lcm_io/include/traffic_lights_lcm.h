@@ -23,9 +23,11 @@ typedef struct traffic_lights_lcm traffic_lights_lcm_t;
 
 /* NULL when the map has no lights (nothing to do) or on an LCM error (message in err). url:
  * the one lcm was made with. filter_bus: on udpm:// its receive socket then keeps only the
- * commands (lcm_receive_filter.h), so lcm must subscribe to nothing else; 0 when it does. */
+ * commands and also_keep's messages unless NULL (lcm_receive_filter.h), so lcm must subscribe
+ * to nothing else; 0 when it does. */
 traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t,
-                                                int filter_bus, char *err, size_t err_sz);
+                                                int filter_bus, const char *also_keep, char *err,
+                                                size_t err_sz);
 void traffic_lights_lcm_destroy(traffic_lights_lcm_t *k);
 
 /* Handles the commands waiting on the socket (no wait) at sim time now_us: accepted ones

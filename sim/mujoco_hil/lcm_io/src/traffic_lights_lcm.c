@@ -116,7 +116,8 @@ static void traffic_lights_lcm_on_command(const lcm_recv_buf_t *rbuf, const char
 }
 
 traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, traffic_lights_t *t,
-                                                int filter_bus, char *err, size_t err_sz) {
+                                                int filter_bus, const char *also_keep, char *err,
+                                                size_t err_sz) {
   if (t->n == 0) return NULL;
   traffic_lights_lcm_t *k = calloc(1, sizeof *k);
   if (!k) {
@@ -149,8 +150,8 @@ traffic_lights_lcm_t *traffic_lights_lcm_create(lcm_t *lcm, const char *url, tra
   char why[256];
   /* The kernel filter keeps one channel only: a simulator that also obeys SIM_TELEPORT (or any
    * other subscription) must read the whole bus. */
-  if (filter_bus && lcm_receive_filter_keep_only(lcm, url, AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, why,
-                                                 sizeof why) < 0)
+  const char *keep[2] = {AUTODRIVE_CH_TRAFFIC_LIGHT_COMMAND, also_keep};
+  if (filter_bus && lcm_receive_filter_keep(lcm, url, keep, also_keep ? 2 : 1, why, sizeof why) < 0)
     fprintf(stderr, "[autodrive-sim] %s: receiving every message on the bus instead\n", why);
   return k;
 }
