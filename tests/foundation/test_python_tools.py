@@ -82,8 +82,8 @@ def test_city_scorer_blocked_cars() -> None:
     town = city_scoring.MapFacts.load(MAPS_DIR / "tiny_town.json")
     sc = city_scoring.Scorer(town, blocked_s=30.0)
     for k in range(400):  # 40 s standing in the middle of the east road
-        sc.truth("NIGEL1", k * 0.1, 4.06, 0.5, -math.pi / 2, 0.0, False)
-        sc.truth("NIGEL2", k * 0.1, 4.34, 0.5 + k * 0.01, math.pi / 2, 0.1, False)
+        sc.truth("NIGEL1", k * 0.1, 4.06, 0.5, -math.pi / 2, False)
+        sc.truth("NIGEL2", k * 0.1, 4.34, 0.5 + k * 0.01, math.pi / 2, False)
     rep = sc.report()
     assert rep["blocked"] == ["NIGEL1"], rep
     assert rep["longest_standstill_away_s"] == {"NIGEL1": 39.9, "NIGEL2": 0.0}, rep

@@ -216,7 +216,8 @@ class Scorer:
                 c.still_at.pop(p.name, None)
             c.prev_past[p.name] = past
         if standing and not at_stop:
-            c.held_since_s = t_s if c.held_since_s is None else c.held_since_s
+            if c.held_since_s is None:  # standing since its standstill began
+                c.held_since_s = t_s if c.still_since_s is None else c.still_since_s
             c.longest_held_s = max(c.longest_held_s, t_s - c.held_since_s)
         else:
             c.held_since_s = None
