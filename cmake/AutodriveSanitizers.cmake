@@ -10,7 +10,9 @@ endif()
 
 # autodrive_python_sanitizer_env(<list var>): appends to the list what a Python test needs to
 # dlopen() this build's shared libraries (cffi) when they are sanitized: the ASan runtime (and
-# libstdc++, whose __cxa_throw ASan intercepts) preloaded. Nothing without AUTODRIVE_SANITIZE.
+# libstdc++, whose __cxa_throw ASan intercepts) preloaded, leak detection on with the third-party
+# suppressions (tests/lsan.supp: CPython's own memory at exit among them). Nothing without
+# AUTODRIVE_SANITIZE.
 function(autodrive_python_sanitizer_env var)
   if(AUTODRIVE_SANITIZE)
     execute_process(COMMAND ${CMAKE_C_COMPILER} -print-file-name=libasan.so
@@ -18,6 +20,7 @@ function(autodrive_python_sanitizer_env var)
     execute_process(COMMAND ${CMAKE_CXX_COMPILER} -print-file-name=libstdc++.so.6
       OUTPUT_VARIABLE stdcxx OUTPUT_STRIP_TRAILING_WHITESPACE)
     set(${var} ${${var}} "LD_PRELOAD=${asan}:${stdcxx}"
-      "ASAN_OPTIONS=detect_leaks=0:verify_asan_link_order=0" PARENT_SCOPE)
+      "ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:verify_asan_link_order=0"
+      "LSAN_OPTIONS=suppressions=${AUTODRIVE_ROOT}/tests/lsan.supp" PARENT_SCOPE)
   endif()
 endfunction()

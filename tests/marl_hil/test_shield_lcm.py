@@ -4,7 +4,9 @@ west_to_east lane: NIGEL1's own pose (<VEH>_POSE_MAP) and NIGEL2's V2V state, on
 engaged, signed by source "marl"); with --no-shield the policy's throttle goes out; the same
 head-on peer stamped 500 ms old is dropped as stale (reported in the status) and does not brake
 the car; a peer far away does not brake it; --v2v-loss 1 loses every state; a 100 ms delay
-still brakes. argv: autodrive-marl, build dir, LCM port."""
+still brakes. The program runs on the test's own SIM_CLOCK (--clock sim), 50 ms of sim time per
+round of inputs, so staleness, delay and the control period are judged on sim time and a loaded
+machine only slows the run. argv: autodrive-marl, build dir, LCM port."""
 
 import os
 import select
@@ -23,6 +25,9 @@ from autodrive.core.settings import REPO_ROOT
 sys.path.insert(0, str(Path(__file__).parent))
 from marl_test_policy import LOOKAHEAD_M, make_policy  # noqa: E402
 
+SIM_STEP_US = 50_000  # sim time per round of inputs [us]: 20 Hz, as the runtimes broadcast V2V
+HANG_BACKSTOP_S = 300.0  # wall time [s]: ends a program that never drives, never a figure
+
 
 def test_shield_and_stale_v2v(
     program: Callable[[str], str], build_dir: Path, lcm_port: int, lcm_url: str
@@ -38,11 +43,11 @@ def test_shield_and_stale_v2v(
     peer_signer = v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL2"))
 
     def run_case(policy: Path, peer_xy_yaw, peer_age_s: float, *extra: str):
-        """Runs autodrive-marl with the scripted inputs for >= 2.5 s and 40 engaged commands; returns
-        (commands, last status)."""
+        """Runs autodrive-marl with the scripted inputs for >= 2.5 s of sim time and 40 engaged
+        commands; returns (commands, last status)."""
         proc = subprocess.Popen(
             [exe, "--vehicle", "NIGEL1", "--lcm-url", url, "--policy", str(policy)]
-            + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "wall"]
+            + ["--map-json", str(MAP_JSON), "--route", "west_to_east", "--clock", "sim"]
             + ["--waypoint-lookahead-m", str(LOOKAHEAD_M), *extra],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -59,13 +64,18 @@ def test_shield_and_stale_v2v(
 
         lc.subscribe(channels.channel("COMMAND", "NIGEL1"), on_command)
         lc.subscribe(channels.channel("MISSION", "NIGEL1"), lambda _c, d: status.append(d))
-        t0 = time.time()
+        sim_t0_us = sim_us = 1_000_000  # the test's SIM_CLOCK [us]
         seq = 0
+        backstop = time.monotonic() + HANG_BACKSTOP_S
 
-        # At least 2.5 s and 40 engaged commands: the count, not the wall time, is what the asserts
-        # need (a loaded machine starts the program late); 60 s caps a program that never drives.
-        while time.time() - t0 < 60.0 and (time.time() - t0 < 2.5 or engaged < 40):
-            now_us = int(time.time() * 1e6)
+        # At least 2.5 s of sim time and 40 engaged commands: the count is what the asserts need
+        # (a loaded machine starts the program late); the wall backstop only ends a hung program.
+        while time.monotonic() < backstop and (sim_us - sim_t0_us < 2_500_000 or engaged < 40):
+            sim_us += SIM_STEP_US
+            now_us = sim_us
+            tick = types.sim_clock_t()
+            tick.utime, tick.real_time_factor, tick.paused = sim_us, 1.0, False
+            lc.publish(channels.channel("SIM_CLOCK"), tick.encode())
             pose = types.odometry_t()
             pose.utime, pose.vehicle, pose.frame_id = now_us, "NIGEL1", "map"
             pose.x_m, pose.y_m, pose.yaw_rad, pose.vx_m_s = -1.0, -0.14, 0.0, 0.15
@@ -79,8 +89,8 @@ def test_shield_and_stale_v2v(
             peer_signer.sign(channels.channel("V2V"), v, now_us)
             lc.publish(channels.channel("V2V"), v.encode())
             seq += 1
-            end = time.time() + 0.05  # 20 Hz, as the runtimes broadcast
-            while (left := end - time.time()) > 0:
+            end = time.monotonic() + SIM_STEP_US * 1e-6  # paced near real time: 20 Hz of V2V
+            while (left := end - time.monotonic()) > 0:
                 if select.select([lc.fileno()], [], [], left)[0]:
                     lc.handle()
         proc.send_signal(2)

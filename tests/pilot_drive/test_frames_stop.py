@@ -4,7 +4,9 @@ Nano pty, and autodrive-pilot with a random fixture model, over real LCM (UDP mu
 loopback, port from argv). The test publishes camera-sized JPEG frames on NIGEL1_CAM_FRONT: the
 pilot engages and the car moves. Then the frames stop: the pilot logs that it stops the car,
 its commands are disengaged, and the car (ground truth) comes to a standstill. Frames again: it
-drives again. Last, SIM_TELEPORT puts the car on a given pose (and one off the map is refused)."""
+drives again. Last, SIM_TELEPORT puts the car on a given pose (and one off the map is refused).
+Every component and the test's frames run on the simulator's clock (SIM_CLOCK): the frames are
+paced and the waits measured in sim time, so a loaded machine only slows the run."""
 import math
 import pathlib
 import select
@@ -20,6 +22,8 @@ from autodrive.core import lcmtypes
 from autodrive import maps
 from autodrive.core.settings import RUNTIME_HIL_CONFIG
 
+HANG_BACKSTOP_S = 120.0  # wall time [s]: ends a hung run only, never a pass/fail figure
+
 
 def test_frames_stop_stop_the_car(
     root: pathlib.Path, build_dir: pathlib.Path, lcm_port: int, lcm_url: str
@@ -30,7 +34,8 @@ def test_frames_stop_stop_the_car(
     veh = channels.vehicle_name(1)
     lc = lcmtypes.bus(url)
     truth: dict[str, float] = {}
-    commands: list[tuple[float, bool, str]] = []  # (wall time, engaged, source)
+    commands: list[tuple[int, bool, str]] = []  # (sim time received [us], engaged, source)
+    clock = {"us": -1}  # the simulator's time [us] (SIM_CLOCK); -1 before its first tick
 
     def on_truth(_c: str, d: bytes) -> None:
         m = types.ground_truth_t.decode(d)
@@ -40,24 +45,35 @@ def test_frames_stop_stop_the_car(
 
     def on_command(_c: str, d: bytes) -> None:
         m = types.vehicle_command_t.decode(d)
-        commands.append((time.time(), bool(m.engaged), m.source))
+        commands.append((clock["us"], bool(m.engaged), m.source))
 
+    def on_clock(_c: str, d: bytes) -> None:
+        clock["us"] = types.sim_clock_t.decode(d).utime
+
+    lc.subscribe(channels.channel("SIM_CLOCK"), on_clock)
     lc.subscribe(channels.channel("GROUND_TRUTH", veh), on_truth)
     lc.subscribe(channels.channel("COMMAND", veh), on_command)
 
-    def pump(wall_s: float, frames: list[bytes] | None = None, fps: float = 30.0) -> None:
-        """Handles the bus for wall_s; publishes frames (cycled) at fps meanwhile when given."""
-        end, next_frame, i = time.time() + wall_s, time.time(), 0
-        while time.time() < end:
-            if frames is not None and time.time() >= next_frame:
+    def pump(sim_s: float, frames: list[bytes] | None = None, fps: float = 30.0) -> None:
+        """Handles the bus for sim_s of sim time; publishes frames (cycled) at fps of sim time
+        meanwhile when given. The wall backstop only ends a hung run."""
+        backstop = time.monotonic() + HANG_BACKSTOP_S
+        while clock["us"] < 0:
+            assert time.monotonic() < backstop, "no SIM_CLOCK"
+            if select.select([lc.fileno()], [], [], 0.005)[0]:
+                lc.handle()
+        end_us, next_frame_us, i = clock["us"] + int(sim_s * 1e6), clock["us"], 0
+        while clock["us"] < end_us:
+            assert time.monotonic() < backstop, f"sim time stuck at {clock['us']} us"
+            if frames is not None and clock["us"] >= next_frame_us:
                 img = types.compressed_image_t()
-                img.utime, img.frame_id, img.format = int(time.time() * 1e6), "camera_front", "jpeg"
+                img.utime, img.frame_id, img.format = clock["us"], "camera_front", "jpeg"
                 img.width_px, img.height_px = fixture.SOURCE_W, fixture.SOURCE_H
                 img.data = frames[i % len(frames)]
                 img.size_bytes = len(img.data)
                 lc.publish(channels.channel("CAM_FRONT", veh), img.encode())
                 i += 1
-                next_frame += 1.0 / fps
+                next_frame_us += int(1e6 / fps)
             if select.select([lc.fileno()], [], [], 0.005)[0]:
                 lc.handle()
 
@@ -79,8 +95,8 @@ def test_frames_stop_stop_the_car(
         rcfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
         (out / "runtime.yaml").write_text(yaml.safe_dump(rcfg))
         pcfg = yaml.safe_load((root / "runtime/jetson/config/pilot_hil.yaml").read_text())
-        # the test's frames are paced on the wall clock: so is the pilot's timeout here
-        pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300, clock="wall")
+        # the test's frames are paced on the sim clock: so is the pilot's timeout [ms of sim time]
+        pcfg.update(lcm_url=url, model=str(model), frame_timeout_ms=300, clock="sim")
         (out / "pilot.yaml").write_text(yaml.safe_dump(pcfg))
         bin_ = build / "bin"
         sim_log, pilot_log = open(out / "sim.log", "w"), open(out / "pilot.log", "w")
@@ -92,9 +108,11 @@ def test_frames_stop_stop_the_car(
                 stdout=sim_log, stderr=subprocess.STDOUT)  # fmt: skip
         ]
         try:
-            t0 = time.time()
+            backstop = time.monotonic() + HANG_BACKSTOP_S
             while not (run_dir / "nigel1-nano").exists():
-                assert time.time() - t0 < 30 and procs[0].poll() is None, "the sim did not start"
+                assert (
+                    time.monotonic() < backstop and procs[0].poll() is None
+                ), "the sim did not start"
                 time.sleep(0.05)
             procs.append(subprocess.Popen(
                 [bin_ / "autodrive-runtime", "--config", out / "runtime.yaml", "--only",
@@ -112,9 +130,9 @@ def test_frames_stop_stop_the_car(
             assert truth["v"] > 0.05, f"the car does not move ({truth['v']:.3f} m/s)"
             print(f"driving: {len(driving)} commands, {truth['v']:.3f} m/s")
             # no frames: within the timeout, the pilot stops the car
-            t_stop = time.time()
+            t_stop = clock["us"]
             pump(3.0)
-            after = [c for c in commands if c[0] > t_stop + 0.5]
+            after = [c for c in commands if c[0] > t_stop + 500_000]
             assert after and not any(
                 e for _, e, _ in after
             ), "commands still engaged without frames"
@@ -123,7 +141,7 @@ def test_frames_stop_stop_the_car(
             log = (out / "pilot.log").read_text()
             assert "STOPPING the car" in log and "CAM_FRONT" in log, log
             print(
-                f"frames stopped: disengaged after {first_off - t_stop:.2f} s, car at {truth['v']:.4f} m/s"
+                f"frames stopped: disengaged after {(first_off - t_stop) * 1e-6:.2f} s of sim time, car at {truth['v']:.4f} m/s"
             )
             # frames again: it drives again
             pump(3.0, jpegs)

@@ -100,10 +100,30 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="also keep N front-camera JPEGs (every 3rd frame) in OUT/frames/ (tools/bench "
         "cloning times the model on them)",
     )
+    p.add_argument(
+        "--start-m",
+        type=float,
+        default=START_ALONG_M,
+        help=f"start this far along the route [m] (default {START_ALONG_M})",
+    )
+    p.add_argument(
+        "--distance-m",
+        type=float,
+        default=0.0,
+        help="drive this far along the route [m] rather than --laps (default 0: the laps)",
+    )
     args = p.parse_args(argv)
     if args.laps < 1:
         p.error(f"--laps {args.laps}: at least 1")
+    if args.start_m < 0 or args.distance_m < 0:
+        p.error(f"--start-m {args.start_m} / --distance-m {args.distance_m}: at least 0")
     return args
+
+
+def driven(args: argparse.Namespace, laps: float, distance_m: float) -> bool:
+    """Whether the run has driven what it was asked: --distance-m when given, else --laps."""
+    wanted_m, wanted_laps = float(args.distance_m), int(args.laps)
+    return distance_m >= wanted_m if wanted_m > 0 else laps >= wanted_laps
 
 
 def _laps_of(recording: dict[str, Any]) -> float:
@@ -132,16 +152,18 @@ def trained(model: Path, key: str, default: float) -> float:
     return float(value) if isinstance(value, (int, float)) else default
 
 
-def condition_route(condition: str) -> tuple[maps.description.Route, maps.Pose]:
+def condition_route(
+    condition: str, start_m: float = START_ALONG_M
+) -> tuple[maps.description.Route, maps.Pose]:
     """The route the car drives and the referee watches in a condition, and the car's start:
-    START_ALONG_M along the route; driven against the map's direction, the same point as the
+    start_m along the route; driven against the map's direction, the same point as the
     route's own start there, facing the other way."""
     name, against = ROUTES[condition]
     route = maps.load(MAP).route(name)
     if not against:
-        return route, route.pose_at(START_ALONG_M)
+        return route, route.pose_at(start_m)
     back = route.reversed()
-    return back, back.pose_at(back.length_m - START_ALONG_M)
+    return back, back.pose_at(back.length_m - start_m)
 
 
 def sim_argv(
@@ -320,7 +342,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
     except ValueError as e:
         say(f"ERROR: {e}")
         return 2
-    route, start = condition_route(args.condition)
+    route, start = condition_route(args.condition, args.start_m)
     run_dir = Path(f"/tmp/autodrive-cloning-{os.getpid()}")
     run_dir.mkdir(parents=True, exist_ok=True)
     runtime_cfg, pilot_cfg = write_configs(out, run_dir, args)
@@ -349,7 +371,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         pilot = [build / "bin" / "autodrive-pilot", "--config", pilot_cfg, "--stats", stats_path]
         procs.start("autodrive-pilot", pilot, out / "pilot.log")
         next_progress = time.time() + PROGRESS_S
-        while referee.watch.laps < args.laps and not interrupted:
+        while not driven(args, referee.watch.laps, referee.watch.progress_m) and not interrupted:
             if time.time() - t_wall0 > args.timeout:
                 raise RuntimeError(
                     f"{args.laps} lap(s) not driven within {args.timeout:.0f} s wall"
@@ -393,7 +415,8 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout) -> int:
         rep["rtf_achieved"] = round(rep["elapsed_sim_s"] / rep["wall_s"], 2)
     if error:
         rep["error"] = error
-    rep["ok"] = not error and not interrupted and rep["laps"] >= args.laps
+    rep["distance_requested_m"] = args.distance_m
+    rep["ok"] = not error and not interrupted and driven(args, rep["laps"], rep["distance_m"])
     record_children(rep, exits, say)
     if referee.path:
         title = (f"cloning, {args.condition}: {rep['laps']:.2f} laps, {rep['interventions']} "
