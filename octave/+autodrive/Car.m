@@ -54,7 +54,8 @@ classdef Car < handle
   end
   methods (Access = private)
     function send(car, throttle, steering, engaged)
-      now_us = int64(javaMethod('currentTimeMillis', 'java.lang.System')) * 1000;
+      now = javaMethod('now', 'java.time.Instant');  % wall clock [us], as the other signers
+      now_us = int64(now.getEpochSecond()) * 1000000 + int64(floor(double(now.getNano()) / 1000));
       car.counter = max(car.counter + 1, now_us);  % the anti-replay counter: strictly increasing
       cmd = struct('utime', now_us, 'seq', car.seq, 'throttle', single(throttle), ...
                    'steering', single(steering), 'headlights', 0, 'indicators', 0, ...

@@ -64,10 +64,19 @@ def test_bad_input_is_named(build_dir, lcm_url, tmp_path):
     """
     r = octave_run(build_dir, lcm_url, script)
     out = r.stdout
-    assert "autodrive:missingJar | autodrive.connect: the jar of the AutoDRIVE types /nonexistent/types.jar is missing" in out
+    assert (
+        "autodrive:missingJar | autodrive.connect: the jar of the AutoDRIVE types /nonexistent/types.jar is missing"
+        in out
+    )
     assert "autodrive:unknownType | autodrive.publish: no LCM type no_such_t" in out
-    assert "autodrive:missingField | autodrive.publish: sim_clock_t: field 'real_time_factor' missing" in out
-    assert "autodrive:badField | autodrive.publish: sim_clock_t: field 'utime' must be one real number" in out
+    assert (
+        "autodrive:missingField | autodrive.publish: sim_clock_t: field 'real_time_factor' missing"
+        in out
+    )
+    assert (
+        "autodrive:badField | autodrive.publish: sim_clock_t: field 'utime' must be one real number"
+        in out
+    )
     assert "autodrive:unsigned" in out
     assert "autodrive:unknownChannel | autodrive.channel: no channel with id 'NO_SUCH'" in out
     assert f"autodrive:badKey | {loose}: command key file is readable by group or others" in out
@@ -138,10 +147,14 @@ def test_octave_reads_state_and_drives(build_dir, lcm_url):
         try:
             wrong = work / "wrong.key"
             command_auth.create_key(wrong)
-            r = octave_run(build_dir, lcm_url, f"window_s = 2; drive_s = 3; keyfile = '{wrong}'; hil_session")
+            r = octave_run(
+                build_dir, lcm_url, f"window_s = 2; drive_s = 3; keyfile = '{wrong}'; hil_session"
+            )
             assert r.returncode == 0
             bad = last_json(r.stdout)
-            r = octave_run(build_dir, lcm_url, "window_s = 4; drive_s = 5; keyfile = ''; hil_session")
+            r = octave_run(
+                build_dir, lcm_url, "window_s = 4; drive_s = 5; keyfile = ''; hil_session"
+            )
             assert r.returncode == 0
             good = last_json(r.stdout)
             procs.check()
@@ -150,7 +163,9 @@ def test_octave_reads_state_and_drives(build_dir, lcm_url):
             exits = procs.stop_all()
         assert not [e for e in exits if e.sanitizer_report]
         on_bus = sum(good["first_utime"] <= t <= good["last_utime"] for t in bus.state)
-        log(f"Octave read {good['state_count']} NIGEL1_STATE, the bus carried {on_bus} in that window")
+        log(
+            f"Octave read {good['state_count']} NIGEL1_STATE, the bus carried {on_bus} in that window"
+        )
         assert good["state_count"] >= 0.95 * on_bus and on_bus > 0
         wrong_m = bus.moved_m(bad["drive_first_utime"], bad["drive_last_utime"])
         good_m = bus.moved_m(good["drive_first_utime"], good["drive_last_utime"])

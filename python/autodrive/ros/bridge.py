@@ -72,7 +72,11 @@ def quaternion_of_yaw(yaw_rad: float) -> tuple[float, float, float, float]:
 
 
 def twist_to_command(
-    v_m_s: float, yaw_rate_rad_s: float, top_speed_m_s: float, wheelbase_m: float, steer_limit_rad: float
+    v_m_s: float,
+    yaw_rate_rad_s: float,
+    top_speed_m_s: float,
+    wheelbase_m: float,
+    steer_limit_rad: float,
 ) -> tuple[float, float]:
     """(throttle, steering), normalised [-1, 1], of a Twist through the kinematic bicycle:
     throttle = v / top speed, steering angle = atan(wheelbase * yaw rate / v). An Ackermann car
@@ -120,9 +124,19 @@ class Commander:
         self.sent = 0
         self.lock = threading.Lock()  # ROS callbacks and the 50 Hz tick run on other threads
         rospy = m["rospy"]
-        rospy.Subscriber(topics.command_topic(car, "cmd_vel"), m["geometry_msgs"].Twist, self.on_twist)
-        rospy.Subscriber(topics.command_topic(car, "throttle"), m["std_msgs"].Float32, self.on_throttle)
-        rospy.Subscriber(topics.command_topic(car, "steering"), m["std_msgs"].Float32, self.on_steering)  # fmt: skip
+        rospy.Subscriber(
+            topics.command_topic(car, "cmd_vel"),
+            m["geometry_msgs"].Twist,
+            self.on_twist,
+            tcp_nodelay=True,
+        )
+        rospy.Subscriber(
+            topics.command_topic(car, "throttle"),
+            m["std_msgs"].Float32,
+            self.on_throttle,
+            tcp_nodelay=True,
+        )
+        rospy.Subscriber(topics.command_topic(car, "steering"), m["std_msgs"].Float32, self.on_steering, tcp_nodelay=True)  # fmt: skip
 
     def on_twist(self, msg: Any) -> None:
         mm = self.model
@@ -192,9 +206,9 @@ class StateBridge:
         self.decode: dict[str, Callable[[bytes, topics.Topic], Any]] = {}
         self.counts: dict[str, int] = {t.topic: 0 for t in self.topics.values()}
         for ch, t in self.topics.items():
-            self.pubs[ch] = rospy.Publisher(t.topic, self.ros_class(t.ros_type), queue_size=200)
+            self.pubs[ch] = rospy.Publisher(t.topic, self.ros_class(t.ros_type), queue_size=1000)
         tf = m["tf2_msgs"].TFMessage
-        self.tf_pub = rospy.Publisher("/tf", tf, queue_size=400)
+        self.tf_pub = rospy.Publisher("/tf", tf, queue_size=1000)
         self.tf_static_pub = rospy.Publisher("/tf_static", tf, queue_size=10, latch=True)
         self.cars = cars
         self.odom: dict[str, tuple[float, float, float]] = {}  # car -> odom pose (x, y, yaw)
@@ -304,16 +318,22 @@ class StateBridge:
     def publish_tf(self, utime: int, car: str, parent: str, child: str,
                    pose: tuple[float, float, float]) -> None:  # fmt: skip
         x, y, yaw = pose
-        tf = self.transform(utime, topics.frame(car, parent), topics.frame(car, child), x, y, 0.0, yaw)
+        tf = self.transform(
+            utime, topics.frame(car, parent), topics.frame(car, child), x, y, 0.0, yaw
+        )
         self.tf_pub.publish(self.m["tf2_msgs"].TFMessage(transforms=[tf]))
 
-    def publish_map_to_odom(self, utime: int, car: str, map_pose: tuple[float, float, float]) -> None:
+    def publish_map_to_odom(
+        self, utime: int, car: str, map_pose: tuple[float, float, float]
+    ) -> None:
         """map -> odom = map -> base_link composed with the inverse of odom -> base_link."""
         ox, oy, oyaw = self.odom[car]
         mx, my, myaw = map_pose
         yaw = myaw - oyaw
         c, s = math.cos(yaw), math.sin(yaw)
-        self.publish_tf(utime, car, "map", "odom", (mx - (c * ox - s * oy), my - (s * ox + c * oy), yaw))
+        self.publish_tf(
+            utime, car, "map", "odom", (mx - (c * ox - s * oy), my - (s * ox + c * oy), yaw)
+        )
 
     def from_ground_truth_t(self, s: Any, t: topics.Topic) -> Any:
         v, w = s.linear_velocity_m_s, s.angular_velocity_rad_s
@@ -324,10 +344,14 @@ class StateBridge:
     def from_pose2d_t(self, s: Any, t: topics.Topic) -> Any:
         r = self.m["geometry_msgs"].PoseStamped()
         frame_id = s.frame_id or "map"
-        r.header = self.header(s.utime, frame_id if frame_id == "map" else topics.frame(t.vehicle, frame_id))
+        r.header = self.header(
+            s.utime, frame_id if frame_id == "map" else topics.frame(t.vehicle, frame_id)
+        )
         p = r.pose
         p.position.x, p.position.y = s.x_m, s.y_m
-        p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_of_yaw(s.yaw_rad)
+        p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_of_yaw(
+            s.yaw_rad
+        )
         return r
 
     def from_compressed_image_t(self, s: Any, t: topics.Topic) -> Any:
@@ -359,7 +383,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    "(default $AUTODRIVE_BUILD, else build/release)")  # fmt: skip
     p.add_argument("--quiet-s", type=float, default=QUIET_S_DEFAULT,
                    help=f"stop the car after this long without a ROS command [s] (default {QUIET_S_DEFAULT})")  # fmt: skip
-    p.add_argument("--no-commands", action="store_true", help="bridge the state only (no key needed)")
+    p.add_argument(
+        "--no-commands", action="store_true", help="bridge the state only (no key needed)"
+    )
     p.add_argument("--seconds", type=float, default=0.0,
                    help="stop after this many wall seconds (default: until SIGINT/SIGTERM)")  # fmt: skip
     a = p.parse_args(argv)

@@ -60,12 +60,16 @@ def state_topics(vehicles: list[str]) -> list[Topic]:
         if ch.status != "live" or ch.type not in ROS_TYPE:
             continue
         if ch.id == CLOCK_ID:
-            out.append(Topic(ch.name, ch.id, "/clock", ch.type, ROS_TYPE[ch.type], "", ch.rate, ch.when))
+            out.append(
+                Topic(ch.name, ch.id, "/clock", ch.type, ROS_TYPE[ch.type], "", ch.rate, ch.when)
+            )
         elif ch.per_vehicle:
             for v in vehicles:
                 topic = f"/{v.lower()}/{ch.id.lower()}"
                 out.append(
-                    Topic(ch.resolve(v), ch.id, topic, ch.type, ROS_TYPE[ch.type], v, ch.rate, ch.when)
+                    Topic(
+                        ch.resolve(v), ch.id, topic, ch.type, ROS_TYPE[ch.type], v, ch.rate, ch.when
+                    )
                 )
     return out
 
@@ -79,7 +83,9 @@ def command_topic(vehicle: str, suffix: str) -> str:
 def markdown(vehicles: list[str]) -> str:
     rows = ["| ROS topic | type | from LCM channel | rate | when |", "|---|---|---|---|---|"]
     for t in state_topics(vehicles):
-        rows.append(f"| `{t.topic}` | `{t.ros_type}` | `{t.channel}` | {t.rate} | {t.when or 'always'} |")
+        rows.append(
+            f"| `{t.topic}` | `{t.ros_type}` | `{t.channel}` | {t.rate} | {t.when or 'always'} |"
+        )
     rows += ["", "| ROS command topic | type | carries |", "|---|---|---|"]
     for v in vehicles:
         for suffix, ros_type, what in COMMAND_TOPICS:
