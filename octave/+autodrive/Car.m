@@ -62,11 +62,7 @@ classdef Car < handle
                    'engaged', logical(engaged), 'source', car.source, 'authority', 1, ...
                    'counter', car.counter);
       cmd.mac = autodrive.sign_command(car.key, car.vehicle, cmd);
-      obj = javaObject('autodrive.vehicle_command_t');
-      obj.utime = cmd.utime; obj.seq = int32(cmd.seq); obj.throttle = cmd.throttle;
-      obj.steering = cmd.steering; obj.headlights = int8(0); obj.indicators = int8(0);
-      obj.engaged = cmd.engaged; obj.source = cmd.source; obj.authority = int8(1);
-      obj.counter = cmd.counter; obj.mac = cmd.mac;
+      obj = autodrive.to_java(car.lc, 'vehicle_command_t', cmd);
       car.lc.java.publish(car.channel, obj);
       car.seq = car.seq + 1;
       car.sent = car.sent + 1;
