@@ -141,7 +141,7 @@ while isempty(first) || double(last - first) < {window_s} * 1e6
 end
 car = autodrive.Car(lc, 'NIGEL1');
 for k = 1:{samples}
-  car.drive(round(0.1 + 0.001 * mod(k, 300), 3), 0);
+  car.drive(0.1 + 0.001 * mod(k, 300), 0);
   pause(0.03);
 end
 car.release();
