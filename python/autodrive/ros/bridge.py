@@ -338,7 +338,7 @@ class StateBridge:
     def from_ground_truth_t(self, s: Any, t: topics.Topic) -> Any:
         v, w = s.linear_velocity_m_s, s.angular_velocity_rad_s
         x, y, _z = s.position_m
-        return self.odometry(s.utime, "map", topics.frame(t.vehicle, "base_link_ground_truth"),
+        return self.odometry(s.utime, topics.MAP_FRAME, topics.frame(t.vehicle, "base_link_ground_truth"),
                              x, y, s.yaw_rad, v[0], v[1], w[2])  # fmt: skip
 
     def from_pose2d_t(self, s: Any, t: topics.Topic) -> Any:

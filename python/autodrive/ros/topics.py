@@ -48,15 +48,18 @@ class Topic:
     when: str  # the table's condition ("" = every run)
 
 
+MAP_FRAME = "map"  # the one frame every car shares
+
+
 def frame(vehicle: str, name: str) -> str:
-    """A car's tf frame: nigel1/base_link."""
-    return f"{vehicle.lower()}/{name}"
+    """A car's tf frame: nigel1/base_link; the map is everyone's: map."""
+    return name if name == MAP_FRAME else f"{vehicle.lower()}/{name}"
 
 
-def state_topics(vehicles: list[str]) -> list[Topic]:
+def state_topics(vehicles: list[str], table: channels.ChannelTable | None = None) -> list[Topic]:
     """Every bridged LCM -> ROS topic for these cars, in channel-table order."""
     out: list[Topic] = []
-    for ch in channels.load().channels:
+    for ch in (table or channels.load()).channels:
         if ch.status != "live" or ch.type not in ROS_TYPE:
             continue
         if ch.id == CLOCK_ID:
@@ -75,14 +78,36 @@ def state_topics(vehicles: list[str]) -> list[Topic]:
 
 
 def command_topic(vehicle: str, suffix: str) -> str:
-    """/nigel1/cmd_vel and the like; the command channel must be in the table."""
-    channels.load().by_id(COMMAND_ID)
+    """/nigel1/cmd_vel and the like (of <VEH>_COMMAND)."""
     return f"/{vehicle.lower()}/{suffix}"
 
 
-def markdown(vehicles: list[str]) -> str:
+PATH = "docs/reference/ros-topics.md"
+FRAMES = """
+Frames (REP-105, one tf tree for every car): `map` -> `<car>/odom` (from `<VEH>_POSE_MAP` and
+`<VEH>_ODOM`, when the car knows its map pose) -> `<car>/base_link` (from `<VEH>_ODOM`) ->
+`<car>/laser`, `<car>/imu_link`, `<car>/camera_front`, `<car>/camera_rear` (static, from
+`vehicle/nigel.params`). The ground truth is `map` -> `<car>/base_link_ground_truth` in its
+Odometry message only (not in tf). Stamps are the LCM messages' own: sim time in HIL (use
+`/use_sim_time`), wall time on the car.
+"""
+
+
+def render(table: channels.ChannelTable, source: str) -> str:
+    """docs/reference/ros-topics.md: the table for car 1, generated from the channel table."""
+    car = f"{table.vehicle_prefix}1"
+    head = (
+        f"<!-- Generated from {source} by autodrive.ros.topics (tools/gen-docs); do not edit. -->\n"
+        "# ROS topics\n\n"
+        "What `autodrive-ros-bridge` publishes and takes, for car 1 (car N: `/nigelN/...`); "
+        "guide: [ROS](../guides/ros.md).\n\n"
+    )
+    return head + markdown([car], table) + FRAMES
+
+
+def markdown(vehicles: list[str], table: channels.ChannelTable | None = None) -> str:
     rows = ["| ROS topic | type | from LCM channel | rate | when |", "|---|---|---|---|---|"]
-    for t in state_topics(vehicles):
+    for t in state_topics(vehicles, table):
         rows.append(
             f"| `{t.topic}` | `{t.ros_type}` | `{t.channel}` | {t.rate} | {t.when or 'always'} |"
         )
