@@ -100,7 +100,7 @@ def render(table: channels.ChannelTable, source: str) -> str:
         f"<!-- Generated from {source} by autodrive.ros.topics (tools/gen-docs); do not edit. -->\n"
         "# ROS topics\n\n"
         "What `autodrive-ros-bridge` publishes and takes, for car 1 (car N: `/nigelN/...`); "
-        "guide: [ROS](../guides/ros.md).\n\n"
+        "the guide: Guides > ROS 1.\n\n"
     )
     return head + markdown([car], table) + FRAMES
 
