@@ -11,9 +11,9 @@ first = [];
 last = [];
 n = 0;
 while isempty(first) || double(last - first) < window_s * 1e6
-  [m, type] = autodrive.next(state, 30);
+  [m, type] = autodrive.next(state, 300);  % a hang guard (a loaded machine starts slowly)
   if isempty(m)
-    error('no %s within 30 s', state.channel);
+    error('no %s within 300 s', state.channel);
   end
   if ~strcmp(type, 'vehicle_state_t')
     error('%s carried a %s', state.channel, type);

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from autodrive.apis import octave, stack
 from autodrive.core import channels, command_auth, lcmtypes
+from autodrive.ros.bridge import with_receive_buffer
 
 GUARD_S = 600.0  # hang guard of one Octave run (wall); nothing is judged on it
 SIM_SECONDS = 120.0
@@ -111,7 +112,7 @@ class Bus(threading.Thread):
     def __init__(self, build_dir, url):
         super().__init__(daemon=True)
         self.types = lcmtypes.load(build_dir)
-        self.lc = lcmtypes.bus(url)
+        self.lc = lcmtypes.bus(with_receive_buffer(url))
         car = channels.vehicle_name(1)
         self.state, self.gt = [], []
         self.lc.subscribe(channels.channel("STATE", car), self.on_state)

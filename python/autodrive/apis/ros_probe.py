@@ -10,6 +10,7 @@ import struct
 import threading
 from typing import Any
 
+from autodrive.core import lcmtypes
 from autodrive.ros import topics
 
 CLOCK = topics.CLOCK_ID
@@ -68,6 +69,24 @@ class RateProbe:
             if self.first_clock_us is None:
                 self.first_clock_us = msg.utime
 
+    def use_lcm_log(self, path: str) -> None:
+        """Takes the LCM side's counts from a log that lcm-logger (C, which keeps up where this
+        process may not on a loaded machine) recorded of the same channels."""
+        stamps: dict[str, list[int]] = {k: [] for k in self.lcm}
+        events = lcmtypes.events(path)
+        while True:
+            try:
+                ev = next(events)
+            except (StopIteration, OSError, ValueError):
+                break  # the end, or the logger's last event half written
+            key = self.by_channel.get(ev.channel)
+            if key is not None:
+                stamps[key].append(
+                    getattr(self.types, self.table[key].lcm_type).decode(ev.data).utime
+                )
+        with self.lock:
+            self.lcm = stamps
+
     def sim_s(self) -> float | None:
         """Sim time since the first SIM_CLOCK [s], or None before one."""
         if self.clock_us is None or self.first_clock_us is None:
@@ -105,6 +124,10 @@ class RateProbe:
                 k: (sum(lo <= t < hi for t in self.ros[k]), sum(lo <= t < hi for t in self.lcm[k]))
                 for k in self.table
             }
+
+    def channel_regex(self) -> str:
+        """The counted channels, as lcm-logger's --channel regex."""
+        return "|".join(sorted(self.by_channel))
 
     def close(self) -> None:
         for s in self.subs:

@@ -6,25 +6,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import yaml
-
 from autodrive.core import channels, v2x_ca
 from autodrive.core.proc import Log, ProcessGroup, wait_for_path
-from autodrive.core.settings import RUNTIME_HIL_CONFIG
+from autodrive.hil.demo import write_runtime_config
 
 PTY_TIMEOUT_S = 60.0  # the sim's ptys appear once its scene is built (a guard: CPU-bound start)
-
-
-def runtime_config(path: Path, run_dir: Path, url: str) -> Path:
-    """The HIL runtime config on this bus and the sim's ptys, on the sim clock."""
-    cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
-    cfg["lcm_url"] = url
-    cfg["clock"] = "sim"
-    cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
-    cfg["lidar"]["device"] = str(run_dir / "nigel1-lidar")
-    cfg.pop("cameras", None)
-    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
-    return path
 
 
 def start(build: Path, work: Path, url: str, log: Log, sim_seconds: float) -> ProcessGroup:
@@ -37,7 +23,7 @@ def start(build: Path, work: Path, url: str, log: Log, sim_seconds: float) -> Pr
     procs.start("autodrive-sim", sim, work / "sim.log")
     try:
         wait_for_path(run_dir / "nigel1-nano", PTY_TIMEOUT_S, procs)
-        cfg = runtime_config(work / "runtime.yaml", run_dir, url)
+        cfg = write_runtime_config(work, run_dir, url)  # the demo's: on the sim clock
         procs.start(
             "autodrive-runtime", [build / "bin" / "autodrive-runtime", "--config", cfg],
             work / "runtime.log",

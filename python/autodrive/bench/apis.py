@@ -34,6 +34,7 @@ from autodrive.bench import Progress, build_dir, last_json, print_figures
 from autodrive.bench.goals import Goal, at_least, at_most, judge
 from autodrive.bench.link import LinkBench
 from autodrive.core import channels, lcmtypes, seeds
+from autodrive.ros.bridge import with_receive_buffer
 
 UNSEEDED = seeds.unseeded("rates and latencies of fixed runs on the HIL stack")
 PORT = 7964
@@ -57,7 +58,7 @@ class CommandWatch(threading.Thread):
 
     def __init__(self, types: Any, url: str, car: str) -> None:
         super().__init__(daemon=True)
-        self.types, self.lc = types, lcmtypes.bus(url)
+        self.types, self.lc = types, lcmtypes.bus(with_receive_buffer(url))
         self.lc.subscribe(channels.channel("COMMAND", car), self.on_command)
         self.seen: list[tuple[int, Any]] = []
         self.lock = threading.Lock()
@@ -94,7 +95,7 @@ def ros_part(
 
     rospy.init_node("autodrive_bench", anonymous=True, disable_signals=True)
     car = channels.vehicle_name(1)
-    lc = lcmtypes.bus(url)
+    lc = lcmtypes.bus(with_receive_buffer(url))
     probe = RateProbe(rospy, types, lc, car, RATE_IDS)
     log(f"ROS rates: counting {window_s:g} s of sim time")
     window = None

@@ -14,6 +14,7 @@ messages' own (sim time in HIL: set /use_sim_time for ROS tools)."""
 from __future__ import annotations
 
 import argparse
+import importlib
 import math
 import select
 import sys
@@ -34,36 +35,39 @@ STOP_COMMANDS = 5  # disengaged zero commands sent when the ROS side goes quiet
 STATIC_TF_PERIOD_S = 1.0
 
 
+RECV_BUF_BYTES = 4 * 1024 * 1024  # the UDP receive buffer asked for (capped by net.core.rmem_max)
+
+
+def with_receive_buffer(url: str) -> str:
+    """The LCM URL with a large UDP receive buffer (LCM's recv_buf_size), so that a process
+    that falls behind for a moment on a loaded machine loses no message."""
+    if not url.startswith("udpm://") or "recv_buf_size=" in url:
+        return url
+    return url + ("&" if "?" in url else "?") + f"recv_buf_size={RECV_BUF_BYTES}"
+
+
 class BridgeError(RuntimeError):
     """Something the bridge cannot start without; the message names it."""
 
 
+# rospy, the master's client library and the message packages the bridge uses (Debian's
+# python3-rospy, python3-<package>); a message package by its name, its module is <name>.msg.
+ROS_LIBRARIES = ("rospy", "rosgraph")
+ROS_MESSAGE_PACKAGES = ("geometry_msgs", "nav_msgs", "sensor_msgs", "std_msgs", "tf2_msgs",
+                        "rosgraph_msgs")  # fmt: skip
+
+
 def ros_modules() -> dict[str, Any]:
-    """rospy and the message modules (Debian's python3-rospy & co.), or BridgeError."""
+    """Name -> module of ROS_LIBRARIES and ROS_MESSAGE_PACKAGES, or BridgeError naming the
+    missing one."""
+    names = [(n, n) for n in ROS_LIBRARIES] + [(n, n + ".msg") for n in ROS_MESSAGE_PACKAGES]
     try:
-        import geometry_msgs.msg as geometry_msgs
-        import nav_msgs.msg as nav_msgs
-        import rosgraph
-        import rosgraph_msgs.msg as rosgraph_msgs
-        import rospy
-        import sensor_msgs.msg as sensor_msgs
-        import std_msgs.msg as std_msgs
-        import tf2_msgs.msg as tf2_msgs
+        return {name: importlib.import_module(module) for name, module in names}
     except ImportError as e:
         raise BridgeError(
             f"ROS 1 Python modules missing ({e.name}): install Debian's python3-rospy and the "
             "message packages (tools/setup does)"
         ) from None
-    return dict(
-        rospy=rospy,
-        rosgraph=rosgraph,
-        geometry_msgs=geometry_msgs,
-        nav_msgs=nav_msgs,
-        sensor_msgs=sensor_msgs,
-        std_msgs=std_msgs,
-        tf2_msgs=tf2_msgs,
-        rosgraph_msgs=rosgraph_msgs,
-    )
 
 
 def quaternion_of_yaw(yaw_rad: float) -> tuple[float, float, float, float]:
@@ -414,7 +418,7 @@ def run(a: argparse.Namespace) -> int:
     types = lcmtypes.load(build_dir(a.build))
     cars = [channels.vehicle_name(i) for i in range(1, a.cars + 1)]
     model = car_model()
-    lc = lcmtypes.bus(a.lcm_url)
+    lc = lcmtypes.bus(with_receive_buffer(a.lcm_url))
     rospy = m["rospy"]
     rospy.init_node("autodrive_ros_bridge", anonymous=False, disable_signals=False)
     state = StateBridge(m, types, cars, model)
