@@ -14,6 +14,7 @@ from typing import Any
 from autodrive.core.settings import settings
 
 SUITES = (
+    "apis",
     "cloning",
     "eye",
     "firmware",

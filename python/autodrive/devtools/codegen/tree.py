@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from autodrive.core import channels, vehicle
+from autodrive.ros import topics as ros_topics
 from autodrive.devtools.codegen import (
     channels_doc,
     eye_configs,
@@ -25,6 +26,7 @@ def render_all(root: Path) -> dict[str, str]:
     table = channels.load(root / CHANNELS)
     return {
         channels_doc.PATH: channels_doc.render(table, CHANNELS),
+        ros_topics.PATH: ros_topics.render(table, CHANNELS),
         vehicle_doc.PATH: vehicle_doc.render(car, PARAMS),
         firmware_header.PATH: firmware_header.render(car, PARAMS),
         protocol_doc.PATH: protocol_doc.render(root),
