@@ -21,6 +21,7 @@ from pathlib import Path
 from types import FrameType
 
 from autodrive.core import channels, lcmtypes, v2x_auth, v2x_ca
+from autodrive.core.v2x_cert import CertificateError
 from autodrive.core.channels import channel
 from autodrive.core.settings import RELEASE_BUILD
 
@@ -82,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, on_signal)
     try:
         return run(args.vehicles.split(","), args.lcm_url, Path(args.build), args.seed, stop)
-    except v2x_ca.CertificateError as err:  # no car would take unsigned poses
+    except CertificateError as err:  # no car would take unsigned poses
         print(f"[eye-standin] cannot sign as {EYE_IDENTITY}: {err}", file=sys.stderr)
         return 2
 
