@@ -21,6 +21,6 @@ function(autodrive_python_sanitizer_env var)
       OUTPUT_VARIABLE stdcxx OUTPUT_STRIP_TRAILING_WHITESPACE)
     set(${var} ${${var}} "LD_PRELOAD=${asan}:${stdcxx}"
       "ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:verify_asan_link_order=0"
-      "LSAN_OPTIONS=suppressions=${AUTODRIVE_ROOT}/tests/lsan.supp" PARENT_SCOPE)
+      "LSAN_OPTIONS=suppressions=${AUTODRIVE_ROOT}/tests/lsan.supp:print_suppressions=0" PARENT_SCOPE)
   endif()
 endfunction()

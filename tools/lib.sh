@@ -6,14 +6,17 @@ export CCACHE_BASEDIR="$ROOT" CCACHE_NOHASHDIR=1
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*"; }
 die() { printf '[%s] ERROR: %s\n' "$(basename "$0")" "$*" >&2; exit 1; }
 # Configures (once) and builds a preset of the host build: dev, release or asan.
+# The compilers run without a caller's sanitizer preload: a guide run as a test under ASan
+# (journeys.scm-operator) preloads it for our cffi libraries, and gcc leaks under LeakSanitizer.
 build_host() {
   local preset="$1"; shift
   if [ ! -f "$ROOT/build/$preset/build.ninja" ]; then
     log "configuring preset $preset"
-    cmake --preset "$preset" -S "$ROOT" >/dev/null || die "cmake configure ($preset) failed"
+    env -u LD_PRELOAD cmake --preset "$preset" -S "$ROOT" >/dev/null \
+      || die "cmake configure ($preset) failed"
   fi
   log "building preset $preset"
-  cmake --build "$ROOT/build/$preset" "$@" || die "build ($preset) failed"
+  env -u LD_PRELOAD cmake --build "$ROOT/build/$preset" "$@" || die "build ($preset) failed"
 }
 # build/bin: the one place the programs a user runs come from, whichever of tools/demo (release)
 # and tools/test (asan) built them. Each autodrive-* program and nano-simavr is a relative link
