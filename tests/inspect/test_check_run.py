@@ -116,3 +116,22 @@ def test_export_mcap_names_its_output(build_dir: Path, tmp_path: Path) -> None:
     )  # fmt: skip
     assert rc.returncode == 0, rc.stderr
     assert (tmp_path / "run.mcap").stat().st_size > 1000
+
+
+def test_export_mcap_places_an_unstamped_marker_at_its_log_time(
+    build_dir: Path, tmp_path: Path
+) -> None:
+    # EYE_FRAME_DONE says "ready" with utime -1 (the Eye in lockstep); MCAP's times are unsigned
+    from autodrive.devtools.inspect.export_mcap import export_mcap
+
+    log = tmp_path / "ready.lcmlog"
+    t = lcmtypes.load(build_dir)
+    ev = lcm.EventLog(str(log), "w", overwrite=True)
+    for utime in (-1, 2_000_000):
+        done = t.eye_frame_done_t()
+        done.utime = utime
+        ch = channels.load().by_id("EYE_FRAME_DONE").resolve(None)
+        ev.write_event(1_000_000 + max(utime, 0), ch, done.encode())
+    ev.close()
+    counts = export_mcap(log, tmp_path / "ready.mcap", build_dir)
+    assert any("EYE_FRAME_DONE" in topic.upper() for topic in counts), counts

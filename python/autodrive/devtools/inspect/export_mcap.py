@@ -156,7 +156,10 @@ class Converter:
             return
         ch, veh = found
         msg = getattr(types, ch.type).decode(data)
-        utime = int(getattr(msg, "utime", 0)) or log_us
+        # a message without a stamp, or with a marker below 0 (EYE_FRAME_DONE's -1 "ready"), is
+        # placed at its log time: MCAP's times are unsigned
+        utime = int(getattr(msg, "utime", 0))
+        utime = utime if utime > 0 else log_us
         topic = frames.topic(ch, veh)
         if veh and veh not in self.static_sent:
             self.static_tf(veh, utime)
