@@ -14,6 +14,8 @@ URL="udpm://239.255.76.67:$PORT?ttl=0"
 export AUTODRIVE_KEY_DIR="$W/keys"
 mkdir -m 700 "$AUTODRIVE_KEY_DIR"
 (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$AUTODRIVE_KEY_DIR/NIGEL1.key"; echo >> "$AUTODRIVE_KEY_DIR/NIGEL1.key")
+# The testbed's authority and certificates: runtime-link-bench signs its Eye poses as EYE.
+"$ROOT/tools/keys" testbed --cars 1 >/dev/null
 "$BIN/autodrive-sim" --run-dir "$W/sim" --lcm-url "$URL" --no-lidar --quiet >"$W/sim.log" 2>&1 &
 PIDS+=($!)
 for _ in $(seq 600); do [ -e "$W/sim/nigel1-nano" ] && break; sleep 0.1; done
