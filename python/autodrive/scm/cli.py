@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import uvicorn
+from sqlalchemy import Engine
 
 from autodrive.core import channels
 from autodrive.core.v2x_cert import CertificateError
@@ -170,9 +171,6 @@ def bind_web_port(host: str, port: int, session: Instance) -> socket.socket | st
 
 
 def serve(argv: list[str]) -> int:
-    from autodrive.scm.api import create_app
-    from autodrive.scm.service import Scm
-
     a = parse_serve(argv)
     try:
         m = maps.load(a.map)
@@ -185,6 +183,16 @@ def serve(argv: list[str]) -> int:
     except DatabaseError as err:
         print(f"autodrive-scm: {err}", file=sys.stderr)
         return 2
+    try:
+        return _serve_on(a, m, engine)
+    finally:
+        engine.dispose()  # close the pool's connections before the interpreter exits
+
+
+def _serve_on(a: argparse.Namespace, m: maps.MapDescription, engine: Engine) -> int:
+    from autodrive.scm.api import create_app
+    from autodrive.scm.service import Scm
+
     try:
         scm = Scm(
             m,
@@ -259,6 +267,17 @@ def user_command(argv: list[str]) -> int:
     a = p.parse_args(argv)
     try:
         engine = open_engine(a.db)
+    except DatabaseError as err:
+        print(f"autodrive-scm user add: {err}", file=sys.stderr)
+        return 2
+    try:
+        return _user_add(a, engine)
+    finally:
+        engine.dispose()  # close the pool's connections before the interpreter exits
+
+
+def _user_add(a: argparse.Namespace, engine: Engine) -> int:
+    try:
         migrate(engine)
         with sessions(engine)() as s:
             exists = user_exists(s, a.name)

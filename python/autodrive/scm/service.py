@@ -219,6 +219,7 @@ class Scm:
         self.receiver.stop()
         self.event("server", "stop", "scm", {})
         self.writer.stop()
+        self.engine.dispose()  # close the pool's connections: nothing of SQLite outlives the server
 
     # --- LCM in -------------------------------------------------------------------------------
 
