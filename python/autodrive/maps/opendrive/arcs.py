@@ -7,6 +7,8 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
+from autodrive.core.geometry import wrap
+
 Vec2 = tuple[float, float]
 MAX_TURN_ERR_RAD = 2e-4  # an arc's end tangent within this of the curve's (the kit: 1 mrad)
 MAX_DEPTH = 12
@@ -64,8 +66,7 @@ def _on(c: Circle | None, a: Vec2, b: Vec2, f: float) -> Vec2:
 
 
 def _diff(x: float, y: float) -> float:
-    d = x - y
-    return abs(math.atan2(math.sin(d), math.cos(d)))
+    return abs(wrap(x - y))
 
 
 def split(

@@ -9,6 +9,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from autodrive.core.geometry import wrap
 from autodrive.maps.opendrive import arcs
 from autodrive.maps.opendrive.lanes import DRIVING_TYPES, RoadLanes
 from autodrive.maps.opendrive.xodr import Lane, Link, Network, OpenDriveError, Road
@@ -181,7 +182,7 @@ def _tangent(a: ImportedLane, b: ImportedLane) -> bool:
     (x0, y0), (x1, y1) = a.points[-2], a.points[-1]
     (u0, v0), (u1, v1) = b.points[0], b.points[1]
     d = math.atan2(y1 - y0, x1 - x0) - math.atan2(v1 - v0, u1 - u0)
-    return abs(math.atan2(math.sin(d), math.cos(d))) < 0.02  # chords of half arcs: loose here
+    return abs(wrap(d)) < 0.02  # chords of half arcs: loose here
 
 
 def raise_no_lanes(net: Network) -> None:
