@@ -43,3 +43,14 @@ def test_bad_instance_is_named(monkeypatch: pytest.MonkeyPatch, bad: str) -> Non
     monkeypatch.setenv("AUTODRIVE_INSTANCE", bad)
     with pytest.raises(InstanceError, match="AUTODRIVE_INSTANCE"):
         instance()
+
+
+def test_the_logger_records_the_instance_bus(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Debian's lcm-logger knows no AUTODRIVE_INSTANCE: a mission's log must name the moved port
+    from autodrive.core import lcmtypes
+
+    monkeypatch.setenv("AUTODRIVE_INSTANCE", "3")
+    url = channels.load().url_default
+    argv = lcmtypes.logger_argv(url, "-f")
+    assert argv == ["lcm-logger", f"--lcm-url={instance().lcm_url(url)}", "-f"]
+    assert instance().lcm_url(url) != url

@@ -49,6 +49,12 @@ def bus(url: str) -> Any:
     return lcm.LCM(instance().lcm_url(url))
 
 
+def logger_argv(url: str, *options: str) -> list[str]:
+    """lcm-logger's command line on url moved to the session's instance: Debian's lcm-logger
+    knows no AUTODRIVE_INSTANCE, and on the unmoved URL it would record another session's bus."""
+    return ["lcm-logger", f"--lcm-url={instance().lcm_url(url)}", *options]
+
+
 def events(log_path: Path | str) -> Iterator[Any]:
     """The events (channel, timestamp [us of receive time], data) of an LCM log file."""
     yield from lcm.EventLog(str(log_path), "r")

@@ -22,7 +22,7 @@ from typing import Any, TextIO
 
 import yaml
 
-from autodrive.core import channels, command_auth, seeds
+from autodrive.core import channels, command_auth, lcmtypes, seeds
 from autodrive.hil import pose_source, report
 from autodrive.devtools.inspect import export_mcap
 from autodrive.hil.missions import (
@@ -362,7 +362,7 @@ def run(
     eye_latency = pose_source.lockstep_latency_ms(args, lockstep=rtf is None)
     ctx = MissionContext(build, out, args.lcm_url, VEHICLE, procs, stop_requested, say, echo)
     try:
-        logger_argv = ["lcm-logger", f"--lcm-url={args.lcm_url}", "-f", "--flush-interval=100"]
+        logger_argv = lcmtypes.logger_argv(args.lcm_url, "-f", "--flush-interval=100")
         procs.start("lcm-logger", [*logger_argv, lcm_log], out / "lcm-logger.log")
         sim = sim_argv(args, build, run_dir, rtf, plan, eye_latency)
         procs.start("autodrive-sim", sim, out / "sim.log")

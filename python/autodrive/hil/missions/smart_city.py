@@ -210,7 +210,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         for i in range(1, cars + 1):
             lc.subscribe(channel("POSE_EYE", vehicle_name(i)), on_eye)
             lc.subscribe(channel("POSE_MAP", vehicle_name(i)), on_ekf)
-        logger = ["lcm-logger", f"--lcm-url={url}", "-f", "--flush-interval=100"]
+        logger = lcmtypes.logger_argv(url, "-f", "--flush-interval=100")
         procs.start("lcm-logger", [*logger, out / "run.lcmlog"], out / "lcm-logger.log")
         sim: list[object] = [build / "bin" / "autodrive-sim", "--map", MAP, "--cars", cars]
         for x, y, yaw in pose_source.placed(starts, args.eye, args.seed):

@@ -15,6 +15,7 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from autodrive.core import lcmtypes
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.core.proc import die_with_parent, stop
 
@@ -91,7 +92,7 @@ def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: s
     with tempfile.TemporaryDirectory(prefix="pilot-expert-") as tmp:
         argv = sim_argv(run, build, url, Path(tmp) / "run")
         logger = subprocess.Popen(
-            ["lcm-logger", f"--lcm-url={url}", "--channel=.*", str(log)],
+            [*lcmtypes.logger_argv(url, "--channel=.*"), str(log)],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
