@@ -67,7 +67,7 @@ struct NanoBridge::Impl {
   int64_t last_tick = -1;       // sync_to_sim_clock: the SIM_CLOCK tick last answered
   bool config_pending = false;  // sync_to_sim_clock: CONFIG goes out as the next tick's frame
   int64_t next_open_us = 0;
-  int64_t last_rx_frame_us = 0;  // last good frame from the Nano
+  int64_t last_rx_frame_us = 0;  // last good frame from the Nano [us, link_now_us]
   bool open_failure_logged = false;
   bool rejected_logged = false;
   // Receive side: what a noisy or hostile link produces is counted and logged at a limited
@@ -128,11 +128,20 @@ struct NanoBridge::Impl {
   // The clock of the command path [us]: the control lease, command freshness, the token bucket
   // and the heartbeat. With bridge.sim_clock_commands (clock: sim) it is the simulator's
   // SIM_CLOCK, so the path behaves the same at any real-time factor (the emulated Nano's
-  // failsafe runs on sim time too); else the monotonic clock. The serial link's own timers
-  // (hello, reconnect, link timeout) stay monotonic: the pty is real whatever the clock.
+  // failsafe runs on sim time too); else the monotonic clock. The serial link's hello and
+  // reconnect timers stay monotonic: the pty is real whatever the clock.
   int64_t command_now_us() const {
     if (config.bridge.sim_clock_commands) return clock.now_us();
     return autodrive::clock::monotonic_us();
+  }
+
+  // The link timeout's clock [us]: with clock: sim the simulator's, because the emulated Nano
+  // writes on sim time; a host too busy to step the sim for a wall second is not a lost link,
+  // and the handshake it would start stops the commands long enough to latch the Nano's
+  // failsafe (a car stuck in FAILSAFE under load, smart city at load 20-30). A dead sim closes
+  // the pty, which lose_device() sees at once.
+  int64_t link_now_us() const {
+    return clock.sim() ? clock.now_us() : autodrive::clock::monotonic_us();
   }
 
   // The control lease's clock [us]: with clock: sim the simulator's, so a holder whose commands
@@ -335,7 +344,7 @@ struct NanoBridge::Impl {
       s.state = LinkState::handshaking;
     });
     next_tx_us = now_us;
-    last_rx_frame_us = now_us;
+    last_rx_frame_us = link_now_us();
   }
 
   void lose_device(const std::string &why) {
@@ -449,7 +458,7 @@ struct NanoBridge::Impl {
   static void on_frame(const protocol_frame_t *f, void *ctx) {
     auto *self = static_cast<Impl *>(ctx);
     const int64_t now = autodrive::clock::monotonic_us();
-    self->last_rx_frame_us = now;
+    self->last_rx_frame_us = self->link_now_us();
     const LinkState s = self->state();
     if (f->id == PROTOCOL_ID_HELLO) {
       self->on_hello(*f, now);
@@ -512,9 +521,10 @@ struct NanoBridge::Impl {
 
     const int64_t t = autodrive::clock::monotonic_us();
     const LinkState s = state();
-    if (s == LinkState::linked && t - last_rx_frame_us > config.bridge.link_timeout_ms * 1000LL) {
-      spdlog::warn("{}no frame from the Nano for {} ms; handshaking again", tag,
-                   config.bridge.link_timeout_ms);
+    if (s == LinkState::linked &&
+        link_now_us() - last_rx_frame_us > config.bridge.link_timeout_ms * 1000LL) {
+      spdlog::warn("{}no frame from the Nano for {} ms{}; handshaking again", tag,
+                   config.bridge.link_timeout_ms, clock.sim() ? " of sim time" : "");
       set_state(LinkState::handshaking);
       next_tx_us = t;
     }
