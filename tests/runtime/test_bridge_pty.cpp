@@ -638,3 +638,26 @@ TEST(BridgePty, OnTheSimClockASilentSourceDisengagesAtItsTimeout) {
   EXPECT_FALSE(stale.flags & PROTOCOL_CMD_ENGAGED) << "250 ms of sim time: past the timeout";
   EXPECT_EQ(stale.throttle_milli, 0);
 }
+
+TEST(BridgePty, OnTheSimClockAStalledSimIsNotALostLink) {
+  // clock: sim: a host too busy to step the sim is no lost link (link_timeout_ms 2000 of sim
+  // time); a sim whose clock runs on while its Nano is silent is one.
+  BridgeHarness h(7779, protocol_schema_hash(), "sim");
+  h.nano.open();
+  h.start();
+  int64_t sim_us = 1000000;
+  ASSERT_TRUE(h.wait_for([&] {
+    h.publish_sim_clock(sim_us);
+    return h.status().state == autodrive::bridge::LinkState::linked && h.states.size() >= 3;
+  }));
+  const int hellos = h.nano.hello_requests;
+  h.send_states = false;  // the Nano falls silent, and so does the sim clock, for 3 s of wall time
+  EXPECT_FALSE(h.wait_for([&] { return h.nano.hello_requests > hellos; }, 3.0))
+      << "a stalled sim clock set off a handshake";
+  EXPECT_EQ(h.status().state, autodrive::bridge::LinkState::linked);
+  sim_us += 2500000;  // now 2.5 s of sim time pass with no frame from the Nano
+  EXPECT_TRUE(h.wait_for([&] {
+    h.publish_sim_clock(sim_us);
+    return h.nano.hello_requests > hellos;
+  })) << "a silent Nano on a running sim clock was never handshaken again";
+}
