@@ -105,6 +105,26 @@ def test_a_stop_past_the_line_is_measured_as_overshoot():
     assert s.report()["max_stop_line_overshoot_m"] == 0.0
 
 
+def test_a_repeated_sample_while_pulling_away_is_no_overshoot():
+    # A full stop at the sign, then off at 0.2 m/s; one ground-truth sample arrives twice 0.28 m
+    # past the line. That is no standstill past the line.
+    s = scorer(GREEN)
+    d = Drive(s)
+    d.drive(4.0, 4.95, 0.2)
+    d.stand(4.95, 1.5)
+    d.drive(4.95, 5.28, 0.2)
+    d.at(5.28)
+    d.drive(5.28, 5.6, 0.2)
+    r = s.report()
+    assert r["max_stop_line_overshoot_m"] == 0.0 and r["stop_sign_violations"] == 0
+    # the planted fault beside it: a real stop 0.28 m past the sign's line is measured
+    s = scorer(GREEN)
+    d = Drive(s)
+    d.drive(4.0, 5.28, 0.2)
+    d.stand(5.28, 1.0)
+    assert math.isclose(s.report()["max_stop_line_overshoot_m"], 0.28, abs_tol=0.005)
+
+
 def test_a_collision_is_counted_once_per_contact():
     s = scorer(GREEN)
     d = Drive(s)

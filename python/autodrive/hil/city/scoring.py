@@ -22,6 +22,10 @@ LATERAL_TOL_M = 0.2  # a car within this of a stop line's centre is on its lane
 STILL_M = 0.003
 NEAR_BEFORE_M = 0.25  # a standstill this close before a stop point counts as stopping there
 STOP_SIGN_HOLD_S = 1.0
+# A standstill counts as a stop at a line (for overshoot) once it lasted this long [s of sim
+# time]: a ground-truth sample repeated while a car pulls away over the line is no stop (it
+# had scored a car driving off a stop sign at 0.2 m/s as a 0.30 m overshoot).
+MIN_STOP_S = 0.2
 RED = 1
 
 
@@ -193,7 +197,8 @@ class Scorer:
             if standing and -NEAR_BEFORE_M < past < 0.3 and c.still_since_s is not None:
                 held = t_s - c.still_since_s
                 c.still_at[p.name] = max(c.still_at.get(p.name, 0.0), held)
-                if p.light_id < 0 or self.lights.get(p.light_id) == RED or held > 0.5:
+                red = self.lights.get(p.light_id) == RED
+                if held >= MIN_STOP_S and (p.light_id < 0 or red or held > 0.5):
                     if past > self.overshoot_m:
                         self.overshoot_at = {"car": car, "t_s": round(t_s, 2), "stop": p.name,
                                              "light_state": self.lights.get(p.light_id, -1)}  # fmt: skip
