@@ -4,6 +4,13 @@ a collision) on a straight lane along +x with a light's stop line at x = 0 and a
 x = 5 m; each fault must be counted, and the clean runs beside them must count nothing."""
 
 import math
+from pathlib import Path
+
+import lcm
+import pytest
+
+from autodrive.core import lcmtypes
+from autodrive.hil.city.rescore import rescore
 
 from autodrive.hil.city.scoring import RED, MapFacts, Scorer, StopPoint, front_offset_m
 
@@ -134,3 +141,26 @@ def test_a_collision_is_counted_once_per_contact():
     d.at(-1.97)
     d.at(-1.96, hit=True)
     assert s.report()["collisions"] == 2
+
+
+def test_a_recorded_red_light_run_is_scored_again_from_its_log(build_dir: Path, tmp_path: Path):
+    # The same planted red-light run, written to an LCM log as the simulator would publish it.
+    types = lcmtypes.load(build_dir)
+    log = tmp_path / "run.lcmlog"
+    writer = lcm.EventLog(str(log), "w", overwrite=True)
+    light = types.traffic_light_state_t()
+    light.light_id, light.state = LIGHT, RED
+    writer.write_event(0, "TRAFFIC_LIGHT_STATE", light.encode())
+    front = front_offset_m()
+    for k in range(101):
+        m = types.ground_truth_t()
+        m.utime, m.vehicle = int(k * STEP_S * 1e6), "car1"
+        m.position_m = [-1.0 + 0.02 * k - front, 0.0, 0.0]
+        writer.write_event(m.utime, "GROUND_TRUTH_car1", m.encode())
+    writer.close()
+    r = rescore(log, facts(), build_dir)
+    assert r["red_light_violations"] == 1 and r["violations"][0]["stop"] == "light_line"
+    empty = tmp_path / "empty.lcmlog"
+    lcm.EventLog(str(empty), "w", overwrite=True).close()
+    with pytest.raises(ValueError, match="no GROUND_TRUTH_"):
+        rescore(empty, facts(), build_dir)
