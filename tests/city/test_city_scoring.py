@@ -164,3 +164,10 @@ def test_a_recorded_red_light_run_is_scored_again_from_its_log(build_dir: Path, 
     lcm.EventLog(str(empty), "w", overwrite=True).close()
     with pytest.raises(ValueError, match="no GROUND_TRUTH_"):
         rescore(empty, facts(), build_dir)
+
+
+def test_a_car_standing_in_its_nanos_failsafe_is_named_so():
+    from autodrive.hil.missions.smart_city import why_blocked
+
+    assert "latched failsafe" in why_blocked(["NIGEL2"], {"NIGEL2": 2, "NIGEL1": 1})
+    assert why_blocked(["NIGEL2"], {"NIGEL2": 1}) == "an obstacle on the lane"

@@ -66,6 +66,16 @@ EYE_FPS_DEFAULT = pose_source.EYE_FPS_DEFAULT
 SCM_START_CPU_S = 30.0
 SIM_START_CPU_S = 60.0
 TIMEOUT_S = 3600.0  # the default --timeout [s wall]: a hang guard, the run ends at its laps
+NANO_FAILSAFE = 2  # vehicle_state_t.mode: the Nano's latched failsafe
+
+
+def why_blocked(cars: list[str], nano_modes: dict[str, int]) -> str:
+    """Why cars stand for good: a Nano in its latched failsafe ignores the commands, else an
+    obstacle on the lane holds them."""
+    latched = [c for c in cars if nano_modes.get(c) == NANO_FAILSAFE]
+    if latched:
+        return f"the Nano of {latched} is in its latched failsafe: its command stream had a gap"
+    return "an obstacle on the lane"
 
 
 def scm_ready(base_url: str) -> str | None:
@@ -195,8 +205,18 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             if not ph or ph[-1][1] != m.state:
                 ph.append((m.utime * 1e-6, m.state))
 
+        nano_modes: dict[str, int] = {}  # each car's Nano mode (vehicle_state_t.mode)
+
+        state_channels = {
+            channel("STATE", vehicle_name(i)): vehicle_name(i) for i in range(1, cars + 1)
+        }
+
+        def on_state(ch: str, data: bytes) -> None:  # the message names no car: its channel does
+            nano_modes[state_channels[ch]] = types.vehicle_state_t.decode(data).mode
+
         for i in range(1, cars + 1):
             lc.subscribe(channel("GROUND_TRUTH", vehicle_name(i)), on_truth)
+            lc.subscribe(channel("STATE", vehicle_name(i)), on_state)
         lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), on_light)
 
         def on_eye(_ch: str, data: bytes) -> None:
@@ -329,7 +349,9 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
                 say(result["error"])
                 break
             if rep["blocked"]:
-                result["error"] = f"blocked for good: {rep['blocked']} (an obstacle on the lane)"
+                result[
+                    "error"
+                ] = f"blocked for good: {rep['blocked']} ({why_blocked(rep['blocked'], nano_modes)})"
                 say(result["error"])
                 break
             if time.monotonic() - last > PROGRESS_S:
