@@ -10,6 +10,7 @@ import lcm
 import pytest
 
 from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 from autodrive.hil.city.rescore import rescore
 
 from autodrive.hil.city.scoring import RED, MapFacts, Scorer, StopPoint, front_offset_m
@@ -156,13 +157,13 @@ def test_a_recorded_red_light_run_is_scored_again_from_its_log(build_dir: Path, 
         m = types.ground_truth_t()
         m.utime, m.vehicle = int(k * STEP_S * 1e6), "car1"
         m.position_m = [-1.0 + 0.02 * k - front, 0.0, 0.0]
-        writer.write_event(m.utime, "GROUND_TRUTH_car1", m.encode())
+        writer.write_event(m.utime, channel("GROUND_TRUTH", "car1"), m.encode())
     writer.close()
     r = rescore(log, facts(), build_dir)
     assert r["red_light_violations"] == 1 and r["violations"][0]["stop"] == "light_line"
     empty = tmp_path / "empty.lcmlog"
     lcm.EventLog(str(empty), "w", overwrite=True).close()
-    with pytest.raises(ValueError, match="no GROUND_TRUTH_"):
+    with pytest.raises(ValueError, match="no <VEH>_GROUND_TRUTH"):
         rescore(empty, facts(), build_dir)
 
 

@@ -16,13 +16,18 @@ from pathlib import Path
 from typing import Any
 
 from autodrive.core import lcmtypes
+from autodrive.core.channels import channel
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.hil.city.scoring import MapFacts, Scorer
 from autodrive.maps.loader import MAPS_DIR
 
 BLOCKED_S = 30.0  # as the live mission: standing this long [s sim] away from a stop: blocked
-TRUTH_PREFIX = "GROUND_TRUTH_"
-LIGHT_CHANNEL = "TRAFFIC_LIGHT_STATE"
+
+
+def is_truth(name: str) -> bool:
+    """Whether name is some car's ground-truth channel (by the channel table's pattern)."""
+    head, _, tail = channel("GROUND_TRUTH", "\0").partition("\0")
+    return name.startswith(head) and name.endswith(tail) and len(name) > len(head) + len(tail)
 
 
 def rescore(log: Path, facts: MapFacts, build: Path) -> dict[str, Any]:
@@ -31,16 +36,18 @@ def rescore(log: Path, facts: MapFacts, build: Path) -> dict[str, Any]:
     scorer = Scorer(facts, blocked_s=BLOCKED_S)
     truths = 0
     for ev in lcmtypes.events(log):
-        if ev.channel.startswith(TRUTH_PREFIX):
+        if is_truth(ev.channel):
             m = types.ground_truth_t.decode(ev.data)
             scorer.truth(m.vehicle, m.utime * 1e-6, m.position_m[0], m.position_m[1],
                          m.yaw_rad, m.in_collision)  # fmt: skip
             truths += 1
-        elif ev.channel == LIGHT_CHANNEL:
+        elif ev.channel == channel("TRAFFIC_LIGHT_STATE"):
             m = types.traffic_light_state_t.decode(ev.data)
             scorer.light(m.light_id, m.state)
     if truths == 0:
-        raise ValueError(f"{log}: no {TRUTH_PREFIX}* message (was the simulator on this bus?)")
+        raise ValueError(
+            f"{log}: no {channel('GROUND_TRUTH', '<VEH>')} message (was the simulator on this bus?)"
+        )
     return scorer.report()
 
 

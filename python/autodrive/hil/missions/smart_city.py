@@ -66,6 +66,8 @@ EYE_FPS_DEFAULT = pose_source.EYE_FPS_DEFAULT
 SCM_START_CPU_S = 30.0
 SIM_START_CPU_S = 60.0
 TIMEOUT_S = 3600.0  # the default --timeout [s wall]: a hang guard, the run ends at its laps
+OVERSHOOT_GOAL_M = 0.03  # a car stops at most this far past its stop line [m]
+EKF_P95_GOAL_M = 0.02  # on the real Eye, every car's EKF error p95 against ground truth [m]
 NANO_FAILSAFE = 2  # vehicle_state_t.mode: the Nano's latched failsafe
 
 
@@ -395,7 +397,12 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         and rep["red_light_violations"] == 0
         and rep["stop_sign_violations"] == 0
         and rep["collisions"] == 0
+        and rep["max_stop_line_overshoot_m"] <= OVERSHOOT_GOAL_M
         and rep["laps_completed"] >= args.laps
+        and (
+            rep["pose_source"] != "eye"
+            or (rep["ekf_error_p95_worst_m"] or math.inf) <= EKF_P95_GOAL_M
+        )
     )
     record_children(rep, exits, say)
     (out / "report.json").write_text(json.dumps(rep, indent=2))
