@@ -8,6 +8,14 @@ if(AUTODRIVE_SANITIZE)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
+# AUTODRIVE_LSAN_OPTIONS: LeakSanitizer's options for every sanitized test and the programs it
+# starts: the third-party suppressions (tests/lsan.supp), without printing their table (it pushed
+# reports out of the log tails tests read). Tests take it as
+# ENVIRONMENT_MODIFICATION "LSAN_OPTIONS=set:${AUTODRIVE_LSAN_OPTIONS}". The asan test preset
+# (CMakePresets.json) keeps its own copy, since a preset cannot read a CMake variable;
+# foundation.single_source checks that the two agree.
+set(AUTODRIVE_LSAN_OPTIONS "suppressions=${PROJECT_SOURCE_DIR}/tests/lsan.supp:print_suppressions=0")
+
 # autodrive_python_sanitizer_env(<list var>): appends to the list what a Python test needs to
 # dlopen() this build's shared libraries (cffi) when they are sanitized: the ASan runtime (and
 # libstdc++, whose __cxa_throw ASan intercepts) preloaded, leak detection on with the third-party
@@ -21,6 +29,6 @@ function(autodrive_python_sanitizer_env var)
       OUTPUT_VARIABLE stdcxx OUTPUT_STRIP_TRAILING_WHITESPACE)
     set(${var} ${${var}} "LD_PRELOAD=${asan}:${stdcxx}"
       "ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:verify_asan_link_order=0"
-      "LSAN_OPTIONS=suppressions=${AUTODRIVE_ROOT}/tests/lsan.supp:print_suppressions=0" PARENT_SCOPE)
+      "LSAN_OPTIONS=${AUTODRIVE_LSAN_OPTIONS}" PARENT_SCOPE)
   endif()
 endfunction()

@@ -7,7 +7,8 @@ log() { printf '[%s] %s\n' "$(basename "$0")" "$*"; }
 die() { printf '[%s] ERROR: %s\n' "$(basename "$0")" "$*" >&2; exit 1; }
 # Configures (once) and builds a preset of the host build: dev, release or asan.
 # The compilers run without a caller's sanitizer preload: a guide run as a test under ASan
-# (journeys.scm-operator) preloads it for our cffi libraries, and gcc leaks under LeakSanitizer.
+# (journeys.scm-operator) preloads it for our cffi libraries, and gcc leaks under LeakSanitizer
+# (the one rule, for Python's callers too: autodrive.core.proc.third_party_env).
 build_host() {
   local preset="$1"; shift
   if [ ! -f "$ROOT/build/$preset/build.ninja" ]; then

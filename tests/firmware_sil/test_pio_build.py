@@ -216,8 +216,11 @@ def upload_once(root: Path, work: Path, pio: Path, simavr: Path, bootloader: Pat
 def check_upload_into_simavr(
     root: Path, work: Path, pio: Path, simavr: Path, bootloader: Path
 ) -> None:
-    # avrdude's timeouts are wall time and the simulated bootloader keeps pace with the wall
-    # clock only while it gets a core: a starved machine may lose one sync, so up to 3 tries.
+    # The one retry left in the suite, and why (issue 34): the cause is a third-party tool's own
+    # timeout. avrdude 7.1's arduino programmer waits for each STK500 answer on wall time
+    # ("programmer is not responding"; it has no option to lengthen the wait), and the
+    # simulated optiboot answers at simavr's pace, slower than real time on a starved machine.
+    # A try that fails prints why; 3 failed tries fail the test.
     errors = []
     for attempt in range(3):
         why = upload_once(root, work, pio, simavr, bootloader)

@@ -4,6 +4,7 @@ generated files in the tree are fresh."""
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -99,3 +100,22 @@ def test_figures_written_once_and_generated_files_fresh(root: Path) -> None:
         f"{len(figures)} distinctive figures checked in {len(files)} files: {len(errors)} problem(s)"
     )
     assert not errors, "\n".join(errors)
+
+
+def test_the_leak_check_options_are_written_once(root: Path) -> None:
+    """LeakSanitizer's options are one CMake variable (cmake/AutodriveSanitizers.cmake); the asan
+    test preset's copy (a preset cannot read a CMake variable) says the same."""
+    root = root.resolve()
+    module = (root / "cmake" / "AutodriveSanitizers.cmake").read_text()
+    m = re.search(r'^set\(AUTODRIVE_LSAN_OPTIONS "([^"]+)"\)', module, re.MULTILINE)
+    assert m, "cmake/AutodriveSanitizers.cmake sets no AUTODRIVE_LSAN_OPTIONS"
+    presets = json.loads((root / "CMakePresets.json").read_text())
+    asan = [p for p in presets["testPresets"] if p["name"] == "asan"][0]
+    copy = asan["environment"]["LSAN_OPTIONS"].replace("${sourceDir}", "${PROJECT_SOURCE_DIR}")
+    assert copy == m.group(1), f"CMakePresets.json's asan LSAN_OPTIONS {copy} != {m.group(1)}"
+    files = subprocess.run(
+        ["git", "ls-files", "*CMakeLists.txt", "*.cmake"],
+        cwd=root, check=True, capture_output=True, text=True,
+    ).stdout.split()  # fmt: skip
+    spelled = [f for f in files if "lsan.supp:" in (root / f).read_text()]
+    assert spelled == ["cmake/AutodriveSanitizers.cmake"], f"LSAN options spelled in {spelled}"

@@ -1,7 +1,9 @@
 """The intersection mission's scoring (missions/intersection.py) is shown to catch what it scores,
 on constructed episodes (no simulator): a car whose EKF says "at the goal" while its ground truth
 is off is no success; episodes a wall --timeout left unrun count as failures in the rate; and
-the mean traverse time counts the cars that did not arrive (at the episode's whole length)."""
+the mean traverse time counts the cars that did not arrive (at the episode's whole length); and
+the mission's exit code fails a collision, a run a wall --timeout shortened, and a sanitizer
+report."""
 
 import pytest
 
@@ -52,3 +54,29 @@ def test_mean_traverse_counts_the_cars_that_did_not_arrive() -> None:
     assert s["mean_traverse_s_arrived"] == pytest.approx(10.0)
     assert s["mean_traverse_s"] == pytest.approx((20.0 + 2 * mission.EPISODE_SIM_S) / 4)
     assert s["cars_arrived"] == 2 and s["timeouts"] == 1 and s["success_rate"] == 0.0
+
+
+def report(requested: int, outcomes: list[str], collisions: int = 0) -> dict[str, object]:
+    """The parts of a mission report its verdict reads, for run episodes' outcomes."""
+    arrived = [[10.0, 12.0, 14.0, 16.0] if o == "goal" else [None] * 4 for o in outcomes]
+    rep = dict(mission.score_episodes(requested, outcomes, arrived))
+    rep.update(collisions=collisions, sanitizer_reports=[])
+    return rep
+
+
+def test_a_collision_fails_the_mission() -> None:
+    plans, rec = episode([0.0] * 4)
+    rec.collided.add("nigel2")
+    outcome = mission.episode_outcome(plans, rec, "collision")
+    assert outcome == "collision"
+    rep = report(2, ["goal", outcome], collisions=1)
+    assert rep["success_rate"] == 0.5 and mission.exit_code(rep) == 1
+    assert mission.exit_code(report(2, ["goal", "goal"])) == 0
+
+
+def test_a_wall_timeout_that_shortens_the_run_fails_it() -> None:
+    assert mission.exit_code(report(20, ["goal"] * 19)) == 1  # 19 of 20 planned, all good
+    assert mission.exit_code(report(2, ["goal", "timeout"])) == 1
+    rep = report(2, ["goal", "goal"])
+    rep["sanitizer_reports"] = ["autodrive-marl nigel1: LeakSanitizer"]
+    assert mission.exit_code(rep) == 1

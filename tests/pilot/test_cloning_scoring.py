@@ -1,10 +1,16 @@
 """The cloning referee's scoring (missions/lane_watch.py) is shown to catch what it scores, on
 constructed runs along a straight 10 m route (no simulator): a lane departure is a wheel out,
 a stalled car (standing, or creeping under 5 cm in 6 s of sim time) counts as interventions and
-scores no autonomy, and a car that keeps moving keeps its 100 %."""
+scores no autonomy, and a car that keeps moving keeps its 100 %; and tools/bench cloning's goals
+fail a condition whose run missed its laps or exited non-zero, at 100 % autonomy."""
 
 from __future__ import annotations
 
+import pytest
+
+from autodrive.bench import cloning as bench
+from autodrive.bench.goals import judge
+from autodrive.core import seeds
 from autodrive.hil.missions import lane_watch
 from autodrive.maps.description import Route
 
@@ -54,3 +60,38 @@ def test_a_stall_midway_costs_autonomy() -> None:
     assert stalls == 3 and autonomy is not None and autonomy < 50.0
     assert lane_watch.autonomy_pct(0, 0.0) is None
     assert lane_watch.autonomy_pct(10, 30.0) == 0.0  # never below 0
+
+
+def test_a_run_short_of_its_laps_or_failed_fails_its_goals() -> None:
+    goals = bench.goal_table(laps=5, unseen_laps=1)
+    good = {"autonomy_pct": 100.0, "laps": 5.0, "exit_code": 0, "cross_track_rms_m": 0.01}
+    figures: dict[str, object] = {"inference_cpu_ms_p99": 3.0, "pipeline_wall_s": 900.0}
+    for cond in ("normal", *bench.UNSEEN, *bench.EXTRA):
+        figures[cond] = dict(good, laps=5.0 if cond == "normal" else 1.0)
+    span = seeds.span(seeds.EVALUATION.start, 1)
+    assert judge(figures, goals, span)["goals_met"] is True
+    for cond, planted, goal in (
+        ("normal", {"laps": 4.2}, "normal_laps_driven"),  # timed out after 4.2 of 5 laps
+        ("normal", {"exit_code": 1}, "normal_exit_0"),  # crashed, or a sanitizer report
+        ("night", {"laps": 0.6}, "unseen_night_laps_driven"),
+        ("reverse", {"exit_code": 124}, "unseen_reverse_exit_0"),
+    ):
+        bad = {k: dict(v) if isinstance(v, dict) else v for k, v in figures.items()}
+        bad[cond].update(planted)  # type: ignore[attr-defined]
+        res = judge(bad, goals, span)
+        assert res["goals_met"] is False and res["goals"][goal] is False, (cond, planted)
+
+
+def test_training_and_evaluation_never_share_a_seed() -> None:
+    from autodrive.hil.missions import cloning
+
+    with pytest.raises(SystemExit):  # a cloning evaluation on the expert's training seed
+        cloning.parse_args(["--seed", str(seeds.CLONING_EXPERT_SEED)])
+    with pytest.raises(SystemExit):
+        bench.parse_args(["--seed", "1"])
+    with pytest.raises(SystemExit):  # a recording on an evaluation seed
+        bench.parse_args(["--train-seed", str(seeds.EVALUATION.start)])
+    assert bench.parse_args([]).seed in seeds.EVALUATION
+    assert seeds.range_of(bench.parse_args([]).train_seed) == "training"
+    with pytest.raises(ValueError, match="evaluation seed"):
+        seeds.require(seeds.EVALUATION.start, ("training",), "the expert recording's seed")

@@ -7,12 +7,12 @@ uses; never committed) and `octave` run on a script with the toolbox on its path
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+from autodrive.core.proc import third_party_env
 from autodrive.core.settings import settings
 from autodrive.devtools.inspect.lcm_spy import types_jar
 
@@ -23,9 +23,8 @@ def toolbox_dir() -> Path:
 
 def environment(build: Path, url: str) -> dict[str, str]:
     """The environment an Octave script of the toolbox runs in: the bus and the types jar."""
-    env = dict(os.environ, AUTODRIVE_LCM_URL=url, AUTODRIVE_TYPES_JAR=str(types_jar(build)))
-    env.pop("LD_PRELOAD", None)  # the JVM does not run under a sanitizer runtime
-    return env
+    jar = str(types_jar(build))
+    return dict(third_party_env(), AUTODRIVE_LCM_URL=url, AUTODRIVE_TYPES_JAR=jar)  # a JVM
 
 
 def command(script: str) -> list[str]:

@@ -55,8 +55,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument(
         "--train-seed",
         type=int,
-        default=1,
-        help="the recording's seed (a training seed, default 1)",
+        default=seeds.CLONING_EXPERT_SEED,
+        help="the recordings' seed (a training seed, default autodrive.core.seeds' "
+        "CLONING_EXPERT_SEED)",
     )
     p.add_argument(
         "--curve-max", type=float, default=0.0, metavar="DK",
@@ -64,7 +65,14 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "experiment, 0: the shipped recipe)",
     )  # fmt: skip
     p.add_argument("--timeout", type=float, default=7200.0, help="per evaluation [wall s]")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    try:  # before hours of recording: training and evaluation never share a seed
+        seeds.require(args.seed, ("development", "evaluation"), "--seed")
+        for s in (args.train_seed, args.train_seed + 1):  # make-model records on S and S + 1
+            seeds.require(s, ("training",), "--train-seed's recording seed")
+    except ValueError as e:
+        p.error(str(e))
+    return args
 
 
 def make_model(

@@ -15,7 +15,9 @@ OpenCV DNN forward pass of 4 observations, median over MARL_BENCH_REPEATS (3) ru
 
 Options (environment): MARL_BENCH_TRAIN (1: train from scratch; 0: measure MARL_BENCH_MODEL,
 default the shipped models/marl/intersection.onnx, without training), MARL_BENCH_EPISODES
-(200), MARL_BENCH_WORKERS (2, evaluation processes), MARL_BENCH_COMPARE (1: adds the same
+(200), MARL_BENCH_FIRST_SEED (every mode's first seed, default
+autodrive.core.seeds.MARL_BENCH_FIRST_SEED; the JSON records the seeds' range),
+MARL_BENCH_WORKERS (2, evaluation processes), MARL_BENCH_COMPARE (1: adds the same
 seeds without the shield, the FCFS baseline, and 1 car on MARL_BENCH_EPISODES_1CAR (50); 0 leaves
 them out, and goals_met is then false: the baseline goals' figures are missing)."""
 
@@ -40,7 +42,6 @@ from autodrive.bench.goals import at_least, at_most, equals, judge
 log = Progress("marl")
 TRAIN_GOAL_WALL_S = 45 * 60  # issue 17: training from scratch to the batch goal
 SUCCESS_GOAL = 0.98  # issue 17: batch success with 4 cars and the shield
-FIRST_SEED = seeds.EVALUATION.start  # every mode on the same evaluation seeds
 # Issue 17's goals. Without training the training time is the shipped model's recorded one;
 # with MARL_BENCH_COMPARE=0 the baseline's figures are missing and fail their goals.
 GOALS = {
@@ -95,6 +96,21 @@ class StoppedClock:
         self._done.set()
         self._thread.join()
         return round(self.stopped_s, 1)
+
+
+def first_seed(episodes: int) -> int:
+    """MARL_BENCH_FIRST_SEED (default seeds.MARL_BENCH_FIRST_SEED): every mode's first seed;
+    SystemExit naming it when it is not an integer or its episodes straddle two seed ranges."""
+    text = os.environ.get("MARL_BENCH_FIRST_SEED", str(seeds.MARL_BENCH_FIRST_SEED))
+    try:
+        first = int(text)
+        seeds.span(first, episodes)
+    except ValueError as e:
+        raise SystemExit(
+            f"[bench marl] ERROR: MARL_BENCH_FIRST_SEED='{text}': want a seed whose "
+            f"{episodes} episodes lie in one range of autodrive.core.seeds ({e})"
+        ) from None
+    return first
 
 
 def load_1min() -> float:
@@ -154,6 +170,7 @@ def main(argv: list[str]) -> int:
     episodes_1 = int(os.environ.get("MARL_BENCH_EPISODES_1CAR", "50"))
     workers = int(os.environ.get("MARL_BENCH_WORKERS", "2"))
     compare = os.environ.get("MARL_BENCH_COMPARE", "1") != "0"
+    first = first_seed(max(episodes, episodes_1))  # every mode on the same seeds
     figures: dict[str, Any] = {"trained_from_scratch": do_train, "load_avg_1min_start": load_1min()}
     if do_train:
         model = out_dir() / "marl-train" / "intersection.onnx"
@@ -186,7 +203,7 @@ def main(argv: list[str]) -> int:
     runs: dict[str, dict[str, Any]] = {}
     t_eval = time.monotonic()
     for name, cars, mode, n in plan:
-        runs[name] = evaluate_logged(model, n, cars, FIRST_SEED, mode, log, workers, name)
+        runs[name] = evaluate_logged(model, n, cars, first, mode, log, workers, name)
     figures["evaluation_wall_s"] = round(time.monotonic() - t_eval, 1)
     figures["load_avg_1min_after_evaluation"] = load_1min()
     for name, r in runs.items():
@@ -209,7 +226,7 @@ def main(argv: list[str]) -> int:
         figures["traverse_ratio_policy_over_baseline"] = s["mean_traverse_s"] / b["mean_traverse_s"]
         figures["collisions_policy_minus_baseline"] = s["collisions"] - b["collisions"]
         figures["success_rate_policy_minus_baseline"] = s["success_rate"] - b["success_rate"]
-    judge(figures, GOALS, seeds.span(FIRST_SEED, max(n for _, _, _, n in plan)))
+    judge(figures, GOALS, seeds.span(first, max(n for _, _, _, n in plan)))
     (out_dir() / "marl.json").write_text(json.dumps({"figures": figures, "runs": runs}, indent=2))
     print_figures(figures, key_value_lines=True)
     sys.stdout.flush()

@@ -70,6 +70,14 @@ def sanitizer_failures(exits: Sequence[ChildExit]) -> list[str]:
     ]
 
 
+def third_party_env() -> dict[str, str]:
+    """This process's environment without LD_PRELOAD, for a third-party program (a compiler, a
+    database, a browser, a JVM): a sanitized test preloads the ASan runtime only for the processes
+    that load our cffi libraries, and under it these hang, exit at start or report their own leaks.
+    tools/lib.sh's build_host applies the same rule to the compilers (env -u LD_PRELOAD)."""
+    return {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+
+
 def die_with_parent() -> Callable[[], None] | None:
     """A preexec_fn that has the kernel send PARENT_DEATH_SIGNAL to the child when the thread
     that started it ends (Linux prctl PR_SET_PDEATHSIG). Everything it calls is bound here, in

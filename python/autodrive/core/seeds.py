@@ -20,6 +20,12 @@ DEVELOPMENT = range(1_000_000_000, 1_500_000_000)
 EVALUATION = range(1_500_000_000, 2_000_000_000)  # below 2^31: every seed type takes it
 RANGES = {"training": TRAINING, "development": DEVELOPMENT, "evaluation": EVALUATION}
 DEVELOPMENT_MISSION_SEED = DEVELOPMENT.start + 1  # tools/demo's default --seed
+# the cloning expert's recordings (tools/pilot expert / make-model --seed S: laps on S and S + 1),
+# the shipped model's; a cloning evaluation never runs on a training seed
+CLONING_EXPERT_SEED = TRAINING.start + 1
+# tools/bench marl's default first seed (MARL_BENCH_FIRST_SEED overrides it): a block of the
+# evaluation range no earlier run used (1 500 000 000 - 1 500 000 199: runs before 2026-12-02)
+MARL_BENCH_FIRST_SEED = EVALUATION.start + 1000
 
 
 def range_of(seed: int) -> str:
@@ -28,6 +34,18 @@ def range_of(seed: int) -> str:
         if seed in r:
             return name
     raise ValueError(f"seed {seed} lies outside every seed range (autodrive.core.seeds)")
+
+
+def require(seed: int, allowed: tuple[str, ...], what: str) -> int:
+    """seed when it lies in one of the allowed ranges; ValueError naming what it is for and its
+    range otherwise (a cloning evaluation on a training seed, a recording on an evaluation one)."""
+    name = range_of(seed)
+    if name not in allowed:
+        raise ValueError(
+            f"{what} {seed} is a {name} seed; it must be a {' or '.join(allowed)} seed "
+            "(autodrive.core.seeds, docs/reference/seeds.md)"
+        )
+    return seed
 
 
 def span(first: int, count: int) -> dict[str, Any]:

@@ -21,6 +21,8 @@ from http.cookiejar import CookieJar
 from pathlib import Path
 from typing import Any
 
+from autodrive.core.proc import third_party_env
+
 PG_BIN = Path("/usr/lib/postgresql/15/bin")
 
 
@@ -163,7 +165,7 @@ class Postgres:
     def _run(self, cmd: list[str]) -> None:
         # PostgreSQL is no part of the build under test: without the test's LD_PRELOAD of the
         # sanitizer runtime (meant for the SCM's cffi libraries), under which it hangs.
-        r = subprocess.run(self.prefix + cmd, capture_output=True, text=True, env=no_preload())
+        r = subprocess.run(self.prefix + cmd, capture_output=True, text=True, env=third_party_env())
         if r.returncode != 0:
             raise RuntimeError(f"{' '.join(cmd[:2])} failed: {r.stdout}{r.stderr}")
 
@@ -171,11 +173,6 @@ class Postgres:
         self._run([str(PG_BIN / "pg_ctl"), "-D", str(self.dir), "-m", "fast", "-w", "stop"])
         if self.own:
             shutil.rmtree(self.tmp, ignore_errors=True)
-
-
-def no_preload() -> dict[str, str]:
-    """This process's environment without LD_PRELOAD: for third-party programs a test starts."""
-    return {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
 
 
 def chromium() -> Any:
@@ -193,7 +190,7 @@ def chromium() -> Any:
     # The browser is no part of the build under test: no sanitizer runtime preloaded into it (a
     # test's LD_PRELOAD for the SCM's cffi libraries makes chromedriver exit at start).
     return webdriver.Chrome(
-        options=opts, service=Service("/usr/bin/chromedriver", env=no_preload())
+        options=opts, service=Service("/usr/bin/chromedriver", env=third_party_env())
     )
 
 

@@ -31,7 +31,7 @@ from typing import Any, TextIO
 
 import yaml
 
-from autodrive.core import channels, command_auth, lcmtypes, plots
+from autodrive.core import channels, command_auth, lcmtypes, plots, seeds
 from autodrive import maps
 from autodrive.core.settings import RUNTIME_HIL_CONFIG, settings
 from autodrive.learn.pilot.expert import ExpertRun
@@ -115,6 +115,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     args = p.parse_args(argv)
     if args.laps < 1:
         p.error(f"--laps {args.laps}: at least 1")
+    try:  # training and evaluation never share a seed: the expert recorded on training seeds
+        seeds.require(args.seed, ("development", "evaluation"), "--seed")
+    except ValueError as e:
+        p.error(str(e))
     if args.start_m < 0 or args.distance_m < 0:
         p.error(f"--start-m {args.start_m} / --distance-m {args.distance_m}: at least 0")
     return args

@@ -543,6 +543,13 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         say("interrupted: every process stopped")
         return EXIT_INTERRUPTED
+    return exit_code(rep)
+
+
+def exit_code(rep: dict[str, Any]) -> int:
+    """The mission's verdict on its report: 0 only when every planned episode succeeded (one a
+    wall --timeout left unrun is a failure), no car collided and no process left a sanitizer
+    report; else 1."""
     ok = rep["success_rate"] == 1.0 and rep["collisions"] == 0 and not rep["sanitizer_reports"]
     return 0 if ok else 1
 

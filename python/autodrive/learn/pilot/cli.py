@@ -9,6 +9,7 @@ import os
 import sys
 from pathlib import Path
 
+from autodrive.core import seeds
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.learn.pilot.expert import ExpertRun
 
@@ -43,7 +44,10 @@ def main(argv: list[str] | None = None) -> int:
         "(1 on Driving School's loop_ccw: the inner lane, counter-clockwise)",
     )  # fmt: skip
     e.add_argument("--laps", type=int, default=5)
-    e.add_argument("--seed", type=int, default=1, help="perturbations and camera noise")
+    e.add_argument(
+        "--seed", type=int, default=seeds.CLONING_EXPERT_SEED,
+        help="perturbations and camera noise (a training seed, autodrive.core.seeds)",
+    )  # fmt: skip
     e.add_argument("--speed", type=float, default=0.8, help="throttle, fraction of top speed")
     e.add_argument("--perturb", type=float, default=0.35, help="perturbation amplitude (0..1)")
     e.add_argument(
@@ -112,7 +116,10 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--work", type=Path, default=Path("out/pilot"), help="log, dataset, figures")
     m.add_argument("--name", default="driving_school")
     m.add_argument("--laps", type=int, default=5)
-    m.add_argument("--seed", type=int, default=1, help="the recording's seed")
+    m.add_argument(
+        "--seed", type=int, default=seeds.CLONING_EXPERT_SEED,
+        help="the recordings' seeds S and S + 1 (training seeds, autodrive.core.seeds)",
+    )  # fmt: skip
     m.add_argument("--train-seed", type=int, default=0)
     m.add_argument(
         "--other-lane-laps", type=int, default=0,

@@ -15,7 +15,7 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from autodrive.core import lcmtypes
+from autodrive.core import lcmtypes, seeds
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.core.proc import die_with_parent, stop
 
@@ -30,7 +30,7 @@ class ExpertRun:
     # other lane; the simulator's `lane_shift`)
     lane_shift: int = 0
     laps: int = 5
-    seed: int = 1
+    seed: int = seeds.CLONING_EXPERT_SEED  # a training seed
     speed: float = 0.8  # throttle, fraction of top speed
     lookahead_m: float = 0.2  # pure pursuit's lookahead [m]
     perturb: float = 0.35  # steering perturbation amplitude, normalised
@@ -81,7 +81,9 @@ def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
 
 
 def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: str = "") -> float:
-    """Drives and records; returns the wall time [s]. Progress lines go to stderr."""
+    """Drives and records; returns the wall time [s]. Progress lines go to stderr. ValueError
+    for a seed outside the training range (what a cloning evaluation must never run on)."""
+    seeds.require(run.seed, ("training",), "the expert recording's seed")
     if log.exists():
         raise FileExistsError(f"{log} exists, not overwriting")
     if shutil.which("lcm-logger") is None:

@@ -21,6 +21,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from autodrive.core import seeds
 from autodrive.learn.pilot.analyse import analyse
 from autodrive.learn.pilot.dataset import record
 from autodrive.learn.pilot.expert import ExpertRun, default_url, meta_path, record_expert
@@ -109,6 +110,8 @@ def make_model(
     times: dict[str, float] = {}
     t0 = time.monotonic()
     runs = expert_runs(laps, seed, other_lane_laps)
+    for r in runs:  # before anything is recorded: the recordings' seeds are training seeds
+        seeds.require(r.seed, ("training",), "the expert recording's seed")
     if reuse_logs:
         logs = reuse_logs
         times["expert_s"] = check_logs(runs, logs)
