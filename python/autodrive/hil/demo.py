@@ -29,6 +29,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     MissionContext,
+    instance_lcm_url,
     record_children,
     loop,
     parking,
@@ -177,6 +178,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
+    args.lcm_url = instance_lcm_url(p, args.lcm_url)
     if args.city_eye is not None:
         if args.eye is not None and args.eye != args.city_eye:
             p.error(f"--city-eye {args.city_eye} contradicts --eye {args.eye}: give --eye only")

@@ -46,6 +46,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     add_run_options,
+    instance_lcm_url,
     record_children,
 )
 
@@ -107,6 +108,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         p.error(f"--shield-pose-error-m {args.shield_pose_error_m}: must be >= 0")
     if args.v2v_delay_ms < 0:
         p.error(f"--v2v-delay-ms {args.v2v_delay_ms}: must be >= 0")
+    args.lcm_url = instance_lcm_url(p, args.lcm_url)
     return args
 
 
