@@ -5,7 +5,7 @@ on the four rendered overhead cameras, each EKF started from its car's first fix
 SIM_SECONDS of sim time (--sim-seconds: the machine's load changes only how long that takes).
 The report must have every key, no violation, no collision, every car driven, pose_source eye
 with the Eye in lockstep (its latency in
-the report), Eye poses at their rate for every car and each EKF within EKF_P95_M of the truth; the PNG
+the report, the sim never giving it up: eye_sync_give_ups 0), Eye poses at their rate for every car and each EKF within EKF_P95_M of the truth; the PNG
 and the LCM log (with V2V, the cars' V2I advisories and LIDAR scans in it) written. Args: ROOT
 BUILD PORT."""
 import json
@@ -63,6 +63,7 @@ def test_smart_city_mission_short(
         cars = ("NIGEL1", "NIGEL2", "NIGEL3")
         assert rep["pose_source"] == "eye", rep["eye"]
         assert rep["eye_latency_ms"] > 0, "the Eye in lockstep with the simulator (--eye-sync)"
+        assert rep["eye_sync_give_ups"] == 0, "the sim gave the Eye up: the run hung on wall time"
         assert set(rep["first_eye_fix_s"]) == set(cars), rep["first_eye_fix_s"]
         for car in cars:
             assert rep["eye_poses_per_car_hz"][car] >= EYE_HZ_MIN, rep["eye_poses_per_car_hz"]

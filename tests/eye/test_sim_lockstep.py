@@ -5,7 +5,7 @@ the frame period). Each run records every NIGEL1_POSE_EYE with the SIM_CLOCK the
 the pose arrived. Both runs give the same poses (stamps and values), each arriving at exactly
 its capture time + 20 ms of sim time, and the same ground truth bytes: how fast the Eye is in
 wall time changes nothing in sim time. Judged on sim time and event order only (the only wall
-clock is the 2 s give-up rule, which a passing run never reaches)."""
+clock is the give-up rule, 10 s, which a passing run never reaches)."""
 
 from __future__ import annotations
 

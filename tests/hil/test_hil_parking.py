@@ -5,7 +5,8 @@ collision, and meet issue 7's bounds by the simulator's ground truth. Lockstep m
 independent of how loaded the machine is (the sim waits for the runtime), so the bounds are the
 issue's own.
 
-The run renders every camera at 2 Hz (sim time) and runs the Eye, so that every live channel of
+The run renders every camera at 2 Hz (sim time) and runs the real Eye (the default pose source,
+in lockstep with the sim, never given up: eye_sync_give_ups 0), so that every live channel of
 lcm_types/channels.yaml is on the bus: the recorded log is checked against the table both ways."""
 import json
 import pathlib
@@ -35,6 +36,11 @@ def test_parking_mission(root: pathlib.Path, build_dir: pathlib.Path, lcm_port: 
         assert report["final_heading_error_deg"] <= 2.0, "parked more than 2 deg off"
         assert report["localization_rms_m"] <= 0.03, "localisation RMS over 3 cm"
         assert report["rtf_requested"] == "lockstep"
+        # the real Eye (the default) on the overhead camera, fused, in lockstep, never given up
+        assert report["pose_source"] == "eye", report["eye"]
+        assert report["eye_latency_ms"] > 0, "the Eye in lockstep with the simulator (--eye-sync)"
+        assert report["eye_sync_give_ups"] == 0, "the sim gave the Eye up: it hung on wall time"
+        assert report["eye_poses_per_car_hz"]["NIGEL1"] > 0, "no Eye pose"
         log = (pathlib.Path(tmp) / "autonomy.log").read_text()
         sim_log = (pathlib.Path(tmp) / "sim.log").read_text()
         appeared = [ln for ln in sim_log.splitlines() if ln.startswith("late box 1 appeared")]

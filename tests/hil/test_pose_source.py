@@ -7,6 +7,7 @@ Eye, in lockstep with the simulator in a lockstep run."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -90,3 +91,47 @@ def test_eye_lockstep_by_default_in_lockstep_runs(capsys: pytest.CaptureFixture[
         with pytest.raises(SystemExit):
             demo.parse_args(["--eye-latency-ms", bad])
         assert "--eye-latency-ms" in capsys.readouterr().err
+
+
+def test_eye_sync_give_ups_fail_the_report(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Planted: a sim log with two give-ups (its EYE_SYNC_GIVE_UP_MARK lines) fails a report
+    that met its goals, naming the count and the option; a clean log and a run not in lockstep
+    pass; an unreadable log is a failure, not a silent 0; the wait limit goes to the sim and a
+    limit out of its range is refused naming the option. The real sim's lines: the test
+    eye.Sim.GiveUpFailsTheReport."""
+    log = tmp_path / "sim.log"
+    mark = pose_source.EYE_SYNC_GIVE_UP_MARK
+    log.write_text(f"[autodrive-sim] t = 1.0 s\n[autodrive-sim] {mark} (1): ...\nx {mark} (2)\n")
+    assert pose_source.eye_sync_give_ups(log, 15.0) == 2
+    assert pose_source.eye_sync_give_ups(log, None) is None, "not in lockstep: not counted"
+    assert pose_source.eye_sync_give_ups(tmp_path / "missing.log", 15.0) == -1
+    rep = pose_source.report("cameras", "t", [pose_source.PoseRecord()], ["NIGEL1"], 15.0, 2)
+    assert rep["eye_sync_give_ups"] == 2
+    rep["ok"] = True
+    said: list[str] = []
+    pose_source.eye_sync_verdict(rep, say=said.append)
+    assert rep["ok"] is False
+    assert rep["error"] == (
+        "the Eye fell behind the sim 2 times: the run depended on wall time; rerun on a quieter "
+        "machine or raise --eye-sync-wait-s"
+    )
+    assert said == [f"FAILED: {rep['error']}"]
+    unknown = {"ok": True, "error": "timeout", "eye_sync_give_ups": -1}
+    pose_source.eye_sync_verdict(unknown)
+    assert unknown["ok"] is False and str(unknown["error"]).startswith("timeout; eye_sync_give")
+    log.write_text("[autodrive-sim] t = 1.0 s\n")
+    for give_ups in (pose_source.eye_sync_give_ups(log, 15.0), None):
+        clean = {"ok": True, **pose_source.report("cameras", "t", [], [], 15.0, give_ups)}
+        pose_source.eye_sync_verdict(clean)
+        assert clean["ok"] is True and "error" not in clean
+    assert pose_source.report("standin", "t", [], [], None, 3)["eye_sync_give_ups"] is None
+    args = demo.parse_args(["--eye-sync-wait-s", "30"])
+    argv = pose_source.sim_argv("cameras", 5.0, 15.0, args.eye_sync_wait_s)
+    assert argv[-3:] == ["--eye-sync", "--eye-sync-wait-s", 30.0], argv
+    assert intersection.parse_args([]).eye_sync_wait_s == pose_source.EYE_SYNC_WAIT_S_DEFAULT
+    for bad in ("0", "4000", "long"):
+        with pytest.raises(SystemExit):
+            demo.parse_args(["--eye-sync-wait-s", bad])
+        assert "--eye-sync-wait-s" in capsys.readouterr().err

@@ -3,7 +3,7 @@ autodrive-runtime processes on their ptys, four autodrive-marl, V2V over real LC
 of the shipped policy (models/marl/intersection.onnx, behind the shield) crosses with every car
 truly at its goal and no collision, and writes the report's fields and the trajectory plot, with
 the real Eye (the default: autodrive-eye on the two rendered overhead cameras, in lockstep with the
-simulator) feeding every car's
+simulator, never given up by it: eye_sync_give_ups 0) feeding every car's
 EKF at its rate from its first fix, each EKF within EKF_P95_M of the truth; Ctrl-C mid-episode of
 the rule-based baseline stops every process (exit 130, the report kept, marked interrupted).
 argv: autodrive-marl, build dir, LCM port."""
@@ -77,6 +77,8 @@ def test_demo_intersection_episode_and_ctrl_c(build_dir: Path, lcm_port: int) ->
         # every car's <VEH>_POSE_EYE from the real Eye at its rate, every EKF close to the truth
         assert rep["pose_source"] == "eye", rep["eye"]
         assert rep["eye_latency_ms"] > 0, "the Eye in lockstep with the simulator (--eye-sync)"
+        assert rep["eye_sync_give_ups"] == 0, "the sim gave the Eye up: the run hung on wall time"
+        assert [e["eye_sync_give_ups"] for e in rep["per_episode"]] == [0], rep["per_episode"]
         for car in ("NIGEL1", "NIGEL2", "NIGEL3", "NIGEL4"):
             assert rep["eye_poses_per_car_hz"][car] >= EYE_HZ_MIN, rep["eye_poses_per_car_hz"]
             assert rep["ekf_error_m"][car]["p95"] <= EKF_P95_M, rep["ekf_error_m"]

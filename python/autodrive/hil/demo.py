@@ -29,6 +29,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     MissionContext,
+    instance_lcm_url,
     record_children,
     loop,
     parking,
@@ -177,6 +178,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
     args = p.parse_args(argv)
+    args.lcm_url = instance_lcm_url(p, args.lcm_url)
     if args.city_eye is not None:
         if args.eye is not None and args.eye != args.city_eye:
             p.error(f"--city-eye {args.city_eye} contradicts --eye {args.eye}: give --eye only")
@@ -231,8 +233,8 @@ def sim_argv(
         argv += ["--cameras"]  # front and rear, at the overhead camera's rate
     if args.cameras > 0 or args.eye == "cameras":
         argv += ["--eye", "--camera-fps", args.cameras or pose_source.EYE_FPS_DEFAULT]
-    if eye_latency_ms is not None:  # the Eye in lockstep: its poses at capture + L, any load
-        argv += ["--eye-sync"]
+    # the Eye in lockstep: its poses at capture + L, any load (none: not in lockstep)
+    argv += pose_source.sim_sync_argv(eye_latency_ms, args.eye_sync_wait_s)
     if plan is not None:
         argv += ["--no-lidar-lcm"]  # <VEH>_LIDAR comes from the runtime's RPLIDAR driver
         s = plan.start
@@ -387,7 +389,8 @@ def run(
     stop_requested()
     if interrupted:
         say("interrupted: everything stopped; analysing what was recorded")
-    rep = report.analyse(lcm_log, out, VEHICLE, build, args.eye, eye_what, eye_latency)
+    give_ups = pose_source.eye_sync_give_ups(out / "sim.log", eye_latency)
+    rep = report.analyse(lcm_log, out, VEHICLE, build, args.eye, eye_what, eye_latency, give_ups)
     rep.update(result)
     if plan is not None and "goal_world" in result:
         rep.update(parking.score(lcm_log, out, VEHICLE, build, result))
@@ -403,6 +406,7 @@ def run(
             "not a success"
         )
     record_children(rep, exits, say)
+    pose_source.eye_sync_verdict(rep, say=say)  # a run that depended on wall time fails
     rep["wall_s"] = round(wall_s, 2)
     rep["rtf_requested"] = rtf if rtf is not None else "lockstep"
     if rep.get("sim_s") and wall_s > 0:

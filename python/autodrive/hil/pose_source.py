@@ -5,6 +5,9 @@
   In a lockstep run the Eye is in lockstep too (`autodrive-sim --eye-sync`, `autodrive-eye run
   --sim-latency-ms L`, L from `--eye-latency-ms`): a frame captured at t has its poses on the
   bus at t + L of sim time whatever the host's load; the report says L (`eye_latency_ms`).
+  The sim gives a silent Eye up after `--eye-sync-wait-s` of wall time (a hang guard); a run
+  where that happened depended on wall time, so every give-up is counted from the sim's log
+  (`eye_sync_give_ups`, per run) and any fails the mission (`eye_sync_verdict`).
 - `standin`: the test double autodrive.hil.city.eye_standin (ground truth + the Eye's noise, at
   once, never late, never missing); `pose_source` "standin".
 - `none`: no absolute poses; each EKF starts from the pose the car was put down at, given with
@@ -41,6 +44,11 @@ PLACEMENT_STD_RAD = 0.035  # 2 deg
 # 2026-11-28), which is also that bench's goal (<= 15 ms).
 EYE_LATENCY_MS_DEFAULT = 15.0
 EYE_LATENCY_FROM = "tools/bench eye capture_to_pose_ms_p99 (14.95 ms, docs/results/benchmarks.md)"
+# autodrive-sim --eye-sync's hang guard [s of wall time]: a silent Eye is given up after this
+# (its EYE_SYNC_LOST_S), and each give-up is a line of its stderr with this mark (eye_sync.h's
+# EYE_SYNC_GIVE_UP_MARK; tests/eye/test_sim_eye_give_up.py runs the two together).
+EYE_SYNC_WAIT_S_DEFAULT = 10.0
+EYE_SYNC_GIVE_UP_MARK = "--eye-sync gave up on the Eye"
 
 
 def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") -> None:
@@ -67,6 +75,27 @@ def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") 
         "its poses, so results do not depend on the host's load; default "
         f"{EYE_LATENCY_MS_DEFAULT:g}, {EYE_LATENCY_FROM}",
     )
+    p.add_argument(
+        "--eye-sync-wait-s",
+        type=wait_s_arg,
+        default=EYE_SYNC_WAIT_S_DEFAULT,
+        metavar="S",
+        help="(--eye cameras, lockstep runs) a hang guard: the simulator gives a silent Eye up "
+        "after S s of wall time and runs on without waiting for it. A run where that happened "
+        "depended on the host's load, so each give-up is counted (report: eye_sync_give_ups) "
+        f"and fails the mission; default {EYE_SYNC_WAIT_S_DEFAULT:g}",
+    )
+
+
+def wait_s_arg(text: str) -> float:
+    """--eye-sync-wait-s's value: 0.1..3600 s (what autodrive-sim accepts)."""
+    try:
+        wait = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: want a number of s") from None
+    if not 0.1 <= wait <= 3600.0:
+        raise argparse.ArgumentTypeError(f"{text}: want 0.1..3600 s")
+    return wait
 
 
 def latency_ms_arg(text: str) -> float:
@@ -174,9 +203,11 @@ def report(
     records: list[PoseRecord],
     cars: list[str],
     latency_ms: float | None = None,
+    give_ups: int | None = None,
 ) -> dict[str, Any]:
     """The report's pose fields over one or more runs (episodes): pose_source, what ran, the
-    Eye's lockstep latency [ms of sim time] (None: not in lockstep), Eye poses per car per
+    Eye's lockstep latency [ms of sim time] (None: not in lockstep) and how often the sim gave
+    the Eye up (give_ups, eye_sync_give_ups: None when not in lockstep), Eye poses per car per
     second of sim time, each car's EKF error against the truth (p50, p95, max [m]) and the
     worst car's p95, and when each car's first Eye fix came [s sim]."""
     rate: dict[str, float] = {}
@@ -192,6 +223,7 @@ def report(
         "pose_source": POSE_SOURCE[eye],
         "eye": what,
         "eye_latency_ms": latency_ms if eye == "cameras" else None,
+        "eye_sync_give_ups": give_ups if eye == "cameras" and latency_ms is not None else None,
         "eye_poses_per_car_hz": rate,
         "ekf_error_m": err,
         "ekf_error_p95_worst_m": max(p95) if p95 else None,
@@ -217,12 +249,63 @@ def summary_line(rep: dict[str, Any]) -> str:
     )
 
 
-def sim_argv(eye: str, fps: float, latency_ms: float | None) -> list[object]:
+def sim_argv(
+    eye: str, fps: float, latency_ms: float | None, wait_s: float = EYE_SYNC_WAIT_S_DEFAULT
+) -> list[object]:
     """autodrive-sim's options for --eye: cameras renders the map's overhead cameras at fps
-    [Hz of sim time]; with latency_ms (a lockstep run) in lockstep with the Eye (--eye-sync)."""
+    [Hz of sim time]; with latency_ms (a lockstep run) in lockstep with the Eye (--eye-sync),
+    a silent Eye given up after wait_s [s wall]."""
     if eye != "cameras":
         return []
-    return ["--eye", "--camera-fps", fps, *(["--eye-sync"] if latency_ms is not None else [])]
+    return ["--eye", "--camera-fps", fps, *sim_sync_argv(latency_ms, wait_s)]
+
+
+def sim_sync_argv(latency_ms: float | None, wait_s: float) -> list[object]:
+    """autodrive-sim's lockstep with the Eye (none when latency_ms is None: not in lockstep)."""
+    return [] if latency_ms is None else ["--eye-sync", "--eye-sync-wait-s", wait_s]
+
+
+def eye_sync_give_ups(sim_log: Path, latency_ms: float | None) -> int | None:
+    """How often autodrive-sim gave the Eye up in a run, from its log (each give-up is a line
+    with EYE_SYNC_GIVE_UP_MARK, also with --quiet); None when the run was not in lockstep with
+    the Eye (latency_ms None). A log that cannot be read counts as -1: unknown, a failure."""
+    if latency_ms is None:
+        return None
+    try:
+        text = sim_log.read_text(errors="replace")
+    except OSError:
+        return -1
+    return sum(EYE_SYNC_GIVE_UP_MARK in line for line in text.splitlines())
+
+
+def eye_sync_failure(give_ups: int | None, runs: int = 1) -> str | None:
+    """The message that fails a mission whose sim gave the Eye up (give_ups > 0, over runs
+    runs) or whose count is unknown (< 0); None when it never did or was not in lockstep."""
+    if give_ups is None or give_ups == 0:
+        return None
+    if give_ups < 0:
+        return (
+            "eye_sync_give_ups unknown: the simulator's log could not be read, so it cannot be "
+            "told whether the run depended on wall time"
+        )
+    over = f" (over {runs} runs)" if runs > 1 else ""
+    return (
+        f"the Eye fell behind the sim {give_ups} times{over}: the run depended on wall time; "
+        "rerun on a quieter machine or raise --eye-sync-wait-s"
+    )
+
+
+def eye_sync_verdict(rep: dict[str, Any], runs: int = 1, say: Any = None) -> None:
+    """Fails a mission's report (ok False, the message in error) when its eye_sync_give_ups
+    says the sim gave the Eye up; says the message (say) too."""
+    msg = eye_sync_failure(rep.get("eye_sync_give_ups"), runs)
+    if msg is None:
+        return
+    rep["ok"] = False
+    rep["eye_sync_error"] = msg
+    rep["error"] = f"{rep['error']}; {msg}" if rep.get("error") else msg
+    if say is not None:
+        say(f"FAILED: {msg}")
 
 
 def eye_lockstep_argv(latency_ms: float | None) -> list[object]:

@@ -34,9 +34,11 @@ def analyse(
     eye: str = "none",
     eye_what: str = "",
     eye_latency_ms: float | None = None,
+    eye_sync_give_ups: int | None = None,
 ) -> Report:
     """eye: the run's --eye (its pose_source); eye_what: what ran (for the report);
-    eye_latency_ms: the Eye's lockstep latency [ms of sim time], None when not in lockstep."""
+    eye_latency_ms: the Eye's lockstep latency [ms of sim time], None when not in lockstep;
+    eye_sync_give_ups: how often the sim gave the Eye up (pose_source.eye_sync_give_ups)."""
     if not Path(log_path).exists():
         return {"ok": False, "error": f"no LCM log at {log_path}"}
     types = lcmtypes.load(build)
@@ -86,7 +88,9 @@ def analyse(
     ekf = ekf if ekf_channel == ch_pose else odom
     rep: Report = {
         "ok": False,
-        **pose_source.report(eye, eye_what or eye, [poses], [veh], eye_latency_ms),
+        **pose_source.report(
+            eye, eye_what or eye, [poses], [veh], eye_latency_ms, eye_sync_give_ups
+        ),
         "ekf_channel": ekf_channel,
         "gt_samples": len(gt),
         "ekf_samples": len(ekf),

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from autodrive.core import channels, seeds
+from autodrive.core import channels, seeds, settings
 from autodrive.core.settings import OUT_DIR, RELEASE_BUILD
 from typing import Any
 
@@ -30,6 +30,16 @@ def add_run_options(
     p.add_argument("--headless", action="store_true", help="never open the simulator's window")
     p.add_argument("--timeout", type=float, default=timeout_s, help="give up after this [s wall]")
     p.add_argument("--lcm-url", default=channels.load().url_default, help="LCM URL")
+
+
+def instance_lcm_url(p: argparse.ArgumentParser, url: str) -> str:
+    """--lcm-url moved to the session's instance (AUTODRIVE_INSTANCE) once, for every child:
+    lcm-logger knows no instance, and with the table's URL it logged another bus than the
+    programs' (an empty run.lcmlog: 'no ground truth in the log')."""
+    try:
+        return settings.instance().lcm_url(url)
+    except settings.InstanceError as e:
+        p.error(str(e))
 
 
 def record_children(rep: dict[str, Any], exits: list[ChildExit], say: Log) -> None:

@@ -40,6 +40,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     add_run_options,
+    instance_lcm_url,
     lane_watch,
     record_children,
 )
@@ -121,6 +122,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         p.error(str(e))
     if args.start_m < 0 or args.distance_m < 0:
         p.error(f"--start-m {args.start_m} / --distance-m {args.distance_m}: at least 0")
+    args.lcm_url = instance_lcm_url(p, args.lcm_url)
     return args
 
 

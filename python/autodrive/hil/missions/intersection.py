@@ -46,6 +46,7 @@ from autodrive.hil.missions import (
     EXIT_INTERRUPTED,
     PTY_TIMEOUT_S,
     add_run_options,
+    instance_lcm_url,
     record_children,
 )
 
@@ -107,6 +108,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         p.error(f"--shield-pose-error-m {args.shield_pose_error_m}: must be >= 0")
     if args.v2v_delay_ms < 0:
         p.error(f"--v2v-delay-ms {args.v2v_delay_ms}: must be >= 0")
+    args.lcm_url = instance_lcm_url(p, args.lcm_url)
     return args
 
 
@@ -159,6 +161,7 @@ class EpisodeRecord:
     goal_t: dict[str, float] = field(default_factory=dict)  # sim time at the goal [s]
     sim_s: float = 0.0
     poses: pose_source.PoseRecord = field(default_factory=pose_source.PoseRecord)
+    eye_sync_give_ups: int | None = None  # the sim gave the Eye up (pose_source; None: no lockstep)
     children: list[ChildExit] = field(default_factory=list)  # how the episode's processes ended
 
 
@@ -235,7 +238,7 @@ def run_episode(
         marked = [p.start for p in plans]
         for i, (x, y, yaw) in enumerate(pose_source.placed(marked, args.eye, seed)):
             sim += ["--car-start", f"{i + 1},{x:.4f},{y:.4f},{math.degrees(yaw):.3f}"]
-        sim += pose_source.sim_argv(args.eye, fps, latency)
+        sim += pose_source.sim_argv(args.eye, fps, latency, args.eye_sync_wait_s)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         procs.start("autodrive-sim", sim, ep_dir / "sim.log")
@@ -294,6 +297,7 @@ def run_episode(
                 break
     finally:
         rec.children = procs.stop_all()
+        rec.eye_sync_give_ups = pose_source.eye_sync_give_ups(ep_dir / "sim.log", latency)
         for s in subs:
             lc.unsubscribe(s)
         shutil.rmtree(run_dir, ignore_errors=True)
@@ -304,6 +308,15 @@ def run_episode(
                 summaries.append(json.loads(line))
                 break
     return rec, summaries, ended
+
+
+def episodes_give_ups(recs: list[EpisodeRecord]) -> int | None:
+    """The episodes' sims' give-ups of the Eye in all: None when none was in lockstep, -1 when
+    any count is unknown (pose_source.eye_sync_give_ups)."""
+    counts = [r.eye_sync_give_ups for r in recs if r.eye_sync_give_ups is not None]
+    if not counts:
+        return None
+    return -1 if min(counts) < 0 else sum(counts)
 
 
 def goal_errors_m(plans: list[CarPlan], rec: EpisodeRecord) -> list[float]:
@@ -503,6 +516,7 @@ def run(args: argparse.Namespace) -> int:
             [r.poses for _p, r, _e in done],
             [channels.vehicle_name(i + 1) for i in range(CARS)],
             lat,
+            episodes_give_ups([r for _p, r, _e in done]),
         ),
         "eye_poses": sum(sum(r.poses.eye_poses.values()) for _p, r, _e in done),
         **score_episodes(args.episodes, outcomes, traverse_s),
@@ -527,6 +541,7 @@ def run(args: argparse.Namespace) -> int:
                 "at_goal": sorted(r.at_goal),
                 "collided": sorted(r.collided),
                 "sim_s": round(r.sim_s, 2),
+                "eye_sync_give_ups": r.eye_sync_give_ups,
             }
             for plans, r, e in done
         ],
@@ -534,6 +549,8 @@ def run(args: argparse.Namespace) -> int:
         "interrupted": interrupted,
     }
     record_children(rep, [c for _p, r, _e in done for c in r.children], say)
+    rep["ok"] = exit_code(rep) == 0
+    pose_source.eye_sync_verdict(rep, runs=len(done), say=say)  # it depended on wall time: fails
     (out / "report.json").write_text(json.dumps(rep, indent=2))
     if done:
         plot(out / "trajectories.png", done)
@@ -551,7 +568,7 @@ def exit_code(rep: dict[str, Any]) -> int:
     wall --timeout left unrun is a failure), no car collided and no process left a sanitizer
     report; else 1."""
     ok = rep["success_rate"] == 1.0 and rep["collisions"] == 0 and not rep["sanitizer_reports"]
-    return 0 if ok else 1
+    return 0 if ok and rep.get("ok", True) else 1  # "ok" false: e.g. the Eye fell behind
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -246,7 +246,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
         eye_fps = args.cameras or EYE_FPS_DEFAULT
         # in lockstep the Eye is too: its poses at capture + L of sim time, at any load
         eye_latency = pose_source.lockstep_latency_ms(args, lockstep=not args.rtf)
-        sim += pose_source.sim_argv(args.eye, eye_fps, eye_latency)
+        sim += pose_source.sim_argv(args.eye, eye_fps, eye_latency, args.eye_sync_wait_s)
         if (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) and not args.headless:
             sim += ["--view"]
         sim_proc = procs.start("autodrive-sim", sim, out / "sim.log")
@@ -389,6 +389,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             [poses],
             [vehicle_name(i) for i in range(1, cars + 1)],
             eye_latency,
+            pose_source.eye_sync_give_ups(out / "sim.log", eye_latency),
         )
     )
     rep["ok"] = (
@@ -404,6 +405,7 @@ def run(args: argparse.Namespace, console: TextIO = sys.stdout, stop_also: Any =
             or (rep["ekf_error_p95_worst_m"] or math.inf) <= EKF_P95_GOAL_M
         )
     )
+    pose_source.eye_sync_verdict(rep, say=say)  # a run that depended on wall time fails
     record_children(rep, exits, say)
     (out / "report.json").write_text(json.dumps(rep, indent=2))
     if tracks:

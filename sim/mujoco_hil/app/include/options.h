@@ -24,9 +24,11 @@ typedef struct app_options {
   int view_w, view_h; /* --view-size [px] */
   /* --video FILE, --record DIR (run_recorder.h), --video-camera NAME; NULL when not given */
   const char *video, *record_dir, *video_camera;
-  int cameras, eye; /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */
-  int eye_sync;     /* --eye-sync: wait for the Eye's EYE_FRAME_DONE (eye_sync.h) */
-  int eye_render;   /* --eye-render: CAMERAS_RENDER_CACHED, _FULL or _COMPARE (cameras.h) */
+  int cameras, eye;       /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */
+  int eye_sync;           /* --eye-sync: wait for the Eye's EYE_FRAME_DONE (eye_sync.h) */
+  double eye_sync_wait_s; /* --eye-sync-wait-s [s wall]: a silent Eye is given up after it */
+  int eye_sync_wait_given;
+  int eye_render; /* --eye-render: CAMERAS_RENDER_CACHED, _FULL or _COMPARE (cameras.h) */
   double camera_fps, light_level, camera_noise, camera_blur;
   scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
   int nstarts;

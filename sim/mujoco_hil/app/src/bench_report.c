@@ -39,7 +39,7 @@ static void bench_print_cameras(const app_t *a) {
     double waited_s = 0.0;
     long given_up = 0;
     const long waits = eye_sync_stats(a->eye_sync, &waited_s, &given_up);
-    printf(", \"eye_sync_waits\": %ld, \"eye_sync_waited_s\": %.3f, \"eye_sync_given_up\": %ld",
+    printf(", \"eye_sync_waits\": %ld, \"eye_sync_waited_s\": %.3f, \"eye_sync_give_ups\": %ld",
            waits, waited_s, given_up);
   }
 }

@@ -23,7 +23,7 @@ struct eye_sync {
   int64_t pending[EYE_SYNC_MAX_PENDING]; /* capture times sent, oldest first from head */
   int head, n;
   long waits, given_up, refused;
-  double waited_s;
+  double waited_s, wait_s; /* wall time waited in all; the limit for a silent Eye [s] */
 };
 
 static void eye_sync_handle(eye_sync_t *e, int timeout_ms);
@@ -58,13 +58,19 @@ static void eye_sync_on_done(const lcm_recv_buf_t *rbuf, const char *channel,
   eye_sync_drop_done(e);
 }
 
-eye_sync_t *eye_sync_create(lcm_t *lcm, char *err, size_t err_sz) {
+eye_sync_t *eye_sync_create(lcm_t *lcm, double wait_s, char *err, size_t err_sz) {
+  if (!(wait_s >= EYE_SYNC_WAIT_MIN_S && wait_s <= EYE_SYNC_WAIT_MAX_S)) {
+    snprintf(err, err_sz, "--eye-sync-wait-s %g: expected %g..%g s", wait_s, EYE_SYNC_WAIT_MIN_S,
+             EYE_SYNC_WAIT_MAX_S);
+    return NULL;
+  }
   eye_sync_t *e = calloc(1, sizeof *e);
   if (!e) {
     snprintf(err, err_sz, "--eye-sync: out of memory");
     return NULL;
   }
   e->lcm = lcm;
+  e->wait_s = wait_s;
   e->done_us = -1;
   e->lost_at_us = INT64_MIN;
   e->sub =
@@ -86,14 +92,18 @@ void eye_sync_destroy(eye_sync_t *e) {
 void eye_sync_before_frame(eye_sync_t *e) {
   if (e->first_sent) return;
   e->first_sent = 1;
-  const double t_give_up = app_wall_s() + EYE_SYNC_FIRST_S;
+  const double limit_s = e->wait_s > EYE_SYNC_FIRST_S ? e->wait_s : EYE_SYNC_FIRST_S;
+  const double t_give_up = app_wall_s() + limit_s;
   while (!e->heard && !app_stop_requested()) {
     eye_sync_handle(e, 50);
     if (!e->heard && app_wall_s() > t_give_up) {
+      e->given_up++;
       fprintf(stderr,
-              "[autodrive-sim] --eye-sync: no Eye announced itself on " AUTODRIVE_CH_EYE_FRAME_DONE
-              " in %.0f s (wall): running on; it is waited for once it answers\n",
-              EYE_SYNC_FIRST_S);
+              "[autodrive-sim] " EYE_SYNC_GIVE_UP_MARK
+              " (%ld): no Eye announced itself on " AUTODRIVE_CH_EYE_FRAME_DONE
+              " in %.1f s (wall): running on, the run now depends on wall time; it is waited "
+              "for once it answers\n",
+              e->given_up, limit_s);
       return;
     }
   }
@@ -127,19 +137,22 @@ int eye_sync_due(const eye_sync_t *e, int64_t now_us) {
 
 void eye_sync_wait(eye_sync_t *e, int64_t now_us) {
   const double t0 = app_wall_s();
-  const double t_give_up = t0 + EYE_SYNC_LOST_S;
+  const double t_give_up = t0 + e->wait_s;
   e->waits++;
   while (eye_sync_due(e, now_us) && !app_stop_requested()) {
     eye_sync_handle(e, 50);
     if (eye_sync_due(e, now_us) && app_wall_s() > t_give_up) {
+      e->given_up++;
       fprintf(stderr,
-              "[autodrive-sim] the Eye has not finished the frame of t = %.3f s for %.1f s "
-              "(wall; no " AUTODRIVE_CH_EYE_FRAME_DONE "): running on without it\n",
-              e->pending[e->head] * 1e-6, EYE_SYNC_LOST_S);
+              "[autodrive-sim] " EYE_SYNC_GIVE_UP_MARK
+              " (%ld): it has not finished the frame of t = %.3f s for %.1f s (wall; "
+              "no " AUTODRIVE_CH_EYE_FRAME_DONE
+              "): running on without it, the run now depends on wall time (--eye-sync-wait-s "
+              "sets the limit)\n",
+              e->given_up, e->pending[e->head] * 1e-6, e->wait_s);
       e->heard = 0;
       e->lost_at_us = e->done_us;
       e->n = 0;
-      e->given_up++;
       break;
     }
   }

@@ -12,6 +12,7 @@
 
 #include "camera_fx.h"
 #include "cameras.h"
+#include "eye_sync.h"
 #include "script.h"
 #include "sim_instance.h"
 
@@ -96,7 +97,12 @@ static void options_usage(FILE *f) {
       "                      (EYE_FRAME_DONE); it publishes SIM_CLOCK at t + L, when the Eye\n"
       "                      releases them. Before the first frame it waits up to 60 s\n"
       "                      (wall) for the Eye to say it is ready; an Eye silent for 10 s\n"
-      "                      (wall) while waited for is given up until it answers again\n"
+      "                      (wall) while waited for is given up until it answers again.\n"
+      "                      Each give-up is a stderr line with '" EYE_SYNC_GIVE_UP_MARK
+      "'\n"
+      "                      (the run then depended on wall time), counted at exit\n"
+      "  --eye-sync-wait-s S (with --eye-sync) give a silent Eye up after S s of wall time\n"
+      "                      (%g..%g; default %g; before the first frame max(S, %g))\n"
       "  --eye-render MODE   cached (default): an overhead camera renders the static world\n"
       "                      once and draws only what moves over it; full: every frame in\n"
       "                      full; compare: both, the cached one published (--bench reports\n"
@@ -130,7 +136,8 @@ static void options_usage(FILE *f) {
       SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT,
       AUTODRIVE_SIM_RUN_DIR_DEFAULT, AUTODRIVE_INSTANCE_MAX, AUTODRIVE_INSTANCE_VARIABLE,
       AUTODRIVE_INSTANCE_PORT_STEP, SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M,
-      CFX_MAX_NOISE, CFX_MAX_BLUR_PX);
+      EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, EYE_SYNC_LOST_S, EYE_SYNC_FIRST_S, CFX_MAX_NOISE,
+      CFX_MAX_BLUR_PX);
 }
 
 static int options_number(const char *opt, const char *v, double lo, double hi, double *out) {
@@ -164,6 +171,7 @@ static void options_defaults(app_options_t *o) {
   o->view_w = 1024;
   o->view_h = 768;
   o->camera_fps = 30.0;
+  o->eye_sync_wait_s = EYE_SYNC_LOST_S;
   o->light_level = -1.0;
   o->rtf = 1.0;
 }
@@ -348,6 +356,11 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     o->eye = 1;
   } else if (!strcmp(a, "--eye-sync")) {
     o->eye_sync = 1;
+  } else if (!strcmp(a, "--eye-sync-wait-s")) {
+    o->eye_sync_wait_given = 1;
+    return options_number(a, v, EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, &o->eye_sync_wait_s)
+               ? OPTIONS_BAD
+               : 1;
   } else if (!strcmp(a, "--eye-render") && v) {
     o->eye_render = !strcmp(v, "cached")    ? CAMERAS_RENDER_CACHED
                     : !strcmp(v, "full")    ? CAMERAS_RENDER_FULL
@@ -394,6 +407,10 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --allow-teleport needs --lockstep, --lockstep-client or "
             "--lockstep-frames (a car never jumps in a real-time run)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->eye_sync_wait_given && !o->eye_sync) {
+    fprintf(stderr, "autodrive-sim: --eye-sync-wait-s needs --eye-sync (it is its give-up time)\n");
     return OPTIONS_BAD;
   }
   if (o->eye_sync && (!o->lockstep || !o->eye)) {

@@ -136,7 +136,7 @@ static int app_build_links(app_t *a, char *err, size_t err_sz) {
     return 1;
   }
   if (a->teleport) printf("teleport: obeying " AUTODRIVE_CH_SIM_TELEPORT " (--allow-teleport)\n");
-  if (o->eye_sync && !(a->eye_sync = eye_sync_create(a->lcm, err, err_sz))) {
+  if (o->eye_sync && !(a->eye_sync = eye_sync_create(a->lcm, o->eye_sync_wait_s, err, err_sz))) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;
   }
