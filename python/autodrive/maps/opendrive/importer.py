@@ -16,6 +16,7 @@ from typing import Any
 
 import yaml
 
+from autodrive.core.geometry import wrap
 from autodrive.maps import mjcf, sidecar, textures
 from autodrive.maps.loader import KIT_FILE, load, load_kit
 from autodrive.maps.opendrive import arcs, network, xodr
@@ -176,6 +177,7 @@ class _Signals:
         pole = [x + d * math.sin(h), y - d * math.cos(h)]  # right of the rightmost lane
         for lane in lanes:
             _, (sx, sy), _ = _along(lane, sig.s_m)
+            junction, entry = self.junction_ahead(lane)
             stop = f"stop_{network.safe_name(sig.id)}_{lane.name}"
             self.stop_lines.append(
                 {
@@ -193,16 +195,62 @@ class _Signals:
                     "group": group,
                     "position_m": pole,
                     "yaw_deg": math.degrees(h + math.pi),
+                    "junction": junction,
+                    "heading_rad": entry,
                 }
             )
+
+    def junction_ahead(self, lane: ImportedLane) -> tuple[str | None, float]:
+        """The junction the lane leads into (through its road's later lane sections) and the
+        heading [rad] where it enters it; (None, 0) if it leads into none."""
+        here = lane
+        for _ in range(len(self.lanes)):
+            (ex, ey), (fx, fy) = here.points[-2], here.points[-1]
+            for key in here.successors:
+                j = self.net.roads[key[0]].junction
+                if j != "-1":
+                    return j, math.atan2(fy - ey, fx - ex)
+            same_road = [k for k in here.successors if k[0] == here.key[0]]
+            if not same_road:
+                break
+            here = self.lanes[same_road[0]]
+        return None, 0.0
+
+    def crossings(self) -> None:
+        """Each light's crosses: the lights before the same junction whose approaches (their
+        lanes' headings where they enter it) are neither the same way nor opposite (more than
+        0.1 rad from either), as the kit's intersection tiles pair theirs. A controller that would show two crossing approaches
+        green at once is split (the later signal gets its own phase), with a warning."""
+        for light in self.lights:
+            light["crosses"] = []
+        for i, a in enumerate(self.lights):
+            for b in self.lights[i + 1 :]:
+                if a["junction"] is None or a["junction"] != b["junction"]:
+                    continue
+                dyaw = abs(wrap(a["heading_rad"] - b["heading_rad"]))
+                if not 0.1 < dyaw < math.pi - 0.1:
+                    continue
+                a["crosses"].append(b["id"])
+                b["crosses"].append(a["id"])
+                if a["group"] == b["group"]:
+                    self.warnings.append(
+                        f"controller '{a['group']}': lights {a['id']} and {b['id']} cross at "
+                        f"junction '{a['junction']}'; light {b['id']} given its own phase"
+                    )
+                    b["group"] = f"{b['group']}/light_{b['id']}"
+                    self.groups.append(b["group"])
 
     def programs(self) -> list[dict[str, Any]]:
         """The lights with fixed-time programs: one phase per controller (signals without one:
         a phase each), in turn, with an all-red interval between phases."""
+        self.crossings()
         n = len(self.groups)
         phase = GREEN_S + YELLOW_S + ALL_RED_S
         out = []
         for light in self.lights:
+            del light["junction"], light["heading_rad"]
+            if not light["crosses"]:
+                del light["crosses"]
             k = self.groups.index(light.pop("group"))
             light["program"] = {
                 "cycle_s": phase * max(2, n),
