@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from autodrive.maps import eye_cameras
 from autodrive.maps.opendrive import fixtures, reference
 from pyhelpers import REPO_ROOT
 
@@ -125,3 +126,17 @@ def test_map_check_refuses_overlapping_greens_of_crossing_lights(tmp_path: Path)
     run = subprocess.run([str(TOOL), "check", str(bad)], capture_output=True, text=True)
     assert run.returncode != 0
     assert "light 3 crosses light 1 but the all-red interval" in run.stdout + run.stderr
+
+
+def test_eye_cameras_see_every_lane(imported: dict[str, tuple[Path, dict, str]]) -> None:
+    """The overhead cameras placed from the network's extent see every point of every driving
+    lane's centre line at roof height, a whole roof tag's half diagonal (and 8 px) inside the
+    image, as Tiny Town's do; a point off the network is not seen (the check can fail)."""
+    for name, (path, doc, _) in imported.items():
+        cams = eye_cameras.load(name, path.parent / "maps")
+        assert 1 <= len(cams) <= 8, name
+        for lane in doc["lanes"]:
+            for p in lane["centre_line"]:
+                assert any(c.sees(p["x_m"], p["y_m"], 0.1, 24) for c in cams), (name, p)
+        far = doc["floor"]["half_size_m"] * 3
+        assert not any(c.sees(far, far, 0.1, 24) for c in cams)
