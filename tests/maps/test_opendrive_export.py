@@ -1,7 +1,9 @@
 """maps.opendrive_export: `tools/map export` of every shipped kit map writes OpenDRIVE 1.7 that
 pyxodr reads, and `tools/map import --scale 1` of it gives back every lane: the same centre line
 within 1 mm (each point of either within 1 mm of the other's line), the same half width, in the
-same driving direction."""
+same driving direction. Where lanes branch or merge (Tiny Town's crossings) the export has
+junctions: connecting roads in them, a connection with a lane link for each lane into one, and
+the re-imported routes walk only the kit's own successors."""
 
 from __future__ import annotations
 
@@ -64,3 +66,21 @@ def test_round_trip_within_1_mm(name: str, tmp_path: Path) -> None:
         assert abs(math.remainder(ours[0][2] - theirs[0][2], 2 * math.pi)) < 0.01, lane.name
         assert back[lane.name]["half_width_m"] == pytest.approx(lane.half_width_m, abs=1e-6)
     assert reference.lane_lines(xodr)  # pyxodr reads the export
+    # junctions: every lane pair where lanes branch or merge is a connection with a lane link
+    # (to a road of its junction), and the imported routes walk only the kit's successors
+    succ = exporter._successors(m)
+    inner = exporter._junctions(succ)
+    ids = {v: k for k, v in road_of.items()}
+    conns = {(road_of[c.get("incomingRoad")], road_of[c.get("connectingRoad")])
+             for j in root.findall("junction") for c in j.findall("connection")
+             if c.find("laneLink") is not None}  # fmt: skip
+    want = {(a, b) for a, bs in succ.items() for b in bs if b in inner and a not in inner}
+    assert conns == want, name
+    for b in inner:
+        road = next(r for r in root.findall("road") if r.get("id") == ids[b])
+        assert root.find(f"junction[@id='{road.get('junction')}']") is not None, b
+    pairs = {(road_of[a.split("_")[0][1:]], road_of[b.split("_")[0][1:]])
+             for r in doc["routes"] for a, b in zip(r["lanes"], r["lanes"][1:])}  # fmt: skip
+    assert pairs <= {(a, b) for a, bs in succ.items() for b in bs}, name
+    if name == "tiny_town":  # a map with 3- and 4-way crossings
+        assert len(root.findall("junction")) >= 4 and want

@@ -11,10 +11,13 @@ from __future__ import annotations
 import json
 import math
 import subprocess
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+import yaml
 
+from autodrive.maps import eye_cameras
 from autodrive.maps.opendrive import fixtures, reference
 from pyhelpers import REPO_ROOT
 
@@ -47,7 +50,10 @@ def test_crossing_routes_signals_and_warnings(imported: dict[str, tuple[Path, di
     r = next(r for r in doc["routes"] if r["name"] == "r1r1_to_r3r1")
     assert r["lanes"][0].startswith("r1_") and r["lanes"][-1].startswith("r3_")
     assert any(lane.startswith("r1") and lane[2:3] != "_" for lane in r["lanes"][1:-1])  # conn.
-    assert len(doc["traffic_lights"]) == 2 and len(doc["stop_lines"]) == 2
+    assert len(doc["traffic_lights"]) == 3 and len(doc["stop_lines"]) == 3
+    # signal 6 (light 3, road 4) crosses the opposite approaches of signals 1 and 2 (lights 1, 2)
+    assert doc["imported_from"]["signal_lights"] == {"1": [1], "2": [2], "6": [3]}
+    assert doc["light_conflicts"] == [[1, 3], [2, 3]]
     assert {s["kind"] for s in doc["signs"]} == {"stop", "speed_limit"}
     limit = next(s for s in doc["signs"] if s["kind"] == "speed_limit")
     assert limit["speed_limit_m_s"] == pytest.approx(50 / 3.6 / 14, abs=1e-6)
@@ -81,3 +87,56 @@ def test_deviation_scorer_sees_a_planted_gap(imported: dict[str, tuple[Path, dic
     p["x_m"] -= shift * math.sin(p["heading_rad"])
     p["y_m"] += shift * math.cos(p["heading_rad"])
     assert reference.max_centre_deviation_m(path, bad) * 1000 > 15.0
+
+
+def test_crossing_lights_of_one_controller_get_their_own_phases(tmp_path: Path) -> None:
+    """A controller planted into the file for signals 1 and 6, whose approaches cross: the
+    importer does not let them show green together (light 3 gets its own phase, with a warning
+    naming the controller), and the programs pass the map's conflict check."""
+    path = fixtures.crossing(tmp_path / "crossing.xodr")
+    tree = ET.parse(path)
+    root = tree.getroot()
+    ctl = ET.SubElement(root, "controller", {"id": "c1", "name": "both"})
+    for rid in ("1", "4"):  # scenariogeneration numbers signals on anew in a second network
+        road = next(r for r in root.findall("road") if r.get("id") == rid)
+        sig = next(g for g in road.iter("signal") if g.get("type") == "1000001")
+        ET.SubElement(ctl, "control", {"signalId": str(sig.get("id"))})
+    tree.write(path)
+    run = subprocess.run([str(TOOL), "import", str(path), "--name", "ctl", "--out",
+                          str(tmp_path / "maps")], capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "controller 'c1': lights 1 and 3 cross at junction '100'" in run.stderr
+    doc = json.loads((tmp_path / "maps" / "ctl.json").read_text())
+    progs = {t["id"]: t["program"] for t in doc["traffic_lights"]}
+    assert progs[1]["offset_s"] != progs[3]["offset_s"] and [1, 3] in doc["light_conflicts"]
+
+
+def test_map_check_refuses_overlapping_greens_of_crossing_lights(tmp_path: Path) -> None:
+    """The planted fault: the imported description edited so that light 3 (crossing light 1)
+    runs light 1's program. The map's check refuses it, naming the lights."""
+    path = fixtures.crossing(tmp_path / "crossing.xodr")
+    subprocess.run([str(TOOL), "import", str(path), "--name", "c", "--out", str(tmp_path)],
+                   check=True, capture_output=True)  # fmt: skip
+    desc = yaml.safe_load((tmp_path / "c.yaml").read_text())
+    light3 = next(t for t in desc["traffic_lights"] if t["id"] == 3)
+    assert light3["crosses"] == [1, 2]
+    light3["program"]["offset_s"] = 0.0
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(desc))
+    run = subprocess.run([str(TOOL), "check", str(bad)], capture_output=True, text=True)
+    assert run.returncode != 0
+    assert "light 3 crosses light 1 but the all-red interval" in run.stdout + run.stderr
+
+
+def test_eye_cameras_see_every_lane(imported: dict[str, tuple[Path, dict, str]]) -> None:
+    """The overhead cameras placed from the network's extent see every point of every driving
+    lane's centre line at roof height, a whole roof tag's half diagonal (and 8 px) inside the
+    image, as Tiny Town's do; a point off the network is not seen (the check can fail)."""
+    for name, (path, doc, _) in imported.items():
+        cams = eye_cameras.load(name, path.parent / "maps")
+        assert 1 <= len(cams) <= 8, name
+        for lane in doc["lanes"]:
+            for p in lane["centre_line"]:
+                assert any(c.sees(p["x_m"], p["y_m"], 0.1, 24) for c in cams), (name, p)
+        far = doc["floor"]["half_size_m"] * 3
+        assert not any(c.sees(far, far, 0.1, 24) for c in cams)

@@ -239,7 +239,8 @@ class MapDescription(MapFile):
 
     def light_conflicts(self) -> list[tuple[int, int]]:
         """Pairs of lights that must never both show green or yellow: lights at the same
-        intersection tile whose approaches cross (not opposite each other)."""
+        intersection tile whose approaches cross (not opposite each other), and the pairs the
+        description names (traffic_lights[].crosses)."""
         tile_of = {s.name: t.spec.name for t in self.tile_contents() for s in t.stop_lines}
         ls = self.lights()
         out = []
@@ -252,6 +253,11 @@ class MapDescription(MapFile):
                 dyaw = abs(wrap(a.yaw_rad - b.yaw_rad))
                 if 0.1 < dyaw < math.pi - 0.1:
                     out.append((a.id, b.id))
+        for spec in self.traffic_lights:  # given by the description (imported junctions)
+            for other in spec.crosses:
+                pair = (min(spec.id, other), max(spec.id, other))
+                if pair not in out:
+                    out.append(pair)
         return out
 
     def placed_signs(self) -> list[Sign]:

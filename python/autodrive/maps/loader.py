@@ -313,6 +313,11 @@ class _Checker:
                                f"{sorted(stops)})")  # fmt: skip
             if (spec.position_m is None) != (spec.yaw_deg is None):
                 raise self.err(key, "give both position_m and yaw_deg, or neither")
+            ids = {t.id for t in self.m.traffic_lights}
+            for j, other in enumerate(spec.crosses):
+                if other == spec.id or other not in ids:
+                    raise self.err(f"{key}.crosses[{j}]", f"must name another light of the map "
+                                   f"(has {sorted(ids - {spec.id})}), got {other}")  # fmt: skip
             p = spec.program
             self.positive((p.cycle_s, p.green_s, p.yellow_s), f"{key}.program")
             if p.green_s + p.yellow_s >= p.cycle_s:

@@ -303,13 +303,15 @@ class Program:
 @dataclass(frozen=True)
 class TrafficLightSpec:
     """A light at a stop line; it stands on the kerb right of the stop line's lane, facing the
-    approach, unless position_m and yaw_deg (the way its lamps face) are given."""
+    approach, unless position_m and yaw_deg (the way its lamps face) are given. crosses: the
+    lights whose approaches cross this one's where no tile says so (an imported junction)."""
 
     id: int
     stop_line: str
     program: Program
     position_m: Optional[Vec2] = None
     yaw_deg: Optional[float] = None
+    crosses: list[int] = field(default_factory=list)
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ rule, from the same code (autodrive.core.road_rules on the map's sidecar JSON): 
 on a lane from its EKF pose (<VEH>_POSE_MAP), its route's lanes first, then walked along its
 route (--routes; without one it stops at a fork); distances are along the lanes.
 
-CLI: python -m autodrive.hil.city.advisory --map tiny_town --vehicles NIGEL1,NIGEL2
+CLI: python -m autodrive.hil.city.advisory --map tiny_town|PATH.json --vehicles NIGEL1,NIGEL2
      [--routes city_east,city_west] [--lcm-url URL]
 """
 
@@ -109,7 +109,11 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
         prog="python -m autodrive.hil.city.advisory", description=__doc__.split("\n\n")[0]
     )
-    p.add_argument("--map", default="tiny_town", help="map name (maps/NAME.json)")
+    p.add_argument(
+        "--map",
+        default="tiny_town",
+        help="map name (maps/NAME.json) or a sidecar's path (an imported map's NAME.json)",
+    )
     p.add_argument("--vehicles", default=channels.vehicle_name(1), help="comma-separated cars")
     p.add_argument(
         "--routes",
@@ -130,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, on_signal)
     from autodrive.core.road_rules import RoadNet, SidecarError
 
-    sidecar = MAPS_DIR / f"{args.map}.json"
+    sidecar = Path(args.map) if args.map.endswith(".json") else MAPS_DIR / f"{args.map}.json"
     if not sidecar.is_file():
         p.error(f"--map {args.map}: no {sidecar}")
     vehicles = args.vehicles.split(",")

@@ -2,8 +2,10 @@
 the map becomes a road whose reference line is the lane's centre line (its line and arc pieces,
 offset and in driving order) with one right driving lane of the lane's width, centred on it by
 a lane offset of half that width. A lane followed by exactly one lane, which follows only it,
-is linked to it (road and lane links); lanes that branch or merge are left for the importer to
-join by geometry (it follows a lane into every lane that starts where it ends, tangent)."""
+is linked to it (road and lane links). Where lanes branch or merge, the lanes after a branch and
+before a merge are connecting roads of a junction (one per group of them that touch): the roads
+into it link to the junction and get a connection with a lane link to each connecting road
+they lead into; a connecting road links to the roads before and after it."""
 
 from __future__ import annotations
 
@@ -48,12 +50,11 @@ def _ends(m: MapDescription, lane: Lane) -> tuple[tuple[float, float, float], ..
     return pts[0], pts[-1]
 
 
-def _links(m: MapDescription) -> dict[str, str]:
-    """lane -> the one lane after it, where neither branches."""
+def _successors(m: MapDescription) -> dict[str, list[str]]:
+    """lane -> the lanes that start where it ends, tangent."""
     lanes = m.lanes()
     ends = {ln.name: _ends(m, ln) for ln in lanes}
     succ: dict[str, list[str]] = {ln.name: [] for ln in lanes}
-    pred: dict[str, list[str]] = {ln.name: [] for ln in lanes}
     for a in lanes:
         end = ends[a.name][1]
         for b in lanes:
@@ -61,8 +62,37 @@ def _links(m: MapDescription) -> dict[str, str]:
             turn = abs(math.remainder(end[2] - start[2], 2 * math.pi))
             if a is not b and math.dist(end[:2], start[:2]) <= JOIN_M and turn <= JOIN_RAD:
                 succ[a.name].append(b.name)
-                pred[b.name].append(a.name)
-    return {a: s[0] for a, s in succ.items() if len(s) == 1 and len(pred[s[0]]) == 1}
+    return succ
+
+
+def _junctions(succ: dict[str, list[str]]) -> dict[str, int]:
+    """Connecting lane -> its junction (1..): the lanes after a branch or before a merge,
+    grouped where they share a start or an end."""
+    pred: dict[str, list[str]] = {n: [] for n in succ}
+    for a, bs in succ.items():
+        for b in bs:
+            pred[b].append(a)
+    inner = {b for a, bs in succ.items() for b in bs if len(bs) > 1 or len(pred[b]) > 1}
+    group = {n: n for n in inner}
+
+    def root(n: str) -> str:
+        while group[n] != n:
+            n = group[n]
+        return n
+
+    def join(a: str, b: str) -> None:
+        group[root(a)] = root(b)
+
+    for a, bs in succ.items():
+        ins = [b for b in bs if b in inner]
+        for b in ins[1:]:  # the same start
+            join(ins[0], b)
+    for b, As in pred.items():
+        ins = [a for a in As if a in inner]
+        for a in ins[1:]:  # the same end
+            join(ins[0], a)
+    ids: dict[str, int] = {}
+    return {n: ids.setdefault(root(n), len(ids) + 1) for n in sorted(inner)}
 
 
 def build(m: MapDescription) -> Any:
@@ -72,6 +102,9 @@ def build(m: MapDescription) -> Any:
         raise MapDescriptionError(f"{m.source}: no lanes (roads or road tiles) to export")
     odr = sg.OpenDrive(m.name, revMajor="1", revMinor="7")
     ids = {ln.name: i + 1 for i, ln in enumerate(lanes)}
+    succ = _successors(m)
+    junction_of = _junctions(succ)
+    jid = {j: len(ids) + j for j in set(junction_of.values())}  # ids after the roads'
     roads = {}
     for ln in lanes:
         pv = sg.PlanView()
@@ -84,14 +117,36 @@ def build(m: MapDescription) -> Any:
         lns = sg.Lanes()
         lns.add_lanesection(section)
         lns.add_laneoffset(sg.LaneOffset(0, ln.half_width_m, 0, 0, 0))
-        roads[ln.name] = sg.Road(ids[ln.name], pv, lns, name=ln.name)
-    for a, b in _links(m).items():
-        roads[a].add_successor(sg.ElementType.road, ids[b], sg.ContactPoint.start)
-        roads[b].add_predecessor(sg.ElementType.road, ids[a], sg.ContactPoint.end)
-        roads[a].lanes.lanesections[0].rightlanes[0].add_link("successor", -1)
-        roads[b].lanes.lanesections[0].rightlanes[0].add_link("predecessor", -1)
+        j = jid[junction_of[ln.name]] if ln.name in junction_of else -1
+        roads[ln.name] = sg.Road(ids[ln.name], pv, lns, road_type=j, name=ln.name)
+    junctions = {j: sg.Junction(f"junction_{j}", j) for j in jid.values()}
+    pred: dict[str, list[str]] = {n: [] for n in succ}
+    for a, bs in succ.items():
+        for b in bs:
+            pred[b].append(a)
+    for a, bs in succ.items():
+        lane = roads[a].lanes.lanesections[0].rightlanes[0]
+        if a not in junction_of and bs and bs[0] in junction_of:  # into a junction
+            j = jid[junction_of[bs[0]]]
+            roads[a].add_successor(sg.ElementType.junction, j)
+            for b in bs:
+                conn = sg.Connection(ids[a], ids[b], sg.ContactPoint.start)
+                junctions[j].add_connection(conn.add_lanelink(-1, -1))
+        elif len(bs) == 1:  # on to one road (a connecting road out of its junction, too)
+            roads[a].add_successor(sg.ElementType.road, ids[bs[0]], sg.ContactPoint.start)
+            lane.add_link("successor", -1)
+        # a connecting road that branches again: no link (the importer joins it by geometry)
+    for b, As in pred.items():
+        lane = roads[b].lanes.lanesections[0].rightlanes[0]
+        if b not in junction_of and As and As[0] in junction_of:  # out of a junction
+            roads[b].add_predecessor(sg.ElementType.junction, jid[junction_of[As[0]]])
+        elif len(As) == 1:
+            roads[b].add_predecessor(sg.ElementType.road, ids[As[0]], sg.ContactPoint.end)
+            lane.add_link("predecessor", -1)
     for r in roads.values():
         odr.add_road(r)
+    for junction in junctions.values():
+        odr.add_junction(junction)
     return odr
 
 

@@ -26,8 +26,9 @@ def _light(sid: int, s_m: float, t_m: float, kind: str = "1000001", **kw: Any) -
 
 def crossing(path: Path) -> Path:
     """A 4-way junction (1 lane each way) of a spiral-arc-spiral road, two paramPoly3 roads
-    (pRange normalized and arcLength) and a sloped straight one; traffic lights on two
-    approaches, a stop sign, a speed limit and a signal type the kit does not know."""
+    (pRange normalized and arcLength) and a sloped straight one; traffic lights on three
+    approaches (two opposite, one crossing them), a stop sign, a speed limit and a signal type
+    the kit does not know."""
     roads = [
         xodr.create_road(
             [
@@ -63,6 +64,7 @@ def crossing(path: Path) -> Path:
     roads[1].add_signal(_light(3, 2, 4.5, kind="206"))
     roads[3].add_signal(_light(4, 20, -4.5, kind="274", value=50, unit="km/h"))
     roads[3].add_signal(_light(5, 25, -4.5, kind="138"))  # "cyclists": not a kit sign
+    roads[3].add_signal(_light(6, 48, -4.5))  # crosses lights 1 and 2 at the junction
     jc = xodr.CommonJunctionCreator(100, "crossing")
     for i, r in enumerate(roads):  # its paramPoly3 roads start at the junction: scenariogeneration
         # 0.16.7 places a road ending in a paramPoly3 at the junction from the wrong end

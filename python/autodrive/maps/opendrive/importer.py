@@ -16,8 +16,9 @@ from typing import Any
 
 import yaml
 
+from autodrive.core.geometry import wrap
 from autodrive.maps import mjcf, sidecar, textures
-from autodrive.maps.loader import KIT_FILE, load, load_kit
+from autodrive.maps.loader import KIT_FILE, MAX_EYE_CAMERAS, load, load_kit
 from autodrive.maps.opendrive import arcs, network, xodr
 from autodrive.maps.opendrive.lanes import DRIVING_TYPES
 from autodrive.maps.opendrive.network import ImportedLane, LaneKey, Transform
@@ -27,6 +28,9 @@ LIGHT_TYPES = {"1000001", "1000002", "1000009", "1000011"}  # StVO traffic light
 SIGN_KINDS = {"206": "stop", "205": "give_way", "274": "speed_limit"}  # StVO sign codes
 GREEN_S, YELLOW_S, ALL_RED_S = 8.0, 2.0, 2.0  # a generated program's phase per controller group
 FLOOR_MARGIN_M = 0.5
+# Overhead Eye cameras as Tiny Town's (maps/tiny_town.yaml): 3.3 m up, the roof tag (about
+# 0.1 m above the floor) 21 px a side; neighbours overlap by at least a tag and its margin.
+EYE_HEIGHT_M, ROOF_M, EYE_OVERLAP_M, EYE_MARGIN_M = 3.3, 0.1, 0.3, 0.1
 UNITS_M_S = {"m/s": 1.0, "km/h": 1 / 3.6, "mph": 0.44704, "": 1 / 3.6}  # OpenDRIVE default km/h
 
 
@@ -176,6 +180,7 @@ class _Signals:
         pole = [x + d * math.sin(h), y - d * math.cos(h)]  # right of the rightmost lane
         for lane in lanes:
             _, (sx, sy), _ = _along(lane, sig.s_m)
+            junction, entry = self.junction_ahead(lane)
             stop = f"stop_{network.safe_name(sig.id)}_{lane.name}"
             self.stop_lines.append(
                 {
@@ -193,16 +198,62 @@ class _Signals:
                     "group": group,
                     "position_m": pole,
                     "yaw_deg": math.degrees(h + math.pi),
+                    "junction": junction,
+                    "heading_rad": entry,
                 }
             )
+
+    def junction_ahead(self, lane: ImportedLane) -> tuple[str | None, float]:
+        """The junction the lane leads into (through its road's later lane sections) and the
+        heading [rad] where it enters it; (None, 0) if it leads into none."""
+        here = lane
+        for _ in range(len(self.lanes)):
+            (ex, ey), (fx, fy) = here.points[-2], here.points[-1]
+            for key in here.successors:
+                j = self.net.roads[key[0]].junction
+                if j != "-1":
+                    return j, math.atan2(fy - ey, fx - ex)
+            same_road = [k for k in here.successors if k[0] == here.key[0]]
+            if not same_road:
+                break
+            here = self.lanes[same_road[0]]
+        return None, 0.0
+
+    def crossings(self) -> None:
+        """Each light's crosses: the lights before the same junction whose approaches (their
+        lanes' headings where they enter it) are neither the same way nor opposite (more than
+        0.1 rad from either), as the kit's intersection tiles pair theirs. A controller that would show two crossing approaches
+        green at once is split (the later signal gets its own phase), with a warning."""
+        for light in self.lights:
+            light["crosses"] = []
+        for i, a in enumerate(self.lights):
+            for b in self.lights[i + 1 :]:
+                if a["junction"] is None or a["junction"] != b["junction"]:
+                    continue
+                dyaw = abs(wrap(a["heading_rad"] - b["heading_rad"]))
+                if not 0.1 < dyaw < math.pi - 0.1:
+                    continue
+                a["crosses"].append(b["id"])
+                b["crosses"].append(a["id"])
+                if a["group"] == b["group"]:
+                    self.warnings.append(
+                        f"controller '{a['group']}': lights {a['id']} and {b['id']} cross at "
+                        f"junction '{a['junction']}'; light {b['id']} given its own phase"
+                    )
+                    b["group"] = f"{b['group']}/light_{b['id']}"
+                    self.groups.append(b["group"])
 
     def programs(self) -> list[dict[str, Any]]:
         """The lights with fixed-time programs: one phase per controller (signals without one:
         a phase each), in turn, with an all-red interval between phases."""
+        self.crossings()
         n = len(self.groups)
         phase = GREEN_S + YELLOW_S + ALL_RED_S
         out = []
         for light in self.lights:
+            del light["junction"], light["heading_rad"]
+            if not light["crosses"]:
+                del light["crosses"]
             k = self.groups.index(light.pop("group"))
             light["program"] = {
                 "cycle_s": phase * max(2, n),
@@ -212,6 +263,50 @@ class _Signals:
             }
             out.append(light)
         return out
+
+
+def _axis_centres(lo: float, hi: float, view: float) -> list[float]:
+    """Camera centres along one axis so that views of width view [m] cover lo..hi, neighbours
+    overlapping by EYE_OVERLAP_M at least."""
+    span = hi - lo
+    if span <= view:
+        return [round((lo + hi) / 2, 3) + 0.0]
+    n = math.ceil((span - EYE_OVERLAP_M) / (view - EYE_OVERLAP_M))
+    step = (span - view) / (n - 1)
+    return [round(lo + view / 2 + k * step, 3) + 0.0 for k in range(n)]
+
+
+def eye_cameras(lanes: list[ImportedLane], kit: Any, warnings: list[str]) -> list[dict[str, Any]]:
+    """A grid of overhead cameras over the driving lanes' extent (their centre lines and half
+    widths, plus EYE_MARGIN_M), each seeing its part of the roof plane (ROOF_M up) whole: at
+    EYE_HEIGHT_M, or as much higher as the simulator's MAX_EYE_CAMERAS need (with a warning:
+    the roof tags are smaller in the images then)."""
+    e = kit.eye_camera
+    pad = max(ln.half_width_m for ln in lanes) + EYE_MARGIN_M
+    xs = [p[0] for ln in lanes for p in ln.points]
+    ys = [p[1] for ln in lanes for p in ln.points]
+    height = EYE_HEIGHT_M
+    while True:
+        half_y = (height - ROOF_M) * math.tan(math.radians(e.fovy_deg / 2))
+        view_x, view_y = 2 * half_y * e.width_px / e.height_px, 2 * half_y
+        cx = _axis_centres(min(xs) - pad, max(xs) + pad, view_x)
+        cy = _axis_centres(min(ys) - pad, max(ys) + pad, view_y)
+        if len(cx) * len(cy) <= MAX_EYE_CAMERAS:
+            break
+        height = round(height + 0.1, 1)
+    if height > EYE_HEIGHT_M:
+        tag_px = (
+            0.08 * 0.5 * e.height_px / math.tan(math.radians(e.fovy_deg / 2)) / (height - ROOF_M)
+        )
+        warnings.append(
+            f"eye_cameras: {len(cx) * len(cy)} cameras {height:g} m up to cover the network "
+            f"(roof tags {tag_px:.0f} px a side, {EYE_HEIGHT_M:g} m: 21 px)"
+        )
+    grid = [(x, y) for y in cy for x in cx]
+    return [
+        {"name": f"eye{k + 1}", "centre_m": [x, y], "height_m": height}
+        for k, (x, y) in enumerate(grid)
+    ]
 
 
 def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
@@ -261,6 +356,7 @@ def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
         "boxes": [],
         "cones": [],
         "parking_slots": [],
+        "eye_cameras": eye_cameras(list(lanes.values()), kit, warnings),
     }
     if sig.lights_of:  # the schema takes no empty mapping
         desc["imported_from"]["signal_lights"] = sig.lights_of

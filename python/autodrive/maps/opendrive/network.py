@@ -177,12 +177,17 @@ def build(
     return lanes, tf
 
 
+def _end_heading(p: list[tuple[float, float]]) -> float:
+    """The heading [rad] at p[-1] of the arc through p[-3], p[-2], p[-1] (an arc's start,
+    middle and end): the last half chord's, turned on by half the turn between the chords."""
+    h = [math.atan2(b[1] - a[1], b[0] - a[0]) for a, b in zip(p[-3:-1], p[-2:])]
+    return h[-1] + (wrap(h[-1] - h[0]) / 2 if len(h) == 2 else 0.0)
+
+
 def _tangent(a: ImportedLane, b: ImportedLane) -> bool:
-    """b goes on in a's direction (within 1 mrad, the kit's route check)."""
-    (x0, y0), (x1, y1) = a.points[-2], a.points[-1]
-    (u0, v0), (u1, v1) = b.points[0], b.points[1]
-    d = math.atan2(y1 - y0, x1 - x0) - math.atan2(v1 - v0, u1 - u0)
-    return abs(wrap(d)) < 0.02  # chords of half arcs: loose here
+    """b goes on in a's direction (the arcs' tangents where they meet within 0.02 rad)."""
+    start = _end_heading([q for q in b.points[2::-1]]) + math.pi  # b's start, walked backwards
+    return abs(wrap(_end_heading(a.points) - start)) < 0.02
 
 
 def raise_no_lanes(net: Network) -> None:
