@@ -25,7 +25,7 @@ import argparse
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -67,7 +67,7 @@ def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") 
     )
     p.add_argument(
         "--eye-latency-ms",
-        type=latency_ms_arg,
+        type=ranged_arg(0.0, 10000.0, "ms"),  # as autodrive-eye accepts
         default=EYE_LATENCY_MS_DEFAULT,
         metavar="L",
         help="(--eye cameras, lockstep runs) the Eye's capture-to-pose time [ms of sim time]: "
@@ -77,7 +77,7 @@ def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") 
     )
     p.add_argument(
         "--eye-sync-wait-s",
-        type=wait_s_arg,
+        type=ranged_arg(0.1, 3600.0, "s"),  # as autodrive-sim accepts
         default=EYE_SYNC_WAIT_S_DEFAULT,
         metavar="S",
         help="(--eye cameras, lockstep runs) a hang guard: the simulator gives a silent Eye up "
@@ -87,26 +87,20 @@ def add_eye_option(p: argparse.ArgumentParser, default: str | None = "cameras") 
     )
 
 
-def wait_s_arg(text: str) -> float:
-    """--eye-sync-wait-s's value: 0.1..3600 s (what autodrive-sim accepts)."""
-    try:
-        wait = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: want a number of s") from None
-    if not 0.1 <= wait <= 3600.0:
-        raise argparse.ArgumentTypeError(f"{text}: want 0.1..3600 s")
-    return wait
+def ranged_arg(low: float, high: float, unit: str) -> Callable[[str], float]:
+    """An argparse type for a number in low..high [unit], bounded as the program it is passed to
+    (autodrive-sim, autodrive-eye) accepts it, so a bad value is named here rather than there."""
 
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: want a number of {unit}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text}: want {low:g}..{high:g} {unit}")
+        return value
 
-def latency_ms_arg(text: str) -> float:
-    """--eye-latency-ms's value: 0..10000 ms (what autodrive-eye accepts)."""
-    try:
-        latency = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: want a number of ms") from None
-    if not 0.0 <= latency <= 10000.0:
-        raise argparse.ArgumentTypeError(f"{text}: want 0..10000 ms")
-    return latency
+    return parse
 
 
 def lockstep_latency_ms(args: argparse.Namespace, lockstep: bool) -> float | None:

@@ -18,10 +18,8 @@ from typing import Any
 from autodrive.core import lcmtypes
 from autodrive.core.channels import channel
 from autodrive.core.settings import RELEASE_BUILD
-from autodrive.hil.city.scoring import MapFacts, Scorer
+from autodrive.hil.city.scoring import BLOCKED_S, MapFacts, Scorer
 from autodrive.maps.loader import MAPS_DIR
-
-BLOCKED_S = 30.0  # as the live mission: standing this long [s sim] away from a stop: blocked
 
 
 def is_truth(name: str) -> bool:

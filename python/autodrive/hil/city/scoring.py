@@ -136,6 +136,11 @@ class CarScore:
     longest_held_s: float = 0.0
 
 
+# A car standing this long [s sim] away from every stop point is reported blocked: the live
+# mission and the rescore of its log judge by the same figure.
+BLOCKED_S = 30.0
+
+
 class Scorer:
     """Feed it ground truth and light states in time order; read report()."""
 

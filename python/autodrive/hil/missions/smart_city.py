@@ -33,7 +33,7 @@ from autodrive.maps import eye_cameras
 from autodrive.core.channels import channel, vehicle_name
 from autodrive.hil import pose_source
 from autodrive.hil.city import hil
-from autodrive.hil.city.scoring import MapFacts, Scorer
+from autodrive.hil.city.scoring import BLOCKED_S, MapFacts, Scorer
 from autodrive.maps.loader import MAPS_DIR
 from autodrive.core.settings import OUT_DIR
 from autodrive.core.proc import ProcessGroup, wait_ready
@@ -51,7 +51,6 @@ MAX_BATCH = 500  # LCM messages handled between two looks at the run's state
 # laps each cannot be. late_box_0 appears in the middle of the crossroads road c1, 0.065 m from
 # both lane centres (less than half a car's width): it blocks city_east and city_west; late_box_1
 # stands on the centre line of w2_n_s, loop_ccw's lane. The report then names the blocked cars.
-BLOCKED_S = 30.0  # a car standing this long [s sim] away from any stop line is reported blocked
 # The overhead cameras' frame rate [Hz of sim time]. The cars drive at most 0.27 m/s, so 5 Hz
 # is <= 54 mm between poses, which the EKF bridges with odometry and gyro; each frame time is
 # four 1280x960 renders (~160 ms of CPU with software OpenGL), which is what 2 shared cores can
