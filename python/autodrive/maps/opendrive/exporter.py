@@ -105,7 +105,11 @@ def _along_m(p: Vec2, line: list[tuple[float, float, float]]) -> float:
     for a, b in zip(line, line[1:]):
         dx, dy = b[0] - a[0], b[1] - a[1]
         seg = math.hypot(dx, dy)
-        t = 0.0 if seg == 0 else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / seg**2))
+        t = (
+            0.0
+            if seg == 0
+            else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / seg**2))
+        )
         d = math.dist(p, (a[0] + t * dx, a[1] + t * dy))
         if d < best:
             best, along = d, total + t * seg

@@ -41,11 +41,12 @@ def _chords(
 
 
 def _stroke(f: Callable[[float], Vec2], a: float, b: float, scale: float) -> list[float]:
+    """s values from a to b (file frame) for f (points at model scale, scale: model / file)."""
     n = max(1, math.ceil((b - a) * scale / MAX_CHORD_M))
     out = [a]
     for k in range(n):
         lo, hi = a + (b - a) * k / n, a + (b - a) * (k + 1) / n
-        out += _chords(f, lo, hi, MAX_DEV_M / scale)[1:]
+        out += _chords(f, lo, hi, MAX_DEV_M)[1:]  # f is at model scale
     return out
 
 
