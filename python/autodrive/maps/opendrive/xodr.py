@@ -403,8 +403,12 @@ class _Reader:
         return RoadMark(self.num(el, "sOffset", where), kind, colour, lines)
 
     def mark_line(self, el: ET.Element, where: str, width_m: float) -> MarkLine:
-        line = MarkLine(*(self.num(el, k, where, 0.0) for k in ("tOffset", "length", "space", "sOffset")),
-                        self.num(el, "width", where, width_m) or width_m)  # fmt: skip
+        t, length, space, s = (
+            self.num(el, k, where, 0.0) for k in ("tOffset", "length", "space", "sOffset")
+        )
+        line = MarkLine(
+            t, length, space, s, self.num(el, "width", where, width_m) or width_m
+        )  # 0: the mark's
         for k, v in (("length", line.length_m), ("space", line.space_m), ("width", line.width_m)):
             if v < 0:
                 raise self.fail(f"{where}.{k}", f"must be >= 0, got {v:g} m")
