@@ -200,6 +200,7 @@ class RouteDrive:
     reached_end: bool
     max_lateral_m: float  # base_link's largest distance from the route's centre line
     half_width_m: float
+    max_lateral_at: tuple[float, float]  # where along the route [m] and when [s, sim] it was
     red_light_violations: int
     stop_sign_violations: int
     collisions: int
@@ -217,12 +218,13 @@ def drive_route(sidecar: Path, route: dict[str, Any], build: Path, url: str, out
     length = float(route["length_m"])
     limit_s = length / SPEED_FLOOR_M_S + 2 * cycle_s
     stack = CityStack(sidecar, route["name"], build, url, out, log, limit_s)
-    worst = [0.0]
+    worst = [0.0, 0.0, 0.0]  # distance, along, sim time
 
     def at_end() -> bool:
         tr = stack.truth
         s, d = _nearest(poly, tr["x"], tr["y"])
-        worst[0] = max(worst[0], d)
+        if d > worst[0]:
+            worst[:] = [d, s, tr["t"]]
         return s >= length - END_MARGIN_M
 
     reached = False
@@ -241,5 +243,6 @@ def drive_route(sidecar: Path, route: dict[str, Any], build: Path, url: str, out
     red, sign, hits = (rep["red_light_violations"], rep["stop_sign_violations"],
                        rep["collisions"])  # fmt: skip
     ok = reached and worst[0] <= route["half_width_m"] and red == sign == hits == 0
-    return RouteDrive(route["name"], ok, reached, worst[0], route["half_width_m"], red, sign, hits,
+    return RouteDrive(route["name"], ok, reached, worst[0], route["half_width_m"],
+                      (round(worst[1], 3), round(worst[2], 2)), red, sign, hits,
                       rep["stop_line_crossings"]["after_red_stop"], stack.truth.get("t", 0.0))  # fmt: skip
