@@ -21,7 +21,7 @@ import pytest
 import yaml
 
 from autodrive.maps import eye_cameras
-from autodrive.maps.opendrive import fixtures, reference
+from autodrive.maps.opendrive import city_drive, fixtures, reference
 from pyhelpers import REPO_ROOT
 
 TOOL = REPO_ROOT / "tools" / "map"
@@ -209,3 +209,13 @@ def test_road_marks_solid_broken_and_yellow(imported: dict[str, tuple[Path, dict
     for a, b in zip(dashes, dashes[1:]):
         assert math.dist(a[0], a[-1]) / s == pytest.approx(3.0, abs=1e-3)
         assert math.dist(a[0], b[0]) / s == pytest.approx(12.0, abs=1e-3)
+
+
+def test_route_lateral_is_measured_across_the_line() -> None:
+    """The bench's lateral measure (city_drive._nearest): a car 0.4 m past a route's end (read
+    late on a loaded machine) is measured across the line's last segment (10 mm), not by its
+    distance from the end (400 mm); a car 0.2 m to the side in the middle is 0.2 m off."""
+    poly = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 0.0)]
+    assert city_drive._nearest(poly, 2.4, 0.01) == pytest.approx((2.4, 0.01))
+    assert city_drive._nearest(poly, 1.5, -0.2) == pytest.approx((1.5, 0.2))
+    assert city_drive._nearest(poly, -0.3, 0.0) == pytest.approx((0.0, 0.3))  # before the start

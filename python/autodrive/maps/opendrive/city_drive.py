@@ -31,12 +31,16 @@ SPEED_FLOOR_M_S = 0.05  # a route is given its length at this speed, plus the li
 
 
 def _nearest(poly: list[tuple[float, float]], x: float, y: float) -> tuple[float, float]:
-    """(distance along poly [m], distance from it [m]) of the point nearest to (x, y)."""
+    """(distance along poly [m], distance from it [m]) of the point nearest to (x, y). Its last
+    segment goes on beyond the end: a car that rolled past the end before the truth was read
+    (a loaded machine) is measured across the line there, not by its distance from the end."""
     best, best_s, s = math.inf, 0.0, 0.0
-    for (ax, ay), (bx, by) in zip(poly, poly[1:]):
+    last = max((k for k, (a, b) in enumerate(zip(poly, poly[1:])) if a != b), default=-1)
+    for k, ((ax, ay), (bx, by)) in enumerate(zip(poly, poly[1:])):
         dx, dy = bx - ax, by - ay
         seg = math.hypot(dx, dy)
-        u = 0.0 if seg == 0 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / seg**2))
+        hi = math.inf if k == last else 1.0
+        u = 0.0 if seg == 0 else max(0.0, min(hi, ((x - ax) * dx + (y - ay) * dy) / seg**2))
         d = math.hypot(ax + u * dx - x, ay + u * dy - y)
         if d < best:
             best, best_s = d, s + u * seg
