@@ -1,5 +1,5 @@
 """maps.opendrive_errors: each class of bad OpenDRIVE file (scenariogeneration's crossing with one
-mistake) is refused by `tools/map import` with exit 2 and a message naming the file, the road
+mistake, a bad roadMark among them) is refused by `tools/map import` with exit 2 and a message naming the file, the road
 (or junction) id, the element and the field, and nothing is written."""
 
 from __future__ import annotations
@@ -30,6 +30,12 @@ def _width(root: ET.Element, rid: str) -> ET.Element:
     w = _road(root, rid).find("lanes/laneSection/right/lane/width")
     assert w is not None
     return w
+
+
+def _mark(root: ET.Element, rid: str) -> ET.Element:
+    m = _road(root, rid).find("lanes/laneSection/right/lane/roadMark")
+    assert m is not None
+    return m
 
 
 def _set(el: ET.Element, **kw: str) -> None:
@@ -82,6 +88,15 @@ CASES: dict[str, tuple[Callable[[ET.Element], None], str]] = {
                 "header.revMajor/revMinor: unsupported OpenDRIVE version 2.0 (supported: 1.4 to 1.8)"),
     "geometry": (_unknown_geometry, "road '1': planView.geometry[0]: unsupported geometry ['clothoidSpline']"),
     "no_lanes": (_no_driving_lanes, "lanes: no driving lane"),
+    "mark_type": (lambda r: _set(_mark(r, "2"), type="zigzag"),
+                  "road '2': laneSection[0]: lane -1.roadMark[0].type: unknown road mark type 'zigzag'"),
+    "mark_width": (lambda r: _set(_mark(r, "3"), width="-0.2"),
+                   "road '3': laneSection[0]: lane -1.roadMark[0].width: must be > 0, got -0.2 m"),
+    "mark_colour": (lambda r: _set(_mark(r, "4"), color="pink"),
+                    "road '4': laneSection[0]: lane -1.roadMark[0].color: unknown colour 'pink'"),
+    "mark_dash": (lambda r: _set(_road(r, "1").find("lanes/laneSection/center/lane/roadMark/type/line"),  # type: ignore[arg-type]
+                                 length="0"),
+                  "road '1': laneSection[0]: lane 0.roadMark[0].type.line[0].length: a broken line (space > 0) needs a dash length > 0"),
 }  # fmt: skip
 
 

@@ -3,7 +3,8 @@ pyxodr reads, and `tools/map import --scale 1` of it gives back every lane: the 
 within 1 mm (each point of either within 1 mm of the other's line), the same half width, in the
 same driving direction. Where lanes branch or merge (Tiny Town's crossings) the export has
 junctions: connecting roads in them, a connection with a lane link for each lane into one, and
-the re-imported routes walk only the kit's own successors."""
+the re-imported routes walk only the kit's own successors. An imported map's markings come
+back as road marks of their lanes."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import pytest
 
 from autodrive.maps import geometry
 from autodrive.maps.loader import load, names
-from autodrive.maps.opendrive import exporter, importer, reference
+from autodrive.maps.opendrive import exporter, fixtures, importer, reference
 from pyhelpers import REPO_ROOT
 
 TOOL = REPO_ROOT / "tools" / "map"
@@ -84,3 +85,49 @@ def test_round_trip_within_1_mm(name: str, tmp_path: Path) -> None:
     assert pairs <= {(a, b) for a, bs in succ.items() for b in bs}, name
     if name == "tiny_town":  # a map with 3- and 4-way crossings
         assert len(root.findall("junction")) >= 4 and want
+
+
+def test_markings_round_trip(tmp_path: Path) -> None:
+    """An imported map with road marks (scenariogeneration's crossing: solid white edges, broken
+    and solid yellow centre lines) exported and imported again at --scale 1: each marking comes
+    back on the same lane and side, of the same kind, colour, width and dash; solid strokes
+    within 1 mm of the first import's, broken ones' dashes within 1 mm of the lane border they
+    paint (the dashes are laid along the exported road's reference line, the lane's centre, so
+    on curves they shift along the line: their count is kept within one)."""
+    xodr = fixtures.crossing(tmp_path / "crossing.xodr")
+    importer.write(xodr, 1 / 14, "a", tmp_path / "a")
+    a = load(tmp_path / "a" / "a.yaml")
+    run = subprocess.run([str(TOOL), "export", str(tmp_path / "a" / "a.yaml"), "--xodr",
+                          str(tmp_path / "a.xodr")], capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    road_of = {
+        r.get("id"): r.get("name") for r in ET.parse(tmp_path / "a.xodr").getroot().findall("road")
+    }
+    importer.write(tmp_path / "a.xodr", 1.0, "b", tmp_path / "b")
+    b = load(tmp_path / "b" / "b.yaml")
+    assert b.imported_from is not None
+    ox, oy = b.imported_from.offset_m
+    back = {}
+    for mk in b.markings:
+        assert mk.lane is not None
+        lane = road_of[mk.lane.split("_")[0][1:]]
+        back.setdefault((lane, mk.side), []).append(mk)
+    owned = [mk for mk in a.markings if mk.lane is not None]
+    assert owned and len(owned) == len(b.markings)
+    for mk in owned:
+        (got,) = back[(mk.lane, mk.side)]
+        assert (got.kind, got.colour) == (mk.kind, mk.colour), mk.name
+        assert got.width_m == pytest.approx(mk.width_m, abs=1e-9)
+        assert got.dash_m == (None if mk.dash_m is None else pytest.approx(mk.dash_m, abs=1e-9))
+        lane = a.lane(mk.lane)
+        d = (lane.half_width_m if mk.side == "left" else -lane.half_width_m) + mk.offset_m
+        border = [
+            (x - d * math.sin(h), y + d * math.cos(h), h) for x, y, h in a.centre_line(lane, 0.01)
+        ]
+        ours = [p for st in mk.strokes for p in st]
+        theirs = [(x - ox, y - oy) for st in got.strokes for x, y in st]
+        assert _gap_m(theirs, border) < 0.001 and _gap_m(ours, border) < 0.001, mk.name
+        if mk.kind == "solid":
+            line = [(x, y, 0.0) for x, y in mk.strokes[0]]
+            assert _gap_m(theirs, line) < 0.001, mk.name
+        assert abs(len(got.strokes) - len(mk.strokes)) <= 1, mk.name

@@ -4,21 +4,24 @@ kinds of paramPoly3 roads with lights, signs, an unknown signal and a slope; a r
 sections with a lane offset, a poly3 geometry and a border record. The maps load and check, the
 sidecar's centre lines lie within 10 mm (full scale) of pyxodr's, routes are walked through the
 junction, signals become lights with stop lines and signs, the unknown one is listed, the slope
-is flattened with a warning naming the road, and imported_from maps the file's points to ours."""
+is flattened with a warning naming the road, imported_from maps the file's points to ours, and
+the road marks (solid, broken, white, yellow) become markings on pyxodr's lane borders."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from autodrive.maps import eye_cameras
-from autodrive.maps.opendrive import fixtures, reference
+from autodrive.maps.opendrive import city_drive, fixtures, reference
 from pyhelpers import REPO_ROOT
 
 TOOL = REPO_ROOT / "tools" / "map"
@@ -140,3 +143,79 @@ def test_eye_cameras_see_every_lane(imported: dict[str, tuple[Path, dict, str]])
                 assert any(c.sees(p["x_m"], p["y_m"], 0.1, 24) for c in cams), (name, p)
         far = doc["floor"]["half_size_m"] * 3
         assert not any(c.sees(far, far, 0.1, 24) for c in cams)
+
+
+def _mark_lane(name: str) -> tuple[str, int, int]:
+    """(road id, lane section, lane id) of a marking named mk_r<road>_s<section>_<c|l<n>|r<n>>_..."""
+    m = re.fullmatch(r"mk_r(.+)_s(\d+)_(c|[lr]\d+)_\d+_\d+", name)
+    assert m is not None, name
+    key = m.group(3)
+    return (
+        m.group(1),
+        int(m.group(2)),
+        0 if key == "c" else int(key[1:]) * (1 if key[0] == "l" else -1),
+    )
+
+
+def test_road_marks_lie_on_pyxodr_borders(imported: dict[str, tuple[Path, dict, str]]) -> None:
+    """Every stroke point of every marking lies on pyxodr's line of the lane border the file's
+    roadMark is on (lane 0: the reference line with the lane offset), within 10 mm at full scale
+    as the centre lines (measured 2026-12-03: 0.09 mm on the crossing, 2.2 mm on the widening
+    lane of the sections road); every road mark of the file is drawn."""
+    for name, (path, _, _) in imported.items():
+        desc = yaml.safe_load((path.parent / "maps" / f"{name}.yaml").read_text())
+        imp = desc["imported_from"]
+        scale, (ox, oy) = imp["scale"], imp["offset_m"]
+        borders = reference.border_lines(path)
+        drawn = set()
+        for mk in desc["markings"]:
+            key = _mark_lane(mk["name"])
+            drawn.add(key)
+            for stroke in mk["strokes"]:
+                for x, y in stroke:
+                    q = np.array([(x - ox) / scale, (y - oy) / scale])
+                    gap_mm = reference._seg_dist(q, borders[key]) * 1000
+                    assert gap_mm <= 10.0, (name, mk["name"], gap_mm)
+        root = ET.parse(path).getroot()
+        marked = {(r.get("id"), i, int(ln.get("id", "0")))
+                  for r in root.findall("road") for i, sec in enumerate(r.iter("laneSection"))
+                  for ln in sec.iter("lane") if ln.find("roadMark") is not None}  # fmt: skip
+        assert marked == drawn, name
+
+
+def test_road_marks_solid_broken_and_yellow(imported: dict[str, tuple[Path, dict, str]]) -> None:
+    """The crossing's centre lines: roads 1 and 4 broken (0.15 m lines, 3 m dashes, 9 m gaps,
+    scaled), road 3 solid yellow, road 2 solid white, edges solid white 0.2 m. On road 4 (a
+    straight) each dash is 3 m long and the next starts 12 m after it, within 1 mm at full scale."""
+    path, _, _ = imported["crossing"]
+    desc = yaml.safe_load((path.parent / "maps" / "crossing.yaml").read_text())
+    s = 1 / 14
+    by = {mk["name"]: mk for mk in desc["markings"]}
+    for rid in ("1", "4"):
+        mk = by[f"mk_r{rid}_s0_c_0_0"]
+        assert (mk["kind"], mk["colour"]) == ("broken", "white")
+        assert mk["width_m"] == pytest.approx(0.15 * s) and mk["dash_m"] == pytest.approx(
+            [3 * s, 9 * s]
+        )
+        assert len(mk["strokes"]) >= 4, rid
+    assert (by["mk_r3_s0_c_0_0"]["kind"], by["mk_r3_s0_c_0_0"]["colour"]) == ("solid", "yellow")
+    assert (by["mk_r2_s0_c_0_0"]["kind"], by["mk_r2_s0_c_0_0"]["colour"]) == ("solid", "white")
+    for rid in ("1", "2", "3", "4"):
+        for side in ("l1", "r1"):
+            edge = by[f"mk_r{rid}_s0_{side}_0_0"]
+            assert (edge["kind"], len(edge["strokes"])) == ("solid", 1)
+            assert edge["width_m"] == pytest.approx(0.2 * s)
+    dashes = by["mk_r4_s0_c_0_0"]["strokes"]
+    for a, b in zip(dashes, dashes[1:]):
+        assert math.dist(a[0], a[-1]) / s == pytest.approx(3.0, abs=1e-3)
+        assert math.dist(a[0], b[0]) / s == pytest.approx(12.0, abs=1e-3)
+
+
+def test_route_lateral_is_measured_across_the_line() -> None:
+    """The bench's lateral measure (city_drive._nearest): a car 0.4 m past a route's end (read
+    late on a loaded machine) is measured across the line's last segment (10 mm), not by its
+    distance from the end (400 mm); a car 0.2 m to the side in the middle is 0.2 m off."""
+    poly = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 0.0)]
+    assert city_drive._nearest(poly, 2.4, 0.01) == pytest.approx((2.4, 0.01))
+    assert city_drive._nearest(poly, 1.5, -0.2) == pytest.approx((1.5, 0.2))
+    assert city_drive._nearest(poly, -0.3, 0.0) == pytest.approx((0.0, 0.3))  # before the start

@@ -12,7 +12,9 @@ routes_driven_ok / routes_generated: every generated route driven from its start
   lockstep with autodrive-runtime, the Eye and advisory stand-ins, autodrive-city-driver on the
   imported sidecar, real LCM), the lights on their imported programs: base_link never farther
   from the route's centre line than its half width, no red light or stop sign run (the
-  smart-city scorer, autodrive.hil.city.scoring), no collision; routes_not_ok lists the others.
+  smart-city scorer, autodrive.hil.city.scoring), no collision; routes_not_ok lists the others
+  (per_route: max_lateral_at_m_s, where along the route [m] and when [s, sim] base_link was
+  farthest from it).
   red_light_violations, stop_sign_violations: summed over the routes; red_stops: the crossings
   of a stop line after standing at it on red (the lights were met and obeyed).
 import_s: the import's CPU time per network (parse, sample, check, write MJCF + sidecar), median
@@ -77,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
             driven[key] = d.ok
             per[key] = {"ok": d.ok, "reached_end": d.reached_end,
                         "max_lateral_m": round(d.max_lateral_m, 5), "half_width_m": d.half_width_m,
+                        "max_lateral_at_m_s": list(d.max_lateral_at),
                         "red_light_violations": d.red_light_violations,
                         "stop_sign_violations": d.stop_sign_violations,
                         "collisions": d.collisions, "red_stops": d.stops_at_red,

@@ -159,6 +159,7 @@ class _Checker:
         self.tiles()
         self.slots()
         self.roads()
+        self.markings()
         self.stop_lines()
         self.routes()
         self.lights()
@@ -448,6 +449,27 @@ class _Checker:
                         f"{lk}.offset_m",
                         f"{lane.offset_m:g} m is off the road (width {r.width_m:g} m)",
                     )
+
+    def markings(self) -> None:
+        lanes = {lane.name for lane in self.m.lanes()}
+        for i, mk in enumerate(self.m.markings):
+            key = f"markings[{i}]"
+            self.unique(mk.name, f"{key}.name")
+            self.positive(mk.width_m, f"{key}.width_m")
+            if not mk.strokes:
+                raise self.err(f"{key}.strokes", "a marking needs at least one stroke")
+            for j, stroke in enumerate(mk.strokes):
+                if len(stroke) < 2:
+                    raise self.err(f"{key}.strokes[{j}]", "a stroke needs at least 2 points")
+                self.on_floor(stroke, f"{key}.strokes[{j}]")
+            if (mk.kind == "broken") != (mk.dash_m is not None):
+                raise self.err(f"{key}.dash_m", "give it for a broken marking, and only then")
+            if mk.dash_m is not None:
+                self.positive(mk.dash_m, f"{key}.dash_m")
+            if mk.lane is not None and mk.lane not in lanes:
+                raise self.err(f"{key}.lane", f"no lane '{mk.lane}'")
+            if (mk.lane is None) != (mk.side is None):
+                raise self.err(f"{key}.side", "give lane and side together")
 
     def stop_lines(self) -> None:
         lanes = {lane.name: lane for lane in self.m.lanes()}

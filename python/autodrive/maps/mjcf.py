@@ -68,15 +68,40 @@ class _Writer:
         return f'friction="{num(mu)} {self.contact}"'
 
     def mark(
-        self, name: str, pos: Vec2, length: float, yaw: float, width: float, road: bool = False
+        self,
+        name: str,
+        pos: Vec2,
+        length: float,
+        yaw: float,
+        width: float,
+        road: bool = False,
+        yellow: bool = False,
     ) -> None:
-        """A visual strip: a painted line, or with road=True a piece of tarmac."""
+        """A visual strip: a painted line (white, or yellow), or with road=True a piece of
+        tarmac."""
         k = self.kit.road if road else self.kit.marking
+        rgba = self.kit.marking.yellow_rgba if yellow else k.rgba
         self.add(
             f'<geom name="{name}" type="box" pos="{nums((*pos, k.height_m))}" '
             f'size="{nums((length / 2, width / 2, k.thickness_m / 2))}" '
-            f'euler="0 0 {num(_axis_yaw(yaw))}" {VIS} rgba="{nums(k.rgba)}"/>'
-        )
+            f'euler="0 0 {num(_axis_yaw(yaw))}" {VIS} rgba="{nums(rgba)}"/>'
+        )  # fmt: skip
+
+    def markings(self) -> None:
+        """A strip per chord of each marking's strokes, lengthened by the width times the turn
+        to the next chord so that a curve's strips close on its outer edge."""
+        for mk in self.m.markings:
+            for j, stroke in enumerate(mk.strokes):
+                for q, (a, b) in enumerate(zip(stroke, stroke[1:])):
+                    length = math.dist(a, b)
+                    if length == 0:
+                        continue
+                    yaw = math.atan2(b[1] - a[1], b[0] - a[0])
+                    nxt = stroke[q + 2] if q + 2 < len(stroke) else None
+                    turn = abs(wrap(math.atan2(nxt[1] - b[1], nxt[0] - b[0]) - yaw)) if nxt else 0.0
+                    mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+                    self.mark(f"{mk.name}_{j}_{q}", mid, length + mk.width_m * turn, yaw, mk.width_m,
+                              yellow=mk.colour == "yellow")  # fmt: skip
 
     def header(self) -> None:
         m, eye = self.m, self.kit.eye_camera
@@ -373,6 +398,7 @@ class _Writer:
         self.tiles()
         self.slots(m.parking_slots)  # the tiles' slots are painted in their textures
         self.roads()
+        self.markings()
         for s in m.stop_lines:
             self.mark(
                 s.name,

@@ -69,6 +69,7 @@ class MarkingKit:
     height_m: float
     thickness_m: float
     rgba: Rgba
+    yellow_rgba: Rgba  # a yellow marking's (the rest are rgba's white)
 
 
 @dataclass(frozen=True)
@@ -268,6 +269,25 @@ class Road:
 
 
 @dataclass(frozen=True)
+class Marking:
+    """A painted line on the floor (an imported OpenDRIVE roadMark line): its strokes, each a
+    stretch painted without a break (a solid line has one, a broken line one per dash), as
+    polylines of the line's middle [m], width_m across. For the export: kind and dash_m (a broken
+    line's dash and space [m]), and the lane whose border it paints, on which side of its traffic,
+    offset_m from that border to the lane's left [m]."""
+
+    name: str
+    kind: Literal["solid", "broken"]
+    colour: Literal["white", "yellow"]
+    width_m: float
+    strokes: list[list[Vec2]]
+    dash_m: Optional[Vec2] = None
+    lane: Optional[str] = None
+    side: Optional[Literal["left", "right"]] = None
+    offset_m: float = 0.0
+
+
+@dataclass(frozen=True)
 class Lane:
     """A lane with its road: its centre line runs offset_m left of the road's forward line.
     half_width_m: half the lane's width; kerb_right_m: from its centre line to the road's edge on
@@ -456,6 +476,7 @@ class MapFile:
     late_obstacles: list[LateObstacle] = field(default_factory=list)
     eye_cameras: list[EyeCameraSpec] = field(default_factory=list)
     reference_tags: list[ReferenceTagSpec] = field(default_factory=list)
+    markings: list[Marking] = field(default_factory=list)
     imported_from: Optional[ImportedFrom] = None
 
 

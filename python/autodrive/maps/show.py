@@ -1,5 +1,5 @@
 """Draws a map from above as a PNG (tools/map show): the tiles with their textures, free-form
-roads, terrain patches, walls, boxes, cones, parking slots, lane centre lines with arrows, stop
+roads and their markings, terrain patches, walls, boxes, cones, parking slots, lane centre lines with arrows, stop
 lines, traffic lights, signs and spawns, all from the description."""
 
 from __future__ import annotations
@@ -58,6 +58,11 @@ def draw(m: MapDescription, out: Path, maps_dir: Path = MAPS_DIR, dpi: int = 110
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], color=kit.road.rgba[:3],
                     lw=r.width_m * 72 * 10 / (2 * h) * 0.9, zorder=1, solid_capstyle="butt")  # fmt: skip
+    for mk in m.markings:  # painted lines at their width
+        colour = kit.marking.yellow_rgba if mk.colour == "yellow" else kit.marking.rgba
+        for st in mk.strokes:
+            ax.plot([p[0] for p in st], [p[1] for p in st], color=colour[:3],
+                    lw=mk.width_m * 72 * 10 / (2 * h) * 0.9, zorder=1, solid_capstyle="butt")  # fmt: skip
     for p in m.terrain_patches:
         c = rect_corners(p.centre_m, p.size_m, 0.0)
         ax.add_patch(Polygon(c, color=kit.surfaces[p.surface].rgba[:3], zorder=2))

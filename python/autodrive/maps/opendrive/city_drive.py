@@ -31,12 +31,16 @@ SPEED_FLOOR_M_S = 0.05  # a route is given its length at this speed, plus the li
 
 
 def _nearest(poly: list[tuple[float, float]], x: float, y: float) -> tuple[float, float]:
-    """(distance along poly [m], distance from it [m]) of the point nearest to (x, y)."""
+    """(distance along poly [m], distance from it [m]) of the point nearest to (x, y). Its last
+    segment goes on beyond the end: a car that rolled past the end before the truth was read
+    (a loaded machine) is measured across the line there, not by its distance from the end."""
     best, best_s, s = math.inf, 0.0, 0.0
-    for (ax, ay), (bx, by) in zip(poly, poly[1:]):
+    last = max((k for k, (a, b) in enumerate(zip(poly, poly[1:])) if a != b), default=-1)
+    for k, ((ax, ay), (bx, by)) in enumerate(zip(poly, poly[1:])):
         dx, dy = bx - ax, by - ay
         seg = math.hypot(dx, dy)
-        u = 0.0 if seg == 0 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / seg**2))
+        hi = math.inf if k == last else 1.0
+        u = 0.0 if seg == 0 else max(0.0, min(hi, ((x - ax) * dx + (y - ay) * dy) / seg**2))
         d = math.hypot(ax + u * dx - x, ay + u * dy - y)
         if d < best:
             best, best_s = d, s + u * seg
@@ -200,6 +204,7 @@ class RouteDrive:
     reached_end: bool
     max_lateral_m: float  # base_link's largest distance from the route's centre line
     half_width_m: float
+    max_lateral_at: tuple[float, float]  # where along the route [m] and when [s, sim] it was
     red_light_violations: int
     stop_sign_violations: int
     collisions: int
@@ -217,12 +222,13 @@ def drive_route(sidecar: Path, route: dict[str, Any], build: Path, url: str, out
     length = float(route["length_m"])
     limit_s = length / SPEED_FLOOR_M_S + 2 * cycle_s
     stack = CityStack(sidecar, route["name"], build, url, out, log, limit_s)
-    worst = [0.0]
+    worst = [0.0, 0.0, 0.0]  # distance, along, sim time
 
     def at_end() -> bool:
         tr = stack.truth
         s, d = _nearest(poly, tr["x"], tr["y"])
-        worst[0] = max(worst[0], d)
+        if d > worst[0]:
+            worst[:] = [d, s, tr["t"]]
         return s >= length - END_MARGIN_M
 
     reached = False
@@ -241,5 +247,6 @@ def drive_route(sidecar: Path, route: dict[str, Any], build: Path, url: str, out
     red, sign, hits = (rep["red_light_violations"], rep["stop_sign_violations"],
                        rep["collisions"])  # fmt: skip
     ok = reached and worst[0] <= route["half_width_m"] and red == sign == hits == 0
-    return RouteDrive(route["name"], ok, reached, worst[0], route["half_width_m"], red, sign, hits,
+    return RouteDrive(route["name"], ok, reached, worst[0], route["half_width_m"],
+                      (round(worst[1], 3), round(worst[2], 2)), red, sign, hits,
                       rep["stop_line_crossings"]["after_red_stop"], stack.truth.get("t", 0.0))  # fmt: skip

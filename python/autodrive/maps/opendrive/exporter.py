@@ -5,7 +5,11 @@ a lane offset of half that width. A lane followed by exactly one lane, which fol
 is linked to it (road and lane links). Where lanes branch or merge, the lanes after a branch and
 before a merge are connecting roads of a junction (one per group of them that touch): the roads
 into it link to the junction and get a connection with a lane link to each connecting road
-they lead into; a connecting road links to the roads before and after it."""
+they lead into; a connecting road links to the roads before and after it. A marking painted on
+a lane's border (an imported roadMark line) goes back as a <roadMark> of that lane's road: on its
+centre lane (the lane's left border) or its driving lane (the right one), its lines in a <type>
+(tOffset, dash, space, width); a marking of no lane (on a border between lanes that are not
+driven) is not exported."""
 
 from __future__ import annotations
 
@@ -17,7 +21,7 @@ from scenariogeneration import xodr as sg  # type: ignore[import-untyped]
 
 from autodrive.maps import geometry
 from autodrive.maps.description import MapDescription
-from autodrive.maps.model import Lane, MapDescriptionError, Piece
+from autodrive.maps.model import Lane, MapDescriptionError, Marking, Piece, Vec2
 
 JOIN_M = 0.001  # lane ends within this, heading within JOIN_RAD, are successors [m]
 JOIN_RAD = 0.001
@@ -95,6 +99,48 @@ def _junctions(succ: dict[str, list[str]]) -> dict[str, int]:
     return {n: ids.setdefault(root(n), len(ids) + 1) for n in sorted(inner)}
 
 
+def _along_m(p: Vec2, line: list[tuple[float, float, float]]) -> float:
+    """Distance along a polyline to the point nearest p [m]."""
+    best, along, total = math.inf, 0.0, 0.0
+    for a, b in zip(line, line[1:]):
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        seg = math.hypot(dx, dy)
+        t = (
+            0.0
+            if seg == 0
+            else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / seg**2))
+        )
+        d = math.dist(p, (a[0] + t * dx, a[1] + t * dy))
+        if d < best:
+            best, along = d, total + t * seg
+        total += seg
+    return along
+
+
+def _road_marks(m: MapDescription, lane: Lane, side: str) -> list[Any]:
+    """The lane's markings on one side as roadMarks of its exported road, one per start along
+    it (the lines of one imported roadMark start together), inside line (larger t) first."""
+    line = m.centre_line(lane, 0.01)
+    groups: dict[float, list[tuple[Marking, float]]] = {}
+    for mk in m.markings:
+        if mk.lane != lane.name or mk.side != side:
+            continue
+        starts = [_along_m(p, line) for st in mk.strokes for p in (st[0], st[-1])]
+        groups.setdefault(round(min(starts), 4), []).append((mk, min(starts)))
+    out = []
+    for start in sorted(groups):
+        lines = sorted(groups[start], key=lambda g: -g[0].offset_m)
+        name = "_".join(mk.kind for mk, _ in lines) if len(lines) <= 2 else "custom"
+        first = lines[0][0]
+        colour = sg.RoadMarkColor.yellow if first.colour == "yellow" else sg.RoadMarkColor.white
+        rm = sg.RoadMark(getattr(sg.RoadMarkType, name), first.width_m, soffset=start, color=colour)
+        for mk, s0 in lines:
+            dash, space = mk.dash_m if mk.dash_m is not None else (0.0, 0.0)
+            rm.add_specific_road_line(sg.RoadLine(mk.width_m, dash, space, mk.offset_m, s0 - start))
+        out.append(rm)
+    return out
+
+
 def build(m: MapDescription) -> Any:
     """The scenariogeneration OpenDrive of a kit map (road ids 1.., named after the lanes)."""
     lanes = m.lanes()
@@ -112,8 +158,13 @@ def build(m: MapDescription) -> Any:
             geom = sg.Line(length) if k == 0 else sg.Arc(k, length=length)
             pv.add_fixed_geometry(geom, x, y, h)
         centre = sg.Lane()
+        for rm in _road_marks(m, ln, "left"):
+            centre.add_roadmark(rm)
         section = sg.LaneSection(0, centre)
-        section.add_right_lane(sg.Lane(a=2 * ln.half_width_m))
+        driving = sg.Lane(a=2 * ln.half_width_m)
+        for rm in _road_marks(m, ln, "right"):
+            driving.add_roadmark(rm)
+        section.add_right_lane(driving)
         lns = sg.Lanes()
         lns.add_lanesection(section)
         lns.add_laneoffset(sg.LaneOffset(0, ln.half_width_m, 0, 0, 0))

@@ -28,7 +28,9 @@ def crossing(path: Path) -> Path:
     """A 4-way junction (1 lane each way) of a spiral-arc-spiral road, two paramPoly3 roads
     (pRange normalized and arcLength) and a sloped straight one; traffic lights on three
     approaches (two opposite, one crossing them), a stop sign, a speed limit and a signal type
-    the kit does not know."""
+    the kit does not know. Road marks: solid white edges; the centre lines of roads 1 and 4
+    broken (scenariogeneration's standard: 0.15 m, 3 m dashes, 9 m gaps), of road 3 solid
+    yellow, of road 2 and the junction's roads solid white."""
     roads = [
         xodr.create_road(
             [
@@ -40,6 +42,7 @@ def crossing(path: Path) -> Path:
             1,
             1,
             1,
+            center_road_mark=xodr.std_roadmark_broken(),
             lane_width=LANE_W_M,
         ),
         xodr.create_road(
@@ -54,9 +57,11 @@ def crossing(path: Path) -> Path:
             3,
             1,
             1,
+            center_road_mark=xodr.RoadMark(xodr.RoadMarkType.solid, 0.2, color=xodr.RoadMarkColor.yellow),
             lane_width=LANE_W_M,
         ),
-        xodr.create_road(xodr.Line(50), 4, 1, 1, lane_width=LANE_W_M),
+        xodr.create_road(xodr.Line(50), 4, 1, 1, center_road_mark=xodr.std_roadmark_broken(),
+                         lane_width=LANE_W_M),  # fmt: skip
     ]
     roads[3].add_elevation(0, 0, 0.02, 0, 0)
     roads[0].add_signal(_light(1, 50, -4.5))

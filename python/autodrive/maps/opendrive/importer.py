@@ -1,7 +1,7 @@
 """tools/map import: an OpenDRIVE network as a kit map description (NAME.yaml), its MJCF scene,
 JSON sidecar and the textures it uses, in one folder. Every driving lane becomes a road of the
 kit with one lane (its centre line as short arcs through points of the file's geometry),
-signals become lights with their stop lines, and signs; the transform (ours = scale * file +
+signals become lights with their stop lines, and signs, road marks become markings; the transform (ours = scale * file +
 offset_m) and every warning go into the sidecar's `imported_from`. Nothing is written unless the
 whole map loads and checks."""
 
@@ -19,7 +19,7 @@ import yaml
 from autodrive.core.geometry import wrap
 from autodrive.maps import mjcf, sidecar, textures
 from autodrive.maps.loader import KIT_FILE, MAX_EYE_CAMERAS, load, load_kit
-from autodrive.maps.opendrive import arcs, network, xodr
+from autodrive.maps.opendrive import arcs, marks, network, xodr
 from autodrive.maps.opendrive.lanes import DRIVING_TYPES
 from autodrive.maps.opendrive.network import ImportedLane, LaneKey, Transform
 from autodrive.maps.model import MapDescriptionError
@@ -347,6 +347,7 @@ def describe(path: Path, scale: float, max_junctions: int = 1) -> Imported:
             "unsupported_signals": sig.unsupported,
         },
         "roads": [_road(ln) for ln in lanes.values()],
+        "markings": marks.markings(net, lanes, tf, warnings),
         "stop_lines": sig.stop_lines,
         "traffic_lights": sig.programs(),
         "signs": sig.signs,

@@ -29,6 +29,27 @@ def lane_lines(path: Path) -> dict[tuple[str, int, int], NDArray[np.float64]]:
         return _lines(net)
 
 
+def border_lines(path: Path) -> dict[tuple[str, int, int], NDArray[np.float64]]:
+    """(road id, lane section index, lane id) -> pyxodr's line (x, y) [m] of the lane's outer
+    border, where a road mark of that lane is painted; every lane. Lane 0 (the reference line
+    moved by the lane offset): the inner border of the lane next to it, 2 * its centre line - its
+    outer border (pyxodr samples both at the same s; its section reference line has no offset)."""
+    from pyxodr.road_objects.network import RoadNetwork
+
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        net = RoadNetwork(str(_for_pyxodr(path, Path(tmp))), resolution=RESOLUTION_M)
+        for road in net.get_roads():
+            for i, sec in enumerate(road.lane_sections):
+                for lane in sorted(sec.lanes, key=lambda ln: -abs(int(ln.id))):  # +-1 last
+                    outer = np.asarray(lane.boundary_line)[:, :2]
+                    out[(str(road.id), i, int(lane.id))] = _extended(outer)
+                    if abs(int(lane.id)) == 1:
+                        inner = 2 * np.asarray(lane.centre_line)[:, :2] - outer
+                        out[(str(road.id), i, 0)] = _extended(inner)
+    return out
+
+
 def _for_pyxodr(path: Path, folder: Path) -> Path:
     """A copy of the file with each spiral of constant curvature (scenariogeneration writes
     them in junctions) as the same arc: pyxodr 0.1.3 divides by the curvature's rate of change."""

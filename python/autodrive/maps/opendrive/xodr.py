@@ -16,6 +16,16 @@ from autodrive.maps.model import MapDescriptionError
 
 SUPPORTED_MINOR_VERSIONS = range(4, 9)  # OpenDRIVE 1.4 .. 1.8 (revMajor 1)
 GEOMETRY_GAP_TOLERANCE_M = 0.01  # a geometry must start this close to where the previous ends
+# roadMark types (OpenDRIVE 1.7 e_roadMarkType) drawn as lines; a double type names its lines
+# from the inside of the road out (on the centre lane: left, then right)
+MARK_LINES = {"solid": "s", "broken": "b", "solid solid": "ss", "solid broken": "sb",
+              "broken solid": "bs", "broken broken": "bb"}  # fmt: skip
+MARKS_NOT_DRAWN = ("none", "botts dots", "grass", "curb", "custom", "edge")
+MARK_COLOURS = ("standard", "white", "yellow", "blue", "green", "red", "orange", "violet", "black")
+# what the file leaves open (ours, not the standard's): a line's width by weight, a broken
+# line's dash and space (scenariogeneration's standard broken mark), a double line's gap
+MARK_WIDTH_M = {"standard": 0.12, "bold": 0.25}
+BROKEN_DASH_M, BROKEN_SPACE_M = 3.0, 9.0
 
 
 class OpenDriveError(MapDescriptionError):
@@ -57,6 +67,31 @@ class Geometry:
 
 
 @dataclass(frozen=True)
+class MarkLine:
+    """One painted line of a road mark: t_offset_m from the lane's border (+ left), dashes of
+    length_m with space_m between them from s_offset_m after the mark's start (space_m 0: solid),
+    width_m across."""
+
+    t_offset_m: float
+    length_m: float
+    space_m: float
+    s_offset_m: float
+    width_m: float
+
+
+@dataclass(frozen=True)
+class RoadMark:
+    """A <roadMark> on a lane's outer border (the centre lane's: on the reference line plus the
+    lane offset), from s_m after its lane section's start to the next one's s_m. lines: what is
+    painted (from its <type> lines, or from its type); empty when the type is drawn by nothing."""
+
+    s_m: float
+    type: str
+    colour: str
+    lines: tuple[MarkLine, ...]
+
+
+@dataclass(frozen=True)
 class Lane:
     id: int
     type: str
@@ -64,12 +99,14 @@ class Lane:
     borders: list[Poly3]
     predecessor: Optional[int]
     successor: Optional[int]
+    marks: list[RoadMark] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
 class LaneSection:
     s_m: float
     lanes: list[Lane]  # left and right lanes (the centre lane 0 has no width)
+    centre_marks: list[RoadMark] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -315,8 +352,69 @@ class _Reader:
                 for k in ("predecessor", "successor"):
                     e = link.find(k) if link is not None else None
                     ids.append(int(self.num(e, "id", f"{lw}.link.{k}")) if e is not None else None)
-                lanes.append(Lane(lid, ln.get("type", "none"), widths, borders, ids[0], ids[1]))
-        return LaneSection(s, lanes)
+                marks = self.marks(ln, lw, -1.0 if lid > 0 else 1.0)
+                lanes.append(
+                    Lane(lid, ln.get("type", "none"), widths, borders, ids[0], ids[1], marks)
+                )
+        centre = el.find("center/lane")
+        centre_marks = self.marks(centre, f"{where}: lane 0", 1.0) if centre is not None else []
+        return LaneSection(s, lanes, centre_marks)
+
+    def marks(self, lane: ET.Element, where: str, inside: float) -> list[RoadMark]:
+        """The lane's road marks; inside: the sign of t towards the road's inside (+1 on the
+        right and centre lanes, -1 on the left ones)."""
+        out = [self.mark(m, f"{where}.roadMark[{i}]", inside)
+               for i, m in enumerate(lane.findall("roadMark"))]  # fmt: skip
+        for i, (a, b) in enumerate(zip(out, out[1:])):
+            if b.s_m < a.s_m:
+                raise self.fail(f"{where}.roadMark[{i + 1}].sOffset",
+                                f"{b.s_m:g} m is before the previous mark's {a.s_m:g} m")  # fmt: skip
+        return out
+
+    def mark(self, el: ET.Element, where: str, inside: float) -> RoadMark:
+        """A roadMark and its lines; an unknown type or colour, a negative width or a broken
+        line without a dash is refused."""
+        kind = el.get("type", "none")
+        colour = el.get("color", "standard")
+        if kind not in MARK_LINES and kind not in MARKS_NOT_DRAWN:
+            known = ", ".join([*MARK_LINES, *MARKS_NOT_DRAWN])
+            raise self.fail(
+                f"{where}.type", f"unknown road mark type {kind!r} (OpenDRIVE: {known})"
+            )
+        if colour not in MARK_COLOURS:
+            raise self.fail(
+                f"{where}.color",
+                f"unknown colour {colour!r} (OpenDRIVE: {', '.join(MARK_COLOURS)})",
+            )
+        weight = el.get("weight", "standard")
+        if weight not in MARK_WIDTH_M:
+            raise self.fail(f"{where}.weight", f"must be standard or bold, got {weight!r}")
+        width = self.num(el, "width", where, MARK_WIDTH_M[weight])
+        if not width > 0:
+            raise self.fail(f"{where}.width", f"must be > 0, got {width:g} m")
+        typed = el.find("type")
+        if typed is not None:
+            lines = tuple(self.mark_line(ln, f"{where}.type.line[{i}]", width)
+                          for i, ln in enumerate(typed.findall("line")))  # fmt: skip
+        elif kind in MARK_LINES:
+            lines = _lines_of(MARK_LINES[kind], width, inside)
+        else:
+            lines = ()
+        return RoadMark(self.num(el, "sOffset", where), kind, colour, lines)
+
+    def mark_line(self, el: ET.Element, where: str, width_m: float) -> MarkLine:
+        t, length, space, s = (
+            self.num(el, k, where, 0.0) for k in ("tOffset", "length", "space", "sOffset")
+        )
+        line = MarkLine(
+            t, length, space, s, self.num(el, "width", where, width_m) or width_m
+        )  # 0: the mark's
+        for k, v in (("length", line.length_m), ("space", line.space_m), ("width", line.width_m)):
+            if v < 0:
+                raise self.fail(f"{where}.{k}", f"must be >= 0, got {v:g} m")
+        if line.space_m > 0 and line.length_m == 0:
+            raise self.fail(f"{where}.length", "a broken line (space > 0) needs a dash length > 0")
+        return line
 
     def link(self, el: Optional[ET.Element], where: str) -> Optional[Link]:
         if el is None:
@@ -417,6 +515,17 @@ class _Reader:
                             f"junction '{j.id}': connection[{i}].{k}",
                             f"links to a missing road '{rid}'",
                         )
+
+
+def _lines_of(code: str, width_m: float, inside: float) -> tuple[MarkLine, ...]:
+    """The lines of a roadMark type given by its letters (s solid, b broken), the inside one
+    first (towards t's sign inside), a line's width apart on a double line."""
+    offsets = [0.0] if len(code) == 1 else [inside * width_m, -inside * width_m]
+    return tuple(
+        MarkLine(t, BROKEN_DASH_M if c == "b" else 0.0, BROKEN_SPACE_M if c == "b" else 0.0,
+                 0.0, width_m)
+        for c, t in zip(code, offsets)
+    )  # fmt: skip
 
 
 def read(path: Path) -> Network:

@@ -288,7 +288,9 @@ int ad_world_camera(ad_world_t *w, int car, uint8_t *rgb, size_t n_bytes, char *
              car, w->cam_w, w->cam_h, n_bytes);
     return -1;
   }
-  const mjModel *m = sim_model(w->sim);
+  /* the render model: the whole map (roads, markings, tiles), not the physics model, which
+   * leaves out the visual-only geoms */
+  const mjModel *m = sim_render_model(w->sim);
   if (!w->render) {
     w->render = sim_render_create(m, w->cam_w, w->cam_h, SIM_RENDER_AUTO, err, err_sz);
     if (!w->render) return -1;
@@ -300,7 +302,7 @@ int ad_world_camera(ad_world_t *w, int car, uint8_t *rgb, size_t n_bytes, char *
                                     API_JPEG_QUALITY, err, err_sz);
     if (!w->cam[car]) return -1;
   }
-  if (sim_camera_capture(w->cam[car], m, sim_data(w->sim), sim_time_us(w->sim)) != 0) {
+  if (sim_camera_capture(w->cam[car], m, sim_render_data(w->sim), sim_time_us(w->sim)) != 0) {
     snprintf(err, err_sz, "car %d camera: rendering failed", car);
     return -1;
   }
