@@ -39,7 +39,7 @@ function lc = connect(url, types_jar)
   lc.java = javaObject('lcm.lcm.LCM', urls);
   lc.url = url;
   lc.recv_buf_bytes = receive_buffer(lc.java, url);
-  [lc.by_fingerprint, lc.fields] = type_table(types_jar);
+  [lc.by_fingerprint, lc.fields, lc.setters] = type_table(types_jar);
 end
 
 function got = receive_buffer(lcm_obj, url)
@@ -68,10 +68,13 @@ function got = receive_buffer(lcm_obj, url)
   end
 end
 
-function [by_fp, fields] = type_table(jar)
-  % fingerprint (hex) -> class name, and class name -> its public instance fields
+function [by_fp, fields, setters] = type_table(jar)
+  % fingerprint (hex) -> class name, class name -> its public instance fields, and class name ->
+  % {java.lang.reflect.Field, its type's name} per field (autodrive.to_java's: looked up once
+  % here, not per message, since each Java call from Octave costs ~0.3 ms, more under load)
   by_fp = containers.Map();
   fields = containers.Map();
+  setters = containers.Map();
   jf = javaObject('java.util.jar.JarFile', jar);
   entries = jf.entries();
   while entries.hasMoreElements()
@@ -83,6 +86,7 @@ function [by_fp, fields] = type_table(jar)
     cls = ['autodrive.' tok{1}];
     obj = javaObject(cls);
     fields(cls) = instance_fields(obj);
+    setters(cls) = field_setters(obj, fields(cls));
     by_fp(fingerprint(obj, fields(cls))) = cls;
   end
   jf.close();
@@ -101,6 +105,14 @@ function fp = fingerprint(obj, names)
   obj.encode(javaObject('java.io.DataOutputStream', bytes));
   data = bytes.toByteArray();
   fp = regexprep(sprintf('%02x', typecast(int8(data(1:8)), 'uint8')), '^0+', '');
+end
+
+function s = field_setters(obj, names)
+  s = cell(numel(names), 2);
+  for i = 1:numel(names)
+    s{i, 1} = obj.getClass().getField(names{i});
+    s{i, 2} = char(s{i, 1}.getType().getName());
+  end
 end
 
 function names = instance_fields(obj)
