@@ -166,8 +166,12 @@ def test_octave_reads_state_and_drives(build_dir, lcm_url):
         try:
             wrong = work / "wrong.key"
             command_auth.create_key(wrong)
-            bad = hil_session(build_dir, lcm_url, procs, f"window_s = 2; drive_s = 3; keyfile = '{wrong}';")
-            good = hil_session(build_dir, lcm_url, procs, "window_s = 4; drive_s = 5; keyfile = '';")
+            bad = hil_session(
+                build_dir, lcm_url, procs, f"window_s = 2; drive_s = 3; keyfile = '{wrong}';"
+            )
+            good = hil_session(
+                build_dir, lcm_url, procs, "window_s = 4; drive_s = 5; keyfile = '';"
+            )
         finally:
             bus.stop = True
             exits = procs.stop_all()
