@@ -10,22 +10,14 @@ function [mac, canonical] = sign_command(key, vehicle, cmd)
   if numel(key) ~= 32
     error('autodrive:badKey', 'autodrive.sign_command: the key has %d bytes, not 32', numel(key));
   end
-  buf = javaMethod('allocate', 'java.nio.ByteBuffer', 6 + 2 * 256 + 36);  % big-endian
-  buf.put(int8('ADCMD1'));
-  put_str(buf, vehicle);
-  put_str(buf, cmd.source);
-  buf.put(int8(cmd.authority));
-  buf.putLong(int64(cmd.counter));
-  buf.putLong(int64(cmd.utime));
-  buf.putInt(int32(cmd.seq));
-  buf.putFloat(single(cmd.throttle));
-  buf.putFloat(single(cmd.steering));
-  buf.put(int8(cmd.headlights));
-  buf.put(int8(cmd.indicators));
-  buf.put(int8(logical(cmd.engaged)));
-  n = buf.position();
-  all_bytes = buf.array();
-  canonical = int8(all_bytes(1:n));
+  % the canonical bytes built in Octave (one Java call per command for the HMAC, not one per field)
+  [~, ~, endian] = computer();
+  be = @(x) big_endian(x, endian == 'L');
+  canonical = typecast([uint8('ADCMD1'), str_bytes(vehicle), str_bytes(cmd.source), ...
+                        be(int8(cmd.authority)), be(int64(cmd.counter)), be(int64(cmd.utime)), ...
+                        be(int32(cmd.seq)), be(single(cmd.throttle)), be(single(cmd.steering)), ...
+                        be(int8(cmd.headlights)), be(int8(cmd.indicators)), ...
+                        uint8(logical(cmd.engaged))], 'int8');
   spec = javaObject('javax.crypto.spec.SecretKeySpec', typecast(key, 'int8'), 'HmacSHA256');
   hmac = javaMethod('getInstance', 'javax.crypto.Mac', 'HmacSHA256');
   hmac.init(spec);
@@ -33,8 +25,16 @@ function [mac, canonical] = sign_command(key, vehicle, cmd)
   mac = int8(digest(1:16));
 end
 
-function put_str(buf, s)
-  b = int8(s(1:min(end, 255)));
-  buf.put(int8(typecast(uint8(numel(b)), 'int8')));
-  buf.put(b);
+function b = big_endian(x, host_little_endian)
+  % the bytes of a number, most significant first
+  b = typecast(x, 'uint8');
+  if host_little_endian
+    b = fliplr(b);
+  end
+end
+
+function b = str_bytes(s)
+  % length byte, then at most 255 bytes of s
+  s = uint8(s(1:min(end, 255)));
+  b = [uint8(numel(s)), s];
 end

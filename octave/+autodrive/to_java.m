@@ -8,18 +8,17 @@ function obj = to_java(lc, type, s)
   end
   obj = javaObject(cls);
   names = lc.fields(cls);
+  setters = lc.setters(cls);  % {Field, type name} per field, looked up by autodrive.connect
   for i = 1:numel(names)
     f = names{i};
     if ~isfield(s, f)
       error('autodrive:missingField', 'autodrive.publish: %s: field ''%s'' missing', type, f);
     end
-    set_field(obj, type, f, s.(f));
+    set_field(obj, type, f, s.(f), setters{i, 1}, setters{i, 2});
   end
 end
 
-function set_field(obj, type, f, v)
-  field = obj.getClass().getField(f);
-  kind = char(field.getType().getName());
+function set_field(obj, type, f, v, field, kind)
   numeric = {'long', 'int', 'short', 'byte', 'float', 'double'};
   if any(strcmp(kind, numeric)) && ~(isnumeric(v) && isscalar(v) && isreal(v))
     error('autodrive:badField', 'autodrive.publish: %s: field ''%s'' must be one real number (%s)', type, f, kind);

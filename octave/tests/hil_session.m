@@ -1,6 +1,7 @@
 % The Octave API on a running HIL stack (autodrive-sim + autodrive-runtime): reads NIGEL1_STATE
 % for window_s of its own stamps (sim time), then drives with signed commands (autodrive.Car,
-% throttle 0.7) for drive_s of sim time at 50 Hz of sim time, then releases the car. Set before
+% throttle 0.7) for drive_s of sim time at 50 Hz of sim time, paced on the newest NIGEL1_STATE
+% (autodrive.latest: not on the backlog the window left), then releases the car. Set before
 % running: window_s, drive_s, keyfile ('' = the default key). The last line is JSON:
 % state_count, first_utime, last_utime (the window), drive_first_utime, drive_last_utime,
 % commands_sent.
@@ -28,7 +29,7 @@ car = autodrive.Car(lc, car_name, keyfile);
 drive_first = [];
 next_cmd = int64(0);
 while isempty(drive_first) || double(m.utime - drive_first) < drive_s * 1e6
-  m = autodrive.next(state, 30);
+  m = autodrive.latest(state, 30);  % the newest: commands paced on the car's sim time now
   if isempty(m)
     error('no %s within 30 s while driving', state.channel);
   end

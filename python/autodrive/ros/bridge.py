@@ -217,6 +217,7 @@ class StateBridge:
         self.cars = cars
         self.odom: dict[str, tuple[float, float, float]] = {}  # car -> odom pose (x, y, yaw)
         self.sim_time_us: int | None = None
+        self.tf_last_us: dict[str, int] = {}  # child frame -> stamp of its newest /tf [us]
 
     def ros_class(self, ros_type: str) -> Any:
         package, name = ros_type.split("/")
@@ -321,10 +322,15 @@ class StateBridge:
 
     def publish_tf(self, utime: int, car: str, parent: str, child: str,
                    pose: tuple[float, float, float]) -> None:  # fmt: skip
+        child_frame = topics.frame(car, child)
+        # One transform per stamp and frame: the runtime's estimator publishes ~10 % of its
+        # ODOM / POSE_MAP stamps twice on the sim clock, and tf2 warns of each repeat
+        # (TF_REPEATED_DATA, seen in rviz's log).
+        if utime <= self.tf_last_us.get(child_frame, -1):
+            return
+        self.tf_last_us[child_frame] = utime
         x, y, yaw = pose
-        tf = self.transform(
-            utime, topics.frame(car, parent), topics.frame(car, child), x, y, 0.0, yaw
-        )
+        tf = self.transform(utime, topics.frame(car, parent), child_frame, x, y, 0.0, yaw)
         self.tf_pub.publish(self.m["tf2_msgs"].TFMessage(transforms=[tf]))
 
     def publish_map_to_odom(
