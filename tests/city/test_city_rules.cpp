@@ -217,6 +217,26 @@ TEST(CityRules, KeepsTheGapBehindACarAhead) {
   const auto out = r.step(in);
   EXPECT_LT(out.speed_m_s, cfg.cruise_m_s);
   EXPECT_EQ(out.reason, "car ahead");
+  EXPECT_EQ(out.peer_index, 0);
+}
+
+// The peer charged with holding the car is the one whose gap binds, and none when another
+// limit binds (the driver's per-peer account rests on this).
+TEST(CityRules, NamesThePeerWhoseGapLimitsTheSpeed) {
+  const Track t = track_for(city(), "loop_ccw");
+  RulesConfig cfg;
+  CityRules r(t, cfg);
+  RulesInput in = at(1.0, 0.2, 0);
+  const double stand_m = cfg.front_m + cfg.rear_m + cfg.min_gap_m;  // bumper gap = min_gap_m
+  in.peers_ahead_m = {1.0, stand_m, 0.4};
+  EXPECT_EQ(r.step(in).peer_index, 1);
+  in.peers_ahead_m = {1.0, 1.1};  // both far: cruise, no peer to blame
+  EXPECT_EQ(r.step(in).peer_index, -1);
+  in.peers_ahead_m = {0.4};
+  in.scan_fresh = false;  // no LIDAR scan holds the car at 0 m/s, below the peer's limit
+  const auto out = r.step(in);
+  EXPECT_EQ(out.speed_m_s, 0.0);
+  EXPECT_EQ(out.peer_index, -1);
 }
 
 namespace {

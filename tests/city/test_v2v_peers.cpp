@@ -1,5 +1,7 @@
 // V2V peer table: own broadcasts ignored, newest state per peer kept, states older than the
-// stale limit dropped and counted, and the runtime config's V2V keys read strictly.
+// stale limit dropped and counted, and the runtime config's V2V keys read strictly. The per-peer
+// account: time in the table and time holding the car, per name and certificate serial.
+#include <autodrive/v2v/peer_account.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <gtest/gtest.h>
 
@@ -129,4 +131,45 @@ TEST(PeerTable, FrozenSimClockDropsEveryPeer) {
   EXPECT_TRUE(clock.frozen());
   EXPECT_TRUE(t.fresh(clock).empty());  // age 0 in sim time, yet not believed
   EXPECT_EQ(t.dropped_stale(), 1u);
+}
+
+// Each step's peers are charged the time until the next step [s of the receiver's clock]; the
+// holding one also its held time; a name under another certificate is a peer of its own.
+TEST(PeerAccount, ChargesTableAndHeldTimePerNameAndCertificate) {
+  autodrive::v2v::PeerAccount a;
+  const auto n2 = state("NIGEL2", 1000000), n3 = state("NIGEL3", 1000000);
+  a.accepted(n2, 22);
+  a.accepted(n3, 33);
+  a.step(1000000, {n2, n3}, 1);   // NIGEL3 holds the car from 1.0 s
+  a.step(1020000, {n2, n3}, -1);  // 20 ms later: nobody holds it
+  a.step(1040000, {n2}, 0);       // NIGEL2 holds it from 1.04 s ...
+  a.step(1100000, {}, -1);        // ... to 1.1 s
+  auto forged = state("NIGEL2", 1200000);
+  a.accepted(forged, 99);  // the newest NIGEL2 state came from another certificate
+  a.step(1200000, {forged}, 0);
+  a.step(1250000, {}, -1);
+  const auto r = a.records();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0].name, "NIGEL2");
+  EXPECT_EQ(r[0].serial, 22u);
+  EXPECT_NEAR(r[0].in_table_s, 0.1, 1e-9);
+  EXPECT_NEAR(r[0].held_s, 0.06, 1e-9);
+  EXPECT_EQ(r[1].serial, 99u);
+  EXPECT_NEAR(r[1].held_s, 0.05, 1e-9);
+  EXPECT_EQ(r[2].name, "NIGEL3");
+  EXPECT_NEAR(r[2].in_table_s, 0.04, 1e-9);
+  EXPECT_NEAR(r[2].held_s, 0.02, 1e-9);
+  EXPECT_EQ(r[2].accepted, 1u);
+}
+
+TEST(PeerAccount, ReportsOneJsonArray) {
+  autodrive::v2v::PeerAccount a;
+  EXPECT_EQ(a.json(), "[]");
+  const auto odd = state("N\"2", 0);  // a name the wire could carry: escaped
+  a.accepted(odd, 18446744073709551615ull);
+  a.step(0, {odd}, 0);
+  a.step(500000, {}, -1);
+  EXPECT_EQ(a.json(),
+            "[{\"name\":\"N\\\"2\",\"serial\":\"18446744073709551615\",\"accepted\":1,"
+            "\"in_table_s\":0.500,\"held_s\":0.500}]");
 }

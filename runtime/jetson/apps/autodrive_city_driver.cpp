@@ -14,6 +14,7 @@
 #include <autodrive/lidar_scan_t.hpp>
 #include <autodrive/odometry_t.hpp>
 #include <autodrive/v2i_advisory_t.hpp>
+#include <autodrive/v2v/peer_account.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
 #include <autodrive/v2x.hpp>
@@ -99,15 +100,10 @@ class Driver {
       in.scan_fresh = scan_us_ > 0 && m->utime - scan_us_ <= o_.scan_stale_ms * 1e3;
       in.obstacle_ahead_m = obstacle_.ahead_m(track_, s_local_);
     }
-    for (const auto &peer : peers_.fresh(clock_)) {
-      const auto q = autodrive::behaviour::project(track_, peer.x_m, peer.y_m, s_local_, 0.0,
-                                                   o_.rules.peer_horizon_m);
-      double ahead = q.s_m - s_local_;
-      if (track_.loop && ahead < 0) ahead += track_.length_m;
-      if (q.dist_m < o_.rules.peer_corridor_m && ahead > 0 && ahead < o_.rules.peer_horizon_m)
-        in.peers_ahead_m.push_back(ahead);
-    }
+    const auto fresh = peers_.fresh(clock_);
+    const std::vector<int> ahead_of = peers_ahead(fresh, in.peers_ahead_m);
     const auto out = rules_.step(in);
+    account_.step(m->utime, fresh, out.peer_index < 0 ? -1 : ahead_of[out.peer_index]);
     // Speed: the open-loop throttle map of the autonomy's tracker plus a P term on the EKF speed.
     const double top_m_s = autodrive::autonomy::TrackerConfig{}.top_speed_m_s;
     double throttle = 0.0;
@@ -128,6 +124,24 @@ class Driver {
     }
   }
 
+  // The fresh peers on the track ahead: their distance along it [m] into ahead_m, and for each
+  // its index in fresh (returned).
+  std::vector<int> peers_ahead(const std::vector<autodrive::v2v_state_t> &fresh,
+                               std::vector<double> &ahead_m) const {
+    std::vector<int> index;
+    for (size_t k = 0; k < fresh.size(); ++k) {
+      const auto q = autodrive::behaviour::project(track_, fresh[k].x_m, fresh[k].y_m, s_local_,
+                                                   0.0, o_.rules.peer_horizon_m);
+      double ahead = q.s_m - s_local_;
+      if (track_.loop && ahead < 0) ahead += track_.length_m;
+      if (q.dist_m < o_.rules.peer_corridor_m && ahead > 0 && ahead < o_.rules.peer_horizon_m) {
+        ahead_m.push_back(ahead);
+        index.push_back(static_cast<int>(k));
+      }
+    }
+    return index;
+  }
+
   // Only the SCM's signed, fresh advisory (on the car's clock) counts: a forged GREEN is dropped.
   void on_advisory(const autodrive::v2i_advisory_t *m) {
     if (m->vehicle != o_.vehicle) return;
@@ -139,13 +153,16 @@ class Driver {
     have_adv_ = true;
   }
 
-  // A peer counts only when signed by the car it names (no ghost cars, no borrowed names).
+  // A peer counts only when signed by the car it names (no ghost cars, no borrowed names); the
+  // account keeps which certificate signed it.
   void on_peer(const autodrive::v2v_state_t *m) {
     if (m->vehicle == o_.vehicle) return;  // our own broadcast: the peer table skips it
     const int64_t now = clock_.now_us();
-    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(),
-                          now))
+    v2x_sender_t sender{};
+    if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(), now,
+                          &sender))
       return;
+    account_.accepted(*m, sender.serial);
     peers_.on_state(*m, now);
   }
 
@@ -163,6 +180,7 @@ class Driver {
   }
 
   std::string refused_summary() const { return verifier_.summary(); }
+  std::string peer_account() const { return account_.json(); }
 
   void send(bool engaged, double throttle, double steering) {
     autodrive::vehicle_command_t c{};
@@ -197,6 +215,7 @@ class Driver {
   autodrive::clock::Clock clock_;
   autodrive::v2x::Verifier verifier_;
   autodrive::v2v::PeerTable peers_;
+  autodrive::v2v::PeerAccount account_;  // per peer: time in the table and holding this car
   autodrive::v2i_advisory_t adv_{};
   int64_t adv_at_us_ = 0;  // the advisory's arrival [us, clock_]
   bool have_adv_ = false, have_s_ = false;
@@ -315,5 +334,9 @@ int main(int argc, char **argv) {
   const std::string refused = d.refused_summary();
   std::printf("[city-driver] %s: stopped; refused V2X messages: %s\n", o.vehicle.c_str(),
               refused.empty() ? "none" : refused.c_str());
+  // per V2V peer accepted (name, certificate serial): seconds of car time in the peer table and
+  // holding or slowing this car (tools/bench v2x charges ghosts with it)
+  std::printf("[city-driver] %s: peer account: %s\n", o.vehicle.c_str(), d.peer_account().c_str());
+  std::fflush(stdout);
   return 0;
 }

@@ -12,6 +12,7 @@
 #include <autodrive/command_auth.hpp>
 #include <autodrive/mission_status_t.hpp>
 #include <autodrive/odometry_t.hpp>
+#include <autodrive/v2v/peer_account.hpp>
 #include <autodrive/v2v/v2v_peers.hpp>
 #include <autodrive/v2v_state_t.hpp>
 #include <autodrive/v2x.hpp>
@@ -86,9 +87,12 @@ class App {
   void on_v2v(const lcm::ReceiveBuffer *, const std::string &, const autodrive::v2v_state_t *m) {
     if (m->vehicle == o_.vehicle) return;
     // Only a state signed by the car it names, fresh on this program's clock: no ghost cars.
+    // The account keeps which certificate signed it.
+    v2x_sender_t sender{};
     if (!verifier_.accept(AUTODRIVE_CH_V2V, *m, AUTODRIVE_CH_V2V_SIGNED_BY, m->vehicle.c_str(),
-                          now_us()))
+                          now_us(), &sender))
       return;
+    account_.accepted(*m, sender.serial);
     link_.on_receive(*m, now_us());
   }
   void on_pose(const lcm::ReceiveBuffer *, const std::string &, const autodrive::odometry_t *m) {
@@ -134,6 +138,7 @@ class App {
       publish_status(now);  // at once: the demo times the arrival by it
     }
     double throttle = 0, steering = 0;
+    int holding = -1;  // the fresh peer the shield braked for (the account's held time), -1 none
     if (goal_us_ < 0) {
       if (baseline_) {
         const autodrive::marl::DriveCommand c =
@@ -154,6 +159,7 @@ class App {
                                                          : last_steering_;
         const autodrive::marl::ShieldResult r =
             core_.shield(own_, throttle, steering, peers, baseline_ != nullptr, steering_now);
+        if (r.intervened && r.throttle < throttle) holding = peer_index(fresh, r.peer_id);
         if (r.intervened) {
           ++shield_interventions_;
           lane_steers_ += r.steered ? 1 : 0;
@@ -176,10 +182,12 @@ class App {
           after_goal_.step({own_.x_m, own_.y_m, own_.yaw_rad}, dt_s, own_.speed_m_s);
       const autodrive::marl::ShieldResult r =
           core_.shield(own_, tc.throttle, tc.steering, peers, true);
+      if (r.intervened && r.throttle < tc.throttle) holding = peer_index(fresh, r.peer_id);
       throttle = r.throttle;
       steering = r.steering;
     }
     publish(now, throttle, steering, true);
+    account_.step(now, fresh, holding);
     last_steering_ = steering;
     ++steps_;
     peers_seen_ = fresh.size();
@@ -224,6 +232,16 @@ class App {
     if (at_exit) publish(now_us(), 0, 0, false);  // a disengaged stop on the way out
   }
 
+  // The index in fresh of the peer with the shield's id, -1 when none.
+  static int peer_index(const std::vector<autodrive::v2v_state_t> &fresh, int peer_id) {
+    for (size_t k = 0; k < fresh.size(); ++k)
+      if (autodrive::marl::vehicle_id(fresh[k].vehicle) == peer_id) return static_cast<int>(k);
+    return -1;
+  }
+
+  // The run's figures; peer_account: per V2V peer accepted (name, certificate serial) the
+  // seconds of car time in the peer table and those the shield braked for it (the policy's and
+  // the baseline's own yielding is not charged to a peer: they weigh every peer at once).
   std::string summary_json() const {
     char buf[512];
     std::snprintf(
@@ -231,7 +249,7 @@ class App {
         "{\"vehicle\": \"%s\", \"mode\": \"%s\", \"shield\": %s, \"route\": \"%s\", "
         "\"steps\": %llu, \"start_s\": %.3f, \"goal_s\": %.3f, \"shield_interventions\": %llu, "
         "\"shield_lane_steers\": %llu, \"v2v_received\": %llu, \"v2v_lost\": %llu, "
-        "\"v2v_dropped_stale\": %llu}",
+        "\"v2v_dropped_stale\": %llu, \"peer_account\": ",
         o_.vehicle.c_str(), o_.mode.c_str(), o_.no_shield ? "false" : "true", route_.name.c_str(),
         static_cast<unsigned long long>(steps_), start_us_ >= 0 ? start_us_ * 1e-6 : -1.0,
         goal_us_ >= 0 ? goal_us_ * 1e-6 : -1.0,
@@ -240,7 +258,7 @@ class App {
         static_cast<unsigned long long>(link_.received()),
         static_cast<unsigned long long>(link_.lost()),
         static_cast<unsigned long long>(peers_.dropped_stale()));
-    return buf;
+    return buf + account_.json() + "}";
   }
 
  private:
@@ -257,6 +275,7 @@ class App {
   autodrive::autonomy::PurePursuit after_goal_;
   double goal_[2] = {0, 0};
   autodrive::v2v::PeerTable peers_;
+  autodrive::v2v::PeerAccount account_;  // per peer: time in the table and braked for
   autodrive::marl::LinkDegrader link_;
   autodrive::marl::CarState own_;
   bool have_pose_ = false, last_intervened_ = false;

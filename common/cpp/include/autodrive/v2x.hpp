@@ -80,10 +80,11 @@ class Verifier {
 
   // True when m on channel is signed by a certificate of one of `roles` (a comma list,
   // AUTODRIVE_CH_<ID>_SIGNED_BY) named `name` (nullptr: any), and fresh on the receiver's
-  // clock now_us [us]. Checks the revocation list (a stat) 4 times a second of now_us.
+  // clock now_us [us]. Checks the revocation list (a stat) 4 times a second of now_us. sender
+  // (may be nullptr) gets the certificate's name, serial and role as far as they were read.
   template <class Msg>
   bool accept(const std::string &channel, const Msg &m, const char *roles, const char *name,
-              int64_t now_us) {
+              int64_t now_us, v2x_sender_t *sender_out = nullptr) {
     // (now_us < last: a clock that went back, such as a new simulator run)
     if (!last_reload_us_ || now_us < *last_reload_us_ || now_us - *last_reload_us_ >= 250000) {
       last_reload_us_ = now_us;
@@ -97,6 +98,7 @@ class Verifier {
         v2x_verify(verifier_.get(), channel.c_str(), payload.data(), payload.size(), m.auth.data(),
                    m.auth.size(), v2x_role_mask(roles), name, now_us,
                    static_cast<int64_t>(std::time(nullptr)), &sender);
+    if (sender_out) *sender_out = sender;
     if (r == V2X_OK) return true;
     const std::string who = sender.name[0] ? std::string("sender ") + sender.name + " (serial " +
                                                  std::to_string(sender.serial) + ")"

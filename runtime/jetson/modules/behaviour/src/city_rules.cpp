@@ -13,8 +13,11 @@ double CityRules::stop_profile(double s_line_m, double front_s_m) const {
 
 RulesOutput CityRules::step(const RulesInput &in) {
   RulesOutput out{cfg_.cruise_m_s, "cruise", -1};
+  // true when v is the new limit (any later limit takes the blame off a peer)
   auto limit = [&](double v, const std::string &why) {
-    if (v < out.speed_m_s) out.speed_m_s = std::max(0.0, v), out.reason = why;
+    if (v >= out.speed_m_s) return false;
+    out.speed_m_s = std::max(0.0, v), out.reason = why, out.peer_index = -1;
+    return true;
   };
   const double L = track_.length_m;
   const double front = in.s_m + cfg_.front_m;
@@ -96,10 +99,12 @@ RulesOutput CityRules::step(const RulesInput &in) {
   if (in.advisory.fresh && in.advisory.speed_limit_m_s > 0)
     limit(in.advisory.speed_limit_m_s, "advisory speed limit");
   // Cars ahead on the track: keep min_gap_m bumper to bumper, braking comfortably.
-  for (const double d : in.peers_ahead_m) {
-    const double gap_m = d - cfg_.rear_m - cfg_.front_m;
+  for (size_t k = 0; k < in.peers_ahead_m.size(); ++k) {
+    const double gap_m = in.peers_ahead_m[k] - cfg_.rear_m - cfg_.front_m;
     const double room_m = gap_m - cfg_.min_gap_m;
-    limit(room_m <= 0.003 ? 0.0 : std::sqrt(2.0 * cfg_.comfort_decel_m_s2 * room_m), "car ahead");
+    if (limit(room_m <= 0.003 ? 0.0 : std::sqrt(2.0 * cfg_.comfort_decel_m_s2 * room_m),
+              "car ahead"))
+      out.peer_index = static_cast<int>(k);
   }
   // An obstacle on the path (LIDAR): brake to stand obstacle_margin_m before it; once it held
   // the car, the path must stay clear for obstacle_clear_s before the car goes on.

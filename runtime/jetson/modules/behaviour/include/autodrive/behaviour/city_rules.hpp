@@ -78,6 +78,9 @@ struct RulesOutput {
   double speed_m_s = 0;  // allowed speed now [m/s]
   std::string reason;    // what limits it ("cruise", "red light 3 at x_stop_s", ...)
   double stop_s_m = -1;  // the stop line the car is stopping for (unwrapped) [m], < 0 none
+  // the entry of RulesInput::peers_ahead_m whose gap limits the speed ("car ahead"), -1: none
+  // (what the driver charges a peer's held time to)
+  int peer_index = -1;
 };
 
 class CityRules {
