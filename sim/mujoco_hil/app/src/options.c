@@ -117,8 +117,11 @@ static void options_usage(FILE *f) {
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
       "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
       "                      eye, 4 free; Tab next car; N day/night; Space pause; R reset;\n"
-      "                      M the Menu Panel; H the HUD; Esc quit\n"
+      "                      M the Menu Panel; H the HUD; T manual driving (arrows or WASD,\n"
+      "                      through autodrive-teleop: signed, on the control lease); Esc quit\n"
       "  --view-size WxH     the window's size (default 1024x768 px)\n"
+      "  --hud-log FILE      with --view: each drawn frame's HUD text as a line of FILE (sim\n"
+      "                      time [us], then title=value fields, tab-separated)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
       "                      time stamped with it, and FILE.frames.csv (frame, sim_time_us);\n"
       "                      needs Debian's ffmpeg\n"
@@ -325,6 +328,9 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
   } else if (!strcmp(a, "--truth-log") && v) {
     o->truth_log = v;
     return 1;
+  } else if (!strcmp(a, "--hud-log") && v) {
+    o->hud_log = v;
+    return 1;
   } else if (!strcmp(a, "--bench")) {
     o->bench = 1;
   } else if (!strcmp(a, "--quiet")) {
@@ -417,6 +423,10 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
             "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->hud_log && !o->view) {
+    fprintf(stderr, "autodrive-sim: --hud-log needs --view (it logs the window's HUD)\n");
     return OPTIONS_BAD;
   }
   if (o->video && o->record_dir) {

@@ -36,13 +36,36 @@ void sim_viewer_key(sim_viewer_t *v, int key) {
     case GLFW_KEY_H: v->in.hud = !v->in.hud; break;
     case GLFW_KEY_SPACE: v->in.paused = !v->in.paused; break;
     case GLFW_KEY_R: v->in.reset_requested = 1; break;
+    case GLFW_KEY_T: v->in.manual = !v->in.manual; break;
     case GLFW_KEY_ESCAPE: v->in.quit = 1; break;
     default: break;
   }
 }
 
+/* The SIM_VIEWER_KEY_* bit of a drive key, 0 for the others. */
+static int viewer_drive_bit(int key) {
+  switch (key) {
+    case GLFW_KEY_UP:
+    case GLFW_KEY_W: return SIM_VIEWER_KEY_FORWARD;
+    case GLFW_KEY_DOWN:
+    case GLFW_KEY_S: return SIM_VIEWER_KEY_BACK;
+    case GLFW_KEY_LEFT:
+    case GLFW_KEY_A: return SIM_VIEWER_KEY_LEFT;
+    case GLFW_KEY_RIGHT:
+    case GLFW_KEY_D: return SIM_VIEWER_KEY_RIGHT;
+    default: return 0;
+  }
+}
+
 void sim_viewer_key_state(sim_viewer_t *v, int key, int down) {
+  const int bit = viewer_drive_bit(key);
+  if (bit) v->in.drive_keys = down ? (v->in.drive_keys | bit) : (v->in.drive_keys & ~bit);
   if (down) sim_viewer_key(v, key);
+}
+
+void sim_viewer_set_manual(sim_viewer_t *v, int manual) {
+  v->in.manual = manual != 0;
+  v->in.drive_keys = 0;
 }
 
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods) {
@@ -270,10 +293,14 @@ static void viewer_overlays(sim_viewer_t *v, mjrRect vp, double t_s) {
   static const char *names[4] = {"driver's", "bird's", "god's", "free"};
   char text[160];
   const char *view = v->in.view >= 0 && v->in.view < 4 ? names[v->in.view] : "overhead";
-  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s", v->in.car,
-           view, t_s, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night");
+  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s%s", v->in.car,
+           view, t_s, v->in.manual ? "  MANUAL" : "", v->in.paused ? "  PAUSED" : "",
+           v->in.day ? "" : "  night");
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, vp, text,
-              "1-4 view  Tab car  N night  Space pause  R reset  M menu  H HUD  Esc quit", &v->con);
+              v->in.manual ? "arrows / WASD drive  T autonomous  1-4 view  Space pause  Esc quit"
+                           : "1-4 view  Tab car  N night  Space pause  R reset  T manual  M menu  "
+                             "H HUD  Esc quit",
+              &v->con);
   if (v->hud_titles[0])
     mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, vp, v->hud_titles, v->hud_values, &v->con);
 }
@@ -300,6 +327,19 @@ static int viewer_read_back(sim_viewer_t *v, mjrRect vp) {
   return 0;
 }
 
+/* The input state to *in; its edges are reported once. */
+static void viewer_take_input(sim_viewer_t *v, sim_viewer_input_t *in) {
+  if (in) *in = v->in;
+  v->in.reset_requested = v->in.step_requested = v->in.record_toggled = 0;
+}
+
+void sim_viewer_poll(sim_viewer_t *v, sim_viewer_input_t *in) {
+  glfwMakeContextCurrent(v->win); /* a click on the panel draws into its buffer */
+  glfwPollEvents();
+  if (glfwWindowShouldClose(v->win)) v->in.quit = 1;
+  viewer_take_input(v, in);
+}
+
 int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_input_t *in) {
   glfwPollEvents();
   if (glfwWindowShouldClose(v->win)) v->in.quit = 1;
@@ -314,8 +354,6 @@ int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_in
   v->have_rgb = 0;
   if (v->capture && viewer_read_back(v, vp) != 0) return -1;
   glfwSwapBuffers(v->win);
-  if (in) *in = v->in;
-  /* edges: reported once */
-  v->in.reset_requested = v->in.step_requested = v->in.record_toggled = 0;
+  viewer_take_input(v, in);
   return 0;
 }
