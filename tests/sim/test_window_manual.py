@@ -6,8 +6,9 @@ bridge takes the lease. Checks: the car drives forward (ground truth), the comma
 are the person's and signed (source teleop, authority person), the bridge names teleop as the
 lease holder and so does the HUD, the HUD's speed follows the ground truth at the same sim time
 (--hud-log: the HUD text of each frame drawn), releasing the key stops the car (dead-man), and
-back to Autonomous the lease is given back. Judged on sim time and events; the waits are guards
-that fail with what was seen."""
+back to Autonomous the lease is given back. The screenshot of manual driving (window-manual.png)
+goes to $AUTODRIVE_SCREENSHOT_DIR when set (the docs' picture). Judged on sim time and events;
+the waits are guards that fail with what was seen."""
 
 from __future__ import annotations
 
@@ -38,8 +39,8 @@ DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 SPEED_TOL_M_S = 0.02  # [m/s] HUD against ground truth at the same sim time (HUD prints 0.01)
 
 pytestmark = pytest.mark.skipif(
-    not (shutil.which("Xvfb") and shutil.which("xdotool")),
-    reason="needs Xvfb and xdotool (tools/debian-packages.txt)",
+    not (shutil.which("Xvfb") and shutil.which("xdotool") and shutil.which("ffmpeg")),
+    reason="needs Xvfb, xdotool and ffmpeg (tools/debian-packages.txt)",
 )
 
 
@@ -139,6 +140,17 @@ class Rig:
     def click(self, x: int, y: int) -> None:
         self.xdotool("mousemove", "--window", self.wid, str(x), str(y), "click", "1")
 
+    def shot(self, name: str) -> None:
+        """The screen (ffmpeg x11grab), copied to $AUTODRIVE_SCREENSHOT_DIR when set."""
+        path = self.tmp / f"{name}.png"
+        subprocess.run(["ffmpeg", "-v", "error", "-y", "-f", "x11grab", "-video_size",
+                        f"{WIN_W}x{WIN_H}", "-i", f"{self.display}+0,0", "-frames:v", "1",
+                        str(path)], env=self.env, check=True)  # fmt: skip
+        assert path.stat().st_size > 0, path
+        out = os.environ.get("AUTODRIVE_SCREENSHOT_DIR")
+        if out:
+            shutil.copy(path, Path(out) / f"{name}.png")
+
     def hud(self) -> list[tuple[float, dict[str, str]]]:
         """The HUD of every frame drawn so far: (sim time [s], {title: value})."""
         rows = []
@@ -200,6 +212,12 @@ def test_manual_driving_from_the_window(rig: Rig) -> None:
         )
         t_driven = r.sim_time()
         r._until(lambda: "ok" if r.holder[-1] == "teleop" else None, "the lease to go to teleop")
+        # the picture of the docs: a frame drawn since whose HUD names the person's lease
+        n_hud = len(r.hud())
+        r._until(lambda: "ok" if any(kv.get("  control lease") == "teleop (person)"
+                                     for _, kv in r.hud()[n_hud:]) else None,
+                 "a HUD frame naming teleop's lease")  # fmt: skip
+        r.shot("window-manual")
     finally:
         r.xdotool("keyup", "--window", r.wid, "Up")
     print(f"drove {ahead():.2f} m forward by t = {t_driven:.2f} s")
