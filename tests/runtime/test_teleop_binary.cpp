@@ -99,3 +99,58 @@ TEST(TeleopBinary, GamepadDeadmanEngagesAndReleaseStops) {
   ::unlink((fifo + ".log").c_str());
   ::unlink(key_file.c_str());
 }
+
+// --keys-stdin: the key bytes a program writes into teleop's standard input (autodrive-sim's
+// window in manual mode) drive as a terminal's do, signed as a person; the end of the input
+// quits, with a last disengaged command.
+TEST(TeleopBinary, KeysFromAPipeDriveAndTheirEndQuits) {
+  const std::string fifo = "/tmp/adr-rt-keys-" + std::to_string(getpid());
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // close-on-exec: teleop must not inherit a writer of its own input
+  const int w = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  ASSERT_GE(w, 0);
+  const std::string url = "udpm://239.255.76.67:7777?ttl=0";
+  lcm::LCM lcm(url);
+  Commands cmds;
+  autodrive_lcm::subscribe<autodrive::vehicle_command_t, Commands, &Commands::on>(
+      lcm, "KEYS1_COMMAND", &cmds);
+  const std::string key_file = fifo + ".key";
+  {
+    std::ofstream k(key_file);
+    k << std::string(64, 'd') << "\n";
+  }
+  ::chmod(key_file.c_str(), 0600);
+  autodrive::child_process::Child teleop(
+      {"/bin/sh", "-c",
+       std::string("exec ") + AUTODRIVE_TELEOP_EXE + " --keys-stdin --vehicle KEYS1 --lcm-url '" +
+           url + "' --key-file " + key_file + " --key-repeat-delay-ms 200 --key-hold-ms 300 < " +
+           fifo},
+      fifo + ".log");
+  ASSERT_TRUE(pump_until(lcm, [&] { return cmds.got.size() >= 5; }));
+  EXPECT_FALSE(cmds.got.back().engaged);
+  // w held (repeated every 50 ms): engaged forward at the keyboard's drive level
+  const auto t_end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < t_end && !(cmds.got.back().engaged)) {
+    ASSERT_EQ(::write(w, "w", 1), 1);
+    lcm.handleTimeout(50);
+  }
+  ASSERT_TRUE(cmds.got.back().engaged);
+  EXPECT_GT(cmds.got.back().throttle, 0.0f);
+  EXPECT_EQ(cmds.got.back().source, "teleop");
+  EXPECT_EQ(cmds.got.back().authority, autodrive::auth::kAuthorityPerson);
+  EXPECT_EQ(
+      autodrive::auth::check_mac(autodrive::auth::load_key(key_file), "KEYS1", cmds.got.back()),
+      autodrive::auth::MacCheck::ok);
+  // the writer closes: teleop ends on its own, its last command disengaged
+  ::close(w);
+  const auto quit_by = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (teleop.running() && std::chrono::steady_clock::now() < quit_by) lcm.handleTimeout(50);
+  EXPECT_FALSE(teleop.running()) << "teleop did not quit at the end of its input";
+  while (lcm.handleTimeout(300) > 0) {
+  }
+  EXPECT_FALSE(cmds.got.back().engaged);
+  ::unlink(fifo.c_str());
+  ::unlink((fifo + ".log").c_str());
+  ::unlink(key_file.c_str());
+}

@@ -27,7 +27,7 @@ from autodrive.core.channels import channel, vehicle_name
 
 WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
-RECORD_BUTTON = (68, 551)  # [px] the Record button (tests/sim_sensors checks the layout)
+RECORD_BUTTON = (68, 581)  # [px] the Record button (tests/sim_sensors checks the layout)
 GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
 FPS = 30.0
 

@@ -84,8 +84,8 @@ int main(int argc, char **argv) {
   std::string vehicle = AUTODRIVE_VEHICLE_DEFAULT, url = AUTODRIVE_LCM_URL_DEFAULT, js_path,
               key_file, source = "teleop";
   double rate_hz = 50.0;
-  bool no_keyboard = false;
-  int repeat_delay_ms = 0;
+  bool no_keyboard = false, keys_stdin = false;
+  int repeat_delay_ms = 0, key_hold_ms = 0;
   autodrive::teleop::Params p;
   app.add_option("--vehicle", vehicle, "vehicle name, channel prefix")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM URL")->capture_default_str();
@@ -99,6 +99,16 @@ int main(int argc, char **argv) {
   app.add_option("--deadman-button", p.deadman_button, "gamepad dead-man button number")
       ->capture_default_str();
   app.add_flag("--no-keyboard", no_keyboard, "do not read the terminal");
+  // A program that has the keyboard (autodrive-sim's window) writes the key bytes a terminal
+  // would send, held keys repeated; the signing and the lease stay here
+  // (docs/reference/simulator.md).
+  app.add_flag("--keys-stdin", keys_stdin,
+               "read key bytes from standard input even when it is a pipe, not a terminal "
+               "(autodrive-sim --view's manual mode writes them); its end quits");
+  app.add_option("--key-hold-ms", key_hold_ms,
+                 "a repeating key counts as released after this long without a repeat [ms] "
+                 "(default 600)")
+      ->check(CLI::Range(50, 5000));
   app.add_option("--key-repeat-delay-ms", repeat_delay_ms,
                  "the keyboard's autorepeat delay [ms]: a fresh key press counts as held this "
                  "long + 150 ms before its first repeat (default: read from the Linux console or "
@@ -142,8 +152,14 @@ int main(int argc, char **argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  if (keys_stdin && no_keyboard) {
+    std::fprintf(stderr,
+                 "autodrive-teleop: --keys-stdin and --no-keyboard contradict each other\n");
+    return 2;
+  }
   RawTerminal term(STDIN_FILENO);
-  if (!no_keyboard && !term.active())
+  const bool read_keys = !no_keyboard && (term.active() || keys_stdin);
+  if (!no_keyboard && !read_keys)
     std::fprintf(stderr, "autodrive-teleop: stdin is not a terminal; keyboard disabled\n");
   if (repeat_delay_ms == 0) {
     std::string from;
@@ -155,6 +171,7 @@ int main(int argc, char **argv) {
       repeat_delay_ms = 660;  // X11's default; --key-repeat-delay-ms to change
   }
   p.key_first_hold_us = (repeat_delay_ms * 1000LL) + autodrive::teleop::kKeyRepeatMarginUs;
+  if (key_hold_ms > 0) p.key_hold_us = key_hold_ms * 1000LL;
   autodrive::teleop::Mapper mapper(p);
   const std::string channel = vehicle + AUTODRIVE_CH_COMMAND_SUFFIX;
   const int64_t period_us = static_cast<int64_t>(1e6 / rate_hz);
@@ -163,14 +180,15 @@ int main(int argc, char **argv) {
   while (running && !g_stop) {
     pollfd fds[2];
     nfds_t n = 0;
-    if (term.active() && !no_keyboard) fds[n++] = {STDIN_FILENO, POLLIN, 0};
+    if (read_keys) fds[n++] = {STDIN_FILENO, POLLIN, 0};
     if (js >= 0) fds[n++] = {js, POLLIN, 0};
     const int64_t wait_us = std::max<int64_t>(0, next_us - autodrive::clock::monotonic_us());
     ::poll(fds, n, static_cast<int>(wait_us / 1000));
     for (nfds_t i = 0; i < n; ++i) {
-      if (fds[i].fd == STDIN_FILENO && (fds[i].revents & POLLIN)) {
+      if (fds[i].fd == STDIN_FILENO && (fds[i].revents & (POLLIN | POLLHUP))) {
         char buf[32];
         const ssize_t k = ::read(STDIN_FILENO, buf, sizeof buf);
+        if (k == 0 && keys_stdin) running = false;  // the writer closed the pipe: hand back
         for (ssize_t j = 0; j < k; ++j)
           running = mapper.key(buf[j], autodrive::clock::monotonic_us()) && running;
       } else if (fds[i].fd == js && fds[i].revents) {

@@ -21,7 +21,8 @@ typedef struct app_options {
   int host_io_ms; /* --host-io-ms; 0: the mode's default */
   double rtf, duration_s;
   int bench, quiet, lidar_lcm, view;
-  int view_w, view_h; /* --view-size [px] */
+  int view_w, view_h;  /* --view-size [px] */
+  const char *hud_log; /* --hud-log FILE: each frame's HUD text, or NULL */
   /* --video FILE, --record DIR (run_recorder.h), --video-camera NAME; NULL when not given */
   const char *video, *record_dir, *video_camera;
   int cameras, eye;       /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */

@@ -45,7 +45,7 @@ static void hud_lamps(uint8_t lights, char *out, size_t n) {
            lights & PROTOCOL_LIGHTS_REVERSE ? ", reverse" : "");
 }
 
-static void hud_car(hud_cols_t *c, sim_t *s, int car) {
+static void hud_car(hud_cols_t *c, sim_t *s, int car, const hud_extra_t *x) {
   sim_truth_t t;
   sim_get_truth(s, car, &t);
   protocol_state_t st;
@@ -67,17 +67,23 @@ static void hud_car(hud_cols_t *c, sim_t *s, int car) {
            gyro[2]);
   hud_line(c, "  battery", "%.2f V", st.battery_mv / 1000.0);
   hud_line(c, "  lamps", "%s", lamps);
+  if (x->lease) {
+    char holder[96];
+    control_status_lcm_holder(x->lease, car, x->now_s, holder, sizeof holder);
+    hud_line(c, "  control lease", "%s", holder);
+  }
 }
 
-void hud_text_build(sim_t *s, double rtf, const char *recording, char *titles, size_t titles_sz,
+void hud_text_build(sim_t *s, double rtf, const hud_extra_t *x, char *titles, size_t titles_sz,
                     char *values, size_t values_sz) {
   hud_cols_t c = {titles, values, titles_sz, values_sz, 0, 0};
   titles[0] = values[0] = 0;
   hud_line(&c, "sim time", "%.2f s", sim_time_us(s) * 1e-6);
   hud_line(&c, "real-time factor", "%.2f", rtf);
-  if (recording) hud_line(&c, "recording", "%s", recording);
+  if (x->recording) hud_line(&c, "recording", "%s", x->recording);
+  if (x->driving) hud_line(&c, "driving", "%s", x->driving);
   const int n = sim_cars(s);
-  for (int car = 1; car <= n && car <= HUD_TEXT_MAX_CARS; car++) hud_car(&c, s, car);
+  for (int car = 1; car <= n && car <= HUD_TEXT_MAX_CARS; car++) hud_car(&c, s, car, x);
   if (n > HUD_TEXT_MAX_CARS) hud_line(&c, "more cars", "%d", n - HUD_TEXT_MAX_CARS);
   const traffic_lights_t *tl = sim_traffic_lights(s);
   static const char *state[4] = {"off", "RED", "YELLOW", "GREEN"};

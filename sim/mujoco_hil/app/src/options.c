@@ -19,7 +19,8 @@
 #define OPTIONS_BAD 2      /* a bad option or value: the exit status */
 #define OPTIONS_UNKNOWN -2 /* not an option of this group */
 
-static void options_usage(FILE *f) {
+/* --help, part 1: what the program is, and the world it builds (cars, map, starts, boxes). */
+static void options_usage_world(FILE *f) {
   fprintf(
       f,
       "usage: autodrive-sim [options]\n"
@@ -46,7 +47,15 @@ static void options_usage(FILE *f) {
       "                      place after it was mapped. With R [m], not before car 1's\n"
       "                      base_link is within R of it (one stepping out in front of\n"
       "                      the car). Up to %d; LIDAR, cameras and the collision flag\n"
-      "                      see it once it is there\n"
+      "                      see it once it is there\n",
+      SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
+      SCN_MAX_LATE_BOXES);
+}
+
+/* --help, part 2: how the run keeps time, its bus, run dir and driver. */
+static void options_usage_run(FILE *f) {
+  fprintf(
+      f,
       "  --lockstep          run as fast as possible (sim time only), publish SIM_CLOCK\n"
       "  --lockstep-client   lockstep with the client on each Nano pty (HIL): never more\n"
       "                      than 40 ms of sim time ahead of its last bytes, as fast as it\n"
@@ -79,7 +88,16 @@ static void options_usage(FILE *f) {
       "                      laps of a loop, default 1); A > 0 adds seeded steering\n"
       "                      perturbations up to A (normalised) now and then (expert\n"
       "                      recordings with recoveries, tools/pilot)\n"
-      "  --no-pty            do not open ptys (with --script)\n"
+      "  --no-pty            do not open ptys (with --script)\n",
+      OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT, AUTODRIVE_SIM_RUN_DIR_DEFAULT,
+      AUTODRIVE_INSTANCE_MAX, AUTODRIVE_INSTANCE_VARIABLE, AUTODRIVE_INSTANCE_PORT_STEP,
+      SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M);
+}
+
+/* --help, part 3: the sensors (LIDAR, cameras, the Eye), the late obstacles, the physics. */
+static void options_usage_sensors(FILE *f) {
+  fprintf(
+      f,
       "  --no-lidar          do not simulate the LIDAR\n"
       "  --late-box-stay S   the --late-box before it leaves again S s after it appeared\n"
       "                      (an obstacle that goes away)\n"
@@ -113,12 +131,22 @@ static void options_usage(FILE *f) {
       "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
       "                      (noise and blur are seeded by --seed: a run repeats)\n"
       "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
-      "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n"
+      "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n",
+      EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, EYE_SYNC_LOST_S, EYE_SYNC_FIRST_S, CFX_MAX_NOISE,
+      CFX_MAX_BLUR_PX);
+}
+
+/* --help, part 4: the outputs (bench, window, video, record), channels, exit status. */
+static void options_usage_output(FILE *f) {
+  fputs(
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
       "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
       "                      eye, 4 free; Tab next car; N day/night; Space pause; R reset;\n"
-      "                      M the Menu Panel; H the HUD; Esc quit\n"
+      "                      M the Menu Panel; H the HUD; T manual driving (arrows or WASD,\n"
+      "                      through autodrive-teleop: signed, on the control lease); Esc quit\n"
       "  --view-size WxH     the window's size (default 1024x768 px)\n"
+      "  --hud-log FILE      with --view: each drawn frame's HUD text as a line of FILE (sim\n"
+      "                      time [us], then title=value fields, tab-separated)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
       "                      time stamped with it, and FILE.frames.csv (frame, sim_time_us);\n"
       "                      needs Debian's ffmpeg\n"
@@ -132,12 +160,15 @@ static void options_usage(FILE *f) {
       "TRAFFIC_LIGHT_STATE (10 Hz per light and on each change); obeys TRAFFIC_LIGHT_COMMAND.\n"
       "Exit status: 0 done; 2 a bad option or value (also a --start or --late-box that does\n"
       "not fit the map); 1 any other error (files, map, LCM, physics).\n",
-      SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-      SCN_MAX_LATE_BOXES, OPTIONS_FREE_LOCKSTEP_IO_MS, AUTODRIVE_LCM_URL_DEFAULT,
-      AUTODRIVE_SIM_RUN_DIR_DEFAULT, AUTODRIVE_INSTANCE_MAX, AUTODRIVE_INSTANCE_VARIABLE,
-      AUTODRIVE_INSTANCE_PORT_STEP, SCRIPT_ROUTE_SPEED_DEFAULT, SCRIPT_ROUTE_LOOKAHEAD_DEFAULT_M,
-      EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, EYE_SYNC_LOST_S, EYE_SYNC_FIRST_S, CFX_MAX_NOISE,
-      CFX_MAX_BLUR_PX);
+      f);
+}
+
+/* --help, in sections so that each stays short. */
+static void options_usage(FILE *f) {
+  options_usage_world(f);
+  options_usage_run(f);
+  options_usage_sensors(f);
+  options_usage_output(f);
 }
 
 static int options_number(const char *opt, const char *v, double lo, double hi, double *out) {
@@ -325,6 +356,9 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
   } else if (!strcmp(a, "--truth-log") && v) {
     o->truth_log = v;
     return 1;
+  } else if (!strcmp(a, "--hud-log") && v) {
+    o->hud_log = v;
+    return 1;
   } else if (!strcmp(a, "--bench")) {
     o->bench = 1;
   } else if (!strcmp(a, "--quiet")) {
@@ -417,6 +451,10 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
             "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->hud_log && !o->view) {
+    fprintf(stderr, "autodrive-sim: --hud-log needs --view (it logs the window's HUD)\n");
     return OPTIONS_BAD;
   }
   if (o->video && o->record_dir) {

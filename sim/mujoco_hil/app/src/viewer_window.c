@@ -1,6 +1,7 @@
 /* The optional window (viewer_window.h). */
 #include "viewer_window.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,8 +16,11 @@
 #define VIEWER_LIDAR_HEIGHT_M 0.12  /* rays drawn this far above base_link (the RPLIDAR's deck) */
 
 int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
-                       const char *map_name, char *err, size_t err_sz) {
+                       const char *map_name, const char *url, int ptys, const char *hud_log,
+                       char *err, size_t err_sz) {
   memset(w, 0, sizeof *w);
+  manual_drive_init(&w->manual);
+  w->url = url;
   if (!want) return 0;
   if (!sim_viewer_display_available()) {
     snprintf(err, err_sz, "no display (DISPLAY and WAYLAND_DISPLAY are unset); run headless");
@@ -28,6 +32,11 @@ int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_p
   const char *slash = map_name ? strrchr(map_name, '/') : NULL;
   sim_viewer_set_map_name(w->v, slash ? slash + 1 : map_name);
   w->rtf_wall_s = app_wall_s();
+  if (ptys && !(w->lease = control_status_lcm_create(url, sim_cars(s), err, err_sz))) return -1;
+  if (hud_log && !(w->hud_log = fopen(hud_log, "w"))) {
+    snprintf(err, err_sz, "--hud-log '%s': %s", hud_log, strerror(errno));
+    return -1;
+  }
   return 0;
 }
 
@@ -39,8 +48,26 @@ static void viewer_rtf(viewer_window_t *w, const sim_t *s, double now_s) {
   w->rtf_sim_us = sim_time_us(s);
 }
 
+/* --hud-log: one line per frame, sim time [us] then title=value fields (tab-separated). */
+static void viewer_hud_log(viewer_window_t *w, const sim_t *s, const char *titles,
+                           const char *values) {
+  if (!w->hud_log) return;
+  fprintf(w->hud_log, "%lld", (long long)sim_time_us(s));
+  const char *t = titles, *v = values;
+  while (*t) {
+    const size_t tn = strcspn(t, "\n"), vn = strcspn(v, "\n");
+    fprintf(w->hud_log, "\t%.*s=%.*s", (int)tn, t, (int)vn, v);
+    t += tn + (t[tn] != 0);
+    v += vn + (v[vn] != 0);
+  }
+  fputc('\n', w->hud_log);
+  fflush(w->hud_log);
+}
+
 int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s, const char *recording) {
   double now = app_wall_s();
+  if (manual_drive_update(&w->manual, w->in.manual, w->in.car, w->in.drive_keys, w->url, now) < 0)
+    sim_viewer_set_manual(w->v, 0); /* could not start: the radio back to Autonomous */
   /* ~30 Hz of wall time, but no more than one frame per 1/30 s of sim time: on a slow machine
    * the window must not take the time the stepping needs */
   if (now < w->next_frame_s || sim_time_us(s) < w->next_frame_us) return 0;
@@ -50,7 +77,10 @@ int viewer_window_frame(viewer_window_t *w, sim_t *s, double *t0_s, const char *
     w->next_frame_s = now + VIEWER_FRAME_S;
     viewer_rtf(w, s, now);
     char titles[2048], values[2048];
-    hud_text_build(s, w->rtf, recording, titles, sizeof titles, values, sizeof values);
+    control_status_lcm_poll(w->lease, now);
+    const hud_extra_t x = {recording, w->manual.status, w->lease, now};
+    hud_text_build(s, w->rtf, &x, titles, sizeof titles, values, sizeof values);
+    viewer_hud_log(w, s, titles, values);
     sim_viewer_set_hud(w->v, titles, values);
     const double draw0_s = app_wall_s();
     if (sim_viewer_frame(w->v, sim_render_model(s), sim_render_data(s), in) != 0) return 1;
@@ -114,6 +144,11 @@ double viewer_window_median_draw_s(const viewer_window_t *w) {
 }
 
 void viewer_window_close(viewer_window_t *w) {
+  manual_drive_stop(&w->manual);
+  control_status_lcm_destroy(w->lease);
+  w->lease = NULL;
+  if (w->hud_log) fclose(w->hud_log);
+  w->hud_log = NULL;
   if (w->v) sim_viewer_destroy(w->v);
   w->v = NULL;
 }

@@ -4,9 +4,10 @@
  * behind and above), god's eye (the map's "eye" camera, else an overview of the whole model),
  * free (an overview), and each overhead Eye camera of the map.
  * Keys: 1/2/3/4 views, Tab next car, N day/night, Space pause, R reset, M the Menu Panel,
- * H the HUD, Esc or closing quits.
+ * H the HUD, T manual or autonomous driving, Esc or closing quits; in manual mode the arrows
+ * or W/A/S/D held drive the ego car (the caller turns them into commands: in.drive_keys).
  * The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map, pause,
- * step, reset, quit), Car (the ego car), View (camera, light level,
+ * step, reset, quit), Car (the ego car, autonomous or manual driving), View (camera, light level,
  * shadows, reflections, skybox, HUD), Sensors (LIDAR rays) and Record (start / stop). The HUD
  * is text the caller sets (sim_viewer_set_hud), drawn at the top right.
  * The viewer only reports what the user asked (sim_viewer_input_t); the sim's main loop acts.
@@ -47,7 +48,15 @@ typedef struct sim_viewer_input {
   int lidar_rays;     /* 1: the caller's LIDAR rays are drawn */
   int step_requested; /* Step clicked (edge): one step while paused */
   int record_toggled; /* the Record button (edge): start or stop recording */
+  int manual;         /* the Car section's Driving radio (T toggles): 0 autonomous, 1 manual */
+  int drive_keys;     /* SIM_VIEWER_KEY_* bits of the drive keys held now */
 } sim_viewer_input_t;
+
+/* in.drive_keys: the arrows or W/S/A/D held */
+#define SIM_VIEWER_KEY_FORWARD 1
+#define SIM_VIEWER_KEY_BACK 2
+#define SIM_VIEWER_KEY_LEFT 4
+#define SIM_VIEWER_KEY_RIGHT 8
 
 typedef struct sim_viewer sim_viewer_t;
 
@@ -66,6 +75,10 @@ void sim_viewer_destroy(sim_viewer_t *v);
 /* Renders the current view of d, swaps, polls events and copies the input state into *in.
  * Returns 0, or -1 on a GL error. */
 int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_input_t *in);
+
+/* Handles the window's events without drawing and copies the input state into *in (its edges
+ * reported once, as by sim_viewer_frame). */
+void sim_viewer_poll(sim_viewer_t *v, sim_viewer_input_t *in);
 
 /* Feeds one key as if pressed (GLFW_KEY_* code): the key handling, exposed for tests. */
 void sim_viewer_key(sim_viewer_t *v, int glfw_key);
@@ -91,6 +104,9 @@ void sim_viewer_click(sim_viewer_t *v, double x_px, double y_px);
 int sim_viewer_item_at(const sim_viewer_t *v, const char *name, double *x_px, double *y_px);
 /* A key pressed (1) or released (0), as from the keyboard (GLFW_KEY_* code). */
 void sim_viewer_key_state(sim_viewer_t *v, int glfw_key, int down);
+/* Sets the Driving radio (0 autonomous, 1 manual): the caller's way back when manual driving
+ * cannot start. */
+void sim_viewer_set_manual(sim_viewer_t *v, int manual);
 
 /* With capture on, every frame is also read back (before the swap) so that
  * sim_viewer_read_rgb can return it. Off by default (it costs a readback). For tests. */

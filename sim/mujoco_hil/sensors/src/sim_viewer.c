@@ -2,6 +2,8 @@
 #include "sim_viewer.h"
 
 #include <autodrive_channels.h>
+#include <dlfcn.h> /* RTLD_NODELETE, dl_iterate_phdr: _GNU_SOURCE from the build */
+#include <link.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +17,24 @@
 #define VIEWER_MAX_RAYS 1024
 
 static int glfw_users; /* glfwInit/glfwTerminate are process-wide */
+
+static int viewer_pin_dri(struct dl_phdr_info *info, size_t size, void *unused) {
+  (void)size;
+  (void)unused;
+  if (info->dlpi_name && strstr(info->dlpi_name, "/dri/")) {
+    void *h = dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    if (h) dlclose(h); /* the reference goes; RTLD_NODELETE keeps it mapped */
+  }
+  return 0;
+}
+
+/* Mesa's DRI driver (swrast_dri.so: llvmpipe under Xvfb) is loaded with the window's GL
+ * context and unloaded at glfwTerminate, before LeakSanitizer reads the stacks at exit: its
+ * frames would be an "<unknown module>" that no suppression can name. Kept mapped, its
+ * allocations carry its name (tests/lsan.supp). */
+static void viewer_pin_gl_driver(void) {
+  dl_iterate_phdr(viewer_pin_dri, NULL);
+}
 
 int sim_viewer_display_available(void) {
   const char *x = getenv("DISPLAY"), *wl = getenv("WAYLAND_DISPLAY");
@@ -36,13 +56,36 @@ void sim_viewer_key(sim_viewer_t *v, int key) {
     case GLFW_KEY_H: v->in.hud = !v->in.hud; break;
     case GLFW_KEY_SPACE: v->in.paused = !v->in.paused; break;
     case GLFW_KEY_R: v->in.reset_requested = 1; break;
+    case GLFW_KEY_T: v->in.manual = !v->in.manual; break;
     case GLFW_KEY_ESCAPE: v->in.quit = 1; break;
     default: break;
   }
 }
 
+/* The SIM_VIEWER_KEY_* bit of a drive key, 0 for the others. */
+static int viewer_drive_bit(int key) {
+  switch (key) {
+    case GLFW_KEY_UP:
+    case GLFW_KEY_W: return SIM_VIEWER_KEY_FORWARD;
+    case GLFW_KEY_DOWN:
+    case GLFW_KEY_S: return SIM_VIEWER_KEY_BACK;
+    case GLFW_KEY_LEFT:
+    case GLFW_KEY_A: return SIM_VIEWER_KEY_LEFT;
+    case GLFW_KEY_RIGHT:
+    case GLFW_KEY_D: return SIM_VIEWER_KEY_RIGHT;
+    default: return 0;
+  }
+}
+
 void sim_viewer_key_state(sim_viewer_t *v, int key, int down) {
+  const int bit = viewer_drive_bit(key);
+  if (bit) v->in.drive_keys = down ? (v->in.drive_keys | bit) : (v->in.drive_keys & ~bit);
   if (down) sim_viewer_key(v, key);
+}
+
+void sim_viewer_set_manual(sim_viewer_t *v, int manual) {
+  v->in.manual = manual != 0;
+  v->in.drive_keys = 0;
 }
 
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods) {
@@ -136,6 +179,7 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   glfwGetFramebufferSize(v->win, &v->w, &v->h);
   mjr_defaultContext(&v->con);
   mjr_makeContext(m, &v->con, mjFONTSCALE_100);
+  viewer_pin_gl_driver();
   mjr_setBuffer(mjFB_WINDOW, &v->con);
   mjv_defaultScene(&v->scn);
   mjv_makeScene(m, &v->scn, 2000 + 4 * m->ngeom);
@@ -270,10 +314,14 @@ static void viewer_overlays(sim_viewer_t *v, mjrRect vp, double t_s) {
   static const char *names[4] = {"driver's", "bird's", "god's", "free"};
   char text[160];
   const char *view = v->in.view >= 0 && v->in.view < 4 ? names[v->in.view] : "overhead";
-  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s", v->in.car,
-           view, t_s, v->in.paused ? "  PAUSED" : "", v->in.day ? "" : "  night");
+  snprintf(text, sizeof text, AUTODRIVE_VEHICLE_PREFIX "%d  %s view  t = %.2f s%s%s%s", v->in.car,
+           view, t_s, v->in.manual ? "  MANUAL" : "", v->in.paused ? "  PAUSED" : "",
+           v->in.day ? "" : "  night");
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, vp, text,
-              "1-4 view  Tab car  N night  Space pause  R reset  M menu  H HUD  Esc quit", &v->con);
+              v->in.manual ? "arrows / WASD drive  T autonomous  1-4 view  Space pause  Esc quit"
+                           : "1-4 view  Tab car  N night  Space pause  R reset  T manual  M menu  "
+                             "H HUD  Esc quit",
+              &v->con);
   if (v->hud_titles[0])
     mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, vp, v->hud_titles, v->hud_values, &v->con);
 }
@@ -300,6 +348,19 @@ static int viewer_read_back(sim_viewer_t *v, mjrRect vp) {
   return 0;
 }
 
+/* The input state to *in; its edges are reported once. */
+static void viewer_take_input(sim_viewer_t *v, sim_viewer_input_t *in) {
+  if (in) *in = v->in;
+  v->in.reset_requested = v->in.step_requested = v->in.record_toggled = 0;
+}
+
+void sim_viewer_poll(sim_viewer_t *v, sim_viewer_input_t *in) {
+  glfwMakeContextCurrent(v->win); /* a click on the panel draws into its buffer */
+  glfwPollEvents();
+  if (glfwWindowShouldClose(v->win)) v->in.quit = 1;
+  viewer_take_input(v, in);
+}
+
 int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_input_t *in) {
   glfwPollEvents();
   if (glfwWindowShouldClose(v->win)) v->in.quit = 1;
@@ -314,8 +375,6 @@ int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_in
   v->have_rgb = 0;
   if (v->capture && viewer_read_back(v, vp) != 0) return -1;
   glfwSwapBuffers(v->win);
-  if (in) *in = v->in;
-  /* edges: reported once */
-  v->in.reset_requested = v->in.step_requested = v->in.record_toggled = 0;
+  viewer_take_input(v, in);
   return 0;
 }

@@ -53,6 +53,7 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   ui_add(v, mjITEM_BUTTON, UI_QUIT, NULL, "");
   ui_add(v, mjITEM_SECTION, "Car", NULL, "");
   ui_add(v, mjITEM_RADIO, "Ego car", &v->ui_car, cars);
+  ui_add(v, mjITEM_RADIO, "Driving", &v->in.manual, "Autonomous\nManual");
   ui_add(v, mjITEM_SECTION, "View", NULL, "");
   ui_add(v, mjITEM_RADIO, "Camera", &v->in.view, cams);
   ui_add(v, mjITEM_SLIDERNUM, "Light level", &v->in.light_level, "0 1");
@@ -84,9 +85,11 @@ void sim_viewer_ui_render(sim_viewer_t *v) {
   v->ui_car = v->in.car - 1;
   /* redrawn into its buffer only when what it shows changed: a software rasteriser pays for
    * every item on every redraw */
-  if (v->ui_dirty || memcmp(&v->ui_shown, &v->in, sizeof v->in) != 0) {
+  sim_viewer_input_t shown = v->in;
+  shown.drive_keys = 0; /* the panel does not show them: holding a key costs no redraw */
+  if (v->ui_dirty || memcmp(&v->ui_shown, &shown, sizeof shown) != 0) {
     mjui_update(-1, -1, &v->ui, &v->ui_state, &v->con);
-    v->ui_shown = v->in;
+    v->ui_shown = shown;
     v->ui_dirty = 0;
   }
   mjui_render(&v->ui, &v->ui_state, &v->con);
