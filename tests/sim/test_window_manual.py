@@ -13,27 +13,21 @@ the waits are guards that fail with what was seen."""
 from __future__ import annotations
 
 import math
-import os
-import select
 import shutil
-import signal
 import subprocess
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import yaml
 
-from autodrive.core import lcmtypes
 from autodrive.core.channels import channel, vehicle_name
 from autodrive.core.settings import RUNTIME_HIL_CONFIG
+from window_rig import GUARD_S, WIN_H, WIN_W, WindowRig, interrupt
 
-WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 # [px] the Car section's Driving radio (tests/sim_sensors checks the layout)
 MANUAL_RADIO = (210, 235)
 AUTONOMOUS_RADIO = (145, 235)
-GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
 AUTHORITY_PERSON = 2  # vehicle_command_t.AUTHORITY_PERSON
 DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 SPEED_TOL_M_S = 0.02  # [m/s] HUD against ground truth at the same sim time (HUD prints 0.01)
@@ -44,36 +38,26 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-class Rig:
+class Rig(WindowRig):
     """Xvfb, the simulator's window with its ptys, the runtime's bridge, and the bus."""
 
     def __init__(self, build: Path, tmp: Path, url: str) -> None:
-        self.display = f":{300 + (os.getpid() + 7) % 600}"
-        self.xvfb = subprocess.Popen(
-            ["Xvfb", self.display, "-screen", "0", f"{WIN_W}x{WIN_H}x24", "-nolisten", "tcp"],
-            stderr=subprocess.DEVNULL,
-        )
-        self.env = dict(os.environ, DISPLAY=self.display)
-        self.types = lcmtypes.load(build)
-        self.lc = lcmtypes.bus(url)
+        super().__init__(build, tmp, url, display_offset=7)
         veh = vehicle_name(1)
-        self.truth: list[tuple[float, float, float, float, float]] = []  # (t [s], x, y, yaw, v)
+        # ground truth: (t [s], x, y [m], yaw [rad], v [m/s])
         self.commands: list[tuple[str, int, bool, float]] = []  # (source, authority, engaged, thr)
         self.holder: list[str] = []
         self.lc.subscribe(channel("GROUND_TRUTH", veh), self._on_truth)
         self.lc.subscribe(channel("COMMAND", veh), self._on_command)
         self.lc.subscribe(channel("CONTROL", veh), self._on_control)
-        self.tmp = tmp
         self.hud_log = tmp / "hud.log"
         run_dir = tmp / "run"
-        self.sim = subprocess.Popen(
+        self.start_sim(
             [str(build / "bin" / "autodrive-sim"), "--view", "--view-size", f"{WIN_W}x{WIN_H}",
              "--no-lidar", "--rtf", "1", "--duration", "3600", "--run-dir", str(run_dir),
              "--lcm-url", url, "--hud-log", str(self.hud_log), "--quiet"],
-            cwd=tmp, env=self.env, stdout=subprocess.PIPE, text=True,
         )  # fmt: skip
-        self.lines: list[str] = []
-        self._until(lambda: "ok" if (run_dir / "nigel1-nano").exists() else None, "the Nano's pty")
+        self.until(lambda: "ok" if (run_dir / "nigel1-nano").exists() else None, "the Nano's pty")
         cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
         cfg.update(lcm_url=url)
         cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
@@ -83,7 +67,7 @@ class Rig:
             [str(build / "bin" / "autodrive-runtime"), "--config", str(tmp / "runtime.yaml"),
              "--only", "bridge"], stdout=self.runtime_log, stderr=subprocess.STDOUT,
         )  # fmt: skip
-        self.wid = self._until(self._window_id, "the window to appear")
+        self.wid = self.until(self.window_id, "the window to appear")
 
     def _on_truth(self, _c: str, data: bytes) -> None:
         m = self.types.ground_truth_t.decode(data)
@@ -97,59 +81,12 @@ class Rig:
     def _on_control(self, _c: str, data: bytes) -> None:
         self.holder.append(self.types.control_status_t.decode(data).holder)
 
-    def _window_id(self) -> str | None:
-        r = subprocess.run(["xdotool", "search", "--name", "AutoDRIVE Nigel sim"],
-                           env=self.env, capture_output=True, text=True)  # fmt: skip
-        return r.stdout.split()[0] if r.returncode == 0 and r.stdout.split() else None
-
-    def pump(self) -> None:
-        while select.select([self.lc.fileno()], [], [], 0.02)[0]:
-            self.lc.handle()
-        assert self.sim.stdout is not None
-        while select.select([self.sim.stdout], [], [], 0)[0]:
-            line = self.sim.stdout.readline()
-            if not line:
-                break
-            self.lines.append(line.strip())
-
-    def _until(self, what: Callable[[], str | None], saying: str) -> str:
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < GUARD_S:
-            self.pump()
-            got = what()
-            if got:
-                return got
-            assert self.sim.poll() is None, f"the simulator exited ({self.sim.returncode})"
-        raise AssertionError(
-            f"waited for {saying}; stdout: {self.lines[-5:]}; holders: {self.holder[-3:]}; "
-            f"commands: {self.commands[-3:]}; truth: {self.truth[-1:]}"
-        )
-
-    def sim_time(self) -> float:
-        self.pump()
-        return self.truth[-1][0] if self.truth else 0.0
-
-    def run_sim(self, seconds: float) -> float:
-        t_end = self.sim_time() + seconds
-        self._until(lambda: "ok" if self.sim_time() >= t_end else None, f"sim time {t_end:.1f} s")
-        return self.sim_time()
-
-    def xdotool(self, *args: str) -> None:
-        subprocess.run(["xdotool", *args], env=self.env, check=True)
+    def details(self) -> str:
+        return (f"; holders: {self.holder[-3:]}; commands: {self.commands[-3:]}; "
+                f"truth: {self.truth[-1:]}")  # fmt: skip
 
     def click(self, x: int, y: int) -> None:
         self.xdotool("mousemove", "--window", self.wid, str(x), str(y), "click", "1")
-
-    def shot(self, name: str) -> None:
-        """The screen (ffmpeg x11grab), copied to $AUTODRIVE_SCREENSHOT_DIR when set."""
-        path = self.tmp / f"{name}.png"
-        subprocess.run(["ffmpeg", "-v", "error", "-y", "-f", "x11grab", "-video_size",
-                        f"{WIN_W}x{WIN_H}", "-i", f"{self.display}+0,0", "-frames:v", "1",
-                        str(path)], env=self.env, check=True)  # fmt: skip
-        assert path.stat().st_size > 0, path
-        out = os.environ.get("AUTODRIVE_SCREENSHOT_DIR")
-        if out:
-            shutil.copy(path, Path(out) / f"{name}.png")
 
     def hud(self) -> list[tuple[float, dict[str, str]]]:
         """The HUD of every frame drawn so far: (sim time [s], {title: value})."""
@@ -162,17 +99,11 @@ class Rig:
         return rows
 
     def close(self) -> int:
+        assert self.sim is not None
         for p in (self.sim, self.runtime):
-            if p.poll() is None:
-                p.send_signal(signal.SIGINT)
-                try:
-                    p.wait(timeout=60)
-                except subprocess.TimeoutExpired:
-                    p.kill()
-                    p.wait()
+            interrupt(p)
         self.runtime_log.close()
-        self.xvfb.terminate()
-        self.xvfb.wait()
+        self.close_display()
         return int(self.sim.returncode)
 
 
@@ -196,10 +127,10 @@ def truth_at(truth: list[tuple[float, float, float, float, float]], t_s: float) 
 
 def test_manual_driving_from_the_window(rig: Rig) -> None:
     r = rig
-    r._until(lambda: "ok" if r.holder else None, "the bridge's NIGEL1_CONTROL")
+    r.until(lambda: "ok" if r.holder else None, "the bridge's NIGEL1_CONTROL")
     r.run_sim(0.3)
     r.click(*MANUAL_RADIO)
-    r._until(lambda: next((s for s in r.lines if s.startswith("manual driving:")), None),
+    r.until(lambda: next((s for s in r.lines if s.startswith("manual driving:")), None),
              "manual mode to start autodrive-teleop")  # fmt: skip
     _, x0, y0, yaw0, _ = r.truth[-1]
     r.xdotool("keydown", "--window", r.wid, "Up")
@@ -207,14 +138,14 @@ def test_manual_driving_from_the_window(rig: Rig) -> None:
         ahead = lambda: (r.truth[-1][1] - x0) * math.cos(yaw0) + (r.truth[-1][2] - y0) * math.sin(
             yaw0
         )  # noqa: E731
-        r._until(
+        r.until(
             lambda: "ok" if ahead() > DRIVE_M else None, f"the car to drive {DRIVE_M} m forward"
         )
         t_driven = r.sim_time()
-        r._until(lambda: "ok" if r.holder[-1] == "teleop" else None, "the lease to go to teleop")
+        r.until(lambda: "ok" if r.holder[-1] == "teleop" else None, "the lease to go to teleop")
         # the picture of the docs: a frame drawn since whose HUD names the person's lease
         n_hud = len(r.hud())
-        r._until(lambda: "ok" if any(kv.get("  control lease") == "teleop (person)"
+        r.until(lambda: "ok" if any(kv.get("  control lease") == "teleop (person)"
                                      for _, kv in r.hud()[n_hud:]) else None,
                  "a HUD frame naming teleop's lease")  # fmt: skip
         r.shot("window-manual")
@@ -225,7 +156,7 @@ def test_manual_driving_from_the_window(rig: Rig) -> None:
     assert engaged and all(c[0] == "teleop" and c[1] == AUTHORITY_PERSON for c in engaged)
     assert max(c[3] for c in engaged) > 0, "no forward throttle commanded"
     # released: the dead-man stops the car (teleop's key hold, then the firmware's brake)
-    r._until(lambda: "ok" if abs(r.truth[-1][4]) < 0.01 else None, "the car to stop")
+    r.until(lambda: "ok" if abs(r.truth[-1][4]) < 0.01 else None, "the car to stop")
     # the HUD: its speed is the ground truth's at the frame's sim time; it named the holder
     hud = r.hud()
     moving = [(t, kv) for t, kv in hud if t <= t_driven and "  speed" in kv]
@@ -240,9 +171,9 @@ def test_manual_driving_from_the_window(rig: Rig) -> None:
     # back to Autonomous: teleop quits, its lease lapses
     n = len(r.holder)
     r.click(*AUTONOMOUS_RADIO)
-    r._until(lambda: next((s for s in r.lines if s.startswith("manual driving off")), None),
+    r.until(lambda: next((s for s in r.lines if s.startswith("manual driving off")), None),
              "autonomous mode to stop autodrive-teleop")  # fmt: skip
-    r._until(lambda: "ok" if len(r.holder) > n and r.holder[-1] == "" else None,
+    r.until(lambda: "ok" if len(r.holder) > n and r.holder[-1] == "" else None,
              "the lease to be free again")  # fmt: skip
     r.xdotool("key", "--window", r.wid, "Escape")
-    assert r.sim.wait(timeout=GUARD_S) == 0
+    assert r.sim is not None and r.sim.wait(timeout=GUARD_S) == 0
