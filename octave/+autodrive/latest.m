@@ -7,14 +7,8 @@ function [msg, type] = latest(sub, timeout_s)
   if nargin < 2
     timeout_s = 1;
   end
-  msg = [];
-  type = '';
-  m = sub.agg.getNextMessage(round(timeout_s * 1000));
-  if isempty(m)
-    return;
+  while sub.agg.numMessagesAvailable() > 1
+    sub.agg.getNextMessage(0);
   end
-  while sub.agg.numMessagesAvailable() > 0
-    m = sub.agg.getNextMessage(0);
-  end
-  [msg, type] = autodrive.decode(sub.lc, m.data);
+  [msg, type] = autodrive.next(sub, timeout_s);
 end
