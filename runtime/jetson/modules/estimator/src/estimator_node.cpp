@@ -123,7 +123,10 @@ struct EstimatorNode::Impl {
     const int64_t period_us = static_cast<int64_t>(1e6 / config.estimator.rate_hz);
     if (next_pub_us == 0 || m->utime >= next_pub_us - period_us / 4) {
       next_pub_us = (next_pub_us == 0 ? m->utime : next_pub_us) + period_us;
-      if (next_pub_us < m->utime) next_pub_us = m->utime + period_us;  // fell behind
+      // fell behind (or just caught up): the next one a period on, so that a STATE of the same
+      // stamp (the sim clock's 10 ms ticks) never publishes this stamp twice (tf's
+      // TF_REPEATED_DATA: 218 of 2054 ODOM stamps were repeats before)
+      if (next_pub_us <= m->utime) next_pub_us = m->utime + period_us;
       publish(odom.estimate_at(m->utime), "odom", AUTODRIVE_CH_ODOM_SUFFIX);
       if (map_fixed)  // never a map pose the car has no fix for (the origin, say)
         publish(map.estimate_at(m->utime), "map", AUTODRIVE_CH_POSE_MAP_SUFFIX);
