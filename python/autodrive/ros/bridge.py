@@ -323,9 +323,8 @@ class StateBridge:
     def publish_tf(self, utime: int, car: str, parent: str, child: str,
                    pose: tuple[float, float, float]) -> None:  # fmt: skip
         child_frame = topics.frame(car, child)
-        # One transform per stamp and frame: the runtime's estimator publishes ~10 % of its
-        # ODOM / POSE_MAP stamps twice on the sim clock, and tf2 warns of each repeat
-        # (TF_REPEATED_DATA, seen in rviz's log).
+        # One transform per stamp and frame: tf2 warns of each repeat (TF_REPEATED_DATA, seen in
+        # rviz's log), and an estimator that published a stamp twice (fixed) must not reach it.
         if utime <= self.tf_last_us.get(child_frame, -1):
             return
         self.tf_last_us[child_frame] = utime
