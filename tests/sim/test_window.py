@@ -9,7 +9,6 @@ Judged by sim time, frames and pixels; the waits are guards that fail with what 
 from __future__ import annotations
 
 import csv
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -19,16 +18,13 @@ import numpy as np
 import pytest
 
 from autodrive.core.channels import channel, vehicle_name
-from window_rig import GUARD_S, WIN_H, WIN_W, WindowRig, interrupt
+from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
 
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
 RECORD_BUTTON = (68, 581)  # [px] the Record button (tests/sim_sensors checks the layout)
 FPS = 30.0
 
-pytestmark = pytest.mark.skipif(
-    not (shutil.which("Xvfb") and shutil.which("xdotool") and shutil.which("ffmpeg")),
-    reason="needs Xvfb, xdotool and ffmpeg (tools/debian-packages.txt)",
-)
+pytestmark = NEEDS_X_TOOLS
 
 
 class Window(WindowRig):

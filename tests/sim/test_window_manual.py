@@ -13,7 +13,6 @@ the waits are guards that fail with what was seen."""
 from __future__ import annotations
 
 import math
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -23,7 +22,7 @@ import yaml
 
 from autodrive.core.channels import channel, vehicle_name
 from autodrive.core.settings import RUNTIME_HIL_CONFIG
-from window_rig import GUARD_S, WIN_H, WIN_W, WindowRig, interrupt
+from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
 
 # [px] the Car section's Driving radio (tests/sim_sensors checks the layout)
 MANUAL_RADIO = (210, 235)
@@ -32,10 +31,7 @@ AUTHORITY_PERSON = 2  # vehicle_command_t.AUTHORITY_PERSON
 DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 SPEED_TOL_M_S = 0.02  # [m/s] HUD against ground truth at the same sim time (HUD prints 0.01)
 
-pytestmark = pytest.mark.skipif(
-    not (shutil.which("Xvfb") and shutil.which("xdotool") and shutil.which("ffmpeg")),
-    reason="needs Xvfb, xdotool and ffmpeg (tools/debian-packages.txt)",
-)
+pytestmark = NEEDS_X_TOOLS
 
 
 class Rig(WindowRig):

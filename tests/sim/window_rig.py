@@ -14,12 +14,19 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
+
 from autodrive.core import lcmtypes
 
 WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
 XVFB_UP_S = 30.0  # [s] wall: a guard for Xvfb's socket (glfwInit failed once before it was up)
 WINDOW_TITLE = "AutoDRIVE Nigel sim"
+
+NEEDS_X_TOOLS = pytest.mark.skipif(
+    not (shutil.which("Xvfb") and shutil.which("xdotool") and shutil.which("ffmpeg")),
+    reason="needs Xvfb, xdotool and ffmpeg (tools/debian-packages.txt)",
+)
 
 
 class WindowRig:
