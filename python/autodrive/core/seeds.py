@@ -29,6 +29,10 @@ MARL_BENCH_FIRST_SEED = EVALUATION.start + 1000
 # tools/bench v2x's smart-city runs (V2X_BENCH_SEED overrides the first): a block of the
 # evaluation range kept for it, one seed per measurement, the next after each
 V2X_BENCH_SEEDS = range(EVALUATION.start + 201, EVALUATION.start + 221)
+# tools/bench cloning's evaluations: a block of the evaluation range kept for it; the default
+# --seed is the next one no measurement used (1 500 000 501: the shipped model, 2026-12-03)
+CLONING_BENCH_SEEDS = range(EVALUATION.start + 501, EVALUATION.start + 521)
+CLONING_BENCH_NEXT_SEED = CLONING_BENCH_SEEDS.start + 1
 
 
 def range_of(seed: int) -> str:
