@@ -12,6 +12,7 @@
 
 #include "camera_fx.h"
 #include "cameras.h"
+#include "sim_viewer.h"
 #include "eye_sync.h"
 #include "script.h"
 #include "sim_instance.h"
@@ -145,6 +146,10 @@ static void options_usage_output(FILE *f) {
       "                      M the Menu Panel; H the HUD; T manual driving (arrows or WASD,\n"
       "                      through autodrive-teleop: signed, on the control lease); Esc quit\n"
       "  --view-size WxH     the window's size (default 1024x768 px)\n"
+      "  --view-scale S      the window's scene drawn at S (0.25..1) of its pixels per side and\n"
+      "                      stretched (default 1, and 0.5 on software GL such as llvmpipe)\n"
+      "  --view-quality Q    low (default: no shadows, reflections, skybox), high (shadows)\n"
+      "                      or ultra (shadows, reflections, skybox); the View section's boxes\n"
       "  --hud-log FILE      with --view: each drawn frame's HUD text as a line of FILE (sim\n"
       "                      time [us], then title=value fields, tab-separated)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
@@ -407,6 +412,19 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
+  } else if (!strcmp(a, "--view-quality") && v) {
+    o->view_quality = !strcmp(v, "low")     ? SIM_VIEWER_QUALITY_LOW
+                      : !strcmp(v, "high")  ? SIM_VIEWER_QUALITY_HIGH
+                      : !strcmp(v, "ultra") ? SIM_VIEWER_QUALITY_ULTRA
+                                            : -1;
+    if (o->view_quality < 0) {
+      fprintf(stderr, "autodrive-sim: --view-quality '%s': expected low, high or ultra\n", v);
+      return OPTIONS_BAD;
+    }
+    o->view_quality_given = 1;
+    return 1;
+  } else if (!strcmp(a, "--view-scale")) {
+    return options_number(a, v, SIM_VIEWER_MIN_SCALE, 1.0, &o->view_scale) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--view-size")) {
     char tail = 0;
     if (!v || sscanf(v, "%dx%d%c", &o->view_w, &o->view_h, &tail) != 2 || o->view_w < 640 ||
@@ -451,6 +469,12 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
             "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
+    return OPTIONS_BAD;
+  }
+  if ((o->view_scale > 0 || o->view_quality_given) && !o->view) {
+    fprintf(stderr,
+            "autodrive-sim: --view-scale and --view-quality need --view (they set how "
+            "the window draws)\n");
     return OPTIONS_BAD;
   }
   if (o->hud_log && !o->view) {

@@ -314,6 +314,7 @@ int app_run(app_t *a, app_run_stats_t *st) {
   publish_queue_destroy(a->pubq); /* sends what is still queued: part of the run's time */
   a->pubq = NULL;
   st->wall_s = app_wall_s() - l.t0;
+  viewer_window_stop(&a->viewer); /* after the run's time: the last frame is no part of it */
   st->cpu_s = app_cpu_s() - cpu0 - bench_pairs_bare_cpu_s(&l.pairs);
   st->steps = l.step;
   double eye_waited_s = 0.0;
