@@ -259,6 +259,7 @@ def sensors(build: Path, res: dict[str, Any]) -> None:
 VIEWER_PARTS = ("update", "scene", "blit", "hud", "ui", "swap")  # sim_viewer_part_t
 # (name, extra autodrive-sim arguments): the breakdown's other looks, one window run each
 VIEWER_LOOKS = (
+    ("nice_0", ["--view-nice", "0"]),  # the window's threads at the stepping's priority
     ("scale_1", ["--view-scale", "1"]),
     ("scale_1_high", ["--view-scale", "1", "--view-quality", "high"]),
     ("scale_1_ultra", ["--view-scale", "1", "--view-quality", "ultra"]),
@@ -299,7 +300,8 @@ def viewer(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None
                 break
             time.sleep(0.05)
         for k in range(repeats):
-            headless.append(bench.run(args, url))
+            # unpaired like the window's run (never paired): a like-for-like baseline
+            headless.append(bench.run(args + ["--bench-unpaired"], url))
             os.environ["DISPLAY"] = display
             try:
                 window.append(bench.run(args + ["--view"], url))

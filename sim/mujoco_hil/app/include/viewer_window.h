@@ -58,6 +58,7 @@ typedef struct viewer_window {
   int started;          /* the thread runs (join it) */
   int sync_made;        /* mu and cv made */
   const mjModel *model; /* the render model */
+  int nice;             /* the drawing thread's */
   viewer_slot_t slot[3];
   int back, pending, front; /* slot indices: the stepping's, the shared one, the drawing's */
   int fresh, stop, failed;  /* fresh: pending holds a snapshot not drawn yet */
@@ -74,10 +75,11 @@ typedef struct viewer_window {
 } viewer_window_t;
 
 /* How the window draws: the render scale (0: the GL renderer's default, sim_viewer.h), the
- * graphics quality (SIM_VIEWER_QUALITY_*), and timing of the frame's parts (--bench). */
+ * graphics quality (SIM_VIEWER_QUALITY_*), timing of the frame's parts (--bench), and the nice
+ * of its drawing and rasteriser threads (--view-nice). */
 typedef struct viewer_window_look {
   double scale;
-  int quality, timing;
+  int quality, timing, nice;
 } viewer_window_look_t;
 
 /* Opens a width_px x height_px window when want (a display is needed) and starts its drawing

@@ -285,7 +285,8 @@ int app_run(app_t *a, app_run_stats_t *st) {
   l.next_progress = l.t0 + LOOP_PROGRESS_S;
   l.next_flush = l.t0;
   int rc = 0;
-  l.paired = o->bench && o->lockstep && !o->client_sync && !o->frame_sync && !a->viewer.v;
+  l.paired = o->bench && !o->bench_unpaired && o->lockstep && !o->client_sync && !o->frame_sync &&
+             !a->viewer.v;
   if (l.paired && bench_pairs_start(&l.pairs, s) != 0) {
     fprintf(stderr, "autodrive-sim: --bench: out of memory for the bare mj_step blocks\n");
     rc = 1;

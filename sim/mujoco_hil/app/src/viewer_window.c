@@ -17,9 +17,6 @@
 #define VIEWER_FRAME_S (1.0 / 30.0) /* [s] wall between frames */
 #define VIEWER_RTF_WINDOW_S 1.0     /* [s] wall over which the HUD's rtf is measured */
 #define VIEWER_LIDAR_HEIGHT_M 0.12  /* rays drawn this far above base_link (the RPLIDAR's deck) */
-/* the drawing thread's nice: the window takes the CPU that the stepping and the programs on the
- * ptys leave (on a 2-core machine with software GL a frame is ~30 ms of CPU) */
-#define VIEWER_DRAW_NICE 10
 
 /* --hud-log: one line per drawn frame, sim time [us] then title=value fields (tab-separated). */
 static void viewer_hud_log(FILE *f, const viewer_slot_t *slot) {
@@ -40,7 +37,7 @@ static void *viewer_thread_run(void *arg) {
   viewer_window_t *w = arg;
   const mjModel *m = NULL;
   /* Linux: PRIO_PROCESS with a thread id sets that thread alone; raising nice is always allowed */
-  setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), VIEWER_DRAW_NICE);
+  setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), w->nice);
   pthread_mutex_lock(&w->mu);
   for (;;) {
     while (!w->fresh && !w->stop) pthread_cond_wait(&w->cv, &w->mu);
@@ -119,6 +116,10 @@ int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_p
   if (look.scale > 0) sim_viewer_set_render_scale(w->v, look.scale);
   sim_viewer_set_quality(w->v, look.quality);
   sim_viewer_time_parts(w->v, look.timing);
+  /* never below the process's own nice (lowering it needs a privilege) */
+  const int own = getpriority(PRIO_PROCESS, 0);
+  w->nice = look.nice > own ? look.nice : own;
+  sim_viewer_nice(w->v, w->nice);
   w->rtf_wall_s = app_wall_s();
   if (ptys && !(w->lease = control_status_lcm_create(url, sim_cars(s), err, err_sz))) return -1;
   if (hud_log && !(w->hud_log = fopen(hud_log, "w"))) {

@@ -119,6 +119,9 @@ void sim_viewer_set_render_scale(sim_viewer_t *v, double scale);
  * low none, high shadows, ultra shadows, reflections and the skybox. Before sim_viewer_detach. */
 enum { SIM_VIEWER_QUALITY_LOW = 0, SIM_VIEWER_QUALITY_HIGH, SIM_VIEWER_QUALITY_ULTRA };
 void sim_viewer_set_quality(sim_viewer_t *v, int quality);
+/* Sets the nice of the rasteriser threads (Mesa's llvmpipe-*) that the window's context
+ * started (none on a GPU): a software rasteriser's frames then take the CPU that others leave. */
+void sim_viewer_nice(sim_viewer_t *v, int nice);
 /* The GL renderer's name (GL_RENDERER) and 1 if it is a software rasteriser. */
 const char *sim_viewer_renderer(const sim_viewer_t *v, int *software);
 

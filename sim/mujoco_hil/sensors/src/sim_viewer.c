@@ -62,17 +62,19 @@ static int viewer_raster_threads(int *tid, int max) {
   return n;
 }
 
-/* The rasteriser threads the window's context started (not in before[0..nbefore)) get
- * SIM_VIEWER_NICE: on a software rasteriser the window then takes the CPU that the stepping
- * and the programs on its ptys leave, instead of tripping their deadlines on a busy machine. */
-static void viewer_nice_new_raster_threads(const int *before, int nbefore) {
-  int now[64];
-  const int n = viewer_raster_threads(now, 64);
+/* The rasteriser threads the window's context started: those not in before[0..nbefore). */
+static void viewer_find_raster_threads(sim_viewer_t *v, const int *before, int nbefore) {
+  int now[SIM_VIEWER_MAX_RASTER];
+  const int n = viewer_raster_threads(now, SIM_VIEWER_MAX_RASTER);
   for (int i = 0; i < n; i++) {
     int old = 0;
     for (int k = 0; k < nbefore && !old; k++) old = before[k] == now[i];
-    if (!old) setpriority(PRIO_PROCESS, (id_t)now[i], SIM_VIEWER_NICE);
+    if (!old) v->raster_tid[v->nraster++] = now[i];
   }
+}
+
+void sim_viewer_nice(sim_viewer_t *v, int nice) {
+  for (int i = 0; i < v->nraster; i++) setpriority(PRIO_PROCESS, (id_t)v->raster_tid[i], nice);
 }
 
 int sim_viewer_display_available(void) {
@@ -238,8 +240,8 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   glfw_users++;
   sim_viewer_t *v = calloc(1, sizeof *v);
   if (!v) return NULL;
-  int raster_before[64];
-  const int nraster_before = viewer_raster_threads(raster_before, 64);
+  int raster_before[SIM_VIEWER_MAX_RASTER];
+  const int nraster_before = viewer_raster_threads(raster_before, SIM_VIEWER_MAX_RASTER);
   glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
   glfwWindowHint(GLFW_SAMPLES, 0);
   glfwWindowHint(GLFW_DOUBLEBUFFER, GLFW_TRUE);
@@ -272,7 +274,7 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   viewer_pin_gl_driver();
   mjr_setBuffer(mjFB_WINDOW, &v->con);
   viewer_detect_renderer(v);
-  viewer_nice_new_raster_threads(raster_before, nraster_before);
+  viewer_find_raster_threads(v, raster_before, nraster_before);
   mjv_defaultScene(&v->scn);
   mjv_makeScene(m, &v->scn, 2000 + 4 * m->ngeom);
   v->scn.flags[mjRND_SHADOW] = 0;
@@ -433,8 +435,13 @@ static void viewer_overlays(sim_viewer_t *v, mjrRect vp, double t_s) {
                            : "1-4 view  Tab car  N night  Space pause  R reset  T manual  M menu  "
                              "H HUD  Esc quit",
               &v->con);
-  if (v->hud_titles[0])
-    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, vp, v->hud_titles, v->hud_values, &v->con);
+  if (!v->hud_titles[0]) return;
+  /* the render scale as the HUD's last line: the status line's left half is under the panel */
+  char titles[SIM_VIEWER_HUD_CHARS + 32], values[SIM_VIEWER_HUD_CHARS + 96];
+  snprintf(titles, sizeof titles, "%s\nrender scale", v->hud_titles);
+  snprintf(values, sizeof values, "%s\n%.2f%s%.40s%s", v->hud_values, v->in.render_scale,
+           v->software ? " (" : "", v->software ? v->renderer : "", v->software ? ")" : "");
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, vp, titles, values, &v->con);
 }
 
 /* Reads the frame back (before the swap) into v->rgb, rows top-down. Returns 0, or -1. */

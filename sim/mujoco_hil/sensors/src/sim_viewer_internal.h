@@ -14,7 +14,7 @@
 #define SIM_VIEWER_NIGHT_LEVEL 0.15 /* N: the light level of night (day 1) */
 #define SIM_VIEWER_QUEUE 256        /* window events queued for the drawing thread */
 #define SIM_VIEWER_SHADOW_PX 2048   /* [px] the shadow map's side when the model has none */
-#define SIM_VIEWER_NICE 10          /* nice of the window's rasteriser threads (llvmpipe) */
+#define SIM_VIEWER_MAX_RASTER 64    /* rasteriser threads (llvmpipe-*) looked at */
 
 /* A window event on its way from the polling thread to the drawing thread. */
 typedef struct sim_viewer_event {
@@ -56,8 +56,10 @@ struct sim_viewer {
   float *ray_end;       /* nrays x 3 [m] world */
   int nrays;
   char hud_titles[SIM_VIEWER_HUD_CHARS], hud_values[SIM_VIEWER_HUD_CHARS];
-  char renderer[128]; /* GL_RENDERER */
-  int software;       /* 1: a software rasteriser (llvmpipe, softpipe) */
+  char renderer[128];                    /* GL_RENDERER */
+  int raster_tid[SIM_VIEWER_MAX_RASTER]; /* the rasteriser threads its context started */
+  int nraster;
+  int software; /* 1: a software rasteriser (llvmpipe, softpipe) */
   /* threads (sim_viewer_detach): mu guards the queue, in_pub, cam_pub and fb_w/h */
   int threaded, bound; /* bound: the context is current on the drawing thread */
   int mu_made;
