@@ -11,7 +11,7 @@ from pathlib import Path
 
 from window_rig import NEEDS_X_TOOLS, WindowRig
 
-SIM_S = 60.0  # [s] sim time: a second or more of wall time in free lockstep, for a few frames
+SIM_S = 60.0  # [s] sim time: ~1 s of wall time in free lockstep (release), a few frames
 SCRIPT = "constant:throttle=0.5,steering=0.3"
 
 pytestmark = NEEDS_X_TOOLS
@@ -41,7 +41,8 @@ def test_stepping_goes_on_while_the_window_draws(
     assert len(headless) > 0 and windowed == headless, "the window changed the run"
     assert bench["steps"] == round(SIM_S * 1000)
     frames_us = [int(line.split("\t")[0]) for line in hud.read_text().splitlines()]
-    assert bench["viewer_frames"] == len(frames_us) >= 2, bench
+    # >= 1: under ASan the first frame (the shaders, the panel's buffer) can outlast the run
+    assert bench["viewer_frames"] == len(frames_us) >= 1, bench
     assert frames_us == sorted(frames_us), "frames drawn out of sim-time order"
     # the stepping did not wait for GL: it stepped while frames were being drawn
     assert bench["viewer_steps_while_drawing"] > 0, bench
