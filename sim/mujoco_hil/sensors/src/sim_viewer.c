@@ -488,7 +488,7 @@ static void viewer_part_done(sim_viewer_t *v, int part, double *t_ms) {
 }
 
 /* The scene at the render scale: straight into the window at 1, else into the offscreen
- * buffer and stretched (GL_LINEAR) to the window. */
+ * buffer and stretched to the window. */
 static void viewer_render_scene(sim_viewer_t *v, mjrRect vp, double *t_ms) {
   double s = v->in.render_scale;
   s = s < SIM_VIEWER_MIN_SCALE ? SIM_VIEWER_MIN_SCALE : s > 1.0 ? 1.0 : s;
