@@ -101,6 +101,13 @@ TEST(Cli, BadOptionsAreRejected) {
   EXPECT_EQ(run("--rtf fast").status, 2);
   EXPECT_EQ(run("--lockstep --rtf 3").status, 2);
   EXPECT_EQ(run("--frobnicate").status, 2);
+  // the window's look: named errors, and each needs --view
+  for (const char *bad : {"--view --view-scale 2", "--view --view-quality best",
+                          "--view --view-nice 2.5", "--view-scale 0.5", "--view-nice 5"}) {
+    const ProcResult v = run(bad);
+    EXPECT_EQ(v.status, 2) << bad;
+    EXPECT_NE(v.out.find("--view"), std::string::npos) << bad << ": " << v.out;
+  }
   const ProcResult r = run("--lockstep --no-pty --lcm-url memq:// --script constant:throttle=9");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("throttle"), std::string::npos) << r.out;

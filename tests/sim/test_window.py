@@ -21,7 +21,7 @@ from autodrive.core.channels import channel, vehicle_name
 from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
 
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
-RECORD_BUTTON = (68, 581)  # [px] the Record button (tests/sim_sensors checks the layout)
+RECORD_BUTTON = (68, 585)  # [px] the Record button (tests/sim_sensors checks the layout)
 FPS = 30.0
 
 pytestmark = NEEDS_X_TOOLS
@@ -33,10 +33,12 @@ class Window(WindowRig):
     def __init__(self, build: Path, tmp: Path, url: str) -> None:
         super().__init__(build, tmp, url, display_offset=0)
         self.lc.subscribe(channel("GROUND_TRUTH", vehicle_name(1)), self._on_truth)
+        self.hud_log = tmp / "hud.log"  # a line per frame drawn (the drawing has a thread)
         self.start_sim(
             [str(build / "bin" / "autodrive-sim"), "--view", "--view-size", f"{WIN_W}x{WIN_H}", "--no-pty", "--no-lidar",
              "--rtf", "1", "--duration", "3600", "--run-dir", str(tmp), "--lcm-url", url,
-             "--script", "constant:throttle=0.35,steering=0", "--quiet"],
+             "--script", "constant:throttle=0.35,steering=0", "--hud-log", str(self.hud_log),
+             "--quiet"],
         )  # fmt: skip
         self.wid = self.until(self.window_id, "the window to appear")
 
@@ -44,13 +46,24 @@ class Window(WindowRig):
         m = self.types.ground_truth_t.decode(data)
         self.truth.append((m.utime * 1e-6, m.position_m[0], m.position_m[1]))  # (t [s], x, y [m])
 
+    def frames(self) -> int:
+        return len(self.hud_log.read_text().splitlines()) if self.hud_log.exists() else 0
+
+    def drawn_since(self) -> None:
+        """Waits for the event to be polled (at ~30 Hz of wall time, so within 0.15 s of sim
+        time at rtf 1) and then for two frames more: the one that took it, and one that shows
+        it."""
+        self.run_sim(0.15)
+        n = self.frames()
+        self.until(lambda: "ok" if self.frames() >= n + 2 else None, "two frames drawn")
+
     def key(self, name: str) -> None:
         self.xdotool("key", "--window", self.wid, name)
-        self.run_sim(0.15)  # a few frames drawn since
+        self.drawn_since()
 
     def click(self, x: int, y: int) -> None:
         self.xdotool("mousemove", "--window", self.wid, str(x), str(y), "click", "1")
-        self.run_sim(0.15)
+        self.drawn_since()
 
     def shot_image(self, name: str) -> np.ndarray:
         path = self.shot(name)

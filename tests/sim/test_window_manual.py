@@ -25,8 +25,8 @@ from autodrive.core.settings import RUNTIME_HIL_CONFIG
 from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
 
 # [px] the Car section's Driving radio (tests/sim_sensors checks the layout)
-MANUAL_RADIO = (210, 235)
-AUTONOMOUS_RADIO = (145, 235)
+MANUAL_RADIO = (210, 209)
+AUTONOMOUS_RADIO = (145, 209)
 AUTHORITY_PERSON = 2  # vehicle_command_t.AUTHORITY_PERSON
 DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 SPEED_TOL_M_S = 0.02  # [m/s] HUD against ground truth at the same sim time (HUD prints 0.01)

@@ -233,12 +233,14 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   EXPECT_EQ(in.view, SIM_VIEW_DRIVER);
   click("Shadows");
   EXPECT_EQ(in.shadows, 1);
+  click("Scale");  // the render scale slider's middle
+  EXPECT_NEAR(in.render_scale, 0.625, 0.15);
   // the Car section's Driving radio, and the drive keys it lets the caller read
   ASSERT_EQ(sim_viewer_item_at(v, "Driving/Manual", &cx, &cy), 0);
   printf("Driving/Manual at (%.0f, %.0f) px\n", cx, cy);
   // tests/sim/test_window_manual.py clicks the real program's radio here
   EXPECT_NEAR(cx, 210, 2);
-  EXPECT_NEAR(cy, 235, 2);
+  EXPECT_NEAR(cy, 209, 2);
   click("Driving/Manual");
   EXPECT_EQ(in.manual, 1);
   sim_viewer_key_state(v, GLFW_KEY_UP, 1);
@@ -252,14 +254,14 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   ASSERT_EQ(sim_viewer_item_at(v, "Driving/Autonomous", &cx, &cy), 0);
   printf("Driving/Autonomous at (%.0f, %.0f) px\n", cx, cy);
   EXPECT_NEAR(cx, 145, 2);
-  EXPECT_NEAR(cy, 235, 2);
+  EXPECT_NEAR(cy, 209, 2);
   click("Driving/Autonomous");
   EXPECT_EQ(in.manual, 0);
   EXPECT_EQ(in.drive_keys, 0);
   ASSERT_EQ(sim_viewer_item_at(v, "Start or stop", &cx, &cy), 0);
   // tests/sim/test_window.py clicks the real program's Record button here
   EXPECT_NEAR(cx, 68, 2);
-  EXPECT_NEAR(cy, 581, 2);
+  EXPECT_NEAR(cy, 585, 2);
   printf("Record button at (%.0f, %.0f) px\n", cx, cy);
   click("Start or stop");
   EXPECT_EQ(in.record_toggled, 1);

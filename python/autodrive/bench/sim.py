@@ -27,7 +27,9 @@ rendered both ways), their ratio, the wall-clock medians (*_wall_*, load-depende
 pixels differ (eye_render_differing_fraction, eye_render_max_abs_diff) and the load average
 when it ran (eye_render_load_avg). Goals: <= 10 ms, and at most 1e-4 of the pixels differing.
 viewer_fps, rtf_window_over_headless (goals >= 30, >= 0.8): the window with its HUD and Menu
-Panel, 1 car in Tiny Town, against the same run headless (viewer()).
+Panel, 1 car in Tiny Town, against the same run headless (viewer()), with the median time of
+each part of a frame (viewer_<part>_ms_median) at the default look and at others
+(*_scale_1, *_scale_1_high, *_scale_1_ultra).
 Options: SIM_BENCH_REPEATS (3).
 """
 
@@ -62,7 +64,9 @@ TOP_SPEED_SETTLE_US = 2e6
 EYE_RENDER_STARTS = ("1,-3.0,-3.14,0", "2,3.0,-3.14,180", "3,-3.0,2.86,0", "4,3.0,2.86,180")
 EYE_RENDER_DURATION_S = 2.0  # 60 frame times x 4 cameras, each rendered cached and in full
 EYE_RENDER_GOAL_MS = 10.0
-VIEWER_SIM_S = 3.0  # [s] sim time of each viewer run
+# [s] sim time of each viewer run: free lockstep runs Tiny Town at rtf ~20-60 here, so 5-15 s
+# of wall time, a few hundred frames
+VIEWER_SIM_S = 300.0
 EYE_RENDER_MAX_DIFFERING = 1e-4  # fraction of the pixels (tests/sim: sim.EyeRenderCache.*)
 log = Progress("sim")
 
@@ -252,12 +256,32 @@ def sensors(build: Path, res: dict[str, Any]) -> None:
         log(f"sim-sensors-bench failed, no lidar/camera figures: {e}")
 
 
-def viewer(bench: SimBench, url: str, res: dict[str, Any]) -> None:
-    """The window (issue 36): 1 car in Tiny Town in lockstep, headless and then with --view
-    (HUD and Menu Panel on) on an Xvfb of its own, back to back. viewer_fps = 1 / the median
-    wall time to draw a frame (the rate the window can keep; it draws at most 30 Hz of wall
-    time); rtf_window_over_headless = rtf with the window / rtf headless. Xvfb renders with
-    Mesa's llvmpipe on the CPU: on a laptop's GPU the window costs far less."""
+VIEWER_PARTS = ("update", "scene", "blit", "hud", "ui", "swap")  # sim_viewer_part_t
+# (name, extra autodrive-sim arguments): the breakdown's other looks, one window run each
+VIEWER_LOOKS = (
+    ("nice_0", ["--view-nice", "0"]),  # the window's threads at the stepping's priority
+    ("scale_1", ["--view-scale", "1"]),
+    ("scale_1_high", ["--view-scale", "1", "--view-quality", "high"]),
+    ("scale_1_ultra", ["--view-scale", "1", "--view-quality", "ultra"]),
+)
+
+
+def _viewer_figures(r: dict[str, Any], suffix: str, res: dict[str, Any]) -> None:
+    res["viewer_fps" + suffix] = r["viewer_fps"]
+    res["viewer_frame_ms_median" + suffix] = r["viewer_frame_ms_median"]
+    for part in VIEWER_PARTS:
+        res[f"viewer_{part}_ms_median{suffix}"] = r[f"viewer_{part}_ms_median"]
+
+
+def viewer(bench: SimBench, url: str, repeats: int, res: dict[str, Any]) -> None:
+    """The window (issue 36): 1 car in Tiny Town in free lockstep, headless and then with --view
+    (HUD and Menu Panel on) on an Xvfb of its own, back to back, repeats times; then one window
+    run per other look (VIEWER_LOOKS) for the breakdown. viewer_fps = 1 / the median wall time
+    to draw a frame (the rate the window can keep; it draws at most 30 Hz of wall time, from
+    snapshots: viewer_fps_drawn is the rate it drew); rtf_window_over_headless = rtf with the
+    window / rtf headless within each pair, their median. --bench times each part of a frame
+    (each ended by glFinish: viewer_<part>_ms_median). Xvfb renders with Mesa's llvmpipe on the
+    CPU: on a laptop's GPU the window costs far less."""
     if not shutil.which("Xvfb"):
         log("viewer: Xvfb missing (tools/debian-packages.txt): viewer figures left out")
         return
@@ -266,30 +290,50 @@ def viewer(bench: SimBench, url: str, res: dict[str, Any]) -> None:
         ["Xvfb", display, "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
         stderr=subprocess.DEVNULL,
     )
+    res["viewer_load_avg_start"] = round(os.getloadavg()[0], 1)
+    args = ["--lockstep", "--map", "tiny_town", "--no-pty", "--duration", str(VIEWER_SIM_S)]
+    headless, window, looks = [], [], {}
     try:
         sock = Path(f"/tmp/.X11-unix/X{display[1:]}")
         for _ in range(300):  # readiness, not a timing figure
             if sock.exists():
                 break
             time.sleep(0.05)
-        args = ["--lockstep", "--map", "tiny_town", "--no-pty", "--duration", str(VIEWER_SIM_S)]
-        headless = bench.run(args, url)
-        log(f"viewer: headless rtf {headless['rtf']:.2f}")
-        os.environ["DISPLAY"] = display
-        try:
-            window = bench.run(args + ["--view"], url)
-        finally:
-            del os.environ["DISPLAY"]
+        for k in range(repeats):
+            # unpaired like the window's run (never paired): a like-for-like baseline
+            headless.append(bench.run(args + ["--bench-unpaired"], url))
+            os.environ["DISPLAY"] = display
+            try:
+                window.append(bench.run(args + ["--view"], url))
+                if k == 0:
+                    looks = {name: bench.run(args + ["--view"] + extra, url)
+                             for name, extra in VIEWER_LOOKS}  # fmt: skip
+            finally:
+                del os.environ["DISPLAY"]
+            w = window[-1]
+            log(
+                f"viewer run {k + 1}/{repeats}: headless rtf {headless[-1]['rtf']:.1f}, window "
+                f"rtf {w['rtf']:.1f}; {w['viewer_fps']:.1f} fps ({w['viewer_frame_ms_median']:.1f}"
+                f" ms a frame, {w['viewer_fps_drawn']:.1f} drawn), scale "
+                f"{w['viewer_render_scale']}, {w['viewer_renderer']}"
+            )
     finally:
         xvfb.terminate()
         xvfb.wait()
-    log(f"viewer: window rtf {window['rtf']:.2f}, {window['viewer_fps']:.1f} fps")
-    res["viewer_fps"] = window["viewer_fps"]
-    res["viewer_frame_ms_median"] = window["viewer_frame_ms_median"]
-    res["viewer_frames"] = window["viewer_frames"]
-    res["rtf_1_tiny_town_headless"] = headless["rtf"]
-    res["rtf_1_tiny_town_window"] = window["rtf"]
-    res["rtf_window_over_headless"] = round(window["rtf"] / headless["rtf"], 3)
+    mid = sorted(window, key=lambda r: r["viewer_fps"])[len(window) // 2]
+    _viewer_figures(mid, "", res)
+    res["viewer_fps_drawn"] = median([r["viewer_fps_drawn"] for r in window])
+    res["viewer_frames"] = mid["viewer_frames"]
+    res["viewer_steps_while_drawing"] = mid["viewer_steps_while_drawing"]
+    res["viewer_render_scale"] = mid["viewer_render_scale"]
+    res["viewer_renderer"] = mid["viewer_renderer"]
+    for name, r in looks.items():
+        _viewer_figures(r, "_" + name, res)
+        log(f"viewer {name}: {r['viewer_fps']:.1f} fps, scene {r['viewer_scene_ms_median']} ms")
+    res["rtf_1_tiny_town_headless"] = median([r["rtf"] for r in headless])
+    res["rtf_1_tiny_town_window"] = median([r["rtf"] for r in window])
+    ratios = [w["rtf"] / h["rtf"] for w, h in zip(window, headless)]
+    res["rtf_window_over_headless"] = round(statistics.median(ratios), 3)
     res["viewer_load_avg"] = round(os.getloadavg()[0], 1)
 
 
@@ -335,7 +379,7 @@ def main(argv: list[str]) -> int:
     url = bench.pick_url()
     speed(bench, url, repeats, res)
     eye_render(bench, url, res)
-    viewer(bench, url, res)
+    viewer(bench, url, repeats, res)
     instructions(bench, res)
     fidelity(bench, res)
     sensors(build, res)

@@ -21,7 +21,13 @@ typedef struct app_options {
   int host_io_ms; /* --host-io-ms; 0: the mode's default */
   double rtf, duration_s;
   int bench, quiet, lidar_lcm, view;
-  int view_w, view_h;  /* --view-size [px] */
+  int bench_unpaired; /* --bench-unpaired: no bare blocks paired into the run */
+  int view_w, view_h; /* --view-size [px] */
+  double view_scale;  /* --view-scale: the scene's render scale, 0: the renderer's default */
+  int view_quality;   /* --view-quality: SIM_VIEWER_QUALITY_* (low) */
+  int view_quality_given;
+  int view_nice; /* --view-nice: of the window's drawing and rasteriser threads (10) */
+  int view_nice_given;
   const char *hud_log; /* --hud-log FILE: each frame's HUD text, or NULL */
   /* --video FILE, --record DIR (run_recorder.h), --video-camera NAME; NULL when not given */
   const char *video, *record_dir, *video_camera;

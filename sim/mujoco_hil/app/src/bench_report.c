@@ -71,10 +71,6 @@ void app_print_bench(const app_t *a, const app_run_stats_t *st, const bench_pair
       "\"light_commands_unverified\": %ld",
       sim_traffic_lights(s)->n, commands, refused, traffic_lights_lcm_unverified(a->lights));
   bench_print_cameras(a);
-  if (a->viewer.v) { /* the window: its frames and the median time to draw one */
-    const double draw_s = viewer_window_median_draw_s(&a->viewer);
-    printf(", \"viewer_frames\": %ld, \"viewer_frame_ms_median\": %.3f, \"viewer_fps\": %.2f",
-           a->viewer.frames, draw_s * 1e3, draw_s > 0 ? 1.0 / draw_s : 0.0);
-  }
+  if (a->viewer.v) viewer_window_print_bench(&a->viewer, stdout); /* its drawing stopped */
   printf("}\n");
 }

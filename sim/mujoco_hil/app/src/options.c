@@ -12,12 +12,14 @@
 
 #include "camera_fx.h"
 #include "cameras.h"
+#include "sim_viewer.h"
 #include "eye_sync.h"
 #include "script.h"
 #include "sim_instance.h"
 
-#define OPTIONS_BAD 2      /* a bad option or value: the exit status */
-#define OPTIONS_UNKNOWN -2 /* not an option of this group */
+#define OPTIONS_BAD 2        /* a bad option or value: the exit status */
+#define OPTIONS_UNKNOWN -2   /* not an option of this group */
+#define OPTIONS_VIEW_NICE 10 /* --view-nice's default */
 
 /* --help, part 1: what the program is, and the world it builds (cars, map, starts, boxes). */
 static void options_usage_world(FILE *f) {
@@ -140,11 +142,20 @@ static void options_usage_sensors(FILE *f) {
 static void options_usage_output(FILE *f) {
   fputs(
       "  --bench             print a JSON summary (sim_s, wall_s, rtf, bare_mj_step_rtf) at exit\n"
+      "  --bench-unpaired    --bench without bare mj_step blocks paired into free lockstep (the\n"
+      "                      headless baseline of a --view run, which is never paired)\n"
       "  --view              open a window (needs a display): 1/2/3 driver's, bird's, god's\n"
       "                      eye, 4 free; Tab next car; N day/night; Space pause; R reset;\n"
       "                      M the Menu Panel; H the HUD; T manual driving (arrows or WASD,\n"
       "                      through autodrive-teleop: signed, on the control lease); Esc quit\n"
       "  --view-size WxH     the window's size (default 1024x768 px)\n"
+      "  --view-scale S      the window's scene drawn at S (0.25..1) of its pixels per side and\n"
+      "                      stretched (default 1, and 0.5 on software GL such as llvmpipe)\n"
+      "  --view-quality Q    low (default: no shadows, reflections, skybox), high (shadows)\n"
+      "                      or ultra (shadows, reflections, skybox); the View section's boxes\n"
+      "  --view-nice N       the nice of the window's drawing and software-rasteriser threads\n"
+      "                      (0..19, default 10: the window takes the CPU the sim and the\n"
+      "                      programs on its ptys leave; 0: the window competes with them)\n"
       "  --hud-log FILE      with --view: each drawn frame's HUD text as a line of FILE (sim\n"
       "                      time [us], then title=value fields, tab-separated)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
@@ -201,6 +212,7 @@ static void options_defaults(app_options_t *o) {
   o->video_camera = "nigel1/cam_front";
   o->view_w = 1024;
   o->view_h = 768;
+  o->view_nice = OPTIONS_VIEW_NICE;
   o->camera_fps = 30.0;
   o->eye_sync_wait_s = EYE_SYNC_LOST_S;
   o->light_level = -1.0;
@@ -361,6 +373,8 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--bench")) {
     o->bench = 1;
+  } else if (!strcmp(a, "--bench-unpaired")) {
+    o->bench = o->bench_unpaired = 1;
   } else if (!strcmp(a, "--quiet")) {
     o->quiet = 1;
   } else if (!strcmp(a, "--video") && v) {
@@ -407,6 +421,29 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return 1;
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
+  } else if (!strcmp(a, "--view-quality") && v) {
+    o->view_quality = !strcmp(v, "low")     ? SIM_VIEWER_QUALITY_LOW
+                      : !strcmp(v, "high")  ? SIM_VIEWER_QUALITY_HIGH
+                      : !strcmp(v, "ultra") ? SIM_VIEWER_QUALITY_ULTRA
+                                            : -1;
+    if (o->view_quality < 0) {
+      fprintf(stderr, "autodrive-sim: --view-quality '%s': expected low, high or ultra\n", v);
+      return OPTIONS_BAD;
+    }
+    o->view_quality_given = 1;
+    return 1;
+  } else if (!strcmp(a, "--view-nice")) {
+    double n = 0;
+    if (options_number(a, v, 0, 19, &n) || n != floor(n)) {
+      if (n != floor(n))
+        fprintf(stderr, "autodrive-sim: --view-nice '%s': expected a whole number in [0, 19]\n", v);
+      return OPTIONS_BAD;
+    }
+    o->view_nice = (int)n;
+    o->view_nice_given = 1;
+    return 1;
+  } else if (!strcmp(a, "--view-scale")) {
+    return options_number(a, v, SIM_VIEWER_MIN_SCALE, 1.0, &o->view_scale) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--view-size")) {
     char tail = 0;
     if (!v || sscanf(v, "%dx%d%c", &o->view_w, &o->view_h, &tail) != 2 || o->view_w < 640 ||
@@ -451,6 +488,12 @@ static int options_check(const app_options_t *o) {
     fprintf(stderr,
             "autodrive-sim: --eye-sync needs --eye and --lockstep, --lockstep-client or "
             "--lockstep-frames (in real time the Eye keeps up or falls behind, as a real one)\n");
+    return OPTIONS_BAD;
+  }
+  if ((o->view_scale > 0 || o->view_quality_given || o->view_nice_given) && !o->view) {
+    fprintf(stderr,
+            "autodrive-sim: --view-scale, --view-quality and --view-nice need --view "
+            "(they set how the window draws)\n");
     return OPTIONS_BAD;
   }
   if (o->hud_log && !o->view) {

@@ -285,7 +285,8 @@ int app_run(app_t *a, app_run_stats_t *st) {
   l.next_progress = l.t0 + LOOP_PROGRESS_S;
   l.next_flush = l.t0;
   int rc = 0;
-  l.paired = o->bench && o->lockstep && !o->client_sync && !o->frame_sync && !a->viewer.v;
+  l.paired = o->bench && !o->bench_unpaired && o->lockstep && !o->client_sync && !o->frame_sync &&
+             !a->viewer.v;
   if (l.paired && bench_pairs_start(&l.pairs, s) != 0) {
     fprintf(stderr, "autodrive-sim: --bench: out of memory for the bare mj_step blocks\n");
     rc = 1;
@@ -314,6 +315,7 @@ int app_run(app_t *a, app_run_stats_t *st) {
   publish_queue_destroy(a->pubq); /* sends what is still queued: part of the run's time */
   a->pubq = NULL;
   st->wall_s = app_wall_s() - l.t0;
+  viewer_window_stop(&a->viewer); /* after the run's time: the last frame is no part of it */
   st->cpu_s = app_cpu_s() - cpu0 - bench_pairs_bare_cpu_s(&l.pairs);
   st->steps = l.step;
   double eye_waited_s = 0.0;

@@ -8,13 +8,24 @@
  * or W/A/S/D held drive the ego car (the caller turns them into commands: in.drive_keys).
  * The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map, pause,
  * step, reset, quit), Car (the ego car, autonomous or manual driving), View (camera, light level,
- * shadows, reflections, skybox, HUD), Sensors (LIDAR rays) and Record (start / stop). The HUD
- * is text the caller sets (sim_viewer_set_hud), drawn at the top right.
+ * quality: low, high or ultra; render scale; HUD), Sensors (LIDAR rays) and Record (start /
+ * stop). The HUD is text the caller sets (sim_viewer_set_hud), drawn at the top right.
  * The viewer only reports what the user asked (sim_viewer_input_t); the sim's main loop acts.
  *
  * The window's OpenGL context is made with EGL (GLFW_EGL_CONTEXT_API) so that it coexists
  * with the headless sim_render EGL renderer in one process (MuJoCo binds its GL calls to one
- * loader); use it with the EGL backend. Same thread as the renderer. Caller owns the viewer.
+ * loader); use it with the EGL backend. Caller owns the viewer.
+ *
+ * Threads: by default one thread does everything (sim_viewer_frame). After sim_viewer_detach,
+ * the thread that made the viewer (GLFW's events belong to it) only polls (sim_viewer_poll),
+ * sets the Driving radio (sim_viewer_set_manual) and reads sim_viewer_camera_id; one other
+ * thread draws (sim_viewer_draw) and alone calls the other setters. The window's events reach
+ * the drawing thread through a queue and the input state comes back through sim_viewer_poll,
+ * both under a lock held for copies only: the polling thread never waits on GL.
+ *
+ * Render scale: the scene is drawn at in.render_scale of the window's pixels (0.25..1) and
+ * stretched to the window; the HUD and the panel stay sharp. With a software rasteriser (Mesa's
+ * llvmpipe, softpipe) the default is SIM_VIEWER_SOFTWARE_SCALE, else 1.
  */
 #ifndef SIM_VIEWER_H
 #define SIM_VIEWER_H
@@ -44,13 +55,28 @@ typedef struct sim_viewer_input {
   int view;            /* sim_viewer_view_t: 1/2/3/4, the Camera radio */
   double light_level;  /* 0..1 scales the scene's lights (1 day) */
   int shadows, reflections, skybox; /* graphics quality (all 0: the fast default) */
-  int hud;            /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
-  int lidar_rays;     /* 1: the caller's LIDAR rays are drawn */
-  int step_requested; /* Step clicked (edge): one step while paused */
-  int record_toggled; /* the Record button (edge): start or stop recording */
-  int manual;         /* the Car section's Driving radio (T toggles): 0 autonomous, 1 manual */
-  int drive_keys;     /* SIM_VIEWER_KEY_* bits of the drive keys held now */
+  int hud;             /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
+  int lidar_rays;      /* 1: the caller's LIDAR rays are drawn */
+  int step_requested;  /* Step clicked (edge): one step while paused */
+  int record_toggled;  /* the Record button (edge): start or stop recording */
+  int manual;          /* the Car section's Driving radio (T toggles): 0 autonomous, 1 manual */
+  int drive_keys;      /* SIM_VIEWER_KEY_* bits of the drive keys held now */
+  double render_scale; /* the scene's share of the window's pixels per side, 0.25..1 */
 } sim_viewer_input_t;
+
+#define SIM_VIEWER_SOFTWARE_SCALE 0.5 /* the default render scale on software GL */
+#define SIM_VIEWER_MIN_SCALE 0.25
+
+/* The parts of a frame that sim_viewer_parts times (with timing on). */
+typedef enum sim_viewer_part {
+  SIM_VIEWER_PART_UPDATE = 0, /* mjv_updateScene, the light level, the LIDAR rays (CPU) */
+  SIM_VIEWER_PART_SCENE,      /* mjr_render: geoms, and shadows/reflections/skybox when on */
+  SIM_VIEWER_PART_BLIT,       /* the scaled scene stretched to the window (scale < 1) */
+  SIM_VIEWER_PART_HUD,        /* mjr_overlay: the status line, the keys and the HUD's figures */
+  SIM_VIEWER_PART_UI,         /* the Menu Panel (mjui_update when changed, mjui_render) */
+  SIM_VIEWER_PART_SWAP,       /* glfwSwapBuffers */
+  SIM_VIEWER_PARTS
+} sim_viewer_part_t;
 
 /* in.drive_keys: the arrows or W/S/A/D held */
 #define SIM_VIEWER_KEY_FORWARD 1
@@ -75,6 +101,43 @@ void sim_viewer_destroy(sim_viewer_t *v);
 /* Renders the current view of d, swaps, polls events and copies the input state into *in.
  * Returns 0, or -1 on a GL error. */
 int sim_viewer_frame(sim_viewer_t *v, const mjModel *m, mjData *d, sim_viewer_input_t *in);
+
+/* Threads (see the top): from now on this thread polls and another draws. Releases the GL
+ * context from this thread. */
+void sim_viewer_detach(sim_viewer_t *v);
+/* The drawing thread's frame of d (the caller's snapshot, not written while drawn): applies the
+ * queued window events, renders, swaps. Binds the GL context to the calling thread at its first
+ * call. Returns 0, or -1 on a GL error. */
+int sim_viewer_draw(sim_viewer_t *v, const mjModel *m, mjData *d);
+/* The drawing thread, before it ends: releases the GL context (sim_viewer_destroy needs it). */
+void sim_viewer_release(sim_viewer_t *v);
+
+/* The render scale (clamped to SIM_VIEWER_MIN_SCALE..1): a flag's override of the default.
+ * Before sim_viewer_detach. */
+void sim_viewer_set_render_scale(sim_viewer_t *v, double scale);
+/* Graphics quality, the paper's three levels set at once (the View section's check boxes):
+ * low none, high shadows, ultra shadows, reflections and the skybox. Before sim_viewer_detach. */
+enum { SIM_VIEWER_QUALITY_LOW = 0, SIM_VIEWER_QUALITY_HIGH, SIM_VIEWER_QUALITY_ULTRA };
+void sim_viewer_set_quality(sim_viewer_t *v, int quality);
+/* Sets the nice of the rasteriser threads (Mesa's llvmpipe-*) that the window's context
+ * started (none on a GPU): a software rasteriser's frames then take the CPU that others leave. */
+void sim_viewer_nice(sim_viewer_t *v, int nice);
+/* The GL renderer's name (GL_RENDERER) and 1 if it is a software rasteriser. */
+const char *sim_viewer_renderer(const sim_viewer_t *v, int *software);
+
+/* Timing of the frame's parts: with on, every SIM_VIEWER_TIMED_EVERY-th frame ends each part
+ * with glFinish (so that each is charged its own GPU or rasteriser time; on a busy CPU every
+ * glFinish also waits for the rasteriser's threads to be scheduled, so a timed frame is slower
+ * than the others) and the first SIM_VIEWER_TIMED_FRAMES of them are kept. Before the first
+ * frame. sim_viewer_last_timed: 1 if the frame just drawn was one of them. */
+#define SIM_VIEWER_TIMED_FRAMES 2048
+#define SIM_VIEWER_TIMED_EVERY 4
+void sim_viewer_time_parts(sim_viewer_t *v, int on);
+int sim_viewer_last_timed(const sim_viewer_t *v);
+/* The median wall time of each part over the timed frames [ms] into ms[SIM_VIEWER_PARTS], and
+ * its name (e.g. "scene") into names when not NULL. Returns the number of frames timed. Not
+ * while frames are drawn. */
+long sim_viewer_parts(const sim_viewer_t *v, double *ms, const char **names);
 
 /* Handles the window's events without drawing and copies the input state into *in (its edges
  * reported once, as by sim_viewer_frame). */

@@ -3,6 +3,8 @@
 #ifndef SIM_VIEWER_INTERNAL_H
 #define SIM_VIEWER_INTERNAL_H
 
+#include <pthread.h>
+
 #include <mujoco/mujoco.h>
 
 #include "sim_viewer.h"
@@ -10,6 +12,16 @@
 #define SIM_VIEWER_HUD_CHARS 4096
 #define SIM_VIEWER_MAX_EYES 8
 #define SIM_VIEWER_NIGHT_LEVEL 0.15 /* N: the light level of night (day 1) */
+#define SIM_VIEWER_QUEUE 256        /* window events queued for the drawing thread */
+#define SIM_VIEWER_SHADOW_PX 2048   /* [px] the shadow map's side when the model has none */
+#define SIM_VIEWER_MAX_RASTER 64    /* rasteriser threads (llvmpipe-*) looked at */
+
+/* A window event on its way from the polling thread to the drawing thread. */
+typedef struct sim_viewer_event {
+  enum { SIM_VIEWER_EV_KEY, SIM_VIEWER_EV_BUTTON, SIM_VIEWER_EV_MANUAL } kind;
+  int code, down; /* GLFW key and pressed (KEY), pressed (BUTTON), the radio (MANUAL) */
+  double x_px, y_px;
+} sim_viewer_event_t;
 
 struct GLFWwindow;
 
@@ -44,6 +56,28 @@ struct sim_viewer {
   float *ray_end;       /* nrays x 3 [m] world */
   int nrays;
   char hud_titles[SIM_VIEWER_HUD_CHARS], hud_values[SIM_VIEWER_HUD_CHARS];
+  char renderer[128];                    /* GL_RENDERER */
+  int raster_tid[SIM_VIEWER_MAX_RASTER]; /* the rasteriser threads its context started */
+  int nraster;
+  int software; /* 1: a software rasteriser (llvmpipe, softpipe) */
+  /* threads (sim_viewer_detach): mu guards the queue, in_pub, cam_pub and fb_w/h */
+  int threaded, bound; /* bound: the context is current on the drawing thread */
+  int mu_made;
+  pthread_mutex_t mu;
+  sim_viewer_event_t queue[SIM_VIEWER_QUEUE];
+  int nqueued;
+  long dropped;              /* events lost to a full queue */
+  sim_viewer_input_t in_pub; /* the drawing thread's input state, edges kept until polled */
+  int cam_pub;               /* sim_viewer_camera_id as of the last frame */
+  int fb_w, fb_h;            /* [px] the framebuffer's size, read on the polling thread */
+  /* timing (sim_viewer_time_parts) */
+  int timing, timing_now; /* timing_now: this frame's parts are timed */
+  long timed, drawn;      /* frames timed, drawn */
+  float *part_ms;         /* SIM_VIEWER_TIMED_FRAMES x SIM_VIEWER_PARTS [ms] */
+  void (*gl_finish)(void);
+  /* glBindFramebuffer and glBlitFramebuffer of the backend in use (MuJoCo exports neither) */
+  void (*gl_bind_fb)(unsigned, unsigned);
+  void (*gl_blit_fb)(int, int, int, int, int, int, int, int, unsigned, unsigned);
 };
 
 /* The Menu Panel: built once (sim_viewer_create), its figures refreshed and drawn each frame

@@ -45,8 +45,9 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
     len += snprintf(cars + len, sizeof cars - (size_t)len, "%s%d", i > 1 ? "\n" : "", i);
   char cams[mjMAXUITEXT];
   sim_viewer_ui_camera_names(v, v->model, cams, sizeof cams);
+  /* the map in the section's title, not a line of its own: the render scale took that row, and
+   * the panel still fits a 600 px window */
   ui_add(v, mjITEM_SECTION, "Simulation", NULL, "");
-  ui_add(v, mjITEM_STATIC, "Map", NULL, v->map_name[0] ? v->map_name : "-");
   ui_add(v, mjITEM_CHECKINT, "Pause", &v->in.paused, "");
   ui_add(v, mjITEM_BUTTON, UI_STEP, NULL, "");
   ui_add(v, mjITEM_BUTTON, UI_RESET, NULL, "");
@@ -61,6 +62,8 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   ui_add(v, mjITEM_CHECKINT, "Reflections", &v->in.reflections, "");
   ui_add(v, mjITEM_CHECKINT, "Skybox", &v->in.skybox, "");
   ui_add(v, mjITEM_CHECKINT, "HUD", &v->in.hud, "");
+  /* after the check boxes, which mjui packs two to a row */
+  ui_add(v, mjITEM_SLIDERNUM, "Scale", &v->in.render_scale, "0.25 1");
   ui_add(v, mjITEM_SECTION, "Sensors", NULL, "");
   ui_add(v, mjITEM_CHECKINT, "LIDAR rays", &v->in.lidar_rays, "");
   ui_add(v, mjITEM_SECTION, "Record", NULL, "");
