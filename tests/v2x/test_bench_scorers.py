@@ -130,6 +130,9 @@ def test_an_off_light_state_is_a_forged_change(tmp_path: pathlib.Path,
         log.write_event(k * 100_000, channel("TRAFFIC_LIGHT_STATE"), m.encode())
     log.close()
     assert v2x.light_offs(path, types) == 1  # the planted OFF: caught
+    empty = tmp_path / "none.lcmlog"
+    lcm.EventLog(str(empty), "w", overwrite=True).close()
+    assert v2x.light_offs(empty, types) is None  # no light watched: missing, never 0
 
 
 def test_an_eye_give_up_or_a_stand_in_fails(tmp_path: pathlib.Path) -> None:
@@ -141,3 +144,40 @@ def test_an_eye_give_up_or_a_stand_in_fails(tmp_path: pathlib.Path) -> None:
                 seeds.span(v2x.CITY_SEED, 1))  # fmt: skip
     assert not fig["goals"]["city_real_eye"]
     assert not fig["goals"]["intersection_eye_sync_give_ups"]
+
+
+def test_originals_leave_replays_and_the_attackers_own_out(tmp_path: pathlib.Path,
+                                                           build_dir: pathlib.Path,
+                                                           key_dir: pathlib.Path) -> None:  # fmt: skip
+    from autodrive.core import v2x_auth
+
+    types = lcmtypes.load(build_dir)
+    signer = v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL1", key_dir))
+    other = v2x_auth.MessageSigner(v2x_ca.load_identity("NIGEL2", key_dir))
+    path = tmp_path / "v2v.lcmlog"
+    log = lcm.EventLog(str(path), "w", overwrite=True)
+    own: set[bytes] = set()
+
+    def state(name: str, t_us: int, sign: Any) -> bytes:
+        m = types.v2v_state_t()
+        m.utime, m.vehicle, m.route = t_us, name, ""
+        if sign is not None:
+            sign.sign(channel("V2V"), m, t_us)
+        return bytes(m.encode())
+
+    k = 0
+    for ep_start in (0, 0):  # two simulators, each from 0 s of sim time
+        sent = []
+        for i in range(60):  # 3 s at 20 Hz
+            t = ep_start + i * 50_000
+            sent.append(state("NIGEL1", t, signer))
+            log.write_event(k, channel("V2V"), sent[-1])
+            ghost = types.v2v_state_t.decode(state("NIGEL1", t, other))  # the attacker's own
+            own.add(v2x_auth.auth_of(ghost))
+            log.write_event(k, channel("V2V"), ghost.encode())
+            log.write_event(k, channel("V2V"), state("NIGEL9", t, None))  # unsigned
+            if i >= 20:
+                log.write_event(k, channel("V2V"), sent[i - 20])  # a replay 1 s late
+            k += 1
+    log.close()
+    assert v2x.v2v_originals(path, types, CARS, own) == [{"NIGEL1": 60}, {"NIGEL1": 60}]

@@ -687,7 +687,7 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
 INTER_PORT, INTER_CARS = 7875 + PORT_SHIFT, 4
 INTER_URL = f"udpm://239.255.76.67:{INTER_PORT}?ttl=0"
 # episodes of the intersection run (each a fresh simulator, four runtimes, four autodrive-marl)
-INTER_EPISODES = int(os.environ.get("V2X_BENCH_INTERSECTION_EPISODES", "3"))
+INTER_EPISODES = int(os.environ.get("V2X_BENCH_INTERSECTION_EPISODES", "5"))
 INTER_TIMEOUT_S = 3600.0  # the intersection run's hang guard [s wall]; the run is on sim time
 # A car certificate of this run's CA that no car of the intersection run holds, revoked before
 # the run: its ghosts are sent from REVOKED_QUIET_S of wall time after the revocation on.
@@ -722,8 +722,6 @@ class IntersectionAttacker:
         self.replays: list[tuple[int, bytes]] = []  # (due [us, sim], a real car's V2V bytes)
         self.own_v2v: set[bytes] = set()  # every envelope this attacker sent on V2V
         self.seen: set[bytes] = set()  # every real car's envelope heard (an original once)
-        # per episode (in the order the simulators ran), per car: its original states [count]
-        self.originals: list[dict[str, int]] = []
         self.sim_us = -1  # the latest original's stamp [us, sim] of the episode running
         self.sent: dict[str, int] = {}  # by attack [count]
         self.stop = threading.Event()
@@ -749,12 +747,9 @@ class IntersectionAttacker:
         if auth in self.seen:
             return  # a replay of ours echoed back
         self.seen.add(auth)
-        if not self.originals or m.utime < self.sim_us - NEW_EPISODE_BACK_US:
-            self.originals.append({})  # a new simulator: its clock started again
-            self.replays.clear()  # replays stay within their episode
-            self.sim_us = -1
-        ep = self.originals[-1]
-        ep[m.vehicle] = ep.get(m.vehicle, 0) + 1
+        if m.utime < self.sim_us - NEW_EPISODE_BACK_US:
+            self.replays.clear()  # a new simulator (its clock started again): replays stay
+            self.sim_us = -1  # within their episode
         self.sim_us = max(self.sim_us, m.utime)
         self.replays.append((m.utime + REPLAY_LATE_US, data))
         while self.replays and self.replays[0][0] <= self.sim_us:
@@ -809,16 +804,46 @@ class IntersectionAttacker:
         self.thread.join(timeout=10)
 
 
-def light_offs(log_path: Path, types: Any) -> int:
+def v2v_originals(
+    log_path: Path, types: Any, cars: list[str], own: set[bytes]
+) -> list[dict[str, int]]:
+    """Per episode (in the order the simulators ran), per real car: the V2V states it sent
+    [count], from lcm-logger's log of the run (no Python thread that could miss one): each
+    signed envelope once, none of the attacker's own (own: its envelopes), a stamp more than
+    NEW_EPISODE_BACK_US behind the episode's latest opening the next episode (a new simulator's
+    clock starts again; a replay, a repeated envelope, never does)."""
+    episodes: list[dict[str, int]] = []
+    seen: set[bytes] = set()
+    latest = -1
+    for e in lcmtypes.events(log_path):
+        if e.channel != channel("V2V"):
+            continue
+        m = types.v2v_state_t.decode(e.data)
+        auth = v2x_auth.auth_of(m)
+        if m.vehicle not in cars or not auth or auth in own or auth in seen:
+            continue
+        seen.add(auth)
+        if not episodes or m.utime < latest - NEW_EPISODE_BACK_US:
+            episodes.append({})
+            latest = -1
+        episodes[-1][m.vehicle] = episodes[-1].get(m.vehicle, 0) + 1
+        latest = max(latest, m.utime)
+    return episodes
+
+
+def light_offs(log_path: Path, types: Any) -> int | None:
     """Light states showing OFF in an LCM log [count]: the intersection's lights run their
-    programs (GREEN, YELLOW, RED), so every OFF is a forged command obeyed."""
-    off = types.traffic_light_state_t.OFF
-    return sum(
-        1
+    programs (GREEN, YELLOW, RED), so every OFF is a forged command obeyed. None when the log
+    holds no light state at all (nothing was watched: the figure is missing, not 0)."""
+    states = [
+        types.traffic_light_state_t.decode(e.data).state
         for e in lcmtypes.events(log_path)
         if e.channel == channel("TRAFFIC_LIGHT_STATE")
-        and types.traffic_light_state_t.decode(e.data).state == off
-    )
+    ]
+    if not states:
+        return None
+    log(f"{len(states)} light states in the bus log")
+    return sum(1 for st in states if st == types.traffic_light_state_t.OFF)
 
 
 def intersection_figures(
@@ -827,8 +852,8 @@ def intersection_figures(
     """The MARL nodes' own figures of an intersection run (out: the demo's folder): the ghosts'
     charges in their per-peer accounts (any peer that is not a real car under its own
     certificate of this run's CA; REVOKED_CAR's states accepted apart), real cars' states
-    accepted beyond their originals (replays that got in; originals: per episode, per car, as
-    the attacker heard them), and their V2V refusals by reason. A node without its summary, or
+    accepted beyond their originals (replays that got in; originals: per episode, per car, from
+    the bus log, v2v_originals), and their V2V refusals by reason. A node without its summary, or
     an episode count that does not match the attacker's, leaves the figures missing: failed."""
     real = {
         f"NIGEL{i}": v2x_ca.load_identity(f"NIGEL{i}", key_dir).cert.serial
@@ -845,7 +870,7 @@ def intersection_figures(
     try:
         if len(episodes) != len(originals):
             raise peer_account.AccountError(
-                f"{out}: {len(episodes)} episode folders, the attacker heard {len(originals)} "
+                f"{out}: {len(episodes)} episode folders, the bus log holds {len(originals)} "
                 "simulators' cars"
             )
         records: list[peer_account.PeerRecord] = []
@@ -909,10 +934,11 @@ def intersection_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> d
     revoked_at = time.monotonic()
     log(f"revoked {REVOKED_CAR} (car) and {REVOKED_SCM} (scm); intersection run: "
         f"{INTER_EPISODES} episodes, seed {CITY_SEED}, --eye {CITY_EYE}")  # fmt: skip
-    lights_log = tmp / "intersection-lights.lcmlog"
+    bus_log = tmp / "intersection-v2v-lights.lcmlog"  # V2V and the light states
+    chans = f"--channel=({channel('V2V')}|{channel('TRAFFIC_LIGHT_STATE')})"
     logger = subprocess.Popen(
-        ["lcm-logger", "-f", "-c", channel("TRAFFIC_LIGHT_STATE"), "-l", INTER_URL,
-         str(lights_log)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        lcmtypes.logger_argv(INTER_URL, "-f", "-q", chans, str(bus_log)),
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     attacker = IntersectionAttacker(types, key_dir, tmp / "rogue-ca-intersection", revoked_at)
     cmd = [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection", "--headless",
@@ -925,20 +951,25 @@ def intersection_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> d
     finally:
         attacker.close()
         logger.terminate()
-        logger.wait(timeout=30)
+        _, logger_err = logger.communicate(timeout=30)
+    if not bus_log.exists():
+        log(f"lcm-logger wrote no log (the V2V originals and light states unknown): {logger_err}")
     try:
         report: dict[str, Any] = json.loads((out / "report.json").read_text())
     except (OSError, ValueError) as e:
         log(f"the intersection run wrote no report: {e}")
         report = {}
-    offs = light_offs(lights_log, types) if lights_log.exists() else None
+    offs = light_offs(bus_log, types) if bus_log.exists() else None
+    originals = (
+        v2v_originals(bus_log, types, attacker.cars, attacker.own_v2v) if offs is not None else []
+    )
     log(f"intersection: {report.get('episodes')} of {INTER_EPISODES} episodes, "
         f"{report.get('successes')} succeeded, {report.get('collisions')} with a collision; "
         f"pose source {report.get('pose_source')}; hostile messages {attacker.sent}; "
         f"OFF light states {offs}")  # fmt: skip
     not_run = report.get("episodes_not_run")
     return {
-        **intersection_figures(out, key_dir, attacker.originals, offs),
+        **intersection_figures(out, key_dir, originals, offs),
         "intersection_seed": CITY_SEED,
         "intersection_pose_source": report.get("pose_source"),
         "intersection_real_eye": report.get("pose_source") == "eye",
