@@ -18,7 +18,11 @@ Figures (goal in brackets):
   bus16_cpu_share              CPU share of one core to check a 16-car bus at 20 Hz (300 msg/s
       from the 15 others) [reported; <= 0.05]
   forged_green_red_violations  red-light violations of a real smart-city run (3 cars, the
-      real SCM, 30 s of sim time, the Eye stand-in: CITY_EYE) while forged GREEN advisories go to every car at 50 Hz [0]
+      real SCM, 30 s of sim time, the real Eye in lockstep: CITY_EYE) while forged GREEN
+      advisories go to every car at 50 Hz [0]
+  city_real_eye, city_eye_sync_give_ups  the three smart-city runs' poses came from the real
+      Eye (their reports' pose_source "eye") [true], and the simulator never gave it up (a run
+      that then depended on wall time) [0]
   ghost_car_extra_stop_s       the same run's held time charged to ghost cars: ghosts 0.3 m
       ahead of each car on V2V (unsigned; a real car's name signed by another car's certificate;
       real and unknown names with another authority's certificates; real cars' states replayed
@@ -32,6 +36,15 @@ Figures (goal in brackets):
       over the last 10 s of sim time, the worst car) over the quiet runs', while forged Eye poses
       walk each car away at 1 cm/s from its true pose (unsigned, signed by a car's certificate,
       and the real Eye's signed pose with the walk written in) [<= 0.02 m]
+  intersection_*               a real intersection run (tools/demo --mission intersection:
+      4 cars, autodrive-marl with its shield, the real Eye, INTER_EPISODES episodes of the same
+      seed) under IntersectionAttacker (ghost cars on V2V, real states replayed 1 s later, a
+      revoked car certificate, forged light commands): collisions [0], episodes not run [0],
+      the MARL nodes' own per-peer accounts' time held by ghosts (ghost_extra_stop_s) and
+      ghosts in their peer tables [0 s], real cars' states accepted beyond their originals
+      (replayed_v2v_accepted) [0], states of the revoked certificate accepted [0], OFF light
+      states (forged_light_state_changes) [0], real_eye [true], eye_sync_give_ups [0]; reported:
+      the MARL nodes' V2V refusals by reason, episodes and successes
 Progress on stderr; the last line is one JSON object. Usage: tools/bench v2x [--help]"""
 
 from __future__ import annotations
@@ -360,10 +373,11 @@ def brute_force(build: Path, tmp: Path) -> dict[str, Any]:
 
 
 CITY_PORT, CITY_CARS, CITY_SIM_S = 7874 + PORT_SHIFT, 3, 30
-# the smart-city runs' seed: V2X_BENCH_SEED, default the first of the evaluation block kept for
-# this bench (seeds.V2X_BENCH_SEEDS; a seed anybody traced moves to development: take the next)
+# the smart-city and intersection runs' seed: V2X_BENCH_SEED, default the next unused of the
+# evaluation block kept for this bench (seeds.V2X_BENCH_SEED_NEXT of seeds.V2X_BENCH_SEEDS; a
+# seed anybody traced moves to development: take the next)
 CITY_SEED = seeds.require(
-    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_SEEDS.start)), ("evaluation",),
+    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_SEED_NEXT)), ("evaluation",),
     "V2X_BENCH_SEED")  # fmt: skip
 CITY_URL = f"udpm://239.255.76.67:{CITY_PORT}?ttl=0"
 STOPPED_M_S = 0.01  # a car slower than this is stopped [m/s]

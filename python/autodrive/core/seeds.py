@@ -29,6 +29,8 @@ MARL_BENCH_FIRST_SEED = EVALUATION.start + 1000
 # tools/bench v2x's smart-city runs (V2X_BENCH_SEED overrides the first): a block of the
 # evaluation range kept for it, one seed per measurement, the next after each
 V2X_BENCH_SEEDS = range(EVALUATION.start + 201, EVALUATION.start + 221)
+# its default: the block's next unused seed (1 500 000 201 ran on 2026-12-03 morning)
+V2X_BENCH_SEED_NEXT = V2X_BENCH_SEEDS.start + 1
 
 
 def range_of(seed: int) -> str:

@@ -121,8 +121,7 @@ class Verifier {
   std::string counts_json() const {
     std::string out = "{";
     for (int r = 1; r < V2X_REASON_COUNT; ++r)
-      out += (r > 1 ? ", \"" : "\"") +
-             std::string(v2x_reason_name(static_cast<v2x_reason_t>(r))) +
+      out += (r > 1 ? ", \"" : "\"") + std::string(v2x_reason_name(static_cast<v2x_reason_t>(r))) +
              "\": " + std::to_string(count(static_cast<v2x_reason_t>(r)));
     return out + "}";
   }

@@ -89,8 +89,9 @@ def read_marl(log: Path) -> tuple[list[PeerRecord], dict[str, int]]:
     raise AccountError(f"{log}: no summary line (autodrive-marl did not stop cleanly)")
 
 
-def replays_accepted(records: list[PeerRecord], real: dict[str, int],
-                     originals: dict[str, int]) -> int:
+def replays_accepted(
+    records: list[PeerRecord], real: dict[str, int], originals: dict[str, int]
+) -> int:
     """States of real cars one receiver accepted beyond the originals those cars sent (each an
     envelope of its own; originals: per car name, in the receiver's run) [count]: a receiver
     takes an original once, so anything more is a replay that got in. (A replay accepted in
