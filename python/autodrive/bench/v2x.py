@@ -820,12 +820,14 @@ class IntersectionAttacker:
 
 def v2v_originals(
     log_path: Path, types: Any, cars: list[str], own: set[bytes]
-) -> list[dict[str, int]]:
+) -> tuple[list[dict[str, int]], int]:
     """Per episode (in the order the simulators ran), per real car: the V2V states it sent
-    [count], from lcm-logger's log of the run (no Python thread that could miss one): each
-    signed envelope once, none of the attacker's own (own: its envelopes), a stamp more than
-    NEW_EPISODE_BACK_US behind the episode's latest opening the next episode (a new simulator's
-    clock starts again; a replay, a repeated envelope, never does)."""
+    [count], from lcm-logger's log of the run, and how many of them the log holds. A car's
+    runtime numbers its states 0, 1, 2, ... (v2v_state_t.seq, from its start, one runtime per
+    episode), so it sent its highest logged seq + 1: a state the logger lost under load (UDP)
+    still counts. Each signed envelope once, none of the attacker's own (own: its envelopes);
+    a stamp more than NEW_EPISODE_BACK_US behind the episode's latest opens the next episode (a
+    new simulator's clock starts again; a replay, a repeated envelope, never does)."""
     episodes: list[dict[str, int]] = []
     seen: set[bytes] = set()
     latest = -1
@@ -840,9 +842,9 @@ def v2v_originals(
         if not episodes or m.utime < latest - NEW_EPISODE_BACK_US:
             episodes.append({})
             latest = -1
-        episodes[-1][m.vehicle] = episodes[-1].get(m.vehicle, 0) + 1
+        episodes[-1][m.vehicle] = max(episodes[-1].get(m.vehicle, 0), m.seq + 1)
         latest = max(latest, m.utime)
-    return episodes
+    return episodes, len(seen)
 
 
 def light_offs(log_path: Path, types: Any) -> int | None:
@@ -866,8 +868,8 @@ def intersection_figures(
     """The MARL nodes' own figures of an intersection run (out: the demo's folder): the ghosts'
     charges in their per-peer accounts (any peer that is not a real car under its own
     certificate of this run's CA; REVOKED_CAR's states accepted apart), real cars' states
-    accepted beyond their originals (replays that got in; originals: per episode, per car, from
-    the bus log, v2v_originals), and their V2V refusals by reason. A node without its summary, or
+    accepted beyond the states they sent (replays that got in; originals: per episode, per car,
+    from the bus log's seq numbers, v2v_originals), and their V2V refusals by reason. A node without its summary, or
     an episode count that does not match the attacker's, leaves the figures missing: failed."""
     real = {
         f"NIGEL{i}": v2x_ca.load_identity(f"NIGEL{i}", key_dir).cert.serial
@@ -974,9 +976,13 @@ def intersection_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> d
         log(f"the intersection run wrote no report: {e}")
         report = {}
     offs = light_offs(bus_log, types) if bus_log.exists() else None
-    originals = (
-        v2v_originals(bus_log, types, attacker.cars, attacker.own_v2v) if offs is not None else []
+    originals, logged = (
+        v2v_originals(bus_log, types, attacker.cars, attacker.own_v2v)
+        if offs is not None
+        else ([], 0)
     )
+    sent = sum(sum(ep.values()) for ep in originals)
+    log(f"the real cars sent {sent} V2V states (their seq), the bus log holds {logged}")
     log(f"intersection: {report.get('episodes')} of {INTER_EPISODES} episodes, "
         f"{report.get('successes')} succeeded, {report.get('collisions')} with a collision; "
         f"pose source {report.get('pose_source')}; hostile messages {attacker.sent}; "
@@ -994,6 +1000,7 @@ def intersection_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> d
         "intersection_collisions": report.get("collisions"),
         "intersection_shield_interventions": report.get("shield_interventions"),
         "intersection_hostile_messages": dict(sorted(attacker.sent.items())),
+        "intersection_v2v_originals_logged": logged,
         "intersection_sim_light_drops_logged": sim_light_drops(out),
         "intersection_wall_s": report.get("wall_s"),
     }
