@@ -74,7 +74,7 @@ from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 
 log = Progress("v2x")
-# LCM ports 7873 (lights) and 7874 (smart city), moved by the session's instance
+# LCM ports 7873 (lights), 7874 (smart city) and 7875 (intersection), moved by the instance
 # (AUTODRIVE_INSTANCE N: + N * port_step), so that two sessions' benches never hear each other
 PORT_SHIFT = settings.instance().number * settings.instance().port_step
 PORT = 7873 + PORT_SHIFT
