@@ -1,10 +1,11 @@
 """autodrive-scm on real LCM (UDP multicast on loopback): car NIGEL1's EKF pose (POSE_MAP)
-drives the route north_to_lot towards light 1 at 50 Hz and announces the route on V2V; NIGEL2
-has both an Eye and an EKF pose. Checks: V2I advisories at 10 Hz for NIGEL1 naming light 1
-with the stop-line distance along the route (within 3 cm of the map's geometry, computed here
-independently), the speed limit of sign 3 on its lane; TRAFFIC_LIGHT_COMMAND for every light;
-the Eye pose wins for NIGEL2; the pose history thinned to 10 Hz (rows counted over REST); a
-viewer may read but not command (403 naming the role). Args: ROOT BUILD PORT."""
+drives the route north_to_lot towards light 1 at 50 Hz, announces the route on V2V, then
+stands; NIGEL2 has both an Eye and an EKF pose. Checks: V2I advisories at 10 Hz for NIGEL1
+naming light 1 with the stop-line distance along the route (within 2 cm of the map's geometry,
+computed here independently; judged by route position, never by wall time), the speed limit of
+sign 3 on its lane; TRAFFIC_LIGHT_COMMAND for every light; the Eye pose wins for NIGEL2; the
+pose history thinned to 10 Hz of the poses' stamps (rows counted over REST); a viewer may read
+but not command (403 naming the role). Args: ROOT BUILD PORT."""
 
 from __future__ import annotations
 
@@ -54,6 +55,8 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
         acc.append(acc[-1] + math.dist(a, b))
     s_stop = acc[min(range(len(pts)), key=lambda i: math.dist(pts[i], stop_c))]
 
+    nigel1_utimes: list[int] = []  # every NIGEL1 pose stamp sent [us]
+
     def odom(vehicle: str, x: float, y: float, yaw: float, v: float) -> bytes:
         o = T.odometry_t()
         o.utime, o.vehicle, o.frame_id, o.child_frame_id = (
@@ -62,6 +65,8 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
             "map",
             "base_link",
         )
+        if vehicle == "NIGEL1":
+            nigel1_utimes.append(o.utime)
         o.x_m, o.y_m, o.yaw_rad, o.vx_m_s = x, y, yaw, v
         return bytes(o.encode())
 
@@ -111,22 +116,53 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
                     lc.publish(channel("V2V"), car_signer.sign(channel("V2V"), v, v.utime).encode())
                 sent += 1
                 time.sleep(0.02)
-            time.sleep(0.5)
-            adv = [(t, a) for t, a in advisories if t > t0 + 1.0]
-            span = adv[-1][0] - adv[0][0]
-            rate = (len(adv) - 1) / span
-            check(abs(rate - 10.0) < 2.0, f"NIGEL1_V2I at {rate:.1f} Hz (10 Hz)")
+            t_end = time.time()
+            s_end = truth[-1][1]
+            p_end = route.pose_at(s_end)
+            # The car then stands at s_end, as an EKF would report it at 50 Hz, until the SCM's
+            # advisories settle (five alike): the geometry is judged on those, at any load.
+            settled: list[float] = []
+            while time.time() - t_end < 30.0:  # hang guard only
+                lc.publish(
+                    channel("POSE_MAP", "NIGEL1"),
+                    odom("NIGEL1", p_end.x_m, p_end.y_m, p_end.yaw_rad, 0.0),
+                )
+                time.sleep(0.02)
+                late = [a.stop_line_distance_m for t, a in advisories if t > t_end]
+                settled = late[-5:]
+                if len(settled) == 5 and max(settled) - min(settled) < 1e-3:
+                    break
+            check(
+                len(settled) == 5 and max(settled) - min(settled) < 1e-3,
+                f"advisories settle while the car stands ({settled})",
+            )
+            geom_err = abs(settled[-1] - (s_stop - s_end))
+            check(
+                geom_err < 0.02,
+                f"stop-line distance along the route within 2 cm of the map's ({geom_err*100:.1f} cm)",
+            )
+            adv = [(t, a) for t, a in advisories if t0 + 1.0 < t <= t_end]
+            gaps = sorted(b[0] - a[0] for a, b in zip(adv, adv[1:]))
+            period = gaps[len(gaps) // 2]
+            check(abs(period - 0.1) < 0.03, f"NIGEL1_V2I at {1 / period:.1f} Hz (10 Hz, median)")
             check(all(a.vehicle == "NIGEL1" for _, a in adv), "advisories are addressed to NIGEL1")
             check(all(a.light_id == 1 for _, a in adv), "the next light on north_to_lot is light 1")
-            errs = []
-            for t, a in adv:
-                s = min(truth, key=lambda x: abs(x[0] - t))[1]
-                errs.append(abs(a.stop_line_distance_m - (s_stop - s)))
-            # the advisory is computed from the newest pose (<= 20 ms old at 0.5 m/s: 1 cm)
+            # Which pose an advisory came from is judged by route position, not by wall time:
+            # under load the SCM may answer late, and a late answer is not a wrong one. Each
+            # advisory's distance must match a pose sent before it arrived (geometry within
+            # 2 cm), and the SCM must never fall back to an older pose than it used before.
+            implied_s = [s_stop - a.stop_line_distance_m for _, a in adv]
+            match_errs = [
+                min(abs(si - s) for ts, s in truth if ts <= t) if truth[0][0] <= t else math.inf
+                for si, (t, _) in zip(implied_s, adv)
+            ]
             check(
-                max(errs) < 0.03,
-                f"stop-line distance along the route within 3 cm (max {max(errs)*100:.1f} cm)",
+                max(match_errs) < 0.02,
+                "every advisory's distance matches a pose sent before it within 2 cm "
+                f"(worst {max(match_errs)*100:.1f} cm)",
             )
+            back = max(b - a for a, b in zip(implied_s[1:], implied_s))
+            check(back < 0.01, f"advisories never use an older pose (went back {back*100:.1f} cm)")
             seqs = [a.seq for _, a in advisories]
             check(
                 seqs == list(range(seqs[0], seqs[0] + len(seqs))), "advisory seq counts up by one"
@@ -149,14 +185,23 @@ def test_scm_on_live_lcm(root: Path, build_dir: Path, lcm_port: int, lcm_url: st
                 "NIGEL2: the Eye pose wins over the EKF's",
             )
             check(cars["NIGEL1"]["route"] == "north_to_lot", "NIGEL1's route taken from V2V")
-            wait_for(
-                lambda: viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"] >= 38,
-                5,
-                "pose history rows written",
-            )
-            rows = viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"]
+            # The SCM keeps a pose when 90 ms of its stamps have passed since the last kept one;
+            # replayed on the stamps sent, that gives the rows it must write at any load (a pose
+            # lost on UDP can only lower the count, so the lower bound leaves room for a few).
+            kept, last = 0, -(10**18)
+            for u in nigel1_utimes:
+                if u - last >= 90_000 or u < last:
+                    kept, last = kept + 1, u
+
+            def rows_now() -> int:
+                return int(viewer.call("GET", "/api/poses/count?vehicle=NIGEL1")[1]["rows"])
+
+            wait_for(lambda: rows_now() >= 0.9 * kept, 30, "pose history rows written")
+            rows = rows_now()
             check(
-                38 <= rows <= 42, f"NIGEL1 history thinned to 10 Hz: {rows} rows for 4 s at 50 Hz"
+                0.9 * kept <= rows <= kept,
+                f"NIGEL1 history thinned to 10 Hz: {rows} rows of {len(nigel1_utimes)} poses "
+                f"({kept} by the 90 ms rule on their stamps)",
             )
             code, body = viewer.call("PUT", "/api/lights/1/state", {"state": "RED"})
             check(

@@ -49,8 +49,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument(
         "--seed",
         type=int,
-        default=seeds.EVALUATION.start,
-        help="the evaluation runs' seed (default the first evaluation seed, autodrive.core.seeds)",
+        default=seeds.CLONING_BENCH_NEXT_SEED,
+        help="the evaluation runs' seed (default the next unused one of the cloning block, "
+        "autodrive.core.seeds.CLONING_BENCH_NEXT_SEED)",
     )
     p.add_argument(
         "--train-seed",

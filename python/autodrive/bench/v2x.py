@@ -374,10 +374,10 @@ def brute_force(build: Path, tmp: Path) -> dict[str, Any]:
 
 CITY_PORT, CITY_CARS, CITY_SIM_S = 7874 + PORT_SHIFT, 3, 30
 # the smart-city and intersection runs' seed: V2X_BENCH_SEED, default the next unused of the
-# evaluation block kept for this bench (seeds.V2X_BENCH_SEED_NEXT of seeds.V2X_BENCH_SEEDS; a
+# evaluation block kept for this bench (seeds.V2X_BENCH_NEXT_SEED of seeds.V2X_BENCH_SEEDS; a
 # seed anybody traced moves to development: take the next)
 CITY_SEED = seeds.require(
-    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_SEED_NEXT)), ("evaluation",),
+    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_NEXT_SEED)), ("evaluation",),
     "V2X_BENCH_SEED")  # fmt: skip
 CITY_URL = f"udpm://239.255.76.67:{CITY_PORT}?ttl=0"
 STOPPED_M_S = 0.01  # a car slower than this is stopped [m/s]

@@ -31,7 +31,11 @@ MARL_BENCH_FIRST_SEED = EVALUATION.start + 1000
 V2X_BENCH_SEEDS = range(EVALUATION.start + 201, EVALUATION.start + 221)
 # its default: the block's next unused seed (used on 2026-12-03: 201 in the morning; 202, a
 # failed run after which a scorer changed, now development; 203, the reported run)
-V2X_BENCH_SEED_NEXT = V2X_BENCH_SEEDS.start + 3
+V2X_BENCH_NEXT_SEED = V2X_BENCH_SEEDS.start + 3
+# tools/bench cloning's evaluations: a block of the evaluation range kept for it; the default
+# --seed is the next one no measurement used (1 500 000 501: the shipped model, 2026-12-03)
+CLONING_BENCH_SEEDS = range(EVALUATION.start + 501, EVALUATION.start + 521)
+CLONING_BENCH_NEXT_SEED = CLONING_BENCH_SEEDS.start + 1
 
 
 def range_of(seed: int) -> str:
