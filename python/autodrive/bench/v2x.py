@@ -18,7 +18,11 @@ Figures (goal in brackets):
   bus16_cpu_share              CPU share of one core to check a 16-car bus at 20 Hz (300 msg/s
       from the 15 others) [reported; <= 0.05]
   forged_green_red_violations  red-light violations of a real smart-city run (3 cars, the
-      real SCM, 30 s of sim time, the Eye stand-in: CITY_EYE) while forged GREEN advisories go to every car at 50 Hz [0]
+      real SCM, 30 s of sim time, the real Eye in lockstep: CITY_EYE) while forged GREEN
+      advisories go to every car at 50 Hz [0]
+  city_real_eye, city_eye_sync_give_ups  the three smart-city runs' poses came from the real
+      Eye (their reports' pose_source "eye") [true], and the simulator never gave it up (a run
+      that then depended on wall time) [0]
   ghost_car_extra_stop_s       the same run's held time charged to ghost cars: ghosts 0.3 m
       ahead of each car on V2V (unsigned; a real car's name signed by another car's certificate;
       real and unknown names with another authority's certificates; real cars' states replayed
@@ -32,6 +36,15 @@ Figures (goal in brackets):
       over the last 10 s of sim time, the worst car) over the quiet runs', while forged Eye poses
       walk each car away at 1 cm/s from its true pose (unsigned, signed by a car's certificate,
       and the real Eye's signed pose with the walk written in) [<= 0.02 m]
+  intersection_*               a real intersection run (tools/demo --mission intersection:
+      4 cars, autodrive-marl with its shield, the real Eye, INTER_EPISODES episodes of the same
+      seed) under IntersectionAttacker (ghost cars on V2V, real states replayed 1 s later, a
+      revoked car certificate, forged light commands): collisions [0], episodes not run [0],
+      the MARL nodes' own per-peer accounts' time held by ghosts (ghost_extra_stop_s) and
+      ghosts in their peer tables [0 s], real cars' states accepted beyond their originals
+      (replayed_v2v_accepted) [0], states of the revoked certificate accepted [0], OFF light
+      states (forged_light_state_changes) [0], real_eye [true], eye_sync_give_ups [0]; reported:
+      the MARL nodes' V2V refusals by reason, episodes and successes
 Progress on stderr; the last line is one JSON object. Usage: tools/bench v2x [--help]"""
 
 from __future__ import annotations
@@ -54,14 +67,14 @@ from pathlib import Path
 from typing import Any
 
 from autodrive.bench import Progress, build_dir, print_figures
-from autodrive.bench.goals import at_most, judge
+from autodrive.bench.goals import at_most, equals, judge
 from autodrive.core import seeds, settings
 from autodrive.hil.city import peer_account
 from autodrive.core import lcmtypes, v2x_auth, v2x_ca
 from autodrive.core.channels import channel
 
 log = Progress("v2x")
-# LCM ports 7873 (lights) and 7874 (smart city), moved by the session's instance
+# LCM ports 7873 (lights), 7874 (smart city) and 7875 (intersection), moved by the instance
 # (AUTODRIVE_INSTANCE N: + N * port_step), so that two sessions' benches never hear each other
 PORT_SHIFT = settings.instance().number * settings.instance().port_step
 PORT = 7873 + PORT_SHIFT
@@ -83,7 +96,20 @@ GOALS = {
         "ghost_car_extra_stop_s": 0.0,
         "ghost_in_peer_table_s": 0.0,
         "eye_walk_ekf_drift_m": 0.02,
+        "city_eye_sync_give_ups": 0,
+        "intersection_eye_sync_give_ups": 0,
+        "intersection_collisions": 0,
+        "intersection_episodes_not_run": 0,
+        "intersection_ghost_extra_stop_s": 0.0,
+        "intersection_ghost_in_peer_table_s": 0.0,
+        "intersection_replayed_v2v_accepted": 0,
+        "intersection_revoked_accepted": 0,
+        "intersection_forged_light_state_changes": 0,
     }.items()
+} | {
+    # the runs' poses came from the real Eye (rendered images, libapriltag), not a stand-in
+    "city_real_eye": equals("city_real_eye", True),
+    "intersection_real_eye": equals("intersection_real_eye", True),
 }
 UNSEEDED = seeds.unseeded("scripted attacks only (no smart-city runs)")
 
@@ -347,18 +373,19 @@ def brute_force(build: Path, tmp: Path) -> dict[str, Any]:
 
 
 CITY_PORT, CITY_CARS, CITY_SIM_S = 7874 + PORT_SHIFT, 3, 30
-# the smart-city runs' seed: V2X_BENCH_SEED, default the first of the evaluation block kept for
-# this bench (seeds.V2X_BENCH_SEEDS; a seed anybody traced moves to development: take the next)
+# the smart-city and intersection runs' seed: V2X_BENCH_SEED, default the next unused of the
+# evaluation block kept for this bench (seeds.V2X_BENCH_NEXT_SEED of seeds.V2X_BENCH_SEEDS; a
+# seed anybody traced moves to development: take the next)
 CITY_SEED = seeds.require(
-    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_SEEDS.start)), ("evaluation",),
+    int(os.environ.get("V2X_BENCH_SEED", seeds.V2X_BENCH_NEXT_SEED)), ("evaluation",),
     "V2X_BENCH_SEED")  # fmt: skip
 CITY_URL = f"udpm://239.255.76.67:{CITY_PORT}?ttl=0"
 STOPPED_M_S = 0.01  # a car slower than this is stopped [m/s]
-# The Eye stand-in (a test double: poses from GROUND_TRUTH at 10 Hz of sim time, seeded noise,
-# signed with the testbed's EYE certificate), so that runs of one seed repeat: with the real
-# Eye, not yet in lockstep with the simulator, two quiet runs differed by 7.3 s of stop time,
-# which hid whatever an attack added.
-CITY_EYE = "standin"
+# The real Eye (the simulator's rendered overhead cameras, autodrive-eye with libapriltag), in
+# lockstep with the simulator (autodrive-sim --eye-sync): its poses at capture + 15 ms of sim
+# time at any load, so that runs of one seed repeat on the sim clock. (Until 2026-12-03 the
+# bench ran the Eye stand-in, from before the Eye was in lockstep.)
+CITY_EYE = "cameras"
 WALK_M_S = 0.01  # the forged Eye poses' walk away from the true pose [m/s of sim time]
 
 
@@ -614,11 +641,24 @@ def ghost_figures(out: Path, key_dir: Path) -> dict[str, Any]:
     }
 
 
+def give_ups(reports: list[dict[str, Any]]) -> int | None:
+    """The runs' Eye give-ups in all (pose_source.eye_sync_give_ups); None when any run does not
+    say (not in lockstep, or its count unknown): the figure is then missing, its goal failed."""
+    counts = [r.get("eye_sync_give_ups") for r in reports]
+    if any(not isinstance(c, int) or c < 0 for c in counts):
+        return None
+    return sum(c for c in counts if isinstance(c, int))
+
+
 def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dict[str, Any]:
-    quiet_stops, quiet_ekf = [], []
+    quiet_stops, quiet_ekf, quiet_sources = [], [], []
+    quiet_reports: list[dict[str, Any]] = []
     for k in (1, 2):  # two quiet runs: their spread is the run-to-run difference
-        log(f"smart-city run, quiet #{k} ({CITY_SIM_S} s of sim time, seed {CITY_SEED})")
+        log(f"smart-city run, quiet #{k} ({CITY_SIM_S} s of sim time, seed {CITY_SEED}, "
+            f"--eye {CITY_EYE})")  # fmt: skip
         quiet = smart_city_run(build, tmp / f"quiet{k}")
+        quiet_sources.append(quiet.get("pose_source"))
+        quiet_reports.append(quiet)
         quiet_stops.append(stopped_s(tmp / f"quiet{k}" / "run.lcmlog", types))
         quiet_ekf.append(ekf_error_m(tmp / f"quiet{k}" / "run.lcmlog", types))
     attacker = CityAttacker(types, key_dir, tmp / "rogue-ca")
@@ -638,7 +678,12 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
     return {
         **ghost_figures(tmp / "attacked", key_dir),
         "city_seed": CITY_SEED,
-        "city_pose_source": attacked.get("pose_source", CITY_EYE),
+        # which poses the cars' EKFs fused, as each run's report says (None: it does not say)
+        "city_pose_source": attacked.get("pose_source"),
+        "city_pose_source_quiet": quiet_sources,
+        # the simulator gave the Eye up (a run that then depended on wall time), all 3 runs
+        "city_eye_sync_give_ups": give_ups(quiet_reports + [attacked]),
+        "city_real_eye": all(src == "eye" for src in [*quiet_sources, attacked.get("pose_source")]),
         "city_hostile_messages": attacker.sent,
         "forged_green_red_violations": attacked["red_light_violations"],
         "city_collisions_under_attack": attacked["collisions"],
@@ -653,10 +698,321 @@ def smart_city_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dic
     }
 
 
+INTER_PORT, INTER_CARS = 7875 + PORT_SHIFT, 4
+INTER_URL = f"udpm://239.255.76.67:{INTER_PORT}?ttl=0"
+# episodes of the intersection run (each a fresh simulator, four runtimes, four autodrive-marl)
+INTER_EPISODES = int(os.environ.get("V2X_BENCH_INTERSECTION_EPISODES", "5"))
+INTER_TIMEOUT_S = 3600.0  # the intersection run's hang guard [s wall]; the run is on sim time
+# A car certificate of this run's CA that no car of the intersection run holds, revoked before
+# the run: its ghosts are sent from REVOKED_QUIET_S of wall time after the revocation on.
+REVOKED_CAR, REVOKED_SCM = "NIGEL12", "SCM3"
+REVOKED_QUIET_S = 1.2  # more than the goal's 1 s, and 0.2 s for a reload in flight [s wall]
+NEW_EPISODE_BACK_US = 2_000_000  # a real car's V2V stamp this far back: a new simulator [us]
+
+
+class IntersectionAttacker:
+    """Beside a real intersection run (tools/demo --mission intersection): on every V2V state a
+    real car sends, ghost cars 0.3 m ahead of it (unsigned as NIGEL9; another real car's name
+    signed by this car's certificate; that car and NIGEL9 under another authority's
+    certificates; REVOKED_CAR under its revoked certificate of this CA), and that state replayed
+    byte for byte REPLAY_LATE_US of sim time later (within its episode: a new simulator's clock
+    starts again); on every light state of the simulator, that light commanded OFF (a state its
+    program never shows) unsigned, as an scm-signed RED altered to OFF, signed by a car's
+    certificate and by the revoked scm certificate REVOKED_SCM. Everything follows the sim
+    clock (the real messages it answers), so the load changes only the wall time."""
+
+    def __init__(self, types: Any, key_dir: Path, rogue_dir: Path, revoked_at: float) -> None:
+        self.types = types
+        self.lc = lcmtypes.bus(INTER_URL)
+        self.cars = [f"NIGEL{i}" for i in range(1, INTER_CARS + 1)]
+        self.car_signers = {
+            c: v2x_auth.MessageSigner(v2x_ca.load_identity(c, key_dir)) for c in self.cars
+        }
+        self.rogue = rogue_signers([*self.cars, "NIGEL9"], rogue_dir)
+        self.revoked_car = v2x_auth.MessageSigner(v2x_ca.load_identity(REVOKED_CAR, key_dir))
+        self.revoked_scm = v2x_auth.MessageSigner(v2x_ca.load_identity(REVOKED_SCM, key_dir))
+        self.scm = v2x_auth.MessageSigner(v2x_ca.load_identity("SCM", key_dir))
+        self.revoked_from = revoked_at + REVOKED_QUIET_S  # [s, time.monotonic]
+        self.replays: list[tuple[int, bytes]] = []  # (due [us, sim], a real car's V2V bytes)
+        self.own_v2v: set[bytes] = set()  # every envelope this attacker sent on V2V
+        self.seen: set[bytes] = set()  # every real car's envelope heard (an original once)
+        self.sim_us = -1  # the latest original's stamp [us, sim] of the episode running
+        self.sent: dict[str, int] = {}  # by attack [count]
+        self.stop = threading.Event()
+        self.lc.subscribe(channel("V2V"), self._on_v2v)
+        self.lc.subscribe(channel("TRAFFIC_LIGHT_STATE"), self._on_light)
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        while not self.stop.is_set():
+            if select.select([self.lc.fileno()], [], [], 0.05)[0]:
+                self.lc.handle()
+
+    def _publish(self, attack: str, chan: str, msg: Any) -> None:
+        self.lc.publish(chan, msg.encode())
+        self.sent[attack] = self.sent.get(attack, 0) + 1
+
+    def _on_v2v(self, _c: str, data: bytes) -> None:
+        m = self.types.v2v_state_t.decode(data)
+        auth = v2x_auth.auth_of(m)
+        if m.vehicle not in self.car_signers or not auth or auth in self.own_v2v:
+            return
+        if auth in self.seen:
+            return  # a replay of ours echoed back
+        self.seen.add(auth)
+        if m.utime < self.sim_us - NEW_EPISODE_BACK_US:
+            self.replays.clear()  # a new simulator (its clock started again): replays stay
+            self.sim_us = -1  # within their episode
+        self.sim_us = max(self.sim_us, m.utime)
+        self.replays.append((m.utime + REPLAY_LATE_US, data))
+        while self.replays and self.replays[0][0] <= self.sim_us:
+            old = self.replays.pop(0)[1]
+            self.lc.publish(channel("V2V"), old)
+            self.sent["v2v_replayed"] = self.sent.get("v2v_replayed", 0) + 1
+        self._ghosts(m)
+
+    def _ghosts(self, own: Any) -> None:
+        signer = self.car_signers[own.vehicle]
+        other = next(c for c in self.cars if c != own.vehicle)
+        variants: list[tuple[str, str, v2x_auth.MessageSigner | None]] = [
+            ("ghost_unsigned", "NIGEL9", None),
+            ("ghost_wrong_name", other, signer),
+            ("ghost_other_authority", other, self.rogue[other]),
+            ("ghost_other_authority", "NIGEL9", self.rogue["NIGEL9"]),
+        ]
+        if time.monotonic() >= self.revoked_from:
+            variants.append(("ghost_revoked_certificate", REVOKED_CAR, self.revoked_car))
+        for attack, name, sign in variants:
+            g = self.types.v2v_state_t.decode(own.encode())
+            g.vehicle, g.speed_m_s, g.auth, g.auth_len = name, 0.0, b"", 0
+            g.x_m += 0.3 * math.cos(own.yaw_rad)
+            g.y_m += 0.3 * math.sin(own.yaw_rad)
+            if sign is not None:
+                sign.sign(channel("V2V"), g, own.utime)
+                self.own_v2v.add(v2x_auth.auth_of(g))
+            self._publish(attack, channel("V2V"), g)
+
+    def _on_light(self, _c: str, data: bytes) -> None:
+        m = self.types.traffic_light_state_t.decode(data)
+        State = self.types.traffic_light_state_t
+        chan = channel("TRAFFIC_LIGHT_COMMAND")
+
+        def command(state: int) -> Any:
+            c = self.types.traffic_light_command_t()
+            c.utime, c.light_id, c.state, c.duration_s = m.utime, m.light_id, state, 0.0
+            return c
+
+        self._publish("light_unsigned", chan, command(State.OFF))
+        altered = self.scm.sign(chan, command(State.RED), m.utime)
+        altered.state = State.OFF  # RED signed, OFF sent
+        self._publish("light_altered", chan, altered)
+        car = self.car_signers[self.cars[0]]
+        self._publish("light_wrong_role", chan, car.sign(chan, command(State.OFF), m.utime))
+        if time.monotonic() >= self.revoked_from:
+            revoked = self.revoked_scm.sign(chan, command(State.OFF), m.utime)
+            self._publish("light_revoked_certificate", chan, revoked)
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join(timeout=10)
+
+
+def v2v_originals(
+    log_path: Path, types: Any, cars: list[str], own: set[bytes]
+) -> tuple[list[dict[str, int]], int]:
+    """Per episode (in the order the simulators ran), per real car: the V2V states it sent
+    [count], from lcm-logger's log of the run, and how many of them the log holds. A car's
+    runtime numbers its states 0, 1, 2, ... (v2v_state_t.seq, from its start, one runtime per
+    episode), so it sent its highest logged seq + 1: a state the logger lost under load (UDP)
+    still counts. Each signed envelope once, none of the attacker's own (own: its envelopes);
+    a stamp more than NEW_EPISODE_BACK_US behind the episode's latest opens the next episode (a
+    new simulator's clock starts again; a replay, a repeated envelope, never does)."""
+    episodes: list[dict[str, int]] = []
+    seen: set[bytes] = set()
+    latest = -1
+    for e in lcmtypes.events(log_path):
+        if e.channel != channel("V2V"):
+            continue
+        m = types.v2v_state_t.decode(e.data)
+        auth = v2x_auth.auth_of(m)
+        if m.vehicle not in cars or not auth or auth in own or auth in seen:
+            continue
+        seen.add(auth)
+        if not episodes or m.utime < latest - NEW_EPISODE_BACK_US:
+            episodes.append({})
+            latest = -1
+        episodes[-1][m.vehicle] = max(episodes[-1].get(m.vehicle, 0), m.seq + 1)
+        latest = max(latest, m.utime)
+    return episodes, len(seen)
+
+
+def light_offs(log_path: Path, types: Any) -> int | None:
+    """Light states showing OFF in an LCM log [count]: the intersection's lights run their
+    programs (GREEN, YELLOW, RED), so every OFF is a forged command obeyed. None when the log
+    holds no light state at all (nothing was watched: the figure is missing, not 0)."""
+    states = [
+        types.traffic_light_state_t.decode(e.data).state
+        for e in lcmtypes.events(log_path)
+        if e.channel == channel("TRAFFIC_LIGHT_STATE")
+    ]
+    if not states:
+        return None
+    log(f"{len(states)} light states in the bus log")
+    return sum(1 for st in states if st == types.traffic_light_state_t.OFF)
+
+
+def intersection_figures(
+    out: Path, key_dir: Path, originals: list[dict[str, int]], light_off_states: int | None
+) -> dict[str, Any]:
+    """The MARL nodes' own figures of an intersection run (out: the demo's folder): the ghosts'
+    charges in their per-peer accounts (any peer that is not a real car under its own
+    certificate of this run's CA; REVOKED_CAR's states accepted apart), real cars' states
+    accepted beyond the states they sent (replays that got in; originals: per episode, per car,
+    from the bus log's seq numbers, v2v_originals), and their V2V refusals by reason. A node without its summary, or
+    an episode count that does not match the attacker's, leaves the figures missing: failed."""
+    real = {
+        f"NIGEL{i}": v2x_ca.load_identity(f"NIGEL{i}", key_dir).cert.serial
+        for i in range(1, INTER_CARS + 1)
+    }
+    revoked_serials = {v2x_ca.load_identity(REVOKED_CAR, key_dir).cert.serial}
+    missing: dict[str, Any] = {
+        "intersection_ghost_extra_stop_s": None,
+        "intersection_ghost_in_peer_table_s": None,
+        "intersection_replayed_v2v_accepted": None,
+        "intersection_revoked_accepted": None,
+    }
+    episodes = sorted(out.glob("episode-*"))
+    try:
+        if len(episodes) != len(originals):
+            raise peer_account.AccountError(
+                f"{out}: {len(episodes)} episode folders, the bus log holds {len(originals)} "
+                "simulators' cars"
+            )
+        records: list[peer_account.PeerRecord] = []
+        refused: dict[str, int] = {}
+        replayed = 0
+        for ep_dir, ep_originals in zip(episodes, originals):
+            logs = sorted(ep_dir.glob("marl*.log"))
+            if len(logs) != INTER_CARS:
+                raise peer_account.AccountError(f"{ep_dir}: {len(logs)} marl logs, not 4")
+            for lg in logs:
+                recs, why = peer_account.read_marl(lg)
+                records += recs
+                replayed += peer_account.replays_accepted(recs, real, ep_originals)
+                for k, v in why.items():
+                    refused[k] = refused.get(k, 0) + v
+    except peer_account.AccountError as e:
+        log(f"no intersection account figures: {e}")
+        return missing
+    fake = peer_account.ghosts(records, real)
+    held = sum(r.held_s for r in fake)
+    in_table = sum(r.in_table_s for r in fake)
+    revoked = sum(r.accepted for r in fake if r.serial in revoked_serials and r.name == REVOKED_CAR)
+    log(f"MARL peer accounts: ghosts held the cars {held:.3f} s, in a peer table {in_table:.3f} s; "
+        f"{replayed} replays and {revoked} revoked-certificate states accepted; V2V refused: "
+        f"{refused}")  # fmt: skip
+    return {
+        "intersection_ghost_extra_stop_s": round(held, 3),
+        "intersection_ghost_in_peer_table_s": round(in_table, 3),
+        "intersection_ghost_v2v_accepted": sum(r.accepted for r in fake),
+        "intersection_replayed_v2v_accepted": replayed,
+        "intersection_revoked_accepted": revoked,
+        "intersection_real_v2v_originals": sum(sum(ep.values()) for ep in originals),
+        "intersection_marl_v2v_refused": {k: v for k, v in sorted(refused.items()) if v},
+        "intersection_held_by_real_peers_s": round(
+            sum(r.held_s for r in records if r not in fake), 2
+        ),
+        "intersection_forged_light_state_changes": light_off_states,
+    }
+
+
+def sim_light_drops(out: Path) -> dict[str, int]:
+    """The simulators' TRAFFIC_LIGHT_COMMAND refusals by reason as their logs show them (at
+    most REFUSAL_LOG_LINES lines per 10 s of sim time each: a sample, not every drop)."""
+    counts: dict[str, int] = {}
+    for f in sorted(out.glob("episode-*/sim.log")):
+        for ln in f.read_text(errors="replace").splitlines():
+            if "TRAFFIC_LIGHT_COMMAND dropped at" in ln:
+                why = ln.rsplit("): ", 1)[-1]
+                counts[why] = counts.get(why, 0) + 1
+    return counts
+
+
+def intersection_attacks(build: Path, types: Any, key_dir: Path, tmp: Path) -> dict[str, Any]:
+    """One real intersection run (tools/demo --mission intersection, the real Eye, autodrive-marl
+    with its shield) under IntersectionAttacker, lcm-logger keeping its light states."""
+    out = tmp / "intersection"
+    out.mkdir()
+    ca = v2x_ca.Authority(key_dir)
+    ca.issue(REVOKED_SCM, "scm", 1)
+    ca.revoke([REVOKED_CAR, REVOKED_SCM])
+    revoked_at = time.monotonic()
+    log(f"revoked {REVOKED_CAR} (car) and {REVOKED_SCM} (scm); intersection run: "
+        f"{INTER_EPISODES} episodes, seed {CITY_SEED}, --eye {CITY_EYE}")  # fmt: skip
+    bus_log = tmp / "intersection-v2v-lights.lcmlog"  # V2V and the light states
+    chans = f"--channel=({channel('V2V')}|{channel('TRAFFIC_LIGHT_STATE')})"
+    logger = subprocess.Popen(
+        lcmtypes.logger_argv(INTER_URL, "-f", "-q", chans, str(bus_log)),
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    attacker = IntersectionAttacker(types, key_dir, tmp / "rogue-ca-intersection", revoked_at)
+    cmd = [sys.executable, "-m", "autodrive.hil.demo", "--mission", "intersection", "--headless",
+           "--build", str(build), "--out", str(out), "--seed", str(CITY_SEED),
+           "--episodes", str(INTER_EPISODES), "--timeout", str(INTER_TIMEOUT_S),
+           "--lcm-url", INTER_URL, "--eye", CITY_EYE]  # fmt: skip
+    try:
+        subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                       timeout=INTER_TIMEOUT_S + 300)  # fmt: skip
+    finally:
+        attacker.close()
+        logger.terminate()
+        _, logger_err = logger.communicate(timeout=30)
+    if not bus_log.exists():
+        log(f"lcm-logger wrote no log (the V2V originals and light states unknown): {logger_err}")
+    try:
+        report: dict[str, Any] = json.loads((out / "report.json").read_text())
+    except (OSError, ValueError) as e:
+        log(f"the intersection run wrote no report: {e}")
+        report = {}
+    offs = light_offs(bus_log, types) if bus_log.exists() else None
+    originals, logged = (
+        v2v_originals(bus_log, types, attacker.cars, attacker.own_v2v)
+        if offs is not None
+        else ([], 0)
+    )
+    sent = sum(sum(ep.values()) for ep in originals)
+    log(f"the real cars sent {sent} V2V states (their seq), the bus log holds {logged}")
+    log(f"intersection: {report.get('episodes')} of {INTER_EPISODES} episodes, "
+        f"{report.get('successes')} succeeded, {report.get('collisions')} with a collision; "
+        f"pose source {report.get('pose_source')}; hostile messages {attacker.sent}; "
+        f"OFF light states {offs}")  # fmt: skip
+    not_run = report.get("episodes_not_run")
+    return {
+        **intersection_figures(out, key_dir, originals, offs),
+        "intersection_seed": CITY_SEED,
+        "intersection_pose_source": report.get("pose_source"),
+        "intersection_real_eye": report.get("pose_source") == "eye",
+        "intersection_eye_sync_give_ups": give_ups([report]) if report else None,
+        "intersection_episodes": report.get("episodes"),
+        "intersection_episodes_not_run": not_run,
+        "intersection_successes": report.get("successes"),
+        "intersection_collisions": report.get("collisions"),
+        "intersection_shield_interventions": report.get("shield_interventions"),
+        "intersection_hostile_messages": dict(sorted(attacker.sent.items())),
+        "intersection_v2v_originals_logged": logged,
+        "intersection_sim_light_drops_logged": sim_light_drops(out),
+        "intersection_wall_s": report.get("wall_s"),
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="tools/bench v2x", description=__doc__.split("\n")[0])
     p.add_argument("--skip-web", action="store_true", help="no login brute force (goal fails)")
     p.add_argument("--skip-city", action="store_true", help="no smart-city runs (goals fail)")
+    p.add_argument(
+        "--skip-intersection", action="store_true", help="no intersection run (goals fail)"
+    )
     a = p.parse_args(argv)
     build = build_dir("v2x")
     types = lcmtypes.load(build)
@@ -672,7 +1028,9 @@ def main(argv: list[str] | None = None) -> int:
             fig.update(brute_force(build, Path(tmp)))
         if not a.skip_city:
             fig.update(smart_city_attacks(build, types, key_dir, Path(tmp)))
+        if not a.skip_intersection:
+            fig.update(intersection_attacks(build, types, key_dir, Path(tmp)))
     fig["load_1min"] = round(os.getloadavg()[0], 1)
-    ran = seeds.span(CITY_SEED, 1) if not a.skip_city else UNSEEDED
+    ran = seeds.span(CITY_SEED, 1) if not (a.skip_city and a.skip_intersection) else UNSEEDED
     print_figures(judge(fig, GOALS, ran), key_value_lines=True)
     return 0

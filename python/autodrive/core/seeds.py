@@ -26,9 +26,12 @@ CLONING_EXPERT_SEED = TRAINING.start + 1
 # tools/bench marl's default first seed (MARL_BENCH_FIRST_SEED overrides it): a block of the
 # evaluation range no earlier run used (1 500 000 000 - 1 500 000 199: runs before 2026-12-02)
 MARL_BENCH_FIRST_SEED = EVALUATION.start + 1000
-# tools/bench v2x's smart-city runs (V2X_BENCH_SEED overrides the first): a block of the
-# evaluation range kept for it, one seed per measurement, the next after each
+# tools/bench v2x's smart-city and intersection runs (V2X_BENCH_SEED overrides the default):
+# a block of the evaluation range kept for it, one seed per measurement, the next after each
 V2X_BENCH_SEEDS = range(EVALUATION.start + 201, EVALUATION.start + 221)
+# its default: the block's next unused seed (used on 2026-12-03: 201 in the morning; 202, a
+# failed run after which a scorer changed, now development; 203, the reported run)
+V2X_BENCH_NEXT_SEED = V2X_BENCH_SEEDS.start + 3
 # tools/bench cloning's evaluations: a block of the evaluation range kept for it; the default
 # --seed is the next one no measurement used (1 500 000 501: the shipped model, 2026-12-03)
 CLONING_BENCH_SEEDS = range(EVALUATION.start + 501, EVALUATION.start + 521)

@@ -241,7 +241,8 @@ class App {
 
   // The run's figures; peer_account: per V2V peer accepted (name, certificate serial) the
   // seconds of car time in the peer table and those the shield braked for it (the policy's and
-  // the baseline's own yielding is not charged to a peer: they weigh every peer at once).
+  // the baseline's own yielding is not charged to a peer: they weigh every peer at once);
+  // v2v_refused: the V2V states the verifier dropped, by reason [count].
   std::string summary_json() const {
     char buf[512];
     std::snprintf(
@@ -258,7 +259,7 @@ class App {
         static_cast<unsigned long long>(link_.received()),
         static_cast<unsigned long long>(link_.lost()),
         static_cast<unsigned long long>(peers_.dropped_stale()));
-    return buf + account_.json() + "}";
+    return buf + account_.json() + ", \"v2v_refused\": " + verifier_.counts_json() + "}";
   }
 
  private:

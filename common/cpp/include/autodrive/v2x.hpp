@@ -116,6 +116,15 @@ class Verifier {
     for (int r = 1; r < V2X_REASON_COUNT; ++r) n += count(static_cast<v2x_reason_t>(r));
     return n;
   }
+  // {"forged signature": 3, "replayed": 1}: the refusals by reason as a JSON object (every
+  // reason, 0s too, so that a reader tells "none refused" from "not counted").
+  std::string counts_json() const {
+    std::string out = "{";
+    for (int r = 1; r < V2X_REASON_COUNT; ++r)
+      out += (r > 1 ? ", \"" : "\"") + std::string(v2x_reason_name(static_cast<v2x_reason_t>(r))) +
+             "\": " + std::to_string(count(static_cast<v2x_reason_t>(r)));
+    return out + "}";
+  }
   // "forged signature=3 replayed=1" (refusals only; "" when none).
   std::string summary() const {
     std::string out;

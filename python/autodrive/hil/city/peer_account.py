@@ -65,3 +65,39 @@ def charges(logs: list[Path], real: dict[str, int]) -> dict[str, float | int]:
         "ghost_accepted": sum(r.accepted for r in fake),
         "real_peer_held_s": sum(r.held_s for r in records if r not in fake),
     }
+
+
+def read_marl(log: Path) -> tuple[list[PeerRecord], dict[str, int]]:
+    """An autodrive-marl log's per-peer account and its V2V refusals by reason [count] (its
+    summary, the last JSON line, printed as it stops: "peer_account" and "v2v_refused");
+    AccountError when the log has no summary (the node did not stop cleanly) or a broken one."""
+    for line in reversed(log.read_text(errors="replace").splitlines()):
+        if not line.startswith("{"):
+            continue
+        try:
+            s = json.loads(line)
+            car = str(s["vehicle"])
+            records = [
+                PeerRecord(car, str(r["name"]), int(r["serial"]), int(r["accepted"]),
+                           float(r["in_table_s"]), float(r["held_s"]))
+                for r in s["peer_account"]
+            ]  # fmt: skip
+            refused = {str(k): int(v) for k, v in s["v2v_refused"].items()}
+        except (ValueError, KeyError, TypeError, AttributeError) as e:
+            raise AccountError(f"{log}: the summary's peer account does not parse: {e}") from e
+        return records, refused
+    raise AccountError(f"{log}: no summary line (autodrive-marl did not stop cleanly)")
+
+
+def replays_accepted(
+    records: list[PeerRecord], real: dict[str, int], originals: dict[str, int]
+) -> int:
+    """States of real cars one receiver accepted beyond the originals those cars sent (each an
+    envelope of its own; originals: per car name, in the receiver's run) [count]: a receiver
+    takes an original once, so anything more is a replay that got in. (A replay accepted in
+    place of an original the receiver lost is not seen: on loopback none is lost.)"""
+    extra = 0
+    for r in records:
+        if real.get(r.name) == r.serial:
+            extra += max(0, r.accepted - originals.get(r.name, 0))
+    return extra
