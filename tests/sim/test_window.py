@@ -1,7 +1,7 @@
 """autodrive-sim --view driven as a person would (issue 36): the real program in its own Xvfb,
 keys and a mouse click injected with xdotool, the screen grabbed with ffmpeg (x11grab), the
 car's ground truth read on real LCM UDP multicast. Checks: the camera keys change the picture,
-night darkens it by a measured amount, R puts the car back at its start, and the Menu Panel's
+night darkens it by a measured amount, C draws the camera thumbnails, R puts the car back at its start, and the Menu Panel's
 Record button writes an LCM log and a playable MP4 whose frame count matches its duration in
 sim time. The screenshots go to $AUTODRIVE_SCREENSHOT_DIR when set (the docs' pictures).
 Judged by sim time, frames and pixels; the waits are guards that fail with what was seen."""
@@ -106,6 +106,16 @@ def test_window_as_a_person_uses_it(window: Window) -> None:
     print(f"night / day brightness of the scene: {ratio:.2f}")
     assert ratio < 0.6, f"night darkened the scene to {ratio:.2f} of the day only"
     w.key("n")
+
+    # C: the ego car's front and rear cameras as thumbnails at the bottom left of the scene
+    thumbs = (slice(WIN_H - 150, WIN_H - 40), slice(PANEL_W + 10, PANEL_W + 300))
+    plain = w.shot_image("window-god-plain")[thumbs].astype(np.float64)
+    w.key("c")
+    cams = w.shot_image("window-cameras")[thumbs].astype(np.float64)
+    change = np.abs(cams - plain).mean()
+    print(f"camera thumbnails changed their corner by {change:.1f} grey levels")
+    assert change > 10, f"C drew no camera thumbnails (the corner changed by {change:.1f})"
+    w.key("c")
 
     # R puts the car back: it has driven off its start, then is back within 5 cm
     t0, x0, y0 = w.truth[0]

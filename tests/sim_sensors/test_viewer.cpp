@@ -235,6 +235,15 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   EXPECT_EQ(in.shadows, 1);
   click("Scale");  // the render scale slider's middle
   EXPECT_NEAR(in.render_scale, 0.625, 0.15);
+  // the Sensors section's Cameras box: the ego car's front camera drawn at the bottom left
+  ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
+  click("Cameras");
+  EXPECT_EQ(in.thumbnails, 1);
+  ASSERT_EQ(sim_viewer_read_rgb(v, other.data()), 0);
+  EXPECT_NE(frame_sum(shot, w, 0, h - 100, w / 2, h), frame_sum(other, w, 0, h - 100, w / 2, h));
+  sim_viewer_key(v, GLFW_KEY_C);  // and C hides it again
+  ASSERT_EQ(sim_viewer_frame(v, room.m, room.d, &in), 0);
+  EXPECT_EQ(in.thumbnails, 0);
   // the Car section's Driving radio, and the drive keys it lets the caller read
   ASSERT_EQ(sim_viewer_item_at(v, "Driving/Manual", &cx, &cy), 0);
   printf("Driving/Manual at (%.0f, %.0f) px\n", cx, cy);

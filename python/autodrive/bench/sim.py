@@ -256,7 +256,7 @@ def sensors(build: Path, res: dict[str, Any]) -> None:
         log(f"sim-sensors-bench failed, no lidar/camera figures: {e}")
 
 
-VIEWER_PARTS = ("update", "scene", "blit", "hud", "ui", "swap")  # sim_viewer_part_t
+VIEWER_PARTS = ("update", "scene", "blit", "thumbs", "hud", "ui", "swap")  # sim_viewer_part_t
 # (name, extra autodrive-sim arguments): the breakdown's other looks, one window run each
 VIEWER_LOOKS = (
     ("nice_0", ["--view-nice", "0"]),  # the window's threads at the stepping's priority

@@ -4,13 +4,14 @@
  * behind and above), god's eye (the map's "eye" camera, else an overview of the whole model),
  * free (an overview), and each overhead Eye camera of the map.
  * Keys: 1/2/3/4 views, Tab next car, N day/night, Space pause, R reset, M the Menu Panel,
- * H the HUD, T manual or autonomous driving, Esc or closing quits; in manual mode the arrows
- * or W/A/S/D held drive the ego car (the caller turns them into commands: in.drive_keys).
- * The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map, pause,
- * step, reset, quit), Car (the ego car, autonomous or manual driving), View (camera, light level,
- * quality: low, high or ultra; render scale; HUD), Sensors (LIDAR rays) and Record (start /
- * stop). The HUD is text the caller sets (sim_viewer_set_hud), drawn at the top right.
- * The viewer only reports what the user asked (sim_viewer_input_t); the sim's main loop acts.
+ * H the HUD, C the camera thumbnails, T manual or autonomous driving, Esc or closing quits; in
+ * manual mode the arrows or W/A/S/D held drive the ego car (the caller turns them into commands:
+ * in.drive_keys). The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map,
+ * pause, step, reset, quit), Car (the ego car, autonomous or manual driving), View (camera, light
+ * level, quality: low, high or ultra; render scale; HUD), Sensors (LIDAR rays, the ego car's front
+ * and rear camera thumbnails, bottom left of the scene) and Record (start / stop). The HUD is text
+ * the caller sets (sim_viewer_set_hud), drawn at the top right. The viewer only reports what the
+ * user asked (sim_viewer_input_t); the sim's main loop acts.
  *
  * The window's OpenGL context is made with EGL (GLFW_EGL_CONTEXT_API) so that it coexists
  * with the headless sim_render EGL renderer in one process (MuJoCo binds its GL calls to one
@@ -57,6 +58,7 @@ typedef struct sim_viewer_input {
   int shadows, reflections, skybox; /* graphics quality (all 0: the fast default) */
   int hud;             /* 1: the HUD (figures, status line, keys) is drawn (H toggles) */
   int lidar_rays;      /* 1: the caller's LIDAR rays are drawn */
+  int thumbnails;      /* 1: the ego car's front and rear camera views are drawn (C toggles) */
   int step_requested;  /* Step clicked (edge): one step while paused */
   int record_toggled;  /* the Record button (edge): start or stop recording */
   int manual;          /* the Car section's Driving radio (T toggles): 0 autonomous, 1 manual */
@@ -72,6 +74,7 @@ typedef enum sim_viewer_part {
   SIM_VIEWER_PART_UPDATE = 0, /* mjv_updateScene, the light level, the LIDAR rays (CPU) */
   SIM_VIEWER_PART_SCENE,      /* mjr_render: geoms, and shadows/reflections/skybox when on */
   SIM_VIEWER_PART_BLIT,       /* the scaled scene stretched to the window (scale < 1) */
+  SIM_VIEWER_PART_THUMBS,     /* the front and rear camera thumbnails (when on) */
   SIM_VIEWER_PART_HUD,        /* mjr_overlay: the status line, the keys and the HUD's figures */
   SIM_VIEWER_PART_UI,         /* the Menu Panel (mjui_update when changed, mjui_render) */
   SIM_VIEWER_PART_SWAP,       /* glfwSwapBuffers */

@@ -95,6 +95,7 @@ void sim_viewer_key(sim_viewer_t *v, int key) {
       break;
     case GLFW_KEY_M: v->panel = !v->panel; break;
     case GLFW_KEY_H: v->in.hud = !v->in.hud; break;
+    case GLFW_KEY_C: v->in.thumbnails = !v->in.thumbnails; break;
     case GLFW_KEY_SPACE: v->in.paused = !v->in.paused; break;
     case GLFW_KEY_R: v->in.reset_requested = 1; break;
     case GLFW_KEY_T: v->in.manual = !v->in.manual; break;
@@ -284,10 +285,11 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   v->ncars = ncars;
   v->car_body = calloc((size_t)ncars, sizeof(int));
   v->car_cam = calloc((size_t)ncars, sizeof(int));
+  v->car_rear_cam = calloc((size_t)ncars, sizeof(int));
   v->ray_end = malloc(VIEWER_MAX_RAYS * 3 * sizeof(float));
   v->rgb_px = (size_t)v->w * (size_t)v->h;
   v->rgb = malloc(v->rgb_px * 3);
-  if (!v->car_body || !v->car_cam || !v->rgb || !v->ray_end) {
+  if (!v->car_body || !v->car_cam || !v->car_rear_cam || !v->rgb || !v->ray_end) {
     sim_viewer_destroy(v);
     return NULL;
   }
@@ -297,6 +299,13 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
     v->car_body[i - 1] = mj_name2id(m, mjOBJ_BODY, name);
     snprintf(name, sizeof name, cam_fmt, i);
     v->car_cam[i - 1] = mj_name2id(m, mjOBJ_CAMERA, name);
+    char *front = strstr(name, "front"); /* nigel1/cam_front -> nigel1/cam_rear */
+    v->car_rear_cam[i - 1] = -1;
+    if (front) {
+      char rear[128];
+      snprintf(rear, sizeof rear, "%.*srear%s", (int)(front - name), name, front + 5);
+      v->car_rear_cam[i - 1] = mj_name2id(m, mjOBJ_CAMERA, rear);
+    }
   }
   for (int id = 0; id < m->ncam && v->neyes < SIM_VIEWER_MAX_EYES; id++) {
     const char *name = mj_id2name(m, mjOBJ_CAMERA, id);
@@ -331,6 +340,7 @@ void sim_viewer_destroy(sim_viewer_t *v) {
   }
   free(v->car_body);
   free(v->car_cam);
+  free(v->car_rear_cam);
   free(v->ray_end);
   free(v->rgb);
   free(v->part_ms);
@@ -391,10 +401,9 @@ int sim_viewer_camera_id(const sim_viewer_t *v) {
   return id;
 }
 
-/* The scene of the chosen view with the light level, the graphics quality and the LIDAR rays. */
-static void viewer_scene(sim_viewer_t *v, const mjModel *m, mjData *d) {
-  viewer_camera(v, m);
-  mjv_updateScene(m, d, &v->opt, NULL, &v->cam, mjCAT_ALL, &v->scn);
+/* The scene seen from cam with the light level and the graphics quality. */
+static void viewer_fill_scene(sim_viewer_t *v, const mjModel *m, mjData *d, mjvCamera *cam) {
+  mjv_updateScene(m, d, &v->opt, NULL, cam, mjCAT_ALL, &v->scn);
   v->scn.flags[mjRND_SHADOW] = (mjtByte)(v->in.shadows != 0);
   v->scn.flags[mjRND_REFLECTION] = (mjtByte)(v->in.reflections != 0);
   v->scn.flags[mjRND_SKYBOX] = (mjtByte)(v->in.skybox != 0);
@@ -406,6 +415,12 @@ static void viewer_scene(sim_viewer_t *v, const mjModel *m, mjData *d) {
       v->scn.lights[i].diffuse[k] *= level;
       v->scn.lights[i].ambient[k] *= level;
     }
+}
+
+/* The scene of the chosen view, with the LIDAR rays when on. */
+static void viewer_scene(sim_viewer_t *v, const mjModel *m, mjData *d) {
+  viewer_camera(v, m);
+  viewer_fill_scene(v, m, d, &v->cam);
   if (!v->in.lidar_rays) return;
   static const float ray_rgba[4] = {1.0f, 0.1f, 0.1f, 0.8f};
   const double *o = v->ray_origin;
@@ -519,6 +534,35 @@ static void viewer_render_scene(sim_viewer_t *v, mjrRect vp, double *t_ms) {
   viewer_part_done(v, SIM_VIEWER_PART_BLIT, t_ms);
 }
 
+/* The ego car's front and rear cameras, side by side at the bottom left of the scene's area
+ * (scene: that area), each labelled; drawn straight into the window at their own small size,
+ * so they cost what their pixels cost, whatever the render scale. */
+static void viewer_thumbnails(sim_viewer_t *v, const mjModel *m, mjData *d, mjrRect scene,
+                              double *t_ms) {
+  if (!v->in.thumbnails) return;
+  const int car = v->in.car - 1;
+  const int ids[2] = {v->car_cam[car], v->car_rear_cam[car]};
+  static const char *labels[2] = {"front camera", "rear camera"};
+  const int w = (int)lround(scene.width * SIM_VIEWER_THUMB_SHARE), h = w * 3 / 4; /* 4:3 */
+  const int gap = 8, label_h = 22;                                                /* [px] */
+  const int bottom = 34; /* [px] above the status line */
+  mjr_setBuffer(mjFB_WINDOW, &v->con);
+  for (int k = 0, shown = 0; k < 2; k++) {
+    if (ids[k] < 0 || w < 32) continue;
+    mjvCamera cam;
+    mjv_defaultCamera(&cam);
+    cam.type = mjCAMERA_FIXED;
+    cam.fixedcamid = ids[k];
+    viewer_fill_scene(v, m, d, &cam);
+    const mjrRect r = {scene.left + gap + shown * (w + gap), bottom, w, h};
+    mjr_render(r, &v->scn, &v->con);
+    const mjrRect label = {r.left, bottom + h, w, label_h}; /* a strip above, not over it */
+    mjr_label(label, mjFONT_NORMAL, labels[k], 0.1f, 0.1f, 0.1f, 0.8f, 1, 1, 1, &v->con);
+    shown++;
+  }
+  viewer_part_done(v, SIM_VIEWER_PART_THUMBS, t_ms);
+}
+
 /* A frame of d into the window (its size in v->w, v->h): scene, HUD, panel, read-back, swap. */
 static int viewer_draw_frame(sim_viewer_t *v, const mjModel *m, mjData *d) {
   v->timing_now =
@@ -530,7 +574,9 @@ static int viewer_draw_frame(sim_viewer_t *v, const mjModel *m, mjData *d) {
   /* the scene right of the Menu Panel only: the panel is opaque, and every pixel drawn under
    * it would be paid for twice (a quarter of a 1024 px wide window) */
   const int left = v->panel && v->w - v->ui.width >= 64 ? v->ui.width : 0;
-  viewer_render_scene(v, (mjrRect){left, 0, v->w - left, v->h}, &t_ms);
+  const mjrRect scene = {left, 0, v->w - left, v->h};
+  viewer_render_scene(v, scene, &t_ms);
+  viewer_thumbnails(v, m, d, scene, &t_ms);
   viewer_overlays(v, vp, d->time);
   viewer_part_done(v, SIM_VIEWER_PART_HUD, &t_ms);
   sim_viewer_ui_render(v);
@@ -659,7 +705,7 @@ static int viewer_cmp_float(const void *a, const void *b) {
 }
 
 long sim_viewer_parts(const sim_viewer_t *v, double *ms, const char **names) {
-  static const char *part_names[SIM_VIEWER_PARTS] = {"update", "scene", "blit",
+  static const char *part_names[SIM_VIEWER_PARTS] = {"update", "scene", "blit", "thumbs",
                                                      "hud",    "ui",    "swap"};
   static float col[SIM_VIEWER_TIMED_FRAMES];
   for (int p = 0; p < SIM_VIEWER_PARTS; p++) {

@@ -15,6 +15,7 @@
 #define SIM_VIEWER_QUEUE 256        /* window events queued for the drawing thread */
 #define SIM_VIEWER_SHADOW_PX 2048   /* [px] the shadow map's side when the model has none */
 #define SIM_VIEWER_MAX_RASTER 64    /* rasteriser threads (llvmpipe-*) looked at */
+#define SIM_VIEWER_THUMB_SHARE 0.3  /* a thumbnail's width as a share of the scene's */
 
 /* A window event on its way from the polling thread to the drawing thread. */
 typedef struct sim_viewer_event {
@@ -34,6 +35,7 @@ struct sim_viewer {
   int ncars;
   int *car_body;                    /* base body id per car (index car-1), -1 if missing */
   int *car_cam;                     /* front camera id per car, -1 if missing */
+  int *car_rear_cam;                /* rear camera id per car (the front's name, rear), or -1 */
   int eye_cam[SIM_VIEWER_MAX_EYES]; /* the map's overhead cameras ("eye", "eye_*") */
   int neyes;
   int w, h;

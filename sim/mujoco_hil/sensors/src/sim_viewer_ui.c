@@ -66,6 +66,8 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   ui_add(v, mjITEM_SLIDERNUM, "Scale", &v->in.render_scale, "0.25 1");
   ui_add(v, mjITEM_SECTION, "Sensors", NULL, "");
   ui_add(v, mjITEM_CHECKINT, "LIDAR rays", &v->in.lidar_rays, "");
+  ui_add(v, mjITEM_CHECKINT, "Cameras", &v->in.thumbnails,
+         ""); /* beside: the panel keeps its height */
   ui_add(v, mjITEM_SECTION, "Record", NULL, "");
   ui_add(v, mjITEM_BUTTON, UI_RECORD, NULL, "");
   mjui_resize(ui, &v->con);
