@@ -354,6 +354,8 @@ def run_dagger(
             "train_wall_s": round(time.monotonic() - tt, 1), "train_cpu_s": round(cpu_s() - ct, 1),
             "model_sha256": _sha(model),
         })  # fmt: skip
+        # the rounds so far, should a later one fail or be stopped
+        (work / f"{REPORT}_partial.json").write_text(json.dumps(rounds, indent=2) + "\n")
     out.mkdir(parents=True, exist_ok=True)
     last = model.parent
     for suffix in (".onnx", ".json"):
