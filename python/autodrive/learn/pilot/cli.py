@@ -189,6 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
         help="round 0's expert recordings (tools/pilot expert) instead of recording them",
     )  # fmt: skip
+    g.add_argument("--lcm-url", default="", help="the rollouts' bus (default: a port of its own)")
 
     args = ap.parse_args(argv)
     try:
@@ -248,7 +249,7 @@ def _run(args: argparse.Namespace) -> int:
             takeover_margin_m=args.takeover_margin, randomise=not args.no_randomise,
             threads=args.threads, name=args.name,
         )  # fmt: skip
-        run_dagger(dcfg, args.out, args.work, _build(), args.logs)
+        run_dagger(dcfg, args.out, args.work, _build(), args.logs, args.lcm_url)
         return 0
     from autodrive.learn.pilot.make_model import make_model
 

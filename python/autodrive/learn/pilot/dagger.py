@@ -36,7 +36,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from autodrive.core import channels, seeds, settings
+from autodrive.core import seeds
 from autodrive.learn.pilot import dataset
 from autodrive.learn.pilot.expert import ExpertRun, meta_path
 
@@ -244,8 +244,9 @@ def _train(cfg: DaggerConfig, data: Path, out: Path, round_: int) -> dict[str, A
 
 
 def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: int,
-             rand: dict[str, float]) -> tuple[Path, dict[str, Any]]:  # fmt: skip
+             rand: dict[str, float], lcm_url: str) -> tuple[Path, dict[str, Any]]:  # fmt: skip
     from autodrive.hil.missions import cloning
+    from autodrive.learn.pilot.expert import default_url
 
     seed = rollout_seed(cfg.seed, round_)
     out = work / "rollout"
@@ -254,7 +255,7 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
         mission="cloning", build=str(build), out=str(out), seed=seed, headless=True,
         timeout=ROLLOUT_TIMEOUT_S, laps=cfg.rollout_laps, condition="normal", model=str(model),
         save_frames=0, start_m=cloning.START_ALONG_M, distance_m=0.0,
-        lcm_url=settings.instance().lcm_url(channels.load().url_default),
+        lcm_url=lcm_url or default_url(0),
         takeover_margin_m=cfg.takeover_margin_m, log=logf,
         light_level=rand.get("light_level"), camera_noise=rand.get("camera_noise"),
         camera_blur=rand.get("camera_blur"),
@@ -281,10 +282,14 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
 
 
 def run_dagger(
-    cfg: DaggerConfig, out: Path, work: Path, build: Path, logs: list[Path] | None = None
+    cfg: DaggerConfig, out: Path, work: Path, build: Path, logs: list[Path] | None = None,
+    lcm_url: str = "",
 ) -> dict[str, Any]:
     """Runs round 0 and cfg.rounds DAgger rounds; writes the last model (NAME.onnx + .json) and
-    the report (dagger_report.json, .md) into out, everything else into work."""
+    the report (dagger_report.json, .md) into out, everything else into work. The rollouts run
+    on lcm_url, by default a multicast port of this process's own (expert.default_url): on the
+    instance's shared bus another cloning run's ground truth and SIM_TELEPORT would mix with
+    the rollout's (seen: two referees resetting one car, and both cars' frames in the log)."""
     cfg.check()
     if (work / "round0").exists():
         raise FileExistsError(f"{work}: holds an earlier run (round0/): give a new --work")
@@ -334,7 +339,7 @@ def run_dagger(
         wr.mkdir(parents=True)
         rand = sim_random.draw(rollout_seed(cfg.seed, r)) if cfg.randomise else {}
         tr, cr = time.monotonic(), cpu_s()
-        logf, roll = _rollout(cfg, model, wr, build, r, rand)
+        logf, roll = _rollout(cfg, model, wr, build, r, rand, lcm_url)
         roll_s = (time.monotonic() - tr, cpu_s() - cr)
         score = round_score(roll, cfg.rollout_laps)
         log(f"round {r}: rollout of round {r - 1}'s model: {json.dumps(score)}")
