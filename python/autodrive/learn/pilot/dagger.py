@@ -282,7 +282,11 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
 
 
 def run_dagger(
-    cfg: DaggerConfig, out: Path, work: Path, build: Path, logs: list[Path] | None = None,
+    cfg: DaggerConfig,
+    out: Path,
+    work: Path,
+    build: Path,
+    logs: list[Path] | None = None,
     lcm_url: str = "",
 ) -> dict[str, Any]:
     """Runs round 0 and cfg.rounds DAgger rounds; writes the last model (NAME.onnx + .json) and
