@@ -2,13 +2,17 @@
 1. The pipeline: record LAPS expert laps, extract the dataset and train (pilot-train's
    `python -m autodrive.learn.pilot make-model`), then deploy and evaluate LAPS laps (tools/demo
    --mission cloning); its wall time (goal <= 20 min). --model M skips recording and training
-   and evaluates M (then the pipeline's time is not measured).
+   and evaluates M (then the pipeline's time is not measured). --dagger-rounds N trains with
+   `tools/pilot dagger --rounds N` instead (issue 38: record, DAgger rounds and train; goal
+   <= 45 min for the pipeline).
 2. inference_ms_p50/p99 of autodrive-pilot on one core (taskset -c 0, cv::setNumThreads(1)) on
    front-camera frames of the run, the median of 5 passes (goal p99 <= 5 ms).
 3. The evaluation in the normal condition (goals: autonomy 100 %, cross-track rms <= 0.04 m) and
    in the issue's three unseen ones, night, noise2x and reverse (the recorded route driven the
    other way; goal: autonomy >= 95 % each), and in one more unseen, other-lane (loop_cw, the
-   inner lane clockwise; reported, with its own goal flag, not one of the issue's).
+   inner lane clockwise), other-lane-reverse (the inner lane counter-clockwise), tiny-town
+   (Tiny Town's loop_ccw) and intersection (Intersection School through the junction), each
+   reported with its own goal flag (issue 38's roads never trained on).
 Every step's wall time is printed beside its CPU time (this process and all its children: the
 simulators, the runtime, the pilot, training). On a shared machine the wall time includes the
 time the pipeline waited for other jobs' CPU, so it is inflated; the CPU time is its own cost.
@@ -65,6 +69,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         help="train with the curvature augmentation up to DK [1/m] (make-model --curve-max; an "
         "experiment, 0: the shipped recipe)",
     )  # fmt: skip
+    p.add_argument(
+        "--dagger-rounds", type=int, default=0, metavar="N",
+        help="train with tools/pilot dagger --rounds N (0: make-model, the shipped recipe)",
+    )  # fmt: skip
     p.add_argument("--timeout", type=float, default=7200.0, help="per evaluation [wall s]")
     args = p.parse_args(argv)
     try:  # before hours of recording: training and evaluation never share a seed
@@ -77,15 +85,22 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
 
 
 def make_model(
-    out: Path, laps: int, seed: int, say: Progress, curve_max: float = 0.0
+    out: Path, laps: int, seed: int, say: Progress, curve_max: float = 0.0, dagger_rounds: int = 0
 ) -> tuple[Path, float]:
-    """Records, extracts and trains with pilot-train's tools; (the model, wall s)."""
+    """Records, extracts and trains with pilot-train's tools (make-model, or tools/pilot dagger
+    with dagger_rounds > 0); (the model, wall s)."""
     if importlib.util.find_spec("autodrive.learn.pilot") is None:
         raise RuntimeError("autodrive.learn.pilot (tools/pilot, branch pilot-train) is missing")
     model_dir, work = out / "model", out / "work"
     shutil.rmtree(model_dir, ignore_errors=True)
-    argv = [sys.executable, "-m", "autodrive.learn.pilot", "make-model", "--out", str(model_dir)]
-    argv += ["--work", str(work), "--laps", str(laps), "--seed", str(seed)]
+    if dagger_rounds > 0:
+        shutil.rmtree(work, ignore_errors=True)  # dagger refuses a work folder of a run
+        argv = [sys.executable, "-m", "autodrive.learn.pilot", "dagger", "--out", str(model_dir)]
+        argv += ["--work", str(work), "--rounds", str(dagger_rounds), "--seed", str(seed)]
+    else:
+        argv = [sys.executable, "-m", "autodrive.learn.pilot", "make-model"]
+        argv += ["--out", str(model_dir), "--work", str(work), "--laps", str(laps)]
+        argv += ["--seed", str(seed)]
     if curve_max > 0:
         argv += ["--curve-max", f"{curve_max:g}"]
     say(f"record {laps} laps + train: {' '.join(argv)}")
@@ -99,6 +114,7 @@ def make_model(
 
 def evaluate(model: Path, condition: str, laps: int, args: argparse.Namespace, out: Path,
              save_frames: int = 0) -> dict[str, Any]:  # fmt: skip
+    laps = condition_laps(condition, laps)
     argv = ["--mission", "cloning", "--build", str(build_dir(SUITE)), "--model", str(model)]
     argv += ["--out", str(out / condition), "--condition", condition, "--laps", str(laps)]
     argv += ["--seed", str(args.seed), "--timeout", str(args.timeout), "--headless"]
@@ -107,6 +123,11 @@ def evaluate(model: Path, condition: str, laps: int, args: argparse.Namespace, o
     rep: dict[str, Any] = json.loads((out / condition / "report.json").read_text())
     rep["exit_code"] = code
     return rep
+
+
+def condition_laps(condition: str, laps: int) -> int:
+    """The laps a condition drives: a route that is not a loop (intersection) is driven once."""
+    return laps if cloning.condition_route(condition)[0].loop else 1
 
 
 def one_core_inference(model: Path, frames_dir: Path, out: Path) -> dict[str, Any]:
@@ -138,13 +159,22 @@ def make_model_times(model: Path) -> Any:
     try:
         report = json.loads(model.with_name(model.stem + "_report.json").read_text())
     except (OSError, ValueError):
-        return None
+        try:  # tools/pilot dagger: its rounds' times
+            dagger = json.loads(model.with_name("dagger_report.json").read_text())
+        except (OSError, ValueError):
+            return None
+        return [{k: v for k, v in r.items() if k.endswith("_s")} for r in dagger["rounds"]]
     return report.get("wall_times_s")
 
 
-def goal_table(laps: int = 5, unseen_laps: int = 1) -> dict[str, Goal]:
-    """Issue 16's goals (and the extra condition's same bar). A condition counts only with its
-    laps driven and its run's exit code 0: a run that timed out or crashed fails its goals."""
+PIPELINE_GOAL_S = 1200.0  # issue 16: record, train, deploy and evaluate in 20 min
+DAGGER_PIPELINE_GOAL_S = 2700.0  # issue 38: record, the DAgger rounds and train in 45 min
+
+
+def goal_table(laps: int = 5, unseen_laps: int = 1, dagger: bool = False) -> dict[str, Goal]:
+    """Issue 16's goals (and the extra conditions' same bar; issue 38's pipeline goal with
+    DAgger). A condition counts only with its laps driven and its run's exit code 0: a run that
+    timed out or crashed fails its goals."""
     goals = {
         "autonomy_100_normal": equals("normal.autonomy_pct", 100.0),
         "normal_laps_driven": at_least("normal.laps", laps),
@@ -152,12 +182,17 @@ def goal_table(laps: int = 5, unseen_laps: int = 1) -> dict[str, Goal]:
         "cross_track_le_0_04": at_most("normal.cross_track_rms_m", 0.04),
         # on one core: the pilot thread's CPU time (wall time includes a loaded host's queue)
         "inference_p99_le_5ms": at_most("inference_cpu_ms_p99", 5.0),
-        "pipeline_le_20min": at_most("pipeline_wall_s", 1200.0),
     }
+    if dagger:
+        goals["pipeline_le_45min"] = at_most("pipeline_wall_s", DAGGER_PIPELINE_GOAL_S)
+    else:
+        goals["pipeline_le_20min"] = at_most("pipeline_wall_s", PIPELINE_GOAL_S)
     for cond in UNSEEN + EXTRA:
         kind = "unseen" if cond in UNSEEN else "extra"  # extra: not one of the issue's goals
         goals[f"{kind}_{cond}_ge_95"] = at_least(f"{cond}.autonomy_pct", 95.0)
-        goals[f"{kind}_{cond}_laps_driven"] = at_least(f"{cond}.laps", unseen_laps)
+        goals[f"{kind}_{cond}_laps_driven"] = at_least(
+            f"{cond}.laps", condition_laps(cond, unseen_laps)
+        )
         goals[f"{kind}_{cond}_exit_0"] = equals(f"{cond}.exit_code", 0)
     return goals
 
@@ -176,6 +211,7 @@ def main(argv: list[str]) -> int:
     out.mkdir(parents=True, exist_ok=True)
     figures: dict[str, Any] = {"laps": args.laps, "unseen_laps": args.unseen_laps}
     figures["curve_max"] = args.curve_max
+    figures["dagger_rounds"] = args.dagger_rounds
     steps: dict[str, dict[str, float]] = {}  # each step's wall and CPU seconds
     t0, cpu0 = time.monotonic(), cpu_s()
     figures["load_avg_start"] = round(os.getloadavg()[0], 1)
@@ -191,7 +227,9 @@ def main(argv: list[str]) -> int:
         if args.model:
             model, train_s = Path(args.model), None
         else:
-            model, train_s = make_model(out, args.laps, args.train_seed, say, args.curve_max)
+            model, train_s = make_model(
+                out, args.laps, args.train_seed, say, args.curve_max, args.dagger_rounds
+            )
             step("record_train", t0, cpu0)
     except (RuntimeError, subprocess.CalledProcessError) as e:
         say(f"ERROR: {e}")
@@ -222,7 +260,8 @@ def main(argv: list[str]) -> int:
         step(f"evaluate_{cond}", tc, cpuc)
     figures["steps"] = steps
 
-    judge(figures, goal_table(args.laps, args.unseen_laps), seeds.span(args.seed, 1))
+    goals = goal_table(args.laps, args.unseen_laps, args.dagger_rounds > 0)
+    judge(figures, goals, seeds.span(args.seed, 1))
     for c in ("normal", *UNSEEN, *EXTRA):
         r = figures[c]
         print(f"{c}: laps {r.get('laps')}  interventions {r.get('interventions')}  autonomy "

@@ -22,6 +22,18 @@ STALL_S = 6.0  # this long of sim time with less than STALL_PROGRESS_M along the
 STALL_PROGRESS_M = 0.05
 
 
+def takeover_due(wheel_margin_m: float, takeover_margin_m: float | None) -> bool:
+    """DAgger's takeover rule (tools/pilot dagger): the expert takes over where the car would
+    leave the lane, a wheel within takeover_margin_m [m] of the lane bound (or over it); never
+    without a margin (None: a mission's referee, which intervenes at the bound only).
+    ValueError for a negative margin (a takeover outside the lane takes over nothing)."""
+    if takeover_margin_m is None:
+        return False
+    if not takeover_margin_m >= 0.0:
+        raise ValueError(f"takeover margin {takeover_margin_m} m: must be >= 0")
+    return wheel_margin_m < takeover_margin_m
+
+
 def autonomy_pct(interventions: int, elapsed_s: float) -> float | None:
     """PilotNet's autonomy, 100 (1 - interventions x 6 s / elapsed) [%], never below 0; None
     before any time has elapsed."""
@@ -96,13 +108,18 @@ class LaneWatch:
 
     def wheels_out(self, pose: Pose3) -> bool:
         """True when any wheel's contact point is past the lane bound (route half width)."""
+        return self.wheel_margin_m(pose) < 0.0
+
+    def wheel_margin_m(self, pose: Pose3) -> float:
+        """[m] from the lane bound to the wheel nearest it (its tyre's outer edge), inward;
+        below 0 when that wheel is over the bound."""
         x, y, yaw = pose
         c, s = math.cos(yaw), math.sin(yaw)
+        worst = math.inf
         for wx, wy in self.wheel_points_m:
             off, _, _ = self.locate(x + c * wx - s * wy, y + s * wx + c * wy)
-            if abs(off) > self.route.half_width_m:
-                return True
-        return False
+            worst = min(worst, self.route.half_width_m - abs(off))
+        return worst
 
     def update(self, pose: Pose3) -> float:
         """Follows the car to pose: progress along the route; returns base_link's offset [m]."""

@@ -21,7 +21,16 @@ sidecar's two preprocessing halves; all of it seeded through the numpy Generator
   with its lines where they were (the dashed centre line on the outside of a right-hand curve
   too); the label becomes the steering of the curvature plus dk, atan(wheelbase (k + dk)). Ground
   the frame did not see (outside its view: 20-30 % of the picture at |dk| 0.5-0.75, mostly on
-  the bend's outer side) is filled with the frame's median colour, the road's asphalt."""
+  the bend's outer side) is filled with the frame's median colour, the road's asphalt.
+- Domain randomisation (an option, `tools/pilot train --randomise`, `tools/pilot dagger`'s
+  default; Randomise): what the simulator cannot vary per frame, on the small frame: the light's
+  colour (per-channel gains), exposure (gain and gamma, clipped as a sensor clips), blur and
+  noise, the camera's pose within the mount's tolerance (pitch and roll as the picture's
+  rotation about the principal point and its vertical shift; yaw as a sideways shift whose label
+  correction is the shift's), the road's texture (the asphalt's pixels tinted towards another
+  of the kit's surfaces, with a seeded grain) and distractors beside the road (cone- and
+  box-coloured blobs at the picture's outer edges). The simulator's own (light level, camera
+  noise and blur) are drawn per recording (tools/pilot dagger, SimRandom)."""
 
 from __future__ import annotations
 
@@ -116,6 +125,85 @@ class CurveWarp:
         return out, self.steering(steering, dk)
 
 
+# The camera mount's tolerance: vehicle/nigel.params gives the camera's pose, no tolerance; we
+# take +-1 deg about each axis (a 3D-printed mount on M2 screws) and say so in the docs.
+MOUNT_TOLERANCE_DEG = 1.0
+# the kit's surfaces (maps/kit.yaml, rgba 0..1 as BGR 8-bit) a road can be tinted towards
+KIT_SURFACES_BGR = {
+    "asphalt": (69.0, 64.0, 64.0),
+    "dirt": (51.0, 84.0, 115.0),
+    "worn": (110.0, 105.0, 100.0),  # asphalt weathered light grey (not a kit surface: a variant)
+}
+# distractor colours (BGR): the kit's cone and box, a parked car's red and blue
+DISTRACTORS_BGR = ((0.0, 102.0, 255.0), (25.0, 153.0, 230.0), (40.0, 40.0, 200.0), (200, 80, 30))
+
+
+@dataclass(frozen=True)
+class Randomise:
+    """Image-level domain randomisation of a small BGR frame (each part with probability p)."""
+
+    fx_small_px: float = 0.0  # focal length at the small frame's width [px] (0: no pose jitter)
+    fy_small_px: float = 0.0  # [px] at the small frame's height
+    cy_small_px: float = 0.0  # the principal point's row in small-frame rows (above: < 0)
+    gain_per_px: float = 0.0  # steering per px of sideways shift (Augment's)
+    p: float = 0.3
+    colour_gain: float = 0.15  # per-channel gain in 1 +- this (the light's colour)
+    exposure_ev: float = 0.7  # gain 2^U(-ev, ev) ...
+    gamma: tuple[float, float] = (0.7, 1.4)  # ... and a gamma in this range
+    blur_sigma_px: float = 1.2  # Gaussian blur up to this sigma [px of the small frame]
+    noise_sigma: float = 6.0  # Gaussian noise up to this sigma [8-bit levels]
+    mount_tolerance_deg: float = MOUNT_TOLERANCE_DEG  # pitch, roll, yaw jitter within +-this
+    texture_strength: float = 0.6  # the road's tint towards a surface, up to this fraction
+    road_luma_max: float = 110.0  # pixels darker than this [8-bit luma], low chroma: the road
+    max_distractors: int = 2
+
+    def __call__(self, img: U8, steering: float, rng: np.random.Generator) -> tuple[U8, float]:
+        h, w = img.shape[:2]
+        out = img
+        if self.fx_small_px > 0 and rng.random() < self.p:  # the camera's pose in its mount
+            tol = math.radians(self.mount_tolerance_deg)
+            pitch, roll, yaw = (float(v) for v in rng.uniform(-tol, tol, 3))
+            dx = self.fx_small_px * math.tan(yaw)
+            dy = self.fy_small_px * math.tan(pitch)
+            m = cv2.getRotationMatrix2D((w / 2.0, self.cy_small_px), math.degrees(roll), 1.0)
+            m[0, 2] += dx
+            m[1, 2] += dy
+            out = cv2.warpAffine(out, m, (w, h), borderMode=cv2.BORDER_REPLICATE)
+            steering -= self.gain_per_px * dx
+        f = out.astype(np.float32)
+        if rng.random() < self.p:  # road texture: the asphalt tinted, with a grain
+            grey = f.mean(axis=2)
+            chroma = f.max(axis=2) - f.min(axis=2)
+            road = (grey < self.road_luma_max) & (chroma < 25.0)
+            names = sorted(KIT_SURFACES_BGR)
+            tint = np.asarray(KIT_SURFACES_BGR[names[int(rng.integers(len(names)))]], np.float32)
+            a = np.float32(rng.uniform(0.0, self.texture_strength))
+            grain = cv2.GaussianBlur(rng.normal(0.0, 12.0, (h, w)).astype(np.float32), (0, 0), 1.5)
+            mixed = (1 - a) * f + a * (tint + grain[:, :, None])
+            f = np.where(road[:, :, None], mixed, f)
+        if rng.random() < self.p:  # distractors beside the road: at the picture's outer edges
+            for _ in range(int(rng.integers(1, self.max_distractors + 1))):
+                side = int(rng.integers(2))
+                bw, bh = int(rng.integers(6, 16)), int(rng.integers(6, 20))
+                x0 = int(rng.integers(0, max(1, w // 8 - bw // 2)))
+                x0 = x0 if side == 0 else w - bw - x0
+                y0 = int(rng.integers(0, max(1, h // 2)))
+                colour = DISTRACTORS_BGR[int(rng.integers(len(DISTRACTORS_BGR)))]
+                f[y0 : y0 + bh, x0 : x0 + bw] = np.asarray(colour, np.float32)
+        if rng.random() < self.p:  # the light's colour
+            f *= rng.uniform(1 - self.colour_gain, 1 + self.colour_gain, 3).astype(np.float32)
+        if rng.random() < self.p:  # exposure: gain and gamma, clipped as a sensor clips
+            g = np.float32(2.0 ** rng.uniform(-self.exposure_ev, self.exposure_ev))
+            gam = np.float32(rng.uniform(*self.gamma))
+            f = 255.0 * np.clip(f * g / 255.0, 0.0, 1.0) ** gam
+        if rng.random() < self.p:
+            f = cv2.GaussianBlur(f, (0, 0), float(rng.uniform(0.3, self.blur_sigma_px)))
+        if rng.random() < self.p:
+            f = f + rng.normal(0.0, rng.uniform(0.0, self.noise_sigma), f.shape).astype(np.float32)
+        res: U8 = np.clip(f, 0, 255).astype(np.uint8)
+        return res, float(steering)
+
+
 @dataclass(frozen=True)
 class Augment:
     gain_per_px: float  # steering correction per px of sideways shift [normalised / px]
@@ -128,12 +216,15 @@ class Augment:
     shadow_levels: tuple[float, float] = (0.25, 0.8)  # the band's levels times U(a, b)
     p_shift: float = 0.5
     curve: CurveWarp | None = None  # the curvature augmentation (None: off)
+    randomise: Randomise | None = None  # domain randomisation (None: off, the shipped recipe)
 
     def __call__(self, img: U8, steering: float, rng: np.random.Generator) -> tuple[U8, float]:
         out = img
         h, w = img.shape[:2]
         if self.curve is not None and rng.random() < self.curve.p_curve:
             out, steering = self.curve(out, steering, rng)
+        if self.randomise is not None:
+            out, steering = self.randomise(out, steering, rng)
         if rng.random() < self.p_shift:
             dx = float(rng.uniform(-self.max_shift_px, self.max_shift_px))
             dy = float(rng.uniform(-2.0, 2.0))

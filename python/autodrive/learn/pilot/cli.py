@@ -11,6 +11,7 @@ from pathlib import Path
 
 from autodrive.core import seeds
 from autodrive.core.settings import RELEASE_BUILD
+from autodrive.learn.pilot.dagger import ROLLOUT_SEED_OFFSET, TAKEOVER_MARGIN_M, DaggerConfig
 from autodrive.learn.pilot.expert import ExpertRun
 
 DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front camera.
@@ -19,6 +20,8 @@ DESCRIPTION = """Behavioural cloning of the lane-keeping expert from the front c
   train       dataset -> NAME.onnx + NAME.json sidecar, loss curves, report
   analyse     activation maps, VisualBackProp saliency and a lap of predictions vs the expert
   make-model  expert 5 laps + record + train + analyse: the shipped models/pilot/driving_school
+  dagger      DAgger: the model drives in HIL, the expert labels every frame (and takes over
+              near the lane bound), the rounds' data aggregated and trained on, N rounds
 A person can drive instead of the expert: autodrive-sim --map driving_school --cameras
 --lockstep-client, the runtime on its pty, autodrive-teleop, and tools/record LOG; then
 `tools/pilot record LOG --map driving_school` (docs/guides/training.md)."""
@@ -99,6 +102,11 @@ def main(argv: list[str] | None = None) -> int:
         "steering (0, the default)",
     )  # fmt: skip
     t.add_argument(
+        "--randomise", action="store_true",
+        help="image-level domain randomisation (augment.Randomise: light colour, exposure, "
+        "blur, noise, camera pose jitter, road texture, distractors); off in the shipped recipe",
+    )  # fmt: skip
+    t.add_argument(
         "--curve-max", type=float, default=0.0, metavar="DK",
         help="an experiment (the shipped recipe: 0): bend the ground of half the drawn frames "
         "by an extra curvature up to +-DK [1/m], the label following (augment.CurveWarp)",
@@ -143,6 +151,46 @@ def main(argv: list[str] | None = None) -> int:
         "recipe's (their LOG.meta.json is checked against --laps and --seed)",
     )  # fmt: skip
 
+    dd = DaggerConfig()
+    g = sub.add_parser(
+        "dagger", help="DAgger rounds: drive the model in HIL, the expert labels, retrain",
+        description="DAgger (docs/guides/training.md): round 0 trains on the expert's laps; "
+        "each round then drives the last model in HIL on the trained route (the cloning "
+        "mission, sim clock, lockstep) with every frame recorded and labelled by the expert's "
+        "pure pursuit from its pose, the expert taking over (the car put back on the centre "
+        "line) where a wheel comes within --takeover-margin of the lane bound; the rounds' data "
+        "aggregated, retrained. Writes OUT/NAME.onnx + .json and OUT/dagger_report.{json,md} "
+        "(autonomy per round).",
+    )  # fmt: skip
+    g.add_argument("--rounds", type=int, default=dd.rounds, help="rounds after round 0 (>= 0)")
+    g.add_argument(
+        "--seed", type=int, default=dd.seed,
+        help="the expert's recordings on S and S + 1, round r's rollout on S + "
+        f"{ROLLOUT_SEED_OFFSET} + r (training seeds, autodrive.core.seeds)",
+    )  # fmt: skip
+    g.add_argument("--out", type=Path, default=Path("out/pilot-dagger/model"))
+    g.add_argument("--work", type=Path, default=Path("out/pilot-dagger/work"),
+                   help="logs, datasets and each round's model (must not hold a run)")  # fmt: skip
+    g.add_argument("--name", default=dd.name)
+    g.add_argument("--expert-laps", type=int, default=dd.expert_laps, help="round 0's laps")
+    g.add_argument("--rollout-laps", type=int, default=dd.rollout_laps, help="laps a rollout")
+    g.add_argument("--epochs", type=int, default=dd.epochs)
+    g.add_argument("--samples-per-epoch", type=int, default=dd.samples_per_epoch)
+    g.add_argument("--train-seed", type=int, default=dd.train_seed)
+    g.add_argument(
+        "--takeover-margin", type=float, default=TAKEOVER_MARGIN_M, metavar="M",
+        help="[m] the expert takes over where a wheel's outer edge comes this near the lane "
+        f"bound (default {TAKEOVER_MARGIN_M})",
+    )  # fmt: skip
+    g.add_argument("--no-randomise", action="store_true",
+                   help="no domain randomisation (simulator or image level)")  # fmt: skip
+    g.add_argument("--threads", type=int, default=dd.threads, help="PyTorch threads")
+    g.add_argument(
+        "--logs", type=Path, nargs="+", default=None, metavar="LOG",
+        help="round 0's expert recordings (tools/pilot expert) instead of recording them",
+    )  # fmt: skip
+    g.add_argument("--lcm-url", default="", help="the rollouts' bus (default: a port of its own)")
+
     args = ap.parse_args(argv)
     try:
         return _run(args)
@@ -180,7 +228,7 @@ def _run(args: argparse.Namespace) -> int:
             threads=args.threads, max_frames=args.max_frames,
             samples_per_epoch=args.samples_per_epoch, stride=args.stride,
             channels=args.channels, label_lookahead_m=args.label_lookahead,
-            curve_max_dk=args.curve_max,
+            curve_max_dk=args.curve_max, randomise=args.randomise,
         )  # fmt: skip
         if args.balance_max_ratio is not None:
             cfg = replace(cfg, balance_max_ratio=args.balance_max_ratio)
@@ -190,6 +238,18 @@ def _run(args: argparse.Namespace) -> int:
         from autodrive.learn.pilot.analyse import analyse
 
         analyse(args.model, args.dataset, args.out, args.lap, args.samples)
+        return 0
+    if args.cmd == "dagger":
+        from autodrive.learn.pilot.dagger import run_dagger
+
+        dcfg = DaggerConfig(
+            rounds=args.rounds, seed=args.seed, expert_laps=args.expert_laps,
+            rollout_laps=args.rollout_laps, epochs=args.epochs,
+            samples_per_epoch=args.samples_per_epoch, train_seed=args.train_seed,
+            takeover_margin_m=args.takeover_margin, randomise=not args.no_randomise,
+            threads=args.threads, name=args.name,
+        )  # fmt: skip
+        run_dagger(dcfg, args.out, args.work, _build(), args.logs, args.lcm_url)
         return 0
     from autodrive.learn.pilot.make_model import make_model
 

@@ -38,6 +38,7 @@ class ExpertRun:
     camera_fps: float = 7.5
     camera_noise: float = 2.0  # sigma [8-bit levels]: the training condition's sensor noise
     light_level: float = 1.0  # day
+    camera_blur: float = 0.0  # Gaussian blur sigma [px] of the rendered frames (0: none)
     duration_s: float = 0.0  # [s] of sim time: stop early (0: when the laps are done)
 
 
@@ -73,6 +74,7 @@ def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
         "--camera-fps", f"{run.camera_fps:g}",
         "--camera-noise", f"{run.camera_noise:g}",
         "--light-level", f"{run.light_level:g}",
+        *(["--camera-blur", f"{run.camera_blur:g}"] if run.camera_blur > 0 else []),
         "--script", script,
         "--seed", str(run.seed),
         "--lcm-url", url,

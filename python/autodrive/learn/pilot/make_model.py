@@ -92,7 +92,7 @@ def check_logs(runs: list[ExpertRun], logs: list[Path]) -> float:
             raise ValueError(f"{logf}: no readable {meta_path(logf).name} ({e})") from e
         for key, want in asdict(run).items():
             # a recording made before lane_shift existed drove the route's own lane
-            have = meta.get(key, 0 if key == "lane_shift" else None)
+            have = meta.get(key, 0 if key in ("lane_shift", "camera_blur") else None)
             if have != want:
                 raise ValueError(f"{logf}: {key} is {have!r}, the recipe's {want!r}")
         wall = max(wall, float(meta.get("wall_s", 0.0)))

@@ -80,6 +80,8 @@ class TrainConfig:
     # > 0: the curvature augmentation (augment.CurveWarp) up to this extra curvature [1/m], on
     # half the draws; 0: off (the shipped recipe)
     curve_max_dk: float = 0.0
+    # image-level domain randomisation (augment.Randomise); False: off (the shipped recipe)
+    randomise: bool = False
 
 
 def log(msg: str) -> None:
@@ -130,6 +132,23 @@ def curve_warp(
         width=spec.width, height=spec.height, cam_ahead_m=ahead, cam_height_m=height,
         wheelbase_m=v.number("wheelbase_m"), steer_limit_rad=v.number("steer_limit_rad"),
         max_dk=cfg.curve_max_dk, p_curve=0.5,
+    )  # fmt: skip
+
+
+def randomiser(
+    manifest: dict[str, Any], spec: InputSpec, cfg: TrainConfig, gain_per_px: float
+) -> augment.Randomise | None:
+    """The image-level domain randomisation for the dataset's camera, or None when off; without
+    the manifest's intrinsics, no camera pose jitter (the rest still applies)."""
+    if not cfg.randomise:
+        return None
+    cam = manifest.get("camera") or {}
+    fx, fy = float(cam.get("fx_px", 0.0)), float(cam.get("fy_px", 0.0))
+    sx = spec.source_width / spec.width
+    sy = (spec.source_height - spec.crop_top_px - spec.crop_bottom_px) / spec.height
+    return augment.Randomise(
+        fx_small_px=fx / sx if fx > 0 and fy > 0 else 0.0, fy_small_px=fy / sy,
+        cy_small_px=(spec.source_height / 2.0 - spec.crop_top_px) / sy, gain_per_px=gain_per_px,
     )  # fmt: skip
 
 
@@ -196,7 +215,10 @@ def train(
     std = tuple(float(max(v, 1e-3)) for v in stack.std(axis=(0, 2, 3)))
     spec = replace(spec, mean=(mean[0], mean[1], mean[2]), std=(std[0], std[1], std[2]))
     gain = shift_gain_per_px(ds.manifest, spec, cfg.label_lookahead_m)
-    aug = augment.Augment(gain_per_px=gain, curve=curve_warp(ds.manifest, spec, cfg))
+    aug = augment.Augment(
+        gain_per_px=gain, curve=curve_warp(ds.manifest, spec, cfg),
+        randomise=randomiser(ds.manifest, spec, cfg, gain),
+    )  # fmt: skip
     weights = augment.balance_weights(steer[idx_train], cfg.balance_max_ratio)
     rng = np.random.default_rng(cfg.seed)
     net = model.PilotNet(spec.height, spec.width, channels=cfg.channels)
@@ -335,6 +357,9 @@ def _conditions(manifest: dict[str, Any]) -> list[dict[str, Any]]:
         "camera_fps",
         "camera_noise",
         "light_level",
+        "camera_blur",
+        "source",
+        "round",
     )
     return [
         {k: s.get("meta", {}).get(k) for k in keys} | {"log": s.get("log")}
