@@ -401,6 +401,18 @@ def rogue_signers(names: list[str], folder: Path) -> dict[str, v2x_auth.MessageS
     return {n: v2x_auth.MessageSigner(v2x_ca.load_identity(n, folder)) for n in names}
 
 
+GHOST_AHEAD_M = 0.3  # [m] a ghost car stands this far ahead of the real car it copies
+
+
+def ghost_ahead(types: Any, own: Any, name: str) -> Any:
+    """A standing car named name, GHOST_AHEAD_M ahead of the real state own, unsigned."""
+    g = types.v2v_state_t.decode(own.encode())
+    g.vehicle, g.speed_m_s, g.auth, g.auth_len = name, 0.0, b"", 0
+    g.x_m += GHOST_AHEAD_M * math.cos(own.yaw_rad)
+    g.y_m += GHOST_AHEAD_M * math.sin(own.yaw_rad)
+    return g
+
+
 class CityAttacker:
     """Beside a real smart-city run: for each car, at 50 Hz of wall time, forged GREEN advisories
     (unsigned; the real signed one with RED made GREEN; signed by a car's certificate), ghost
@@ -521,10 +533,7 @@ class CityAttacker:
         other = next(c for c in self.car_signers if c != car)
         for name, sign in (("NIGEL9", None), (other, signer), (other, self.rogue[other]),
                            ("NIGEL9", self.rogue["NIGEL9"])):  # fmt: skip
-            g = self.types.v2v_state_t.decode(own.encode())
-            g.vehicle, g.speed_m_s, g.auth, g.auth_len = name, 0.0, b"", 0
-            g.x_m += 0.3 * math.cos(own.yaw_rad)
-            g.y_m += 0.3 * math.sin(own.yaw_rad)
+            g = ghost_ahead(self.types, own, name)
             if sign is not None:
                 sign.sign(channel("V2V"), g, own.utime)
                 self._sent_v2v(v2x_auth.auth_of(g))
@@ -784,10 +793,7 @@ class IntersectionAttacker:
         if time.monotonic() >= self.revoked_from:
             variants.append(("ghost_revoked_certificate", REVOKED_CAR, self.revoked_car))
         for attack, name, sign in variants:
-            g = self.types.v2v_state_t.decode(own.encode())
-            g.vehicle, g.speed_m_s, g.auth, g.auth_len = name, 0.0, b"", 0
-            g.x_m += 0.3 * math.cos(own.yaw_rad)
-            g.y_m += 0.3 * math.sin(own.yaw_rad)
+            g = ghost_ahead(self.types, own, name)
             if sign is not None:
                 sign.sign(channel("V2V"), g, own.utime)
                 self.own_v2v.add(v2x_auth.auth_of(g))
