@@ -20,6 +20,7 @@ from autodrive.core import lcmtypes
 
 WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
+PUMP_S = 0.5  # [s] wall: the longest one pump reads before its caller looks again
 XVFB_UP_S = 30.0  # [s] wall: a guard for Xvfb's socket (glfwInit failed once before it was up)
 WINDOW_TITLE = "AutoDRIVE Nigel sim"
 
@@ -63,8 +64,11 @@ class WindowRig:
         return r.stdout.split()[0] if r.returncode == 0 and r.stdout.split() else None
 
     def pump(self) -> None:
-        """Reads the LCM messages and the program's stdout lines that arrived."""
-        while select.select([self.lc.fileno()], [], [], 0.02)[0]:
+        """Reads the LCM messages and the program's stdout lines that arrived, for at most
+        PUMP_S: a test slower than the bus (a loaded machine) would else never return to its
+        guard, and hang past it."""
+        deadline = time.monotonic() + PUMP_S
+        while time.monotonic() < deadline and select.select([self.lc.fileno()], [], [], 0.02)[0]:
             self.lc.handle()
         if self.sim is None or self.sim.stdout is None:
             return
