@@ -108,6 +108,11 @@ TEST(Cli, BadOptionsAreRejected) {
     EXPECT_EQ(v.status, 2) << bad;
     EXPECT_NE(v.out.find("--view"), std::string::npos) << bad << ": " << v.out;
   }
+  for (const char *bad : {"--camera-scale 0.1", "--camera-scale 2", "--camera-scale half"}) {
+    const ProcResult v = run(bad);
+    EXPECT_EQ(v.status, 2) << bad;
+    EXPECT_NE(v.out.find("--camera-scale"), std::string::npos) << bad << ": " << v.out;
+  }
   const ProcResult r = run("--lockstep --no-pty --lcm-url memq:// --script constant:throttle=9");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("throttle"), std::string::npos) << r.out;

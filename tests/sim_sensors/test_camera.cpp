@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,35 @@ void check_front_frame(sim_render_backend_t backend) {
   EXPECT_GT(bottom.g, bottom.b + 40);
   EXPECT_GT(left.r, left.g + 40) << left.r << "," << left.g << "," << left.b;
   EXPECT_GT(left.r, left.b + 40);
+  sim_camera_destroy(c);
+}
+
+// --camera-scale: a frame rendered at half size per side and stretched back keeps its size and
+// what it shows (within a few grey levels on average), but is not the full render
+TEST(SimCamera, RenderScaleKeepsTheFrameSizeAndWhatItShows) {
+  Scene s(SIM_RENDER_AUTO);
+  ASSERT_NE(s.r, nullptr);
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
+                                      err, sizeof err);
+  ASSERT_NE(c, nullptr) << err;
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  const std::vector<uint8_t> full(sim_camera_rgb(c), sim_camera_rgb(c) + 640 * 480 * 3);
+  EXPECT_EQ(sim_camera_set_render_scale(c, 0.1), -1);  // below SIM_CAMERA_MIN_SCALE
+  EXPECT_EQ(sim_camera_set_render_scale(c, 1.5), -1);
+  ASSERT_EQ(sim_camera_set_render_scale(c, 0.5), 0);
+  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 43), 0);
+  EXPECT_EQ(sim_camera_width(c), 640);
+  EXPECT_EQ(sim_camera_height(c), 480);
+  const uint8_t *half = sim_camera_rgb(c);
+  double diff = 0;
+  for (size_t i = 0; i < full.size(); i++) diff += std::abs(int(full[i]) - int(half[i]));
+  diff /= double(full.size());
+  printf("render scale 0.5: mean |full - scaled| %.2f grey levels\n", diff);
+  EXPECT_GT(diff, 0.0);  // it did render smaller
+  EXPECT_LT(diff, 6.0);  // and shows the same room
+  Px centre = px(half, 640, 320, 240);
+  EXPECT_GT(centre.b, centre.r + 40);  // the blue pillar ahead, as in full
   sim_camera_destroy(c);
 }
 

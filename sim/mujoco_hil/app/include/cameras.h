@@ -39,6 +39,9 @@ int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, int eye_ren
                  size_t err_sz);
 /* Noise and blur on every camera: each its own seeded noise stream. */
 void cameras_set_effects(cameras_t *k, double noise, double blur_px, uint64_t seed);
+/* --camera-scale: the render scale of the cars' cameras (sim_camera_set_render_scale); the
+ * overhead Eye cameras keep theirs (the Eye's detections are measured at full size). */
+void cameras_set_render_scale(cameras_t *k, double scale);
 /* Renders and publishes every camera from dv (the whole map at sim time now_us). */
 int cameras_publish(cameras_t *k, const mjModel *mv, mjData *dv, lcm_t *lcm, int64_t now_us,
                     char *err, size_t err_sz);

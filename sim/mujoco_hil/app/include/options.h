@@ -37,6 +37,7 @@ typedef struct app_options {
   int eye_sync_wait_given;
   int eye_render; /* --eye-render: CAMERAS_RENDER_CACHED, _FULL or _COMPARE (cameras.h) */
   double camera_fps, light_level, camera_noise, camera_blur;
+  double camera_scale; /* the cars' cameras' render scale per side, SIM_CAMERA_MIN_SCALE..1 */
   scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
   int nstarts;
   scn_pose_t car_start[SIM_MAX_CARS]; /* --car-start I,...: car I alone */

@@ -35,6 +35,7 @@ typedef struct render_thread {
   int stop, opened, failed;     /* opened: 1 ok, -1 failed */
   int cameras, eye, eye_render; /* cameras_open's arguments */
   double noise, blur_px;
+  double scale; /* the cars' cameras' render scale (--camera-scale) */
   uint64_t seed;
   long rendered, skipped;
   char err[256];

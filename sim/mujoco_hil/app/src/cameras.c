@@ -19,6 +19,11 @@ void cameras_set_effects(cameras_t *k, double noise, double blur_px, uint64_t se
   }
 }
 
+void cameras_set_render_scale(cameras_t *k, double scale) {
+  for (int i = 0; i < k->n; i++)
+    if (!k->eye[i]) sim_camera_set_render_scale(k->cam[i], scale); /* options checked the range */
+}
+
 /* A map's several overhead cameras (its eye_cameras): the MJCF cameras whose user data holds
  * their image size (width, height px), as tools/gen-maps writes them. */
 static int cameras_eye_size(const mjModel *m, int id, int *w, int *h) {

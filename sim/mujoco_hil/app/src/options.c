@@ -132,10 +132,13 @@ static void options_usage_sensors(FILE *f) {
       "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
       "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
       "                      (noise and blur are seeded by --seed: a run repeats)\n"
+      "  --camera-scale S    render the cars' cameras at S x their size per side and stretch\n"
+      "                      the frames back (%g..1, default 1: a slow machine's trade of\n"
+      "                      sharpness for render time; the Eye's cameras stay full)\n"
       "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
       "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n",
       EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, EYE_SYNC_LOST_S, EYE_SYNC_FIRST_S, CFX_MAX_NOISE,
-      CFX_MAX_BLUR_PX);
+      CFX_MAX_BLUR_PX, SIM_CAMERA_MIN_SCALE);
 }
 
 /* --help, part 4: the outputs (bench, window, video, record), channels, exit status. */
@@ -216,6 +219,7 @@ static void options_defaults(app_options_t *o) {
   o->camera_fps = 30.0;
   o->eye_sync_wait_s = EYE_SYNC_LOST_S;
   o->light_level = -1.0;
+  o->camera_scale = 1.0;
   o->rtf = 1.0;
 }
 
@@ -461,6 +465,8 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return options_number(a, v, 0, CFX_MAX_NOISE, &o->camera_noise) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--camera-blur")) {
     return options_number(a, v, 0, CFX_MAX_BLUR_PX, &o->camera_blur) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--camera-scale")) {
+    return options_number(a, v, SIM_CAMERA_MIN_SCALE, 1, &o->camera_scale) ? OPTIONS_BAD : 1;
   } else {
     return OPTIONS_UNKNOWN;
   }

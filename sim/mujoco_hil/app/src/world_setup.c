@@ -106,6 +106,7 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
   render.eye_render = o->eye_render;
   render.noise = o->camera_noise;
   render.blur_px = o->camera_blur;
+  render.scale = o->camera_scale;
   render.seed = o->cfg.seed;
   if (threaded
           ? render_thread_start(&render, a->sim, a->lcm, err, err_sz) != 0
@@ -115,6 +116,7 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
   }
   if (threaded) a->render = &render;
   cameras_set_effects(&a->cams, o->camera_noise, o->camera_blur, o->cfg.seed);
+  cameras_set_render_scale(&a->cams, o->camera_scale);
   a->cam_period_us = (int64_t)llround(1e6 / o->camera_fps);
   return -1;
 }

@@ -47,6 +47,13 @@ void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx);
 
 /* Renders the current state d and JPEG-encodes it. Returns 0, or -1 on failure. */
 int sim_camera_capture(sim_camera_t *c, const mjModel *m, mjData *d, int64_t utime);
+/* The render scale (SIM_CAMERA_MIN_SCALE..1, default 1): a frame is rendered at scale x the
+ * camera's size per side and stretched back (bilinear) to it, so that a slow machine trades
+ * sharpness for render time; the published size and intrinsics never change. A camera fixed in
+ * the world with a render cache keeps rendering in full. Returns 0, or -1 (unchanged) for a
+ * scale outside the range. */
+#define SIM_CAMERA_MIN_SCALE 0.25
+int sim_camera_set_render_scale(sim_camera_t *c, double scale);
 /* The two halves of sim_camera_capture: render (the filter applied) into the RGB frame, then
  * JPEG-encode that frame stamped utime. Each returns 0, or -1 on failure. */
 int sim_camera_render(sim_camera_t *c, const mjModel *m, mjData *d);

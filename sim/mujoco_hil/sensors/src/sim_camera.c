@@ -27,7 +27,64 @@ struct sim_camera {
   void *filter_ctx;
   sim_render_cache_t *cache; /* a camera fixed in the world: its static world, or NULL */
   int full_render;           /* 1: render in full even with a cache */
+  double scale;              /* render scale per side, SIM_CAMERA_MIN_SCALE..1 */
+  uint8_t *small;            /* the frame at the render scale (scale < 1), else NULL */
+  int *taps;                 /* camera_stretch's scratch: 6 x max(w, h) */
 };
+
+int sim_camera_set_render_scale(sim_camera_t *c, double scale) {
+  if (!(scale >= SIM_CAMERA_MIN_SCALE && scale <= 1.0)) return -1; /* NaN too */
+  if (scale < 1.0 && !c->small) /* enough for any scale below 1 */
+    c->small = malloc((size_t)c->w * (size_t)c->h * 3);
+  if (scale < 1.0 && !c->taps)
+    c->taps = malloc(6 * (size_t)(c->w > c->h ? c->w : c->h) * sizeof(int));
+  if (scale < 1.0 && (!c->small || !c->taps)) return -1;
+  c->scale = scale;
+  return 0;
+}
+
+/* Where output column (or row) i of n samples a source of sn: the two source indices and the
+ * second's weight in 1/256, on pixel centres, clamped at the edges. */
+static void camera_taps(int n, int sn, int *i0, int *i1, int *w256) {
+  for (int i = 0; i < n; i++) {
+    double s = (i + 0.5) * sn / n - 0.5;
+    s = s < 0 ? 0 : s > sn - 1 ? sn - 1 : s;
+    i0[i] = (int)s;
+    i1[i] = i0[i] + 1 < sn ? i0[i] + 1 : i0[i];
+    w256[i] = (int)((s - i0[i]) * 256.0);
+  }
+}
+
+/* src (sw x sh RGB, rows top-down) stretched to dst (w x h), bilinear in 8-bit fixed point
+ * (taps: 6 x max(w, h) ints of scratch). */
+static void camera_stretch(const uint8_t *src, int sw, int sh, uint8_t *dst, int w, int h,
+                           int *taps) {
+  int *x0 = taps, *x1 = x0 + w, *wx = x1 + w, *y0 = wx + w, *y1 = y0 + h, *wy = y1 + h;
+  camera_taps(w, sw, x0, x1, wx);
+  camera_taps(h, sh, y0, y1, wy);
+  for (int y = 0; y < h; y++) {
+    const uint8_t *top = src + (size_t)y0[y] * sw * 3, *bot = src + (size_t)y1[y] * sw * 3;
+    uint8_t *o = dst + (size_t)y * w * 3;
+    for (int x = 0; x < w; x++, o += 3) {
+      const uint8_t *a = top + x0[x] * 3, *b = top + x1[x] * 3;
+      const uint8_t *p = bot + x0[x] * 3, *q = bot + x1[x] * 3;
+      for (int k = 0; k < 3; k++) {
+        const int t = a[k] * (256 - wx[x]) + b[k] * wx[x];
+        const int u = p[k] * (256 - wx[x]) + q[k] * wx[x];
+        o[k] = (uint8_t)((t * (256 - wy[y]) + u * wy[y] + 32768) >> 16);
+      }
+    }
+  }
+}
+
+/* The frame at the render scale into c->rgb: rendered small, then stretched. */
+static int camera_render_scaled(sim_camera_t *c, const mjModel *m, mjData *d) {
+  const int sw = (int)lround(c->w * c->scale), sh = (int)lround(c->h * c->scale);
+  if (sw < 1 || sh < 1) return -1;
+  if (sim_render_camera(c->render, m, d, c->cam_id, sw, sh, c->small) != 0) return -1;
+  camera_stretch(c->small, sw, sh, c->rgb, c->w, c->h, c->taps);
+  return 0;
+}
 
 void sim_camera_set_filter(sim_camera_t *c, sim_camera_filter_fn fn, void *ctx) {
   c->filter = fn;
@@ -61,6 +118,7 @@ sim_camera_t *sim_camera_create(sim_render_t *r, const mjModel *m, const char *c
   c->cam_id = id;
   c->w = width_px;
   c->h = height_px;
+  c->scale = 1.0;
   snprintf(c->frame_id, sizeof c->frame_id, "%s", frame_id);
   c->rgb = calloc((size_t)width_px * (size_t)height_px, 3);
   c->frame = c->rgb;
@@ -80,6 +138,8 @@ void sim_camera_destroy(sim_camera_t *c) {
   sim_jpeg_destroy(c->jpeg);
   sim_render_cache_destroy(c->cache);
   free(c->rgb);
+  free(c->small);
+  free(c->taps);
   free(c);
 }
 
@@ -96,7 +156,9 @@ int sim_camera_render(sim_camera_t *c, const mjModel *m, mjData *d) {
   /* a filter changes the frame: it works on our copy, never on the cache's own image */
   uint8_t *into = cached && !c->filter ? NULL : c->rgb;
   const int rc = cached ? sim_render_camera_cached(c->render, c->cache, m, d, into)
-                        : sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb);
+                 : c->scale < 1.0 && !c->cache
+                     ? camera_render_scaled(c, m, d)
+                     : sim_render_camera(c->render, m, d, c->cam_id, c->w, c->h, c->rgb);
   if (rc != 0) return -1;
   c->frame = into ? c->rgb : sim_render_cache_image(c->cache);
   if (c->filter) c->filter(c->rgb, c->w, c->h, c->filter_ctx);
