@@ -54,16 +54,30 @@ struct Scene {
   ~Scene() { sim_render_destroy(r); }
 };
 
+// The room's front camera at 640x480 with one frame captured, or NULL (the test failed, why).
+sim_camera_t *front_camera_captured(Scene &s) {
+  char err[256] = "";
+  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
+                                      err, sizeof err);
+  if (!c) {
+    ADD_FAILURE() << err;
+    return nullptr;
+  }
+  if (sim_camera_capture(c, s.room.m, s.room.d, 42) != 0) {
+    ADD_FAILURE() << "the first capture failed";
+    sim_camera_destroy(c);
+    return nullptr;
+  }
+  return c;
+}
+
 }  // namespace
 
 void check_front_frame(sim_render_backend_t backend) {
   Scene s(backend);
   ASSERT_NE(s.r, nullptr);
-  char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
-                                      err, sizeof err);
-  ASSERT_NE(c, nullptr) << err;
-  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  sim_camera_t *c = front_camera_captured(s);
+  ASSERT_NE(c, nullptr);
   const uint8_t *rgb = sim_camera_rgb(c);
   maybe_dump("front.ppm", rgb, 640, 480);
   // not blank: many distinct grey levels
@@ -90,11 +104,8 @@ void check_front_frame(sim_render_backend_t backend) {
 TEST(SimCamera, RenderScaleKeepsTheFrameSizeAndWhatItShows) {
   Scene s(SIM_RENDER_AUTO);
   ASSERT_NE(s.r, nullptr);
-  char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
-                                      err, sizeof err);
-  ASSERT_NE(c, nullptr) << err;
-  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  sim_camera_t *c = front_camera_captured(s);
+  ASSERT_NE(c, nullptr);
   const std::vector<uint8_t> full(sim_camera_rgb(c), sim_camera_rgb(c) + 640 * 480 * 3);
   EXPECT_EQ(sim_camera_set_render_scale(c, 0.1), -1);  // below SIM_CAMERA_MIN_SCALE
   EXPECT_EQ(sim_camera_set_render_scale(c, 1.5), -1);
@@ -134,11 +145,8 @@ TEST(SimCamera, OsmesaBackendRendersTheSameRoom) {
 TEST(SimCamera, JpegDecodesBackToTheFrame) {
   Scene s;
   ASSERT_NE(s.r, nullptr);
-  char err[256] = "";
-  sim_camera_t *c = sim_camera_create(s.r, s.room.m, "car_cam_front", "camera_front", 640, 480, 90,
-                                      err, sizeof err);
-  ASSERT_NE(c, nullptr) << err;
-  ASSERT_EQ(sim_camera_capture(c, s.room.m, s.room.d, 42), 0);
+  sim_camera_t *c = front_camera_captured(s);
+  ASSERT_NE(c, nullptr);
   size_t n = 0;
   const uint8_t *jpg = sim_camera_jpeg(c, &n);
   ASSERT_GT(n, 1000u);
