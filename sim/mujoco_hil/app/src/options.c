@@ -185,6 +185,22 @@ static void options_usage(FILE *f) {
   options_usage_output(f);
 }
 
+/* v as one of n names: *out = values[k] for names[k] and 1 (one value taken), or a message
+ * naming opt, v and every name, and OPTIONS_BAD. */
+static int options_pick(const char *opt, const char *v, const char *const *names, const int *values,
+                        int n, int *out) {
+  for (int k = 0; k < n; k++)
+    if (!strcmp(v, names[k])) {
+      *out = values[k];
+      return 1;
+    }
+  fprintf(stderr, "autodrive-sim: %s '%s': expected ", opt, v);
+  for (int k = 0; k < n; k++)
+    fprintf(stderr, "%s%s", k == 0 ? "" : k == n - 1 ? " or " : ", ", names[k]);
+  fputc('\n', stderr);
+  return OPTIONS_BAD;
+}
+
 static int options_number(const char *opt, const char *v, double lo, double hi, double *out) {
   char *end;
   errno = 0;
@@ -414,28 +430,18 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
                ? OPTIONS_BAD
                : 1;
   } else if (!strcmp(a, "--eye-render") && v) {
-    o->eye_render = !strcmp(v, "cached")    ? CAMERAS_RENDER_CACHED
-                    : !strcmp(v, "full")    ? CAMERAS_RENDER_FULL
-                    : !strcmp(v, "compare") ? CAMERAS_RENDER_COMPARE
-                                            : -1;
-    if (o->eye_render < 0) {
-      fprintf(stderr, "autodrive-sim: --eye-render '%s': expected cached, full or compare\n", v);
-      return OPTIONS_BAD;
-    }
-    return 1;
+    static const char *const names[] = {"cached", "full", "compare"};
+    static const int modes[] = {CAMERAS_RENDER_CACHED, CAMERAS_RENDER_FULL, CAMERAS_RENDER_COMPARE};
+    return options_pick(a, v, names, modes, 3, &o->eye_render);
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
   } else if (!strcmp(a, "--view-quality") && v) {
-    o->view_quality = !strcmp(v, "low")     ? SIM_VIEWER_QUALITY_LOW
-                      : !strcmp(v, "high")  ? SIM_VIEWER_QUALITY_HIGH
-                      : !strcmp(v, "ultra") ? SIM_VIEWER_QUALITY_ULTRA
-                                            : -1;
-    if (o->view_quality < 0) {
-      fprintf(stderr, "autodrive-sim: --view-quality '%s': expected low, high or ultra\n", v);
-      return OPTIONS_BAD;
-    }
-    o->view_quality_given = 1;
-    return 1;
+    static const char *const names[] = {"low", "high", "ultra"};
+    static const int levels[] = {SIM_VIEWER_QUALITY_LOW, SIM_VIEWER_QUALITY_HIGH,
+                                 SIM_VIEWER_QUALITY_ULTRA};
+    const int taken = options_pick(a, v, names, levels, 3, &o->view_quality);
+    o->view_quality_given = taken == 1;
+    return taken;
   } else if (!strcmp(a, "--view-nice")) {
     double n = 0;
     if (options_number(a, v, 0, 19, &n) || n != floor(n)) {
