@@ -24,7 +24,6 @@ import argparse
 import importlib.util
 import json
 import os
-import resource
 import shutil
 import statistics
 import subprocess
@@ -33,6 +32,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from autodrive.core.proc import cpu_s
 from autodrive.hil.missions import cloning
 from autodrive.bench import Progress, build_dir, out_dir, print_figures
 from autodrive.core import seeds
@@ -195,13 +195,6 @@ def goal_table(laps: int = 5, unseen_laps: int = 1, dagger: bool = False) -> dic
         )
         goals[f"{kind}_{cond}_exit_0"] = equals(f"{cond}.exit_code", 0)
     return goals
-
-
-def cpu_s() -> float:
-    """CPU time [s] (user + system) of this process and every finished child process and their
-    children: the pipeline's own cost, whatever else loads the machine."""
-    rs = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
-    return sum(r.ru_utime + r.ru_stime for r in rs)
 
 
 def main(argv: list[str]) -> int:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -256,3 +257,10 @@ def wait_ready(
             next_note += 15.0
             log(f"waiting for {name}: {cpu:.1f} s CPU, {wall:.0f} s wall, load {load:.1f} ({why})")
         time.sleep(0.2)
+
+
+def cpu_s() -> float:
+    """CPU time [s] (user + system) of this process and every finished child process and their
+    children: a pipeline's own cost, whatever else loads the machine."""
+    rs = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return sum(r.ru_utime + r.ru_stime for r in rs)

@@ -15,7 +15,6 @@ goal is on argmax episodes, so this selects on what the goal measures."""
 from __future__ import annotations
 
 import json
-import resource
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -25,6 +24,7 @@ import numpy as np
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
 
+from autodrive.core.proc import cpu_s
 from autodrive.learn.marl.env import STEER_RATE_PENALTY
 from autodrive.learn.marl.vec import EnvSpec, MarlVecEnv
 
@@ -193,14 +193,6 @@ class Validator:
         model.policy.load_state_dict(self.best_state)
         steps = self.best_key[2]
         return next(r for r in self.results if r["agent_steps"] == steps)
-
-
-def cpu_s() -> float:
-    """User + system CPU time [s] of this process and its reaped children."""
-    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
-        resource.RUSAGE_CHILDREN
-    )
-    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def linear(lr0: float) -> Any:

@@ -24,11 +24,9 @@ from __future__ import annotations
 
 import argparse
 import csv
-import hashlib
 import json
 import os
 import random
-import resource
 import shutil
 import sys
 import time
@@ -36,6 +34,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from autodrive.learn.pilot.spec import sha256_file
+from autodrive.core.proc import cpu_s
 from autodrive.core import seeds
 from autodrive.learn.pilot import dataset
 from autodrive.learn.pilot.expert import ExpertRun, meta_path
@@ -211,18 +211,8 @@ def label_rollout(root: Path, lookahead_m: float) -> int:
     return len(d.rows)
 
 
-def cpu_s() -> float:
-    """CPU [s] of this process and its finished children (simulators, runtime, pilot)."""
-    rs = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
-    return sum(r.ru_utime + r.ru_stime for r in rs)
-
-
 def log(msg: str) -> None:
     print(f"pilot dagger: {msg}", file=sys.stderr, flush=True)
-
-
-def _sha(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _train(cfg: DaggerConfig, data: Path, out: Path, round_: int) -> dict[str, Any]:
@@ -274,7 +264,7 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
         "lookahead_m": ExpertRun.lookahead_m, "camera_fps": fps, "camera_noise": noise,
         "light_level": rand.get("light_level", 1.0), "camera_blur": rand.get("camera_blur", 0.0),
         "takeover_margin_m": cfg.takeover_margin_m, "model": str(model),
-        "model_sha256": _sha(model), "randomisation": rand or None,
+        "model_sha256": sha256_file(model), "randomisation": rand or None,
         "speed": None, "perturb": 0.0,
     }  # fmt: skip
     meta_path(logf).write_text(json.dumps(meta, indent=2) + "\n")
@@ -336,7 +326,7 @@ def run_dagger(
         "frames_total": rep["frames"], "val_rmse": rep["val_rmse"],
         "record_wall_s": round(record_s[0], 1), "record_cpu_s": round(record_s[1], 1),
         "train_wall_s": round(time.monotonic() - tt, 1), "train_cpu_s": round(cpu_s() - ct, 1),
-        "model_sha256": _sha(model),
+        "model_sha256": sha256_file(model),
     })  # fmt: skip
     for r in range(1, cfg.rounds + 1):
         wr = work / f"round{r}"
@@ -361,7 +351,7 @@ def run_dagger(
             "frames_added": added, "frames_total": rep["frames"], "val_rmse": rep["val_rmse"],
             "rollout_wall_s": round(roll_s[0], 1), "rollout_cpu_s": round(roll_s[1], 1),
             "train_wall_s": round(time.monotonic() - tt, 1), "train_cpu_s": round(cpu_s() - ct, 1),
-            "model_sha256": _sha(model),
+            "model_sha256": sha256_file(model),
         })  # fmt: skip
         # the rounds so far, should a later one fail or be stopped
         (work / f"{REPORT}_partial.json").write_text(json.dumps(rounds, indent=2) + "\n")
@@ -375,7 +365,7 @@ def run_dagger(
         "expert_logs": [str(p) for p in logs],
         "rounds": rounds,
         "model": str(out / f"{cfg.name}.onnx"),
-        "model_sha256": _sha(out / f"{cfg.name}.onnx"),
+        "model_sha256": sha256_file(out / f"{cfg.name}.onnx"),
         "wall_s": round(time.monotonic() - t0, 1),
         "cpu_s": round(cpu_s() - cpu0, 1),
         "load_avg_end": round(os.getloadavg()[0], 1),
