@@ -23,7 +23,6 @@ def test_demo_drives_the_track(root: pathlib.Path, build_dir: pathlib.Path, lcm_
                 "loop",
                 "--duration",
                 "20",
-                "--realtime",
                 "--eye",
                 "none",
             ),

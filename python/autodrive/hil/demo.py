@@ -54,7 +54,6 @@ LOOP_SIM_MARGIN_S = 8.0
 PARKING_SIM_MARGIN_S = 30.0
 PARKING_LOCKSTEP_RTF_BOUND = 20.0  # the fastest a lockstep run is assumed to go
 PARKING_TIMEOUT_S = 240.0  # the default --timeout of parking and loop [s wall]
-LOOP_RTF = 2.0  # the loop driver commands at 50 Hz of wall time: keep the sim paced
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -334,8 +333,6 @@ def run(
     # None: lockstep. The sim then steps only while the runtime's bridge keeps writing (its
     # 50 Hz COMMAND stream on SIM_CLOCK), never more than 40 ms of sim time ahead of it.
     rtf = 1.0 if args.realtime else args.rtf
-    if rtf is None and args.mission == "loop":
-        rtf = LOOP_RTF
     try:
         plan = parking_plan(args) if args.mission == "parking" else None
     except ValueError as e:

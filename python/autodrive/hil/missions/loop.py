@@ -1,8 +1,11 @@
 """The loop mission: closes the loop through the whole HIL chain. It follows a stadium-shaped
 track (two 1.0 m straights, 0.4 m radius ends, laid out from the car's start pose) with pure
 pursuit on the runtime's EKF estimate (<VEH>_POSE_MAP; <VEH>_ODOM in a run without an Eye, whose
-map filter has no fix), publishing <VEH>_COMMAND at 50 Hz.
-Ground truth is never used to drive; the report compares with it afterwards."""
+map filter has no fix), publishing <VEH>_COMMAND at 50 Hz of sim time: a command per
+COMMAND_PERIOD_S of the estimate's own stamps (the runtime stamps on the sim's SIM_CLOCK), so
+in lockstep the drive is the same at any real-time factor and a starved driver slows the run
+instead of falling behind it. Ground truth is never used to drive; the report compares with it
+afterwards."""
 
 from __future__ import annotations
 
@@ -18,12 +21,14 @@ from autodrive.hil.missions import MissionContext
 
 LOOKAHEAD_M = 0.25
 THROTTLE = 0.7  # normalised; ~0.19 m/s on the flat
-COMMAND_PERIOD_S = 0.02  # 50 Hz
+COMMAND_PERIOD_S = 0.02  # [s of sim time] between commands: 50 Hz
 STEERING_INDICATOR = 0.3  # |steering| above which the indicator blinks
 INDICATOR_LEFT, INDICATOR_RIGHT = 1, 2
-STATE_TIMEOUT_S = 30.0
+STATE_TIMEOUT_S = 30.0  # [s wall] a hang guard: no state or pose from the runtime at all
+POSE_TIMEOUT_S = 60.0  # [s wall] a hang guard: the runtime stopped publishing poses
 STOP_COMMANDS = 10  # disengaged zero commands at the end
-PRINT_PERIOD_S = 2.0
+STOP_PERIOD_S = 0.02  # [s wall] between them: the car brakes either way
+PRINT_PERIOD_S = 2.0  # [s wall] between progress lines
 
 
 def stadium_track(step_m: float = 0.02) -> tuple[list[Point], list[Point]]:
@@ -62,7 +67,7 @@ def drive(
 
     def on_pose(_ch: str, data: bytes) -> None:
         m = types.odometry_t.decode(data)
-        pose.update(x=m.x_m, y=m.y_m, yaw=m.yaw_rad, t=m.utime)
+        pose.update(x=m.x_m, y=m.y_m, yaw=m.yaw_rad, t=m.utime, heard=time.time())
 
     def on_state(_ch: str, data: bytes) -> None:
         m = types.vehicle_state_t.decode(data)
@@ -88,9 +93,8 @@ def drive(
     laps = 0
     mode = "lockstep" if rtf is None else f"rtf {rtf:g}"
     ctx.say(f"driving the stadium track for {duration_s:.0f} s of sim time ({mode}) ...")
-    t_start = time.time()
-    next_cmd = t_start
-    last_print = t_start
+    last_print = time.time()
+    last_cmd_t = -math.inf  # [us of sim time] the stamp of the pose the last command used
 
     def command(engaged: bool, throttle: float = 0.0, steering: float = 0.0) -> Any:
         nonlocal seq
@@ -104,16 +108,19 @@ def drive(
         return cmd
 
     while True:
-        now = time.time()
-        # The runtime stamps on the sim clock: elapsed sim time even when the sim slips.
+        # The runtime stamps on the sim clock: elapsed sim time, at any pace of the sim.
         sim_elapsed = (pose["t"] - start["t"]) * 1e-6
         if sim_elapsed >= duration_s or ctx.stop_requested():
             break
         ctx.procs.check()
-        if select.select([lc.fileno()], [], [], max(0.0, next_cmd - now))[0]:
-            lc.handle()
+        if pose["t"] - last_cmd_t < COMMAND_PERIOD_S * 1e6:
+            # Wait for the next pose; the only wall time here is the hang guard.
+            if select.select([lc.fileno()], [], [], 1.0)[0]:
+                lc.handle()
+            elif time.time() - pose["heard"] > POSE_TIMEOUT_S:
+                raise RuntimeError(f"no {ch_pose} from the runtime for {POSE_TIMEOUT_S:g} s")
             continue
-        next_cmd += COMMAND_PERIOD_S
+        last_cmd_t = pose["t"]
         # Pure pursuit (the one, in C): the goal is the first sample the lookahead away from
         # the target index on; past the track's end the index goes back to the lap's start.
         x, y, yaw = pose["x"], pose["y"], pose["yaw"]
@@ -129,8 +136,8 @@ def drive(
             else (INDICATOR_RIGHT if cmd.steering < -STEERING_INDICATOR else 0)
         )
         lc.publish(ch_command, signer.sign(cmd).encode())
-        if now - last_print > PRINT_PERIOD_S:
-            last_print = now
+        if time.time() - last_print > PRINT_PERIOD_S:
+            last_print = time.time()
             ctx.say(
                 f"t_sim={sim_elapsed:5.1f}/{duration_s:.0f} s  lap {laps}  "
                 f"pose=({x:+.2f}, {y:+.2f}, {math.degrees(yaw):+6.1f} deg)  "
@@ -139,7 +146,7 @@ def drive(
     # Stop: a few disengaged zero commands, then silence (the firmware brakes either way).
     for _ in range(STOP_COMMANDS):
         lc.publish(ch_command, signer.sign(command(False)).encode())
-        time.sleep(COMMAND_PERIOD_S)
+        time.sleep(STOP_PERIOD_S)
     return {
         "driver": f"pure pursuit on the runtime EKF's {ch_pose} (stadium track)",
         "laps": laps,
