@@ -22,10 +22,17 @@
 
 extern char **environ;
 
+/* The pad's name in the HUD: the last part of its path (js0), which keeps the HUD narrow. */
+static const char *manual_drive_pad(const manual_drive_t *m) {
+  const char *slash = m->gamepad ? strrchr(m->gamepad, '/') : NULL;
+  return slash ? slash + 1 : m->gamepad ? m->gamepad : "";
+}
+
 /* The HUD's line while no one drives by hand. */
 static void manual_drive_idle(manual_drive_t *m) {
   if (m->gamepad)
-    snprintf(m->status, sizeof m->status, "autonomous (gamepad %.100s for manual)", m->gamepad);
+    snprintf(m->status, sizeof m->status, "autonomous (gamepad %.60s for manual)",
+             manual_drive_pad(m));
   else
     snprintf(m->status, sizeof m->status, "autonomous");
 }
@@ -110,8 +117,8 @@ static int manual_drive_start(manual_drive_t *m, int car, const char *url) {
   m->gamepad_lost = 0;
   m->line_n = 0;
   if (m->gamepad)
-    snprintf(m->status, sizeof m->status, "manual: keys + gamepad %.100s -> autodrive-teleop",
-             m->gamepad);
+    snprintf(m->status, sizeof m->status, "manual: keys + gamepad %.60s -> autodrive-teleop",
+             manual_drive_pad(m));
   else
     snprintf(m->status, sizeof m->status, "manual: keys -> autodrive-teleop");
   printf("manual driving: %s by keys%s%s through autodrive-teleop (pid %d)\n", veh,
@@ -150,8 +157,8 @@ static void manual_drive_read(manual_drive_t *m) {
       m->line_n = 0;
       if (strcmp(m->line, "gamepad lost") != 0 || m->gamepad_lost) continue;
       m->gamepad_lost = 1;
-      snprintf(m->status, sizeof m->status,
-               "manual: keys; gamepad %.100s lost, car stopped", m->gamepad ? m->gamepad : "");
+      snprintf(m->status, sizeof m->status, "manual: keys; gamepad %.60s lost, car stopped",
+               manual_drive_pad(m));
       printf("manual driving: gamepad %s lost; autodrive-teleop stopped the car\n",
              m->gamepad ? m->gamepad : "");
       fflush(stdout);
