@@ -21,7 +21,7 @@ from autodrive.core.channels import channel, vehicle_name
 from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
 
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
-RECORD_BUTTON = (68, 585)  # [px] the Record button (tests/sim_sensors checks the layout)
+RECORD_BUTTON = (68, 581)  # [px] the Record button (tests/sim_sensors checks the layout)
 FPS = 30.0
 
 pytestmark = NEEDS_X_TOOLS

@@ -12,100 +12,29 @@ the waits are guards that fail with what was seen."""
 
 from __future__ import annotations
 
-import math
-import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-import yaml
 
-from autodrive.core.channels import channel, vehicle_name
-from autodrive.core.settings import RUNTIME_HIL_CONFIG
-from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
+from window_rig import (
+    AUTHORITY_PERSON,
+    AUTONOMOUS_RADIO,
+    DRIVE_M,
+    GUARD_S,
+    MANUAL_RADIO,
+    NEEDS_X_TOOLS,
+    BridgeRig,
+)
 
-# [px] the Car section's Driving radio (tests/sim_sensors checks the layout)
-MANUAL_RADIO = (210, 209)
-AUTONOMOUS_RADIO = (145, 209)
-AUTHORITY_PERSON = 2  # vehicle_command_t.AUTHORITY_PERSON
-DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 SPEED_TOL_M_S = 0.02  # [m/s] HUD against ground truth at the same sim time (HUD prints 0.01)
 
 pytestmark = NEEDS_X_TOOLS
 
 
-class Rig(WindowRig):
-    """Xvfb, the simulator's window with its ptys, the runtime's bridge, and the bus."""
-
-    def __init__(self, build: Path, tmp: Path, url: str) -> None:
-        super().__init__(build, tmp, url, display_offset=7)
-        veh = vehicle_name(1)
-        # ground truth: (t [s], x, y [m], yaw [rad], v [m/s])
-        self.commands: list[tuple[str, int, bool, float]] = []  # (source, authority, engaged, thr)
-        self.holder: list[str] = []
-        self.lc.subscribe(channel("GROUND_TRUTH", veh), self._on_truth)
-        self.lc.subscribe(channel("COMMAND", veh), self._on_command)
-        self.lc.subscribe(channel("CONTROL", veh), self._on_control)
-        self.hud_log = tmp / "hud.log"
-        run_dir = tmp / "run"
-        self.start_sim(
-            [str(build / "bin" / "autodrive-sim"), "--view", "--view-size", f"{WIN_W}x{WIN_H}",
-             "--no-lidar", "--rtf", "1", "--duration", "3600", "--run-dir", str(run_dir),
-             "--lcm-url", url, "--hud-log", str(self.hud_log), "--quiet"],
-        )  # fmt: skip
-        self.until(lambda: "ok" if (run_dir / "nigel1-nano").exists() else None, "the Nano's pty")
-        cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
-        cfg.update(lcm_url=url)
-        cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
-        (tmp / "runtime.yaml").write_text(yaml.safe_dump(cfg))
-        self.runtime_log = open(tmp / "runtime.log", "w")
-        self.runtime = subprocess.Popen(
-            [str(build / "bin" / "autodrive-runtime"), "--config", str(tmp / "runtime.yaml"),
-             "--only", "bridge"], stdout=self.runtime_log, stderr=subprocess.STDOUT,
-        )  # fmt: skip
-        self.wid = self.until(self.window_id, "the window to appear")
-
-    def _on_truth(self, _c: str, data: bytes) -> None:
-        m = self.types.ground_truth_t.decode(data)
-        self.truth.append((m.utime * 1e-6, m.position_m[0], m.position_m[1], m.yaw_rad,
-                           m.linear_velocity_m_s[0]))  # fmt: skip
-
-    def _on_command(self, _c: str, data: bytes) -> None:
-        m = self.types.vehicle_command_t.decode(data)
-        self.commands.append((m.source, m.authority, bool(m.engaged), m.throttle))
-
-    def _on_control(self, _c: str, data: bytes) -> None:
-        self.holder.append(self.types.control_status_t.decode(data).holder)
-
-    def details(self) -> str:
-        return (f"; holders: {self.holder[-3:]}; commands: {self.commands[-3:]}; "
-                f"truth: {self.truth[-1:]}")  # fmt: skip
-
-    def click(self, x: int, y: int) -> None:
-        self.xdotool("mousemove", "--window", self.wid, str(x), str(y), "click", "1")
-
-    def hud(self) -> list[tuple[float, dict[str, str]]]:
-        """The HUD of every frame drawn so far: (sim time [s], {title: value})."""
-        rows = []
-        for line in self.hud_log.read_text().splitlines():
-            f = line.split("\t")
-            if len(f) < 2:
-                continue
-            rows.append((int(f[0]) * 1e-6, dict(kv.split("=", 1) for kv in f[1:] if "=" in kv)))
-        return rows
-
-    def close(self) -> int:
-        assert self.sim is not None
-        for p in (self.sim, self.runtime):
-            interrupt(p)
-        self.runtime_log.close()
-        self.close_display()
-        return int(self.sim.returncode)
-
-
 @pytest.fixture
-def rig(build_dir: Path, tmp_path: Path, lcm_url: str) -> Iterator[Rig]:
-    r = Rig(build_dir, tmp_path, lcm_url)
+def rig(build_dir: Path, tmp_path: Path, lcm_url: str) -> Iterator[BridgeRig]:
+    r = BridgeRig(build_dir, tmp_path, lcm_url, display_offset=7, extra=[])
     try:
         yield r
     finally:
@@ -121,19 +50,16 @@ def truth_at(truth: list[tuple[float, float, float, float, float]], t_s: float) 
     return None
 
 
-def test_manual_driving_from_the_window(rig: Rig) -> None:
+def test_manual_driving_from_the_window(rig: BridgeRig) -> None:
     r = rig
     r.until(lambda: "ok" if r.holder else None, "the bridge's NIGEL1_CONTROL")
     r.run_sim(0.3)
     r.click(*MANUAL_RADIO)
     r.until(lambda: next((s for s in r.lines if s.startswith("manual driving:")), None),
              "manual mode to start autodrive-teleop")  # fmt: skip
-    _, x0, y0, yaw0, _ = r.truth[-1]
+    ahead = r.ahead_of_here()
     r.xdotool("keydown", "--window", r.wid, "Up")
     try:
-        ahead = lambda: (r.truth[-1][1] - x0) * math.cos(yaw0) + (r.truth[-1][2] - y0) * math.sin(
-            yaw0
-        )  # noqa: E731
         r.until(
             lambda: "ok" if ahead() > DRIVE_M else None, f"the car to drive {DRIVE_M} m forward"
         )

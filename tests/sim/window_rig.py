@@ -5,6 +5,7 @@ wall time that fail with what was seen, never pass criteria."""
 
 from __future__ import annotations
 
+import math
 import os
 import select
 import shutil
@@ -15,14 +16,22 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+import yaml
 
 from autodrive.core import lcmtypes
+from autodrive.core.channels import channel, vehicle_name
+from autodrive.core.settings import RUNTIME_HIL_CONFIG
 
 WIN_W, WIN_H = 800, 600  # [px] --view-size: small, for llvmpipe on a busy CPU
 GUARD_S = 240.0  # [s] wall: a guard against a hung run, never a pass criterion
 PUMP_S = 0.5  # [s] wall: the longest one pump reads before its caller looks again
 XVFB_UP_S = 30.0  # [s] wall: a guard for Xvfb's socket (glfwInit failed once before it was up)
 WINDOW_TITLE = "AutoDRIVE Nigel sim"
+# [px] the Car section's Driving radio (tests/sim_sensors checks the layout)
+MANUAL_RADIO = (210, 197)
+AUTONOMOUS_RADIO = (145, 197)
+AUTHORITY_PERSON = 2  # vehicle_command_t.AUTHORITY_PERSON
+DRIVE_M = 0.3  # [m] forward along the start heading: the car drove
 
 NEEDS_X_TOOLS = pytest.mark.skipif(
     not (shutil.which("Xvfb") and shutil.which("xdotool") and shutil.which("ffmpeg")),
@@ -129,3 +138,82 @@ def interrupt(p: subprocess.Popen[str] | subprocess.Popen[bytes]) -> None:
     except subprocess.TimeoutExpired:
         p.kill()
         p.wait()
+
+
+class BridgeRig(WindowRig):
+    """Xvfb, the simulator's window with its ptys (and extra, its further arguments), the
+    runtime's bridge on the Nano pty, and the bus: the ground truth, the commands and the
+    lease of NIGEL1."""
+
+    def __init__(
+        self, build: Path, tmp: Path, url: str, display_offset: int, extra: list[str]
+    ) -> None:
+        super().__init__(build, tmp, url, display_offset)
+        veh = vehicle_name(1)
+        # ground truth: (t [s], x, y [m], yaw [rad], v [m/s])
+        self.commands: list[tuple[str, int, bool, float]] = []  # (source, authority, engaged, thr)
+        self.holder: list[str] = []
+        self.lc.subscribe(channel("GROUND_TRUTH", veh), self._on_truth)
+        self.lc.subscribe(channel("COMMAND", veh), self._on_command)
+        self.lc.subscribe(channel("CONTROL", veh), self._on_control)
+        self.hud_log = tmp / "hud.log"
+        run_dir = tmp / "run"
+        self.start_sim(
+            [str(build / "bin" / "autodrive-sim"), "--view", "--view-size", f"{WIN_W}x{WIN_H}",
+             "--no-lidar", "--rtf", "1", "--duration", "3600", "--run-dir", str(run_dir),
+             "--lcm-url", url, "--hud-log", str(self.hud_log), "--quiet", *extra],
+        )  # fmt: skip
+        self.until(lambda: "ok" if (run_dir / "nigel1-nano").exists() else None, "the Nano's pty")
+        cfg = yaml.safe_load(RUNTIME_HIL_CONFIG.read_text())
+        cfg.update(lcm_url=url)
+        cfg["bridge"]["device"] = str(run_dir / "nigel1-nano")
+        (tmp / "runtime.yaml").write_text(yaml.safe_dump(cfg))
+        self.runtime_log = open(tmp / "runtime.log", "w")
+        self.runtime = subprocess.Popen(
+            [str(build / "bin" / "autodrive-runtime"), "--config", str(tmp / "runtime.yaml"),
+             "--only", "bridge"], stdout=self.runtime_log, stderr=subprocess.STDOUT,
+        )  # fmt: skip
+        self.wid = self.until(self.window_id, "the window to appear")
+
+    def _on_truth(self, _c: str, data: bytes) -> None:
+        m = self.types.ground_truth_t.decode(data)
+        self.truth.append((m.utime * 1e-6, m.position_m[0], m.position_m[1], m.yaw_rad,
+                           m.linear_velocity_m_s[0]))  # fmt: skip
+
+    def _on_command(self, _c: str, data: bytes) -> None:
+        m = self.types.vehicle_command_t.decode(data)
+        self.commands.append((m.source, m.authority, bool(m.engaged), m.throttle))
+
+    def _on_control(self, _c: str, data: bytes) -> None:
+        self.holder.append(self.types.control_status_t.decode(data).holder)
+
+    def details(self) -> str:
+        return (f"; holders: {self.holder[-3:]}; commands: {self.commands[-3:]}; "
+                f"truth: {self.truth[-1:]}")  # fmt: skip
+
+    def click(self, x: int, y: int) -> None:
+        self.xdotool("mousemove", "--window", self.wid, str(x), str(y), "click", "1")
+
+    def hud(self) -> list[tuple[float, dict[str, str]]]:
+        """The HUD of every frame drawn so far: (sim time [s], {title: value})."""
+        rows = []
+        for line in self.hud_log.read_text().splitlines():
+            f = line.split("\t")
+            if len(f) < 2:
+                continue
+            rows.append((int(f[0]) * 1e-6, dict(kv.split("=", 1) for kv in f[1:] if "=" in kv)))
+        return rows
+
+    def ahead_of_here(self) -> Callable[[], float]:
+        """How far the car has come since now along its heading now [m], as a function."""
+        _, x0, y0, yaw0, _ = self.truth[-1]
+        c, s = math.cos(yaw0), math.sin(yaw0)
+        return lambda: (self.truth[-1][1] - x0) * c + (self.truth[-1][2] - y0) * s
+
+    def close(self) -> int:
+        assert self.sim is not None
+        for p in (self.sim, self.runtime):
+            interrupt(p)
+        self.runtime_log.close()
+        self.close_display()
+        return int(self.sim.returncode)

@@ -233,8 +233,25 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   EXPECT_EQ(in.view, SIM_VIEW_DRIVER);
   click("Shadows");
   EXPECT_EQ(in.shadows, 1);
-  click("Scale");  // the render scale slider's middle
+  click("View scale");  // the window's render scale slider's middle
   EXPECT_NEAR(in.render_scale, 0.625, 0.15);
+  // the View section's Cam scale line: the sensor cameras' render scale the caller applies
+  EXPECT_EQ(in.camera_scale, 1.0);
+  ASSERT_EQ(sim_viewer_item_at(v, "Cam scale/0.25", &cx, &cy), 0);
+  printf("Cam scale/0.25 at (%.0f, %.0f) px\n", cx, cy);
+  // tests/sim/test_window_camera_scale.py clicks the real program's line here
+  EXPECT_NEAR(cx, 221, 2);
+  EXPECT_NEAR(cy, 453, 2);
+  click("Cam scale/0.25");
+  EXPECT_EQ(in.camera_scale, 0.25);
+  ASSERT_EQ(sim_viewer_item_at(v, "Cam scale/1", &cx, &cy), 0);
+  printf("Cam scale/1 at (%.0f, %.0f) px\n", cx, cy);
+  EXPECT_NEAR(cx, 134, 2);
+  EXPECT_NEAR(cy, 453, 2);
+  click("Cam scale/0.5");
+  EXPECT_EQ(in.camera_scale, 0.5);
+  click("Cam scale/1");
+  EXPECT_EQ(in.camera_scale, 1.0);
   // the Sensors section's Cameras box: the ego car's front camera drawn at the bottom left
   ASSERT_EQ(sim_viewer_read_rgb(v, shot.data()), 0);
   click("Cameras");
@@ -249,7 +266,7 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   printf("Driving/Manual at (%.0f, %.0f) px\n", cx, cy);
   // tests/sim/test_window_manual.py clicks the real program's radio here
   EXPECT_NEAR(cx, 210, 2);
-  EXPECT_NEAR(cy, 209, 2);
+  EXPECT_NEAR(cy, 197, 2);
   click("Driving/Manual");
   EXPECT_EQ(in.manual, 1);
   sim_viewer_key_state(v, GLFW_KEY_UP, 1);
@@ -263,14 +280,14 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   ASSERT_EQ(sim_viewer_item_at(v, "Driving/Autonomous", &cx, &cy), 0);
   printf("Driving/Autonomous at (%.0f, %.0f) px\n", cx, cy);
   EXPECT_NEAR(cx, 145, 2);
-  EXPECT_NEAR(cy, 209, 2);
+  EXPECT_NEAR(cy, 197, 2);
   click("Driving/Autonomous");
   EXPECT_EQ(in.manual, 0);
   EXPECT_EQ(in.drive_keys, 0);
   ASSERT_EQ(sim_viewer_item_at(v, "Start or stop", &cx, &cy), 0);
   // tests/sim/test_window.py clicks the real program's Record button here
   EXPECT_NEAR(cx, 68, 2);
-  EXPECT_NEAR(cy, 585, 2);
+  EXPECT_NEAR(cy, 581, 2);
   printf("Record button at (%.0f, %.0f) px\n", cx, cy);
   click("Start or stop");
   EXPECT_EQ(in.record_toggled, 1);

@@ -13,6 +13,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -199,9 +200,16 @@ int main(int argc, char **argv) {
           if (type == JS_EVENT_AXIS) mapper.js_axis(e.number, e.value);
           if (type == JS_EVENT_BUTTON) mapper.js_button(e.number, e.value != 0);
         }
-        if (k < 0 && errno != EAGAIN) {
+        // lost: a device read fails once unplugged (ENODEV); a FIFO standing in for one
+        // (tests/sim/test_window_gamepad.py) reaches its end when its writer closes it
+        if (k == 0 || (k < 0 && errno != EAGAIN)) {
           std::fprintf(stderr, "\rautodrive-teleop: gamepad %s lost; stopping the car\n",
                        js_path.c_str());
+          // the window that started us (--keys-stdin) reads our stdout for this line
+          if (keys_stdin) {
+            std::printf("gamepad lost\n");
+            std::fflush(stdout);
+          }
           mapper.js_lost();
           ::close(js);
           js = -1;

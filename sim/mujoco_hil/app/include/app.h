@@ -29,6 +29,8 @@ typedef struct app {
   cameras_t cams;          /* rendered on the stepping thread; empty when the thread has them */
   render_thread_t *render; /* the render thread (real time, --rtf, --lockstep-client) or NULL */
   int64_t cam_period_us;
+  double camera_scale; /* the cars' cameras' render scale now: --camera-scale, then the View
+                          section's Cam scale radio */
   traffic_lights_lcm_t *lights; /* the map's traffic lights on LCM, or NULL */
   teleport_lcm_t *teleport;     /* --allow-teleport, or NULL */
   eye_sync_t *eye_sync;         /* --eye-sync, or NULL */

@@ -29,6 +29,7 @@ typedef struct app_options {
   int view_nice; /* --view-nice: of the window's drawing and rasteriser threads (10) */
   int view_nice_given;
   const char *hud_log; /* --hud-log FILE: each frame's HUD text, or NULL */
+  const char *gamepad; /* --gamepad PATH: the joystick manual driving reads, or NULL */
   /* --video FILE, --record DIR (run_recorder.h), --video-camera NAME; NULL when not given */
   const char *video, *record_dir, *video_camera;
   int cameras, eye;       /* cameras: 0, CAMERAS_ALL or CAMERAS_FRONT (cameras.h) */

@@ -31,11 +31,13 @@ typedef struct render_thread {
   lcm_t *lcm;
   mjData *snap[RENDER_THREAD_QUEUE]; /* a ring of states at frame times */
   int64_t frame_us[RENDER_THREAD_QUEUE];
+  double frame_scale[RENDER_THREAD_QUEUE]; /* the cars' cameras' render scale for each */
   int head, queued;             /* next to render; queued (the one in hand included) */
   int stop, opened, failed;     /* opened: 1 ok, -1 failed */
   int cameras, eye, eye_render; /* cameras_open's arguments */
   double noise, blur_px;
-  double scale; /* the cars' cameras' render scale (--camera-scale) */
+  double scale; /* the cars' cameras' render scale: --camera-scale, then the thread's own copy
+                   of the last snapshot's (frame_scale) */
   uint64_t seed;
   long rendered, skipped;
   char err[256];
@@ -44,10 +46,12 @@ typedef struct render_thread {
 /* Starts the thread, which opens the cameras (t->cameras, t->eye, effects from t->noise,
  * t->blur_px, t->seed) and waits for snapshots. */
 int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err, size_t err_sz);
-/* The state at frame time now_us to the render thread's queue, unless it is full. Returns 1
- * when queued, 0 when skipped (the queue was full), -1 when the thread failed (err). */
-int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, char *err,
-                         size_t err_sz);
+/* The state at frame time now_us to the render thread's queue, unless it is full, to be
+ * rendered with the cars' cameras at render scale scale (the View section's Cam scale can change
+ * it between frames). Returns 1 when queued, 0 when skipped (the queue was full), -1 when the
+ * thread failed (err). */
+int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, double scale,
+                         char *err, size_t err_sz);
 /* Frames waiting behind the one being rendered: the stepping thread's pause this step [us]. */
 long render_thread_backlog_us(render_thread_t *t);
 /* Stops and joins it; prints how many frame times it rendered and skipped. */

@@ -75,20 +75,23 @@ typedef struct viewer_window {
 } viewer_window_t;
 
 /* How the window draws: the render scale (0: the GL renderer's default, sim_viewer.h), the
- * graphics quality (SIM_VIEWER_QUALITY_*), timing of the frame's parts (--bench), and the nice
- * of its drawing and rasteriser threads (--view-nice). */
+ * graphics quality (SIM_VIEWER_QUALITY_*), timing of the frame's parts (--bench), the nice
+ * of its drawing and rasteriser threads (--view-nice), and the cars' cameras' render scale
+ * (--camera-scale: the View section's Cam scale radio starts there). */
 typedef struct viewer_window_look {
   double scale;
   int quality, timing, nice;
+  double camera_scale;
 } viewer_window_look_t;
 
 /* Opens a width_px x height_px window when want (a display is needed) and starts its drawing
  * thread; else leaves w->v NULL. map_name goes into the Simulation section. url: the LCM bus
  * (teleop's, and the leases', listened to when ptys: a runtime may be on them). hud_log: a
- * file for each drawn frame's HUD, or NULL. */
+ * file for each drawn frame's HUD, or NULL. gamepad: --gamepad's joystick for manual driving,
+ * or NULL. */
 int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
                        const char *map_name, const char *url, int ptys, const char *hud_log,
-                       viewer_window_look_t look, char *err, size_t err_sz);
+                       const char *gamepad, viewer_window_look_t look, char *err, size_t err_sz);
 /* Manual driving (every pass: the held keys repeat on wall time), then, when a frame is due,
  * the window's events and a snapshot for the drawing thread; blocks while paused (shifting
  * *t0_s so pacing resumes smoothly) until Step or Pause is clicked. recording: shown in the

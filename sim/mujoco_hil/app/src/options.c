@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <autodrive_channels.h>
 #include <autodrive_instance_rule.h>
@@ -159,6 +161,10 @@ static void options_usage_output(FILE *f) {
       "  --view-nice N       the nice of the window's drawing and software-rasteriser threads\n"
       "                      (0..19, default 10: the window takes the CPU the sim and the\n"
       "                      programs on its ptys leave; 0: the window competes with them)\n"
+      "  --gamepad PATH      with --view: manual driving also reads this Linux joystick\n"
+      "                      (e.g. /dev/input/js0; through autodrive-teleop: hold the dead-man\n"
+      "                      button LB, left stick throttle, right stick steering); the keys\n"
+      "                      still work beside it\n"
       "  --hud-log FILE      with --view: each drawn frame's HUD text as a line of FILE (sim\n"
       "                      time [us], then title=value fields, tab-separated)\n"
       "  --video FILE        write an MP4 of --video-camera, one frame per 1/30 s of sim\n"
@@ -435,6 +441,9 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return options_pick(a, v, names, modes, 3, &o->eye_render);
   } else if (!strcmp(a, "--view")) {
     o->view = 1;
+  } else if (!strcmp(a, "--gamepad") && v) {
+    o->gamepad = v;
+    return 1;
   } else if (!strcmp(a, "--view-quality") && v) {
     static const char *const names[] = {"low", "high", "ultra"};
     static const int levels[] = {SIM_VIEWER_QUALITY_LOW, SIM_VIEWER_QUALITY_HIGH,
@@ -479,6 +488,20 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
   return 0;
 }
 
+/* --gamepad: a readable joystick device (or a FIFO carrying its events), checked now rather
+ * than when Manual is first clicked. */
+static int options_gamepad_check(const char *path) {
+  struct stat st;
+  const char *why = NULL;
+  if (stat(path, &st) != 0 || access(path, R_OK) != 0)
+    why = strerror(errno);
+  else if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))
+    why = "not a character device (a gamepad is /dev/input/jsN)";
+  if (!why) return 0;
+  fprintf(stderr, "autodrive-sim: --gamepad '%s': %s\n", path, why);
+  return -1;
+}
+
 /* Options that exclude or need each other. */
 static int options_check(const app_options_t *o) {
   if (o->lockstep && o->rtf_given) {
@@ -508,6 +531,11 @@ static int options_check(const app_options_t *o) {
             "(they set how the window draws)\n");
     return OPTIONS_BAD;
   }
+  if (o->gamepad && !o->view) {
+    fprintf(stderr, "autodrive-sim: --gamepad needs --view (it drives from the window)\n");
+    return OPTIONS_BAD;
+  }
+  if (o->gamepad && options_gamepad_check(o->gamepad) != 0) return OPTIONS_BAD;
   if (o->hud_log && !o->view) {
     fprintf(stderr, "autodrive-sim: --hud-log needs --view (it logs the window's HUD)\n");
     return OPTIONS_BAD;

@@ -20,7 +20,9 @@ static void *render_thread_run(void *arg) {
     if (t->stop) break;
     mjData *snap = t->snap[t->head];
     const int64_t frame_us = t->frame_us[t->head];
+    const double scale = t->frame_scale[t->head];
     pthread_mutex_unlock(&t->mu);
+    if (scale != t->scale) cameras_set_render_scale(&t->cams, t->scale = scale);
     const int r =
         cameras_publish(&t->cams, sim_render_model(t->s), snap, t->lcm, frame_us, err, sizeof err);
     pthread_mutex_lock(&t->mu);
@@ -59,8 +61,8 @@ int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err, siz
   return -1;
 }
 
-int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, char *err,
-                         size_t err_sz) {
+int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, double scale,
+                         char *err, size_t err_sz) {
   pthread_mutex_lock(&t->mu);
   const int failed = t->failed;
   int queued = 0;
@@ -73,6 +75,7 @@ int render_thread_submit(render_thread_t *t, const sim_t *s, int64_t now_us, cha
     const int tail = (t->head + t->queued) % RENDER_THREAD_QUEUE;
     sim_render_snapshot(s, t->snap[tail]);
     t->frame_us[tail] = now_us;
+    t->frame_scale[tail] = scale;
     t->queued++;
     pthread_cond_signal(&t->cv);
   }

@@ -95,6 +95,18 @@ static void loop_publish_sensors(app_t *a, const loop_t *l) {
   }
 }
 
+/* The View section's Cam scale radio changed the cars' cameras' render scale. The cameras
+ * rendered here take it at once; the render thread's take it with the next snapshot queued
+ * (render_thread_submit), in sim-time order: it alone touches its cameras, so the scale
+ * crosses threads only inside the queue, under its lock. */
+static void loop_camera_scale(app_t *a, int64_t now_us) {
+  a->camera_scale = a->viewer.in.camera_scale;
+  cameras_set_render_scale(&a->cams, a->camera_scale);
+  printf("camera scale %.2f from t = %.3f s (the View section)\n", a->camera_scale,
+         now_us * 1e-6);
+  fflush(stdout);
+}
+
 /* The cameras at their frame times: rendered here, or queued for the render thread (which
  * slows the stepping down while frames wait); --eye-sync learns of each frame sent. Returns 0,
  * or -1 with the message in err. */
@@ -109,7 +121,8 @@ static int loop_cameras(app_t *a, int64_t now_us, char *err, size_t err_sz) {
         return -1;
       sent = 1;
     }
-    if (a->render && (sent = render_thread_submit(a->render, s, now_us, err, err_sz)) < 0)
+    if (a->render &&
+        (sent = render_thread_submit(a->render, s, now_us, a->camera_scale, err, err_sz)) < 0)
       return -1;
     if (sent && a->eye_sync) eye_sync_frame_sent(a->eye_sync, now_us);
   }
@@ -258,6 +271,7 @@ static int loop_once(app_t *a, loop_t *l) {
   if (a->viewer.v) {
     const char *rec = run_recorder_active(&a->recorder) ? a->recorder.video_path : NULL;
     if (viewer_window_frame(&a->viewer, s, &l->t0, rec) != 0) return 0;
+    if (a->viewer.in.camera_scale != a->camera_scale) loop_camera_scale(a, now_us);
     if (a->viewer.record_toggles && loop_record_button(a, err, sizeof err) != 0) {
       fprintf(stderr, "autodrive-sim: %s\n", err);
       return -1;

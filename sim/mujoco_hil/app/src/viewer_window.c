@@ -98,10 +98,11 @@ static int viewer_thread_start(viewer_window_t *w, const sim_t *s, char *err, si
 
 int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
                        const char *map_name, const char *url, int ptys, const char *hud_log,
-                       viewer_window_look_t look, char *err, size_t err_sz) {
+                       const char *gamepad, viewer_window_look_t look, char *err,
+                       size_t err_sz) {
   memset(w, 0, sizeof *w);
   atomic_init(&w->passes, 0);
-  manual_drive_init(&w->manual);
+  manual_drive_init(&w->manual, gamepad);
   w->url = url;
   if (!want) return 0;
   if (!sim_viewer_display_available()) {
@@ -115,6 +116,7 @@ int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_p
   sim_viewer_set_map_name(w->v, slash ? slash + 1 : map_name);
   if (look.scale > 0) sim_viewer_set_render_scale(w->v, look.scale);
   sim_viewer_set_quality(w->v, look.quality);
+  sim_viewer_set_camera_scale(w->v, look.camera_scale);
   sim_viewer_time_parts(w->v, look.timing);
   /* never below the process's own nice (lowering it needs a privilege) */
   const int own = getpriority(PRIO_PROCESS, 0);

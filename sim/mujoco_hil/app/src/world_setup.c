@@ -117,6 +117,7 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
   if (threaded) a->render = &render;
   cameras_set_effects(&a->cams, o->camera_noise, o->camera_blur, o->cfg.seed);
   cameras_set_render_scale(&a->cams, o->camera_scale);
+  a->camera_scale = o->camera_scale;
   a->cam_period_us = (int64_t)llround(1e6 / o->camera_fps);
   return -1;
 }
@@ -144,9 +145,10 @@ static int app_build_links(app_t *a, char *err, size_t err_sz) {
   }
   if (viewer_window_open(
           &a->viewer, a->sim, o->view, o->view_w, o->view_h, o->cfg.map_path, o->url,
-          o->cfg.open_ptys, o->hud_log,
-          (viewer_window_look_t){o->view_scale, o->view_quality, o->bench, o->view_nice}, err,
-          err_sz) != 0) {
+          o->cfg.open_ptys, o->hud_log, o->gamepad,
+          (viewer_window_look_t){o->view_scale, o->view_quality, o->bench, o->view_nice,
+                                 o->camera_scale},
+          err, err_sz) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
     return 1;
   }

@@ -8,7 +8,8 @@
  * manual mode the arrows or W/A/S/D held drive the ego car (the caller turns them into commands:
  * in.drive_keys). The Menu Panel (MuJoCo's mjui, sim_viewer_ui.c) has the sections Simulation (map,
  * pause, step, reset, quit), Car (the ego car, autonomous or manual driving), View (camera, light
- * level, quality: low, high or ultra; render scale; HUD), Sensors (LIDAR rays, the ego car's front
+ * level, quality: low, high or ultra; the window's render scale; the render scale of the cars'
+ * sensor cameras, which the caller applies; HUD), Sensors (LIDAR rays, the ego car's front
  * and rear camera thumbnails, bottom left of the scene) and Record (start / stop). The HUD is text
  * the caller sets (sim_viewer_set_hud), drawn at the top right. The viewer only reports what the
  * user asked (sim_viewer_input_t); the sim's main loop acts.
@@ -64,6 +65,8 @@ typedef struct sim_viewer_input {
   int manual;          /* the Car section's Driving radio (T toggles): 0 autonomous, 1 manual */
   int drive_keys;      /* SIM_VIEWER_KEY_* bits of the drive keys held now */
   double render_scale; /* the scene's share of the window's pixels per side, 0.25..1 */
+  double camera_scale; /* the View section's Cam scale radio: the render scale per side the
+                          caller gives the cars' sensor cameras (1, 0.5 or 0.25) */
 } sim_viewer_input_t;
 
 #define SIM_VIEWER_SOFTWARE_SCALE 0.5 /* the default render scale on software GL */
@@ -118,6 +121,9 @@ void sim_viewer_release(sim_viewer_t *v);
 /* The render scale (clamped to SIM_VIEWER_MIN_SCALE..1): a flag's override of the default.
  * Before sim_viewer_detach. */
 void sim_viewer_set_render_scale(sim_viewer_t *v, double scale);
+/* The Cam scale radio's start (--camera-scale): the element equal to scale (1, 0.5, 0.25) is
+ * lit, none for another value until one is clicked. Before sim_viewer_detach. */
+void sim_viewer_set_camera_scale(sim_viewer_t *v, double scale);
 /* Graphics quality, the paper's three levels set at once (the View section's check boxes):
  * low none, high shadows, ultra shadows, reflections and the skybox. Before sim_viewer_detach. */
 enum { SIM_VIEWER_QUALITY_LOW = 0, SIM_VIEWER_QUALITY_HIGH, SIM_VIEWER_QUALITY_ULTRA };

@@ -318,6 +318,7 @@ sim_viewer_t *sim_viewer_create(const mjModel *m, int ncars, const char *body_fm
   v->in.car = 1;
   v->in.view = SIM_VIEW_BIRD;
   v->in.render_scale = v->software ? SIM_VIEWER_SOFTWARE_SCALE : 1.0;
+  v->in.camera_scale = 1.0;
   v->cam_pub = -1;
   v->panel = 1;
   if (pthread_mutex_init(&v->mu, NULL) != 0) {
@@ -675,6 +676,11 @@ void sim_viewer_set_render_scale(sim_viewer_t *v, double scale) {
   v->in.render_scale = scale < SIM_VIEWER_MIN_SCALE ? SIM_VIEWER_MIN_SCALE
                        : scale > 1.0                ? 1.0
                                                     : scale;
+  v->ui_dirty = 1;
+}
+
+void sim_viewer_set_camera_scale(sim_viewer_t *v, double scale) {
+  v->in.camera_scale = scale;
   v->ui_dirty = 1;
 }
 

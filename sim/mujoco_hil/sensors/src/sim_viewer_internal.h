@@ -49,6 +49,7 @@ struct sim_viewer {
   mjuiState ui_state;
   int panel;                   /* 1: shown (M toggles) */
   int ui_car;                  /* the Ego car radio: in.car - 1 */
+  int ui_cam_scale;            /* the Cam scale radio: in.camera_scale's element, or -1 */
   int ui_dirty;                /* the panel's buffer needs a redraw (mjui_update) */
   sim_viewer_input_t ui_shown; /* the state the buffer shows */
   const mjModel *model;

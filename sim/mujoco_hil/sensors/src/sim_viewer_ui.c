@@ -13,6 +13,19 @@
 #define UI_RESET "Reset"
 #define UI_QUIT "Quit"
 #define UI_RECORD "Start or stop"
+#define UI_ROW_GAP_PX 2 /* [px] between the panel's rows */
+
+/* The Cam scale radio's elements: the cars' sensor cameras' render scale per side. */
+static const double ui_cam_scales[] = {1.0, 0.5, 0.25};
+#define UI_CAM_SCALES "1\n0.5\n0.25"
+#define UI_NCAM_SCALES ((int)(sizeof ui_cam_scales / sizeof *ui_cam_scales))
+
+/* The radio's element of in.camera_scale, or -1 for a scale that is none of them. */
+static int ui_cam_scale_index(double scale) {
+  for (int k = 0; k < UI_NCAM_SCALES; k++)
+    if (scale == ui_cam_scales[k]) return k;
+  return -1;
+}
 
 void sim_viewer_ui_camera_names(const sim_viewer_t *v, const mjModel *m, char *out, size_t n) {
   int len = snprintf(out, n, "Driver\nBird\nGod\nFree");
@@ -36,6 +49,9 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   mjUI *ui = &v->ui;
   memset(ui, 0, sizeof *ui);
   ui->spacing = mjui_themeSpacing(0);
+  /* 2 px less between rows (theme 0 has 4): the panel's 20 rows, the Cam scale line among them,
+   * fit a 600 px window */
+  ui->spacing.itemver = UI_ROW_GAP_PX;
   ui->color = mjui_themeColor(0);
   ui->rectid = 1;
   ui->auxid = 0;
@@ -45,8 +61,7 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
     len += snprintf(cars + len, sizeof cars - (size_t)len, "%s%d", i > 1 ? "\n" : "", i);
   char cams[mjMAXUITEXT];
   sim_viewer_ui_camera_names(v, v->model, cams, sizeof cams);
-  /* the map in the section's title, not a line of its own: the render scale took that row, and
-   * the panel still fits a 600 px window */
+  /* the map in the section's title, not a line of its own: the panel fits a 600 px window */
   ui_add(v, mjITEM_SECTION, "Simulation", NULL, "");
   ui_add(v, mjITEM_CHECKINT, "Pause", &v->in.paused, "");
   ui_add(v, mjITEM_BUTTON, UI_STEP, NULL, "");
@@ -63,7 +78,9 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   ui_add(v, mjITEM_CHECKINT, "Skybox", &v->in.skybox, "");
   ui_add(v, mjITEM_CHECKINT, "HUD", &v->in.hud, "");
   /* after the check boxes, which mjui packs two to a row */
-  ui_add(v, mjITEM_SLIDERNUM, "Scale", &v->in.render_scale, "0.25 1");
+  ui_add(v, mjITEM_SLIDERNUM, "View scale", &v->in.render_scale, "0.25 1");
+  /* one line: the sensor cameras' render scale, beside the window's */
+  ui_add(v, mjITEM_RADIOLINE, "Cam scale", &v->ui_cam_scale, UI_CAM_SCALES);
   ui_add(v, mjITEM_SECTION, "Sensors", NULL, "");
   ui_add(v, mjITEM_CHECKINT, "LIDAR rays", &v->in.lidar_rays, "");
   ui_add(v, mjITEM_CHECKINT, "Cameras", &v->in.thumbnails,
@@ -88,6 +105,7 @@ void sim_viewer_ui_render(sim_viewer_t *v) {
   if (!v->panel) return;
   ui_rects(v);
   v->ui_car = v->in.car - 1;
+  v->ui_cam_scale = ui_cam_scale_index(v->in.camera_scale);
   /* redrawn into its buffer only when what it shows changed: a software rasteriser pays for
    * every item on every redraw */
   sim_viewer_input_t shown = v->in;
@@ -127,20 +145,27 @@ int sim_viewer_ui_mouse(sim_viewer_t *v, double x_px, double y_px, int press) {
   }
   const int owned = st->dragrect == 1;
   v->ui_car = v->in.car - 1;
+  v->ui_cam_scale = ui_cam_scale_index(v->in.camera_scale);
   mjuiItem *it = mjui_event(&v->ui, st, &v->con);
   v->ui_dirty = 1;
   if (it && it->type == mjITEM_BUTTON) ui_button(v, it->name); /* edges: once a frame */
   if (it && it->pdata == &v->ui_car) v->in.car = v->ui_car + 1;
+  if (it && it->pdata == &v->ui_cam_scale && v->ui_cam_scale >= 0 &&
+      v->ui_cam_scale < UI_NCAM_SCALES)
+    v->in.camera_scale = ui_cam_scales[v->ui_cam_scale];
   if (it && it->pdata == &v->in.light_level) v->in.day = v->in.light_level >= 0.5;
   if (!press) st->dragrect = 0;
   mjr_setBuffer(mjFB_WINDOW, &v->con);
   return owned || inside;
 }
 
-/* The centre of element k of a radio item (radiocol columns) in the item's own rectangle;
- * y up. */
+/* The centre of element k of a radio item (radiocol columns; a radio line's all in one row) in
+ * the item's own rectangle; y up. A radio line's elements are as wide as their text: equal
+ * shares still land inside each (short names, few of them). */
 static void ui_radio_centre(const mjUI *ui, const mjuiItem *it, int k, double *x, double *y) {
-  const int ncol = ui->radiocol > 0 ? ui->radiocol : 2;
+  const int ncol = it->type == mjITEM_RADIOLINE ? it->multi.nelem
+                   : ui->radiocol > 0             ? ui->radiocol
+                                                  : 2;
   const int nrow = (it->multi.nelem + ncol - 1) / ncol;
   const double left = it->rect.left; /* the rectangle is the elements' (the label is left of it) */
   const double col_w = (double)it->rect.width / ncol;
