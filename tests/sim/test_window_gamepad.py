@@ -70,7 +70,9 @@ def pad(tmp_path: Path) -> Iterator[Pad]:
 
 @pytest.fixture
 def rig(build_dir: Path, tmp_path: Path, lcm_url: str, pad: Pad) -> Iterator[BridgeRig]:
-    r = BridgeRig(build_dir, tmp_path, lcm_url, display_offset=11, extra=["--gamepad", str(pad.path)])
+    r = BridgeRig(
+        build_dir, tmp_path, lcm_url, display_offset=11, extra=["--gamepad", str(pad.path)]
+    )
     try:
         yield r
     finally:

@@ -32,9 +32,9 @@ typedef struct render_thread {
   mjData *snap[RENDER_THREAD_QUEUE]; /* a ring of states at frame times */
   int64_t frame_us[RENDER_THREAD_QUEUE];
   double frame_scale[RENDER_THREAD_QUEUE]; /* the cars' cameras' render scale for each */
-  int head, queued;             /* next to render; queued (the one in hand included) */
-  int stop, opened, failed;     /* opened: 1 ok, -1 failed */
-  int cameras, eye, eye_render; /* cameras_open's arguments */
+  int head, queued;                        /* next to render; queued (the one in hand included) */
+  int stop, opened, failed;                /* opened: 1 ok, -1 failed */
+  int cameras, eye, eye_render;            /* cameras_open's arguments */
   double noise, blur_px;
   double scale; /* the cars' cameras' render scale: --camera-scale, then the thread's own copy
                    of the last snapshot's (frame_scale) */

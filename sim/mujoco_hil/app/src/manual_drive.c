@@ -90,12 +90,18 @@ static int manual_drive_start(manual_drive_t *m, int car, const char *url) {
   posix_spawn_file_actions_adddup2(&fa, p[0], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&fa, q[1], STDOUT_FILENO);
   /* a fresh press counts as held for this delay + 150 ms before its first repeat */
-  char *argv[] = {path,          "--keys-stdin",
-                  "--vehicle",   veh,
-                  "--lcm-url",   (char *)url,
-                  "--key-hold-ms", hold,
-                  "--key-repeat-delay-ms", hold,
-                  m->gamepad ? "--joystick" : NULL, (char *)m->gamepad,
+  char *argv[] = {path,
+                  "--keys-stdin",
+                  "--vehicle",
+                  veh,
+                  "--lcm-url",
+                  (char *)url,
+                  "--key-hold-ms",
+                  hold,
+                  "--key-repeat-delay-ms",
+                  hold,
+                  m->gamepad ? "--joystick" : NULL,
+                  (char *)m->gamepad,
                   NULL};
   const int rc = posix_spawn(&m->pid, path, &fa, NULL, argv, environ);
   posix_spawn_file_actions_destroy(&fa);

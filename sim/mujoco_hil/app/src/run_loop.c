@@ -102,8 +102,7 @@ static void loop_publish_sensors(app_t *a, const loop_t *l) {
 static void loop_camera_scale(app_t *a, int64_t now_us) {
   a->camera_scale = a->viewer.in.camera_scale;
   cameras_set_render_scale(&a->cams, a->camera_scale);
-  printf("camera scale %.2f from t = %.3f s (the View section)\n", a->camera_scale,
-         now_us * 1e-6);
+  printf("camera scale %.2f from t = %.3f s (the View section)\n", a->camera_scale, now_us * 1e-6);
   fflush(stdout);
 }
 

@@ -98,8 +98,7 @@ static int viewer_thread_start(viewer_window_t *w, const sim_t *s, char *err, si
 
 int viewer_window_open(viewer_window_t *w, const sim_t *s, int want, int width_px, int height_px,
                        const char *map_name, const char *url, int ptys, const char *hud_log,
-                       const char *gamepad, viewer_window_look_t look, char *err,
-                       size_t err_sz) {
+                       const char *gamepad, viewer_window_look_t look, char *err, size_t err_sz) {
   memset(w, 0, sizeof *w);
   atomic_init(&w->passes, 0);
   manual_drive_init(&w->manual, gamepad);

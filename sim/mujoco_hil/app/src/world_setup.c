@@ -143,12 +143,11 @@ static int app_build_links(app_t *a, char *err, size_t err_sz) {
     fprintf(stderr, "autodrive-sim: %s\n", err);
     return 1;
   }
-  if (viewer_window_open(
-          &a->viewer, a->sim, o->view, o->view_w, o->view_h, o->cfg.map_path, o->url,
-          o->cfg.open_ptys, o->hud_log, o->gamepad,
-          (viewer_window_look_t){o->view_scale, o->view_quality, o->bench, o->view_nice,
-                                 o->camera_scale},
-          err, err_sz) != 0) {
+  if (viewer_window_open(&a->viewer, a->sim, o->view, o->view_w, o->view_h, o->cfg.map_path, o->url,
+                         o->cfg.open_ptys, o->hud_log, o->gamepad,
+                         (viewer_window_look_t){o->view_scale, o->view_quality, o->bench,
+                                                o->view_nice, o->camera_scale},
+                         err, err_sz) != 0) {
     fprintf(stderr, "autodrive-sim: --view: %s\n", err);
     return 1;
   }

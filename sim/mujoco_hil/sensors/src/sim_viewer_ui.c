@@ -164,8 +164,8 @@ int sim_viewer_ui_mouse(sim_viewer_t *v, double x_px, double y_px, int press) {
  * shares still land inside each (short names, few of them). */
 static void ui_radio_centre(const mjUI *ui, const mjuiItem *it, int k, double *x, double *y) {
   const int ncol = it->type == mjITEM_RADIOLINE ? it->multi.nelem
-                   : ui->radiocol > 0             ? ui->radiocol
-                                                  : 2;
+                   : ui->radiocol > 0           ? ui->radiocol
+                                                : 2;
   const int nrow = (it->multi.nelem + ncol - 1) / ncol;
   const double left = it->rect.left; /* the rectangle is the elements' (the label is left of it) */
   const double col_w = (double)it->rect.width / ncol;
