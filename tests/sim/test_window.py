@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from autodrive.core.channels import channel, vehicle_name
-from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
+from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig
 
 PANEL_W = 260  # [px] the Menu Panel's width (mjui theme 0): the scene is right of it
 RECORD_BUTTON = (68, 581)  # [px] the Record button (tests/sim_sensors checks the layout)
@@ -72,10 +72,7 @@ class Window(WindowRig):
         return img
 
     def close(self) -> int:
-        assert self.sim is not None
-        interrupt(self.sim)
-        self.close_display()
-        return int(self.sim.returncode)
+        return self.stop_sim_and_display()
 
 
 @pytest.fixture

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from autodrive.core.channels import channel, vehicle_name
-from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig, interrupt
+from window_rig import GUARD_S, NEEDS_X_TOOLS, WIN_H, WIN_W, WindowRig
 
 # [px] the View section's Cam scale radio (tests/sim_sensors checks the layout)
 CAM_SCALE_QUARTER = (221, 453)
@@ -78,9 +78,7 @@ def window(build_dir: Path, tmp_path: Path, lcm_url: str) -> Iterator[Window]:
     try:
         yield w
     finally:
-        assert w.sim is not None
-        interrupt(w.sim)
-        w.close_display()
+        w.stop_sim_and_display()
 
 
 def differ(a: np.ndarray, b: np.ndarray) -> float:

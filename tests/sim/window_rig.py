@@ -127,6 +127,13 @@ class WindowRig:
         self.xvfb.terminate()
         self.xvfb.wait()
 
+    def stop_sim_and_display(self) -> int:
+        """Stops the simulator as Ctrl-C does, then Xvfb; the simulator's exit code."""
+        assert self.sim is not None
+        interrupt(self.sim)
+        self.close_display()
+        return int(self.sim.returncode)
+
 
 def interrupt(p: subprocess.Popen[str] | subprocess.Popen[bytes]) -> None:
     """Stops a program as Ctrl-C does, killing it after 60 s of wall time (a hang guard)."""

@@ -237,17 +237,17 @@ TEST(SimViewer, MenuPanelItemsChangeWhatTheySayAndTheHudIsDrawn) {
   EXPECT_NEAR(in.render_scale, 0.625, 0.15);
   // the View section's Cam scale line: the sensor cameras' render scale the caller applies
   EXPECT_EQ(in.camera_scale, 1.0);
-  ASSERT_EQ(sim_viewer_item_at(v, "Cam scale/0.25", &cx, &cy), 0);
-  printf("Cam scale/0.25 at (%.0f, %.0f) px\n", cx, cy);
-  // tests/sim/test_window_camera_scale.py clicks the real program's line here
-  EXPECT_NEAR(cx, 221, 2);
-  EXPECT_NEAR(cy, 453, 2);
+  // tests/sim/test_window_camera_scale.py clicks the real program's line at these [px]
+  const auto expect_item_at = [&](const char *item, double x_px, double y_px) {
+    ASSERT_EQ(sim_viewer_item_at(v, item, &cx, &cy), 0);
+    printf("%s at (%.0f, %.0f) px\n", item, cx, cy);
+    EXPECT_NEAR(cx, x_px, 2);
+    EXPECT_NEAR(cy, y_px, 2);
+  };
+  expect_item_at("Cam scale/0.25", 221, 453);
   click("Cam scale/0.25");
   EXPECT_EQ(in.camera_scale, 0.25);
-  ASSERT_EQ(sim_viewer_item_at(v, "Cam scale/1", &cx, &cy), 0);
-  printf("Cam scale/1 at (%.0f, %.0f) px\n", cx, cy);
-  EXPECT_NEAR(cx, 134, 2);
-  EXPECT_NEAR(cy, 453, 2);
+  expect_item_at("Cam scale/1", 134, 453);
   click("Cam scale/0.5");
   EXPECT_EQ(in.camera_scale, 0.5);
   click("Cam scale/1");
