@@ -17,7 +17,6 @@
 
 /* The Cam scale radio's elements: the cars' sensor cameras' render scale per side. */
 static const double ui_cam_scales[] = {1.0, 0.5, 0.25};
-#define UI_CAM_SCALES "1\n0.5\n0.25"
 #define UI_NCAM_SCALES ((int)(sizeof ui_cam_scales / sizeof *ui_cam_scales))
 
 /* The radio's element of in.camera_scale, or -1 for a scale that is none of them. */
@@ -59,7 +58,10 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   char cars[mjMAXUITEXT] = "";
   for (int i = 1, len = 0; i <= v->ncars && i <= mjMAXUIMULTI; i++)
     len += snprintf(cars + len, sizeof cars - (size_t)len, "%s%d", i > 1 ? "\n" : "", i);
-  char cams[mjMAXUITEXT];
+  char cams[mjMAXUITEXT], cam_scales[mjMAXUITEXT]; /* the radio's names, from ui_cam_scales */
+  for (int k = 0, len = 0; k < UI_NCAM_SCALES; k++)
+    len += snprintf(cam_scales + len, sizeof cam_scales - (size_t)len, "%s%g", k ? "\n" : "",
+                    ui_cam_scales[k]);
   sim_viewer_ui_camera_names(v, v->model, cams, sizeof cams);
   /* the map in the section's title, not a line of its own: the panel fits a 600 px window */
   ui_add(v, mjITEM_SECTION, "Simulation", NULL, "");
@@ -80,7 +82,7 @@ void sim_viewer_ui_init(sim_viewer_t *v) {
   /* after the check boxes, which mjui packs two to a row */
   ui_add(v, mjITEM_SLIDERNUM, "View scale", &v->in.render_scale, "0.25 1");
   /* one line: the sensor cameras' render scale, beside the window's */
-  ui_add(v, mjITEM_RADIOLINE, "Cam scale", &v->ui_cam_scale, UI_CAM_SCALES);
+  ui_add(v, mjITEM_RADIOLINE, "Cam scale", &v->ui_cam_scale, cam_scales);
   ui_add(v, mjITEM_SECTION, "Sensors", NULL, "");
   ui_add(v, mjITEM_CHECKINT, "LIDAR rays", &v->in.lidar_rays, "");
   ui_add(v, mjITEM_CHECKINT, "Cameras", &v->in.thumbnails,
