@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import math
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -15,7 +16,7 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from autodrive.maps import tiles
-from autodrive.maps.model import Kit, Lane, SignKindKit, TileKit, TileSpec, Vec2
+from autodrive.maps.model import Kit, Lane, SignKindKit, TileKit, TileSpec, Vec2, Vec3
 
 DIR_NAME = "textures"
 Mask = npt.NDArray[np.bool_]  # a boolean image
@@ -51,6 +52,23 @@ def sign_texture_name(kind: str, speed_limit_m_s: float | None = None) -> str:
     if kind == "speed_limit" and speed_limit_m_s is not None:
         return f"sign_{kind}_{round(speed_limit_m_s * 100)}"
     return f"sign_{kind}"
+
+
+@dataclass(frozen=True)
+class Marking:
+    """How a tile's centre line and edge lines are painted and its road surface coloured. The
+    default is the kit's own (its centre_rgb dashed, its line_rgb solid edges, its asphalt);
+    other values are domain-randomisation variants (autodrive.maps.road_styles). Lane dividers,
+    stop lines, slot lines, a corner's curb and a closed side keep the kit's look."""
+
+    centre_rgb: Vec3 | None = None  # None: the kit's centre_rgb
+    centre_dashed: bool = True
+    edge_rgb: Vec3 | None = None  # None: the kit's line_rgb
+    edge_dashed: bool = False
+    asphalt_rgb: Vec3 | None = None  # None: the kit's asphalt_rgb
+
+
+KIT_MARKING = Marking()
 
 
 # --- tiles --------------------------------------------------------------------------------------
@@ -147,13 +165,14 @@ def _dashes(cv: _Canvas, prims: list[tuple[str, tuple[float, ...]]], offset_m: f
     return on
 
 
-def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
+def _tile_png(kit: Kit, tile_type: str, lanes: int, marking: Marking = KIT_MARKING) -> bytes:
     tk = kit.tiles
     spec = TileSpec(name="t", type=tile_type, lanes=lanes, centre_m=(0.0, 0.0))  # type: ignore[arg-type]
     content = tiles.expand(tk, spec)
     cv = _Canvas(tk, content.size_m)
+    asphalt = marking.asphalt_rgb or tk.asphalt_rgb
     if tile_type == "patch":
-        cv.rgb[:] = tk.asphalt_rgb
+        cv.rgb[:] = asphalt
         return cv.png()
     w, half_w = tk.lane_width_m, content.road_width_m / 2
     lw = tk.paint_width_m / 2
@@ -169,7 +188,11 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
     }
     road = np.zeros(cv.x.shape, bool)
     white = np.zeros(cv.x.shape, bool)
-    yellow = np.zeros(cv.x.shape, bool)
+    yellow = np.zeros(cv.x.shape, bool)  # the centre line where it is drawn in full
+    centre_on = np.zeros(cv.x.shape, bool)  # the dash pattern along the centre line
+    edge = np.zeros(cv.x.shape, bool)  # the edge lines (of the arms and lanes) in full
+    edge_on = np.ones(cv.x.shape, bool)  # the dash pattern along them (all on: no pattern)
+    pitch_m = tk.dash_length_m + tk.dash_gap_m
     by_name = {lane.name: lane for lane in content.lanes}
 
     def approach(i: int, from_m: float) -> tuple[Vec2, Vec2, Callable[[float], tuple[Vec2, Vec2]]]:
@@ -188,13 +211,18 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
         a, b, off = approach(i, to_m)
         road[cv.seg(a, b) <= half_w] = True
         for s in (-1, 1):
-            white[cv.seg(*off(s * (half_w - edge_off))) <= lw] = True
+            ea, eb = off(s * (half_w - edge_off))
+            near = cv.seg(ea, eb) <= lw
+            edge[near] = True
+            edge_on[near] = np.mod(cv.along(ea, eb), pitch_m)[near] < tk.dash_length_m
             for d in offsets[1:]:
                 pa, pb = off(s * (d - w / 2))
                 white[(cv.seg(pa, pb) <= lw) & (np.mod(cv.along(pa, pb), tk.dash_length_m + tk.dash_gap_m) < tk.dash_length_m)] = True  # fmt: skip
         if lanes == 2:
             pa, pb = off(0.0)
-            yellow[(cv.seg(pa, pb) <= lw) & (np.mod(cv.along(pa, pb), tk.dash_length_m + tk.dash_gap_m) < tk.dash_length_m)] = True  # fmt: skip
+            near = cv.seg(pa, pb) <= lw
+            yellow[near] = True
+            centre_on[near & (np.mod(cv.along(pa, pb), pitch_m) < tk.dash_length_m)] = True
         elif lanes > 2:
             for s in (-1, 1):
                 yellow[cv.seg(*off(s * 1.5 * tk.paint_width_m)) <= lw] = True
@@ -240,14 +268,20 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
                     continue
                 prims = _lane_prims(lane)
                 if i == k - 1:  # the road's edge on its right
-                    white |= np.abs(_dist(cv, prims, -(w / 2 + tk.shoulder_m - edge_off) if lanes > 1 else -(half_w - edge_off))) <= lw  # fmt: skip
+                    e_off = -(w / 2 + tk.shoulder_m - edge_off) if lanes > 1 else -(half_w - edge_off)  # fmt: skip
+                    near = np.abs(_dist(cv, prims, e_off)) <= lw
+                    edge |= near
+                    edge_on[near] = _dashes(cv, prims, e_off)[near]
                 if i > 0:
                     white |= _dashes(cv, prims, w / 2) & (_dist(cv, prims, w / 2) <= lw)
                 first_arm = lane.name.split("_")[1] == tiles.ARMS[tile_type][0]
                 if i == 0 and lanes == 2 and first_arm:  # one direction draws the shared line
-                    yellow |= _dashes(cv, prims, w / 2) & (_dist(cv, prims, w / 2) <= lw)
-                if i == 0 and lanes > 2:
-                    yellow |= _dist(cv, prims, w / 2 - 1.5 * tk.paint_width_m) <= lw
+                    yellow |= _dist(cv, prims, w / 2) <= lw
+                    centre_on |= _dashes(cv, prims, w / 2)
+                if i == 0 and lanes > 2:  # a double line, always in full
+                    solid = _dist(cv, prims, w / 2 - 1.5 * tk.paint_width_m) <= lw
+                    yellow |= solid
+                    centre_on |= solid
     # stop lines (a dead end's and a lot aisle's end bars too)
     for s in content.stop_lines:
         lane = by_name[s.lane]
@@ -279,9 +313,14 @@ def _tile_png(kit: Kit, tile_type: str, lanes: int) -> bytes:
         road |= (np.abs((cv.x - cx) * c + (cv.y - cy) * s_) <= hd) & (
             np.abs(-(cv.x - cx) * s_ + (cv.y - cy) * c) <= hw
         )
-    cv.paint(road, tk.asphalt_rgb)
-    cv.paint(yellow & road, tk.centre_rgb)
+    if lanes > 2 or not marking.centre_dashed:
+        centre_on |= yellow
+    if not marking.edge_dashed:
+        edge_on[:] = True
+    cv.paint(road, asphalt)
+    cv.paint(yellow & centre_on & road, marking.centre_rgb or tk.centre_rgb)
     cv.paint(white, tk.line_rgb)
+    cv.paint(edge & edge_on, marking.edge_rgb or tk.line_rgb)
     return cv.png()
 
 
@@ -353,11 +392,18 @@ def _sign_png(kit: Kit, kind: str, spec: SignKindKit, text: str) -> bytes:
     return png_bytes(img)
 
 
+def tile_textures(
+    kit: Kit, tile_keys: set[tuple[str, int]], marking: Marking = KIT_MARKING
+) -> dict[str, bytes]:
+    """PNG bytes by texture name of the tiles (type, lanes), painted with marking."""
+    return {tiles.texture_name(t, n): _tile_png(kit, t, n, marking) for t, n in sorted(tile_keys)}
+
+
 def generate(
     kit: Kit, tile_keys: set[tuple[str, int]], sign_keys: set[tuple[str, str]]
 ) -> dict[str, bytes]:
     """PNG bytes by texture name: the tiles (type, lanes) and the signs (kind, texture name)."""
-    out = {tiles.texture_name(t, n): _tile_png(kit, t, n) for t, n in sorted(tile_keys)}
+    out = tile_textures(kit, tile_keys)
     for kind, name in sorted(sign_keys):
         spec = kit.sign.kinds[kind]
         text = name.rsplit("_", 1)[1] if kind == "speed_limit" else spec.text
