@@ -130,6 +130,8 @@ static void options_usage_sensors(FILE *f) {
       "                      full; compare: both, the cached one published (--bench reports\n"
       "                      their times and how their pixels differ)\n"
       "  --camera-fps F      camera frame rate in sim time (default 30)\n"
+      "  --texture-dir DIR   the map's textures from DIR/textures/ instead of its own folder's\n"
+      "                      (a road style: tools/pilot's domain randomisation)\n"
       "  --light-level X     scene light level 0..1 (1 = day) instead of the map's own\n"
       "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
       "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
@@ -317,6 +319,9 @@ static int options_world(app_options_t *o, const char *a, const char *v) {
       snprintf(o->map, sizeof o->map, "%s", v);
     else
       snprintf(o->map, sizeof o->map, "%s/%s.xml", AUTODRIVE_MAPS_DIR, v);
+    return 1;
+  } else if (!strcmp(a, "--texture-dir") && v) {
+    o->cfg.texture_dir = v;
     return 1;
   } else if (!strcmp(a, "--params") && v) {
     snprintf(o->params, sizeof o->params, "%s", v);

@@ -24,6 +24,9 @@ extern "C" {
 typedef struct sim_config {
   const char *params_path; /* vehicle parameter file */
   const char *map_path;    /* map MJCF */
+  /* NULL: the map's textures; else a folder whose textures/ replaces the map's folder's (a
+   * road style of domain randomisation, autodrive.maps.road_styles) */
+  const char *texture_dir;
   const char *run_dir;     /* ptys' symlinks and the generated scene go here */
   int cars;                /* 1..SIM_MAX_CARS */
   uint64_t seed;           /* IMU biases and noise */

@@ -64,6 +64,16 @@ int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) 
   if (sim_check_map(s, map_abs, !cfg->no_map_late_boxes, err, err_sz) != 0) return -1;
   mjcf_gen_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
   o.map_path = map_abs;
+  char tex_abs[4096];
+  if (cfg->texture_dir) {
+    char probe[4200];
+    snprintf(probe, sizeof probe, "%s/textures", cfg->texture_dir);
+    if (!realpath(cfg->texture_dir, tex_abs) || access(probe, R_OK | X_OK) != 0)
+      return sim_fail(err, err_sz, "--texture-dir '%s': no readable textures/ folder in it (%s)",
+                      cfg->texture_dir, strerror(errno));
+    strcat(tex_abs, "/");
+    o.texture_dir = tex_abs;
+  }
   char *asset = NULL, **geoms = NULL;
   int rc = sim_tag_snippets(s, cfg->cars, &asset, &geoms, err, err_sz);
   o.tag_asset_xml = asset;
