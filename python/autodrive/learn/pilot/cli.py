@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from autodrive.core import seeds
+from autodrive.maps import road_styles
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.learn.pilot.dagger import ROLLOUT_SEED_OFFSET, TAKEOVER_MARGIN_M, DaggerConfig
 from autodrive.learn.pilot.expert import ExpertRun
@@ -58,6 +59,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     e.add_argument("--camera-noise", type=float, default=2.0, help="sigma [8-bit levels]")
     e.add_argument("--light-level", type=float, default=1.0, help="0..1 (1: day)")
+    e.add_argument("--camera-blur", type=float, default=0.0, help="Gaussian sigma [px]")
+    e.add_argument(
+        "--road-style", choices=("kit", "random"), default="kit",
+        help="kit: the map's own lines and asphalt; random: the lines' colours, dashes and the "
+        "asphalt's tone drawn from --seed (domain randomisation, autodrive.maps.road_styles)",
+    )  # fmt: skip
     e.add_argument(
         "--duration", type=float, default=0.0,
         help="[s] of sim time: stop there (0: when the laps are done); the run is the same up to it",
@@ -210,7 +217,8 @@ def _run(args: argparse.Namespace) -> int:
             map=args.map, route=args.route, lane_shift=args.lane_shift, laps=args.laps,
             seed=args.seed, speed=args.speed,
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
-            light_level=args.light_level, duration_s=args.duration,
+            light_level=args.light_level, duration_s=args.duration, camera_blur=args.camera_blur,
+            road_style=road_styles.draw(args.seed) if args.road_style == "random" else None,
         )  # fmt: skip
         wall = record_expert(run, args.out, _build(), args.lcm_url)
         print(f"pilot expert: {args.out} in {wall:.0f} s wall")

@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from autodrive.core import lcmtypes, seeds
+from autodrive.maps import road_styles
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.core.proc import die_with_parent, stop
 
@@ -40,6 +41,8 @@ class ExpertRun:
     light_level: float = 1.0  # day
     camera_blur: float = 0.0  # Gaussian blur sigma [px] of the rendered frames (0: none)
     duration_s: float = 0.0  # [s] of sim time: stop early (0: when the laps are done)
+    # how the road is painted (domain randomisation; None: the map's own textures)
+    road_style: road_styles.RoadStyle | None = None
 
 
 def meta_path(log: Path) -> Path:
@@ -61,7 +64,9 @@ def sim_binary(build: Path) -> Path:
     return b
 
 
-def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
+def sim_argv(
+    run: ExpertRun, build: Path, url: str, run_dir: Path, texture_dir: Path | None = None
+) -> list[str]:
     script = (
         f"route:{run.route},speed={run.speed:g},lookahead={run.lookahead_m:g},"
         f"laps={run.laps},perturb={run.perturb:g}"
@@ -75,6 +80,7 @@ def sim_argv(run: ExpertRun, build: Path, url: str, run_dir: Path) -> list[str]:
         "--camera-noise", f"{run.camera_noise:g}",
         "--light-level", f"{run.light_level:g}",
         *(["--camera-blur", f"{run.camera_blur:g}"] if run.camera_blur > 0 else []),
+        *(["--texture-dir", str(texture_dir)] if texture_dir else []),
         "--script", script,
         "--seed", str(run.seed),
         "--lcm-url", url,
@@ -94,7 +100,10 @@ def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: s
     url = url or default_url()
     t0 = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="pilot-expert-") as tmp:
-        argv = sim_argv(run, build, url, Path(tmp) / "run")
+        tex = None
+        if run.road_style is not None:
+            tex = road_styles.write_texture_dir(run.map, run.road_style, Path(tmp) / "road")
+        argv = sim_argv(run, build, url, Path(tmp) / "run", tex)
         logger = subprocess.Popen(
             [*lcmtypes.logger_argv(url, "--channel=.*"), str(log)],
             stdout=subprocess.DEVNULL,
