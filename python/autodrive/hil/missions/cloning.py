@@ -14,6 +14,7 @@ driven the other way: its own points in reverse order, from the normal start tur
 referee on that same lane). More, not among issue 16's (issue 38's roads never trained on):
 other-lane (loop_cw, the road's inner lane driven clockwise: tighter curves than any recorded),
 other-lane-reverse (the inner lane counter-clockwise: loop_cw's points driven the other way),
+other-lane-night and other-lane-noise2x (loop_cw at night, and with twice the noise),
 tiny-town (Tiny Town's loop_ccw: another map of the same kit, parked cars and props beside the
 road; the map's late obstacles left out, as in every condition) and intersection (Intersection School's south_to_north, straight through the junction,
 where the lane lines end: not a loop, so its "laps" is the fraction of the route driven, from
@@ -65,13 +66,18 @@ ROUTES = {
     "reverse": (MAP, TRAINED_ROUTE, True),
     "other-lane": (MAP, "loop_cw", False),
     "other-lane-reverse": (MAP, "loop_cw", True),
+    "other-lane-night": (MAP, "loop_cw", False),
+    "other-lane-noise2x": (MAP, "loop_cw", False),
     "tiny-town": ("tiny_town", "loop_ccw", False),
     "intersection": ("intersection_school", "south_to_north", False),
 }
 CONDITIONS = tuple(ROUTES)
 UNSEEN = ("night", "noise2x", "reverse")  # issue 16's conditions not in the training data
 # unseen too, not among issue 16's: issue 38's roads never trained on
-EXTRA = ("other-lane", "other-lane-reverse", "tiny-town", "intersection")
+EXTRA = (
+    "other-lane", "other-lane-reverse", "other-lane-night", "other-lane-noise2x", "tiny-town",
+    "intersection",
+)  # fmt: skip
 # a route that is not a loop is driven from its start to this far before its end [m] (the
 # car needs room to stop inside the lane; its "laps" is the fraction of that part driven)
 ROUTE_END_MARGIN_M = 0.4
@@ -108,6 +114,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         f"night (light level {NIGHT_LIGHT_LEVEL}), noise2x (twice the training's camera noise), "
         f"reverse ({TRAINED_ROUTE}'s own lane driven the other way), other-lane (loop_cw: the "
         "road's inner lane, clockwise), other-lane-reverse (the inner lane counter-clockwise), "
+        "other-lane-night and other-lane-noise2x (the inner lane clockwise at night, with twice "
+        "the noise), "
         "tiny-town (Tiny Town's loop_ccw), intersection (Intersection School's south_to_north "
         "through the junction, once: --laps 1)",
     )
@@ -223,7 +231,7 @@ def sim_argv(
     # has no answer to a box in the lane, the referee would count the car stopped behind it
     argv += ["--no-late-obstacles"]
     noise = trained(Path(args.model), "camera_noise", DEFAULT_TRAINED_NOISE)
-    if args.condition == "noise2x":
+    if args.condition.endswith("noise2x"):
         noise *= 2.0
     # a DAgger rollout's domain randomisation (tools/pilot dagger) sets these; a mission doesn't
     noise = float(getattr(args, "camera_noise", None) or noise)
@@ -231,7 +239,9 @@ def sim_argv(
         argv += ["--camera-noise", noise]
     if getattr(args, "camera_blur", None):
         argv += ["--camera-blur", float(args.camera_blur)]
-    if args.condition == "night":
+    if getattr(args, "texture_dir", None):  # a DAgger rollout's road style
+        argv += ["--texture-dir", Path(args.texture_dir)]
+    if args.condition.endswith("night"):
         argv += ["--light-level", NIGHT_LIGHT_LEVEL]
     elif getattr(args, "light_level", None) is not None:
         argv += ["--light-level", float(args.light_level)]
