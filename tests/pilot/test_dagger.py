@@ -186,3 +186,11 @@ def test_new_conditions_from_maps() -> None:
         cloning.drivable_m(junction, junction.length_m)
     for c in ("other-lane-reverse", "tiny-town", "intersection"):
         assert c in cloning.EXTRA and cloning.parse_args(["--condition", c]).condition == c
+
+
+def test_road_styles_are_opt_in_and_in_the_command() -> None:
+    # off by default: the recorded recipes' figures were measured on the kit's markings
+    plain, styled = dagger.DaggerConfig(), dagger.DaggerConfig(road_styles=True)
+    assert not plain.road_styles
+    assert "--road-styles" in dagger.command_line(styled, Path("o"), Path("w"), None)
+    assert "--road-styles" not in dagger.command_line(plain, Path("o"), Path("w"), None)

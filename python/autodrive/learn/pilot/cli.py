@@ -191,6 +191,11 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     g.add_argument("--no-randomise", action="store_true",
                    help="no domain randomisation (simulator or image level)")  # fmt: skip
+    g.add_argument(
+        "--road-styles", action="store_true",
+        help="each recording's and rollout's road markings drawn from its seed (centre and "
+        "edge lines' colour and dashing, the asphalt's tone: autodrive.maps.road_styles)",
+    )  # fmt: skip
     g.add_argument("--threads", type=int, default=dd.threads, help="PyTorch threads")
     g.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
@@ -255,7 +260,7 @@ def _run(args: argparse.Namespace) -> int:
             rollout_laps=args.rollout_laps, epochs=args.epochs,
             samples_per_epoch=args.samples_per_epoch, train_seed=args.train_seed,
             takeover_margin_m=args.takeover_margin, randomise=not args.no_randomise,
-            threads=args.threads, name=args.name,
+            road_styles=args.road_styles, threads=args.threads, name=args.name,
         )  # fmt: skip
         run_dagger(dcfg, args.out, args.work, _build(), args.logs, args.lcm_url)
         return 0

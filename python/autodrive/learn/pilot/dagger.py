@@ -16,8 +16,8 @@ Autonomy per round is the rollout's, scored honestly (round_score): the laps mus
 (else 0), a stall (6 s of sim time under 5 cm of progress, lane_watch.StallWatch) and a takeover
 count as interventions. Seeded and repeatable: the expert's laps on S (and S + 1), round r's
 rollout on S + ROLLOUT_SEED_OFFSET + r, all training seeds; the simulator's domain randomisation
-(SimRandom: light level, camera noise and blur per recording) is drawn from each recording's
-seed; training is seeded by --train-seed (numpy, torch, the draws, the image-level
+(SimRandom: light level, camera noise and blur per recording; with --road-styles the road's
+markings, road_styles.draw) is drawn from each recording's seed; training is seeded by --train-seed (numpy, torch, the draws, the image-level
 randomisation, augment.Randomise)."""
 
 from __future__ import annotations
@@ -39,6 +39,7 @@ from autodrive.core.proc import cpu_s
 from autodrive.core import seeds
 from autodrive.learn.pilot import dataset
 from autodrive.learn.pilot.expert import ExpertRun, meta_path
+from autodrive.maps import road_styles
 
 # The expert takes over where a wheel's outer edge comes within this of the lane bound [m]:
 # before the car leaves the lane (a wheel over it is the referee's intervention), late enough
@@ -83,6 +84,9 @@ class DaggerConfig:
     train_seed: int = 0
     takeover_margin_m: float = TAKEOVER_MARGIN_M
     randomise: bool = True  # the simulator's (SimRandom) and the image-level (augment.Randomise)
+    # each recording's road markings drawn from its seed (road_styles.draw); off in the
+    # recorded recipes, whose figures were measured on the kit's markings
+    road_styles: bool = False
     threads: int = 1  # PyTorch threads (the machine's 2 cores are shared)
     name: str = "dagger"
 
@@ -239,6 +243,8 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
     from autodrive.learn.pilot.expert import default_url
 
     seed = rollout_seed(cfg.seed, round_)
+    style = road_styles.draw(seed) if cfg.road_styles else None
+    tex = road_styles.write_texture_dir(cloning.MAP, style, work / "road") if style else None
     out = work / "rollout"
     logf = work / "rollout.lcmlog"
     args = argparse.Namespace(
@@ -248,7 +254,7 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
         lcm_url=lcm_url or default_url(0),
         takeover_margin_m=cfg.takeover_margin_m, log=logf,
         light_level=rand.get("light_level"), camera_noise=rand.get("camera_noise"),
-        camera_blur=rand.get("camera_blur"),
+        camera_blur=rand.get("camera_blur"), texture_dir=tex,
     )  # fmt: skip
     log(f"round {round_}: rollout of {model} on seed {seed} ({json.dumps(rand)})")
     code = cloning.run(args, console=sys.stderr)
@@ -266,6 +272,7 @@ def _rollout(cfg: DaggerConfig, model: Path, work: Path, build: Path, round_: in
         "takeover_margin_m": cfg.takeover_margin_m, "model": str(model),
         "model_sha256": sha256_file(model), "randomisation": rand or None,
         "speed": None, "perturb": 0.0,
+        "road_style": road_styles.as_record(style) if style else None,
     }  # fmt: skip
     meta_path(logf).write_text(json.dumps(meta, indent=2) + "\n")
     return logf, rep
@@ -305,6 +312,7 @@ def run_dagger(
             run = ExpertRun(
                 laps=laps, seed=s, camera_noise=rand.get("camera_noise", 2.0),
                 light_level=rand.get("light_level", 1.0), camera_blur=rand.get("camera_blur", 0.0),
+                road_style=road_styles.draw(s) if cfg.road_styles else None,
             )  # fmt: skip
             logf = r0 / f"expert_seed{s}.lcmlog"
             log(f"round 0: the expert, {laps} lap(s) on seed {s} ({json.dumps(rand)})")
@@ -388,6 +396,8 @@ def command_line(cfg: DaggerConfig, out: Path, work: Path, logs: list[Path] | No
             parts.append(f"{flag} {getattr(cfg, key)}")
     if not cfg.randomise:
         parts.append("--no-randomise")
+    if cfg.road_styles:
+        parts.append("--road-styles")
     if logs and all(p.parent != work / "round0" for p in logs):
         parts.append("--logs " + " ".join(map(str, logs)))
     return " ".join(parts)
@@ -401,7 +411,8 @@ def report_md(r: dict[str, Any]) -> str:
         f"`{r['command']}`: {c['rounds']} rounds after round 0, seed {c['seed']} (rollouts on "
         f"seed + {ROLLOUT_SEED_OFFSET} + round), {c['rollout_laps']} lap(s) a rollout, takeover "
         f"margin {c['takeover_margin_m']} m, {c['epochs']} epochs of {c['samples_per_epoch']} "
-        f"draws, train seed {c['train_seed']}, randomisation {'on' if c['randomise'] else 'off'}.",
+        f"draws, train seed {c['train_seed']}, randomisation {'on' if c['randomise'] else 'off'}, "
+        f"road styles {'on' if c.get('road_styles') else 'off'}.",
         f"Whole run: {r['wall_s']:.0f} s wall, {r['cpu_s']:.0f} s CPU (load {r['load_avg_end']} "
         "at the end; the machine is shared: the wall time includes other jobs').",
         "",
