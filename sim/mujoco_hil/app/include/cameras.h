@@ -26,7 +26,7 @@ typedef struct cameras {
   int cam_id[CAMERAS_MAX];
   char channel[CAMERAS_MAX][48], info_channel[CAMERAS_MAX][48];
   int64_t next_info_us;
-  cfx_t fx[CAMERAS_MAX]; /* --camera-noise / --camera-blur, seeded per camera */
+  cfx_t fx[CAMERAS_MAX]; /* --camera-noise / -blur / -exposure, seeded per camera */
   int eye[CAMERAS_MAX];  /* 1: an overhead camera (its render timed, per eye_render) */
   int eye_render;        /* CAMERAS_RENDER_* */
   uint8_t *full_rgb;     /* compare: the full render of the camera at hand */
@@ -37,8 +37,10 @@ typedef struct cameras {
  * CAMERAS_RENDER_*). */
 int cameras_open(cameras_t *k, const sim_t *s, int cameras, int eye, int eye_render, char *err,
                  size_t err_sz);
-/* Noise and blur on every camera: each its own seeded noise stream. */
-void cameras_set_effects(cameras_t *k, double noise, double blur_px, uint64_t seed);
+/* Noise and blur on every camera: each its own seeded noise stream; exposure_ev [EV] on the
+ * cars' cameras only (the Eye's are fixed installations with their own exposure). */
+void cameras_set_effects(cameras_t *k, double noise, double blur_px, double exposure_ev,
+                         uint64_t seed);
 /* --camera-scale: the render scale of the cars' cameras (sim_camera_set_render_scale); the
  * overhead Eye cameras keep theirs (the Eye's detections are measured at full size). */
 void cameras_set_render_scale(cameras_t *k, double scale);

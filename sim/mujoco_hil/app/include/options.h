@@ -38,6 +38,9 @@ typedef struct app_options {
   int eye_sync_wait_given;
   int eye_render; /* --eye-render: CAMERAS_RENDER_CACHED, _FULL or _COMPARE (cameras.h) */
   double camera_fps, light_level, camera_noise, camera_blur;
+  double light_rgb[3];          /* --light-rgb: gain per channel, 1 1 1 when not given */
+  double camera_exposure;       /* --camera-exposure [EV], 0: none */
+  double jitter_mm, jitter_deg; /* --camera-jitter: the front mounts' tolerance [mm], [deg] */
   double camera_scale; /* the cars' cameras' render scale per side, SIM_CAMERA_MIN_SCALE..1 */
   scn_pose_t starts[SIM_MAX_CARS]; /* --start, once for car 1 or once per car */
   int nstarts;

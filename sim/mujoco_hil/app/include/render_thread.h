@@ -35,7 +35,7 @@ typedef struct render_thread {
   int head, queued;                        /* next to render; queued (the one in hand included) */
   int stop, opened, failed;                /* opened: 1 ok, -1 failed */
   int cameras, eye, eye_render;            /* cameras_open's arguments */
-  double noise, blur_px;
+  double noise, blur_px, exposure_ev;
   double scale; /* the cars' cameras' render scale: --camera-scale, then the thread's own copy
                    of the last snapshot's (frame_scale) */
   uint64_t seed;
@@ -44,7 +44,7 @@ typedef struct render_thread {
 } render_thread_t;
 
 /* Starts the thread, which opens the cameras (t->cameras, t->eye, effects from t->noise,
- * t->blur_px, t->seed) and waits for snapshots. */
+ * t->blur_px, t->exposure_ev, t->seed) and waits for snapshots. */
 int render_thread_start(render_thread_t *t, sim_t *s, lcm_t *lcm, char *err, size_t err_sz);
 /* The state at frame time now_us to the render thread's queue, unless it is full, to be
  * rendered with the cars' cameras at render scale scale (the View section's Cam scale can change

@@ -12,9 +12,11 @@ static void cameras_filter(uint8_t *rgb, int w, int h, void *ctx) {
   cfx_apply(ctx, rgb, w, h);
 }
 
-void cameras_set_effects(cameras_t *k, double noise, double blur_px, uint64_t seed) {
+void cameras_set_effects(cameras_t *k, double noise, double blur_px, double exposure_ev,
+                         uint64_t seed) {
   for (int i = 0; i < k->n; i++) {
     cfx_init(&k->fx[i], noise, blur_px, seed * 2654435761ull + (uint64_t)i);
+    if (!k->eye[i]) cfx_set_exposure(&k->fx[i], exposure_ev);
     if (cfx_active(&k->fx[i])) sim_camera_set_filter(k->cam[i], cameras_filter, &k->fx[i]);
   }
 }

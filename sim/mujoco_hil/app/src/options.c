@@ -136,13 +136,23 @@ static void options_usage_sensors(FILE *f) {
       "  --camera-noise S    Gaussian noise on rendered frames, sigma S [8-bit levels, 0..%g]\n"
       "  --camera-blur PX    Gaussian blur on rendered frames, sigma PX [px, 0..%g]\n"
       "                      (noise and blur are seeded by --seed: a run repeats)\n"
+      "  --light-rgb R,G,B   the lights' colour: a gain per channel (%g..%g) on every light's\n"
+      "                      diffuse and specular colour (with --light-level too)\n"
+      "  --camera-exposure EV\n"
+      "                      the cars' camera frames x 2^EV (EV %g..%g), clipped at 255 as a\n"
+      "                      sensor clips, before blur and noise (the Eye's cameras stay)\n"
+      "  --camera-jitter MM,DEG\n"
+      "                      each car's front camera mount moved by up to +-MM [mm, 0..%g] per\n"
+      "                      axis and turned by up to +-DEG [deg, 0..%g] about each, drawn once\n"
+      "                      from --seed and the car (printed at start; intrinsics stay)\n"
       "  --camera-scale S    render the cars' cameras at S x their size per side and stretch\n"
       "                      the frames back (%g..1, default 1: a slow machine's trade of\n"
       "                      sharpness for render time; the Eye's cameras stay full)\n"
       "  --tyre-model M      paper or mujoco (default: the parameter file's)\n"
       "  --truth-log FILE    also write every ground-truth message to FILE (determinism checks)\n",
       EYE_SYNC_WAIT_MIN_S, EYE_SYNC_WAIT_MAX_S, EYE_SYNC_LOST_S, EYE_SYNC_FIRST_S, CFX_MAX_NOISE,
-      CFX_MAX_BLUR_PX, SIM_CAMERA_MIN_SCALE);
+      CFX_MAX_BLUR_PX, CFX_MIN_LIGHT_GAIN, CFX_MAX_LIGHT_GAIN, -CFX_MAX_EXPOSURE_EV,
+      CFX_MAX_EXPOSURE_EV, CFX_MAX_JITTER_MM, CFX_MAX_JITTER_DEG, SIM_CAMERA_MIN_SCALE);
 }
 
 /* --help, part 4: the outputs (bench, window, video, record), channels, exit status. */
@@ -222,6 +232,26 @@ static int options_number(const char *opt, const char *v, double lo, double hi, 
   return 0;
 }
 
+/* n comma-separated numbers, each in [lo[k], hi[k]] (what names them in the message). */
+static int options_numbers(const char *opt, const char *v, int n, const double *lo,
+                           const double *hi, const char *what, double *out) {
+  const char *p = v;
+  int k = 0;
+  for (; p && k < n; k++) {
+    char *end;
+    errno = 0;
+    const double x = strtod(p, &end);
+    if (end == p || errno || !isfinite(x) || x < lo[k] || x > hi[k]) break;
+    out[k] = x;
+    if (k + 1 < n && *end != ',') break;
+    if (k + 1 == n && *end) break;
+    p = end + 1;
+  }
+  if (p && k == n) return 0;
+  fprintf(stderr, "autodrive-sim: %s '%s': expected %s\n", opt, v ? v : "", what);
+  return -1;
+}
+
 static void options_defaults(app_options_t *o) {
   memset(o, 0, sizeof *o);
   snprintf(o->params, sizeof o->params, "%s/vehicle/nigel.params", AUTODRIVE_ROOT_DIR);
@@ -243,6 +273,7 @@ static void options_defaults(app_options_t *o) {
   o->camera_fps = 30.0;
   o->eye_sync_wait_s = EYE_SYNC_LOST_S;
   o->light_level = -1.0;
+  o->light_rgb[0] = o->light_rgb[1] = o->light_rgb[2] = 1.0;
   o->camera_scale = 1.0;
   o->rtf = 1.0;
 }
@@ -423,6 +454,8 @@ static int options_run(app_options_t *o, const char *a, const char *v) {
   return 0;
 }
 
+static int options_randomise(app_options_t *o, const char *a, const char *v);
+
 /* What is rendered and published: LIDAR on LCM, cameras, the Eye, the window, camera effects. */
 static int options_output(app_options_t *o, const char *a, const char *v) {
   if (!strcmp(a, "--no-lidar-lcm")) {
@@ -487,6 +520,35 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
     return options_number(a, v, 0, CFX_MAX_BLUR_PX, &o->camera_blur) ? OPTIONS_BAD : 1;
   } else if (!strcmp(a, "--camera-scale")) {
     return options_number(a, v, SIM_CAMERA_MIN_SCALE, 1, &o->camera_scale) ? OPTIONS_BAD : 1;
+  } else {
+    return options_randomise(o, a, v);
+  }
+  return 0;
+}
+
+/* Domain randomisation beyond noise and blur: light colour, exposure, mount jitter. */
+static int options_randomise(app_options_t *o, const char *a, const char *v) {
+  if (!strcmp(a, "--light-rgb")) {
+    static const double lo[3] = {CFX_MIN_LIGHT_GAIN, CFX_MIN_LIGHT_GAIN, CFX_MIN_LIGHT_GAIN};
+    static const double hi[3] = {CFX_MAX_LIGHT_GAIN, CFX_MAX_LIGHT_GAIN, CFX_MAX_LIGHT_GAIN};
+    char what[96];
+    snprintf(what, sizeof what, "R,G,B, each a gain in [%g, %g]", CFX_MIN_LIGHT_GAIN,
+             CFX_MAX_LIGHT_GAIN);
+    return options_numbers(a, v, 3, lo, hi, what, o->light_rgb) ? OPTIONS_BAD : 1;
+  } else if (!strcmp(a, "--camera-exposure")) {
+    return options_number(a, v, -CFX_MAX_EXPOSURE_EV, CFX_MAX_EXPOSURE_EV, &o->camera_exposure)
+               ? OPTIONS_BAD
+               : 1;
+  } else if (!strcmp(a, "--camera-jitter")) {
+    static const double lo[2] = {0, 0}, hi[2] = {CFX_MAX_JITTER_MM, CFX_MAX_JITTER_DEG};
+    char what[96];
+    snprintf(what, sizeof what, "MM,DEG with MM in [0, %g] mm and DEG in [0, %g] deg",
+             CFX_MAX_JITTER_MM, CFX_MAX_JITTER_DEG);
+    double mm_deg[2];
+    if (options_numbers(a, v, 2, lo, hi, what, mm_deg)) return OPTIONS_BAD;
+    o->jitter_mm = mm_deg[0];
+    o->jitter_deg = mm_deg[1];
+    return 1;
   } else {
     return OPTIONS_UNKNOWN;
   }

@@ -8,7 +8,7 @@ static void *render_thread_run(void *arg) {
   char err[256] = "";
   int rc = cameras_open(&t->cams, t->s, t->cameras, t->eye, t->eye_render, err, sizeof err);
   if (rc == 0) {
-    cameras_set_effects(&t->cams, t->noise, t->blur_px, t->seed);
+    cameras_set_effects(&t->cams, t->noise, t->blur_px, t->exposure_ev, t->seed);
     cameras_set_render_scale(&t->cams, t->scale);
   }
   pthread_mutex_lock(&t->mu);

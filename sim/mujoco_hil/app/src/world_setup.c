@@ -57,6 +57,30 @@ static int app_check_starts(app_t *a, char *err, size_t err_sz) {
   return bad_starts || sim_check_scenario(a->sim, err, err_sz) != 0 ? -1 : 0;
 }
 
+/* --light-rgb on the render model's lights, and --camera-jitter on each car's front camera
+ * mount (drawn from --seed and the car; printed, so a dataset can record it). */
+static void app_randomise_scene(app_t *a) {
+  const app_options_t *o = a->opt;
+  mjModel *m = sim_render_model(a->sim);
+  if (o->light_rgb[0] != 1.0 || o->light_rgb[1] != 1.0 || o->light_rgb[2] != 1.0)
+    cfx_set_light_rgb(m, o->light_rgb);
+  if (!(o->jitter_mm > 0 || o->jitter_deg > 0)) return;
+  for (int c = 1; c <= sim_cars(a->sim); c++) {
+    char name[48];
+    snprintf(name, sizeof name, "nigel%d/cam_front", c);
+    const int id = mj_name2id(m, mjOBJ_CAMERA, name);
+    if (id < 0) continue;
+    const cfx_jitter_t j = cfx_jitter_draw(o->cfg.seed, c, o->jitter_mm, o->jitter_deg);
+    cfx_jitter_camera(m, id, &j);
+    printf(AUTODRIVE_VEHICLE_PREFIX
+           "%d cam_front jitter (--camera-jitter): x %+.3f, y %+.3f, z %+.3f mm; about x %+.3f, "
+           "y %+.3f, z %+.3f deg\n",
+           c, 1e3 * j.pos_m[0], 1e3 * j.pos_m[1], 1e3 * j.pos_m[2], j.rot_deg[0], j.rot_deg[1],
+           j.rot_deg[2]);
+  }
+  fflush(stdout);
+}
+
 /* The world itself: LCM, the truth log, the sim, its start poses and light level. */
 static int app_build_world(app_t *a, char *err, size_t err_sz) {
   const app_options_t *o = a->opt;
@@ -91,6 +115,7 @@ static int app_build_world(app_t *a, char *err, size_t err_sz) {
             o->light_level, o->cfg.map_path);
     return 2;
   }
+  app_randomise_scene(a);
   return -1;
 }
 
@@ -106,6 +131,7 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
   render.eye_render = o->eye_render;
   render.noise = o->camera_noise;
   render.blur_px = o->camera_blur;
+  render.exposure_ev = o->camera_exposure;
   render.scale = o->camera_scale;
   render.seed = o->cfg.seed;
   if (threaded
@@ -115,7 +141,7 @@ static int app_build_cameras(app_t *a, char *err, size_t err_sz) {
     return 1;
   }
   if (threaded) a->render = &render;
-  cameras_set_effects(&a->cams, o->camera_noise, o->camera_blur, o->cfg.seed);
+  cameras_set_effects(&a->cams, o->camera_noise, o->camera_blur, o->camera_exposure, o->cfg.seed);
   cameras_set_render_scale(&a->cams, o->camera_scale);
   a->camera_scale = o->camera_scale;
   a->cam_period_us = (int64_t)llround(1e6 / o->camera_fps);

@@ -28,11 +28,55 @@ int cfx_set_light_level(mjModel *m, double level) {
   return 0;
 }
 
+void cfx_set_light_rgb(mjModel *m, const double gain_rgb[3]) {
+  for (int c = 0; c < 3; c++) {
+    const float k = (float)gain_rgb[c];
+    m->vis.headlight.diffuse[c] *= k;
+    m->vis.headlight.specular[c] *= k;
+    for (int i = 0; i < m->nlight; i++) {
+      m->light_diffuse[3 * i + c] *= k;
+      m->light_specular[3 * i + c] *= k;
+    }
+  }
+}
+
+cfx_jitter_t cfx_jitter_draw(uint64_t seed, int car, double mm, double deg) {
+  rng_t r;
+  /* a stream of its own: not the IMU's, the noise's or another car's */
+  rng_seed(&r, (seed ^ 0x6a177e5ull) * 0x9E3779B97F4A7C15ull + (uint64_t)car);
+  cfx_jitter_t j;
+  for (int a = 0; a < 3; a++) j.pos_m[a] = (2.0 * rng_uniform(&r) - 1.0) * mm * 1e-3;
+  for (int a = 0; a < 3; a++) j.rot_deg[a] = (2.0 * rng_uniform(&r) - 1.0) * deg;
+  return j;
+}
+
+void cfx_jitter_camera(mjModel *m, int cam_id, const cfx_jitter_t *j) {
+  for (int a = 0; a < 3; a++) m->cam_pos[3 * cam_id + a] += j->pos_m[a];
+  /* q = qz * qy * qx * q_cam: about the car's x, then y, then z (fixed axes) */
+  mjtNum q[4] = {1, 0, 0, 0};
+  for (int a = 0; a < 3; a++) {
+    const double h = 0.5 * j->rot_deg[a] * (M_PI / 180.0);
+    mjtNum qa[4] = {cos(h), 0, 0, 0}, t[4];
+    qa[1 + a] = sin(h);
+    mju_mulQuat(t, qa, q);
+    mju_copy4(q, t);
+  }
+  mjtNum *cq = m->cam_quat + 4 * cam_id, out[4];
+  mju_mulQuat(out, q, cq);
+  mju_normalize4(out);
+  mju_copy4(cq, out);
+}
+
 void cfx_init(cfx_t *f, double noise_sigma, double blur_px, uint64_t seed) {
   memset(f, 0, sizeof *f);
   f->noise_sigma = noise_sigma;
   f->blur_px = blur_px;
+  f->gain = 1.0;
   rng_seed(&f->rng, seed);
+}
+
+void cfx_set_exposure(cfx_t *f, double ev) {
+  f->gain = exp2(ev);
 }
 
 void cfx_free(cfx_t *f) {
@@ -41,7 +85,7 @@ void cfx_free(cfx_t *f) {
 }
 
 int cfx_active(const cfx_t *f) {
-  return f->noise_sigma > 0 || f->blur_px > 0;
+  return f->noise_sigma > 0 || f->blur_px > 0 || f->gain != 1.0;
 }
 
 /* One pass of the separable Gaussian along x (dx = 3) or y (dx = 3 w), edges clamped. */
@@ -85,6 +129,13 @@ static void cfx_blur(cfx_t *f, uint8_t *rgb, int w, int h) {
 }
 
 void cfx_apply(cfx_t *f, uint8_t *rgb, int w, int h) {
+  if (f->gain != 1.0) { /* the sensor's exposure: brighter saturates at 255 */
+    const size_t n = (size_t)w * (size_t)h * 3;
+    for (size_t i = 0; i < n; i++) {
+      const double v = rgb[i] * f->gain;
+      rgb[i] = (uint8_t)lround(v > 255 ? 255 : v);
+    }
+  }
   if (f->blur_px > 0) cfx_blur(f, rgb, w, h);
   if (f->noise_sigma > 0) {
     const size_t n = (size_t)w * (size_t)h * 3;
