@@ -51,9 +51,13 @@ static void options_usage_world(FILE *f) {
       "                      place after it was mapped. With R [m], not before car 1's\n"
       "                      base_link is within R of it (one stepping out in front of\n"
       "                      the car). Up to %d; LIDAR, cameras and the collision flag\n"
-      "                      see it once it is there\n",
+      "                      see it once it is there\n"
+      "  --distractors N     N (0..%d) static cones, boxes and parked-car-sized boxes placed\n"
+      "                      from --seed beside the road: off every lane, clear of the cars'\n"
+      "                      starts, the map's obstacles and each other (an error when the\n"
+      "                      map has no room); cameras and LIDAR see them\n",
       SIM_MAX_CARS, AUTODRIVE_ROOT_DIR, SCN_LATE_BOX_HALF_DEFAULT_M, SCN_LATE_BOX_HEIGHT_M,
-      SCN_MAX_LATE_BOXES);
+      SCN_MAX_LATE_BOXES, SIM_MAX_DISTRACTORS);
 }
 
 /* --help, part 2: how the run keeps time, its bus, run dir and driver. */
@@ -526,8 +530,9 @@ static int options_output(app_options_t *o, const char *a, const char *v) {
   return 0;
 }
 
-/* Domain randomisation beyond noise and blur: light colour, exposure, mount jitter. */
+/* Domain randomisation beyond noise and blur: light colour, exposure, mount jitter, distractors. */
 static int options_randomise(app_options_t *o, const char *a, const char *v) {
+  double x = 0;
   if (!strcmp(a, "--light-rgb")) {
     static const double lo[3] = {CFX_MIN_LIGHT_GAIN, CFX_MIN_LIGHT_GAIN, CFX_MIN_LIGHT_GAIN};
     static const double hi[3] = {CFX_MAX_LIGHT_GAIN, CFX_MAX_LIGHT_GAIN, CFX_MAX_LIGHT_GAIN};
@@ -548,6 +553,15 @@ static int options_randomise(app_options_t *o, const char *a, const char *v) {
     if (options_numbers(a, v, 2, lo, hi, what, mm_deg)) return OPTIONS_BAD;
     o->jitter_mm = mm_deg[0];
     o->jitter_deg = mm_deg[1];
+    return 1;
+  } else if (!strcmp(a, "--distractors")) {
+    if (options_number(a, v, 0, SIM_MAX_DISTRACTORS, &x) || x != floor(x)) {
+      if (x != floor(x))
+        fprintf(stderr, "autodrive-sim: --distractors '%s': expected a whole number in [0, %d]\n",
+                v, SIM_MAX_DISTRACTORS);
+      return OPTIONS_BAD;
+    }
+    o->cfg.distractors = (int)x;
     return 1;
   } else {
     return OPTIONS_UNKNOWN;

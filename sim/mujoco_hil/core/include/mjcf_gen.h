@@ -22,6 +22,16 @@
 extern "C" {
 #endif
 
+/* A distractor (--distractors): world geom scenario/distractor<k>, parked at MG_PARKED_Z_M
+ * like a late box until the sim puts it beside the road. */
+typedef enum { MG_CONE, MG_BOX, MG_PARKED_CAR } mjcf_gen_distractor_kind_t;
+typedef struct mjcf_gen_distractor {
+  mjcf_gen_distractor_kind_t kind;
+  double half_m[3]; /* half sizes x, y, z [m]; a cone (cylinder) has radius half_m[0] */
+  double yaw_rad;
+  float rgba[4];
+} mjcf_gen_distractor_t;
+
 typedef struct mjcf_gen_options {
   int cars;                        /* >= 1 */
   const char *map_path;            /* absolute path of the map MJCF */
@@ -31,6 +41,8 @@ typedef struct mjcf_gen_options {
   const scn_late_box_t *late_box;  /* their sizes (positions are set at run time) */
   const char *texture_dir;         /* NULL: the map's folder; else where its textures are */
   int physics_only; /* 1: without the cars' visual-only lamps, wheel discs and roof tags */
+  int distractors;  /* --distractors */
+  const mjcf_gen_distractor_t *distractor;
 } mjcf_gen_options_t;
 
 #define MG_PARKED_Z_M (-2000.0) /* late boxes wait here [m]; the far plane is at 1000 m */

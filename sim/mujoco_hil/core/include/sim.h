@@ -20,6 +20,7 @@ extern "C" {
 
 #define SIM_STEP_US 1000 /* physics and Nano loop period [us] */
 #define SIM_MAX_CARS 32
+#define SIM_MAX_DISTRACTORS 20 /* --distractors */
 
 typedef struct sim_config {
   const char *params_path; /* vehicle parameter file */
@@ -39,6 +40,10 @@ typedef struct sim_config {
   int late_boxes;          /* 0..SCN_MAX_LATE_BOXES boxes that appear during the run (the
                             * map's late_obstacles come on top, after them) */
   const scn_late_box_t *late_box;
+  /* 0..SIM_MAX_DISTRACTORS static cones, boxes and parked-car-sized boxes placed from seed
+   * beside the road (distractors.c): off every lane and route, clear of the cars' starts, the
+   * map's obstacles, the late boxes and each other. sim_create fails when there is no room. */
+  int distractors;
   /* Host link service period [ms of sim time, = steps]: the ptys are read and written every
    * this many steps. 0 or 1: every step (real time, --rtf, --lockstep-client). Larger batches
    * the bytes the way a USB-serial adapter's latency timer does; free lockstep uses it so an

@@ -160,6 +160,25 @@ static void mjcf_gen_late_box(FILE *f, int k, const scn_late_box_t *b) {
           k, MG_PARKED_Z_M, b->yaw_rad, b->half_x_m, b->half_y_m, scn_late_box_half_z(b));
 }
 
+/* A distractor: a world geom with the world's collision bits (the cars hit it, the LIDAR and
+ * the cameras see it), parked out of sight until the sim places it (distractors.c). */
+static void mjcf_gen_distractor(FILE *f, int k, const mjcf_gen_distractor_t *d) {
+  const float *c = d->rgba;
+  if (d->kind == MG_CONE)
+    fprintf(f,
+            "  <geom name=\"scenario/distractor%d\" type=\"cylinder\" pos=\"0 0 %g\" "
+            "size=\"%.6g %.6g\" contype=\"1\" conaffinity=\"6\" friction=\"0.5 0.005 0.0001\" "
+            "rgba=\"%.3g %.3g %.3g 1\"/>\n",
+            k, MG_PARKED_Z_M, d->half_m[0], d->half_m[2], c[0], c[1], c[2]);
+  else
+    fprintf(f,
+            "  <geom name=\"scenario/distractor%d\" type=\"box\" pos=\"0 0 %g\" "
+            "euler=\"0 0 %.9g\" size=\"%.6g %.6g %.6g\" contype=\"1\" conaffinity=\"6\" "
+            "friction=\"0.5 0.005 0.0001\" rgba=\"%.3g %.3g %.3g 1\"/>\n",
+            k, MG_PARKED_Z_M, d->yaw_rad, d->half_m[0], d->half_m[1], d->half_m[2], c[0], c[1],
+            c[2]);
+}
+
 /* Whether line is a one-line <geom> named one of the names (a space-separated list). */
 static int mjcf_gen_geom_named(const char *line, const char *names) {
   const char *at = strstr(line, "<geom name=\"");
@@ -242,6 +261,7 @@ int mjcf_gen_write_scene(const char *out_path, const vehicle_params_t *p,
   for (int i = 1; i <= o->cars; i++)
     mjcf_gen_car(f, p, i, o->tag_geom_xml ? o->tag_geom_xml[i - 1] : NULL, o->physics_only);
   for (int k = 0; k < o->late_boxes; k++) mjcf_gen_late_box(f, k + 1, &o->late_box[k]);
+  for (int k = 0; k < o->distractors; k++) mjcf_gen_distractor(f, k + 1, &o->distractor[k]);
   fprintf(f, " </worldbody>\n");
   fprintf(f, " <sensor>\n");
   for (int i = 1; i <= o->cars; i++) /* the MPU-9250 at its mount: specific force, rate, field */

@@ -62,7 +62,10 @@ int sim_load_model(sim_t *s, const sim_config_t *cfg, char *err, size_t err_sz) 
   if (!realpath(cfg->map_path, map_abs))
     return sim_fail(err, err_sz, "map file '%s': %s", cfg->map_path, strerror(errno));
   if (sim_check_map(s, map_abs, !cfg->no_map_late_boxes, err, err_sz) != 0) return -1;
-  mjcf_gen_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0};
+  mjcf_gen_options_t o = {cfg->cars, NULL, NULL, NULL, s->nbox, s->box, NULL, 0, 0, NULL};
+  sim_draw_distractors(s, cfg);
+  o.distractors = s->ndistractor;
+  o.distractor = s->distractor;
   o.map_path = map_abs;
   char tex_abs[4096];
   if (cfg->texture_dir) {

@@ -14,6 +14,7 @@
 
 #include "clearance.h"
 #include "drive.h"
+#include "mjcf_gen.h"
 #include "nano_core.h"
 #include "ptylink.h"
 #include "rng.h"
@@ -123,8 +124,12 @@ struct sim {
   int64_t box_at_us[SIM_MAX_BOXES];    /* when it appeared [us] */
   int box_gone[SIM_MAX_BOXES];         /* has left again (stay_s) */
   int box_left[SIM_MAX_BOXES];         /* left during the last step */
-  uint64_t seed;                       /* of the current run (sim_create, sim_reset) */
-  char script_spec[256];               /* every car's scripted driver, "" for none */
+  int ndistractor; /* --distractors: drawn in sim_draw_distractors, placed after the cars */
+  mjcf_gen_distractor_t distractor[SIM_MAX_DISTRACTORS];
+  int distractor_geom[SIM_MAX_DISTRACTORS];     /* its world geom in m */
+  double distractor_xy[SIM_MAX_DISTRACTORS][2]; /* where it stands [m] */
+  uint64_t seed;                                /* of the current run (sim_create, sim_reset) */
+  char script_spec[256];                        /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
   int accel_wanted;      /* sim_want_accel: the next step computes the accelerometer */
   traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
@@ -146,6 +151,11 @@ void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row
 int sim_place_cars(sim_t *s, char *err, size_t err_sz);
 void sim_car_prism(const sim_t *s, int i, clearance_prism_t *out);
 void sim_box_prism(const scn_late_box_t *b, clearance_prism_t *out);
+
+/* distractors.c: --distractors, their kinds and sizes before the scene is written, their
+ * places once the cars stand */
+void sim_draw_distractors(sim_t *s, const sim_config_t *cfg);
+int sim_place_distractors(sim_t *s, char *err, size_t err_sz);
 
 /* late_boxes.c */
 int sim_read_map_late_boxes(sim_t *s, const mjModel *mm, const char *path, char *err,

@@ -52,6 +52,10 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
              cfg->late_boxes);
     return NULL;
   }
+  if (cfg->distractors < 0 || cfg->distractors > SIM_MAX_DISTRACTORS) {
+    snprintf(err, err_sz, "--distractors %d: must be 0..%d", cfg->distractors, SIM_MAX_DISTRACTORS);
+    return NULL;
+  }
   sim_t *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   if (cfg->start) {
@@ -110,6 +114,7 @@ sim_t *sim_create(const sim_config_t *cfg, char *err, size_t err_sz) {
   if (tl_load(&s->tl, s->mv ? s->mv : s->m, err, err_sz) != 0) goto fail;
   if (sim_bind_route(s, cfg, err, err_sz) != 0) goto fail;
   if (sim_place_cars(s, err, err_sz) != 0) goto fail;
+  if (sim_place_distractors(s, err, err_sz) != 0) goto fail;
   mj_forward(s->m, s->d);
   for (int i = 0; i < cfg->cars; i++)
     if (sim_setup_car(s, cfg, &s->car[i], err, err_sz) != 0) goto fail;
