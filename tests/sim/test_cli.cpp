@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -116,6 +117,53 @@ TEST(Cli, BadOptionsAreRejected) {
   const ProcResult r = run("--lockstep --no-pty --lcm-url memq:// --script constant:throttle=9");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("throttle"), std::string::npos) << r.out;
+}
+
+// Domain randomisation (issue 38): bad values name the option and the value, exit 2.
+TEST(Cli, RandomisationBoundsAreRefusedNamingOptionAndValue) {
+  for (const char *bad :
+       {"--light-rgb 1.6,1,1", "--light-rgb 1,0.4,1", "--light-rgb 1,1", "--light-rgb 1,1,1,1",
+        "--light-rgb red", "--camera-exposure 2.5", "--camera-exposure -3", "--camera-exposure x",
+        "--camera-jitter 11,1", "--camera-jitter 5,3.5", "--camera-jitter -1,1",
+        "--camera-jitter 5", "--distractors 21", "--distractors -1", "--distractors 2.5"}) {
+    const ProcResult r = run(bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.out;
+    const std::string opt(bad, strchr(bad, ' ')), value(strchr(bad, ' ') + 1);
+    EXPECT_NE(r.out.find(opt + " '" + value + "'"), std::string::npos) << bad << ": " << r.out;
+  }
+  const ProcResult h = run("--help");
+  for (const char *opt :
+       {"--light-rgb R,G,B", "--camera-exposure EV", "--camera-jitter MM,DEG", "--distractors N"})
+    EXPECT_NE(h.out.find(opt), std::string::npos) << opt;
+}
+
+// --camera-jitter prints each car's drawn offset once: the same for a seed, another for
+// another seed or car; with the other options the run starts and ends cleanly.
+TEST(Cli, CameraJitterIsPrintedOncePerCarFromTheSeed) {
+  const std::string dir = simtest::temp_dir();
+  const std::string common =
+      " --lockstep --duration 0.1 --cars 2 --no-pty --no-lidar --lcm-url memq:// --run-dir " + dir +
+      " --camera-jitter 10,3 --light-rgb 1.2,0.9,0.7 --light-level 0.8 --camera-exposure -1"
+      " --distractors 5 --map tiny_town";
+  const ProcResult a = run("--seed 1" + common), b = run("--seed 1" + common),
+                   c = run("--seed 2" + common);
+  ASSERT_EQ(a.status, 0) << a.out;
+  ASSERT_EQ(c.status, 0) << c.out;
+  auto lines = [](const std::string &out, const char *car) {
+    std::string found;
+    int n = 0;
+    for (size_t at = 0;
+         (at = out.find(std::string(car) + " cam_front jitter", at)) != std::string::npos;
+         at++, n++)
+      found = out.substr(at, out.find('\n', at) - at);
+    return n == 1 ? found : std::string("printed ") + std::to_string(n) + " times";
+  };
+  const std::string a1 = lines(a.out, "NIGEL1"), a2 = lines(a.out, "NIGEL2");
+  EXPECT_NE(a1.find(" mm; "), std::string::npos) << a1;
+  EXPECT_EQ(a1, lines(b.out, "NIGEL1"));
+  EXPECT_NE(a1, lines(c.out, "NIGEL1"));
+  EXPECT_NE(a1.substr(6), a2.substr(6)) << "each car draws its own";
+  EXPECT_EQ(rmdir(dir.c_str()), 0);
 }
 
 TEST(Cli, PtySymlinksArePrintedAndRemovedOnExit) {

@@ -1,6 +1,7 @@
 // The world side of the simulator (ctest prefix "world."): every map loads and steps, the route
 // driver keeps its lane, traffic lights are lit in rendered frames and refuse conflicting
-// commands, signs are visible, camera noise and blur. In-process, real MuJoCo and rendering.
+// commands, signs are visible, camera noise, blur, exposure, light colour, mount jitter and
+// distractors. In-process, real MuJoCo and rendering.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "camera_fx.h"
+#include "route.h"
 #include <autodrive/pure_pursuit.h>
 #include "route_driver.h"
 #include "sim.h"
@@ -33,7 +35,8 @@ struct WorldSim {
   sim_t *s = nullptr;
   std::string run_dir, err, params, map;
   scn_pose_t start{};
-  WorldSim(const char *map_name, const scn_pose_t *pose, const char *script = nullptr) {
+  WorldSim(const char *map_name, const scn_pose_t *pose, const char *script = nullptr,
+           int distractors = 0, uint64_t seed = 1) {
     run_dir = simtest::temp_dir();
     params = simtest::params_path();
     map = simtest::map_path(map_name);
@@ -42,8 +45,9 @@ struct WorldSim {
     cfg.map_path = map.c_str();
     cfg.run_dir = run_dir.c_str();
     cfg.cars = 1;
-    cfg.seed = 1;
+    cfg.seed = seed;
     cfg.script = script;
+    cfg.distractors = distractors;
     cfg.tyre_model = -1;
     if (pose) {
       start = *pose;
@@ -418,6 +422,209 @@ TEST(World, CameraNoiseIsSeededAndBlurSmooths) {
   cfx_free(&f1);
   cfx_free(&f2);
   cfx_free(&blur);
+}
+
+TEST(World, LightRgbIsAGainPerChannelOnEveryLight) {
+  WorldSim w("tiny_town", nullptr);
+  ASSERT_NE(w.s, nullptr) << w.err;
+  mjModel *m = sim_render_model(w.s);
+  ASSERT_GT(m->nlight, 0);
+  std::vector<float> diffuse(m->light_diffuse, m->light_diffuse + 3 * m->nlight),
+      specular(m->light_specular, m->light_specular + 3 * m->nlight);
+  const float head = m->vis.headlight.diffuse[1];
+  const double level0 = cfx_light_level(m);
+  ASSERT_EQ(cfx_set_light_level(m, 0.5), 0);  // both options: the level first, then the colour
+  const double gain[3] = {1.5, 0.5, 1.0};
+  cfx_set_light_rgb(m, gain);
+  for (int i = 0; i < m->nlight; i++)
+    for (int c = 0; c < 3; c++) {
+      const double k = 0.5 / level0 * gain[c];
+      EXPECT_NEAR(m->light_diffuse[3 * i + c], diffuse[3 * i + c] * k, 1e-5) << i << " " << c;
+      EXPECT_NEAR(m->light_specular[3 * i + c], specular[3 * i + c] * k, 1e-5) << i << " " << c;
+    }
+  EXPECT_NEAR(m->vis.headlight.diffuse[1], head * 0.5 / level0 * 0.5, 1e-5) << "the headlight too";
+}
+
+TEST(World, CameraExposureScalesClipsAndComesBeforeBlur) {
+  std::vector<uint8_t> a(64 * 48 * 3), b;
+  for (size_t i = 0; i < a.size(); i++) a[i] = (i / 3) % 2 ? 200 : 40;  // fine stripes
+  cfx_t up, down, up_blur;
+  cfx_init(&up, 0.0, 0.0, 7);
+  cfx_set_exposure(&up, 1.0);
+  cfx_init(&down, 0.0, 0.0, 7);
+  cfx_set_exposure(&down, -2.0);
+  cfx_init(&up_blur, 0.0, 2.0, 7);
+  cfx_set_exposure(&up_blur, 1.0);
+  EXPECT_TRUE(cfx_active(&up));
+  b = a;
+  cfx_apply(&up, b.data(), 64, 48);
+  EXPECT_EQ(b[3], 255) << "200 x 2 clips at 255, as a sensor does";
+  EXPECT_EQ(b[0], 80);
+  b = a;
+  cfx_apply(&down, b.data(), 64, 48);
+  EXPECT_EQ(b[3], 50);
+  EXPECT_EQ(b[0], 10);
+  b = a;
+  cfx_apply(&up_blur, b.data(), 64, 48);
+  // exposed first (255, 80), then blurred: their mean 167.5; blurred first would give 240
+  EXPECT_NEAR(b[3 * (24 * 64 + 32)], 167.5, 8);
+  cfx_t none;
+  cfx_init(&none, 0.0, 0.0, 7);
+  cfx_set_exposure(&none, 0.0);
+  EXPECT_FALSE(cfx_active(&none)) << "0 EV changes nothing";
+  for (cfx_t *f : {&up, &down, &up_blur, &none}) cfx_free(f);
+}
+
+TEST(World, CameraJitterIsSeededPerCarAndWithinTheTolerance) {
+  const cfx_jitter_t a = cfx_jitter_draw(5, 1, 10, 3), b = cfx_jitter_draw(5, 1, 10, 3);
+  const cfx_jitter_t c = cfx_jitter_draw(6, 1, 10, 3), d = cfx_jitter_draw(5, 2, 10, 3);
+  EXPECT_EQ(memcmp(&a, &b, sizeof a), 0) << "same seed and car, same offset";
+  EXPECT_NE(memcmp(&a, &c, sizeof a), 0) << "another seed, another offset";
+  EXPECT_NE(memcmp(&a, &d, sizeof a), 0) << "another car, another offset";
+  double max_mm = 0, max_deg = 0;
+  for (uint64_t seed = 0; seed < 200; seed++) {
+    const cfx_jitter_t j = cfx_jitter_draw(seed, 1, 4, 1.5);
+    for (int k = 0; k < 3; k++) {
+      max_mm = fmax(max_mm, fabs(j.pos_m[k]) * 1e3);
+      max_deg = fmax(max_deg, fabs(j.rot_deg[k]));
+    }
+  }
+  EXPECT_LE(max_mm, 4.0);
+  EXPECT_GT(max_mm, 3.5) << "uniform over the whole +-MM";
+  EXPECT_LE(max_deg, 1.5);
+  EXPECT_GT(max_deg, 1.3);
+  // on the model: the mount moves by the offset, turns by no more than the angles, and keeps
+  // its field of view (the published intrinsics)
+  WorldSim w("driving_school", nullptr);
+  ASSERT_NE(w.s, nullptr) << w.err;
+  mjModel *m = sim_render_model(w.s);
+  const int id = mj_name2id(m, mjOBJ_CAMERA, "nigel1/cam_front");
+  ASSERT_GE(id, 0);
+  const double pos0[3] = {m->cam_pos[3 * id], m->cam_pos[3 * id + 1], m->cam_pos[3 * id + 2]};
+  const double q0[4] = {m->cam_quat[4 * id], m->cam_quat[4 * id + 1], m->cam_quat[4 * id + 2],
+                        m->cam_quat[4 * id + 3]};
+  const double fovy = m->cam_fovy[id];
+  cfx_jitter_camera(m, id, &a);
+  for (int k = 0; k < 3; k++) EXPECT_NEAR(m->cam_pos[3 * id + k] - pos0[k], a.pos_m[k], 1e-12);
+  double dot = 0;
+  for (int k = 0; k < 4; k++) dot += q0[k] * m->cam_quat[4 * id + k];
+  const double turned_deg = 2 * acos(fmin(1.0, fabs(dot))) * 180 / M_PI;
+  EXPECT_GT(turned_deg, 0.01);
+  EXPECT_LE(turned_deg, sqrt(3.0) * 3.0 + 1e-9);
+  EXPECT_EQ(m->cam_fovy[id], fovy);
+}
+
+// Every distractor's place: x, y [m] of its geom in the physics model.
+std::vector<double> distractor_places(const WorldSim &w, int n) {
+  std::vector<double> xy;
+  const mjModel *m = sim_model(w.s);
+  for (int k = 1; k <= n; k++) {
+    const int g = mj_name2id(m, mjOBJ_GEOM, ("scenario/distractor" + std::to_string(k)).c_str());
+    EXPECT_GE(g, 0) << k;
+    if (g < 0) continue;
+    xy.push_back(m->geom_pos[3 * g]);
+    xy.push_back(m->geom_pos[3 * g + 1]);
+  }
+  return xy;
+}
+
+// Distance from (x, y) to the polyline r [m].
+double to_line(const route_t &r, double x, double y) {
+  double best = 1e9;
+  for (int i = 0; i + 1 < r.n + (r.loop ? 1 : 0); i++) {
+    const double *a = r.xy + 2 * i, *b = r.xy + 2 * ((i + 1) % r.n);
+    const double ex = b[0] - a[0], ey = b[1] - a[1], l2 = ex * ex + ey * ey;
+    const double t = l2 > 0 ? fmin(1.0, fmax(0.0, ((x - a[0]) * ex + (y - a[1]) * ey) / l2)) : 0;
+    best = fmin(best, hypot(x - a[0] - t * ex, y - a[1] - t * ey));
+  }
+  return best;
+}
+
+TEST(World, DistractorsStandBesideTheRoadFromTheSeed) {
+  for (const char *map : {"driving_school", "tiny_town", "intersection_school"}) {
+    WorldSim a(map, nullptr, nullptr, 20, 4), b(map, nullptr, nullptr, 20, 4),
+        c(map, nullptr, nullptr, 20, 5);
+    ASSERT_NE(a.s, nullptr) << map << ": " << a.err;
+    ASSERT_NE(b.s, nullptr) << b.err;
+    ASSERT_NE(c.s, nullptr) << c.err;
+    const std::vector<double> pa = distractor_places(a, 20), pb = distractor_places(b, 20),
+                              pc = distractor_places(c, 20);
+    EXPECT_EQ(pa, pb) << map << ": same seed, same places";
+    EXPECT_NE(pa, pc) << map << ": another seed, other places";
+    const mjModel *m = sim_model(a.s);
+    // none on a lane: its footprint's circle clear of every lane's (and route's) width
+    int lanes = 0;
+    for (int i = 0; i < m->nnumeric; i++) {
+      const std::string name = m->names + m->name_numericadr[i];
+      const bool lane = name.rfind("lane_", 0) == 0, route = name.rfind("route_", 0) == 0;
+      if ((!lane && !route) || name.find(".part") != std::string::npos) continue;
+      route_t r;
+      char err[256];
+      ASSERT_EQ(route_from_numeric(&r, m, i, route, err, sizeof err), 0) << err;
+      lanes++;
+      for (int k = 0; k < 20; k++) {
+        const int g =
+            mj_name2id(m, mjOBJ_GEOM, ("scenario/distractor" + std::to_string(k + 1)).c_str());
+        const double radius =
+            hypot(m->geom_size[3 * g],
+                  m->geom_type[g] == mjGEOM_BOX ? m->geom_size[3 * g + 1] : m->geom_size[3 * g]);
+        EXPECT_GT(to_line(r, pa[2 * k], pa[2 * k + 1]), r.half_width_m + radius)
+            << map << ": distractor " << k + 1 << " on " << name;
+      }
+      route_free(&r);
+    }
+    EXPECT_GT(lanes, 0) << map;
+    // on the floor, not on the car's start, not on each other
+    sim_truth_t t;
+    sim_get_truth(a.s, 1, &t);
+    for (int k = 0; k < 20; k++) {
+      EXPECT_GT(hypot(pa[2 * k] - t.pos_m[0], pa[2 * k + 1] - t.pos_m[1]), 0.2) << map << k;
+      for (int j = 0; j < k; j++)
+        EXPECT_GT(hypot(pa[2 * k] - pa[2 * j], pa[2 * k + 1] - pa[2 * j + 1]), 0.05) << map << k;
+    }
+    // the cars stand clear: the run steps without a collision
+    ASSERT_TRUE(a.run_to(0.5)) << a.err;
+    sim_get_truth(a.s, 1, &t);
+    EXPECT_FALSE(t.in_collision) << map;
+  }
+}
+
+TEST(World, DistractorsAreSeenByRaysAsTheLidarAndCamerasSeeThem) {
+  WorldSim w("parking_school", nullptr, nullptr, 20, 2);
+  ASSERT_NE(w.s, nullptr) << w.err;
+  for (const mjModel *m : {sim_model(w.s), (const mjModel *)sim_render_model(w.s)}) {
+    mjData *d = mj_makeData(m);
+    mj_forward(m, d);
+    int seen = 0;
+    for (int k = 1; k <= 20; k++) {
+      const int g = mj_name2id(m, mjOBJ_GEOM, ("scenario/distractor" + std::to_string(k)).c_str());
+      ASSERT_GE(g, 0);
+      // a ray from 0.5 m beside it, 1 cm above the floor, towards its centre (the LIDAR's
+      // groups 0..2), and one from 1 m above, looking down (a camera)
+      const mjtNum *c = d->geom_xpos + 3 * g;
+      const mjtNum side[3] = {c[0] - 0.5, c[1], 0.01}, at[3] = {0.5, 0, 0};
+      const mjtNum top[3] = {c[0], c[1], 1.0}, down[3] = {0, 0, -1};
+      const mjtByte groups[mjNGROUP] = {1, 1, 1, 0, 0, 0};
+      int hit = -1;
+      mj_ray(m, d, side, at, groups, 1, -1, &hit);
+      seen += hit == g;
+      hit = -1;
+      mj_ray(m, d, top, down, nullptr, 1, -1, &hit);
+      EXPECT_EQ(hit, g) << k;
+    }
+    EXPECT_GE(seen, 18) << "a sideways ray may meet another distractor first";
+    mj_deleteData(d);
+  }
+}
+
+TEST(World, DistractorsWithoutRoomAreAClearError) {
+  const std::string small = simtest::fixture("small_floor.xml");
+  WorldSim w(small.c_str(), nullptr, nullptr, 20, 1);
+  EXPECT_EQ(w.s, nullptr);
+  EXPECT_NE(w.err.find("--distractors 20"), std::string::npos) << w.err;
+  EXPECT_NE(w.err.find("no free place"), std::string::npos) << w.err;
+  WorldSim one(small.c_str(), nullptr, nullptr, 1, 1);
+  EXPECT_NE(one.s, nullptr) << "one small thing fits: " << one.err << " / " << w.err;
 }
 
 }  // namespace
