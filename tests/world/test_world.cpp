@@ -599,10 +599,11 @@ TEST(World, DistractorsAreSeenByRaysAsTheLidarAndCamerasSeeThem) {
     for (int k = 1; k <= 20; k++) {
       const int g = mj_name2id(m, mjOBJ_GEOM, ("scenario/distractor" + std::to_string(k)).c_str());
       ASSERT_GE(g, 0);
-      // a ray from 0.5 m beside it, 1 cm above the floor, towards its centre (the LIDAR's
-      // groups 0..2), and one from 1 m above, looking down (a camera)
+      // a ray from 0.5 m beside it in the LIDAR's scan plane (0.176 m over base_link, ~2 mm
+      // over the floor) towards its centre (the LIDAR's groups 0..2), and one from 1 m above,
+      // looking down (a camera)
       const mjtNum *c = d->geom_xpos + 3 * g;
-      const mjtNum side[3] = {c[0] - 0.5, c[1], 0.01}, at[3] = {0.5, 0, 0};
+      const mjtNum side[3] = {c[0] - 0.5, c[1], 0.178}, at[3] = {0.5, 0, 0};
       const mjtNum top[3] = {c[0], c[1], 1.0}, down[3] = {0, 0, -1};
       const mjtByte groups[mjNGROUP] = {1, 1, 1, 0, 0, 0};
       int hit = -1;

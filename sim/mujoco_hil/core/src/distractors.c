@@ -11,11 +11,14 @@
 #include "route.h"
 #include "sim_internal.h"
 
-#define DIS_TRIES 4000 /* random places tried per distractor before giving up */
-#define DIS_LANE_MARGIN_M \
-  0.06 /* beyond a lane's edge: the road's kerb side (0.64 m road, 2 x 0.28 m lanes) */
+#define DIS_TRIES 4000        /* random places tried per distractor before giving up */
 #define DIS_CAR_MARGIN_M 0.15 /* clear of a car's start footprint */
 #define DIS_GAP_M 0.05        /* between distractors and late boxes */
+/* beyond a lane's edge: the road's kerb side (a 0.64 m road holds 2 x 0.28 m lanes) */
+#define DIS_LANE_MARGIN_M 0.06
+/* every distractor reaches above the LIDAR's scan plane (0.176 m over base_link, which rides
+ * ~2 mm above the floor), so the LIDAR sees it as the cameras do */
+#define DIS_MIN_HALF_Z_M 0.095
 
 static double dis_between(rng_t *r, double lo, double hi) {
   return lo + (hi - lo) * rng_uniform(r);
@@ -31,13 +34,14 @@ void sim_draw_distractors(sim_t *s, const sim_config_t *cfg) {
     d->kind = (mjcf_gen_distractor_kind_t)(int)(3.0 * rng_uniform(&r));
     d->yaw_rad = dis_between(&r, -M_PI, M_PI);
     const float shade = (float)dis_between(&r, 0.6, 1.0);
-    if (d->kind == MG_CONE) { /* 8..20 cm tall: the taller ones reach the LIDAR's plane */
+    if (d->kind == MG_CONE) { /* a pylon: 19..24 cm tall, 4..8 cm across */
       d->half_m[0] = d->half_m[1] = dis_between(&r, 0.02, 0.04);
-      d->half_m[2] = dis_between(&r, 0.04, 0.10);
+      d->half_m[2] = dis_between(&r, DIS_MIN_HALF_Z_M, 0.12);
       d->yaw_rad = 0.0;
       memcpy(d->rgba, (float[4]){shade, 0.45f * shade, 0.05f, 1}, sizeof d->rgba);
-    } else if (d->kind == MG_BOX) { /* construction boxes, 6..24 cm a side */
-      for (int a = 0; a < 3; a++) d->half_m[a] = dis_between(&r, 0.03, 0.12);
+    } else if (d->kind == MG_BOX) { /* construction boxes, 6..24 cm across, 19..30 cm tall */
+      for (int a = 0; a < 2; a++) d->half_m[a] = dis_between(&r, 0.03, 0.12);
+      d->half_m[2] = dis_between(&r, DIS_MIN_HALF_Z_M, 0.15);
       memcpy(d->rgba, (float[4]){0.75f * shade, 0.55f * shade, 0.3f * shade, 1}, sizeof d->rgba);
     } else { /* a parked Nigel's size (the maps' parked cars: 0.24 x 0.18 x 0.24 m) */
       d->half_m[0] = 0.12;
