@@ -36,7 +36,7 @@ struct WorldSim {
   std::string run_dir, err, params, map;
   scn_pose_t start{};
   WorldSim(const char *map_name, const scn_pose_t *pose, const char *script = nullptr,
-           int distractors = 0, uint64_t seed = 1) {
+           int distractors = 0, uint64_t seed = 1, const scn_pose_t *keep_clear = nullptr) {
     run_dir = simtest::temp_dir();
     params = simtest::params_path();
     map = simtest::map_path(map_name);
@@ -48,6 +48,8 @@ struct WorldSim {
     cfg.seed = seed;
     cfg.script = script;
     cfg.distractors = distractors;
+    cfg.distractor_keep_clear = keep_clear ? 1 : 0;
+    cfg.distractor_keep_clear_pose = keep_clear;
     cfg.tyre_model = -1;
     if (pose) {
       start = *pose;
@@ -587,6 +589,26 @@ TEST(World, DistractorsStandBesideTheRoadFromTheSeed) {
     sim_get_truth(a.s, 1, &t);
     EXPECT_FALSE(t.in_collision) << map;
   }
+}
+
+// A start pose the program gives later (--car-start, --start per car) is kept clear too: a car
+// put where the first distractor stood moves that distractor elsewhere, clear of the car.
+TEST(World, DistractorsKeepClearOfTheStartPosesGivenLater) {
+  WorldSim before("tiny_town", nullptr, nullptr, 3, 9);
+  ASSERT_NE(before.s, nullptr) << before.err;
+  const std::vector<double> p = distractor_places(before, 3);
+  const scn_pose_t there = {p[0] - 0.07, p[1], 0.0};  // base_link 7 cm behind: the car over it
+  WorldSim after("tiny_town", nullptr, nullptr, 3, 9, &there);
+  ASSERT_NE(after.s, nullptr) << after.err;
+  const std::vector<double> q = distractor_places(after, 3);
+  EXPECT_NE(p, q);
+  for (int k = 0; k < 3; k++)
+    EXPECT_GT(hypot(q[2 * k] - there.x_m, q[2 * k + 1] - there.y_m), 0.2) << k;
+  char err[512];
+  const double poses[3] = {there.x_m, there.y_m, 0.0};
+  EXPECT_NE(sim_reset(before.s, 9, poses, err, sizeof err), 0) << "the car would stand on it";
+  EXPECT_NE(std::string(err).find("distractor"), std::string::npos) << err;
+  EXPECT_EQ(sim_reset(after.s, 9, poses, err, sizeof err), 0) << err;
 }
 
 TEST(World, DistractorsAreSeenByRaysAsTheLidarAndCamerasSeeThem) {

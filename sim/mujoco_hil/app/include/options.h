@@ -47,6 +47,8 @@ typedef struct app_options {
   scn_pose_t car_start[SIM_MAX_CARS]; /* --car-start I,...: car I alone */
   int car_start_given[SIM_MAX_CARS];
   scn_late_box_t late_box[SCN_MAX_LATE_BOXES];
+  scn_pose_t keep_clear[2 * SIM_MAX_CARS]; /* the --start and --car-start poses, for
+                                            * --distractors (cfg.distractor_keep_clear_pose) */
 } app_options_t;
 
 /* Parses argv into o (defaults first). Returns -1 to run, else the exit status: 0 after

@@ -634,6 +634,17 @@ static int options_check(const app_options_t *o) {
   return -1;
 }
 
+/* The start poses the program gives after sim_create (--start once per car, --car-start):
+ * the distractors keep clear of them too. */
+static void options_keep_clear(app_options_t *o) {
+  int n = 0;
+  for (int k = 0; k < o->nstarts; k++) o->keep_clear[n++] = o->starts[k];
+  for (int i = 0; i < SIM_MAX_CARS; i++)
+    if (o->car_start_given[i]) o->keep_clear[n++] = o->car_start[i];
+  o->cfg.distractor_keep_clear = n;
+  o->cfg.distractor_keep_clear_pose = o->keep_clear;
+}
+
 /* Moves the URL and, unless given, the run dir to the session's instance. */
 static void options_instance(app_options_t *o) {
   o->url = sim_instance_url(o->instance, o->url, o->instance_url, sizeof o->instance_url);
@@ -661,6 +672,7 @@ int app_options_parse(app_options_t *o, int argc, char **argv) {
     i += took;
   }
   options_instance(o);
+  options_keep_clear(o);
   const int free_lockstep = app_options_free_lockstep(o);
   o->cfg.host_io_period_ms = o->host_io_ms   ? o->host_io_ms
                              : free_lockstep ? OPTIONS_FREE_LOCKSTEP_IO_MS

@@ -42,8 +42,14 @@ typedef struct sim_config {
   const scn_late_box_t *late_box;
   /* 0..SIM_MAX_DISTRACTORS static cones, boxes and parked-car-sized boxes placed from seed
    * beside the road (distractors.c): off every lane and route, clear of the cars' starts, the
-   * map's obstacles, the late boxes and each other. sim_create fails when there is no room. */
+   * map's obstacles, the late boxes and each other. sim_create fails when there is no room.
+   * Placed once: sim_reset keeps them where they are, whatever its seed. */
   int distractors;
+  /* More start poses the distractors keep clear of, besides where the cars stand after
+   * sim_create: poses the program gives with sim_reset later (--start once per car,
+   * --car-start). x_m, y_m [m] of base_link and yaw_deg [deg]. */
+  int distractor_keep_clear;
+  const scn_pose_t *distractor_keep_clear_pose;
   /* Host link service period [ms of sim time, = steps]: the ptys are read and written every
    * this many steps. 0 or 1: every step (real time, --rtf, --lockstep-client). Larger batches
    * the bytes the way a USB-serial adapter's latency timer does; free lockstep uses it so an

@@ -67,23 +67,28 @@ int sim_place_cars(sim_t *s, char *err, size_t err_sz) {
 
 /* The upright prism around car i's chassis and wheels at its current pose. */
 void sim_car_prism(const sim_t *s, int i, clearance_prism_t *out) {
+  const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
+  const double yaw =
+      atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
+  sim_car_prism_at(s, qp[0], qp[1], qp[2], yaw, out);
+}
+
+void sim_car_prism_at(const sim_t *s, double x_m, double y_m, double z_m, double yaw,
+                      clearance_prism_t *out) {
   const vehicle_params_t *p = &s->p;
   const double *co = p->chassis_offset_m, *cs = p->chassis_size_m;
   const double r = p->wheel_radius_m, wy = 0.5 * (p->track_m + p->wheel_width_m);
   const double x0 = fmin(co[0] - 0.5 * cs[0], -r),
                x1 = fmax(co[0] + 0.5 * cs[0], p->wheelbase_m + r);
   const double y0 = fmin(co[1] - 0.5 * cs[1], -wy), y1 = fmax(co[1] + 0.5 * cs[1], wy);
-  const mjtNum *qp = s->d->qpos + s->car[i].root_qpos;
-  const double yaw =
-      atan2(2.0 * (qp[3] * qp[6] + qp[4] * qp[5]), 1.0 - 2.0 * (qp[5] * qp[5] + qp[6] * qp[6]));
   const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1); /* in the car's frame */
-  out->centre_m[0] = qp[0] + cos(yaw) * cx - sin(yaw) * cy;
-  out->centre_m[1] = qp[1] + sin(yaw) * cx + cos(yaw) * cy;
+  out->centre_m[0] = x_m + cos(yaw) * cx - sin(yaw) * cy;
+  out->centre_m[1] = y_m + sin(yaw) * cx + cos(yaw) * cy;
   out->yaw_rad = yaw;
   out->half_m[0] = 0.5 * (x1 - x0);
   out->half_m[1] = 0.5 * (y1 - y0);
   out->z_lo_m = SIM_GROUND_CLEARANCE_M;
-  out->z_hi_m = qp[2] + co[2] + 0.5 * cs[2];
+  out->z_hi_m = z_m + co[2] + 0.5 * cs[2];
 }
 
 void sim_box_prism(const scn_late_box_t *b, clearance_prism_t *out) {

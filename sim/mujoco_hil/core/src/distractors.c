@@ -25,6 +25,9 @@ static double dis_between(rng_t *r, double lo, double hi) {
 }
 
 void sim_draw_distractors(sim_t *s, const sim_config_t *cfg) {
+  s->ndistractor_keep_clear = 0;
+  for (int i = 0; i < cfg->distractor_keep_clear && i < 2 * SIM_MAX_CARS; i++)
+    s->distractor_keep_clear[s->ndistractor_keep_clear++] = cfg->distractor_keep_clear_pose[i];
   rng_t r;
   rng_seed(&r, (cfg->seed ^ 0xd157ac7ull) * 0xBF58476D1CE4E5B9ull);
   s->ndistractor = cfg->distractors;
@@ -123,8 +126,13 @@ static int dis_fits(const sim_t *s, const dis_lanes_t *lanes, const mjcf_gen_dis
       return 0;
   clearance_prism_t p, q;
   dis_prism(d, x, y, &p);
-  for (int i = 0; i < s->ncars; i++) {
-    sim_car_prism(s, i, &q);
+  for (int i = 0; i < s->ncars + s->ndistractor_keep_clear; i++) {
+    if (i < s->ncars) {
+      sim_car_prism(s, i, &q);
+    } else {
+      const scn_pose_t *at = &s->distractor_keep_clear[i - s->ncars];
+      sim_car_prism_at(s, at->x_m, at->y_m, SIM_SPAWN_Z_M, at->yaw_deg * (M_PI / 180.0), &q);
+    }
     dis_grow(&q, DIS_CAR_MARGIN_M);
     if (clearance_prisms_overlap(&p, &q)) return 0;
   }

@@ -128,8 +128,10 @@ struct sim {
   mjcf_gen_distractor_t distractor[SIM_MAX_DISTRACTORS];
   int distractor_geom[SIM_MAX_DISTRACTORS];     /* its world geom in m */
   double distractor_xy[SIM_MAX_DISTRACTORS][2]; /* where it stands [m] */
-  uint64_t seed;                                /* of the current run (sim_create, sim_reset) */
-  char script_spec[256];                        /* every car's scripted driver, "" for none */
+  int ndistractor_keep_clear; /* sim_config_t's distractor_keep_clear poses, copied */
+  scn_pose_t distractor_keep_clear[2 * SIM_MAX_CARS];
+  uint64_t seed;         /* of the current run (sim_create, sim_reset) */
+  char script_spec[256]; /* every car's scripted driver, "" for none */
   int lidar, lidar_on_request, lidar_rays;
   int accel_wanted;      /* sim_want_accel: the next step computes the accelerometer */
   traffic_lights_t tl;   /* the map's lights (traffic_lights.h) */
@@ -150,6 +152,9 @@ void sim_draw_lamps(sim_t *s, sim_car_t *c);
 void sim_set_car_pose(sim_t *s, int i, const double base[3], double yaw, int row, int col);
 int sim_place_cars(sim_t *s, char *err, size_t err_sz);
 void sim_car_prism(const sim_t *s, int i, clearance_prism_t *out);
+/* The same with base_link at x_m, y_m, z_m [m], heading yaw [rad]. */
+void sim_car_prism_at(const sim_t *s, double x_m, double y_m, double z_m, double yaw,
+                      clearance_prism_t *out);
 void sim_box_prism(const scn_late_box_t *b, clearance_prism_t *out);
 
 /* distractors.c: --distractors, their kinds and sizes before the scene is written, their
