@@ -7,6 +7,7 @@ import argparse
 from dataclasses import replace
 import os
 import sys
+from typing import Any
 from pathlib import Path
 
 from autodrive.core import seeds
@@ -41,7 +42,11 @@ def main(argv: list[str] | None = None) -> int:
     e = sub.add_parser("expert", help="record the expert driving laps (LCM log + LOG.meta.json)")
     e.add_argument("--out", type=Path, required=True, help="the LCM log to write")
     e.add_argument("--map", default="driving_school")
-    e.add_argument("--route", default="loop_ccw", help="a loop route of the map")
+    e.add_argument(
+        "--route", default="loop_ccw",
+        help="a route of the map: a loop is driven --laps times, any other once (Driving "
+        "School's south_to_north and west_to_north: its junctions' 0.46 m right turns)",
+    )  # fmt: skip
     e.add_argument(
         "--lane-shift", type=int, default=0,
         help="drive the lane this many lane widths left of the route's, in its direction "
@@ -65,6 +70,33 @@ def main(argv: list[str] | None = None) -> int:
         help="kit: the map's own lines and asphalt; random: the lines' colours, dashes and the "
         "asphalt's tone drawn from --seed (domain randomisation, autodrive.maps.road_styles)",
     )  # fmt: skip
+    e.add_argument(
+        "--light-rgb",
+        default="",
+        metavar="R,G,B",
+        help="the lights' gain per channel, 0.5..1.5 (autodrive-sim --light-rgb)",
+    )
+    e.add_argument(
+        "--camera-exposure",
+        type=float,
+        default=0.0,
+        metavar="EV",
+        help="[EV] the frames x 2^EV, clipped (-2..2)",
+    )
+    e.add_argument(
+        "--camera-jitter",
+        default="",
+        metavar="MM,DEG",
+        help="the camera mount moved up to +-MM [mm] and turned up to +-DEG [deg] "
+        "per axis, drawn from --seed",
+    )
+    e.add_argument(
+        "--distractors",
+        type=int,
+        default=0,
+        metavar="N",
+        help="N static cones and boxes beside the road, placed from --seed (0..20)",
+    )
     e.add_argument(
         "--duration", type=float, default=0.0,
         help="[s] of sim time: stop there (0: when the laps are done); the run is the same up to it",
@@ -214,6 +246,19 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
 
+def _floats(text: str, n: int, option: str) -> Any:
+    """A comma-separated list of n numbers, or None for ""; ValueError naming the option."""
+    if not text:
+        return None
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != n:
+        raise ValueError(f"{option} {text!r}: needs {n} comma-separated numbers")
+    return vals
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.cmd == "expert":
         from autodrive.learn.pilot.expert import record_expert
@@ -224,6 +269,10 @@ def _run(args: argparse.Namespace) -> int:
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
             light_level=args.light_level, duration_s=args.duration, camera_blur=args.camera_blur,
             road_style=road_styles.draw(args.seed) if args.road_style == "random" else None,
+            light_rgb=_floats(args.light_rgb, 3, "--light-rgb"),
+            camera_exposure_ev=args.camera_exposure,
+            camera_jitter=_floats(args.camera_jitter, 2, "--camera-jitter"),
+            distractors=args.distractors,
         )  # fmt: skip
         wall = record_expert(run, args.out, _build(), args.lcm_url)
         print(f"pilot expert: {args.out} in {wall:.0f} s wall")

@@ -43,6 +43,11 @@ class ExpertRun:
     duration_s: float = 0.0  # [s] of sim time: stop early (0: when the laps are done)
     # how the road is painted (domain randomisation; None: the map's own textures)
     road_style: road_styles.RoadStyle | None = None
+    # the simulator's other randomisation (autodrive-sim options of the same names)
+    light_rgb: tuple[float, float, float] | None = None  # a gain per channel, 0.5..1.5
+    camera_exposure_ev: float = 0.0  # [EV] frames x 2^EV
+    camera_jitter: tuple[float, float] | None = None  # the mount's offset [mm] and turn [deg]
+    distractors: int = 0  # static objects beside the road, placed from the seed
 
 
 def meta_path(log: Path) -> Path:
@@ -81,6 +86,11 @@ def sim_argv(
         "--light-level", f"{run.light_level:g}",
         *(["--camera-blur", f"{run.camera_blur:g}"] if run.camera_blur > 0 else []),
         *(["--texture-dir", str(texture_dir)] if texture_dir else []),
+        *(["--light-rgb", ",".join(f"{g:g}" for g in run.light_rgb)] if run.light_rgb else []),
+        *(["--camera-exposure", f"{run.camera_exposure_ev:g}"] if run.camera_exposure_ev else []),
+        *(["--camera-jitter", f"{run.camera_jitter[0]:g},{run.camera_jitter[1]:g}"]
+          if run.camera_jitter else []),
+        *(["--distractors", str(run.distractors)] if run.distractors else []),
         "--script", script,
         "--seed", str(run.seed),
         "--lcm-url", url,
@@ -131,5 +141,7 @@ def record_expert(run: ExpertRun, log: Path, build: Path = RELEASE_BUILD, url: s
             stop(logger, "lcm-logger", lambda m: print(m, file=sys.stderr))
     wall_s = time.monotonic() - t0
     meta = dict(asdict(run), source="expert", sim_argv=argv, wall_s=round(wall_s, 2))
+    # the mount offsets the simulator drew (its one line per car), for the dataset's manifest
+    meta["camera_jitter_drawn"] = [x.strip() for x in lines if "(--camera-jitter)" in x] or None
     meta_path(log).write_text(json.dumps(meta, indent=2) + "\n")
     return wall_s
