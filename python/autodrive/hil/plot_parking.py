@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from autodrive.core import plots, vehicle
+from autodrive.core.cli_numbers import comma_floats
 from autodrive.core.geometry import Footprint, Pose, Rect
 from autodrive.core.plots import Layer
 from autodrive.core.runfiles import has_column, read_columns, read_occupancy
@@ -85,16 +86,6 @@ def draw(run: ParkingRun) -> None:
     plots.parking(run.out, read_occupancy(run.map_yaml), layers(run))
 
 
-def _floats(text: str, n: int, what: str, flag: str) -> tuple[float, ...]:
-    try:
-        v = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        v = ()
-    if len(v) != n:
-        raise ValueError(f"{flag} '{text}': want {what}")
-    return v
-
-
 def _optional_path(v: str | None) -> Path | None:
     return Path(v) if v else None
 
@@ -130,16 +121,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", required=True, help="PNG to write")
     a = ap.parse_args(argv)
     try:
-        length_m, width_m, ahead_m = _floats(
+        length_m, width_m, ahead_m = comma_floats(
             a.footprint, 3, "length_m,width_m,centre_ahead_m", "--footprint"
         )
         boxes: list[Rect] = []
         for spec in a.box:
-            bx, by, byaw, hx, hy = _floats(spec, 5, "x_m,y_m,yaw_rad,half_x_m,half_y_m", "--box")
+            bx, by, byaw, hx, hy = comma_floats(
+                spec, 5, "x_m,y_m,yaw_rad,half_x_m,half_y_m", "--box"
+            )
             boxes.append((bx, by, hx, hy, byaw))
         goal = None
         if a.goal:
-            gx, gy, gyaw = _floats(a.goal, 3, "x_m,y_m,yaw_rad", "--goal")
+            gx, gy, gyaw = comma_floats(a.goal, 3, "x_m,y_m,yaw_rad", "--goal")
             goal = (gx, gy, gyaw)
         draw(
             ParkingRun(

@@ -7,10 +7,10 @@ import argparse
 from dataclasses import replace
 import os
 import sys
-from typing import Any
 from pathlib import Path
 
 from autodrive.core import seeds
+from autodrive.core.cli_numbers import comma_floats
 from autodrive.maps import road_styles
 from autodrive.core.settings import RELEASE_BUILD
 from autodrive.learn.pilot.dagger import ROLLOUT_SEED_OFFSET, TAKEOVER_MARGIN_M, DaggerConfig
@@ -246,19 +246,6 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
 
-def _floats(text: str, n: int, option: str) -> Any:
-    """A comma-separated list of n numbers, or None for ""; ValueError naming the option."""
-    if not text:
-        return None
-    try:
-        vals = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        vals = ()
-    if len(vals) != n:
-        raise ValueError(f"{option} {text!r}: needs {n} comma-separated numbers")
-    return vals
-
-
 def _run(args: argparse.Namespace) -> int:
     if args.cmd == "expert":
         from autodrive.learn.pilot.expert import record_expert
@@ -269,9 +256,9 @@ def _run(args: argparse.Namespace) -> int:
             perturb=args.perturb, camera_fps=args.camera_fps, camera_noise=args.camera_noise,
             light_level=args.light_level, duration_s=args.duration, camera_blur=args.camera_blur,
             road_style=road_styles.draw(args.seed) if args.road_style == "random" else None,
-            light_rgb=_floats(args.light_rgb, 3, "--light-rgb"),
+            light_rgb=comma_floats(args.light_rgb, 3, "R,G,B", "--light-rgb") if args.light_rgb else None,
             camera_exposure_ev=args.camera_exposure,
-            camera_jitter=_floats(args.camera_jitter, 2, "--camera-jitter"),
+            camera_jitter=comma_floats(args.camera_jitter, 2, "MM,DEG", "--camera-jitter") if args.camera_jitter else None,
             distractors=args.distractors,
         )  # fmt: skip
         wall = record_expert(run, args.out, _build(), args.lcm_url)

@@ -44,9 +44,9 @@ class ExpertRun:
     # how the road is painted (domain randomisation; None: the map's own textures)
     road_style: road_styles.RoadStyle | None = None
     # the simulator's other randomisation (autodrive-sim options of the same names)
-    light_rgb: tuple[float, float, float] | None = None  # a gain per channel, 0.5..1.5
+    light_rgb: tuple[float, ...] | None = None  # a gain per channel, 0.5..1.5
     camera_exposure_ev: float = 0.0  # [EV] frames x 2^EV
-    camera_jitter: tuple[float, float] | None = None  # the mount's offset [mm] and turn [deg]
+    camera_jitter: tuple[float, ...] | None = None  # the mount's offset [mm] and turn [deg]
     distractors: int = 0  # static objects beside the road, placed from the seed
 
 
