@@ -194,3 +194,14 @@ def test_road_styles_are_opt_in_and_in_the_command() -> None:
     assert not plain.road_styles
     assert "--road-styles" in dagger.command_line(styled, Path("o"), Path("w"), None)
     assert "--road-styles" not in dagger.command_line(plain, Path("o"), Path("w"), None)
+
+
+def test_balance_ratio_is_checked_and_in_the_command() -> None:
+    # the junctions' tight turns are rare frames: a recipe that draws them more must say so
+    assert "--balance-max-ratio" not in dagger.command_line(
+        dagger.DaggerConfig(), Path("o"), Path("w"), None
+    )
+    cmd = dagger.command_line(dagger.DaggerConfig(balance_max_ratio=6.0), Path("o"), Path("w"), None)
+    assert "--balance-max-ratio 6.0" in cmd
+    with pytest.raises(ValueError, match="balance max ratio 0.5"):
+        dagger.DaggerConfig(balance_max_ratio=0.5).check()

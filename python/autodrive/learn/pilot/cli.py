@@ -228,6 +228,11 @@ def main(argv: list[str] | None = None) -> int:
         help="each recording's and rollout's road markings drawn from its seed (centre and "
         "edge lines' colour and dashing, the asphalt's tone: autodrive.maps.road_styles)",
     )  # fmt: skip
+    g.add_argument(
+        "--balance-max-ratio", type=float, default=dd.balance_max_ratio, metavar="R",
+        help="training's balancing (tools/pilot train --balance-max-ratio; default "
+        f"{dd.balance_max_ratio:g})",
+    )  # fmt: skip
     g.add_argument("--threads", type=int, default=dd.threads, help="PyTorch threads")
     g.add_argument(
         "--logs", type=Path, nargs="+", default=None, metavar="LOG",
@@ -297,6 +302,7 @@ def _run(args: argparse.Namespace) -> int:
             samples_per_epoch=args.samples_per_epoch, train_seed=args.train_seed,
             takeover_margin_m=args.takeover_margin, randomise=not args.no_randomise,
             road_styles=args.road_styles, threads=args.threads, name=args.name,
+            balance_max_ratio=args.balance_max_ratio,
         )  # fmt: skip
         run_dagger(dcfg, args.out, args.work, _build(), args.logs, args.lcm_url)
         return 0

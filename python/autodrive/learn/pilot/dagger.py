@@ -37,7 +37,7 @@ from typing import Any
 from autodrive.learn.pilot.spec import sha256_file
 from autodrive.core.proc import cpu_s
 from autodrive.core import seeds
-from autodrive.learn.pilot import dataset
+from autodrive.learn.pilot import augment, dataset
 from autodrive.learn.pilot.expert import ExpertRun, meta_path
 from autodrive.maps import road_styles
 
@@ -89,6 +89,9 @@ class DaggerConfig:
     road_styles: bool = False
     threads: int = 1  # PyTorch threads (the machine's 2 cores are shared)
     name: str = "dagger"
+    # training's balancing (augment.balance_weights): a frame drawn at most this many times as
+    # often as one of the commonest steering; the tight turns are rare frames
+    balance_max_ratio: float = augment.DEFAULT_MAX_RATIO
 
     def check(self) -> None:
         if self.rounds < 0 or self.expert_laps < 2 or self.rollout_laps < 1 or self.epochs < 1:
@@ -96,6 +99,8 @@ class DaggerConfig:
                 f"rounds {self.rounds} (>= 0), expert laps {self.expert_laps} (>= 2: validation "
                 f"by lap), rollout laps {self.rollout_laps} (>= 1), epochs {self.epochs} (>= 1)"
             )
+        if not self.balance_max_ratio >= 1:
+            raise ValueError(f"balance max ratio {self.balance_max_ratio}: must be >= 1")
         if not self.takeover_margin_m >= 0:
             raise ValueError(f"takeover margin {self.takeover_margin_m} m: must be >= 0")
         seeds.require(self.seed, ("training",), "the DAgger seed")
@@ -225,6 +230,7 @@ def _train(cfg: DaggerConfig, data: Path, out: Path, round_: int) -> dict[str, A
     tcfg = TrainConfig(
         epochs=cfg.epochs, seed=cfg.train_seed, name=cfg.name, threads=cfg.threads,
         samples_per_epoch=cfg.samples_per_epoch, randomise=cfg.randomise,
+        balance_max_ratio=cfg.balance_max_ratio,
     )  # fmt: skip
     log(f"round {round_}: training on {data}")
     rep = train(data, out, tcfg)
@@ -391,7 +397,8 @@ def command_line(cfg: DaggerConfig, out: Path, work: Path, logs: list[Path] | No
     for key, flag in (("rounds", "--rounds"), ("seed", "--seed"), ("expert_laps", "--expert-laps"),
                       ("rollout_laps", "--rollout-laps"), ("epochs", "--epochs"),
                       ("samples_per_epoch", "--samples-per-epoch"), ("train_seed", "--train-seed"),
-                      ("takeover_margin_m", "--takeover-margin"), ("name", "--name")):  # fmt: skip
+                      ("takeover_margin_m", "--takeover-margin"), ("name", "--name"),
+                      ("balance_max_ratio", "--balance-max-ratio")):  # fmt: skip
         if getattr(cfg, key) != getattr(d, key):
             parts.append(f"{flag} {getattr(cfg, key)}")
     if not cfg.randomise:
@@ -411,7 +418,8 @@ def report_md(r: dict[str, Any]) -> str:
         f"`{r['command']}`: {c['rounds']} rounds after round 0, seed {c['seed']} (rollouts on "
         f"seed + {ROLLOUT_SEED_OFFSET} + round), {c['rollout_laps']} lap(s) a rollout, takeover "
         f"margin {c['takeover_margin_m']} m, {c['epochs']} epochs of {c['samples_per_epoch']} "
-        f"draws, train seed {c['train_seed']}, randomisation {'on' if c['randomise'] else 'off'}, "
+        f"draws, train seed {c['train_seed']}, balance max ratio "
+        f"{c.get('balance_max_ratio', augment.DEFAULT_MAX_RATIO)}, randomisation {'on' if c['randomise'] else 'off'}, "
         f"road styles {'on' if c.get('road_styles') else 'off'}.",
         f"Whole run: {r['wall_s']:.0f} s wall, {r['cpu_s']:.0f} s CPU (load {r['load_avg_end']} "
         "at the end; the machine is shared: the wall time includes other jobs').",
